@@ -1,0 +1,37 @@
+// farfield: the command-line front end. Parses arguments, calls the library, prints, returns an exit code:
+// 0 success, 1 internal failure, 2 bad input (farfield::Error or bad arguments).
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+
+#include "command.h"
+#include "farfield/core/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Farfield: large scenes at a bounded frame time with measured impostor error.", "farfield"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "farfield 0.1.0");
+  auto& commands = farfield::app::CommandRegistry::commands();
+  std::sort(commands.begin(), commands.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto& [name, setup] : commands) setup(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "Run with --help for usage.\n");
+    return 2;
+  } catch (const farfield::Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "internal error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

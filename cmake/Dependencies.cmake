@@ -1,0 +1,34 @@
+# Every dependency is a Debian package (scripts/install-deps.sh); nothing is downloaded at build time.
+find_package(PkgConfig REQUIRED)
+find_package(glm REQUIRED)
+find_package(Threads REQUIRED)
+find_package(OpenGL REQUIRED COMPONENTS EGL OpenGL)
+pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
+pkg_check_modules(GLFW REQUIRED IMPORTED_TARGET glfw3)
+find_package(PNG REQUIRED)
+find_package(assimp REQUIRED)
+find_package(nlohmann_json REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(TBB REQUIRED)
+pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+
+# tinygltf ships a shared library and a header (no CMake config in Debian 12).
+find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h REQUIRED)
+find_library(TINYGLTF_LIBRARY tinygltf REQUIRED)
+add_library(ff_tinygltf INTERFACE)
+target_include_directories(ff_tinygltf SYSTEM INTERFACE ${TINYGLTF_INCLUDE_DIR})
+target_link_libraries(ff_tinygltf INTERFACE ${TINYGLTF_LIBRARY})
+
+# stb: Debian builds the implementations into libstb.
+find_path(STB_INCLUDE_DIR stb_image.h PATH_SUFFIXES stb REQUIRED)
+find_library(STB_LIBRARY stb REQUIRED)
+add_library(ff_stb INTERFACE)
+target_include_directories(ff_stb SYSTEM INTERFACE ${STB_INCLUDE_DIR})
+target_link_libraries(ff_stb INTERFACE ${STB_LIBRARY})
+
+if(FF_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(FF_BUILD_BENCH)
+  find_package(benchmark REQUIRED)
+endif()

@@ -1,0 +1,20 @@
+# ff_module(NAME DEPS <modules or targets>...)
+# Builds src/farfield/NAME/*.cpp into the static library farfield_NAME. Each module is its own library so that a
+# module's tests link only what that module may use (DESIGN.md's dependency table) and a broken module does not
+# stop the others from building. The target `farfield` links them all. A module with no .cpp yet (headers only)
+# becomes an interface library.
+function(ff_module name)
+  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${name}/*.cpp)
+  if(sources)
+    add_library(farfield_${name} STATIC ${sources})
+    target_include_directories(farfield_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+    target_link_libraries(farfield_${name} PUBLIC ${ARG_DEPS} PRIVATE farfield_warnings)
+    set_target_properties(farfield_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  else()
+    add_library(farfield_${name} INTERFACE)
+    target_include_directories(farfield_${name} INTERFACE ${PROJECT_SOURCE_DIR}/src)
+    target_link_libraries(farfield_${name} INTERFACE ${ARG_DEPS})
+  endif()
+  set_property(GLOBAL APPEND PROPERTY FF_MODULES farfield_${name})
+endfunction()

@@ -1,0 +1,41 @@
+// 2D textures: RGBA8 (with mipmaps), R32F, depth 32F, R32UI.
+#pragma once
+
+#include <cstdint>
+
+#include "farfield/image/image.h"
+
+namespace farfield::gpu {
+
+enum class TextureFormat { Rgba8, R32F, Depth32F, R32UI };
+
+class Texture {
+ public:
+  Texture() = default;
+  Texture(int width, int height, TextureFormat format, bool mipmaps = false);
+  // RGBA8 texture with mipmaps and trilinear, anisotropic filtering, repeat wrapping.
+  static Texture fromImage(const image::ColorImage& image, bool mipmaps = true);
+  ~Texture();
+  Texture(Texture&& other) noexcept;
+  Texture& operator=(Texture&& other) noexcept;
+  Texture(const Texture&) = delete;
+  Texture& operator=(const Texture&) = delete;
+
+  void upload(const image::ColorImage& image);  // RGBA8 textures; regenerates mipmaps if it has them
+  void setClampToEdge();
+  void bind(int unit) const;
+  uint32_t handle() const { return handle_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  TextureFormat format() const { return format_; }
+  size_t byteSize() const;
+
+ private:
+  uint32_t handle_ = 0;
+  int width_ = 0;
+  int height_ = 0;
+  TextureFormat format_ = TextureFormat::Rgba8;
+  bool mipmaps_ = false;
+};
+
+}  // namespace farfield::gpu
