@@ -1,0 +1,38 @@
+# Farfield's front door. `make demo` and `make test` work on a fresh Debian 12 machine: both install the Debian
+# packages the project needs first (scripts/install-deps.sh, through apt-get; root or sudo).
+JOBS        ?= $(shell nproc 2>/dev/null || echo 2)
+BUILD       ?= build/release
+BUILD_ASAN  ?= build/asan
+CMAKE_FLAGS ?=
+# Real windows for the viewer's tests come from Xvfb when it is installed and no display is set.
+XVFB        := $(shell if [ -z "$$DISPLAY" ] && command -v xvfb-run >/dev/null 2>&1; then echo "xvfb-run -a -s '-screen 0 1280x1024x24'"; fi)
+
+.PHONY: all deps configure build demo test test-asan bench clean
+
+all: build
+
+deps:
+	@bash scripts/install-deps.sh
+
+configure: deps
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DFF_BUILD_TESTS=ON -DFF_BUILD_BENCH=ON $(CMAKE_FLAGS) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD) -j $(JOBS)
+
+demo: build
+	@bash scripts/demo.sh $(BUILD)/bin/farfield out/demo
+
+test: build
+	@cd $(BUILD) && $(XVFB) ctest --output-on-failure -j $(JOBS) --timeout 900
+
+test-asan: deps
+	@cmake -S . -B $(BUILD_ASAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFF_SANITIZE=ON -DFF_BUILD_BENCH=OFF $(CMAKE_FLAGS) >/dev/null
+	@cmake --build $(BUILD_ASAN) -j $(JOBS)
+	@cd $(BUILD_ASAN) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $(XVFB) ctest --output-on-failure -j $(JOBS) --timeout 1800
+
+bench: build
+	@bash scripts/bench.sh $(BUILD)/bin out/bench
+
+clean:
+	rm -rf build out
