@@ -96,7 +96,8 @@ TEST(Polygon2d, Distances) {
   EXPECT_DOUBLE_EQ(distancePointSegment({3, 4}, {0, 0}, {0, 0}), 5.0);   // degenerate segment
   EXPECT_NEAR(distanceToBoundary({2, 0.25f}, kL), 0.25, 1e-7);
   EXPECT_NEAR(distanceToBoundary({0.5f, 2.0f}, kL), 0.5, 1e-7);
-  EXPECT_NEAR(distanceToBoundary({3, 3}, kL), std::sqrt(4.0 + 4.0), 1e-6);  // nearest point (1, 1)
+  EXPECT_NEAR(distanceToBoundary({3, 3}, kL), 2.0, 1e-6);             // edges y = 1 and x = 1
+  EXPECT_NEAR(distanceToBoundary({3, 4}, kL), std::sqrt(5.0), 1e-6);  // nearest point: the corner (1, 3)
 }
 
 TEST(Polygon2d, SegmentIntersection) {
@@ -238,8 +239,12 @@ TEST(Polygon2d, InsetLShapeKeepsDistance) {
   EXPECT_NEAR(signedArea(in), 1.75 + 1.0, 1e-5);
   for (const Vec2& v : in) {
     EXPECT_TRUE(pointInPolygon(v, kL));
-    EXPECT_NEAR(distanceToBoundary(v, kL), 0.25, 1e-5);  // the reflex corner (1,1) maps to (1.25, 1.25)
+    // Convex corners end 0.25 from both edges; the reflex corner (1, 1) maps to (0.75, 0.75), 0.25 from both edge
+    // lines and so 0.25 sqrt(2) from the corner itself.
+    bool reflex = glm::length(v - Vec2(0.75f, 0.75f)) < 1e-5f;
+    EXPECT_NEAR(distanceToBoundary(v, kL), reflex ? 0.25 * std::sqrt(2.0) : 0.25, 1e-5);
   }
+  EXPECT_TRUE(std::any_of(in.begin(), in.end(), [](Vec2 v) { return glm::length(v - Vec2(0.75f, 0.75f)) < 1e-5f; }));
   // The stem is 1 wide: inset 0.5 collapses it, and the short edges go; what remains must still be inside.
   Polygon2 thin = insetPolygon(kL, 0.45f);
   for (const Vec2& v : thin) EXPECT_TRUE(pointInPolygon(v, kL));
@@ -276,4 +281,20 @@ TEST(Polygon2d, CleanPolygon) {
   EXPECT_TRUE(isSimplePolygon(c));
   // A clean polygon is unchanged.
   EXPECT_EQ(cleanPolygon(kL), kL);
+}
+
+TEST(Polygon2d, InsetDropsSwallowedEdge) {
+  // A rectangle with a tiny chamfer at one corner: inset by 1 the chamfer edge comes out reversed, so it is
+  // dropped and the result is the plain inset rectangle.
+  Polygon2 chamfered = {{0, 0}, {10, 0}, {10, 3.9f}, {9.9f, 4}, {0, 4}};
+  Polygon2 in = insetPolygon(chamfered, 1.0f);
+  ASSERT_EQ(in.size(), 4u);
+  EXPECT_NEAR(signedArea(in), 8.0 * 2.0, 1e-4);
+  Box2 b = polygonBounds(in);
+  EXPECT_NEAR(b.lo.x, 1.0, 1e-5);
+  EXPECT_NEAR(b.lo.y, 1.0, 1e-5);
+  EXPECT_NEAR(b.hi.x, 9.0, 1e-5);
+  EXPECT_NEAR(b.hi.y, 3.0, 1e-5);
+  // A small inset keeps the chamfer.
+  EXPECT_EQ(insetPolygon(chamfered, 0.01f).size(), 5u);
 }

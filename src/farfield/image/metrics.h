@@ -13,7 +13,8 @@ double meanAbsoluteError(const ColorImage& a, const ColorImage& b);
 // Share (0..1) of pixels whose largest channel difference exceeds threshold (8-bit units; default 8/255).
 double shareOverThreshold(const ColorImage& a, const ColorImage& b, int threshold = 8);
 // Structural similarity (Wang et al. 2004) on luma (BT.601), 11x11 Gaussian window with sigma 1.5,
-// K1 = 0.01, K2 = 0.03, L = 255; mean over the valid windows. SSIM(x, x) = 1.
+// K1 = 0.01, K2 = 0.03, L = 255; mean over the valid windows. SSIM(x, x) = 1. An image narrower or shorter than
+// 11 pixels uses the largest odd window that fits in that direction (Gaussian renormalised); empty images give 1.
 double ssim(const ColorImage& a, const ColorImage& b);
 
 struct ImageMetrics {
