@@ -32,3 +32,9 @@ endif()
 if(FF_BUILD_BENCH)
   find_package(benchmark REQUIRED)
 endif()
+
+# CGAL (header-only in Debian 12): constrained Delaunay triangulation of impostor depth meshes.
+find_package(CGAL REQUIRED)
+
+# GDAL: DEM input (GeoTIFF, netCDF, 16-bit PNG) for the terrain module.
+find_package(GDAL REQUIRED)

@@ -13,7 +13,9 @@ namespace farfield::scene {
 struct Mesh {
   std::vector<Vec3> positions;
   std::vector<Vec3> normals;  // empty or one per position
-  std::vector<Vec2> uvs;      // empty or one per position
+  // empty or one per position; glTF convention: (0, 0) is the top-left of the texture image (its row 0) and v grows
+  // down the rows, so uploading row 0 first (glTexImage2D) samples it at v = 0
+  std::vector<Vec2> uvs;
   std::vector<uint32_t> indices;
   Box3 bounds;  // of positions, kept current by computeBounds()
 
