@@ -11,7 +11,7 @@ namespace farfield::gpu {
 enum class Platform {
   Auto,         // FF_GL_PLATFORM=device|surfaceless in the environment, else device if an EGL device with a
                 // non-software renderer is found, else surfaceless
-  Device,       // EGL_EXT_platform_device
+  Device,       // EGL_EXT_platform_device: the first EGL device giving 4.5 core (software devices included)
   Surfaceless,  // EGL_MESA_platform_surfaceless
   Window,       // GLFW window (needs a display)
 };
@@ -60,7 +60,9 @@ class Context {
   ContextInfo info_;
 };
 
-// One process-wide headless context, created on first use (tests and tools that render a few frames).
+// One process-wide headless context, created on first use (tests and tools that render a few frames). Every call
+// makes it current on the calling thread (a GL context is current on one thread at a time), so calling it again
+// after using another context (a window) switches back. Throws farfield::Error when no context can be made.
 Context& sharedHeadlessContext();
 
 }  // namespace farfield::gpu

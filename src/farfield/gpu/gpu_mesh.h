@@ -19,6 +19,7 @@ class GpuMesh {
   GpuMesh& operator=(const GpuMesh&) = delete;
 
   void draw() const;  // binds the vertex array and draws all triangles
+  uint32_t vertexArray() const { return vao_; }  // 0 for an empty mesh (the renderer binds it itself)
   uint32_t indexCount() const { return index_count_; }
   uint64_t triangleCount() const { return index_count_ / 3; }
   const Box3& bounds() const { return bounds_; }

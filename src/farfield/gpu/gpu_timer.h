@@ -3,6 +3,8 @@
 
 #include <cstdint>
 
+#include "farfield/core/timer.h"
+
 namespace farfield::gpu {
 
 class GpuTimer {
@@ -14,11 +16,14 @@ class GpuTimer {
 
   void begin();
   void end();
-  // Milliseconds between begin() and end(); blocks until the result is available.
+  // Milliseconds between begin() and end(); blocks until the result is available. Capped at the CPU wall time
+  // from begin() to the result (the GPU cannot have worked longer): llvmpipe sometimes reports a time since boot.
   double elapsedMs() const;
 
  private:
   uint32_t query_ = 0;
+  bool ended_ = false;  // a result exists once end() ran
+  Stopwatch since_begin_;
 };
 
 }  // namespace farfield::gpu

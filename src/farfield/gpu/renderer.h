@@ -16,6 +16,9 @@
 
 namespace farfield::gpu {
 
+// Colour = base colour times the texture (if any); with a texture, texels whose resulting alpha is below 0.5 are
+// cut out (not drawn, no depth, no id), which is what billboard and impostor textures with transparent
+// backgrounds need. A null DrawItem::material draws with the default (white, lit, single-sided).
 struct GpuMaterial {
   Vec4 base_color{1.0f};
   const Texture* texture = nullptr;  // may be null
@@ -32,7 +35,7 @@ struct DrawItem {
 
 enum class RenderMode {
   Shaded,      // lit, textured colour + ids
-  ItemBuffer,  // ids only (colour gets a flat false colour of the id); no texture sampling
+  ItemBuffer,  // ids only (colour gets a flat false colour of the id, background black); no texture sampling
 };
 
 struct LightSettings {
@@ -47,7 +50,7 @@ struct FrameStats {
   uint32_t draw_calls = 0;
   uint32_t objects = 0;  // distinct object ids drawn
   double wall_ms = 0.0;  // CPU wall time from the first command to glFinish
-  double gpu_ms = 0.0;   // GL_TIME_ELAPSED
+  double gpu_ms = 0.0;   // GL_TIME_ELAPSED, at most wall_ms (see GpuTimer); 0 from draw()
 };
 
 class Renderer {
@@ -74,8 +77,11 @@ class Renderer {
 // A scene's meshes, textures and materials uploaded once; draw items for all or some of its objects.
 class GpuScene {
  public:
+  // Keeps a pointer to the scene (for its objects), which must outlive the GpuScene. Throws farfield::Error for
+  // unusable meshes or textures.
   explicit GpuScene(const scene::Scene& scene);
-  // One draw item per part of each listed object (ids 1-based); all objects when ids is empty.
+  // One draw item per part of each listed object (ids 1-based); all objects when ids is empty. Throws
+  // farfield::Error for an id out of range.
   void appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out) const;
   std::vector<DrawItem> drawItems() const;
   size_t gpuBytes() const;

@@ -1,4 +1,6 @@
 // 2D textures: RGBA8 (with mipmaps), R32F, depth 32F, R32UI.
+// Texture coordinates: an image's row 0 (its top) is uploaded first and lies at v = 0, so uv (0, 0) is the image's
+// top-left corner and v grows downwards (the glTF convention; OBJ-style uvs with v up need v' = 1 - v).
 #pragma once
 
 #include <cstdint>

@@ -1,0 +1,25 @@
+#version 450 core
+// Farfield terrain fragment shader (gpu/terrain_renderer.h), unlit: the original texture, or with FF_SPRITE the
+// sprite (an earlier frame) projected through the sprite camera: the clip position is interpolated perspective-
+// correctly and divided per fragment, so a point of the surface samples the sprite where the sprite camera saw it.
+
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out uint o_id;
+
+uniform uint u_object_id;
+layout(binding = 0) uniform sampler2D u_texture;
+#ifdef FF_SPRITE
+in vec4 v_sprite_clip;
+#else
+in vec2 v_uv;
+#endif
+
+void main() {
+#ifdef FF_SPRITE
+  vec2 st = v_sprite_clip.xy / v_sprite_clip.w * 0.5 + 0.5;
+  o_color = vec4(texture(u_texture, st).rgb, 1.0);
+#else
+  o_color = vec4(texture(u_texture, v_uv).rgb, 1.0);
+#endif
+  o_id = u_object_id;
+}
