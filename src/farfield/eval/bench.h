@@ -1,0 +1,133 @@
+// `farfield bench`: the walkthrough benchmark. Every mode runs over the same camera-path frames in one process,
+// interleaved (for each frame every mode in turn, the order rotated by one each frame) so that machine drift (clock
+// boost, thermal state, other processes) hits all modes alike. Each mode renders one untimed warm-up frame first.
+// With a reference, every frame is also rendered from full geometry (untimed) and each mode's frame is compared
+// with it (image::compareImages: PSNR, SSIM, share of pixels off by more than 8/255).
+//
+// Outputs (writeBenchOutputs): OUTDIR/bench.json, OUTDIR/bench.md, OUTDIR/frames.csv, sample frames under
+// OUTDIR/frames/; plots come from tools/plot_bench.py (runPlotScript) and a report from writeReport().
+//
+// bench.json (later modes add their own entries under "modes"; readers must ignore keys they do not know):
+//   {"scene": "...", "path": "...", "path_frames": P, "frames": N, "size": [w, h], "renderer": "...",
+//    "date": "2024-01-31T12:00:00Z", "machine": {"hostname", "os", "cpu", "logical_cores"},
+//    "baseline": "full", "baseline_added": bool, "reference": bool, "warmup_frames_per_mode": 1,
+//    "percentiles": "linear interpolation between closest ranks", "psnr_cap_db": 99,
+//    "modes": {"full": {"median_ms", "p95_ms", "p99_ms", "max_ms", "mean_ms", "gpu_median_ms", "gpu_p95_ms",
+//                       "mean_triangles", "mean_draw_calls", "mean_objects", "speedup_vs_full",
+//                       "psnr_db_mean", "psnr_db_min", "ssim_mean", "bad_pixel_share_mean", "info": {...}}, ...}}
+// speedup_vs_full = median_ms(full) / median_ms(mode). PSNR of identical frames is infinite; it is stored capped at
+// kPsnrCapDb (per frame, before the mean and min). Without a reference the four error keys are null.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "farfield/eval/frame_runner.h"
+#include "farfield/eval/frame_stats.h"
+#include "farfield/gen/camera_path.h"
+#include "farfield/gpu/context.h"
+#include "farfield/image/metrics.h"
+#include "farfield/scene/scene.h"
+
+namespace farfield::eval {
+
+inline constexpr double kPsnrCapDb = 99.0;
+
+struct BenchOptions {
+  std::vector<std::string> modes{"full", "culled"};  // "full" is added first when missing (the baseline)
+  int width = 640;
+  int height = 360;
+  size_t frames = 0;   // measure the first N frames of the path (after stride); 0 = all
+  size_t stride = 1;   // take every stride-th path frame
+  bool reference = false;
+  int bad_pixel_threshold = 8;  // 8-bit units
+  int samples = 4;              // sample frames saved under out_dir/frames (evenly spaced); 0 = none
+  std::string out_dir;          // where sample frames go; "" = none saved
+  std::map<std::string, std::string> mode_options;  // ModeContext::options
+  std::string scene_label;      // for the outputs, e.g. the SCENE argument
+  std::string path_label;       // e.g. the path file
+  float near_plane = 0.5f;      // metres
+  float far_plane = 20000.0f;
+};
+
+struct ModeResult {
+  std::string name;
+  std::vector<FrameRecord> frames;            // in measurement order (= path order), one per measured frame
+  std::vector<int> order;                     // position of the mode within each frame's rotation (0 = first)
+  std::vector<image::ImageMetrics> errors;    // per frame, against the reference (empty without one);
+                                              // psnr_db capped at kPsnrCapDb
+  FrameSummary wall;
+  FrameSummary gpu;
+  double mean_triangles = 0.0;
+  double mean_draw_calls = 0.0;
+  double mean_objects = 0.0;
+  double speedup_vs_full = 0.0;
+  bool has_errors = false;
+  double psnr_db_mean = 0.0;
+  double psnr_db_min = 0.0;
+  double ssim_mean = 0.0;
+  double bad_pixel_share_mean = 0.0;
+  std::map<std::string, double> info;  // Mode::info()
+};
+
+struct SampleFrame {
+  size_t path_frame = 0;
+  std::string reference_png;                  // relative to out_dir; "" without a reference
+  std::map<std::string, std::string> mode_png;  // mode -> PNG relative to out_dir
+  std::map<std::string, std::string> diff_png;  // mode -> heat map PNG relative to out_dir (with a reference)
+};
+
+struct MachineInfo {
+  std::string hostname;
+  std::string os;   // uname: sysname release machine
+  std::string cpu;  // /proc/cpuinfo model name
+  unsigned logical_cores = 0;
+};
+MachineInfo machineInfo();
+
+struct BenchResult {
+  std::string scene;
+  std::string path;
+  size_t path_frames = 0;           // frames in the camera path
+  std::vector<size_t> frame_indices;  // the path frames measured
+  int width = 0;
+  int height = 0;
+  std::string renderer;
+  std::string date;  // ISO 8601 UTC
+  MachineInfo machine;
+  bool reference = false;
+  bool baseline_added = false;  // "full" was not asked for and was added as the baseline
+  int bad_pixel_threshold = 8;
+  std::vector<ModeResult> modes;  // "full" first, then the asked order
+  std::vector<SampleFrame> samples;
+  std::vector<std::string> plots;  // PNGs relative to out_dir (filled by runPlotScript)
+
+  const ModeResult* mode(const std::string& name) const;
+};
+
+// Makes the context current and runs the benchmark. Throws farfield::Error for unknown modes (before rendering
+// anything, listing the known ones), bad options, an empty path or an unusable camera in it.
+BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen::CameraPath& path,
+                     const BenchOptions& options);
+
+void writeBenchJson(const BenchResult& result, const std::string& file);
+// A markdown table (one row per mode) with a short header (scene, size, frames, renderer, date, notes).
+void writeBenchMarkdown(const BenchResult& result, const std::string& file);
+// One row per frame per mode: frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,
+// psnr_db,ssim,bad_pixel_share (error columns empty without a reference).
+void writeFramesCsv(const BenchResult& result, const std::string& file);
+// bench.json, bench.md and frames.csv into out_dir (created if missing).
+void writeBenchOutputs(const BenchResult& result, const std::string& out_dir);
+
+// Runs `PYTHON SCRIPT OUT_DIR` (tools/plot_bench.py) to draw frame_time.png and error.png from frames.csv. PYTHON
+// is the first of: the given interpreter, $FF_PYTHON, python3, /usr/bin/python3 that can import matplotlib.
+// Returns the plots written (relative to out_dir); warns (never throws) when none could be drawn.
+std::vector<std::string> runPlotScript(const std::string& out_dir, const std::string& script,
+                                       const std::string& python = "");
+
+// A markdown report: the table, the plots and the sample frames embedded as images with links relative to the
+// report's directory. Reads result.plots and result.samples (files under out_dir).
+void writeReport(const BenchResult& result, const std::string& out_dir, const std::string& report_file);
+
+}  // namespace farfield::eval

@@ -1,0 +1,192 @@
+#include "farfield/eval/mode.h"
+
+#include <algorithm>
+#include <mutex>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+
+namespace farfield::eval {
+
+std::string ModeContext::option(const std::string& key, const std::string& fallback) const {
+  auto it = options.find(key);
+  return it == options.end() ? fallback : it->second;
+}
+
+const std::string& ModeContext::requireOption(const std::string& key, const std::string& mode_name) const {
+  auto it = options.find(key);
+  if (it == options.end())
+    throw Error("mode '" + mode_name + "'", "needs the option '" + key + "' (--mode-option " + key + "=VALUE)");
+  return it->second;
+}
+
+std::map<std::string, std::string> parseModeOptions(const std::vector<std::string>& items) {
+  std::map<std::string, std::string> options;
+  for (const std::string& item : items) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw Error("--mode-option", "expected key=value, got '" + item + "'");
+    options[item.substr(0, eq)] = item.substr(eq + 1);
+  }
+  return options;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// FrameContext
+
+FrameContext::FrameContext(const Camera& camera, size_t path_frame, gpu::Renderer& renderer,
+                           gpu::RenderTarget& target, std::vector<gpu::DrawItem>& items, gpu::GpuTimer* timer)
+    : camera_(camera),
+      path_frame_(path_frame),
+      renderer_(renderer),
+      target_(target),
+      items_(items),
+      timer_(timer) {
+  items_.clear();
+}
+
+void FrameContext::clearOnce() {
+  if (drew_passes_) return;
+  drew_passes_ = true;
+  if (timer_) timer_->begin();
+  target_.clear(renderer_.light().sky_color);
+}
+
+gpu::FrameStats FrameContext::drawPass(std::span<const gpu::DrawItem> items, gpu::RenderMode mode) {
+  clearOnce();
+  gpu::FrameStats stats = renderer_.draw(camera_, items, target_, mode);
+  addStats(stats);
+  return stats;
+}
+
+gpu::RenderTarget& FrameContext::beginOwnPass() {
+  clearOnce();
+  return target_;
+}
+
+void FrameContext::addStats(const gpu::FrameStats& stats) {
+  pass_stats_.triangles += stats.triangles;
+  pass_stats_.draw_calls += stats.draw_calls;
+  // Distinct objects across passes are not tracked; an object drawn in two passes counts twice. Modes that care
+  // report a corrected figure through info().
+  pass_stats_.objects += stats.objects;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Built-in modes
+
+namespace {
+
+// Every object of the scene, every frame: the baseline every other mode is measured against.
+class FullMode final : public Mode {
+ public:
+  std::string name() const override { return "full"; }
+  void prepare(const ModeContext& context) override { items_ = context.gpu_scene->drawItems(); }
+  void frame(FrameContext& frame) override { frame.submit(items_); }
+  std::map<std::string, double> info() const override { return {{"draw_items", double(items_.size())}}; }
+
+ private:
+  std::vector<gpu::DrawItem> items_;
+};
+
+// View-frustum culling of object bounds through the BVH; what a plain renderer does before any impostor.
+class CulledMode final : public Mode {
+ public:
+  explicit CulledMode(const ModeContext& context) : gpu_scene_(context.gpu_scene), bvh_(context.bvh) {}
+  std::string name() const override { return "culled"; }
+  void frame(FrameContext& frame) override {
+    ids_.clear();
+    bvh_->queryFrustum(Frustum::fromMatrix(frame.camera().viewProjection()), ids_);
+    // GpuScene::appendDrawItems takes an empty list as "all objects": nothing visible must draw nothing.
+    if (ids_.empty()) return;
+    // Same order as "full" (ascending ids), so objects at equal depth resolve the same way in both modes.
+    std::sort(ids_.begin(), ids_.end());
+    gpu_scene_->appendDrawItems(ids_, frame.items());
+  }
+
+ private:
+  const gpu::GpuScene* gpu_scene_;
+  const scene::Bvh* bvh_;
+  std::vector<uint32_t> ids_;
+};
+
+struct Entry {
+  std::string description;
+  ModeFactory factory;
+};
+
+struct Registry {
+  std::mutex mutex;
+  std::map<std::string, Entry> entries;
+};
+
+// Built-ins are added here rather than by static objects in their own files: the eval library is static, and the
+// linker would drop a file that nothing refers to, registration included.
+Registry& registry() {
+  static Registry* r = [] {
+    auto* reg = new Registry;
+    reg->entries["full"] = {"every object of the scene (the baseline)",
+                            [](const ModeContext&) { return std::make_unique<FullMode>(); }};
+    reg->entries["culled"] = {"objects whose bounds intersect the view frustum (BVH)",
+                              [](const ModeContext& c) { return std::make_unique<CulledMode>(c); }};
+    return reg;
+  }();
+  return *r;
+}
+
+std::string knownList() {
+  std::string list;
+  for (const auto& name : modeNames()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+}  // namespace
+
+void registerMode(const std::string& name, const std::string& description, ModeFactory factory) {
+  FF_CHECK(!name.empty() && factory);
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  r.entries[name] = {description, std::move(factory)};
+}
+
+std::vector<std::string> modeNames() {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  std::vector<std::string> names;
+  for (const auto& [name, entry] : r.entries) names.push_back(name);
+  return names;  // std::map keeps them sorted
+}
+
+std::string modeDescription(const std::string& name) {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  auto it = r.entries.find(name);
+  return it == r.entries.end() ? std::string() : it->second.description;
+}
+
+bool hasMode(const std::string& name) {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  return r.entries.count(name) != 0;
+}
+
+void checkModeNames(std::span<const std::string> names) {
+  for (const auto& name : names)
+    if (!hasMode(name)) throw Error("mode '" + name + "'", "unknown mode; known modes: " + knownList());
+}
+
+std::unique_ptr<Mode> createMode(const std::string& name, const ModeContext& context) {
+  ModeFactory factory;
+  {
+    Registry& r = registry();
+    std::lock_guard<std::mutex> lock(r.mutex);
+    auto it = r.entries.find(name);
+    if (it != r.entries.end()) factory = it->second.factory;
+  }
+  if (!factory) throw Error("mode '" + name + "'", "unknown mode; known modes: " + knownList());
+  std::unique_ptr<Mode> mode = factory(context);
+  FF_CHECK(mode != nullptr);
+  return mode;
+}
+
+}  // namespace farfield::eval

@@ -1,0 +1,143 @@
+// Benchmark modes: the one thing that differs between the techniques the walkthrough benchmark compares.
+//
+// A mode turns a camera into a frame. It either returns draw items for the harness to draw in one pass (full
+// geometry, view-frustum culling, near geometry plus impostor quads drawn by the standard renderer), or draws
+// passes itself (impostors with their own programs, dynamic impostor updates rendered into textures inside the
+// frame), or both. The harness times the whole frame the same way for every mode: from the call of Mode::frame()
+// (so culling and selection on the CPU count) through the clear, every pass and glFinish.
+//
+// Modes are created by name from a registry. Built in: "full" (every object) and "culled" (objects whose world
+// bounds intersect the view frustum, through scene::Bvh::queryFrustum). Later modules add theirs with registerMode()
+// (or a static RegisterMode object in a translation unit that the executable links for certain: static libraries
+// drop object files nothing refers to) without touching the harness.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/gpu_timer.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/scene/bvh.h"
+#include "farfield/scene/scene.h"
+
+namespace farfield::eval {
+
+// What modes are built from. The harness fills it once per run and keeps everything it points to alive (and the
+// OpenGL context current) for the whole run.
+struct ModeContext {
+  const scene::Scene* scene = nullptr;
+  const gpu::GpuScene* gpu_scene = nullptr;  // the scene's meshes, textures and materials on the GPU
+  const scene::Bvh* bvh = nullptr;           // over the scene's objects
+  gpu::Renderer* renderer = nullptr;         // the renderer the harness draws with
+  int width = 0;                             // frame size, pixels
+  int height = 0;
+  // Free-form options of the run ("--mode-option key=value"), e.g. {"impostor_dir": "baked/city"}. A mode reads
+  // the keys it knows; keys are shared by all modes of a run.
+  std::map<std::string, std::string> options;
+
+  // The option's value, or fallback when absent.
+  std::string option(const std::string& key, const std::string& fallback = {}) const;
+  // The option's value; throws farfield::Error naming the mode and the key when absent.
+  const std::string& requireOption(const std::string& key, const std::string& mode_name) const;
+};
+
+// One frame of one mode, handed to Mode::frame(). Made by the harness.
+class FrameContext {
+ public:
+  // timer: started with the first pass the mode draws itself (may be null: no GPU time for such frames).
+  FrameContext(const Camera& camera, size_t path_frame, gpu::Renderer& renderer, gpu::RenderTarget& target,
+               std::vector<gpu::DrawItem>& items, gpu::GpuTimer* timer = nullptr);
+
+  const Camera& camera() const { return camera_; }
+  // Index of this frame in the camera path (modes with temporal state, e.g. caches, may use it).
+  size_t pathFrame() const { return path_frame_; }
+  gpu::Renderer& renderer() { return renderer_; }
+
+  // The main pass: draw items the harness draws with the shared renderer after frame() returns, on top of any
+  // passes the mode drew itself. Starts empty each frame; its capacity is kept between frames.
+  std::vector<gpu::DrawItem>& items() { return items_; }
+  // Instead of filling items(): a prebuilt list that outlives the frame (e.g. all of the scene's items).
+  void submit(std::span<const gpu::DrawItem> items) { submitted_ = items; has_submitted_ = true; }
+  // What the harness draws in the main pass: the submitted list if any, else items().
+  std::span<const gpu::DrawItem> mainItems() const {
+    return has_submitted_ ? submitted_ : std::span<const gpu::DrawItem>(items_);
+  }
+
+  // Draws a pass into the frame's target now with the shared renderer (Renderer::draw: no clear, no wait). The
+  // target is cleared to the renderer's sky colour before the first pass. Its triangles, draw calls and objects
+  // count towards the frame.
+  gpu::FrameStats drawPass(std::span<const gpu::DrawItem> items,
+                           gpu::RenderMode mode = gpu::RenderMode::Shaded);
+  // Call before any GPU work of the mode's own (its own programs on the frame's target, impostor updates rendered
+  // into other targets): clears the frame's target and starts the frame's GPU timer, both once per frame. Returns
+  // the frame's target. The mode reports what it drew with addStats().
+  //
+  // Inside frame() draw with Renderer::draw or the mode's own programs, never with Renderer::render: render() waits
+  // for the GPU (a stall no real frame would have) and its GL_TIME_ELAPSED query cannot nest in the harness's.
+  gpu::RenderTarget& beginOwnPass();
+  void addStats(const gpu::FrameStats& stats);
+
+  // Harness side: whether the mode drew into the frame's target itself, and the sums of what it reported.
+  bool drewPasses() const { return drew_passes_; }
+  const gpu::FrameStats& passStats() const { return pass_stats_; }
+
+ private:
+  void clearOnce();
+
+  const Camera& camera_;
+  size_t path_frame_;
+  gpu::Renderer& renderer_;
+  gpu::RenderTarget& target_;
+  std::vector<gpu::DrawItem>& items_;
+  gpu::GpuTimer* timer_;
+  std::span<const gpu::DrawItem> submitted_;
+  bool has_submitted_ = false;
+  bool drew_passes_ = false;
+  gpu::FrameStats pass_stats_;
+};
+
+class Mode {
+ public:
+  virtual ~Mode() = default;
+  // The registry name ("full", "culled", ...).
+  virtual std::string name() const = 0;
+  // Once per run before the warm-up frame, with the context current: load baked data, upload GPU resources.
+  // Not timed. Throws farfield::Error for bad inputs (missing directory, wrong format).
+  virtual void prepare(const ModeContext& /*context*/) {}
+  // Produces one frame (see FrameContext). Timed as a whole by the harness.
+  virtual void frame(FrameContext& frame) = 0;
+  // Numbers about the run the mode wants reported (bench.json "modes.<name>.info"), e.g. impostor count, bytes.
+  virtual std::map<std::string, double> info() const { return {}; }
+};
+
+// Makes a mode; cheap (heavy work belongs in prepare()). May throw farfield::Error for bad options.
+using ModeFactory = std::function<std::unique_ptr<Mode>(const ModeContext& context)>;
+
+// Adds (or replaces) a mode in the process-wide registry. The built-in modes are always there.
+void registerMode(const std::string& name, const std::string& description, ModeFactory factory);
+// Registered names, sorted.
+std::vector<std::string> modeNames();
+std::string modeDescription(const std::string& name);  // "" for an unknown name
+bool hasMode(const std::string& name);
+// Throws farfield::Error for an unknown name, listing the known ones.
+std::unique_ptr<Mode> createMode(const std::string& name, const ModeContext& context);
+// Throws farfield::Error listing the known modes when a name is unknown (check a list before rendering anything).
+void checkModeNames(std::span<const std::string> names);
+
+// "key=value" items (from repeated --mode-option) into ModeContext::options; a later key wins. Throws
+// farfield::Error naming --mode-option for an item without '=' or with an empty key.
+std::map<std::string, std::string> parseModeOptions(const std::vector<std::string>& items);
+
+// Static registration helper: `static farfield::eval::RegisterMode reg("impostor", "...", factory);`
+struct RegisterMode {
+  RegisterMode(const std::string& name, const std::string& description, ModeFactory factory) {
+    registerMode(name, description, std::move(factory));
+  }
+};
+
+}  // namespace farfield::eval

@@ -1,0 +1,117 @@
+#include "farfield/eval/walk.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "farfield/core/error.h"
+#include "farfield/core/progress.h"
+#include "farfield/image/png_io.h"
+#include "farfield/scene/bvh.h"
+
+namespace farfield::eval {
+
+WalkResult runWalk(gpu::Context& context, const scene::Scene& scene, const gen::CameraPath& path,
+                   const WalkOptions& options) {
+  checkModeNames(std::span<const std::string>(&options.mode, 1));
+  if (path.frames.empty()) throw Error("camera path", "has no frames");
+  if (options.every < 1) throw Error("--every", "must be at least 1");
+  const size_t count = options.frames == 0 ? path.frames.size() : std::min(options.frames, path.frames.size());
+  // Check every camera before the GPU work starts, so a bad frame fails fast.
+  for (size_t i = 0; i < count; ++i)
+    pathCamera(path, i, options.width, options.height, options.near_plane, options.far_plane);
+  if (!options.frames_dir.empty()) std::filesystem::create_directories(options.frames_dir);
+
+  context.makeCurrent();
+  WalkResult result;
+  result.mode = options.mode;
+  result.renderer = context.description();
+  result.width = options.width;
+  result.height = options.height;
+
+  gpu::GpuScene gpu_scene(scene);
+  scene::Bvh bvh(scene);
+  gpu::Renderer renderer;
+  gpu::RenderTarget target(options.width, options.height);
+  ModeContext mode_context;
+  mode_context.scene = &scene;
+  mode_context.gpu_scene = &gpu_scene;
+  mode_context.bvh = &bvh;
+  mode_context.renderer = &renderer;
+  mode_context.width = options.width;
+  mode_context.height = options.height;
+  mode_context.options = options.mode_options;
+  std::unique_ptr<Mode> mode = createMode(options.mode, mode_context);
+  mode->prepare(mode_context);
+
+  FrameRunner runner(renderer, target);
+  auto camera_of = [&](size_t i) {
+    return pathCamera(path, i, options.width, options.height, options.near_plane, options.far_plane);
+  };
+  // The first frame pays for shader compilation, texture residency and driver caches; it is not the walk's.
+  if (options.warm_up) runner.run(*mode, camera_of(0), 0);
+
+  Progress progress("walk " + options.mode, count);
+  result.frames.reserve(count);
+  for (size_t i = 0; i < count; ++i) {
+    result.frames.push_back(runner.run(*mode, camera_of(i), i));
+    if (!options.frames_dir.empty() && i % size_t(options.every) == 0) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "frame_%05zu.png", i);
+      const std::string file = (std::filesystem::path(options.frames_dir) / name).string();
+      image::writePng(file, target.readColor());
+      result.written_frames.push_back(file);
+    }
+    progress.advance();
+  }
+  progress.finish();
+
+  std::vector<double> wall, gpu;
+  for (const FrameRecord& f : result.frames) {
+    wall.push_back(f.wall_ms);
+    gpu.push_back(f.gpu_ms);
+  }
+  result.wall = summarize(wall);
+  result.gpu = summarize(gpu);
+  result.mean_triangles = meanOf(result.frames, [](const FrameRecord& f) { return f.triangles; });
+  result.mean_draw_calls = meanOf(result.frames, [](const FrameRecord& f) { return f.draw_calls; });
+  result.mean_objects = meanOf(result.frames, [](const FrameRecord& f) { return f.objects; });
+  return result;
+}
+
+void writeWalkCsv(const WalkResult& result, const std::string& file) {
+  std::ofstream out(file);
+  if (!out) throw Error(file, "cannot open for writing");
+  out << "frame,path_frame,mode,wall_ms,gpu_ms,triangles,draw_calls,objects\n";
+  char line[256];
+  for (size_t i = 0; i < result.frames.size(); ++i) {
+    const FrameRecord& f = result.frames[i];
+    std::snprintf(line, sizeof(line), "%zu,%zu,%s,%.4f,%.4f,%llu,%u,%u\n", i, f.path_frame, result.mode.c_str(),
+                  f.wall_ms, f.gpu_ms, (unsigned long long)f.triangles, f.draw_calls, f.objects);
+    out << line;
+  }
+  if (!out) throw Error(file, "write failed");
+}
+
+std::string formatWalkSummary(const WalkResult& r) {
+  char buf[1024];
+  std::snprintf(buf, sizeof(buf),
+                "mode:            %s\n"
+                "renderer:        %s\n"
+                "size:            %dx%d\n"
+                "frames:          %zu\n"
+                "wall ms:         median %.3f  p95 %.3f  p99 %.3f  max %.3f  mean %.3f\n"
+                "gpu ms:          median %.3f  p95 %.3f  p99 %.3f  max %.3f\n"
+                "triangles:       %.0f (mean per frame)\n"
+                "draw calls:      %.1f (mean per frame)\n"
+                "objects drawn:   %.1f (mean per frame)\n"
+                "percentiles:     linear interpolation between closest ranks\n",
+                r.mode.c_str(), r.renderer.c_str(), r.width, r.height, r.frames.size(), r.wall.median, r.wall.p95,
+                r.wall.p99, r.wall.max, r.wall.mean, r.gpu.median, r.gpu.p95, r.gpu.p99, r.gpu.max, r.mean_triangles,
+                r.mean_draw_calls, r.mean_objects);
+  return buf;
+}
+
+}  // namespace farfield::eval
