@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,8 @@ struct StreetWalkOptions {
   float fps = 30.0f;
   float fov_deg = 60.0f;
   float turn_radius = 6.0f;  // metres: smooth turns at junctions
+  // Ground height z at (x, y) for terrain under the streets (a hill); null means flat ground at z = 0.
+  std::function<float(float x, float y)> ground_height;
 };
 
 // A walk along the street graph: starts on a random edge, at each junction takes a random (seeded) next edge,

@@ -27,5 +27,7 @@ struct BlockFootprint {
   Polygon2 footprint;       // counter-clockwise, metres; empty blocks (collapsed by the inset) are not listed
 };
 std::vector<BlockFootprint> buildableBlocks(const urban::StreetGraph& graph);
+// The buildable area of one bounded face (as in buildableBlocks); empty when it collapses or for the outer face.
+Polygon2 buildableFootprint(const urban::StreetGraph& graph, uint32_t face);
 
 }  // namespace farfield::gen

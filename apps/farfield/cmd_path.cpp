@@ -1,0 +1,124 @@
+// farfield path street STREETS.json [--frames N] [--seed S] [--car] [--fps F] [--fov DEG] [--turn-radius M] -o FILE
+// farfield path flyover SCENE [--frames N] [--fps F] [--altitude M] [--fov DEG] -o FILE
+// farfield path orbit SCENE [--frames N] [--fps F] [--radius-scale K] [--elevation DEG] [--fov DEG] -o FILE
+// Writes a camera path (JSON, see farfield/gen/camera_path.h) for the walkthrough benchmark.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "cli_util.h"
+#include "command.h"
+#include "farfield/core/error.h"
+#include "farfield/gen/camera_path.h"
+#include "farfield/scene/import.h"
+#include "farfield/urban/street_graph.h"
+
+namespace farfield::app {
+namespace {
+
+struct PathArgs {
+  std::string input;
+  std::string output;
+  int frames = 600;
+  uint64_t seed = 1;
+  bool car = false;
+  float fps = 30.0f;
+  float fov_deg = 0.0f;  // 0: the default of each kind
+  float turn_radius = 6.0f;
+  float altitude = 150.0f;
+  float radius_scale = 1.2f;
+  float elevation_deg = 25.0f;
+};
+
+void writeAndReport(const gen::CameraPath& path, const std::string& output, const std::string& what) {
+  ensureParentDirectory(output);
+  gen::saveCameraPath(path, output);
+  double length = 0.0;
+  for (size_t i = 1; i < path.frames.size(); ++i) length += glm::length(path.frames[i].eye - path.frames[i - 1].eye);
+  const double duration = double(path.frames.size()) / path.fps;
+  std::printf("wrote %s: %s, %zu frames, %.1f m, %.1f s at %.0f fps\n", output.c_str(), what.c_str(),
+              path.frames.size(), length, duration, double(path.fps));
+}
+
+void runStreet(const PathArgs& args) {
+  const urban::StreetGraph graph = urban::StreetGraph::load(args.input);
+  gen::StreetWalkOptions options;
+  options.frames = args.frames;
+  options.seed = args.seed;
+  options.walker = args.car ? gen::Walker::Car : gen::Walker::Pedestrian;
+  options.fps = args.fps;
+  if (args.fov_deg > 0.0f) options.fov_deg = args.fov_deg;
+  options.turn_radius = args.turn_radius;
+  const gen::CameraPath path = gen::streetWalk(graph, options);
+  writeAndReport(path, args.output,
+                 std::string("street walk (") + (args.car ? "car, 10 m/s" : "pedestrian, 1.4 m/s") + ", " +
+                     std::to_string(graph.streetCount()) + " streets, " + std::to_string(graph.blockCount()) +
+                     " blocks)");
+}
+
+Box3 sceneBounds(const std::string& spec) {
+  const scene::Scene scene = scene::loadScene(spec);
+  const Box3 bounds = scene.bounds();
+  if (bounds.empty()) throw Error(spec, "the scene is empty (no bounds to fly over)");
+  return bounds;
+}
+
+void runFlyover(const PathArgs& args) {
+  gen::FlyoverOptions options;
+  options.frames = args.frames;
+  options.fps = args.fps;
+  options.altitude = args.altitude;
+  if (args.fov_deg > 0.0f) options.fov_deg = args.fov_deg;
+  writeAndReport(gen::flyover(sceneBounds(args.input), options), args.output, "flyover");
+}
+
+void runOrbit(const PathArgs& args) {
+  gen::OrbitOptions options;
+  options.frames = args.frames;
+  options.fps = args.fps;
+  options.radius_scale = args.radius_scale;
+  options.elevation_deg = args.elevation_deg;
+  if (args.fov_deg > 0.0f) options.fov_deg = args.fov_deg;
+  writeAndReport(gen::orbit(sceneBounds(args.input), options), args.output, "orbit");
+}
+
+void addCommon(CLI::App* cmd, PathArgs& args) {
+  cmd->add_option("--frames", args.frames, "Number of frames")->check(CLI::Range(1, 10000000));
+  cmd->add_option("--fps", args.fps, "Frames per second")->check(CLI::PositiveNumber);
+  cmd->add_option("--fov", args.fov_deg, "Vertical field of view, degrees")->check(CLI::Range(1.0, 179.0));
+  cmd->add_option("-o,--output", args.output, "Output camera path (.json)")->required();
+}
+
+const RegisterCommand reg("path", [](CLI::App& app) {
+  auto* cmd = app.add_subcommand("path", "Write a camera path: a street walk, a flyover or an orbit.");
+  cmd->require_subcommand(1);
+
+  auto street = std::make_shared<PathArgs>();
+  auto* s = cmd->add_subcommand("street", "A walk along the streets of a street graph (.streets.json).");
+  s->add_option("streets", street->input, "Street graph file (city.streets.json)")->required();
+  addCommon(s, *street);
+  s->add_option("--seed", street->seed, "Random seed for the walk");
+  s->add_flag("--car", street->car, "Drive (1.2 m eye height, 10 m/s) instead of walking (1.7 m, 1.4 m/s)");
+  s->add_option("--turn-radius", street->turn_radius, "Turn radius at junctions, metres")
+      ->check(CLI::NonNegativeNumber);
+  s->callback([street] { runStreet(*street); });
+
+  auto fly = std::make_shared<PathArgs>();
+  auto* f = cmd->add_subcommand("flyover", "A straight flight across the scene's bounds, looking ahead and down.");
+  f->add_option("scene", fly->input, "Scene file or builtin:NAME")->required();
+  addCommon(f, *fly);
+  f->add_option("--altitude", fly->altitude, "Height above the lowest point of the scene, metres");
+  f->callback([fly] { runFlyover(*fly); });
+
+  auto orb = std::make_shared<PathArgs>();
+  auto* o = cmd->add_subcommand("orbit", "A circle around the scene's bounds, looking at their centre.");
+  o->add_option("scene", orb->input, "Scene file or builtin:NAME")->required();
+  addCommon(o, *orb);
+  o->add_option("--radius-scale", orb->radius_scale, "Radius as a multiple of half the bounds' diagonal")
+      ->check(CLI::PositiveNumber);
+  o->add_option("--elevation", orb->elevation_deg, "Elevation angle, degrees")->check(CLI::Range(-89.0, 89.0));
+  o->callback([orb] { runOrbit(*orb); });
+});
+
+}  // namespace
+}  // namespace farfield::app
