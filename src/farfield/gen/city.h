@@ -25,10 +25,25 @@ struct City {
   urban::StreetGraph streets;
   // For each object id (index id - 1): the street-graph face (block) it stands in, or -1 (ground).
   std::vector<int32_t> object_block;
+  Box2 bounds;                   // streets.bounds(): what cityGroundHeight() takes
+  size_t buildings = 0;          // buildings generated, landmarks included
+  size_t landmarks = 0;
+  size_t skipped_blocks = 0;     // faces whose buildable area collapsed (street inset) or held no building
+  size_t skipped_lots = 0;       // lots dropped as degenerate while subdividing blocks
 };
 
 // Deterministic for a given options value. Throws farfield::Error for options out of range.
+// Materials: ground (asphalt), three facade tints, roof tiles, landmark stone (textures from textures.h). A block
+// object has up to three parts (facades, roofs, landmark); a building object the parts of its building. Every
+// object keeps its 2D footprint: the block's buildable footprint, or the building's footprint; the ground's is the
+// ground rectangle. Big cities show progress on stderr (farfield/core/progress.h).
 City generateCity(const CityOptions& options);
+
+// Height of the ground (z, metres) at p for a city generated with `options`, whose street graph has the 2D bounds
+// `city_bounds` (StreetGraph::bounds()). 0 everywhere without a hill; with one, a smooth bump (raised cosine)
+// centred on the bounds. Camera paths use it to follow the ground; the ground mesh is a tessellation of it (within
+// about 0.2 m) and buildings stand on it (their walls reach 1 m below the lowest ground under their footprint).
+float cityGroundHeight(const CityOptions& options, const Box2& city_bounds, Vec2 p);
 
 // Writes scene to `glb_path` and the street graph to the `.streets.json` next to it
 // (city.glb -> city.streets.json).
