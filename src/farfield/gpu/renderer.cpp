@@ -23,6 +23,7 @@ enum Variant : int { kShadedPlain = 0, kShadedTextured = 1, kItemBuffer = 2, kVa
 struct Locations {
   int view_proj = -1, model = -1, normal_matrix = -1, object_id = -1;
   int base_color = -1, unlit = -1, light_dir = -1, light_color = -1, ambient = -1;
+  int projective_texture = -1, texture_projection = -1;
 };
 
 const GpuMaterial& defaultMaterial() {
@@ -56,6 +57,8 @@ struct Renderer::Impl {
       l.light_dir = p.uniformLocation("u_light_dir");
       l.light_color = p.uniformLocation("u_light_color");
       l.ambient = p.uniformLocation("u_ambient");
+      l.projective_texture = p.uniformLocation("u_projective_texture");
+      l.texture_projection = p.uniformLocation("u_texture_projection");
     }
   }
 };
@@ -162,6 +165,11 @@ FrameStats Renderer::draw(const Camera& camera, std::span<const DrawItem> items,
       if (variant != kItemBuffer) {
         glUniform4fv(l.base_color, 1, glm::value_ptr(material.base_color));
         glUniform1i(l.unlit, material.unlit ? 1 : 0);
+      }
+      if (variant == kShadedTextured) {
+        glUniform1i(l.projective_texture, material.projective_texture ? 1 : 0);
+        if (material.projective_texture)
+          glUniformMatrix4fv(l.texture_projection, 1, GL_FALSE, glm::value_ptr(material.texture_projection));
       }
       if (variant == kShadedTextured && material.texture->handle() != current_texture) {
         current_texture = material.texture->handle();

@@ -24,6 +24,12 @@ struct GpuMaterial {
   const Texture* texture = nullptr;  // may be null
   bool unlit = false;
   bool double_sided = false;
+  // Projective texturing (image-based impostors): when set, the texture coordinate of a point is
+  // texture_projection * (object-space position, 1) divided by its w, instead of the mesh's interpolated uvs. With an
+  // impostor's creation camera (uv = its image position) every point shows exactly the texel captured there,
+  // whatever the depths of its triangle's vertices.
+  bool projective_texture = false;
+  Mat4 texture_projection{1.0f};
 };
 
 struct DrawItem {

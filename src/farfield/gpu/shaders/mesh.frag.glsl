@@ -7,6 +7,7 @@
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
+in vec4 v_uv_projected;
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uint o_id;
@@ -26,6 +27,7 @@ void main() {
 
 uniform vec4 u_base_color;
 uniform int u_unlit;
+uniform int u_projective_texture;  // 1: texture coordinate = v_uv_projected.xy / v_uv_projected.w
 uniform vec3 u_light_dir;  // direction the light travels, unit length
 uniform vec3 u_light_color;
 uniform float u_ambient;
@@ -36,7 +38,8 @@ layout(binding = 0) uniform sampler2D u_texture;
 void main() {
   vec4 albedo = u_base_color;
 #ifdef FF_TEXTURED
-  albedo *= texture(u_texture, v_uv);
+  const vec2 uv = u_projective_texture != 0 ? v_uv_projected.xy / v_uv_projected.w : v_uv;
+  albedo *= texture(u_texture, uv);
   if (albedo.a < 0.5) discard;
 #endif
   vec3 rgb = albedo.rgb;

@@ -9,15 +9,18 @@ layout(location = 2) in vec2 a_uv;
 uniform mat4 u_view_proj;
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;  // inverse transpose of the model matrix's 3x3 part
+uniform mat4 u_texture_projection;  // projective texturing (GpuMaterial::projective_texture)
 
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;
+out vec4 v_uv_projected;  // homogeneous texture coordinate for projective texturing
 
 void main() {
   vec4 world = u_model * vec4(a_position, 1.0);
   v_world = world.xyz;
   v_normal = u_normal_matrix * a_normal;
   v_uv = a_uv;
+  v_uv_projected = u_texture_projection * vec4(a_position, 1.0);  // object space: sticks to the mesh
   gl_Position = u_view_proj * world;
 }
