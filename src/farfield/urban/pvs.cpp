@@ -1,0 +1,136 @@
+// Decoret et al. 1999, "Multi-layered impostors for accelerated rendering", sections 5.3 (visibility culling by
+// item-buffer sampling) and 5.4 (near/far model segmentation).
+#include "farfield/urban/pvs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <unordered_set>
+
+#include "farfield/core/error.h"
+#include "farfield/image/image.h"
+
+namespace farfield::urban {
+
+namespace {
+
+bool finite3(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+}  // namespace
+
+std::vector<Vec3> pvsSamplePoints(const Vec3& p, const Vec3& q, float spacing) {
+  if (!finite3(p) || !finite3(q)) throw Error("PVS cell", "segment end point is not finite");
+  if (!(spacing > 0.0f) || !std::isfinite(spacing))
+    throw Error("PVS options", "sample spacing must be a positive number of metres, got " + std::to_string(spacing));
+  const double length = glm::length(DVec3(q) - DVec3(p));
+  if (length == 0.0) return {p};
+  const size_t intervals = size_t(std::max(1.0, std::ceil(length / double(spacing))));
+  std::vector<Vec3> points;
+  points.reserve(intervals + 1);
+  for (size_t i = 0; i <= intervals; ++i) {
+    const double t = double(i) / double(intervals);
+    points.push_back(Vec3(DVec3(p) + (DVec3(q) - DVec3(p)) * t));
+  }
+  points.back() = q;  // exactly the end point
+  return points;
+}
+
+std::vector<Camera> cubeFaceCameras(const Vec3& eye, int face_size, float near_plane, float far_plane) {
+  // A 90-degree square frustum per axis direction: the six tile the sphere of directions around the eye. The up
+  // vector only has to be off the view axis: +z for the four horizontal faces, +y for the two vertical ones.
+  static const Vec3 kDirections[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<Camera> cameras;
+  cameras.reserve(6);
+  for (int f = 0; f < 6; ++f) {
+    Camera camera;
+    camera.eye = eye;
+    camera.at = eye + kDirections[f];
+    camera.up = f < 4 ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
+    camera.fov_y = float(kPi / 2.0);
+    camera.width = camera.height = face_size;
+    camera.near_plane = near_plane;
+    camera.far_plane = far_plane;
+    cameras.push_back(camera);
+  }
+  return cameras;
+}
+
+PvsSampler::PvsSampler(const gpu::GpuScene& scene, const PvsOptions& options) : scene_(&scene), options_(options) {
+  if (options.face_size < 1 || options.face_size > 4096)
+    throw Error("PVS options", "face size must be 1..4096 pixels, got " + std::to_string(options.face_size));
+  if (!(options.near_plane > 0.0f) || !(options.far_plane > options.near_plane) || !std::isfinite(options.far_plane))
+    throw Error("PVS options", "need 0 < near plane < far plane (finite)");
+  target_ = gpu::RenderTarget(options.face_size, options.face_size);
+  items_ = scene_->drawItems();
+  item_bounds_.reserve(items_.size());
+  for (const gpu::DrawItem& item : items_) item_bounds_.push_back(transformBox(item.mesh->bounds(), item.transform));
+}
+
+// Section 5.3: full 360-degree views from closely spaced points of the cell, the objects' ids in an item buffer;
+// every id found is in the PVS. It is an estimate from below: an object seen only between the sample points, or
+// only through gaps narrower than a pixel of the cube faces, is missed; the spacing and the face size bound that.
+// Each face draws only the items whose bounds meet its frustum (the renderer does not cull).
+void PvsSampler::sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen) {
+  for (const Camera& camera : cubeFaceCameras(eye, options_.face_size, options_.near_plane, options_.far_plane)) {
+    const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+    visible_items_.clear();
+    for (size_t i = 0; i < items_.size(); ++i)
+      if (frustum.intersects(item_bounds_[i])) visible_items_.push_back(items_[i]);
+    if (visible_items_.empty()) continue;
+    renderer_.render(camera, visible_items_, target_, gpu::RenderMode::ItemBuffer);
+    const image::IdImage ids = target_.readIds();
+    for (uint32_t id : ids.pixels()) {
+      if (id == 0) continue;
+      if (id >= seen.size()) seen.resize(size_t(id) + 1, 0);
+      seen[id] = 1;
+    }
+  }
+}
+
+Pvs PvsSampler::sample(const Vec3& p, const Vec3& q) {
+  const std::vector<Vec3> points = pvsSamplePoints(p, q, options_.spacing);
+  std::vector<uint8_t> seen;
+  for (const Vec3& eye : points) sampleViewpoint(eye, seen);
+  Pvs pvs;
+  pvs.sample_points = points.size();
+  pvs.views = points.size() * 6;
+  for (size_t id = 1; id < seen.size(); ++id)
+    if (seen[id]) pvs.ids.push_back(uint32_t(id));
+  return pvs;
+}
+
+// Section 5.4 leaves the split to the target's rendering budget; two rules are offered. By distance: the cell's
+// segment against each object's ground footprint, so a long block beside the street counts as near all along the
+// street rather than by its centre; a radius is the natural knob for scenes without a street graph. By local model:
+// Sillion's local model of a street (the blocks touching it) is exactly the geometry that must stay polygons,
+// since any impostor of it would be seen from too close.
+NearFarSplit splitNearFar(const scene::Scene& scene, std::span<const uint32_t> pvs_ids, const CellSegment& cell,
+                          float near_radius) {
+  if (!(near_radius >= 0.0f) || !std::isfinite(near_radius))
+    throw Error("near/far split", "near radius must be a finite number >= 0 metres");
+  NearFarSplit split;
+  for (uint32_t id : pvs_ids) {
+    if (id == 0 || id > scene.objects.size())
+      throw Error("near/far split", "object id " + std::to_string(id) + " out of range (the scene has " +
+                                        std::to_string(scene.objects.size()) + " objects, ids from 1)");
+    const scene::Object& object = scene.objects[id - 1];
+    Polygon2 footprint = object.footprint;
+    if (footprint.empty() && !object.world_bounds.empty()) {
+      const Box3& b = object.world_bounds;
+      footprint = {{b.lo.x, b.lo.y}, {b.hi.x, b.lo.y}, {b.hi.x, b.hi.y}, {b.lo.x, b.hi.y}};
+    }
+    const double distance = distanceToCell(footprint, cell);  // infinity without a footprint
+    (distance <= double(near_radius) ? split.near_ids : split.far_ids).push_back(id);
+  }
+  return split;
+}
+
+NearFarSplit splitNearFar(std::span<const uint32_t> pvs_ids, std::span<const uint32_t> local_model_ids) {
+  const std::unordered_set<uint32_t> local(local_model_ids.begin(), local_model_ids.end());
+  NearFarSplit split;
+  for (uint32_t id : pvs_ids) (local.count(id) ? split.near_ids : split.far_ids).push_back(id);
+  return split;
+}
+
+}  // namespace farfield::urban

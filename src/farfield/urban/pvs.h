@@ -1,0 +1,79 @@
+// Potentially visible set of a viewing cell by item-buffer sampling, and the near/far segmentation of it
+// (Decoret et al. 1999, sections 5.3 and 5.4).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "farfield/core/math.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/scene/scene.h"
+#include "farfield/urban/visibility_events.h"
+
+namespace farfield::urban {
+
+struct PvsOptions {
+  float spacing = 2.0f;        // metres between sample points along the cell (both end points are sampled)
+  int face_size = 128;         // pixels per side of each cube face (90-degree field of view)
+  float near_plane = 0.25f;    // metres
+  float far_plane = 20000.0f;  // metres
+};
+
+struct Pvs {
+  std::vector<uint32_t> ids;  // object ids seen from at least one sample point, sorted, no 0 (background)
+  size_t sample_points = 0;
+  size_t views = 0;           // cube faces rendered (6 per sample point)
+};
+
+// Points along [p, q]: both end points and evenly spaced ones between, no farther apart than `spacing`
+// (ceil(|pq| / spacing) + 1 points; one point when p == q). Throws farfield::Error for a non-finite end point or a
+// spacing that is not a positive finite number.
+std::vector<Vec3> pvsSamplePoints(const Vec3& p, const Vec3& q, float spacing);
+
+// The six 90-degree cameras of a 360-degree view from `eye` (+x, -x, +y, -y, +z, -z), face_size pixels square.
+std::vector<Camera> cubeFaceCameras(const Vec3& eye, int face_size, float near_plane, float far_plane);
+
+// Renders item buffers of a GpuScene. Needs a current OpenGL context for its whole life (gpu::sharedHeadlessContext()
+// in tools and tests); the GpuScene must outlive it.
+class PvsSampler {
+ public:
+  // Throws farfield::Error for a face size outside 1..4096 or bad near/far planes.
+  explicit PvsSampler(const gpu::GpuScene& scene, const PvsOptions& options = {});
+
+  // PVS of the cell from p to q: 360-degree views from pvsSamplePoints(p, q, spacing), union of the ids seen.
+  // p and q are eye positions (the street's centreline end points at eye height above the ground).
+  Pvs sample(const Vec3& p, const Vec3& q);
+  // Adds to `seen` (indexed by id, grown as needed) the ids visible in a 360-degree view from `eye`.
+  void sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen);
+
+  const PvsOptions& options() const { return options_; }
+
+ private:
+  const gpu::GpuScene* scene_;
+  PvsOptions options_;
+  gpu::Renderer renderer_;
+  gpu::RenderTarget target_;
+  std::vector<gpu::DrawItem> items_;
+  std::vector<Box3> item_bounds_;  // world bounds per draw item, for culling each face
+  std::vector<gpu::DrawItem> visible_items_;
+};
+
+struct NearFarSplit {
+  std::vector<uint32_t> near_ids;  // drawn as geometry
+  std::vector<uint32_t> far_ids;   // replaced by image-based representations
+};
+
+// Near/far segmentation by distance: an object is near when its ground footprint (Object::footprint, or its world
+// bounds' xy rectangle when it has none) comes within near_radius metres of the cell segment, far otherwise (an
+// object without geometry and footprint is far). Ids keep the PVS order. Throws farfield::Error for an id out of
+// range or a negative or non-finite radius.
+NearFarSplit splitNearFar(const scene::Scene& scene, std::span<const uint32_t> pvs_ids, const CellSegment& cell,
+                          float near_radius);
+// Near/far segmentation by the cell's local model (Sillion 1997: the blocks touching the street): PVS members in
+// `local_model_ids` are near, the others far. Ids keep the PVS order.
+NearFarSplit splitNearFar(std::span<const uint32_t> pvs_ids, std::span<const uint32_t> local_model_ids);
+
+}  // namespace farfield::urban
