@@ -1,5 +1,7 @@
 #include "support/test_support.h"
 
+#include <unistd.h>
+
 namespace farfield::test {
 
 std::filesystem::path sharedDataDir() { return std::filesystem::path(FF_SOURCE_DIR) / ".." / "shared" / "data"; }
@@ -7,7 +9,9 @@ std::filesystem::path sharedDataDir() { return std::filesystem::path(FF_SOURCE_D
 std::filesystem::path testDataDir() { return std::filesystem::path(FF_TEST_DATA_DIR); }
 
 std::filesystem::path scratchDir(const std::string& name) {
-  auto dir = std::filesystem::path(FF_BINARY_DIR) / "test_scratch" / name;
+  // ctest runs every test in its own process, several at once: a directory per process keeps tests that share a
+  // name (or a fixture that writes once per process) from deleting each other's files.
+  auto dir = std::filesystem::path(FF_BINARY_DIR) / "test_scratch" / (name + "." + std::to_string(getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

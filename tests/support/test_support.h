@@ -10,7 +10,7 @@ namespace farfield::test {
 std::filesystem::path sharedDataDir();
 // tests/data (small hand-made files, malformed inputs).
 std::filesystem::path testDataDir();
-// A fresh, empty directory under the build tree for this test's outputs.
+// A fresh, empty directory under the build tree for this test's outputs, unique to this process.
 std::filesystem::path scratchDir(const std::string& name);
 
 }  // namespace farfield::test
