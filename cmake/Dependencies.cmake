@@ -38,3 +38,17 @@ find_package(CGAL REQUIRED)
 
 # GDAL: DEM input (GeoTIFF, netCDF, 16-bit PNG) for the terrain module.
 find_package(GDAL REQUIRED)
+
+# libosmium (header-only, with protozero) for OpenStreetMap PBF/XML input in the geodata module; its readers need
+# expat (XML), bzip2 and zlib (compressed blocks) and threads (parallel decoding).
+find_path(OSMIUM_INCLUDE_DIR osmium/version.hpp REQUIRED)
+find_path(PROTOZERO_INCLUDE_DIR protozero/version.hpp REQUIRED)
+find_package(EXPAT REQUIRED)
+find_package(BZip2 REQUIRED)
+find_package(ZLIB REQUIRED)
+add_library(ff_osmium INTERFACE)
+target_include_directories(ff_osmium SYSTEM INTERFACE ${OSMIUM_INCLUDE_DIR} ${PROTOZERO_INCLUDE_DIR})
+target_link_libraries(ff_osmium INTERFACE EXPAT::EXPAT BZip2::BZip2 ZLIB::ZLIB Threads::Threads)
+
+# PROJ: geographic coordinates (OSM) to local metres (UTM) in the geodata module.
+pkg_check_modules(PROJ REQUIRED IMPORTED_TARGET proj)
