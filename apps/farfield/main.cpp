@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "command.h"
 #include "farfield/core/error.h"
@@ -14,6 +15,15 @@ int main(int argc, char** argv) {
   auto& commands = farfield::app::CommandRegistry::commands();
   std::sort(commands.begin(), commands.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [name, setup] : commands) setup(app);
+  const bool known_command = argc > 1 && std::any_of(commands.begin(), commands.end(),
+                                                     [&](const auto& c) { return c.first == argv[1]; });
+  if (argc > 1 && argv[1][0] != '-' && !known_command) {
+    std::string known;
+    for (const auto& [name, setup] : commands) known += (known.empty() ? "" : ", ") + name;
+    std::fprintf(stderr, "error: unknown command '%s'; commands: %s\nRun with --help for usage.\n", argv[1],
+                 known.c_str());
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
