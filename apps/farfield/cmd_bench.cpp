@@ -1,8 +1,10 @@
 // farfield bench SCENE --path path.json --modes full,culled,... [--reference] [--size WxH] [--frames N]
 //                [--stride K] [--samples K] -o OUTDIR [--report FILE] [--no-plots] [--plot-script FILE]
-//                [--python EXE] [--mode-option key=value]...
+//                [--python EXE] [--mode-option key=value]... [--impostors DIR]
 // The walkthrough benchmark (see farfield/eval/bench.h): all modes interleaved over the same frames, with
-// bench.json, bench.md, frames.csv, plots, sample frames and a report in OUTDIR.
+// bench.json, bench.md, frames.csv, plots, sample frames and a report in OUTDIR. --impostors DIR is the impostor
+// store of `farfield bake` for the depth-mesh and grid-mesh modes (the mode option impostor_dir; see
+// farfield/runtime/impostor_mode.h).
 #include <unistd.h>
 
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include "farfield/eval/mode.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gpu/context.h"
+#include "farfield/runtime/impostor_mode.h"
 #include "farfield/scene/import.h"
 
 namespace fs = std::filesystem;
@@ -40,6 +43,7 @@ struct BenchArgs {
   std::string plot_script;
   std::string python;
   std::vector<std::string> mode_options;
+  std::string impostors;
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
 };
@@ -89,6 +93,7 @@ void runBenchCommand(const BenchArgs& args) {
   options.reference = args.reference;
   options.out_dir = args.out_dir;
   options.mode_options = eval::parseModeOptions(args.mode_options);
+  if (!args.impostors.empty()) options.mode_options["impostor_dir"] = args.impostors;
   options.scene_label = args.scene;
   options.path_label = args.path;
   if (!(args.near_plane > 0.0f && args.far_plane > args.near_plane))
@@ -121,8 +126,8 @@ void runBenchCommand(const BenchArgs& args) {
   std::printf("frames:   %zu of %zu (size %dx%d)\n", result.frame_indices.size(), result.path_frames, result.width,
               result.height);
   if (result.baseline_added) std::printf("note:     \"full\" was not asked for; it ran anyway as the baseline\n");
-  std::printf("\n%-16s %10s %10s %10s %10s %12s %9s %10s\n", "mode", "median ms", "p95 ms", "p99 ms", "max ms",
-              "triangles", "speedup", "PSNR dB");
+  std::printf("\n%-16s %10s %10s %10s %10s %12s %9s %10s %8s\n", "mode", "median ms", "p95 ms", "p99 ms", "max ms",
+              "triangles", "speedup", "PSNR dB", "cracks");
   for (const eval::ModeResult& m : result.modes) {
     char psnr[32] = "n/a";
     if (m.has_errors) {
@@ -131,8 +136,10 @@ void runBenchCommand(const BenchArgs& args) {
       else
         std::snprintf(psnr, sizeof(psnr), "%.2f", m.psnr_db_mean);
     }
-    std::printf("%-16s %10.3f %10.3f %10.3f %10.3f %12.0f %8.2fx %10s\n", m.name.c_str(), m.wall.median, m.wall.p95,
-                m.wall.p99, m.wall.max, m.mean_triangles, m.speedup_vs_full, psnr);
+    char cracks[32] = "n/a";
+    if (m.has_errors) std::snprintf(cracks, sizeof(cracks), "%.3f%%", 100.0 * m.crack_share_mean);
+    std::printf("%-16s %10.3f %10.3f %10.3f %10.3f %12.0f %8.2fx %10s %8s\n", m.name.c_str(), m.wall.median,
+                m.wall.p95, m.wall.p99, m.wall.max, m.mean_triangles, m.speedup_vs_full, psnr, cracks);
   }
   std::printf("\nwrote %s/{bench.json,bench.md,frames.csv}", args.out_dir.c_str());
   for (const std::string& p : result.plots) std::printf(", %s", p.c_str());
@@ -140,6 +147,7 @@ void runBenchCommand(const BenchArgs& args) {
 }
 
 const RegisterCommand reg("bench", [](CLI::App& app) {
+  runtime::registerModes();  // the impostor modes (depth-mesh, grid-mesh), before the mode list below
   auto args = std::make_shared<BenchArgs>();
   auto* cmd = app.add_subcommand("bench", "Walkthrough benchmark: modes interleaved over a camera path, with "
                                           "frame-time statistics, image error, plots and a report.");
@@ -162,6 +170,9 @@ const RegisterCommand reg("bench", [](CLI::App& app) {
   cmd->add_option("--plot-script", args->plot_script, "Path of plot_bench.py (default: found automatically)");
   cmd->add_option("--python", args->python, "Python interpreter for the plots (default: python3)");
   cmd->add_option("--mode-option", args->mode_options, "key=value passed to the modes (repeatable)");
+  cmd->add_option("--impostors", args->impostors,
+                  "Impostor store of farfield bake for the depth-mesh and grid-mesh modes (= --mode-option "
+                  "impostor_dir=DIR)");
   cmd->add_option("--near", args->near_plane, "Near plane, metres")->capture_default_str();
   cmd->add_option("--far", args->far_plane, "Far plane, metres")->capture_default_str();
   cmd->callback([args] { runBenchCommand(*args); });

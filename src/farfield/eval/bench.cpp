@@ -91,7 +91,19 @@ void summarizeMode(ModeResult& m) {
     m.psnr_db_mean = psnr_sum / n;
     m.ssim_mean = ssim_sum / n;
     m.bad_pixel_share_mean = bad_sum / n;
+    double crack_sum = 0.0;
+    for (double c : m.crack_shares) crack_sum += c;
+    m.crack_share_mean = m.crack_shares.empty() ? 0.0 : crack_sum / double(m.crack_shares.size());
   }
+}
+
+// Share of pixels where the reference shows geometry and the frame the sky (both id images of the same size).
+double crackShare(const image::IdImage& reference, const image::IdImage& frame) {
+  if (reference.pixelCount() == 0 || reference.pixelCount() != frame.pixelCount()) return 0.0;
+  size_t cracks = 0;
+  for (size_t i = 0; i < reference.pixelCount(); ++i)
+    cracks += (reference.pixels()[i] != 0 && frame.pixels()[i] == 0) ? 1 : 0;
+  return double(cracks) / double(reference.pixelCount());
 }
 
 std::string shellQuote(const std::string& s) {
@@ -127,7 +139,8 @@ std::string markdownHeader(const BenchResult& r) {
   if (r.reference)
     md << "- error against full-geometry reference frames: PSNR (identical frames are capped at "
        << fmt("%.0f", kPsnrCapDb) << " dB), SSIM, share of pixels off by more than " << r.bad_pixel_threshold
-       << "/255.\n";
+       << "/255; cracks = share of pixels where the reference shows geometry and the mode's frame shows sky "
+          "(object ids).\n";
   else
     md << "- no reference frames (run with --reference for image error).\n";
   return md.str();
@@ -137,8 +150,8 @@ std::string markdownTable(const BenchResult& r) {
   std::ostringstream md;
   md << "| mode | median ms | p95 ms | p99 ms | max ms | GPU median ms | triangles | draw calls | objects | "
         "speedup vs full | PSNR mean dB | PSNR min dB | SSIM mean | pixels > "
-     << r.bad_pixel_threshold << "/255 |\n";
-  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+     << r.bad_pixel_threshold << "/255 | cracks |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const ModeResult& m : r.modes) {
     md << "| " << m.name << " | " << fmt("%.2f", m.wall.median) << " | " << fmt("%.2f", m.wall.p95) << " | "
        << fmt("%.2f", m.wall.p99) << " | " << fmt("%.2f", m.wall.max) << " | " << fmt("%.2f", m.gpu.median)
@@ -147,9 +160,10 @@ std::string markdownTable(const BenchResult& r) {
     if (m.has_errors) {
       const auto psnr = [](double v) { return v >= kPsnrCapDb ? std::string("identical") : fmt("%.2f", v); };
       md << psnr(m.psnr_db_mean) << " | " << psnr(m.psnr_db_min) << " | " << fmt("%.4f", m.ssim_mean) << " | "
-         << fmt("%.3f", 100.0 * m.bad_pixel_share_mean) << "% |\n";
+         << fmt("%.3f", 100.0 * m.bad_pixel_share_mean) << "% | " << fmt("%.3f", 100.0 * m.crack_share_mean)
+         << "% |\n";
     } else {
-      md << "n/a | n/a | n/a | n/a |\n";
+      md << "n/a | n/a | n/a | n/a | n/a |\n";
     }
   }
   return md.str();
@@ -271,9 +285,11 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
     const size_t path_frame = result.frame_indices[k];
     const Camera camera = camera_of(path_frame);
     image::ColorImage reference;
+    image::IdImage reference_ids;
     if (options.reference) {
       renderer.render(camera, reference_items, reference_target);
       reference = reference_target.readColor();
+      reference_ids = reference_target.readIds();
     }
     const bool sample = sample_at.count(k) != 0;
     SampleFrame sample_frame;
@@ -290,6 +306,7 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
           image::ImageMetrics e = image::compareImages(reference, frame, options.bad_pixel_threshold);
           if (!(e.psnr_db < kPsnrCapDb)) e.psnr_db = kPsnrCapDb;  // +inf (identical) and above the cap
           mode_result.errors.push_back(e);
+          mode_result.crack_shares.push_back(crackShare(reference_ids, target.readIds()));
         }
         if (sample) {
           const std::string name = "frames/" + tag + "_" + fileSafe(mode_result.name) + ".png";
@@ -363,11 +380,13 @@ void writeBenchJson(const BenchResult& r, const std::string& file) {
       e["psnr_db_min"] = m.psnr_db_min;
       e["ssim_mean"] = m.ssim_mean;
       e["bad_pixel_share_mean"] = m.bad_pixel_share_mean;
+      e["crack_share_mean"] = m.crack_share_mean;
     } else {
       e["psnr_db_mean"] = nullptr;
       e["psnr_db_min"] = nullptr;
       e["ssim_mean"] = nullptr;
       e["bad_pixel_share_mean"] = nullptr;
+      e["crack_share_mean"] = nullptr;
     }
     Json info = Json::object();
     for (const auto& [key, value] : m.info) info[key] = value;

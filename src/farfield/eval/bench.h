@@ -14,9 +14,10 @@
 //    "percentiles": "linear interpolation between closest ranks", "psnr_cap_db": 99,
 //    "modes": {"full": {"median_ms", "p95_ms", "p99_ms", "max_ms", "mean_ms", "gpu_median_ms", "gpu_p95_ms",
 //                       "mean_triangles", "mean_draw_calls", "mean_objects", "speedup_vs_full",
-//                       "psnr_db_mean", "psnr_db_min", "ssim_mean", "bad_pixel_share_mean", "info": {...}}, ...}}
+//                       "psnr_db_mean", "psnr_db_min", "ssim_mean", "bad_pixel_share_mean", "crack_share_mean",
+//                       "info": {...}}, ...}}
 // speedup_vs_full = median_ms(full) / median_ms(mode). PSNR of identical frames is infinite; it is stored capped at
-// kPsnrCapDb (per frame, before the mean and min). Without a reference the four error keys are null.
+// kPsnrCapDb (per frame, before the mean and min). Without a reference the five error keys are null.
 #pragma once
 
 #include <map>
@@ -68,6 +69,10 @@ struct ModeResult {
   double psnr_db_min = 0.0;
   double ssim_mean = 0.0;
   double bad_pixel_share_mean = 0.0;
+  // Cracks (Sillion 1997, section 3.1): per frame, with a reference, the share of pixels where the reference shows
+  // geometry (object id != 0) and the mode's frame shows sky (id 0); bench.json "crack_share_mean".
+  std::vector<double> crack_shares;
+  double crack_share_mean = 0.0;
   std::map<std::string, double> info;  // Mode::info()
 };
 

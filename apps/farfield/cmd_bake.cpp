@@ -1,0 +1,207 @@
+// farfield bake SCENE [--streets city.streets.json] --technique depth-mesh|grid-mesh|both [--local edge|junction]
+//                [--resolution 512] [--fov DEG] [--eye-height M] [--path path.json] [--cell-lookup street|nearest]
+//                [--cells E,E,...] [--limit N] [--workers N]
+//                [--list] -o city.imp/
+// Bakes one impostor per viewing cell (oriented street edge, Sillion et al. 1997) into an impostor store directory
+// (farfield/store/impostor_store.h): captures on the GL thread, constructions on the other core(s), with a progress
+// bar; prints the bake time per impostor (render vs build) and the polygons per impostor. `--technique both` builds
+// the depth mesh and the grid mesh from the same capture into one store, which `farfield bench --impostors DIR` uses
+// for both the depth-mesh and the grid-mesh modes.
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <numeric>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_util.h"
+#include "command.h"
+#include "farfield/bake/bake.h"
+#include "farfield/core/error.h"
+#include "farfield/gen/camera_path.h"
+#include "farfield/gen/city.h"
+#include "farfield/gpu/context.h"
+#include "farfield/scene/import.h"
+#include "farfield/urban/cells.h"
+
+namespace farfield::app {
+namespace {
+
+struct BakeArgs {
+  std::string scene;
+  std::string streets;
+  std::string technique = "depth-mesh";
+  std::string local = "edge";
+  std::string lookup = "street";
+  int resolution = 512;
+  float fov_deg = 60.0f;
+  float eye_height = 1.7f;
+  std::string path;
+  size_t limit = 0;
+  std::string cells;
+  int workers = 0;
+  bool list = false;
+  std::string out_dir;
+};
+
+std::vector<uint32_t> parseCells(const std::string& text) {
+  std::vector<uint32_t> cells;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) {
+    size_t used = 0;
+    unsigned long v = 0;
+    try {
+      v = std::stoul(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || v >= 0xffffffffUL)
+      throw Error("--cells", "expected comma-separated half-edge ids, got '" + item + "'");
+    cells.push_back(uint32_t(v));
+  }
+  return cells;
+}
+
+struct Summary {
+  double mean = 0.0, median = 0.0, max = 0.0, total = 0.0;
+};
+Summary summarize(std::vector<double> v) {
+  Summary s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  s.total = std::accumulate(v.begin(), v.end(), 0.0);
+  s.mean = s.total / double(v.size());
+  s.median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  s.max = v.back();
+  return s;
+}
+
+void runBakeCommand(const BakeArgs& args) {
+  bake::BakeOptions options;
+  options.techniques = bake::parseTechniques(args.technique);
+  urban::CellOptions cell_options;
+  cell_options.local = urban::parseLocalModel(args.local);
+  cell_options.lookup = urban::parseCellLookup(args.lookup, "--cell-lookup");
+  options.resolution = args.resolution;
+  options.fov_deg = args.fov_deg;
+  options.eye_height = args.eye_height;
+  options.workers = args.workers;
+  options.scene_label = args.scene;
+  if (args.out_dir.empty()) throw Error("-o", "an output directory is needed");
+
+  // Cheap inputs first: streets and path fail before the scene is loaded.
+  const std::string streets_file = args.streets.empty() ? gen::streetsPathFor(args.scene) : args.streets;
+  urban::StreetGraph graph = urban::StreetGraph::load(streets_file);
+  gen::CameraPath path;
+  if (!args.path.empty()) path = gen::loadCameraPath(args.path);
+  std::vector<uint32_t> requested;
+  if (!args.cells.empty()) requested = parseCells(args.cells);
+  const scene::Scene scene = scene::loadScene(args.scene);
+  const urban::CellMap cells(std::move(graph), scene, cell_options);
+
+  if (!args.path.empty()) {
+    const std::vector<uint32_t> visited = bake::cellsOnPath(cells, path);
+    requested.insert(requested.end(), visited.begin(), visited.end());
+    std::printf("path:          %s visits %zu cells\n", args.path.c_str(), visited.size());
+  }
+  if (requested.empty())
+    for (uint32_t e = 0; e < cells.cellCount(); ++e) requested.push_back(e);
+  if (args.limit > 0 && requested.size() > args.limit) requested.resize(args.limit);
+
+  const urban::BlockAssignment& a = cells.assignment();
+  const size_t in_blocks = a.object_face.size() - a.shared.size();
+  std::printf("scene:         %s (%zu objects, %llu triangles)\n", args.scene.c_str(), scene.objects.size(),
+              (unsigned long long)scene.triangleCount());
+  std::printf("streets:       %s (%zu streets, %zu blocks, %zu cells)\n", streets_file.c_str(),
+              cells.graph().streetCount(), cells.graph().blockCount(), cells.cellCount());
+  std::printf("segmentation:  local model = %s, cell lookup = %s; %zu objects in blocks, %zu shared (%zu without footprint, %zu in no "
+              "block, %zu larger than their block)\n",
+              urban::localModelName(cell_options.local), urban::cellLookupName(cell_options.lookup), in_blocks, a.shared.size(), a.without_footprint,
+              a.outside_blocks, a.too_large);
+
+  const bake::BakeReport report =
+      bake::bakeCells(gpu::sharedHeadlessContext(), scene, cells, requested, options, args.out_dir);
+
+  std::printf("cells:         %zu requested, %zu baked, %zu skipped (street shorter than %.2f m)\n",
+              report.requested, report.cells.size(), report.skipped_degenerate.size(),
+              double(cell_options.min_cell_length));
+  for (uint32_t e : report.skipped_degenerate)
+    std::printf("  skipped cell %u: street %u is %.4f m long\n", e, e / 2, double(cells.graph().length(e)));
+  std::printf("threads:       1 GL thread (captures) + %zu worker(s) (constructions)\n", report.workers);
+  std::printf("impostors:     %dx%d, fov %.0f deg, eye %.2f m above the ground\n", options.resolution,
+              options.resolution, double(options.fov_deg), double(options.eye_height));
+
+  if (args.list) {
+    std::printf("\n%8s %10s %10s", "cell", "render ms", "pixels");
+    for (const std::string& t : options.techniques) std::printf(" %14s %12s", (t + " ms").c_str(), "triangles");
+    std::printf("\n");
+    for (const bake::CellBake& c : report.cells) {
+      std::printf("%8u %10.1f %10zu", c.half_edge, c.render_ms, c.data_pixels);
+      for (const std::string& t : options.techniques)
+        std::printf(" %14.1f %12zu", c.build_ms.at(t), c.triangles.at(t));
+      std::printf("\n");
+    }
+  }
+
+  if (!report.cells.empty()) {
+    std::printf("\nper impostor        %10s %10s %10s\n", "mean", "median", "max");
+    auto row = [](const char* label, const Summary& s, const char* format) {
+      char buf[3][32];
+      std::snprintf(buf[0], sizeof(buf[0]), format, s.mean);
+      std::snprintf(buf[1], sizeof(buf[1]), format, s.median);
+      std::snprintf(buf[2], sizeof(buf[2]), format, s.max);
+      std::printf("%-19s %10s %10s %10s\n", label, buf[0], buf[1], buf[2]);
+    };
+    std::vector<double> render, write;
+    for (const bake::CellBake& c : report.cells) {
+      render.push_back(c.render_ms);
+      write.push_back(c.write_ms);
+    }
+    row("render ms", summarize(render), "%.1f");
+    for (const std::string& t : options.techniques) {
+      std::vector<double> build, tris;
+      for (const bake::CellBake& c : report.cells) {
+        build.push_back(c.build_ms.at(t));
+        tris.push_back(double(c.triangles.at(t)));
+      }
+      row((t + " build ms").c_str(), summarize(build), "%.1f");
+      row((t + " polygons").c_str(), summarize(tris), "%.0f");
+    }
+    row("write ms", summarize(write), "%.1f");
+  }
+  std::printf("\nwall:          %.1f s for %zu impostors (%.2f s per cell)\n", report.wall_s, report.cells.size(),
+              report.cells.empty() ? 0.0 : report.wall_s / double(report.cells.size()));
+  std::printf("wrote %s/index.json\n", args.out_dir.c_str());
+}
+
+const RegisterCommand reg("bake", [](CLI::App& app) {
+  auto args = std::make_shared<BakeArgs>();
+  auto* cmd = app.add_subcommand("bake", "Bake one impostor per street cell (oriented edge) into an impostor store "
+                                         "directory (Sillion 1997 textured depth meshes, or the grid-mesh baseline).");
+  cmd->add_option("scene", args->scene, "Scene file (the city .glb)")->required();
+  cmd->add_option("--streets", args->streets, "Street graph JSON (default: the .streets.json next to the scene)");
+  cmd->add_option("--technique", args->technique, "depth-mesh, grid-mesh or both (one capture, both meshes)")
+      ->capture_default_str();
+  cmd->add_option("--local", args->local, "Local model: edge (blocks touching the street) or junction (also the "
+                                          "blocks around both end junctions)")
+      ->capture_default_str();
+  cmd->add_option("--resolution", args->resolution, "Impostor image size (square), pixels")->capture_default_str();
+  cmd->add_option("--fov", args->fov_deg, "Field of view of the creation camera, degrees")->capture_default_str();
+  cmd->add_option("--eye-height", args->eye_height, "Creation camera height above the ground, metres")
+      ->capture_default_str();
+  cmd->add_option("--path", args->path, "Bake only the cells this camera path visits");
+  cmd->add_option("--cell-lookup", args->lookup, "How a viewer's cell is found: street (best-aligned street the "
+                                                 "viewer stands on) or nearest (nearest agreeing edge)")
+      ->capture_default_str();
+  cmd->add_option("--cells", args->cells, "Bake these half-edge ids (comma-separated)");
+  cmd->add_option("--limit", args->limit, "Bake at most N cells (0 = no limit)");
+  cmd->add_option("--workers", args->workers, "Worker threads for the constructions (0 = cores - 1, at least 1)")
+      ->capture_default_str();
+  cmd->add_flag("--list", args->list, "Print one line per baked cell");
+  cmd->add_option("-o,--output", args->out_dir, "Impostor store directory")->required();
+  cmd->callback([args] { runBakeCommand(*args); });
+});
+
+}  // namespace
+}  // namespace farfield::app

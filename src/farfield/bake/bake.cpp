@@ -1,0 +1,261 @@
+// Parallel bake of cell impostors (Sillion et al. 1997, sections 4.1-4.2): one capture per cell on the GL thread,
+// the constructions on worker threads.
+//
+// Why a producer/consumer instead of a parallel loop: the capture needs the one OpenGL context, which is current on
+// one thread only, while the constructions are pure CPU work without shared state (buildDepthMesh and buildGridMesh
+// say so). A tbb::concurrent_bounded_queue between the two bounds the captures in flight (each is colour, depth and
+// ids at the impostor resolution: 3 MB at 512x512), and lets the GL thread block when the workers fall behind instead
+// of rendering ahead without limit. The queue carries a null job per worker to stop them.
+#include "farfield/bake/bake.h"
+
+#include <oneapi/tbb/concurrent_queue.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "farfield/bake/ground_height.h"
+#include "farfield/core/error.h"
+#include "farfield/core/progress.h"
+#include "farfield/core/timer.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/store/impostor_store.h"
+
+namespace farfield::bake {
+
+std::vector<std::string> parseTechniques(const std::string& text, const std::string& what) {
+  if (text == kDepthMesh) return {kDepthMesh};
+  if (text == kGridMesh) return {kGridMesh};
+  if (text == "both") return {kDepthMesh, kGridMesh};
+  throw Error(what, "unknown technique '" + text + "' (expected depth-mesh, grid-mesh or both)");
+}
+
+namespace {
+
+void validateOptions(const BakeOptions& o) {
+  if (o.techniques.empty()) throw Error("bake options", "no technique given");
+  for (const std::string& t : o.techniques)
+    if (t != kDepthMesh && t != kGridMesh)
+      throw Error("bake options", "unknown technique '" + t + "' (expected depth-mesh or grid-mesh)");
+  if (o.resolution < 8 || o.resolution > 8192)
+    throw Error("--resolution", "must be 8..8192 pixels, got " + std::to_string(o.resolution));
+  if (!(o.fov_deg > 1.0f && o.fov_deg < 170.0f))
+    throw Error("--fov", "must be between 1 and 170 degrees, got " + std::to_string(o.fov_deg));
+  if (!std::isfinite(o.eye_height)) throw Error("--eye-height", "must be finite");
+  if (!(o.near_plane > 0.0f && o.far_plane > o.near_plane)) throw Error("bake options", "need 0 < near < far");
+  if (o.workers < 0) throw Error("--workers", "must be 0 (automatic) or more");
+}
+
+struct Job {
+  CellBake record;
+  store::CellEntry entry;
+  impostor::ImpostorCapture capture;
+};
+
+}  // namespace
+
+Camera cellCamera(const urban::CellMap& cells, uint32_t cell, const BakeOptions& options,
+                  const std::function<float(float, float)>& ground) {
+  if (cell >= cells.cellCount())
+    throw Error("cell " + std::to_string(cell), "no such half-edge (the street graph has " +
+                                                    std::to_string(cells.cellCount()) + ")");
+  if (cells.degenerate(cell))
+    throw Error("cell " + std::to_string(cell), "street too short (" + std::to_string(cells.graph().length(cell)) +
+                                                    " m) to place a creation camera along it");
+  const Vec2 a = cells.graph().originPosition(cell), b = cells.graph().destinationPosition(cell);
+  const Vec3 eye(a, ground(a.x, a.y) + options.eye_height);
+  const Vec3 at(b, ground(b.x, b.y) + options.eye_height);
+  impostor::DepthMeshOptions o = options.depth_mesh;
+  o.resolution = options.resolution;
+  o.fov_y = float(degToRad(double(options.fov_deg)));
+  return impostor::creationCamera(eye, at, o, options.near_plane, options.far_plane);
+}
+
+std::vector<uint32_t> cellsOnPath(const urban::CellMap& cells, const gen::CameraPath& path) {
+  std::vector<uint32_t> order;
+  std::set<uint32_t> seen;
+  for (const gen::PathFrame& f : path.frames) {
+    const uint32_t cell = cells.lookup(f.eye, f.at - f.eye);
+    if (cell != urban::kNone && seen.insert(cell).second) order.push_back(cell);
+  }
+  return order;
+}
+
+BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urban::CellMap& cells,
+                     std::vector<uint32_t> half_edges, const BakeOptions& options, const std::string& out_dir) {
+  validateOptions(options);
+  if (cells.objectCount() != scene.objects.size())
+    throw Error("bake", "the cell map was made for " + std::to_string(cells.objectCount()) +
+                            " objects but the scene has " + std::to_string(scene.objects.size()));
+  Stopwatch wall;
+  BakeReport report;
+  report.store_dir = out_dir;
+
+  // The cells: requested order without repeats; degenerate ones reported and skipped.
+  if (half_edges.empty())
+    for (uint32_t e = 0; e < cells.cellCount(); ++e) half_edges.push_back(e);
+  std::vector<uint32_t> todo;
+  {
+    std::set<uint32_t> seen;
+    for (uint32_t e : half_edges) {
+      if (e >= cells.cellCount())
+        throw Error("cell " + std::to_string(e), "no such half-edge (the street graph has " +
+                                                     std::to_string(cells.cellCount()) + ")");
+      if (!seen.insert(e).second) continue;
+      if (cells.degenerate(e))
+        report.skipped_degenerate.push_back(e);
+      else
+        todo.push_back(e);
+    }
+    report.requested = seen.size();
+  }
+
+  const GroundHeight ground_height(scene, cells.assignment().shared);
+  const auto ground = [&](float x, float y) { return ground_height.at(x, y, 0.0f); };
+
+  store::StoreIndex index;
+  index.techniques = options.techniques;
+  index.scene = options.scene_label;
+  index.scene_objects = scene.objects.size();
+  index.local_model = urban::localModelName(cells.options().local);
+  index.cell_lookup = urban::cellLookupName(cells.options().lookup);
+  index.options = {{"resolution", options.resolution},
+                   {"fov_deg", options.fov_deg},
+                   {"eye_height", options.eye_height},
+                   {"near", options.near_plane},
+                   {"far", options.far_plane},
+                   {"block_margin", cells.options().block_margin},
+                   {"detect_seen_from_below", options.capture.detect_seen_from_below},
+                   {"depth_mesh",
+                    {{"grid_spacing_px", options.depth_mesh.grid_spacing_px},
+                     {"contour_tolerance_px", options.depth_mesh.contour.tolerance_px},
+                     {"contour_dilation_px", options.depth_mesh.contour_dilation_px}}},
+                   {"grid_mesh", {{"grid_spacing_px", options.grid_mesh.grid_spacing_px}}}};
+  {
+    std::error_code ec;
+    std::filesystem::create_directories(out_dir, ec);
+    if (ec) throw Error(out_dir, "cannot create the store directory: " + ec.message());
+  }
+  cells.graph().save((std::filesystem::path(out_dir) / store::kStreetsFile).string());
+
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const size_t workers = options.workers > 0 ? size_t(options.workers) : size_t(std::max(1u, hw - 1));
+  report.workers = workers;
+
+  tbb::concurrent_bounded_queue<std::shared_ptr<Job>> queue;
+  queue.set_capacity(std::ptrdiff_t(std::max<size_t>(1, options.queue_capacity)));
+  std::mutex results_mutex;
+  std::vector<CellBake> records;
+  std::vector<store::CellEntry> entries;
+  std::exception_ptr worker_error;
+  std::atomic<bool> failed{false};
+  std::unique_ptr<Progress> progress;
+  if (options.progress) progress = std::make_unique<Progress>("bake", todo.size());
+
+  auto work = [&] {
+    for (;;) {
+      std::shared_ptr<Job> job;
+      queue.pop(job);
+      if (!job) return;
+      if (failed.load()) continue;  // drain without work after an error
+      try {
+        std::map<std::string, impostor::DepthMeshImpostor> built;
+        for (const std::string& technique : options.techniques) {
+          Stopwatch t;
+          if (technique == kDepthMesh) {
+            impostor::DepthMeshOptions o = options.depth_mesh;
+            o.resolution = options.resolution;
+            o.fov_y = job->capture.camera.fov_y;
+            built[technique] = impostor::buildDepthMesh(job->capture, o);
+          } else {
+            built[technique] = impostor::buildGridMesh(job->capture, options.grid_mesh);
+          }
+          job->record.build_ms[technique] = t.milliseconds();
+          job->record.triangles[technique] = built[technique].mesh.triangleCount();
+        }
+        Stopwatch t;
+        std::map<std::string, const impostor::DepthMeshImpostor*> pointers;
+        for (const auto& [technique, imp] : built) pointers[technique] = &imp;
+        store::writeCell(out_dir, job->entry, pointers);
+        for (auto& [technique, stored] : job->entry.impostors) stored.build_ms = job->record.build_ms[technique];
+        job->record.write_ms = t.milliseconds();
+        {
+          std::lock_guard<std::mutex> lock(results_mutex);
+          records.push_back(job->record);
+          entries.push_back(std::move(job->entry));
+        }
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(results_mutex);
+        if (!worker_error) worker_error = std::current_exception();
+        failed = true;
+      }
+      if (progress) progress->advance();
+    }
+  };
+
+  std::vector<std::thread> pool;
+  for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
+  // Whatever happens on this thread, the workers are stopped and joined before leaving.
+  struct Joiner {
+    tbb::concurrent_bounded_queue<std::shared_ptr<Job>>& queue;
+    std::vector<std::thread>& pool;
+    ~Joiner() {
+      for (size_t i = 0; i < pool.size(); ++i) queue.push(nullptr);
+      for (std::thread& t : pool) t.join();
+    }
+  };
+  std::exception_ptr producer_error;
+  {
+    Joiner joiner{queue, pool};
+    try {
+      context.makeCurrent();
+      gpu::GpuScene gpu_scene(scene);
+      gpu::Renderer renderer;
+      for (uint32_t cell : todo) {
+        if (failed.load()) break;
+        auto job = std::make_shared<Job>();
+        const Camera camera = cellCamera(cells, cell, options, ground);
+        const std::vector<uint32_t> distant = cells.distantObjects(cell);
+        job->capture = impostor::captureView(renderer, gpu_scene, distant, camera, options.capture);
+        job->record.half_edge = cell;
+        job->record.render_ms = job->capture.render_ms;
+        job->record.data_pixels = job->capture.data_pixels;
+        job->record.distant_objects = distant.size();
+        job->entry.half_edge = cell;
+        job->entry.camera = camera;
+        job->entry.local_objects = cells.localObjects(cell);
+        job->record.local_objects = job->entry.local_objects.size();
+        job->entry.distant_objects = distant.size();
+        job->entry.data_pixels = job->capture.data_pixels;
+        job->entry.render_ms = job->capture.render_ms;
+        queue.push(std::move(job));
+      }
+    } catch (...) {
+      producer_error = std::current_exception();
+      failed = true;
+    }
+  }
+  if (progress) progress->finish();
+  if (producer_error) std::rethrow_exception(producer_error);
+  if (worker_error) std::rethrow_exception(worker_error);
+
+  std::sort(records.begin(), records.end(), [](const CellBake& a, const CellBake& b) {
+    return a.half_edge < b.half_edge;
+  });
+  std::sort(entries.begin(), entries.end(), [](const store::CellEntry& a, const store::CellEntry& b) {
+    return a.half_edge < b.half_edge;
+  });
+  index.cells = std::move(entries);
+  store::writeIndex(out_dir, index);
+  report.cells = std::move(records);
+  report.wall_s = wall.seconds();
+  return report;
+}
+
+}  // namespace farfield::bake
