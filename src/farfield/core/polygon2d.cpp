@@ -102,6 +102,8 @@ double distancePointSegment(const Vec2& p, const Vec2& a, const Vec2& b) {
   return distPointSegment(d2(p), d2(a), d2(b));
 }
 
+double distancePointSegmentD(const DVec2& p, const DVec2& a, const DVec2& b) { return distPointSegment(p, a, b); }
+
 double distanceToBoundary(const Vec2& point, const Polygon2& polygon) {
   const size_t n = polygon.size();
   if (n == 0) return std::numeric_limits<double>::infinity();
@@ -112,8 +114,11 @@ double distanceToBoundary(const Vec2& point, const Polygon2& polygon) {
   return best;
 }
 
-bool segmentsIntersect(const Vec2& a_in, const Vec2& b_in, const Vec2& c_in, const Vec2& d_in) {
-  const DVec2 a = d2(a_in), b = d2(b_in), c = d2(c_in), d = d2(d_in);
+bool segmentsIntersect(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  return segmentsIntersectD(d2(a), d2(b), d2(c), d2(d));
+}
+
+bool segmentsIntersectD(const DVec2& a, const DVec2& b, const DVec2& c, const DVec2& d) {
   int o1 = sign(orient(a, b, c)), o2 = sign(orient(a, b, d));
   int o3 = sign(orient(c, d, a)), o4 = sign(orient(c, d, b));
   // Each segment's endpoints on different sides of (or one on) the other's line: a single crossing point.

@@ -25,9 +25,12 @@ bool pointInPolygon(const Vec2& p, const Polygon2& polygon);
 // Distance from p to the polygon's boundary.
 double distanceToBoundary(const Vec2& p, const Polygon2& polygon);
 double distancePointSegment(const Vec2& p, const Vec2& a, const Vec2& b);
+double distancePointSegmentD(const DVec2& p, const DVec2& a, const DVec2& b);
 
 // Closed segments [a, b] and [c, d] intersect (touching counts).
 bool segmentsIntersect(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d);
+// Same predicates on double-precision points (street graphs keep their geometry in double).
+bool segmentsIntersectD(const DVec2& a, const DVec2& b, const DVec2& c, const DVec2& d);
 // Intersection point of two segments when they cross at a single point.
 std::optional<Vec2> segmentIntersection(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d);
 

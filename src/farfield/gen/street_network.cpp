@@ -58,18 +58,6 @@ DVec2 d2(const Vec2& v) { return DVec2(v.x, v.y); }
 Vec2 f2(const DVec2& v) { return Vec2(float(v.x), float(v.y)); }
 
 double orient(const DVec2& a, const DVec2& b, const DVec2& c) { return cross2(b - a, c - a); }
-int sgn(double v) { return (v > 0.0) - (v < 0.0); }
-bool inBox(const DVec2& a, const DVec2& b, const DVec2& c) {
-  return std::min(a.x, b.x) <= c.x && c.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= c.y &&
-         c.y <= std::max(a.y, b.y);
-}
-bool segmentsTouch(const DVec2& a, const DVec2& b, const DVec2& c, const DVec2& d) {
-  int o1 = sgn(orient(a, b, c)), o2 = sgn(orient(a, b, d));
-  int o3 = sgn(orient(c, d, a)), o4 = sgn(orient(c, d, b));
-  if (o1 != o2 && o3 != o4) return true;
-  return (o1 == 0 && inBox(a, b, c)) || (o2 == 0 && inBox(a, b, d)) || (o3 == 0 && inBox(c, d, a)) ||
-         (o4 == 0 && inBox(c, d, b));
-}
 
 // The network under construction: junction positions and streets with generator flags.
 struct Draft {
@@ -302,7 +290,7 @@ int addLanes(Draft& draft, int count, float block, Rng& rng) {
     bool ok = true;
     for (size_t i = 0; i < n && ok; ++i) {
       if (i == i1 || i == i2) continue;
-      if (segmentsTouch(m1, m2, d2(g.originPosition(edges[i])), d2(g.destinationPosition(edges[i])))) ok = false;
+      if (segmentsIntersectD(m1, m2, d2(g.originPosition(edges[i])), d2(g.destinationPosition(edges[i])))) ok = false;
     }
     if (!ok) continue;
     // Both halves big enough: the lane splits the polygon at the two points.
@@ -424,7 +412,7 @@ void curveStreets(Draft& draft, float block, Rng& rng) {
             if (glm::dot(u, v) > std::cos(degToRad(10.0))) ok = false;
             continue;
           }
-          if (segmentsTouch(chain[i], chain[i + 1], p, q)) ok = false;
+          if (segmentsIntersectD(chain[i], chain[i + 1], p, q)) ok = false;
         }
         if (!ok) break;
       }

@@ -13,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "farfield/core/polygon2d.h"
+
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 
@@ -24,37 +26,11 @@ DVec2 d2(const Vec2& v) { return DVec2(v.x, v.y); }
 
 double orient(const DVec2& a, const DVec2& b, const DVec2& c) { return cross2(b - a, c - a); }
 
-int sgn(double v) { return (v > 0.0) - (v < 0.0); }
-
-bool inBox(const DVec2& a, const DVec2& b, const DVec2& c) {
-  return std::min(a.x, b.x) <= c.x && c.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= c.y &&
-         c.y <= std::max(a.y, b.y);
-}
-
-// Closed segments [a, b] and [c, d] share a point (touching counts).
-bool segmentsTouch(const DVec2& a, const DVec2& b, const DVec2& c, const DVec2& d) {
-  int o1 = sgn(orient(a, b, c)), o2 = sgn(orient(a, b, d));
-  int o3 = sgn(orient(c, d, a)), o4 = sgn(orient(c, d, b));
-  if (o1 != o2 && o3 != o4) return true;
-  if (o1 == 0 && inBox(a, b, c)) return true;
-  if (o2 == 0 && inBox(a, b, d)) return true;
-  if (o3 == 0 && inBox(c, d, a)) return true;
-  if (o4 == 0 && inBox(c, d, b)) return true;
-  return false;
-}
-
-double distPointSegment(const DVec2& p, const DVec2& a, const DVec2& b) {
-  DVec2 ab = b - a;
-  double len2 = glm::dot(ab, ab);
-  double t = len2 > 0.0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
-  return glm::length(p - (a + t * ab));
-}
-
 // A point where two touching segments meet: the endpoint lying on the other segment, else the crossing point.
 Vec2 contactPoint(const DVec2& a, const DVec2& b, const DVec2& c, const DVec2& d) {
   struct Cand { DVec2 p; double dist; };
-  Cand cands[4] = {{a, distPointSegment(a, c, d)}, {b, distPointSegment(b, c, d)},
-                   {c, distPointSegment(c, a, b)}, {d, distPointSegment(d, a, b)}};
+  Cand cands[4] = {{a, distancePointSegmentD(a, c, d)}, {b, distancePointSegmentD(b, c, d)},
+                   {c, distancePointSegmentD(c, a, b)}, {d, distancePointSegmentD(d, a, b)}};
   Cand best = cands[0];
   for (const Cand& k : cands)
     if (k.dist < best.dist) best = k;
@@ -273,7 +249,7 @@ StreetGraph StreetGraph::build(std::vector<Vec2> junctions, std::vector<Street> 
           const bool share = u.a == st[s].a || u.a == st[s].b || u.b == st[s].a || u.b == st[s].b;
           if (share) continue;  // overlaps of adjacent streets are found around the junctions above
           const DVec2 b0 = d2(pos[u.a]), b1 = d2(pos[u.b]);
-          if (segmentsTouch(a0, a1, b0, b1)) {
+          if (segmentsIntersectD(a0, a1, b0, b1)) {
             uint32_t lo = std::min(s, t), hi = std::max(s, t);
             throw Error(source, "streets " + std::to_string(lo) + " and " + std::to_string(hi) + " cross near " +
                                     fmtPoint(contactPoint(a0, a1, b0, b1)) + " (the street graph must be planar)");
@@ -391,7 +367,7 @@ std::vector<uint32_t> StreetGraph::blocksAtJunction(uint32_t junction, bool incl
 }
 
 float StreetGraph::distanceToEdge(const Vec2& p, uint32_t e) const {
-  return float(distPointSegment(d2(p), d2(originPosition(e)), d2(destinationPosition(e))));
+  return float(distancePointSegmentD(d2(p), d2(originPosition(e)), d2(destinationPosition(e))));
 }
 
 uint32_t StreetGraph::nearestOrientedEdge(const Vec2& p, const Vec2& heading) const {
@@ -415,7 +391,7 @@ uint32_t StreetGraph::nearestOrientedEdge(const Vec2& p, const Vec2& heading) co
   const DVec2 hn = has_heading ? h / glm::length(h) : DVec2(0.0);
   auto visit = [&](uint32_t s) {
     const DVec2 a = d2(positions_[streets_[s].a]), b = d2(positions_[streets_[s].b]);
-    const double dist = distPointSegment(d2(p), a, b);
+    const double dist = distancePointSegmentD(d2(p), a, b);
     const DVec2 dir = glm::normalize(b - a);
     const double c = glm::dot(dir, hn);
     // Half-edge 2s runs a -> b (alignment c), 2s + 1 runs b -> a (alignment -c).
@@ -442,7 +418,7 @@ uint32_t StreetGraph::nearestStreet(const Vec2& p) const {
   uint32_t best = kNone;
   double best_d = std::numeric_limits<double>::infinity();
   searchNear(p, [&](uint32_t s) {
-    double d = distPointSegment(d2(p), d2(positions_[streets_[s].a]), d2(positions_[streets_[s].b]));
+    double d = distancePointSegmentD(d2(p), d2(positions_[streets_[s].a]), d2(positions_[streets_[s].b]));
     if (d < best_d || (d == best_d && s < best)) {
       best_d = d;
       best = s;
