@@ -1,0 +1,124 @@
+#include "farfield/gpu/terrain_renderer.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+#include "farfield/core/timer.h"
+
+namespace farfield::gpu {
+
+TerrainRenderer::TerrainRenderer(std::span<const Vec3> positions, const image::ColorImage& texture, Vec2 uv_scale,
+                                 Vec2 uv_offset)
+    : uv_scale_(uv_scale), uv_offset_(uv_offset) {
+  if (positions.empty()) throw Error("terrain renderer", "no grid vertices");
+  if (texture.empty()) throw Error("terrain renderer", "empty texture");
+  vertex_count_ = positions.size();
+  texture_ = Texture::fromImage(texture, true);
+  texture_.setClampToEdge();
+  textured_ = Program::fromEmbedded("terrain.vert.glsl", "terrain.frag.glsl");
+  sprite_ = Program::fromEmbedded("terrain.vert.glsl", "terrain.frag.glsl", "#define FF_SPRITE 1");
+
+  glCreateBuffers(1, &vbo_);
+  glNamedBufferStorage(vbo_, GLsizeiptr(positions.size_bytes()), positions.data(), 0);
+  glCreateBuffers(kSlots, ibo_);
+  glCreateVertexArrays(1, &vao_);
+  glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(Vec3));
+  glEnableVertexArrayAttrib(vao_, 0);
+  glVertexArrayAttribFormat(vao_, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(vao_, 0, 0);
+}
+
+TerrainRenderer::~TerrainRenderer() {
+  if (vao_) glDeleteVertexArrays(1, &vao_);
+  if (vbo_) glDeleteBuffers(1, &vbo_);
+  glDeleteBuffers(kSlots, ibo_);
+}
+
+void TerrainRenderer::setIndices(std::span<const uint32_t> indices, int slot) {
+  FF_CHECK(slot >= 0 && slot < kSlots);
+  FF_CHECK(indices.size() % 3 == 0);
+  index_count_[slot] = indices.size();
+  const size_t bytes = indices.size_bytes();
+  // Orphan-and-refill: a fresh store each time (the driver keeps the old one for draws still in flight), sized with
+  // some headroom so that the allocation size stays the same from frame to frame.
+  size_t& capacity = index_capacity_bytes_[slot];
+  if (bytes > capacity || bytes < capacity / 4) capacity = std::max<size_t>(bytes + bytes / 2, 64);
+  glNamedBufferData(ibo_[slot], GLsizeiptr(capacity), nullptr, GL_STREAM_DRAW);
+  if (bytes) glNamedBufferSubData(ibo_[slot], 0, GLsizeiptr(bytes), indices.data());
+}
+
+void TerrainRenderer::setState(const Camera& camera, RenderTarget& target, int slot) {
+  camera.validate("camera");
+  target.bind();
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
+  glDisable(GL_SCISSOR_TEST);
+  glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
+  glVertexArrayElementBuffer(vao_, ibo_[slot]);
+}
+
+void TerrainRenderer::drawRange(size_t first, size_t count) {
+  glBindVertexArray(vao_);
+  glDrawElements(GL_TRIANGLES, GLsizei(count * 3), GL_UNSIGNED_INT,
+                 reinterpret_cast<const void*>(first * 3 * sizeof(uint32_t)));
+  glBindVertexArray(0);
+}
+
+FrameStats TerrainRenderer::drawTextured(const Camera& camera, RenderTarget& target, size_t first, size_t count,
+                                         int slot) {
+  FF_CHECK(slot >= 0 && slot < kSlots && (first + count) * 3 <= index_count_[slot]);
+  Stopwatch wall;
+  FrameStats stats;
+  if (count == 0) return stats;
+  setState(camera, target, slot);
+  textured_.use();
+  textured_.set("u_view_proj", camera.viewProjection());
+  glUniform2fv(textured_.uniformLocation("u_uv_scale"), 1, glm::value_ptr(uv_scale_));
+  glUniform2fv(textured_.uniformLocation("u_uv_offset"), 1, glm::value_ptr(uv_offset_));
+  textured_.set("u_object_id", uint32_t(1));
+  texture_.bind(0);
+  drawRange(first, count);
+  stats.triangles = count;
+  stats.draw_calls = 1;
+  stats.objects = 1;
+  stats.wall_ms = wall.milliseconds();
+  return stats;
+}
+
+FrameStats TerrainRenderer::drawSprite(const Camera& camera, RenderTarget& target, const Texture& sprite,
+                                       const Mat4& sprite_view_proj, size_t first, size_t count, int slot) {
+  FF_CHECK(slot >= 0 && slot < kSlots && (first + count) * 3 <= index_count_[slot]);
+  Stopwatch wall;
+  FrameStats stats;
+  if (count == 0) return stats;
+  FF_CHECK_MSG(sprite.handle() != target.colorTexture().handle(), "a sprite cannot be drawn into itself");
+  setState(camera, target, slot);
+  sprite_.use();
+  sprite_.set("u_view_proj", camera.viewProjection());
+  sprite_.set("u_sprite_view_proj", sprite_view_proj);
+  sprite_.set("u_object_id", uint32_t(1));
+  sprite.bind(0);
+  drawRange(first, count);
+  stats.triangles = count;
+  stats.draw_calls = 1;
+  stats.objects = 1;
+  stats.wall_ms = wall.milliseconds();
+  return stats;
+}
+
+size_t TerrainRenderer::gpuBytes() const {
+  size_t bytes = vertex_count_ * sizeof(Vec3) + texture_.byteSize();
+  for (size_t c : index_capacity_bytes_) bytes += c;
+  return bytes;
+}
+
+}  // namespace farfield::gpu

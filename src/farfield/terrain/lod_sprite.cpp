@@ -1,0 +1,328 @@
+// LOD-sprite rendering, Chen et al. 1999 section 3 (Figure 3) and section 5 (keyframes rendered ahead, keyframe cache).
+#include "farfield/terrain/lod_sprite.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+
+namespace farfield::terrain {
+
+gpu::FrameStats renderLodFrame(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, const Camera& camera,
+                               const LodSettings& settings, gpu::RenderTarget& target, LodMesh& scratch) {
+  lod.build(camera, settings, scratch);
+  renderer.setIndices(scratch.indices, 0);
+  return renderer.drawTextured(camera, target, 0, scratch.triangleCount(), 0);
+}
+
+std::vector<uint8_t> simulateKeyframes(const QuadtreeLod& lod, const std::vector<Camera>& cameras, float low_error,
+                                       double epsilon, std::vector<double>* error_px) {
+  std::vector<uint8_t> keyframes(cameras.size(), 0);
+  if (error_px) error_px->assign(cameras.size(), 0.0);
+  LodMesh low;
+  bool have = false;
+  Vec3 key_eye(0.0f);
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    const Camera& camera = cameras[f];
+    lod.build(camera, LodSettings{low_error, true, true}, low);
+    bool due = !have;
+    double shown = 0.0;
+    if (have) {
+      const SpriteError e = spriteError(lod, low.quadrants, key_eye, camera.eye);
+      due = keyframeDue(e, pixelAngle(camera), epsilon);
+      shown = e.pixels(pixelAngle(camera));
+    }
+    if (due) {
+      keyframes[f] = 1;
+      key_eye = camera.eye;
+      have = true;
+      shown = 0.0;
+    }
+    if (error_px) (*error_px)[f] = shown;
+  }
+  return keyframes;
+}
+
+const char* spriteSourceName(SpriteSource source) {
+  switch (source) {
+    case SpriteSource::Kept: return "kept";
+    case SpriteSource::Fresh: return "fresh";
+    case SpriteSource::Predicted: return "predicted";
+    case SpriteSource::Cached: return "cached";
+  }
+  return "?";
+}
+
+// A sprite: the keyframe's colour (the target's colour texture), its camera and z-buffer.
+struct LodSpriteRenderer::Keyframe {
+  Camera camera;        // the keyframe's camera (with the guard band)
+  Camera frame_camera;  // the frame's camera it was made for
+  Mat4 view_proj{1.0f};
+  gpu::RenderTarget target;
+  image::DepthImage depth;
+  double coverage_at_creation = 1.0;  // visible share of its own low-resolution mesh
+  uint64_t last_used = 0;
+  bool ready = false;
+};
+
+namespace {
+
+void add(gpu::FrameStats& sum, const gpu::FrameStats& s) {
+  sum.triangles += s.triangles;
+  sum.draw_calls += s.draw_calls;
+  sum.objects = std::max(sum.objects, s.objects);
+}
+
+}  // namespace
+
+LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, int width, int height,
+                                     const LodSpriteOptions& options)
+    : lod_(lod), renderer_(renderer), width_(width), height_(height), options_(options) {
+  if (!(options.epsilon > 0.0)) throw Error("lod-sprite", "error threshold epsilon must be positive (pixels)");
+  if (!(options.high_error > 0.0f) || !(options.low_error >= options.high_error))
+    throw Error("lod-sprite", "need 0 < high-resolution error <= low-resolution error (pixels)");
+  if (options.predict_history < 2 || options.predict_chunks < 1)
+    throw Error("lod-sprite", "prediction needs at least 2 viewpoints of history and 1 chunk");
+  if (options.cache_size < 1) throw Error("lod-sprite", "cache size must be at least 1 (the current keyframe)");
+  if (!(options.predict_lead > 0.0f)) throw Error("lod-sprite", "prediction lead must be positive");
+  if (width < 1 || height < 1) throw Error("lod-sprite", "frame size must be positive");
+  if (!(options.keyframe_margin >= 0.0f && options.keyframe_margin <= 1.0f))
+    throw Error("lod-sprite", "keyframe margin must be 0..1 (share of the frame size per side)");
+}
+
+LodSpriteRenderer::~LodSpriteRenderer() = default;
+
+void LodSpriteRenderer::reset() {
+  for (auto& k : kept_) spare_.push_back(std::move(k));
+  kept_.clear();
+  if (pending_) spare_.push_back(std::move(pending_));
+  current_ = nullptr;
+  counters_ = {};
+  frame_ = 0;
+  sprite_since_ = 0;
+  last_lifetime_ = 10;
+  pending_chunk_ = 0;
+  pending_chunks_ = 1;
+  history_.clear();
+}
+
+const Camera* LodSpriteRenderer::spriteCamera() const { return current_ ? &current_->camera : nullptr; }
+const gpu::RenderTarget* LodSpriteRenderer::spriteTarget() const { return current_ ? &current_->target : nullptr; }
+const image::DepthImage* LodSpriteRenderer::spriteDepth() const { return current_ ? &current_->depth : nullptr; }
+
+std::unique_ptr<LodSpriteRenderer::Keyframe> LodSpriteRenderer::takeKeyframe() {
+  if (!spare_.empty()) {
+    std::unique_ptr<Keyframe> k = std::move(spare_.back());
+    spare_.pop_back();
+    k->ready = false;
+    return k;
+  }
+  auto k = std::make_unique<Keyframe>();
+  const Camera size = keyframeCamera(Camera{});
+  k->target = gpu::RenderTarget(size.width, size.height);
+  return k;
+}
+
+Camera LodSpriteRenderer::keyframeCamera(const Camera& camera) const {
+  // Same eye, direction and pixel density; the image grows by a whole number of pixels on each side, so at the
+  // keyframe's own viewpoint every frame pixel centre falls on a sprite texel centre.
+  const int mx = int(std::lround(options_.keyframe_margin * width_));
+  const int my = int(std::lround(options_.keyframe_margin * height_));
+  Camera k = camera;
+  k.width = width_ + 2 * mx;
+  k.height = height_ + 2 * my;
+  k.fov_y = 2.0f * std::atan(std::tan(camera.fov_y * 0.5f) * float(k.height) / float(height_));
+  return k;
+}
+
+void LodSpriteRenderer::keep(std::unique_ptr<Keyframe> keyframe) {
+  // Least recently used out first; the current sprite is never evicted here (it is about to be replaced by the new
+  // one, but it was used in the previous frame, so it is the most recent of the others).
+  while (!kept_.empty() && kept_.size() >= size_t(options_.cache_size)) {
+    auto oldest = std::min_element(kept_.begin(), kept_.end(),
+                                   [](const auto& a, const auto& b) { return a->last_used < b->last_used; });
+    if (oldest->get() == current_) current_ = nullptr;
+    spare_.push_back(std::move(*oldest));
+    kept_.erase(oldest);
+  }
+  kept_.push_back(std::move(keyframe));
+}
+
+LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& camera, gpu::FrameStats& stats,
+                                                              LodSpriteFrameInfo& info) {
+  std::unique_ptr<Keyframe> k = takeKeyframe();
+  k->frame_camera = camera;
+  k->camera = keyframeCamera(camera);
+  k->view_proj = k->camera.viewProjection();
+  // Figure 3, lines 1 and 5: the high-resolution mesh rendered into the sprite; then the z-buffer is kept.
+  lod_.build(k->camera, LodSettings{options_.high_error, true, false}, high_);
+  renderer_.setIndices(high_.indices, 0);
+  k->target.clear(options_.sky_color);
+  add(stats, renderer_.drawTextured(k->camera, k->target, 0, high_.triangleCount(), 0));
+  info.keyframe_triangles += high_.triangleCount();
+  k->depth = k->target.readDepth();
+  k->ready = true;
+  ++counters_.fresh_keyframes;
+  Keyframe* raw = k.get();
+  keep(std::move(k));
+  return raw;
+}
+
+double LodSpriteRenderer::coverage(Keyframe& keyframe) {
+  probe_.reset(lod_, keyframe.camera, &keyframe.depth, options_.visibility);
+  return probe_.visibleShare(low_.indices);
+}
+
+void LodSpriteRenderer::schedulePrediction(const Camera& camera) {
+  if (pending_) {
+    ++counters_.predicted_discarded;
+    spare_.push_back(std::move(pending_));
+  }
+  // Linear extrapolation of eye and look-at over the recent viewpoints, as many frames ahead as the previous sprite
+  // lasted (at least long enough to finish drawing it).
+  const size_t n = history_.size();
+  Vec3 eye_velocity(0.0f), at_velocity(0.0f);
+  if (n >= 2) {
+    eye_velocity = (history_.back().first - history_.front().first) / float(n - 1);
+    at_velocity = (history_.back().second - history_.front().second) / float(n - 1);
+  }
+  const float ahead = std::clamp(float(last_lifetime_) * options_.predict_lead, 2.0f, 600.0f);
+  Camera predicted = camera;
+  predicted.eye = camera.eye + eye_velocity * ahead;
+  predicted.at = camera.at + at_velocity * ahead;
+  // Never extrapolate into the ground (a descent would otherwise end below the terrain): keep at least half of the
+  // current height above the ground.
+  const Heightfield& hf = lod_.heightfield();
+  const float ground_now = hf.sample(camera.eye.x, camera.eye.y);
+  const float ground_then = hf.sample(predicted.eye.x, predicted.eye.y);
+  predicted.eye.z = std::max(predicted.eye.z, ground_then + 0.5f * std::max(camera.eye.z - ground_now, 0.0f));
+  if (glm::length(predicted.at - predicted.eye) < 1e-3f) predicted.at = predicted.eye + camera.forward();
+  try {
+    predicted.validate("predicted keyframe camera");
+  } catch (const Error&) {
+    return;  // e.g. extrapolated into looking straight up: no prediction this time
+  }
+  pending_ = takeKeyframe();
+  pending_->frame_camera = predicted;
+  pending_->camera = keyframeCamera(predicted);
+  pending_->view_proj = pending_->camera.viewProjection();
+  pending_chunk_ = 0;
+  // Ready by about half of the expected lifetime: at most predict_chunks slices, fewer for short-lived sprites.
+  pending_chunks_ = size_t(std::clamp<uint64_t>(last_lifetime_ / 2, 1, uint64_t(options_.predict_chunks)));
+}
+
+void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info) {
+  // Step 0 (the frame after the switch): the mesh; steps 1..chunks: one slice of it each; then the z-buffer.
+  Keyframe& k = *pending_;
+  const size_t chunks = pending_chunks_;
+  if (pending_chunk_ == 0) {
+    lod_.build(k.camera, LodSettings{options_.high_error, true, false}, pending_mesh_);
+    renderer_.setIndices(pending_mesh_.indices, 1);
+    k.target.clear(options_.sky_color);
+    ++pending_chunk_;
+    return;
+  }
+  const size_t total = pending_mesh_.triangleCount();
+  const size_t per_chunk = (total + chunks - 1) / chunks;
+  const size_t first = std::min(total, (pending_chunk_ - 1) * per_chunk);
+  const size_t count = std::min(total - first, per_chunk);
+  add(stats, renderer_.drawTextured(k.camera, k.target, first, count, 1));
+  info.ahead_triangles += count;
+  if (++pending_chunk_ <= chunks) return;
+  k.depth = k.target.readDepth();
+  k.ready = true;
+  ++counters_.predicted_rendered;
+  // Its own coverage, for the reuse test: the low-resolution mesh at its viewpoint against its z-buffer.
+  lod_.build(k.frame_camera, LodSettings{options_.low_error, true, false}, probe_mesh_);
+  probe_.reset(lod_, k.camera, &k.depth, options_.visibility);
+  k.coverage_at_creation = probe_.visibleShare(probe_mesh_.indices);
+}
+
+gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo* out) {
+  if (camera.width != width_ || camera.height != height_)
+    throw Error("lod-sprite", "camera size differs from the renderer's frame size");
+  ++frame_;
+  ++counters_.frames;
+  LodSpriteFrameInfo info;
+  gpu::FrameStats stats;
+  history_.emplace_back(camera.eye, camera.at);
+  while (history_.size() > size_t(options_.predict_history)) history_.pop_front();
+
+  // Figure 3, line 6 (done first: the error metric of line 3 runs over this mesh's quadrants).
+  lod_.build(camera, LodSettings{options_.low_error, true, true}, low_);
+  info.quadrants = low_.quadrants.size();
+  const double beta = pixelAngle(camera);
+  auto errorOf = [&](const Keyframe& k) { return spriteError(lod_, low_.quadrants, k.camera.eye, camera.eye); };
+
+  // Lines 3-5: error of the current sprite; a new one when it reaches the threshold.
+  bool due = current_ == nullptr;
+  if (current_) {
+    const SpriteError e = errorOf(*current_);
+    info.trigger_error_px = info.error_px = e.pixels(beta);
+    due = keyframeDue(e, beta, options_.epsilon);
+  }
+  if (due) {
+    if (current_) last_lifetime_ = std::max<uint64_t>(frame_ - sprite_since_, 1);
+    Keyframe* chosen = nullptr;
+    double chosen_error = 0.0;
+    if (pending_ && pending_->ready) {
+      const SpriteError e = errorOf(*pending_);
+      // Only with some life left (error at most 3/4 of the threshold here), or it would trip again at once.
+      if (!keyframeDue(e, beta, 0.75 * options_.epsilon) &&
+          coverage(*pending_) >= options_.reuse_coverage * pending_->coverage_at_creation) {
+        chosen = pending_.get();
+        chosen_error = e.pixels(beta);
+        info.source = SpriteSource::Predicted;
+        ++counters_.predicted_used;
+        keep(std::move(pending_));
+      }
+    }
+    if (!chosen && options_.cache_size > 1) {
+      double best = std::numeric_limits<double>::max();
+      for (auto& k : kept_) {
+        if (k.get() == current_) continue;
+        const SpriteError e = errorOf(*k);
+        if (keyframeDue(e, beta, options_.epsilon) || e.mean_theta_sq >= best) continue;
+        if (coverage(*k) < options_.reuse_coverage * k->coverage_at_creation) continue;
+        best = e.mean_theta_sq;
+        chosen = k.get();
+        chosen_error = e.pixels(beta);
+      }
+      if (chosen) {
+        info.source = SpriteSource::Cached;
+        ++counters_.cache_hits;
+      }
+    }
+    if (!chosen) {
+      chosen = renderKeyframe(camera, stats, info);
+      chosen_error = 0.0;
+      info.source = SpriteSource::Fresh;
+    }
+    current_ = chosen;
+    sprite_since_ = frame_;
+    info.error_px = chosen_error;
+    visibility_.reset(lod_, current_->camera, &current_->depth, options_.visibility);
+    if (options_.predict) schedulePrediction(camera);
+  }
+  current_->last_used = frame_;
+
+  // Section 5: the keyframe rendered ahead, one step per frame, from the frame after a switch on (the switch frame
+  // may already have drawn a whole keyframe).
+  if (options_.predict && pending_ && !pending_->ready && !due) advancePrediction(stats, info);
+
+  // Lines 7-11: visible triangles with the sprite, the others with the original texture.
+  const size_t n = low_.triangleCount();
+  const size_t visible = visibility_.partition(low_.indices);
+  if (info.source == SpriteSource::Fresh) current_->coverage_at_creation = n ? double(visible) / double(n) : 1.0;
+  renderer_.setIndices(low_.indices, 0);
+  add(stats, renderer_.drawSprite(camera, target, current_->target.colorTexture(), current_->view_proj, 0, visible, 0));
+  add(stats, renderer_.drawTextured(camera, target, visible, n - visible, 0));
+  info.low_triangles = n;
+  info.visible_triangles = visible;
+  if (out) *out = info;
+  return stats;
+}
+
+}  // namespace farfield::terrain

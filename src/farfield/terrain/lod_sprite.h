@@ -1,0 +1,156 @@
+// LOD-sprite terrain rendering, Chen et al. 1999 section 3 (Figure 3's algorithm), with section 5's future work.
+//
+// Each frame: build the low-resolution LOD mesh for the camera; measure the error of the current sprite at this
+// viewpoint (sprite_error.h, equation 2); when it reaches the threshold, render a new keyframe: the high-resolution
+// mesh into an off-screen target whose colour is the sprite, keeping its camera (view/projection) and z-buffer. Then
+// draw the low-resolution mesh: triangles whose three vertices were visible in the keyframe (equation 3,
+// keyframe_visibility.h) take the sprite through the keyframe's projection, the others the original texture.
+// As in the pseudocode, a keyframe's own frame is drawn the same way, from the fresh sprite.
+//
+// Section 5, built (both off by default, so the default is the paper's technique):
+// - predict: right after a new sprite is taken into use, the next keyframe is rendered ahead, from a viewpoint
+//   extrapolated linearly from the last few viewpoints to the frame where the current sprite is expected to expire
+//   (predict_lead times as many frames ahead as the previous sprite lasted). From the next frame on, its mesh is
+//   built (one frame), then its triangles are drawn in up to `predict_chunks` slices, one per frame (no frame pays
+//   a whole keyframe; fewer slices when sprites are short-lived), then its z-buffer is read. When
+//   the current sprite's error trips, the predicted keyframe is used if its error at the current viewpoint is below
+//   3/4 of the threshold and it covers the view (see reuse_coverage); otherwise a keyframe is rendered at once.
+// - cache_size > 1: the most recent keyframes are kept (least recently used replaced). When the error trips, the
+//   kept keyframe with the smallest error at the current viewpoint is reused if it passes the error test and
+//   covers the view; otherwise a new keyframe is rendered.
+// "Covers the view": the share of the current low-resolution triangles visible in that keyframe is at least
+// reuse_coverage times the share its own low-resolution mesh had when it was rendered (a keyframe looking the other
+// way passes the angular test but would texture little of the view).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/gpu/terrain_renderer.h"
+#include "farfield/image/image.h"
+#include "farfield/terrain/keyframe_visibility.h"
+#include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/sprite_error.h"
+
+namespace farfield::terrain {
+
+// Figure 3's keyframe decisions (lines 1-5) along a camera sequence without rendering: the decision depends only on
+// the keyframe's eye and the low-resolution mesh of each frame. 1 marks a keyframe. (What LodSpriteRenderer does
+// with cache_size 1 and no prediction; cheap enough to sweep frame counts and thresholds.)
+std::vector<uint8_t> simulateKeyframes(const QuadtreeLod& lod, const std::vector<Camera>& cameras, float low_error,
+                                       double epsilon, std::vector<double>* error_px = nullptr);
+
+// Renders one frame of a LOD mesh with the original texture (the "high" and "low" runs). Binds the target; does not
+// clear it and does not wait. `scratch` keeps its allocation between frames.
+gpu::FrameStats renderLodFrame(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, const Camera& camera,
+                               const LodSettings& settings, gpu::RenderTarget& target, LodMesh& scratch);
+
+struct LodSpriteOptions {
+  double epsilon = 1.0;     // error threshold, pixels (equation 2)
+  float high_error = 1.0f;  // LOD threshold of keyframes, pixels
+  float low_error = 4.0f;   // LOD threshold of novel frames, pixels (about 1500 triangles at 512x512, as the paper)
+  VisibilityOptions visibility;
+  Vec4 sky_color{0.62f, 0.74f, 0.88f, 1.0f};  // background of keyframes
+  // Guard band: keyframes are rendered round(margin * width) pixels wider on each side (and likewise taller), at the
+  // frame's pixel density, so that low-resolution triangles reaching a little past the frame edge, and views that
+  // have moved a little, still find their vertices in the keyframe. 0 = the paper's keyframe, exactly the frame.
+  float keyframe_margin = 0.1f;
+  // Section 5.
+  bool predict = false;
+  int predict_history = 4;  // viewpoints the extrapolation uses (>= 2)
+  int predict_chunks = 4;   // at most this many frames a predicted keyframe's triangles are spread over (>= 1);
+                            // fewer when sprites last less than twice that
+  // How far ahead, in lifetimes of the previous sprite: 1 = where the current sprite should expire; more centres the
+  // next keyframe on the stretch where it will be used, so it serves views before and after it (with steady motion,
+  // lead 1.25 makes sprites last about 4/3 as long; above 1.5 they would be too far ahead to take over).
+  float predict_lead = 1.25f;
+  int cache_size = 1;       // keyframes kept (1 = only the current one, as in the paper)
+  double reuse_coverage = 0.95;
+};
+
+enum class SpriteSource : uint8_t {
+  Kept,       // the current sprite stays (error below the threshold)
+  Fresh,      // a keyframe rendered in this frame
+  Predicted,  // the keyframe rendered ahead was taken into use
+  Cached,     // an earlier keyframe was reused
+};
+const char* spriteSourceName(SpriteSource source);
+
+struct LodSpriteFrameInfo {
+  SpriteSource source = SpriteSource::Kept;
+  double error_px = 0.0;          // error of the sprite used in this frame at this viewpoint (0 for a fresh one)
+  double trigger_error_px = 0.0;  // error of the previous sprite at this viewpoint (what the test saw)
+  uint64_t low_triangles = 0;
+  uint64_t visible_triangles = 0;   // low-resolution triangles textured with the sprite
+  uint64_t keyframe_triangles = 0;  // high-resolution triangles of a keyframe rendered in this frame
+  uint64_t ahead_triangles = 0;     // triangles of the predicted keyframe drawn in this frame
+  size_t quadrants = 0;             // n of equation 2
+};
+
+struct LodSpriteCounters {
+  size_t frames = 0;
+  size_t fresh_keyframes = 0;      // rendered at once when the error tripped (or the first frame)
+  size_t predicted_rendered = 0;   // predicted keyframes completed
+  size_t predicted_used = 0;
+  size_t predicted_discarded = 0;  // completed or started but never used
+  size_t cache_hits = 0;
+  // Every high-resolution render, whatever became of it.
+  size_t highResolutionRenders() const { return fresh_keyframes + predicted_rendered; }
+};
+
+class LodSpriteRenderer {
+ public:
+  // Needs a current context. lod and renderer must outlive this object; frames are width x height.
+  LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, int width, int height,
+                    const LodSpriteOptions& options);
+  ~LodSpriteRenderer();
+
+  // Draws one frame into target (bound here; not cleared: the caller clears it to the sky colour). The camera must
+  // have the size given to the constructor.
+  gpu::FrameStats render(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo* info = nullptr);
+
+  // Forgets every keyframe and counter (a new pass over a path); keeps the GPU allocations for reuse.
+  void reset();
+
+  const LodSpriteCounters& counters() const { return counters_; }
+  const LodSpriteOptions& options() const { return options_; }
+  // The current sprite's camera and colour (tests, figures); null before the first frame.
+  const Camera* spriteCamera() const;
+  const gpu::RenderTarget* spriteTarget() const;
+  const image::DepthImage* spriteDepth() const;
+
+ private:
+  struct Keyframe;
+  std::unique_ptr<Keyframe> takeKeyframe();
+  Camera keyframeCamera(const Camera& camera) const;
+  Keyframe* renderKeyframe(const Camera& camera, gpu::FrameStats& stats, LodSpriteFrameInfo& info);
+  double coverage(Keyframe& keyframe);
+  void schedulePrediction(const Camera& camera);
+  void advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info);
+  void keep(std::unique_ptr<Keyframe> keyframe);
+
+  const QuadtreeLod& lod_;
+  gpu::TerrainRenderer& renderer_;
+  int width_, height_;
+  LodSpriteOptions options_;
+  LodSpriteCounters counters_;
+  uint64_t frame_ = 0;
+  uint64_t sprite_since_ = 0;    // frame the current sprite was taken into use
+  uint64_t last_lifetime_ = 10;  // frames the previous sprite lasted
+  std::vector<std::unique_ptr<Keyframe>> kept_;  // the current sprite and (with a cache) earlier ones
+  std::vector<std::unique_ptr<Keyframe>> spare_;
+  Keyframe* current_ = nullptr;
+  std::unique_ptr<Keyframe> pending_;  // predicted keyframe in progress or ready
+  LodMesh low_, high_, pending_mesh_, probe_mesh_;
+  size_t pending_chunk_ = 0;   // next step of the predicted keyframe (0 = build its mesh)
+  size_t pending_chunks_ = 1;  // slices it is drawn in
+  KeyframeVisibility visibility_, probe_;
+  std::deque<std::pair<Vec3, Vec3>> history_;  // recent (eye, look-at)
+};
+
+}  // namespace farfield::terrain

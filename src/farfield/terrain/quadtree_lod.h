@@ -1,0 +1,105 @@
+// Quadtree continuous LOD for heightfields, in the spirit of Lindstrom et al. 1996 (which LOD-sprite, Chen et al.
+// 1999 section 2.2, builds on), as a right-triangulated irregular network (longest-edge bisection) with the
+// vertex dependencies of a restricted quadtree.
+//
+// The grid is a forest of square blocks of `block` x `block` cells (block a power of two); every grid point that is
+// not a block corner is the split vertex of exactly one "diamond": either the centre of a quadtree square (the
+// diamond is the square, split by one diagonal into two right triangles) or the midpoint of a square's edge (the
+// diamond is the two triangles on either side of that edge). Splitting a triangle at its hypotenuse midpoint
+// produces the next level; a vertex is in the mesh ("active") when its projected error exceeds the threshold.
+//
+// Per vertex v, precomputed bottom-up:
+//   delta(v): the largest vertical distance (metres) between a grid point of v's diamond and the unsplit diamond
+//             (its two triangles through the grid heights), then raised to the largest delta of v's descendants;
+//   radius(v): the largest 3D distance from v to a grid point of its diamond, raised to cover each descendant's
+//             sphere (radius(child) + |v - child|).
+// A vertex is active when lambda * delta(v) > tau * (|eye - v| - radius(v)), lambda = pixels per radian (image
+// height / (2 tan(fov_y / 2))), tau the threshold in pixels. Because delta and the spheres nest, a vertex is only
+// ever active when the vertices it depends on are, so the mesh is conforming: no cracks and no T-junctions, and
+// neighbouring triangles differ by at most one bisection level. And any grid point that a leaf triangle leaves out
+// has vertical error e with lambda * e / |eye - p| <= tau: the screen-space error threshold, in pixels of angular
+// size seen from the eye (Lindstrom et al.'s projection of the vertical error; exact at the image centre).
+//
+// "Quadrants" (Chen et al. section 3.2): the diamonds whose split vertex is not in the mesh but at least one of whose
+// triangles is (a leaf of the refinement). Their central vertex C is the grid point the low-resolution mesh skips,
+// their 4 corners (3 on the grid boundary) are mesh vertices or lie on mesh edges.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/terrain/heightfield.h"
+
+namespace farfield::terrain {
+
+struct LodSettings {
+  float pixel_error = 1.0f;       // tau: screen-space error threshold, pixels
+  bool cull = true;               // leave out triangles whose bounding sphere is outside the view frustum
+  bool collect_quadrants = false; // fill LodMesh::quadrants
+};
+
+struct LodQuadrant {
+  uint32_t centre = 0;                // grid index of the central vertex C (not in the mesh)
+  std::array<uint32_t, 4> corners{};  // grid indices, counter-clockwise seen from above
+  uint8_t corner_count = 4;           // 4, or 3 for an edge diamond on the grid boundary
+  uint8_t square = 1;                 // 1: a quadtree square (axis-aligned); 0: an edge diamond (45 degrees)
+};
+
+struct LodMesh {
+  std::vector<uint32_t> indices;         // grid indices, three per triangle, counter-clockwise seen from above
+  std::vector<LodQuadrant> quadrants;    // with LodSettings::collect_quadrants, sorted by centre index
+  size_t triangleCount() const { return indices.size() / 3; }
+  void clear() {
+    indices.clear();
+    quadrants.clear();
+  }
+};
+
+class QuadtreeLod {
+ public:
+  // hf must be (a * block + 1) x (b * block + 1) points, block a power of two >= 2 (cropForBlocks makes such a
+  // grid); block 0 picks the largest power of two (at most 512) that fits. Throws farfield::Error otherwise. Keeps a
+  // reference to hf, which must outlive the LOD.
+  explicit QuadtreeLod(const Heightfield& hf, int block = 0);
+
+  const Heightfield& heightfield() const { return *hf_; }
+  int block() const { return block_; }
+  int width() const { return hf_->width; }
+  int height() const { return hf_->height; }
+  // Saturated object-space error (metres) and sphere radius of a grid vertex; block corners give +infinity / 0.
+  float objectError(uint32_t v) const { return delta_[v]; }
+  float radius(uint32_t v) const { return radius_[v]; }
+  // Grid vertices v depends on (0, 1 or 2; block corners have none).
+  int parents(uint32_t v, std::array<uint32_t, 2>& out) const;
+  Vec3 position(uint32_t v) const { return positions_[v]; }
+  const std::vector<Vec3>& positions() const { return positions_; }
+
+  static double pixelsPerRadian(const Camera& camera);
+  bool active(uint32_t v, const Vec3& eye, double lambda, float tau) const;
+
+  // The view-dependent mesh for a camera (its eye, frustum and image height) and threshold.
+  void build(const Camera& camera, const LodSettings& settings, LodMesh& out) const;
+  LodMesh build(const Camera& camera, const LodSettings& settings) const;
+  // The grid at full resolution (two triangles per cell), counter-clockwise seen from above.
+  std::vector<uint32_t> fullResolutionIndices() const;
+
+ private:
+  struct Build;
+  void computeErrors();
+
+  const Heightfield* hf_;
+  int block_ = 0;
+  std::vector<Vec3> positions_;
+  std::vector<float> delta_;
+  std::vector<float> radius_;
+};
+
+// Kind of a grid point in the LOD's hierarchy (exposed for tests).
+enum class LodVertexKind { BlockCorner, SquareCentre, EdgeHorizontal, EdgeVertical };
+// Kind and scale s (the side of the square whose centre or edge midpoint the point is) of grid point (x, y).
+LodVertexKind lodVertexKind(int x, int y, int block, int* scale);
+
+}  // namespace farfield::terrain

@@ -1,0 +1,132 @@
+// LOD-sprite error metric, Chen et al. 1999 section 3.2, equations 1-2.
+#include "farfield/terrain/sprite_error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace farfield::terrain {
+namespace {
+
+// Is q (in xy) inside triangle (a, b, c) (either orientation), with a relative tolerance?
+bool insideXY(const DVec3& q, const DVec3& a, const DVec3& b, const DVec3& c) {
+  const DVec2 p(q), pa(a), pb(b), pc(c);
+  const double area = cross2(pb - pa, pc - pa);
+  if (std::abs(area) < 1e-12) return false;
+  const double s = area > 0 ? 1.0 : -1.0;
+  const double eps = -1e-9 * std::abs(area);
+  return s * cross2(pb - pa, p - pa) >= eps && s * cross2(pc - pb, p - pb) >= eps && s * cross2(pa - pc, p - pc) >= eps;
+}
+
+// Ray v1 + t * dir against the plane through (p0, p1, p2); false when parallel.
+bool rayPlane(const DVec3& v1, const DVec3& dir, const DVec3& p0, const DVec3& p1, const DVec3& p2, double& t) {
+  const DVec3 n = glm::cross(p1 - p0, p2 - p0);
+  const double denom = glm::dot(n, dir);
+  if (std::abs(denom) < 1e-12 * glm::length(n) * glm::length(dir)) return false;
+  t = glm::dot(n, p0 - v1) / denom;
+  return std::isfinite(t);
+}
+
+}  // namespace
+
+bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, DVec3& c_prime) {
+  const size_t n = corners.size();
+  if (n < 3) return false;
+  const DVec3 dir = c - v1;
+  if (glm::length(dir) <= 0.0) return false;
+  // C^: the low-resolution surface above the quadrant's centre.
+  DVec3 centre(0.0);
+  if (n == 4) {
+    for (const DVec3& q : corners) centre += q;
+    centre /= 4.0;
+  } else {
+    // Boundary diamond: the corner pair whose midpoint lies at C's xy.
+    double best = std::numeric_limits<double>::max();
+    for (size_t k = 0; k < n; ++k) {
+      const DVec3 mid = 0.5 * (corners[k] + corners[(k + 1) % n]);
+      const double dxy = glm::length(DVec2(mid) - DVec2(c));
+      if (dxy < best) best = dxy, centre = mid;
+    }
+  }
+  // Fan triangles (C^, Q_k, Q_k+1), skipping degenerate ones (the boundary edge through C^).
+  double best_t = std::numeric_limits<double>::max();
+  bool hit = false;
+  double fallback_t = 0.0;
+  bool have_fallback = false;
+  double fallback_score = -std::numeric_limits<double>::max();
+  const DVec2 ray_xy = DVec2(dir);
+  const double ray_xy_len = glm::length(ray_xy);
+  const bool above = c.z > centre.z;
+  for (size_t k = 0; k < n; ++k) {
+    const DVec3& a = corners[k];
+    const DVec3& b = corners[(k + 1) % n];
+    if (std::abs(cross2(DVec2(a) - DVec2(centre), DVec2(b) - DVec2(centre))) < 1e-9) continue;
+    double t = 0.0;
+    if (!rayPlane(v1, dir, centre, a, b, t)) continue;
+    const DVec3 p = v1 + t * dir;
+    if (t > 0.0 && insideXY(p, centre, a, b) && t < best_t) {
+      best_t = t;
+      hit = true;
+    }
+    // Fallback: the fan triangle whose direction from C^ best matches the ray's xy direction (forward when C lies
+    // above C^, backward otherwise), if its plane lies ahead of v1.
+    const DVec2 towards = 0.5 * (DVec2(a) + DVec2(b)) - DVec2(centre);
+    const double score = ray_xy_len > 0.0 ? glm::dot(glm::normalize(towards), ray_xy / ray_xy_len) * (above ? 1 : -1)
+                                          : 0.0;
+    if (t > 0.0 && score > fallback_score) {
+      fallback_score = score;
+      fallback_t = t;
+      have_fallback = true;
+    }
+  }
+  if (hit) {
+    c_prime = v1 + best_t * dir;
+    return true;
+  }
+  if (!have_fallback) return false;
+  c_prime = v1 + fallback_t * dir;
+  return true;
+}
+
+double quadrantTheta(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, const DVec3& v2, bool* ok) {
+  DVec3 c_prime;
+  const bool good = spriteProjection(c, corners, v1, c_prime);
+  if (ok) *ok = good;
+  if (!good) return 0.0;
+  const DVec3 a = c - v2, b = c_prime - v2;
+  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+}
+
+double pixelAngle(const Camera& camera) { return double(camera.fovX()) / double(camera.width); }
+
+SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> quadrants, const Vec3& v1,
+                        const Vec3& v2) {
+  SpriteError e;
+  double sum = 0.0;
+  DVec3 corners[4];
+  for (const LodQuadrant& q : quadrants) {
+    for (int k = 0; k < q.corner_count; ++k) corners[k] = DVec3(lod.position(q.corners[size_t(k)]));
+    bool ok = false;
+    const double theta =
+        quadrantTheta(DVec3(lod.position(q.centre)), std::span<const DVec3>(corners, q.corner_count), DVec3(v1),
+                      DVec3(v2), &ok);
+    if (!ok) {
+      ++e.skipped;
+      continue;
+    }
+    sum += theta * theta;
+    e.max_theta = std::max(e.max_theta, theta);
+    ++e.quadrants;
+  }
+  e.mean_theta_sq = e.quadrants ? sum / double(e.quadrants) : 0.0;
+  return e;
+}
+
+bool keyframeDue(const SpriteError& error, double beta, double epsilon_pixels) {
+  if (error.quadrants == 0) return false;
+  const double limit = beta * epsilon_pixels;
+  return error.mean_theta_sq >= limit * limit;
+}
+
+}  // namespace farfield::terrain

@@ -1,0 +1,76 @@
+#include "farfield/terrain/terrain_data.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "farfield/core/error.h"
+#include "farfield/terrain/dem_io.h"
+#include "farfield/terrain/fractal.h"
+
+namespace farfield::terrain {
+
+std::unique_ptr<TerrainData> TerrainData::load(const std::string& spec, const TerrainLoadOptions& options) {
+  auto data = std::make_unique<TerrainData>();
+  if (spec.rfind("fractal:", 0) == 0) {
+    FractalOptions f;
+    int size = 0;
+    unsigned long long seed = 1;
+    const int n = std::sscanf(spec.c_str() + 8, "%d:%llu", &size, &seed);
+    if (n < 1) throw Error(spec, "expected fractal:SIZE or fractal:SIZE:SEED (SIZE = 2^n + 1, e.g. fractal:513:7)");
+    f.size = size;
+    f.seed = seed;
+    data->source = fractalTerrain(f);
+  } else {
+    data->source = loadDem(spec);
+  }
+  if (options.block < 2 || (options.block & (options.block - 1)) != 0)
+    throw Error("LOD block size", "must be a power of two >= 2");
+  // Blocks as large as the grid allows, up to the option: bigger blocks let the low-resolution LOD get coarser.
+  int block = options.block;
+  while (block > 2 && ((data->source.width - 1) / block < 1 || (data->source.height - 1) / block < 1)) block /= 2;
+  data->hf = cropForBlocks(data->source, block);
+  data->crop_i0 = (data->source.width - data->hf.width) / 2;
+  data->crop_j0 = (data->source.height - data->hf.height) / 2;
+  data->lod = std::make_unique<QuadtreeLod>(data->hf, block);
+  if (options.texture.empty()) {
+    TextureOptions t;
+    t.scale = options.texture_scale;
+    data->texture = terrainTexture(data->hf, t);
+  } else {
+    data->texture = loadTexture(options.texture);
+  }
+  return data;
+}
+
+std::string TerrainData::describe() const {
+  std::ostringstream s;
+  s << source.source << ": " << source.width << "x" << source.height << " grid points, cells " << source.cell_x
+    << " x " << source.cell_y << " m, heights " << source.minHeight() << ".." << source.maxHeight() << " m, "
+    << source.nodata_count << " nodata points filled";
+  if (hf.width != source.width || hf.height != source.height)
+    s << "; cropped to " << hf.width << "x" << hf.height << " at (" << crop_i0 << ", " << crop_j0
+      << ") for LOD blocks of " << lod->block() << " cells";
+  for (const std::string& note : source.notes) s << "; " << note;
+  return s.str();
+}
+
+scene::Scene TerrainData::fullResolutionScene() const {
+  scene::Scene scene;
+  scene::Mesh mesh;
+  mesh.positions = lod->positions();
+  mesh.uvs.resize(mesh.positions.size());
+  for (size_t k = 0; k < mesh.positions.size(); ++k) mesh.uvs[k] = texCoord(hf, Vec2(mesh.positions[k]));
+  mesh.indices = lod->fullResolutionIndices();
+  mesh.computeBounds();
+  scene::Material material;
+  material.name = "terrain";
+  material.texture = std::make_shared<const image::ColorImage>(texture);
+  material.unlit = true;
+  scene::Object object;
+  object.name = "terrain";
+  object.parts.push_back({scene.addMesh(std::move(mesh)), scene.addMaterial(std::move(material))});
+  scene.addObject(std::move(object));
+  return scene;
+}
+
+}  // namespace farfield::terrain

@@ -1,0 +1,38 @@
+// A terrain ready to render: the heightfield (cropped to whole LOD blocks), its quadtree LOD, the original texture,
+// and the full-resolution mesh as a scene (the benchmark's full-geometry baseline and reference).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "farfield/image/image.h"
+#include "farfield/scene/scene.h"
+#include "farfield/terrain/heightfield.h"
+#include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_texture.h"
+
+namespace farfield::terrain {
+
+struct TerrainLoadOptions {
+  int block = 128;        // LOD block size (cells); the heightfield is cropped (centred) to whole blocks
+  int texture_scale = 1;  // texels per cell
+  std::string texture;    // a PNG to use as the original texture instead of the generated one ("" = generate)
+};
+
+struct TerrainData {
+  Heightfield source;  // as loaded (before cropping)
+  Heightfield hf;      // cropped to whole LOD blocks; the terrain everything renders
+  int crop_i0 = 0, crop_j0 = 0;  // position of hf's grid point (0, 0) in `source`
+  std::unique_ptr<QuadtreeLod> lod;
+  image::ColorImage texture;
+
+  // spec: a DEM file (see dem_io.h) or "fractal:SIZE[:SEED]" (see fractal.h; SIZE = 2^n + 1). Throws
+  // farfield::Error for bad files or specs.
+  static std::unique_ptr<TerrainData> load(const std::string& spec, const TerrainLoadOptions& options = {});
+  // One-line description: size, cell size, height range, nodata count, crop.
+  std::string describe() const;
+  // The full-resolution grid (two triangles per cell) as a one-object scene with the original texture, unlit.
+  scene::Scene fullResolutionScene() const;
+};
+
+}  // namespace farfield::terrain

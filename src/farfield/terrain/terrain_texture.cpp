@@ -1,0 +1,97 @@
+#include "farfield/terrain/terrain_texture.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "farfield/core/error.h"
+#include "farfield/image/png_io.h"
+
+namespace farfield::terrain {
+namespace {
+
+// Elevation ramp (normalised height 0..1): lowland green, dry grass, brown foothills, grey rock, snow.
+Vec3 elevationColor(float t) {
+  struct Stop {
+    float t;
+    Vec3 c;
+  };
+  static const Stop stops[] = {{0.00f, {0.28f, 0.45f, 0.22f}}, {0.25f, {0.52f, 0.58f, 0.30f}},
+                               {0.50f, {0.60f, 0.50f, 0.34f}}, {0.75f, {0.55f, 0.52f, 0.50f}},
+                               {0.92f, {0.80f, 0.80f, 0.82f}}, {1.00f, {0.96f, 0.96f, 0.98f}}};
+  t = std::clamp(t, 0.0f, 1.0f);
+  for (size_t k = 1; k < std::size(stops); ++k)
+    if (t <= stops[k].t) {
+      const float s = (t - stops[k - 1].t) / (stops[k].t - stops[k - 1].t);
+      return glm::mix(stops[k - 1].c, stops[k].c, s);
+    }
+  return stops[std::size(stops) - 1].c;
+}
+
+// Cheap deterministic per-texel variation so that flat areas carry some texture detail the sprite can show.
+float hashNoise(int i, int j) {
+  uint32_t h = uint32_t(i) * 73856093u ^ uint32_t(j) * 19349663u;
+  h = (h ^ (h >> 13)) * 1274126177u;
+  return float(h & 0xffffu) / 65535.0f;
+}
+
+}  // namespace
+
+image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& o) {
+  if (hf.width < 2 || hf.height < 2) throw Error(hf.source, "heightfield too small for a texture");
+  if (o.scale < 1 || o.scale > 4) throw Error("texture scale", "must be 1..4");
+  const int tw = hf.width * o.scale, th = hf.height * o.scale;
+  image::ColorImage tex(tw, th);
+  const float lo = hf.minHeight(), hi = hf.maxHeight();
+  const float span = hi > lo ? hi - lo : 1.0f;
+  const Vec3 to_light = -glm::normalize(o.light_direction);
+  const float rock = float(degToRad(o.rock_slope_deg));
+  for (int ty = 0; ty < th; ++ty)
+    for (int tx = 0; tx < tw; ++tx) {
+      // Grid position of the texel centre.
+      const double gx = (tx + 0.5) / o.scale - 0.5, gy = (ty + 0.5) / o.scale - 0.5;
+      const double x = std::clamp(gx, 0.0, double(hf.width - 1)) * hf.cell_x;
+      const double y = std::clamp(gy, 0.0, double(hf.height - 1)) * hf.cell_y;
+      const float z = hf.sample(x, y);
+      // Normal from the bilinear surface (central differences of half a cell).
+      const double dx = 0.5 * hf.cell_x, dy = 0.5 * hf.cell_y;
+      const float zx = (hf.sample(x + dx, y) - hf.sample(x - dx, y)) / float(2 * dx);
+      const float zy = (hf.sample(x, y + dy) - hf.sample(x, y - dy)) / float(2 * dy);
+      const Vec3 n = glm::normalize(Vec3(-zx, -zy, 1.0f));
+      const float slope = std::acos(std::clamp(n.z, -1.0f, 1.0f));
+      Vec3 c = elevationColor((z - lo) / span + 0.04f * (hashNoise(tx, ty) - 0.5f));
+      const float r = std::clamp((slope - rock * 0.7f) / (rock * 0.6f), 0.0f, 1.0f);
+      c = glm::mix(c, Vec3(0.47f, 0.44f, 0.42f), r);
+      const float shade = o.ambient + (1.0f - o.ambient) * std::max(glm::dot(n, to_light), 0.0f);
+      c *= shade * 1.15f;
+      c = glm::clamp(c, Vec3(0.0f), Vec3(1.0f));
+      tex.at(tx, ty) = image::Rgba8(uint8_t(std::lround(c.r * 255)), uint8_t(std::lround(c.g * 255)),
+                                    uint8_t(std::lround(c.b * 255)), 255);
+    }
+  return tex;
+}
+
+Vec2 texCoord(const Heightfield& hf, Vec2 world_xy) {
+  Vec2 scale, offset;
+  texCoordTransform(hf, scale, offset);
+  return world_xy * scale + offset;
+}
+
+void texCoordTransform(const Heightfield& hf, Vec2& scale, Vec2& offset) {
+  // Independent of the texture's scale factor: grid point i sits at texel position (i + 0.5) * s of s * width.
+  scale = Vec2(float(1.0 / (hf.cell_x * hf.width)), float(1.0 / (hf.cell_y * hf.height)));
+  offset = Vec2(float(0.5 / hf.width), float(0.5 / hf.height));
+}
+
+image::ColorImage loadTexture(const std::string& path) {
+  image::ColorImage img = image::readPng(path);
+  img.flipVertically();
+  return img;
+}
+
+void writeTexturePng(const std::string& path, const image::ColorImage& texture) {
+  image::ColorImage img = texture;
+  img.flipVertically();
+  image::writePng(path, img);
+}
+
+}  // namespace farfield::terrain

@@ -1,0 +1,39 @@
+// The "original texture map" of LOD-sprite (Chen et al. 1999, section 3.1): a colour image over the heightfield,
+// from elevation and slope with hill shading baked in (the terrain is drawn unlit, so every technique shows the
+// same shading), or a given image.
+//
+// Texel layout: texel (i, j) of a `scale`-times texture covers the heightfield around world
+// ((i + 0.5) / scale * cell_x - 0.5 * cell_x, ...); with scale 1, texel (i, j) is centred on grid point (i, j).
+// Image row r is grid row r (row 0 = SOUTH), so flip the image vertically to view it north-up (writeTexturePng
+// does). texCoord() gives the uv of a world point under this layout.
+#pragma once
+
+#include <string>
+
+#include "farfield/core/math.h"
+#include "farfield/image/image.h"
+#include "farfield/terrain/heightfield.h"
+
+namespace farfield::terrain {
+
+struct TextureOptions {
+  int scale = 1;                              // texels per grid cell along each axis (1..4)
+  Vec3 light_direction{-0.5f, 0.6f, -0.62f};  // direction the light travels (from the north-west, down)
+  float ambient = 0.45f;
+  float rock_slope_deg = 35.0f;  // slopes steeper than this turn to rock
+};
+
+image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& options = {});
+
+// uv of a world (x, y) for a texture of the layout above (any scale): u = (x / cell_x + 0.5) / width.
+Vec2 texCoord(const Heightfield& hf, Vec2 world_xy);
+// Scale and offset so that uv = world_xy * scale + offset (what the GPU renderer needs).
+void texCoordTransform(const Heightfield& hf, Vec2& scale, Vec2& offset);
+
+// A given image as the original texture: read as PNG, row 0 = NORTH as usual for image files (flipped into the
+// layout above). Throws farfield::Error for unreadable files.
+image::ColorImage loadTexture(const std::string& path);
+// Writes the texture north-up.
+void writeTexturePng(const std::string& path, const image::ColorImage& texture);
+
+}  // namespace farfield::terrain

@@ -1,0 +1,101 @@
+// The Figure-8-style flythrough: starts away and high, zooms in, stays above the ground, passes the plain and the
+// mountains the heightfield has (checked against heights sampled independently); and the texture's layout.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "farfield/core/error.h"
+#include "farfield/terrain/flythrough.h"
+#include "farfield/terrain/fractal.h"
+#include "farfield/terrain/terrain_texture.h"
+
+namespace farfield::terrain {
+namespace {
+
+// Plain on the west half (low, flat), a mountain range on the east half.
+Heightfield plainAndMountains() {
+  Heightfield hf(129, 97, 50.0);
+  hf.source = "plain and mountains";
+  for (int j = 0; j < hf.height; ++j)
+    for (int i = 0; i < hf.width; ++i) {
+      const double x = double(i) / (hf.width - 1);
+      const double ridge = std::exp(-std::pow((x - 0.72) / 0.08, 2.0));
+      hf.at(i, j) = float(100.0 + 1200.0 * ridge * (0.8 + 0.2 * std::sin(j * 0.3)));
+    }
+  return hf;
+}
+
+TEST(Flythrough, StartsAwayZoomsInAndCrossesPlainThenMountains) {
+  const Heightfield hf = plainAndMountains();
+  FlythroughOptions o;
+  o.frames = 300;
+  FlythroughLandmarks marks;
+  const std::vector<Viewpoint> path = flythroughPath(hf, o, &marks);
+  ASSERT_EQ(path.size(), 300u);
+  const float ex = float(hf.extentX()), ey = float(hf.extentY());
+  // Landmarks: the mountains on the ridge, the plains lower and flatter.
+  EXPECT_NEAR(marks.mountains.x, 0.72f * ex, 0.1f * ex);
+  EXPECT_LT(hf.sample(marks.plain.x, marks.plain.y), hf.sample(marks.mountains.x, marks.mountains.y) - 300.0f);
+  EXPECT_LT(hf.sample(marks.beyond.x, marks.beyond.y), hf.sample(marks.mountains.x, marks.mountains.y) - 300.0f);
+  // Starts outside the map and high above it; the distance to the map shrinks (zooms in).
+  auto outside = [&](const Vec3& p) { return p.x < 0 || p.y < 0 || p.x > ex || p.y > ey; };
+  EXPECT_TRUE(outside(path.front().eye));
+  EXPECT_GT(path.front().eye.z, hf.maxHeight() + 1000.0f);
+  EXPECT_FALSE(outside(path[path.size() / 2].eye));
+  // Above the ground everywhere (sampled independently, bilinear) and over the mountains late in the path.
+  for (const Viewpoint& v : path)
+    if (!outside(v.eye)) {
+      EXPECT_GT(v.eye.z, hf.sample(v.eye.x, v.eye.y) + 50.0f);
+    }
+  // The closest passes: the plain first, then the mountains, then the plain beyond; each passed within a few km.
+  auto closest = [&](Vec2 mark, float* distance) {
+    size_t best = 0;
+    *distance = 1e30f;
+    for (size_t f = 0; f < path.size(); ++f) {
+      const float d = glm::length(Vec2(path[f].eye) - mark);
+      if (d < *distance) *distance = d, best = f;
+    }
+    return best;
+  };
+  float dp = 0, dm = 0, db = 0;
+  const size_t fp = closest(marks.plain, &dp), fm = closest(marks.mountains, &dm), fb = closest(marks.beyond, &db);
+  EXPECT_LT(fp, fm);
+  EXPECT_LT(fm, fb);
+  EXPECT_LT(std::max({dp, dm, db}), 0.1f * ex);
+  // Looking ahead and down (never up).
+  for (const Viewpoint& v : path) EXPECT_LT(v.at.z, v.eye.z);
+  EXPECT_THROW(flythroughPath(hf, FlythroughOptions{1}), Error);
+}
+
+TEST(Flythrough, BackAndForthRepeatsTheSpanBothWays) {
+  std::vector<Viewpoint> path(10);
+  for (size_t i = 0; i < path.size(); ++i) path[i].eye = Vec3(float(i), 0, 0);
+  const auto bf = backAndForth(path, 2, 4, 2);
+  ASSERT_EQ(bf.size(), 16u);
+  const float want[] = {2, 3, 4, 5, 5, 4, 3, 2, 2, 3, 4, 5, 5, 4, 3, 2};
+  for (size_t i = 0; i < bf.size(); ++i) EXPECT_EQ(bf[i].eye.x, want[i]);
+  EXPECT_THROW(backAndForth(path, 8, 4, 1), Error);
+}
+
+TEST(TerrainTexture, GridPointsMapToTexelCentres) {
+  Heightfield hf(9, 5, 30.0);
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < 9; ++i) hf.at(i, j) = float(10 * j);
+  for (int scale : {1, 2}) {
+    TextureOptions o;
+    o.scale = scale;
+    const image::ColorImage tex = terrainTexture(hf, o);
+    ASSERT_EQ(tex.width(), 9 * scale);
+    ASSERT_EQ(tex.height(), 5 * scale);
+    // Grid point (3, 2) at world (90, 60): texel centre ((3 + 0.5) * s, (2 + 0.5) * s) / size.
+    const Vec2 uv = texCoord(hf, Vec2(90.0f, 60.0f));
+    EXPECT_NEAR(uv.x * tex.width(), 3.5f * scale, 1e-4f);
+    EXPECT_NEAR(uv.y * tex.height(), 2.5f * scale, 1e-4f);
+  }
+  // Elevation drives the colour: the lowest row differs from the highest.
+  const image::ColorImage tex = terrainTexture(hf);
+  EXPECT_NE(tex.at(4, 0), tex.at(4, 4));
+}
+
+}  // namespace
+}  // namespace farfield::terrain
