@@ -10,6 +10,7 @@
 #include "command.h"
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
+#include "farfield/gen/city.h"
 #include "farfield/scene/import.h"
 #include "farfield/urban/street_graph.h"
 
@@ -22,6 +23,7 @@ struct PathArgs {
   int frames = 600;
   uint64_t seed = 1;
   bool car = false;
+  bool hill = false;
   float fps = 30.0f;
   float fov_deg = 0.0f;  // 0: the default of each kind
   float turn_radius = 6.0f;
@@ -49,6 +51,13 @@ void runStreet(const PathArgs& args) {
   options.fps = args.fps;
   if (args.fov_deg > 0.0f) options.fov_deg = args.fov_deg;
   options.turn_radius = args.turn_radius;
+  if (args.hill) {
+    // The streets file keeps only the plan; the ground of a `gen city --hill` city is a function of its bounds.
+    gen::CityOptions city;
+    city.hill = true;
+    const Box2 bounds = graph.bounds();
+    options.ground_height = [city, bounds](float x, float y) { return gen::cityGroundHeight(city, bounds, {x, y}); };
+  }
   const gen::CameraPath path = gen::streetWalk(graph, options);
   writeAndReport(path, args.output,
                  std::string("street walk (") + (args.car ? "car, 10 m/s" : "pedestrian, 1.4 m/s") + ", " +
@@ -98,6 +107,7 @@ const RegisterCommand reg("path", [](CLI::App& app) {
   s->add_option("streets", street->input, "Street graph file (city.streets.json)")->required();
   addCommon(s, *street);
   s->add_option("--seed", street->seed, "Random seed for the walk");
+  s->add_flag("--hill", street->hill, "The city was made with `gen city --hill`: follow its ground");
   s->add_flag("--car", street->car, "Drive (1.2 m eye height, 10 m/s) instead of walking (1.7 m, 1.4 m/s)");
   s->add_option("--turn-radius", street->turn_radius, "Turn radius at junctions, metres")
       ->check(CLI::NonNegativeNumber);
