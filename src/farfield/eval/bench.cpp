@@ -67,16 +67,7 @@ std::set<size_t> samplePositions(size_t n, int samples) {
 }
 
 void summarizeMode(ModeResult& m) {
-  std::vector<double> wall, gpu;
-  for (const FrameRecord& f : m.frames) {
-    wall.push_back(f.wall_ms);
-    gpu.push_back(f.gpu_ms);
-  }
-  m.wall = summarize(wall);
-  m.gpu = summarize(gpu);
-  m.mean_triangles = meanOf(m.frames, [](const FrameRecord& f) { return f.triangles; });
-  m.mean_draw_calls = meanOf(m.frames, [](const FrameRecord& f) { return f.draw_calls; });
-  m.mean_objects = meanOf(m.frames, [](const FrameRecord& f) { return f.objects; });
+  summarizeFrames(m);
   m.has_errors = !m.errors.empty();
   if (m.has_errors) {
     double psnr_sum = 0.0, ssim_sum = 0.0, bad_sum = 0.0;

@@ -7,6 +7,7 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/eval/mode.h"
+#include "farfield/eval/frame_stats.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gpu/gpu_timer.h"
 #include "farfield/gpu/render_target.h"
@@ -36,6 +37,25 @@ double meanOf(const std::vector<FrameRecord>& frames, F&& field) {
   double sum = 0.0;
   for (const FrameRecord& f : frames) sum += double(field(f));
   return sum / double(frames.size());
+}
+
+// Fills a run's frame statistics from its frames: wall and GPU summaries (frame_stats.h) and the mean triangles,
+// draw calls and objects. R is any result with `frames`, `wall`, `gpu` and the three means (bench's ModeResult,
+// walk's WalkResult).
+template <class R>
+void summarizeFrames(R& result) {
+  std::vector<double> wall, gpu;
+  wall.reserve(result.frames.size());
+  gpu.reserve(result.frames.size());
+  for (const FrameRecord& f : result.frames) {
+    wall.push_back(f.wall_ms);
+    gpu.push_back(f.gpu_ms);
+  }
+  result.wall = summarize(wall);
+  result.gpu = summarize(gpu);
+  result.mean_triangles = meanOf(result.frames, [](const FrameRecord& f) { return f.triangles; });
+  result.mean_draw_calls = meanOf(result.frames, [](const FrameRecord& f) { return f.draw_calls; });
+  result.mean_objects = meanOf(result.frames, [](const FrameRecord& f) { return f.objects; });
 }
 
 class FrameRunner {

@@ -68,16 +68,7 @@ WalkResult runWalk(gpu::Context& context, const scene::Scene& scene, const gen::
   }
   progress.finish();
 
-  std::vector<double> wall, gpu;
-  for (const FrameRecord& f : result.frames) {
-    wall.push_back(f.wall_ms);
-    gpu.push_back(f.gpu_ms);
-  }
-  result.wall = summarize(wall);
-  result.gpu = summarize(gpu);
-  result.mean_triangles = meanOf(result.frames, [](const FrameRecord& f) { return f.triangles; });
-  result.mean_draw_calls = meanOf(result.frames, [](const FrameRecord& f) { return f.draw_calls; });
-  result.mean_objects = meanOf(result.frames, [](const FrameRecord& f) { return f.objects; });
+  summarizeFrames(result);
   return result;
 }
 
