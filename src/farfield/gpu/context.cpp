@@ -345,7 +345,7 @@ class GlfwContext final : public Context {
 
 GLFWwindow* openGlfwWindow(const ContextOptions& options, bool debug) {
   std::lock_guard<std::mutex> lock(glfwMutex());
-  IgnoreDriverLeaks ignore_driver_leaks;
+  [[maybe_unused]] IgnoreDriverLeaks ignore_driver_leaks;
   glfwSetErrorCallback(glfwErrorCallback);
   glfw_error.clear();
   if (glfw_windows == 0 && !glfwInit())
