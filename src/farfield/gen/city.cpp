@@ -324,21 +324,11 @@ City generateCity(const CityOptions& options) {
 
   // Materials.
   scene::Scene& scene = city.scene;
-  const CityTextures& tex = cityTextures();
-  auto material = [&](const std::string& name, const Vec4& colour,
-                      const std::shared_ptr<const image::ColorImage>& texture) {
-    scene::Material m;
-    m.name = name;
-    m.base_color = colour;
-    m.texture = texture;
-    return scene.addMaterial(std::move(m));
-  };
-  const uint32_t ground_material = material("asphalt", Vec4(1.0f), tex.ground);
-  const uint32_t facade_materials[3] = {material("facade cream", Vec4(1.0f, 0.97f, 0.92f, 1.0f), tex.facade),
-                                        material("facade ochre", Vec4(1.0f, 0.86f, 0.68f, 1.0f), tex.facade),
-                                        material("facade grey", Vec4(0.86f, 0.87f, 0.9f, 1.0f), tex.facade)};
-  const uint32_t roof_material = material("roof tiles", Vec4(1.0f), tex.roof);
-  const uint32_t landmark_material = material("landmark stone", Vec4(1.0f), tex.landmark);
+  const CityMaterials palette = addCityMaterials(scene);
+  const uint32_t ground_material = palette.ground;
+  const uint32_t* facade_materials = palette.facades;
+  const uint32_t roof_material = palette.roof;
+  const uint32_t landmark_material = palette.landmark;
 
   // Object 1: the ground.
   Box2 ground = city.bounds;

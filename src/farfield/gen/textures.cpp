@@ -176,4 +176,23 @@ const CityTextures& cityTextures() {
   return textures;
 }
 
+CityMaterials addCityMaterials(scene::Scene& scene) {
+  const CityTextures& tex = cityTextures();
+  auto add = [&](const char* name, const Vec4& colour, const std::shared_ptr<const image::ColorImage>& texture) {
+    scene::Material m;
+    m.name = name;
+    m.base_color = colour;
+    m.texture = texture;
+    return scene.addMaterial(std::move(m));
+  };
+  CityMaterials ids;
+  ids.ground = add("asphalt", Vec4(1.0f), tex.ground);
+  ids.facades[0] = add("facade cream", Vec4(1.0f, 0.97f, 0.92f, 1.0f), tex.facade);
+  ids.facades[1] = add("facade ochre", Vec4(1.0f, 0.86f, 0.68f, 1.0f), tex.facade);
+  ids.facades[2] = add("facade grey", Vec4(0.86f, 0.87f, 0.9f, 1.0f), tex.facade);
+  ids.roof = add("roof tiles", Vec4(1.0f), tex.roof);
+  ids.landmark = add("landmark stone", Vec4(1.0f), tex.landmark);
+  return ids;
+}
+
 }  // namespace farfield::gen

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "farfield/image/image.h"
+#include "farfield/scene/scene.h"
 
 namespace farfield::gen {
 
@@ -34,5 +35,15 @@ struct CityTextures {
   std::shared_ptr<const image::ColorImage> landmark;
 };
 const CityTextures& cityTextures();
+
+// Material ids of the city palette in a scene (procedural and imported cities look alike).
+struct CityMaterials {
+  uint32_t ground = 0;      // asphalt
+  uint32_t facades[3] = {};  // cream, ochre, grey tints of the facade texture
+  uint32_t roof = 0;        // roof tiles
+  uint32_t landmark = 0;    // landmark stone
+};
+// Adds the palette to the scene in that order: asphalt, the three facades, roof tiles, landmark stone.
+CityMaterials addCityMaterials(scene::Scene& scene);
 
 }  // namespace farfield::gen

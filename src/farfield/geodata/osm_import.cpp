@@ -347,21 +347,15 @@ OsmCity importOsm(const std::string& path, const OsmImportOptions& options) {
   clock.restart();
   gen::City& city = result.city;
   scene::Scene& scene = city.scene;
-  const gen::CityTextures& tex = gen::cityTextures();
-  auto material = [&](const std::string& name, const Vec4& colour,
-                      const std::shared_ptr<const image::ColorImage>& texture) {
-    scene::Material m;
-    m.name = name;
-    m.base_color = colour;
-    m.texture = texture;
-    return scene.addMaterial(std::move(m));
-  };
-  const uint32_t asphalt = material("asphalt", Vec4(1.0f), tex.ground);
-  const uint32_t pavement = material("pavement", Vec4(0.95f, 0.91f, 0.84f, 1.0f), tex.ground);
-  const uint32_t facade_materials[3] = {material("facade cream", Vec4(1.0f, 0.97f, 0.92f, 1.0f), tex.facade),
-                                        material("facade ochre", Vec4(1.0f, 0.86f, 0.68f, 1.0f), tex.facade),
-                                        material("facade grey", Vec4(0.86f, 0.87f, 0.9f, 1.0f), tex.facade)};
-  const uint32_t roof_material = material("roof tiles", Vec4(1.0f), tex.roof);
+  const gen::CityMaterials palette = gen::addCityMaterials(scene);
+  const uint32_t asphalt = palette.ground;
+  const uint32_t* facade_materials = palette.facades;
+  const uint32_t roof_material = palette.roof;
+  scene::Material pavement_material;
+  pavement_material.name = "pavement";
+  pavement_material.base_color = Vec4(0.95f, 0.91f, 0.84f, 1.0f);
+  pavement_material.texture = gen::cityTextures().ground;
+  const uint32_t pavement = scene.addMaterial(std::move(pavement_material));
 
   Box2 data_box = graph.bounds();
   for (const Item& it : items) data_box.expand(it.box);
