@@ -63,6 +63,20 @@ void RenderTarget::bind() const {
   glViewport(0, 0, width_, height_);
 }
 
+void RenderTarget::bindForOpaquePass() const {
+  bind();
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);  // reversed Z: nearer is larger
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
+  glDisable(GL_SCISSOR_TEST);
+  glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
+}
+
 void RenderTarget::clear(const Vec4& color) const {
   // Clears obey the write masks and the scissor test; open them so the whole target is cleared.
   glDisable(GL_SCISSOR_TEST);

@@ -19,6 +19,9 @@ class RenderTarget {
   int width() const { return width_; }
   int height() const { return height_; }
   void bind() const;  // binds the framebuffer and sets the viewport
+  // bind(), plus the state of an opaque pass: depth test GL_GREATER (reversed Z) with writes, back-face culling of
+  // counter-clockwise fronts, no blending or scissor, all colour and id channels written.
+  void bindForOpaquePass() const;
   // Clears colour to the given value, ids to 0 and depth to 0 (far, reversed Z).
   void clear(const Vec4& color) const;
 

@@ -89,17 +89,7 @@ FrameStats Renderer::draw(const Camera& camera, std::span<const DrawItem> items,
   Impl& im = *impl_;
   FrameStats stats;
 
-  target.bind();
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_GREATER);  // reversed Z: nearer is larger
-  glDepthMask(GL_TRUE);
-  glDisable(GL_BLEND);
-  glDisable(GL_SCISSOR_TEST);
-  glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glEnable(GL_CULL_FACE);
-  glCullFace(GL_BACK);
-  glFrontFace(GL_CCW);
+  target.bindForOpaquePass();
 
   // Per-frame uniforms on every variant (cheap, and the loop below then only switches programs).
   const Mat4 view_proj = camera.viewProjection();

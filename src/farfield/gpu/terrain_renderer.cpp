@@ -52,17 +52,7 @@ void TerrainRenderer::setIndices(std::span<const uint32_t> indices, int slot) {
 
 void TerrainRenderer::setState(const Camera& camera, RenderTarget& target, int slot) {
   camera.validate("camera");
-  target.bind();
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_GREATER);
-  glDepthMask(GL_TRUE);
-  glDisable(GL_BLEND);
-  glDisable(GL_SCISSOR_TEST);
-  glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glEnable(GL_CULL_FACE);
-  glCullFace(GL_BACK);
-  glFrontFace(GL_CCW);
+  target.bindForOpaquePass();
   glVertexArrayElementBuffer(vao_, ibo_[slot]);
 }
 
