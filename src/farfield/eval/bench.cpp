@@ -236,20 +236,13 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
 
   context.makeCurrent();
   result.renderer = context.description();
-  gpu::GpuScene gpu_scene(scene);
-  scene::Bvh bvh(scene);
-  gpu::Renderer renderer;
-  gpu::RenderTarget target(options.width, options.height);
+  ModeRunResources run(scene, options.width, options.height, options.mode_options);
+  const gpu::GpuScene& gpu_scene = run.gpu_scene;
+  gpu::Renderer& renderer = run.renderer;
+  gpu::RenderTarget& target = run.target;
+  ModeContext& mode_context = run.context;
   gpu::RenderTarget reference_target;
   if (options.reference) reference_target = gpu::RenderTarget(options.width, options.height);
-  ModeContext mode_context;
-  mode_context.scene = &scene;
-  mode_context.gpu_scene = &gpu_scene;
-  mode_context.bvh = &bvh;
-  mode_context.renderer = &renderer;
-  mode_context.width = options.width;
-  mode_context.height = options.height;
-  mode_context.options = options.mode_options;
 
   std::vector<std::unique_ptr<Mode>> modes;
   for (const std::string& name : names) modes.push_back(createMode(name, mode_context));

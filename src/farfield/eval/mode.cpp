@@ -189,4 +189,16 @@ std::unique_ptr<Mode> createMode(const std::string& name, const ModeContext& con
   return mode;
 }
 
+ModeRunResources::ModeRunResources(const scene::Scene& scene, int width, int height,
+                                   std::map<std::string, std::string> options)
+    : gpu_scene(scene), bvh(scene), target(width, height) {
+  context.scene = &scene;
+  context.gpu_scene = &gpu_scene;
+  context.bvh = &bvh;
+  context.renderer = &renderer;
+  context.width = width;
+  context.height = height;
+  context.options = std::move(options);
+}
+
 }  // namespace farfield::eval

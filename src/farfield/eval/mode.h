@@ -46,6 +46,20 @@ struct ModeContext {
   const std::string& requireOption(const std::string& key, const std::string& mode_name) const;
 };
 
+// What a run of modes over a scene draws with: the scene on the GPU, its BVH, a renderer, the frame target, and the
+// ModeContext pointing at them. Needs a current context; keep it alive for the whole run.
+struct ModeRunResources {
+  ModeRunResources(const scene::Scene& scene, int width, int height, std::map<std::string, std::string> options);
+  ModeRunResources(const ModeRunResources&) = delete;
+  ModeRunResources& operator=(const ModeRunResources&) = delete;
+
+  gpu::GpuScene gpu_scene;
+  scene::Bvh bvh;
+  gpu::Renderer renderer;
+  gpu::RenderTarget target;
+  ModeContext context;
+};
+
 // One frame of one mode, handed to Mode::frame(). Made by the harness.
 class FrameContext {
  public:

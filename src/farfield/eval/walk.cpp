@@ -31,18 +31,10 @@ WalkResult runWalk(gpu::Context& context, const scene::Scene& scene, const gen::
   result.width = options.width;
   result.height = options.height;
 
-  gpu::GpuScene gpu_scene(scene);
-  scene::Bvh bvh(scene);
-  gpu::Renderer renderer;
-  gpu::RenderTarget target(options.width, options.height);
-  ModeContext mode_context;
-  mode_context.scene = &scene;
-  mode_context.gpu_scene = &gpu_scene;
-  mode_context.bvh = &bvh;
-  mode_context.renderer = &renderer;
-  mode_context.width = options.width;
-  mode_context.height = options.height;
-  mode_context.options = options.mode_options;
+  ModeRunResources run(scene, options.width, options.height, options.mode_options);
+  gpu::Renderer& renderer = run.renderer;
+  gpu::RenderTarget& target = run.target;
+  ModeContext& mode_context = run.context;
   std::unique_ptr<Mode> mode = createMode(options.mode, mode_context);
   mode->prepare(mode_context);
 
