@@ -1,0 +1,51 @@
+// Parallax (visibility) error of an impostor measured from object-id renders (Decoret et al. 1999, sections 3-4:
+// the displacement, in pixels, between where an object is drawn and where it should be seen).
+//
+// Inputs are two item buffers of the same size (image::IdImage, 0 = background): the reference, full geometry, and
+// the test, the impostor drawn with per-object ids (impostor::GpuImpostorOptions::split_by_object_id). Two ids
+// differ at a *mismatching* pixel. Its displacement is the larger of
+//   - test side: the test shows object k (not background, not ignored) -> the Euclidean distance, between pixel
+//     centres, to the nearest reference pixel showing k (the object drawn there belongs that far away);
+//   - reference side: the reference shows object k (not background, not ignored) -> the distance to the nearest test
+//     pixel showing k (a de-occluded or missing part of k, the "rubber sheet" hole).
+// When k is absent from the other image the distance is the image diagonal, sqrt(width^2 + height^2) (larger than
+// any distance inside the image). A pixel whose two ids are both background or ignored (say the ground, drawn as
+// geometry in both, against the sky) does not count, nor a pixel where the ids agree.
+//
+// The distances are exact: one Felzenszwalb-Huttenlocher squared Euclidean distance transform per id that occurs
+// at a mismatching pixel, evaluated only on the rows that hold such pixels.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "farfield/image/image.h"
+
+namespace farfield::eval {
+
+struct ParallaxOptions {
+  std::vector<uint32_t> ignore_ids;  // treated as background on both sides (0 is always background)
+  // Percentile of the mismatching pixels' displacements, in (0, 1]; linear interpolation between closest ranks
+  // (eval::percentile's rule, frame_stats.h).
+  double percentile = 0.99;
+};
+
+struct ParallaxError {
+  size_t mismatched = 0;      // mismatching pixels (see above)
+  double share = 0.0;         // mismatched / all pixels
+  double mean_px = 0.0;       // mean displacement over the mismatching pixels (0 when none)
+  double percentile_px = 0.0; // ParallaxOptions::percentile of the displacements (0 when none)
+  double max_px = 0.0;        // largest displacement (0 when none)
+  int worst_x = -1, worst_y = -1;  // a pixel with the largest displacement (first in row order), -1 when none
+};
+
+// Throws farfield::Error when the sizes differ or the percentile is outside (0, 1]. Empty images give zeros.
+ParallaxError parallaxError(const image::IdImage& reference, const image::IdImage& test,
+                            const ParallaxOptions& options = {});
+
+// Per-pixel displacement map of the same computation (0 where a pixel does not count), for inspection and tests.
+image::Image<float> parallaxErrorMap(const image::IdImage& reference, const image::IdImage& test,
+                                     const ParallaxOptions& options = {});
+
+}  // namespace farfield::eval
