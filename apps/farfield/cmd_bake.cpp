@@ -1,4 +1,6 @@
 // farfield bake SCENE [--streets city.streets.json] --technique depth-mesh|grid-mesh|both [--local edge|junction]
+//                [--pipeline pvs,near-far,mmi [--online mmi] [--error-px 10] [--layer-mesh grid|depth-mesh]
+//                 [--grid-cells 30] [--views street|six] [--pvs-spacing M] [--pvs-face PX] [--near-radius M]]
 //                [--resolution 512] [--fov DEG] [--eye-height M] [--path path.json] [--cell-lookup street|nearest]
 //                [--cells E,E,...] [--limit N] [--workers N]
 //                [--list] -o city.imp/
@@ -6,7 +8,9 @@
 // (farfield/store/impostor_store.h): captures on the GL thread, constructions on the other core(s), with a progress
 // bar; prints the bake time per impostor (render vs build) and the polygons per impostor. `--technique both` builds
 // the depth mesh and the grid mesh from the same capture into one store, which `farfield bench --impostors DIR` uses
-// for both the depth-mesh and the grid-mesh modes.
+// for both the depth-mesh and the grid-mesh modes. With --pipeline it runs the extractor pipeline of Decoret et al.
+// 1999 instead (bake/pipeline.h): PVS, near/far split, multi-mesh impostors and the single mesh of the same far
+// objects, which the bench modes local, visible, smi, mmi and mmi-dynamic read.
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -18,6 +22,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "farfield/bake/bake.h"
+#include "farfield/bake/pipeline.h"
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gen/city.h"
@@ -43,6 +48,17 @@ struct BakeArgs {
   int workers = 0;
   bool list = false;
   std::string out_dir;
+  // Extractor pipeline (Decoret 1999): --pipeline pvs,near-far,mmi and its options.
+  std::string pipeline;
+  std::string online;
+  double error_px = 10.0;
+  int frame_width = 512;
+  std::string layer_mesh = "grid";
+  int grid_cells = 30;
+  std::string views = "street";
+  float pvs_spacing = 2.0f;
+  int pvs_face = 128;
+  float near_radius = 0.0f;
 };
 
 std::vector<uint32_t> parseCells(const std::string& text) {
@@ -75,6 +91,97 @@ Summary summarize(std::vector<double> v) {
   s.median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
   s.max = v.back();
   return s;
+}
+
+std::string megabytes(double bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.1f MB", bytes / 1e6);
+  return buf;
+}
+
+// The extractor pipeline (bake/pipeline.h): per cell PVS, near/far split, layers and their impostors.
+void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const scene::Scene& scene,
+                     const urban::CellMap& cells, const std::vector<uint32_t>& requested) {
+  const bake::PipelineSpec spec = bake::parsePipeline(args.pipeline, args.online);
+  bake::PipelineOptions options;
+  options.base = base;
+  options.error_px = args.error_px;
+  options.frame_width = args.frame_width;
+  options.mesh = bake::parseLayerMesh(args.layer_mesh);
+  options.grid_cells = args.grid_cells;
+  options.views = bake::parseLayerViews(args.views);
+  options.pvs.spacing = args.pvs_spacing;
+  options.pvs.face_size = args.pvs_face;
+  options.near_radius = args.near_radius;
+  std::string baked, online;
+  for (const std::string& s : spec.baked()) baked += (baked.empty() ? "" : ",") + s;
+  for (const std::string& s : spec.online()) online += (online.empty() ? "" : ",") + s;
+  std::printf("pipeline:      baked [%s], online [%s]\n", baked.c_str(), online.empty() ? "" : online.c_str());
+  std::printf("layers:        error %.1f px in %d-px frames, %s mesh (%d x %d grid), %s view(s), %dx%d images\n",
+              options.error_px, options.frame_width, bake::layerMeshName(options.mesh), options.grid_cells,
+              options.grid_cells, bake::layerViewsName(options.views), options.base.resolution,
+              options.base.resolution);
+  const bake::PipelineReport report = bake::bakePipeline(gpu::sharedHeadlessContext(), scene, cells, requested,
+                                                         spec, options, args.out_dir);
+  std::printf("threshold:     T = %.4f rad\n", report.threshold_rad);
+  std::printf("cells:         %zu requested, %zu baked, %zu skipped (too short)\n", report.requested,
+              report.cells.size(), report.skipped_degenerate.size());
+  if (args.list) {
+    std::printf("\n%8s %6s %6s %6s %6s %10s %10s %9s %9s %9s %9s\n", "cell", "pvs", "near", "far", "layers",
+                "mmi tris", "smi tris", "pvs ms", "layer ms", "capt ms", "build ms");
+    for (const bake::PipelineCellReport& c : report.cells)
+      std::printf("%8u %6zu %6zu %6zu %6zu %10zu %10zu %9.0f %9.1f %9.0f %9.0f\n", c.half_edge, c.pvs, c.near,
+                  c.far, c.layers, c.layer_triangles, c.single_triangles, c.pvs_ms, c.weights_ms, c.capture_ms,
+                  c.build_ms);
+  }
+  if (!report.cells.empty()) {
+    std::vector<double> pvs, near, far, layers, mmi_tris, smi_tris, pvs_ms, weights_ms, capture_ms, build_ms;
+    for (const bake::PipelineCellReport& c : report.cells) {
+      pvs.push_back(double(c.pvs));
+      near.push_back(double(c.near));
+      far.push_back(double(c.far));
+      layers.push_back(double(c.layers));
+      mmi_tris.push_back(double(c.layer_triangles));
+      smi_tris.push_back(double(c.single_triangles));
+      pvs_ms.push_back(c.pvs_ms);
+      weights_ms.push_back(c.weights_ms);
+      capture_ms.push_back(c.capture_ms);
+      build_ms.push_back(c.build_ms);
+    }
+    std::printf("\nper cell            %10s %10s %10s   (scene: %zu objects)\n", "mean", "median", "max",
+                scene.objects.size());
+    const auto row = [](const char* label, const Summary& s) {
+      std::printf("%-19s %10.1f %10.1f %10.1f\n", label, s.mean, s.median, s.max);
+    };
+    row("PVS objects", summarize(pvs));
+    row("near objects", summarize(near));
+    row("far objects", summarize(far));
+    row("layers", summarize(layers));
+    row("MMI triangles", summarize(mmi_tris));
+    row("SMI triangles", summarize(smi_tris));
+    row("PVS ms", summarize(pvs_ms));
+    row("layering ms", summarize(weights_ms));
+    row("capture ms", summarize(capture_ms));
+    row("mesh build ms", summarize(build_ms));
+  }
+  const nlohmann::json& st = report.storage;
+  if (st.value("cells", 0) > 0) {
+    std::printf("\nstorage (section 5.1): %zu cells, %.2f layers per cell, %d view(s) per layer\n",
+                st["cells"].get<size_t>(), st["mean_layers"].get<double>(), st["views_per_layer"].get<int>());
+    std::printf("  paper's estimate with our layer count: %s (%s per image, %s per mesh)\n",
+                megabytes(st["estimate_bytes_measured_layers"].get<double>()).c_str(),
+                megabytes(st["image_bytes_each"].get<double>()).c_str(),
+                megabytes(st["mesh_bytes_each"].get<double>()).c_str());
+    std::printf("  paper's worst case (3 layers):         %s\n",
+                megabytes(st["estimate_bytes_3_layers"].get<double>()).c_str());
+    std::printf("  written (PNG textures + meshes):       %s (textures %s, meshes %s; SMI included)\n",
+                megabytes(st["written_bytes"].get<double>()).c_str(),
+                megabytes(st["written_texture_bytes"].get<double>()).c_str(),
+                megabytes(st["written_mesh_bytes"].get<double>()).c_str());
+  }
+  std::printf("\nwall:          %.1f s for %zu cells (%.2f s per cell)\n", report.wall_s, report.cells.size(),
+              report.cells.empty() ? 0.0 : report.wall_s / double(report.cells.size()));
+  std::printf("wrote %s/index.json\n", args.out_dir.c_str());
 }
 
 void runBakeCommand(const BakeArgs& args) {
@@ -120,6 +227,10 @@ void runBakeCommand(const BakeArgs& args) {
               urban::localModelName(cell_options.local), urban::cellLookupName(cell_options.lookup), in_blocks, a.shared.size(), a.without_footprint,
               a.outside_blocks, a.too_large);
 
+  if (!args.pipeline.empty()) {
+    runPipelineBake(args, options, scene, cells, requested);
+    return;
+  }
   const bake::BakeReport report =
       bake::bakeCells(gpu::sharedHeadlessContext(), scene, cells, requested, options, args.out_dir);
 
@@ -199,6 +310,25 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
   cmd->add_option("--workers", args->workers, "Worker threads for the constructions (0 = cores - 1, at least 1)")
       ->capture_default_str();
   cmd->add_flag("--list", args->list, "Print one line per baked cell");
+  cmd->add_option("--pipeline", args->pipeline, "Extractor pipeline (Decoret 1999) instead of --technique: stages "
+                                                "from pvs, near-far, mmi, e.g. pvs,near-far,mmi");
+  cmd->add_option("--online", args->online, "Pipeline stages left to the runtime (the pipeline's tail: mmi or "
+                                            "near-far,mmi); the rest is baked");
+  cmd->add_option("--error-px", args->error_px, "MMI layering: largest de-occlusion error, pixels")
+      ->capture_default_str();
+  cmd->add_option("--frame-width", args->frame_width, "MMI layering: width of the final frames, pixels")
+      ->capture_default_str();
+  cmd->add_option("--layer-mesh", args->layer_mesh, "Mesh of each layer: grid (regular grid) or depth-mesh")
+      ->capture_default_str();
+  cmd->add_option("--grid-cells", args->grid_cells, "Regular grid layer mesh: cells per side")->capture_default_str();
+  cmd->add_option("--views", args->views, "Views per layer: street (along the cell) or six (360 degrees)")
+      ->capture_default_str();
+  cmd->add_option("--pvs-spacing", args->pvs_spacing, "PVS: metres between sample points along the cell")
+      ->capture_default_str();
+  cmd->add_option("--pvs-face", args->pvs_face, "PVS: cube face size, pixels")->capture_default_str();
+  cmd->add_option("--near-radius", args->near_radius, "Near/far by distance to the street (metres) instead of the "
+                                                      "local model (0)")
+      ->capture_default_str();
   cmd->add_option("-o,--output", args->out_dir, "Impostor store directory")->required();
   cmd->callback([args] { runBakeCommand(*args); });
 });

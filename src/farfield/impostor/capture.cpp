@@ -31,7 +31,14 @@ ImpostorCapture captureView(gpu::Renderer& renderer, const gpu::GpuScene& scene,
   if (!object_ids.empty()) scene.appendDrawItems(object_ids, items);
 
   gpu::RenderTarget target(camera.width, camera.height);
-  renderer.render(camera, items, target);
+  // Clear + draw, not Renderer::render: render() starts a GPU timer query, which cannot nest in the one a timed
+  // frame has running when the runtime captures online (bake/pipeline.h). The readbacks wait for the GPU anyway.
+  const auto pass = [&](gpu::RenderMode mode) {
+    target.bind();
+    target.clear(mode == gpu::RenderMode::ItemBuffer ? Vec4(0.0f, 0.0f, 0.0f, 1.0f) : renderer.light().sky_color);
+    renderer.draw(camera, items, target, mode);
+  };
+  pass(gpu::RenderMode::Shaded);
   ImpostorCapture capture;
   capture.camera = camera;
   capture.color = target.readColor();
@@ -57,7 +64,7 @@ ImpostorCapture captureView(gpu::Renderer& renderer, const gpu::GpuScene& scene,
     }
     if (any_single_sided) {
       // Depth only matters here: the item-buffer mode skips texturing, which is most of the cost in software.
-      renderer.render(camera, items, target, gpu::RenderMode::ItemBuffer);
+      pass(gpu::RenderMode::ItemBuffer);
       const image::DepthImage both = target.readDepth();
       for (size_t i = 0; i < both.pixelCount(); ++i) {
         const float front = capture.depth.pixels()[i], any = both.pixels()[i];

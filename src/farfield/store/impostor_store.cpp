@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 
@@ -118,6 +120,104 @@ class JsonReader {
   std::string source_;
 };
 
+nlohmann::json viewJson(const StoredView& v) {
+  return {{"camera", cameraJson(v.camera)}, {"texture", v.texture},         {"mesh", v.mesh},
+          {"triangles", v.triangles},       {"vertices", v.vertices},       {"data_pixels", v.data_pixels},
+          {"render_ms", v.render_ms},       {"build_ms", v.build_ms}};
+}
+
+nlohmann::json layerJson(const StoredLayer& l) {
+  nlohmann::json views = nlohmann::json::array();
+  for (const StoredView& v : l.views) views.push_back(viewJson(v));
+  return {{"objects", l.objects}, {"views", std::move(views)}};
+}
+
+nlohmann::json pipelineJson(const CellPipeline& p) {
+  nlohmann::json j = nlohmann::json::object();
+  if (p.has_pvs) j["pvs"] = {{"ids", p.pvs}, {"samples", p.pvs_samples}, {"ms", p.pvs_ms}};
+  if (p.has_split) j["split"] = {{"near", p.near}, {"far", p.far}};
+  if (p.has_mmi) {
+    nlohmann::json layers = nlohmann::json::array();
+    for (const StoredLayer& l : p.layers) layers.push_back(layerJson(l));
+    j["mmi"] = {{"threshold_rad", p.threshold_rad}, {"event_edges", p.event_edges},
+                {"max_weight_rad", p.max_weight_rad}, {"weights_ms", p.weights_ms},
+                {"layers", std::move(layers)},       {"single", layerJson(p.single)}};
+  }
+  return j;
+}
+
+std::vector<uint32_t> readIds(const JsonReader& r, const nlohmann::json& j, const char* key, const std::string& where,
+                              size_t scene_objects) {
+  const nlohmann::json& list = r.member(j, key, where);
+  if (!list.is_array()) r.fail(where, std::string("\"") + key + "\" must be an array of object ids");
+  std::vector<uint32_t> ids;
+  ids.reserve(list.size());
+  for (const nlohmann::json& id : list) {
+    if (!id.is_number_unsigned() || id.get<uint64_t>() == 0 || id.get<uint64_t>() > scene_objects)
+      r.fail(where, std::string("\"") + key + "\" holds an id outside 1.." + std::to_string(scene_objects));
+    ids.push_back(id.get<uint32_t>());
+  }
+  if (std::adjacent_find(ids.begin(), ids.end(), std::greater_equal<uint32_t>()) != ids.end())
+    r.fail(where, std::string("\"") + key + "\" must be ascending without repeats");
+  return ids;
+}
+
+StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::string& where, size_t scene_objects) {
+  StoredLayer layer;
+  layer.objects = readIds(r, j, "objects", where, scene_objects);
+  const nlohmann::json& views = r.member(j, "views", where);
+  if (!views.is_array()) r.fail(where, "\"views\" must be an array");
+  for (size_t v = 0; v < views.size(); ++v) {
+    const std::string at = where + ": views[" + std::to_string(v) + "]";
+    StoredView view;
+    view.camera = r.camera(views[v], at);
+    view.texture = r.relativeFile(views[v], "texture", at, true);
+    view.mesh = r.relativeFile(views[v], "mesh", at, false);
+    view.triangles = size_t(r.count(views[v], "triangles", at));
+    view.vertices = size_t(r.count(views[v], "vertices", at));
+    view.data_pixels = size_t(r.count(views[v], "data_pixels", at));
+    view.render_ms = r.number(views[v], "render_ms", at);
+    view.build_ms = r.number(views[v], "build_ms", at);
+    if (view.triangles > 0 && view.texture.empty()) r.fail(at, "has triangles but no texture");
+    layer.views.push_back(std::move(view));
+  }
+  return layer;
+}
+
+CellPipeline readPipeline(const JsonReader& r, const nlohmann::json& j, const std::string& where,
+                          size_t scene_objects) {
+  if (!j.is_object()) r.fail(where, "expected an object");
+  CellPipeline p;
+  if (j.contains("pvs")) {
+    const std::string at = where + ".pvs";
+    p.has_pvs = true;
+    p.pvs = readIds(r, j["pvs"], "ids", at, scene_objects);
+    p.pvs_samples = size_t(r.count(j["pvs"], "samples", at));
+    p.pvs_ms = r.number(j["pvs"], "ms", at);
+  }
+  if (j.contains("split")) {
+    const std::string at = where + ".split";
+    p.has_split = true;
+    p.near = readIds(r, j["split"], "near", at, scene_objects);
+    p.far = readIds(r, j["split"], "far", at, scene_objects);
+  }
+  if (j.contains("mmi")) {
+    const std::string at = where + ".mmi";
+    const nlohmann::json& m = j["mmi"];
+    p.has_mmi = true;
+    p.threshold_rad = r.number(m, "threshold_rad", at);
+    p.event_edges = size_t(r.count(m, "event_edges", at));
+    p.max_weight_rad = r.number(m, "max_weight_rad", at);
+    p.weights_ms = r.number(m, "weights_ms", at);
+    const nlohmann::json& layers = r.member(m, "layers", at);
+    if (!layers.is_array()) r.fail(at, "\"layers\" must be an array");
+    for (size_t l = 0; l < layers.size(); ++l)
+      p.layers.push_back(readLayer(r, layers[l], at + ".layers[" + std::to_string(l) + "]", scene_objects));
+    p.single = readLayer(r, r.member(m, "single", at), at + ".single", scene_objects);
+  }
+  return p;
+}
+
 }  // namespace
 
 const CellEntry* StoreIndex::find(uint32_t half_edge) const {
@@ -141,6 +241,11 @@ nlohmann::json indexToJson(const StoreIndex& index) {
   j["local_model"] = index.local_model;
   j["cell_lookup"] = index.cell_lookup;
   j["options"] = index.options;
+  if (!index.pipeline.empty()) {
+    j["pipeline"] = index.pipeline;
+    j["online"] = index.online;
+    j["storage"] = index.storage;
+  }
   nlohmann::json cells = nlohmann::json::array();
   for (const CellEntry& c : index.cells) {
     nlohmann::json cell;
@@ -158,6 +263,7 @@ nlohmann::json indexToJson(const StoreIndex& index) {
                          {"vertices", imp.vertices},
                          {"build_ms", imp.build_ms}};
     cell["impostors"] = std::move(imps);
+    if (c.pipeline) cell["pipeline"] = pipelineJson(*c.pipeline);
     cells.push_back(std::move(cell));
   }
   j["cells"] = std::move(cells);
@@ -171,12 +277,27 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
   if (r.text(j, "format", "top level") != kIndexFormat)
     r.fail("\"format\"", std::string("expected \"") + kIndexFormat + "\"");
   const uint64_t version = r.count(j, "version", "top level");
-  if (version != uint64_t(kIndexVersion))
+  if (version != 1 && version != uint64_t(kIndexVersion))
     r.fail("\"version\"", "unsupported version " + std::to_string(version) + " (this build reads version " +
                               std::to_string(kIndexVersion) + ")");
   index.version = int(version);
+  for (const char* key : {"pipeline", "online"}) {
+    if (!j.contains(key)) continue;
+    const nlohmann::json& list = j[key];
+    if (!list.is_array()) r.fail(std::string("\"") + key + "\"", "must be an array of stage names");
+    for (const nlohmann::json& s : list) {
+      if (!s.is_string() || s.get<std::string>().empty())
+        r.fail(std::string("\"") + key + "\"", "stage names must be non-empty strings");
+      (std::string(key) == "pipeline" ? index.pipeline : index.online).push_back(s.get<std::string>());
+    }
+  }
+  for (const std::string& s : index.online)
+    if (std::find(index.pipeline.begin(), index.pipeline.end(), s) == index.pipeline.end())
+      r.fail("\"online\"", "stage \"" + s + "\" is not in the pipeline");
+  if (j.contains("storage")) index.storage = j["storage"];
   const nlohmann::json& techniques = r.member(j, "techniques", "top level");
-  if (!techniques.is_array() || techniques.empty()) r.fail("\"techniques\"", "must be a non-empty array of names");
+  if (!techniques.is_array() || (techniques.empty() && index.pipeline.empty()))
+    r.fail("\"techniques\"", "must be a non-empty array of names (or empty in a pipeline store)");
   for (const nlohmann::json& t : techniques) {
     if (!t.is_string() || t.get<std::string>().empty()) r.fail("\"techniques\"", "names must be non-empty strings");
     index.techniques.push_back(t.get<std::string>());
@@ -226,6 +347,7 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
       if (s.triangles > 0 && e.texture.empty()) r.fail(at, "has triangles but the cell has no texture");
       e.impostors[technique] = std::move(s);
     }
+    if (c.contains("pipeline")) e.pipeline = readPipeline(r, c["pipeline"], where + ": pipeline", index.scene_objects);
     index.cells.push_back(std::move(e));
   }
   return index;
@@ -386,21 +508,54 @@ impostor::DepthMeshImpostor loadImpostor(const std::string& dir, const CellEntry
   if (it == entry.impostors.end())
     throw Error(joinPath(dir, kIndexFile), "cell " + std::to_string(entry.half_edge) + " has no " + technique +
                                                " impostor");
-  const StoredImpostor& s = it->second;
-  const std::string mesh_file = joinPath(dir, s.mesh);
+  // A Sillion cell impostor is a one-view layer whose texture is the cell's.
+  StoredView view;
+  view.camera = entry.camera;
+  view.texture = entry.texture;
+  view.mesh = it->second.mesh;
+  view.triangles = it->second.triangles;
+  view.vertices = it->second.vertices;
+  return loadLayerView(dir, view);
+}
+
+std::string layerFileStem(uint32_t half_edge, const std::string& kind, size_t layer, size_t view) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "cells/e%06u.%s.%02zu.%zu", half_edge, kind.c_str(), layer, view);
+  return buf;
+}
+
+StoredView writeLayerView(const std::string& dir, const std::string& stem, const impostor::DepthMeshImpostor& view) {
+  std::error_code ec;
+  fs::create_directories(fs::path(dir) / "cells", ec);
+  if (ec) throw Error(dir, "cannot create the cells directory: " + ec.message());
+  StoredView out;
+  out.camera = view.camera;
+  out.mesh = stem + ".ffmesh";
+  out.triangles = view.mesh.triangleCount();
+  out.vertices = view.mesh.vertexCount();
+  writeMesh(joinPath(dir, out.mesh), view);
+  if (!view.empty() && view.texture) {
+    out.texture = stem + ".png";
+    image::writePng(joinPath(dir, out.texture), *view.texture);
+  }
+  return out;
+}
+
+impostor::DepthMeshImpostor loadLayerView(const std::string& dir, const StoredView& view) {
+  const std::string mesh_file = joinPath(dir, view.mesh);
   impostor::DepthMeshImpostor out = readMesh(mesh_file);
-  if (out.mesh.triangleCount() != s.triangles || out.mesh.vertexCount() != s.vertices)
+  if (out.mesh.triangleCount() != view.triangles || out.mesh.vertexCount() != view.vertices)
     throw Error(mesh_file, "holds " + std::to_string(out.mesh.triangleCount()) + " triangles and " +
                                std::to_string(out.mesh.vertexCount()) + " vertices, the index says " +
-                               std::to_string(s.triangles) + " and " + std::to_string(s.vertices));
-  out.camera = entry.camera;
+                               std::to_string(view.triangles) + " and " + std::to_string(view.vertices));
+  out.camera = view.camera;
   if (out.empty()) return out;
-  const std::string texture_file = joinPath(dir, entry.texture);
+  const std::string texture_file = joinPath(dir, view.texture);
   auto texture = std::make_shared<image::ColorImage>(image::readPng(texture_file));
-  if (texture->width() != entry.camera.width || texture->height() != entry.camera.height)
+  if (texture->width() != view.camera.width || texture->height() != view.camera.height)
     throw Error(texture_file, "texture is " + std::to_string(texture->width()) + "x" +
                                   std::to_string(texture->height()) + " but the creation camera is " +
-                                  std::to_string(entry.camera.width) + "x" + std::to_string(entry.camera.height));
+                                  std::to_string(view.camera.width) + "x" + std::to_string(view.camera.height));
   out.texture = std::move(texture);
   return out;
 }

@@ -9,7 +9,7 @@
 //   DIR/cells/eNNNNNN.TECHNIQUE.ffmesh   per baked cell and technique: the impostor mesh (binary, below)
 //
 // index.json:
-//   {"format": "farfield-impostor-store", "version": 1,
+//   {"format": "farfield-impostor-store", "version": 2,
 //    "techniques": ["depth-mesh", "grid-mesh"],        // built for every baked cell
 //    "streets": "streets.json", "scene": "city.glb",  // streets relative to DIR; scene only informative
 //    "scene_objects": 1234,                             // object count of the scene baked (checked on load)
@@ -23,6 +23,17 @@
 //               "texture": "cells/e000012.png",        // "" when every impostor of the cell is empty
 //               "impostors": {"depth-mesh": {"mesh": "cells/e000012.depth-mesh.ffmesh", "triangles": 1034,
 //                                            "vertices": 560, "build_ms": 40.1}, ...}}, ...]}
+//   Version 2 adds, for stores written by `farfield bake --pipeline` (bake/pipeline.h): top-level "pipeline" (the
+//   stages, e.g. ["pvs", "near-far", "mmi"]), "online" (the stages left to the runtime) and "storage" (section 5.1's
+//   estimate next to the bytes written); "techniques" may then be empty. Each cell gets
+//     "pipeline": {"pvs": {"ids": [...], "samples": 31, "ms": 4000},
+//                  "split": {"near": [...], "far": [...]},
+//                  "mmi": {"threshold_rad": 0.0205, "event_edges": 120, "max_weight_rad": 0.9, "weights_ms": 0.4,
+//                          "layers": [{"objects": [...], "views": [VIEW, ...]}, ...],   // nearest layer first
+//                          "single": {"objects": [...], "views": [VIEW, ...]}}}          // the single mesh
+//   with VIEW = {"camera": {...}, "texture": "cells/e000012.mmi.00.0.png", "mesh": "cells/e000012.mmi.00.0.ffmesh",
+//                "triangles": 540, "vertices": 300, "data_pixels": 81234, "render_ms": 20.1, "build_ms": 3.2}
+//   (each part present when its stage was baked). Version 1 indexes are still read.
 //   Cells are sorted by half-edge id, each at most once. Numbers are JSON numbers (floats written with enough digits
 //   to read back exactly).
 //
@@ -42,6 +53,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,7 +64,7 @@
 
 namespace farfield::store {
 
-inline constexpr int kIndexVersion = 1;
+inline constexpr int kIndexVersion = 2;  // 1 (Sillion only) is still read
 inline constexpr uint32_t kMeshVersion = 1;
 inline constexpr char kIndexFormat[] = "farfield-impostor-store";
 inline constexpr char kIndexFile[] = "index.json";
@@ -65,6 +77,45 @@ struct StoredImpostor {
   double build_ms = 0.0;   // CPU time of the construction (contour, discrepancy, triangulation, reprojection)
 };
 
+// One image-based view of a layer (multi-mesh impostors, Decoret et al. 1999): the creation camera, its texture and
+// its mesh. A layer has one view along the street, or six (cube faces) for 360 degrees.
+struct StoredView {
+  Camera camera;
+  std::string texture;     // relative to the store directory; "" when the view has no data
+  std::string mesh;        // relative to the store directory (an empty view has a mesh file with zero counts)
+  size_t triangles = 0;
+  size_t vertices = 0;
+  size_t data_pixels = 0;
+  double render_ms = 0.0;  // capture (GL thread)
+  double build_ms = 0.0;   // mesh construction (worker thread)
+};
+
+// One layer of a cell's far geometry: objects among which only negligible visibility events occur (w_ij <= T for
+// every pair), drawn as one meshed impostor per view.
+struct StoredLayer {
+  std::vector<uint32_t> objects;  // object ids, ascending
+  std::vector<StoredView> views;
+};
+
+// What the extractor pipeline (farfield/bake/pipeline.h) found for a cell. Each part is present when its stage ran
+// in the bake; stages run online (index "online") leave theirs for the runtime.
+struct CellPipeline {
+  bool has_pvs = false;
+  std::vector<uint32_t> pvs;      // potentially visible object ids, ascending
+  size_t pvs_samples = 0;         // sample points along the cell
+  double pvs_ms = 0.0;
+  bool has_split = false;
+  std::vector<uint32_t> near;     // drawn as geometry (ascending)
+  std::vector<uint32_t> far;      // replaced by image-based representations (ascending)
+  bool has_mmi = false;
+  double threshold_rad = 0.0;     // T of the layering
+  size_t event_edges = 0;         // edges of the visibility-event graph (w_ij > 0)
+  double max_weight_rad = 0.0;
+  double weights_ms = 0.0;        // event graph + layering
+  std::vector<StoredLayer> layers;  // the multi-mesh impostor (MMI), nearest layer first
+  StoredLayer single;             // the single-mesh impostor (SMI) of the same far objects, for comparison
+};
+
 struct CellEntry {
   uint32_t half_edge = 0;
   Camera camera;                         // creation camera
@@ -74,6 +125,7 @@ struct CellEntry {
   double render_ms = 0.0;
   std::string texture;                   // relative to the store directory; "" when no impostor has data
   std::map<std::string, StoredImpostor> impostors;  // technique -> impostor
+  std::optional<CellPipeline> pipeline;              // stores written by `farfield bake --pipeline`
 };
 
 struct StoreIndex {
@@ -85,6 +137,11 @@ struct StoreIndex {
   std::string local_model = "edge";
   std::string cell_lookup = "street";  // how the viewer's cell is found (urban::CellLookup): runtime default
   nlohmann::json options = nlohmann::json::object();
+  // Extractor pipeline of the bake (`--pipeline`), empty for a Sillion-only store, and the stages left to run
+  // online (a tail of the pipeline).
+  std::vector<std::string> pipeline;
+  std::vector<std::string> online;
+  nlohmann::json storage = nlohmann::json::object();  // the paper's storage estimate next to the bytes written
   std::vector<CellEntry> cells;  // sorted by half_edge
 
   // The entry of a half-edge, or null when the cell was not baked.
@@ -115,6 +172,14 @@ std::string meshFileName(uint32_t half_edge, const std::string& technique);
 // different texture throws farfield::Error). Creates DIR/cells. Thread-safe for different cells.
 void writeCell(const std::string& dir, CellEntry& entry,
                const std::map<std::string, const impostor::DepthMeshImpostor*>& impostors);
+
+// File names of a layer view: cells/eNNNNNN.KIND.LL.V.png and .ffmesh (KIND "mmi" or "smi").
+std::string layerFileStem(uint32_t half_edge, const std::string& kind, size_t layer, size_t view);
+// Writes one layer view (texture when it has data, mesh always) under `dir` and returns its entry (camera, files,
+// counts; render_ms and build_ms left to the caller). Creates DIR/cells. Thread-safe for different stems.
+StoredView writeLayerView(const std::string& dir, const std::string& stem, const impostor::DepthMeshImpostor& view);
+// Loads a layer view (mesh, texture, camera) and checks the counts and the texture size against the entry.
+impostor::DepthMeshImpostor loadLayerView(const std::string& dir, const StoredView& view);
 
 // Loads one impostor of a cell: mesh, texture (shared, RGBA8) and creation camera. Empty impostors have a mesh file
 // too (with zero counts) and no texture. Throws farfield::Error (file and problem), also when the

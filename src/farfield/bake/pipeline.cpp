@@ -1,0 +1,660 @@
+// The extractor pipeline (Decoret et al. 1999, sections 4-5): PVS sampling, near/far segmentation, layering by
+// visibility events and one meshed impostor per layer, baked in parallel like bake.cpp (GL stages and captures on
+// the calling thread, meshes and files on worker threads through a bounded queue).
+#include "farfield/bake/pipeline.h"
+
+#include <oneapi/tbb/concurrent_queue.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "farfield/core/error.h"
+#include "farfield/core/progress.h"
+#include "farfield/core/timer.h"
+#include "farfield/impostor/depth_mesh.h"
+#include "farfield/impostor/grid_mesh.h"
+
+namespace fs = std::filesystem;
+
+namespace farfield::bake {
+
+// ---------------------------------------------------------------------------------------------------------------
+// Parsing
+
+namespace {
+
+const std::vector<std::string>& knownStages() {
+  static const std::vector<std::string> stages{kStagePvs, kStageNearFar, kStageMmi};
+  return stages;
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) out.push_back(item);
+  if (!text.empty() && text.back() == ',') out.emplace_back();
+  return out;
+}
+
+size_t stageRank(const std::string& stage) {
+  const auto& k = knownStages();
+  return size_t(std::find(k.begin(), k.end(), stage) - k.begin());
+}
+
+bool contains(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+}  // namespace
+
+std::vector<std::string> PipelineSpec::baked() const {
+  return {stages.begin(), stages.begin() + std::ptrdiff_t(std::min(online_from, stages.size()))};
+}
+
+std::vector<std::string> PipelineSpec::online() const {
+  return {stages.begin() + std::ptrdiff_t(std::min(online_from, stages.size())), stages.end()};
+}
+
+PipelineSpec parsePipeline(const std::string& stages_text, const std::string& online_text) {
+  PipelineSpec spec;
+  if (stages_text.empty()) throw Error("--pipeline", "no stages given (expected e.g. pvs,near-far,mmi)");
+  for (const std::string& s : splitList(stages_text)) {
+    if (stageRank(s) == knownStages().size())
+      throw Error("--pipeline", "unknown stage '" + s + "' (known: pvs, near-far, mmi)");
+    if (contains(spec.stages, s)) throw Error("--pipeline", "stage '" + s + "' is listed twice");
+    if (!spec.stages.empty() && stageRank(s) < stageRank(spec.stages.back()))
+      throw Error("--pipeline", "stage '" + s + "' must come before '" + spec.stages.back() +
+                                    "' (the order is pvs, near-far, mmi)");
+    spec.stages.push_back(s);
+  }
+  if (contains(spec.stages, kStageMmi) && !contains(spec.stages, kStageNearFar))
+    throw Error("--pipeline", "mmi needs near-far before it (the impostors stand for the far geometry)");
+  spec.online_from = spec.stages.size();
+  if (!online_text.empty()) {
+    const std::vector<std::string> online = splitList(online_text);
+    for (const std::string& s : online) {
+      if (!contains(spec.stages, s)) throw Error("--online", "stage '" + s + "' is not in the pipeline");
+      if (s == kStagePvs)
+        throw Error("--online", "pvs cannot run online: it renders hundreds of 360-degree views per cell");
+    }
+    const size_t from = spec.stages.size() - online.size();
+    for (size_t i = 0; i < online.size(); ++i)
+      if (from + i >= spec.stages.size() || spec.stages[from + i] != online[i])
+        throw Error("--online", "the online stages must be the end of the pipeline, in its order (e.g. mmi, or "
+                                "near-far,mmi)");
+    spec.online_from = from;
+  }
+  return spec;
+}
+
+LayerMesh parseLayerMesh(const std::string& text, const std::string& what) {
+  if (text == "grid") return LayerMesh::Grid;
+  if (text == "depth-mesh") return LayerMesh::DepthMesh;
+  throw Error(what, "unknown layer mesh '" + text + "' (expected grid or depth-mesh)");
+}
+
+const char* layerMeshName(LayerMesh mesh) { return mesh == LayerMesh::Grid ? "grid" : "depth-mesh"; }
+
+LayerViews parseLayerViews(const std::string& text, const std::string& what) {
+  if (text == "street") return LayerViews::Street;
+  if (text == "six") return LayerViews::Six;
+  throw Error(what, "unknown views '" + text + "' (expected street or six)");
+}
+
+const char* layerViewsName(LayerViews views) { return views == LayerViews::Street ? "street" : "six"; }
+
+// ---------------------------------------------------------------------------------------------------------------
+// Options as JSON
+
+nlohmann::json pipelineOptionsToJson(const PipelineOptions& o) {
+  return {{"resolution", o.base.resolution},
+          {"fov_deg", o.base.fov_deg},
+          {"eye_height", o.base.eye_height},
+          {"near", o.base.near_plane},
+          {"far", o.base.far_plane},
+          {"detect_seen_from_below", o.base.capture.detect_seen_from_below},
+          {"error_px", o.error_px},
+          {"frame_width", o.frame_width},
+          {"pvs_spacing", o.pvs.spacing},
+          {"pvs_face_size", o.pvs.face_size},
+          {"near_radius", o.near_radius},
+          {"representative_points",
+           o.events.points == urban::RepresentativePoints::HullVertices ? "hull" : "footprint"},
+          {"landmark_boost", o.events.landmark_boost},
+          {"layer_order", o.layer_order == urban::LayerOrder::Given ? "given" : "nearest-first"},
+          {"layer_choice", o.layer_choice == urban::LayerChoice::SmallestArea ? "smallest-area" : "least-growth"},
+          {"layer_mesh", layerMeshName(o.mesh)},
+          {"grid_cells", o.grid_cells},
+          {"views", layerViewsName(o.views)},
+          {"single_mesh", o.single_mesh}};
+}
+
+PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::string& source) {
+  PipelineOptions o;
+  if (!j.is_object()) throw Error(source, "pipeline options must be an object");
+  auto number = [&](const char* key, auto& out) {
+    if (!j.contains(key)) return;
+    if (!j[key].is_number()) throw Error(source, std::string("pipeline option \"") + key + "\" must be a number");
+    out = j[key].get<std::remove_reference_t<decltype(out)>>();
+  };
+  auto text = [&](const char* key) -> std::string {
+    if (!j.contains(key)) return {};
+    if (!j[key].is_string()) throw Error(source, std::string("pipeline option \"") + key + "\" must be a string");
+    return j[key].get<std::string>();
+  };
+  number("resolution", o.base.resolution);
+  number("fov_deg", o.base.fov_deg);
+  number("eye_height", o.base.eye_height);
+  number("near", o.base.near_plane);
+  number("far", o.base.far_plane);
+  if (j.contains("detect_seen_from_below") && j["detect_seen_from_below"].is_boolean())
+    o.base.capture.detect_seen_from_below = j["detect_seen_from_below"].get<bool>();
+  number("error_px", o.error_px);
+  number("frame_width", o.frame_width);
+  number("pvs_spacing", o.pvs.spacing);
+  number("pvs_face_size", o.pvs.face_size);
+  number("near_radius", o.near_radius);
+  number("landmark_boost", o.events.landmark_boost);
+  number("grid_cells", o.grid_cells);
+  if (const std::string p = text("representative_points"); p == "hull")
+    o.events.points = urban::RepresentativePoints::HullVertices;
+  if (text("layer_order") == "given") o.layer_order = urban::LayerOrder::Given;
+  if (text("layer_choice") == "smallest-area") o.layer_choice = urban::LayerChoice::SmallestArea;
+  if (const std::string m = text("layer_mesh"); !m.empty()) o.mesh = parseLayerMesh(m, source + ": layer_mesh");
+  if (const std::string v = text("views"); !v.empty()) o.views = parseLayerViews(v, source + ": views");
+  if (j.contains("single_mesh") && j["single_mesh"].is_boolean()) o.single_mesh = j["single_mesh"].get<bool>();
+  return o;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// PipelineRunner
+
+namespace {
+
+void validatePipelineOptions(const PipelineOptions& o) {
+  if (!(o.error_px > 0.0) || !std::isfinite(o.error_px))
+    throw Error("--error-px", "must be a positive number of pixels");
+  if (o.frame_width < 1) throw Error("--frame-width", "must be at least 1 pixel");
+  if (o.grid_cells < 1 || o.grid_cells > o.base.resolution)
+    throw Error("--grid-cells", "must be 1.." + std::to_string(o.base.resolution) + " (the impostor resolution)");
+  if (!(o.near_radius >= 0.0f) || !std::isfinite(o.near_radius))
+    throw Error("--near-radius", "must be a finite number of metres >= 0");
+}
+
+Polygon2 footprintOf(const scene::Object& object) {
+  if (!object.footprint.empty()) return object.footprint;
+  const Box3& b = object.world_bounds;
+  if (b.empty()) return {};
+  return {{b.lo.x, b.lo.y}, {b.hi.x, b.lo.y}, {b.hi.x, b.hi.y}, {b.lo.x, b.hi.y}};
+}
+
+std::vector<uint32_t> allObjects(const scene::Scene& scene) {
+  std::vector<uint32_t> ids(scene.objects.size());
+  for (size_t i = 0; i < ids.size(); ++i) ids[i] = uint32_t(i + 1);
+  return ids;
+}
+
+}  // namespace
+
+PipelineRunner::PipelineRunner(const scene::Scene& scene, const gpu::GpuScene& gpu_scene,
+                               const urban::CellMap& cells, const PipelineOptions& options)
+    : scene_(scene), gpu_scene_(gpu_scene), cells_(cells), options_(options) {
+  validatePipelineOptions(options_);
+  if (cells.objectCount() != scene.objects.size())
+    throw Error("pipeline", "the cell map was made for " + std::to_string(cells.objectCount()) +
+                                " objects but the scene has " + std::to_string(scene.objects.size()));
+  // Square frames: the horizontal field of view is the vertical one.
+  threshold_ = urban::layerThreshold(options_.error_px, degToRad(double(options_.base.fov_deg)), options_.frame_width);
+  ground_ = std::make_unique<GroundHeight>(scene, cells.assignment().shared);
+}
+
+PipelineRunner::~PipelineRunner() = default;
+
+CellWork PipelineRunner::start(uint32_t cell) const {
+  const auto ground = [this](float x, float y) { return ground_->at(x, y, 0.0f); };
+  CellWork work;
+  work.cell = cell;
+  work.street_camera = cellCamera(cells_, cell, options_.base, ground);  // checks the id and degeneracy
+  const Vec2 p = cells_.graph().originPosition(cell), q = cells_.graph().destinationPosition(cell);
+  work.segment = {p, q};
+  work.p_eye = Vec3(p, ground(p.x, p.y) + options_.base.eye_height);
+  work.q_eye = Vec3(q, ground(q.x, q.y) + options_.base.eye_height);
+  work.candidates = allObjects(scene_);
+  return work;
+}
+
+CellWork PipelineRunner::resume(uint32_t cell, const store::CellPipeline& stored) const {
+  CellWork work = start(cell);
+  work.result = stored;
+  if (stored.has_pvs) work.candidates = stored.pvs;
+  if (stored.has_split) work.candidates = stored.far;
+  return work;
+}
+
+void PipelineRunner::runStage(const std::string& stage, CellWork& work) {
+  if (stage == kStagePvs)
+    runPvs(work);
+  else if (stage == kStageNearFar)
+    runNearFar(work);
+  else if (stage == kStageMmi)
+    runMmi(work);
+  else
+    throw Error("pipeline", "unknown stage '" + stage + "'");
+}
+
+void PipelineRunner::runStages(const std::vector<std::string>& stages, CellWork& work) {
+  for (const std::string& stage : stages) {
+    runStage(stage, work);
+    if (stage == kStageMmi) buildMeshes(work);
+  }
+}
+
+// Section 5.3: 360-degree item buffers from points spaced along the cell at eye height.
+void PipelineRunner::runPvs(CellWork& work) {
+  if (!pvs_) pvs_ = std::make_unique<urban::PvsSampler>(gpu_scene_, options_.pvs);
+  Stopwatch timer;
+  const urban::Pvs pvs = pvs_->sample(work.p_eye, work.q_eye);
+  work.result.has_pvs = true;
+  work.result.pvs = pvs.ids;
+  work.result.pvs_samples = pvs.sample_points;
+  work.result.pvs_ms = timer.milliseconds();
+  work.candidates = pvs.ids;
+}
+
+// Section 5.4: the near geometry is the candidates in the cell's local model (the blocks touching the street and the
+// shared objects such as the ground), or within near_radius of the street; the rest is far.
+void PipelineRunner::runNearFar(CellWork& work) const {
+  const std::vector<uint32_t> local = cells_.localObjects(work.cell);
+  urban::NearFarSplit split;
+  if (options_.near_radius > 0.0f) {
+    split = urban::splitNearFar(scene_, work.candidates, work.segment, options_.near_radius);
+    // The shared objects (the ground) are geometry in every cell whatever their distance.
+    const std::vector<uint32_t>& shared = cells_.assignment().shared;
+    auto is_shared = [&](uint32_t id) { return std::binary_search(shared.begin(), shared.end(), id); };
+    for (uint32_t id : split.far_ids)
+      if (is_shared(id)) split.near_ids.push_back(id);
+    split.far_ids.erase(std::remove_if(split.far_ids.begin(), split.far_ids.end(), is_shared), split.far_ids.end());
+  } else {
+    split = urban::splitNearFar(work.candidates, local);
+  }
+  std::sort(split.near_ids.begin(), split.near_ids.end());
+  std::sort(split.far_ids.begin(), split.far_ids.end());
+  work.result.has_split = true;
+  work.result.near = std::move(split.near_ids);
+  work.result.far = std::move(split.far_ids);
+  work.candidates = work.result.far;
+}
+
+std::vector<Camera> PipelineRunner::viewCameras(const CellWork& work) const {
+  if (options_.views == LayerViews::Street) return {work.street_camera};
+  return urban::cubeFaceCameras(work.street_camera.eye, options_.base.resolution, options_.base.near_plane,
+                                options_.base.far_plane);
+}
+
+// Sections 4.1-4.3: the event graph over the far objects' footprints, the greedy layering with T, then per layer and
+// view a capture of that layer's objects alone (so no layer hides another in its image: what the viewer uncovers
+// while walking the cell is in the layer behind), and the same for all far objects together (the single mesh).
+void PipelineRunner::runMmi(CellWork& work) {
+  if (!work.result.has_split)
+    throw Error("pipeline", "cell " + std::to_string(work.cell) + ": mmi needs the near-far stage before it");
+  // Only the far objects some view shows are layered: with the street view, the PVS (360 degrees) also holds what
+  // lies behind the viewer, which no street-facing layer could hold. Moving forward along the cell keeps the view
+  // inside the frustum from P (a cone translated along its axis stays inside itself), so P's frustum is enough.
+  const std::vector<Camera> cameras = viewCameras(work);
+  std::vector<Frustum> frusta;
+  for (const Camera& camera : cameras) frusta.push_back(Frustum::fromMatrix(camera.viewProjection()));
+  std::vector<uint32_t> far;
+  for (uint32_t id : work.result.far) {
+    const Box3& b = scene_.objects[id - 1].world_bounds;
+    if (std::any_of(frusta.begin(), frusta.end(), [&](const Frustum& f) { return f.intersects(b); }))
+      far.push_back(id);
+  }
+  Stopwatch weights_timer;
+  std::vector<urban::EventObject> objects;
+  objects.reserve(far.size());
+  for (uint32_t id : far) {
+    urban::EventObject o;
+    o.footprint = footprintOf(scene_.objects[id - 1]);
+    if (o.footprint.empty()) o.footprint = {work.segment.q};  // no geometry: a point, it joins any layer
+    objects.push_back(std::move(o));
+  }
+  const urban::EventGraph graph = urban::computeEventGraph(objects, work.segment, options_.events);
+  urban::LayeringOptions lo;
+  lo.threshold = threshold_;
+  lo.order = options_.layer_order;
+  lo.choice = options_.layer_choice;
+  const urban::Layering layering = urban::layerObjects(graph, objects, work.segment, lo);
+  // Nearest layer first (by the distance of its nearest member to the cell): the front-most layers are the
+  // candidates for dynamic updates (section 5.5).
+  std::vector<std::pair<double, std::vector<uint32_t>>> layers;
+  for (const std::vector<uint32_t>& members : layering.layers) {
+    double nearest = std::numeric_limits<double>::infinity();
+    std::vector<uint32_t> ids;
+    for (uint32_t m : members) {
+      nearest = std::min(nearest, urban::distanceToCell(objects[m].footprint, work.segment));
+      ids.push_back(far[m]);
+    }
+    std::sort(ids.begin(), ids.end());
+    layers.emplace_back(nearest, std::move(ids));
+  }
+  std::stable_sort(layers.begin(), layers.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  work.result.has_mmi = true;
+  work.result.threshold_rad = threshold_;
+  work.result.event_edges = graph.edgeCount();
+  work.result.max_weight_rad = graph.maxWeight();
+  work.result.weights_ms = weights_timer.milliseconds();
+  work.result.layers.clear();
+  for (auto& [distance, ids] : layers) {
+    store::StoredLayer layer;
+    layer.objects = std::move(ids);
+    work.result.layers.push_back(std::move(layer));
+  }
+  work.result.single = {};
+  work.result.single.objects = far;
+
+  Stopwatch capture_timer;
+  // Only the objects in a view's frustum are drawn into it (the renderer does not cull).
+  auto capture = [&](const std::vector<uint32_t>& ids, size_t view) {
+    std::vector<uint32_t> seen;
+    for (uint32_t id : ids)
+      if (frusta[view].intersects(scene_.objects[id - 1].world_bounds)) seen.push_back(id);
+    return impostor::captureView(renderer_, gpu_scene_, seen, cameras[view], options_.base.capture);
+  };
+  work.layer_captures.assign(work.result.layers.size(), {});
+  for (size_t l = 0; l < work.result.layers.size(); ++l)
+    for (size_t v = 0; v < cameras.size(); ++v) work.layer_captures[l].push_back(capture(work.result.layers[l].objects, v));
+  work.single_captures.clear();
+  if (options_.single_mesh)
+    for (size_t v = 0; v < cameras.size(); ++v) work.single_captures.push_back(capture(far, v));
+  work.capture_ms = capture_timer.milliseconds();
+}
+
+void PipelineRunner::buildMeshes(CellWork& work) const {
+  Stopwatch timer;
+  auto build = [&](const impostor::ImpostorCapture& capture) {
+    if (options_.mesh == LayerMesh::Grid) {
+      impostor::GridMeshOptions o;
+      o.grid_spacing_px = double(capture.camera.width) / double(options_.grid_cells);
+      return impostor::buildGridMesh(capture, o);
+    }
+    impostor::DepthMeshOptions o = options_.base.depth_mesh;
+    o.resolution = capture.camera.width;
+    o.fov_y = capture.camera.fov_y;
+    return impostor::buildDepthMesh(capture, o);
+  };
+  work.layer_views.assign(work.layer_captures.size(), {});
+  for (size_t l = 0; l < work.layer_captures.size(); ++l)
+    for (const impostor::ImpostorCapture& c : work.layer_captures[l]) work.layer_views[l].push_back(build(c));
+  work.single_views.clear();
+  for (const impostor::ImpostorCapture& c : work.single_captures) work.single_views.push_back(build(c));
+  // Counts into the record (file names are the bake's business).
+  for (size_t l = 0; l < work.layer_views.size(); ++l) {
+    work.result.layers[l].views.assign(work.layer_views[l].size(), {});
+    for (size_t v = 0; v < work.layer_views[l].size(); ++v) {
+      store::StoredView& sv = work.result.layers[l].views[v];
+      sv.camera = work.layer_captures[l][v].camera;
+      sv.triangles = work.layer_views[l][v].mesh.triangleCount();
+      sv.vertices = work.layer_views[l][v].mesh.vertexCount();
+      sv.data_pixels = work.layer_captures[l][v].data_pixels;
+      sv.render_ms = work.layer_captures[l][v].render_ms;
+    }
+  }
+  work.result.single.views.assign(work.single_views.size(), {});
+  for (size_t v = 0; v < work.single_views.size(); ++v) {
+    store::StoredView& sv = work.result.single.views[v];
+    sv.camera = work.single_captures[v].camera;
+    sv.triangles = work.single_views[v].mesh.triangleCount();
+    sv.vertices = work.single_views[v].mesh.vertexCount();
+    sv.data_pixels = work.single_captures[v].data_pixels;
+    sv.render_ms = work.single_captures[v].render_ms;
+  }
+  work.layer_captures.clear();
+  work.single_captures.clear();
+  work.build_ms = timer.milliseconds();
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Storage (section 5.1)
+
+nlohmann::json storageReport(const store::StoreIndex& index, const std::string& dir, const PipelineOptions& options) {
+  size_t cells = 0, layers = 0, layer_views = 0, single_views = 0;
+  uint64_t texture_bytes = 0, mesh_bytes = 0, raw_texture_bytes = 0;
+  auto file_bytes = [&](const std::string& name) -> uint64_t {
+    if (name.empty()) return 0;
+    std::error_code ec;
+    const uintmax_t n = fs::file_size(fs::path(dir) / name, ec);
+    return ec ? 0 : uint64_t(n);
+  };
+  auto count_view = [&](const store::StoredView& v) {
+    texture_bytes += file_bytes(v.texture);
+    mesh_bytes += file_bytes(v.mesh);
+    if (!v.texture.empty()) raw_texture_bytes += uint64_t(v.camera.width) * uint64_t(v.camera.height) * 4;
+  };
+  for (const store::CellEntry& c : index.cells) {
+    if (!c.pipeline || !c.pipeline->has_mmi) continue;
+    ++cells;
+    layers += c.pipeline->layers.size();
+    for (const store::StoredLayer& l : c.pipeline->layers)
+      for (const store::StoredView& v : l.views) {
+        ++layer_views;
+        count_view(v);
+      }
+    for (const store::StoredView& v : c.pipeline->single.views) {
+      ++single_views;
+      count_view(v);
+    }
+  }
+  const int views = options.views == LayerViews::Six ? 6 : 1;
+  const double image = double(options.base.resolution) * double(options.base.resolution) * 3.0;  // RGB, as the paper
+  const double grid = double(options.grid_cells) * double(options.grid_cells) * 3.0 * 4.0;      // float xyz
+  const double mean_layers = cells ? double(layers) / double(cells) : 0.0;
+  nlohmann::json j;
+  j["cells"] = cells;
+  j["layers"] = layers;
+  j["mean_layers"] = mean_layers;
+  j["views_per_layer"] = views;
+  j["image_bytes_each"] = image;
+  j["mesh_bytes_each"] = grid;
+  j["estimate_bytes_measured_layers"] = double(layer_views) * (image + grid);
+  j["estimate_bytes_3_layers"] = double(cells) * 3.0 * double(views) * (image + grid);
+  j["estimate_bytes_paper_city"] = 572.0 * 18.0 * (256.0 * 256.0 * 3.0 + 10800.0);  // section 5.1's own numbers
+  j["written_texture_bytes"] = texture_bytes;
+  j["written_mesh_bytes"] = mesh_bytes;
+  j["written_bytes"] = texture_bytes + mesh_bytes;
+  j["uncompressed_texture_bytes"] = raw_texture_bytes;
+  j["single_mesh_views"] = single_views;
+  return j;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The bake
+
+namespace {
+
+struct PipelineJob {
+  CellWork work;
+  store::CellEntry entry;
+};
+
+}  // namespace
+
+PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, const urban::CellMap& cells,
+                            std::vector<uint32_t> half_edges, const PipelineSpec& spec,
+                            const PipelineOptions& options, const std::string& out_dir) {
+  validatePipelineOptions(options);
+  if (spec.stages.empty()) throw Error("--pipeline", "no stages given");
+  if (options.base.workers < 0) throw Error("--workers", "must be 0 (automatic) or more");
+  if (cells.objectCount() != scene.objects.size())
+    throw Error("bake", "the cell map was made for " + std::to_string(cells.objectCount()) +
+                            " objects but the scene has " + std::to_string(scene.objects.size()));
+  Stopwatch wall;
+  PipelineReport report;
+  report.store_dir = out_dir;
+  if (half_edges.empty())
+    for (uint32_t e = 0; e < cells.cellCount(); ++e) half_edges.push_back(e);
+  std::vector<uint32_t> todo;
+  {
+    std::set<uint32_t> seen;
+    for (uint32_t e : half_edges) {
+      if (e >= cells.cellCount())
+        throw Error("cell " + std::to_string(e), "no such half-edge (the street graph has " +
+                                                     std::to_string(cells.cellCount()) + ")");
+      if (!seen.insert(e).second) continue;
+      (cells.degenerate(e) ? report.skipped_degenerate : todo).push_back(e);
+    }
+    report.requested = seen.size();
+  }
+  {
+    std::error_code ec;
+    fs::create_directories(fs::path(out_dir) / "cells", ec);
+    if (ec) throw Error(out_dir, "cannot create the store directory: " + ec.message());
+  }
+  cells.graph().save((fs::path(out_dir) / store::kStreetsFile).string());
+
+  const std::vector<std::string> baked = spec.baked();
+  const bool bake_mmi = contains(baked, kStageMmi);
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const size_t workers = options.base.workers > 0 ? size_t(options.base.workers) : size_t(std::max(1u, hw - 1));
+  report.workers = workers;
+
+  tbb::concurrent_bounded_queue<std::shared_ptr<PipelineJob>> queue;
+  queue.set_capacity(std::ptrdiff_t(std::max<size_t>(1, options.base.queue_capacity)));
+  std::mutex results_mutex;
+  std::vector<store::CellEntry> entries;
+  std::vector<PipelineCellReport> records;
+  std::exception_ptr worker_error;
+  std::atomic<bool> failed{false};
+  std::unique_ptr<Progress> progress;
+  if (options.base.progress) progress = std::make_unique<Progress>("bake pipeline", todo.size());
+  PipelineRunner* runner_ptr = nullptr;  // set on the GL thread before the first job is queued
+
+  auto work_fn = [&] {
+    for (;;) {
+      std::shared_ptr<PipelineJob> job;
+      queue.pop(job);
+      if (!job) return;
+      if (failed.load()) continue;
+      try {
+        CellWork& w = job->work;
+        if (bake_mmi) {
+          runner_ptr->buildMeshes(w);
+          for (size_t l = 0; l < w.layer_views.size(); ++l)
+            for (size_t v = 0; v < w.layer_views[l].size(); ++v) {
+              store::StoredView& sv = w.result.layers[l].views[v];
+              const store::StoredView written =
+                  store::writeLayerView(out_dir, store::layerFileStem(w.cell, "mmi", l, v), w.layer_views[l][v]);
+              sv.texture = written.texture;
+              sv.mesh = written.mesh;
+              sv.build_ms = w.build_ms / double(w.layer_views.size() * w.layer_views[l].size() +
+                                                w.single_views.size());
+            }
+          for (size_t v = 0; v < w.single_views.size(); ++v) {
+            store::StoredView& sv = w.result.single.views[v];
+            const store::StoredView written =
+                store::writeLayerView(out_dir, store::layerFileStem(w.cell, "smi", 0, v), w.single_views[v]);
+            sv.texture = written.texture;
+            sv.mesh = written.mesh;
+          }
+        }
+        PipelineCellReport r;
+        r.half_edge = w.cell;
+        r.pvs = w.result.pvs.size();
+        r.near = w.result.near.size();
+        r.far = w.result.far.size();
+        r.layers = w.result.layers.size();
+        for (const store::StoredLayer& l : w.result.layers)
+          for (const store::StoredView& v : l.views) r.layer_triangles += v.triangles;
+        for (const store::StoredView& v : w.result.single.views) r.single_triangles += v.triangles;
+        r.pvs_ms = w.result.pvs_ms;
+        r.weights_ms = w.result.weights_ms;
+        r.capture_ms = w.capture_ms;
+        r.build_ms = w.build_ms;
+        job->entry.pipeline = std::move(w.result);
+        job->work.layer_views.clear();
+        job->work.single_views.clear();
+        std::lock_guard<std::mutex> lock(results_mutex);
+        records.push_back(r);
+        entries.push_back(std::move(job->entry));
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(results_mutex);
+        if (!worker_error) worker_error = std::current_exception();
+        failed = true;
+      }
+      if (progress) progress->advance();
+    }
+  };
+
+  std::vector<std::thread> pool;
+  struct Joiner {
+    tbb::concurrent_bounded_queue<std::shared_ptr<PipelineJob>>& queue;
+    std::vector<std::thread>& pool;
+    ~Joiner() {
+      for (size_t i = 0; i < pool.size(); ++i) queue.push(nullptr);
+      for (std::thread& t : pool) t.join();
+    }
+  };
+  std::exception_ptr producer_error;
+  double threshold = 0.0;
+  {
+    context.makeCurrent();
+    gpu::GpuScene gpu_scene(scene);
+    PipelineRunner runner(scene, gpu_scene, cells, options);
+    threshold = runner.threshold();
+    runner_ptr = &runner;
+    for (size_t w = 0; w < workers; ++w) pool.emplace_back(work_fn);
+    Joiner joiner{queue, pool};  // declared after the runner: the workers stop before it is destroyed
+    try {
+      for (uint32_t cell : todo) {
+        if (failed.load()) break;
+        auto job = std::make_shared<PipelineJob>();
+        job->work = runner.start(cell);
+        for (const std::string& stage : baked) runner.runStage(stage, job->work);
+        store::CellEntry& e = job->entry;
+        e.half_edge = cell;
+        e.camera = job->work.street_camera;
+        e.local_objects = cells.localObjects(cell);
+        e.distant_objects = cells.distantObjects(cell).size();
+        e.render_ms = job->work.capture_ms;
+        queue.push(std::move(job));
+      }
+    } catch (...) {
+      producer_error = std::current_exception();
+      failed = true;
+    }
+  }
+  if (progress) progress->finish();
+  if (producer_error) std::rethrow_exception(producer_error);
+  if (worker_error) std::rethrow_exception(worker_error);
+
+  std::sort(entries.begin(), entries.end(),
+            [](const store::CellEntry& a, const store::CellEntry& b) { return a.half_edge < b.half_edge; });
+  std::sort(records.begin(), records.end(),
+            [](const PipelineCellReport& a, const PipelineCellReport& b) { return a.half_edge < b.half_edge; });
+
+  store::StoreIndex index;
+  index.scene = options.base.scene_label;
+  index.scene_objects = scene.objects.size();
+  index.local_model = urban::localModelName(cells.options().local);
+  index.cell_lookup = urban::cellLookupName(cells.options().lookup);
+  index.pipeline = spec.stages;
+  index.online = spec.online();
+  index.options = {{"pipeline", pipelineOptionsToJson(options)}, {"block_margin", cells.options().block_margin}};
+  index.cells = std::move(entries);
+  index.storage = storageReport(index, out_dir, options);
+  store::writeIndex(out_dir, index);
+
+  report.cells = std::move(records);
+  report.threshold_rad = threshold;
+  report.storage = index.storage;
+  report.wall_s = wall.seconds();
+  return report;
+}
+
+}  // namespace farfield::bake

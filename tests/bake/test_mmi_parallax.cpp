@@ -1,0 +1,215 @@
+// Multi-mesh impostors against the single mesh (Decoret et al. 1999, sections 3-4): in a constructed scene, along the
+// cell, the MMI's parallax error stays under the pixel threshold while the single mesh exceeds it, measured from
+// object-id renders (eval/parallax_error.h).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "farfield/bake/pipeline.h"
+#include "farfield/eval/parallax_error.h"
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/image/png_io.h"
+#include "farfield/impostor/drawable.h"
+#include "farfield/scene/builtin.h"
+#include "support/test_support.h"
+
+namespace farfield::bake {
+namespace {
+
+using urban::StreetGraph;
+
+// A 3 x 2 grid of blocks, streets along y = -100, 0, 100 and x = 0, 50, 150, 450:
+//
+//      y=100  +----+---------+----------------------------+
+//             |    |  [NL]   |                   [FL]     |
+//      y=0    P====Q---------+----------------------------+      the cell: the street (0,0) -> (50,0)
+//             |[L] |    [NR] |                       [FR] |
+//      y=-100 +----+---------+----------------------------+
+//            x=0  50        150                          450
+//
+// Objects: 1 the ground (shared: its footprint covers every block); L, a low building in a block touching the
+// street (local model: geometry, in no impostor); the far model: NL, a 40 m building 10-30 m ahead of Q on the left;
+// FL, a large block 250-290 m ahead of Q behind it; NR, a building on the right; FR, a tower far behind NR. From P,
+// NL hides most of FL and NR part of FR; walking to Q, NL and NR slide out to the sides and uncover them (tens of
+// pixels): the de-occlusion a single mesh fills with "rubber sheets".
+struct Street {
+  scene::Scene scene;
+  StreetGraph graph;
+  uint32_t cell = 0;
+  uint32_t ground = 0, local = 0, near_left = 0, far_left = 0, near_right = 0, far_right = 0;
+};
+
+Street constructedStreet() {
+  Street s;
+  const std::vector<float> xs{0, 50, 150, 450}, ys{-100, 0, 100};
+  std::vector<Vec2> junctions;
+  for (float y : ys)
+    for (float x : xs) junctions.emplace_back(x, y);
+  std::vector<urban::Street> streets;
+  const auto at = [&](size_t ix, size_t iy) { return uint32_t(iy * xs.size() + ix); };
+  for (size_t iy = 0; iy < ys.size(); ++iy)
+    for (size_t ix = 0; ix + 1 < xs.size(); ++ix) streets.push_back({at(ix, iy), at(ix + 1, iy), 12.0f});
+  for (size_t ix = 0; ix < xs.size(); ++ix)
+    for (size_t iy = 0; iy + 1 < ys.size(); ++iy) streets.push_back({at(ix, iy), at(ix, iy + 1), 12.0f});
+  s.graph = StreetGraph::build(junctions, streets, "constructed street");
+  s.cell = urban::kNone;
+  for (uint32_t e = 0; e < s.graph.halfEdgeCount(); ++e)
+    if (s.graph.originPosition(e) == Vec2(0, 0) && s.graph.destinationPosition(e) == Vec2(50, 0)) s.cell = e;
+
+  const auto add = [&](scene::Mesh mesh, const Vec3& color, std::vector<Vec2> footprint) {
+    scene::Material m;
+    m.base_color = Vec4(color, 1.0f);
+    scene::Object o;
+    o.parts.push_back({s.scene.addMesh(std::move(mesh)), s.scene.addMaterial(m)});
+    o.footprint = std::move(footprint);
+    return s.scene.addObject(o);
+  };
+  const auto box = [&](const Vec2& lo, const Vec2& hi, float height, const Vec3& color) {
+    return add(scene::makeBox(Vec3(lo, 0.0f), Vec3(hi, height)), color,
+               {{lo.x, lo.y}, {hi.x, lo.y}, {hi.x, hi.y}, {lo.x, hi.y}});
+  };
+  s.ground = add(scene::makeGroundQuad(Vec2(-200, -300), Vec2(700, 300)), Vec3(0.5f, 0.55f, 0.45f),
+                 {{-200, -300}, {700, -300}, {700, 300}, {-200, 300}});
+  s.local = box({10, -40}, {40, -8}, 15.0f, {0.7f, 0.7f, 0.6f});
+  s.near_left = box({60, 6}, {80, 30}, 40.0f, {0.9f, 0.5f, 0.3f});
+  s.far_left = box({300, 20}, {340, 80}, 50.0f, {0.3f, 0.4f, 0.9f});
+  s.near_right = box({100, -60}, {130, -20}, 25.0f, {0.8f, 0.8f, 0.3f});
+  s.far_right = box({350, -70}, {380, -30}, 70.0f, {0.5f, 0.8f, 0.5f});
+  s.scene.updateBounds();
+  return s;
+}
+
+class MmiParallaxTest : public ::testing::Test {
+ protected:
+  void SetUp() override { gpu::sharedHeadlessContext(); }
+};
+
+TEST_F(MmiParallaxTest, MmiStaysUnderThePixelThresholdAlongTheCellWhileTheSingleMeshExceedsIt) {
+  const Street s = constructedStreet();
+  ASSERT_NE(s.cell, urban::kNone);
+  const urban::CellMap cells(s.graph, s.scene);
+  // The segmentation the test relies on: the ground shared, L local, the four buildings distant.
+  ASSERT_EQ(cells.assignment().shared, (std::vector<uint32_t>{s.ground}));
+  ASSERT_EQ(cells.localObjects(s.cell), (std::vector<uint32_t>{s.ground, s.local}));
+
+  PipelineOptions options;
+  options.base.resolution = 256;
+  options.base.fov_deg = 60.0f;
+  options.base.progress = false;
+  options.frame_width = 256;
+  options.error_px = 10.0;  // T = 10 px * 60 degrees / 256 px = 0.041 rad
+  options.mesh = LayerMesh::Grid;
+  options.grid_cells = 30;
+  options.views = LayerViews::Street;
+  options.pvs.face_size = 64;
+  options.pvs.spacing = 10.0f;
+
+  const gpu::GpuScene gpu_scene(s.scene);
+  PipelineRunner runner(s.scene, gpu_scene, cells, options);
+  CellWork work = runner.start(s.cell);
+  runner.runStages({kStagePvs, kStageNearFar, kStageMmi}, work);
+
+  const store::CellPipeline& r = work.result;
+  ASSERT_TRUE(r.has_pvs && r.has_split && r.has_mmi);
+  EXPECT_EQ(r.far, (std::vector<uint32_t>{s.near_left, s.far_left, s.near_right, s.far_right}));
+  // The test is only meaningful when each near building and the one it hides are in different layers, which they
+  // must be: their visibility-event weight is far above T.
+  const auto layer_of = [&](uint32_t id) {
+    for (size_t l = 0; l < r.layers.size(); ++l)
+      if (std::binary_search(r.layers[l].objects.begin(), r.layers[l].objects.end(), id)) return int(l);
+    return -1;
+  };
+  ASSERT_GE(r.layers.size(), 2u);
+  EXPECT_GT(r.max_weight_rad, runner.threshold());
+  EXPECT_NEAR(runner.threshold(), 10.0 * degToRad(60.0) / 256.0, 1e-9);
+  for (uint32_t id : r.far) ASSERT_GE(layer_of(id), 0) << "object " << id << " is in no layer";
+  EXPECT_NE(layer_of(s.near_left), layer_of(s.far_left));
+  EXPECT_NE(layer_of(s.near_right), layer_of(s.far_right));
+  ASSERT_EQ(work.layer_views.size(), r.layers.size());
+  ASSERT_EQ(work.single_views.size(), 1u);
+  EXPECT_EQ(r.single.objects, r.far);
+
+  // The impostors with per-object ids, and the geometry they stand for.
+  impostor::GpuImpostorOptions split;
+  split.split_by_object_id = true;
+  std::vector<impostor::GpuImpostor> layers;
+  for (const auto& views : work.layer_views) {
+    ASSERT_EQ(views.size(), 1u);
+    ASSERT_FALSE(views[0].triangle_ids.empty());
+    layers.emplace_back(views[0], split);
+  }
+  const impostor::GpuImpostor single(work.single_views[0], split);
+  std::vector<uint32_t> reference_ids{s.ground};  // the ground is geometry in every frame, impostors or not
+  reference_ids.insert(reference_ids.end(), r.far.begin(), r.far.end());
+  std::vector<gpu::DrawItem> reference_items, mmi_items, smi_items;
+  gpu_scene.appendDrawItems(reference_ids, reference_items);
+  gpu_scene.appendDrawItems(std::vector<uint32_t>{s.ground}, mmi_items);
+  smi_items = mmi_items;
+  for (const impostor::GpuImpostor& layer : layers) layer.appendDrawItems(mmi_items);
+  single.appendDrawItems(smi_items);
+
+  gpu::Renderer renderer;
+  gpu::RenderTarget target(options.frame_width, options.frame_width);
+  // The impostors are drawn Shaded, the way the viewer sees them, and their ids read from that pass: the texture's
+  // alpha cuts the grid triangles that overhang a silhouette (a 30 x 30 grid's cells are 8.5 px wide), so only what
+  // the viewer sees counts. An ItemBuffer pass samples no texture and would count those overhangs as well (measured:
+  // 8 px at P for both impostors, MMI 16 px at Q). The reference is geometry: its ItemBuffer ids are exact.
+  const auto ids = [&](const Camera& camera, const std::vector<gpu::DrawItem>& items, gpu::RenderMode mode) {
+    renderer.render(camera, items, target, mode);
+    return target.readIds();
+  };
+  eval::ParallaxOptions metric;
+  metric.ignore_ids = {s.ground};
+  metric.percentile = 0.99;
+
+  const std::string dir = test::scratchDir("mmi_parallax").string();
+  const int samples = 6;
+  double worst_mmi = 0.0, worst_smi = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const float t = float(i) / float(samples - 1);
+    Camera camera = work.street_camera;  // the bake's field of view, planes and image size
+    camera.width = camera.height = options.frame_width;
+    const Vec3 forward = camera.at - camera.eye;
+    camera.eye = work.p_eye + t * (work.q_eye - work.p_eye);
+    camera.at = camera.eye + forward;
+
+    const image::IdImage reference = ids(camera, reference_items, gpu::RenderMode::ItemBuffer);
+    const image::IdImage mmi = ids(camera, mmi_items, gpu::RenderMode::Shaded);
+    const image::IdImage smi = ids(camera, smi_items, gpu::RenderMode::Shaded);
+    const eval::ParallaxError e_mmi = eval::parallaxError(reference, mmi, metric);
+    const eval::ParallaxError e_smi = eval::parallaxError(reference, smi, metric);
+    std::printf("t=%.1f  MMI: p99 %6.2f max %6.2f mean %5.2f px, %5zu px mismatched | "
+                "SMI: p99 %6.2f max %6.2f mean %5.2f px, %5zu px mismatched\n",
+                double(t), e_mmi.percentile_px, e_mmi.max_px, e_mmi.mean_px, e_mmi.mismatched,
+                e_smi.percentile_px, e_smi.max_px, e_smi.mean_px, e_smi.mismatched);
+    const std::string stem = dir + "/t" + std::to_string(i);
+    image::writeIdPng(stem + "_reference.png", reference);
+    image::writeIdPng(stem + "_mmi.png", mmi);
+    image::writeIdPng(stem + "_smi.png", smi);
+
+    // The 99th percentile, not the maximum: the MMI's largest displacements are not visibility events between
+    // objects but the grid mesh's depth inside one object. The near-left building's street-side face is seen at a
+    // grazing angle from P (about 6 px wide in the capture, less than one 8.5 px grid cell) and about 85 px wide
+    // from Q; the depth interpolated across it puts the face's foot a little off, so the ground (geometry) hides a
+    // sliver of it (measured at Q: 8 px at most, 99.9th percentile 7.7 px; 18 px with LayerMesh::DepthMesh, whose
+    // triangles cut across the building's corner).
+    EXPECT_LE(e_mmi.percentile_px, options.error_px) << "MMI at t = " << t;
+    if (i == 0) {  // at the creation viewpoint both impostors are exact up to sampling: what follows is parallax
+      EXPECT_LE(e_mmi.max_px, 3.0);
+      EXPECT_LE(e_smi.max_px, 3.0);
+    }
+    worst_mmi = std::max(worst_mmi, e_mmi.percentile_px);
+    worst_smi = std::max(worst_smi, e_smi.percentile_px);
+  }
+  // The single mesh has no layer behind the near buildings: what they uncover is rubber sheet or nothing.
+  EXPECT_GT(worst_smi, options.error_px);
+  EXPECT_GT(worst_smi, 2.0 * worst_mmi);
+}
+
+}  // namespace
+}  // namespace farfield::bake
