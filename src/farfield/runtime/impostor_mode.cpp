@@ -14,6 +14,7 @@
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
+#include "farfield/runtime/mmi_mode.h"
 
 namespace fs = std::filesystem;
 
@@ -31,6 +32,37 @@ void registerModes() {
   eval::registerMode("grid-mesh",
                      "local model + the cell's regular-grid mesh impostor (baseline); --impostors DIR",
                      [](const eval::ModeContext& c) { return std::make_unique<ImpostorMode>("grid-mesh", c); });
+  registerMmiModes();
+}
+
+OpenStore openStore(const std::string& dir, const scene::Scene& scene, const std::string& lookup_option) {
+  OpenStore out;
+  out.index = store::readIndex(dir);
+  out.index_file = (fs::path(dir) / store::kIndexFile).string();
+  if (out.index.scene_objects != scene.objects.size())
+    throw Error(out.index_file, "was baked for a scene with " + std::to_string(out.index.scene_objects) +
+                                    " objects, but this scene has " + std::to_string(scene.objects.size()));
+  out.graph = urban::StreetGraph::load((fs::path(dir) / out.index.streets).string());
+  out.locator = urban::CellLocator(
+      out.graph, urban::parseCellLookup(lookup_option.empty() ? out.index.cell_lookup : lookup_option,
+                                        lookup_option.empty() ? out.index_file + ": cell_lookup" : "cell_lookup"));
+  for (const store::CellEntry& e : out.index.cells)
+    if (e.half_edge >= out.graph.halfEdgeCount())
+      throw Error(out.index_file,
+                  "cell " + std::to_string(e.half_edge) + " is not a half-edge of " + out.index.streets);
+  return out;
+}
+
+size_t positiveOption(const eval::ModeContext& context, const std::string& key, size_t fallback) {
+  const std::string text = context.option(key, std::to_string(fallback));
+  try {
+    size_t used = 0;
+    const long long n = std::stoll(text, &used);
+    if (used != text.size() || n < 1) throw std::invalid_argument("range");
+    return size_t(n);
+  } catch (const std::exception&) {
+    throw Error("--mode-option " + key, "expected a positive integer, got '" + text + "'");
+  }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -80,15 +112,7 @@ ImpostorMode::ImpostorMode(std::string technique, const eval::ModeContext& conte
   if (dir_.empty())
     throw Error("mode '" + technique_ + "'", "needs an impostor store: farfield bench --impostors DIR (or "
                                              "--mode-option impostor_dir=DIR), baked with farfield bake");
-  const std::string cache = context.option("impostor_cache", std::to_string(kDefaultCache));
-  try {
-    size_t used = 0;
-    const long long n = std::stoll(cache, &used);
-    if (used != cache.size() || n < 1) throw std::invalid_argument("range");
-    cache_capacity_ = size_t(n);
-  } catch (const std::exception&) {
-    throw Error("--mode-option impostor_cache", "expected a positive integer, got '" + cache + "'");
-  }
+  cache_capacity_ = positiveOption(context, "impostor_cache", kDefaultCache);
   const std::string projective = context.option("impostor_projective", "1");
   if (projective != "0" && projective != "1")
     throw Error("--mode-option impostor_projective", "expected 0 or 1, got '" + projective + "'");
@@ -103,24 +127,17 @@ void ImpostorMode::prepare(const eval::ModeContext& context) {
   scene_ = context.scene;
   gpu_scene_ = context.gpu_scene;
   bvh_ = context.bvh;
-  index_ = store::readIndex(dir_);
-  const std::string index_file = (fs::path(dir_) / store::kIndexFile).string();
+  OpenStore opened = openStore(dir_, *scene_, lookup_option_);
+  index_ = std::move(opened.index);
+  graph_ = std::move(opened.graph);
+  locator_ = std::move(opened.locator);
+  const std::string& index_file = opened.index_file;
   if (!index_.hasTechnique(technique_)) {
     std::string have;
     for (const std::string& t : index_.techniques) have += (have.empty() ? "" : ", ") + t;
     throw Error(index_file, "holds no " + technique_ + " impostors (it has: " + have +
                                 "); bake with --technique " + technique_ + " or both");
   }
-  if (index_.scene_objects != scene_->objects.size())
-    throw Error(index_file, "was baked for a scene with " + std::to_string(index_.scene_objects) +
-                                " objects, but this scene has " + std::to_string(scene_->objects.size()));
-  graph_ = urban::StreetGraph::load((fs::path(dir_) / index_.streets).string());
-  locator_ = urban::CellLocator(
-      graph_, urban::parseCellLookup(lookup_option_.empty() ? index_.cell_lookup : lookup_option_,
-                                     lookup_option_.empty() ? index_file + ": cell_lookup" : "cell_lookup"));
-  for (const store::CellEntry& e : index_.cells)
-    if (e.half_edge >= graph_.halfEdgeCount())
-      throw Error(index_file, "cell " + std::to_string(e.half_edge) + " is not a half-edge of " + index_.streets);
 
   impostor_id_ = uint32_t(scene_->objects.size() + 1);
   object_triangles_.assign(scene_->objects.size() + 1, 0);

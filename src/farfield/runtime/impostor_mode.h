@@ -38,9 +38,23 @@
 
 namespace farfield::runtime {
 
-// Registers "depth-mesh" and "grid-mesh" into eval's mode registry (idempotent). Executables call it before they
+// Registers "depth-mesh" and "grid-mesh", and the pipeline-store modes of mmi_mode.h (local, visible, smi, mmi,
+// mmi-dynamic), into eval's mode registry (idempotent). Executables call it before they
 // list or create modes (see the .cpp for why registration is not a static object).
 void registerModes();
+
+// An impostor store opened for a walkthrough: its index, street graph and cell locator. Checks that the store was
+// baked for a scene with as many objects as `scene` and that its cells are half-edges of its graph; lookup_option
+// ("" = the store's rule, else street or nearest) picks the cell lookup. Throws farfield::Error naming the file.
+struct OpenStore {
+  store::StoreIndex index;
+  std::string index_file;
+  urban::StreetGraph graph;
+  urban::CellLocator locator;
+};
+OpenStore openStore(const std::string& dir, const scene::Scene& scene, const std::string& lookup_option);
+// A positive integer mode option (e.g. impostor_cache); throws farfield::Error naming the option.
+size_t positiveOption(const eval::ModeContext& context, const std::string& key, size_t fallback);
 
 // Least-recently-used cache of GPU impostors by cell. Needs a current context for get() and for destruction.
 class ImpostorCache {
