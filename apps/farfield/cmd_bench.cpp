@@ -126,8 +126,8 @@ void runBenchCommand(const BenchArgs& args) {
   std::printf("frames:   %zu of %zu (size %dx%d)\n", result.frame_indices.size(), result.path_frames, result.width,
               result.height);
   if (result.baseline_added) std::printf("note:     \"full\" was not asked for; it ran anyway as the baseline\n");
-  std::printf("\n%-16s %10s %10s %10s %10s %12s %9s %10s %8s\n", "mode", "median ms", "p95 ms", "p99 ms", "max ms",
-              "triangles", "speedup", "PSNR dB", "cracks");
+  std::printf("\n%-16s %10s %10s %10s %10s %12s %9s %10s %8s %12s\n", "mode", "median ms", "p95 ms", "p99 ms",
+              "max ms", "triangles", "speedup", "PSNR dB", "cracks", "parallax px");
   for (const eval::ModeResult& m : result.modes) {
     char psnr[32] = "n/a";
     if (m.has_errors) {
@@ -138,8 +138,10 @@ void runBenchCommand(const BenchArgs& args) {
     }
     char cracks[32] = "n/a";
     if (m.has_errors) std::snprintf(cracks, sizeof(cracks), "%.3f%%", 100.0 * m.crack_share_mean);
-    std::printf("%-16s %10.3f %10.3f %10.3f %10.3f %12.0f %8.2fx %10s %8s\n", m.name.c_str(), m.wall.median,
-                m.wall.p95, m.wall.p99, m.wall.max, m.mean_triangles, m.speedup_vs_full, psnr, cracks);
+    char parallax[32] = "n/a";
+    if (m.has_parallax) std::snprintf(parallax, sizeof(parallax), "%.2f", m.parallax_px_mean);
+    std::printf("%-16s %10.3f %10.3f %10.3f %10.3f %12.0f %8.2fx %10s %8s %12s\n", m.name.c_str(), m.wall.median,
+                m.wall.p95, m.wall.p99, m.wall.max, m.mean_triangles, m.speedup_vs_full, psnr, cracks, parallax);
   }
   std::printf("\nwrote %s/{bench.json,bench.md,frames.csv}", args.out_dir.c_str());
   for (const std::string& p : result.plots) std::printf(", %s", p.c_str());

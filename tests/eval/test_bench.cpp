@@ -108,6 +108,9 @@ TEST(Bench, JsonHasEveryKeyForEveryMode) {
   EXPECT_DOUBLE_EQ(full.at("psnr_db_mean").get<double>(), kPsnrCapDb);
   EXPECT_DOUBLE_EQ(full.at("ssim_mean").get<double>(), 1.0);
   EXPECT_DOUBLE_EQ(full.at("bad_pixel_share_mean").get<double>(), 0.0);
+  // Same ids as the reference everywhere: no parallax; culling drops only what is out of view.
+  EXPECT_DOUBLE_EQ(full.at("parallax_p99_px_max").get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(culled.at("parallax_p99_px_max").get<double>(), 0.0);
   EXPECT_GT(culled.at("psnr_db_min").get<double>(), 50.0);
   // 1 ground quad (2 triangles) + 25 boxes (12 each), every frame.
   EXPECT_DOUBLE_EQ(full.at("mean_triangles").get<double>(), 302.0);
@@ -138,7 +141,7 @@ TEST(Bench, CsvMarkdownAndSampleFrames) {
   const auto csv = lines(readText(run.dir / "frames.csv"));
   ASSERT_EQ(csv.size(), 1u + 3u * 2u);
   EXPECT_EQ(csv[0].rfind("frame,path_frame,mode,order,wall_ms,gpu_ms,triangles", 0), 0u);
-  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 11) << csv[i];
+  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 12) << csv[i];
 
   const std::string md = readText(run.dir / "bench.md");
   EXPECT_NE(md.find("| mode |"), std::string::npos);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -24,6 +25,7 @@
 #include "farfield/core/progress.h"
 #include "farfield/image/png_io.h"
 #include "farfield/scene/bvh.h"
+#include "farfield/eval/parallax_error.h"
 
 namespace fs = std::filesystem;
 
@@ -85,6 +87,16 @@ void summarizeMode(ModeResult& m) {
     double crack_sum = 0.0;
     for (double c : m.crack_shares) crack_sum += c;
     m.crack_share_mean = m.crack_shares.empty() ? 0.0 : crack_sum / double(m.crack_shares.size());
+    double parallax_sum = 0.0;
+    size_t parallax_frames = 0;
+    for (double p : m.parallax_px) {
+      if (std::isnan(p)) continue;
+      parallax_sum += p;
+      ++parallax_frames;
+      m.parallax_px_max = std::max(m.parallax_px_max, p);
+    }
+    m.has_parallax = parallax_frames > 0;
+    m.parallax_px_mean = parallax_frames ? parallax_sum / double(parallax_frames) : 0.0;
   }
 }
 
@@ -95,6 +107,14 @@ double crackShare(const image::IdImage& reference, const image::IdImage& frame) 
   for (size_t i = 0; i < reference.pixelCount(); ++i)
     cracks += (reference.pixels()[i] != 0 && frame.pixels()[i] == 0) ? 1 : 0;
   return double(cracks) / double(reference.pixelCount());
+}
+
+// The parallax error of a frame (99th percentile, pixels), or NaN when its item buffer shows ids that are not scene
+// objects (an impostor drawn with an id of its own: the metric needs the ids of the objects it stands for).
+double frameParallax(const image::IdImage& reference, const image::IdImage& frame, size_t object_count) {
+  for (uint32_t id : frame.pixels())
+    if (id > object_count) return std::numeric_limits<double>::quiet_NaN();
+  return parallaxError(reference, frame).percentile_px;
 }
 
 std::string shellQuote(const std::string& s) {
@@ -131,7 +151,9 @@ std::string markdownHeader(const BenchResult& r) {
     md << "- error against full-geometry reference frames: PSNR (identical frames are capped at "
        << fmt("%.0f", kPsnrCapDb) << " dB), SSIM, share of pixels off by more than " << r.bad_pixel_threshold
        << "/255; cracks = share of pixels where the reference shows geometry and the mode's frame shows sky "
-          "(object ids).\n";
+          "(object ids); parallax = 99th percentile of the distance (pixels) from each pixel whose object differs "
+          "from the reference's to where the reference shows that object (object ids, eval/parallax_error.h), mean "
+          "and worst over the frames; n/a for modes whose impostors carry no object ids.\n";
   else
     md << "- no reference frames (run with --reference for image error).\n";
   return md.str();
@@ -141,8 +163,8 @@ std::string markdownTable(const BenchResult& r) {
   std::ostringstream md;
   md << "| mode | median ms | p95 ms | p99 ms | max ms | GPU median ms | triangles | draw calls | objects | "
         "speedup vs full | PSNR mean dB | PSNR min dB | SSIM mean | pixels > "
-     << r.bad_pixel_threshold << "/255 | cracks |\n";
-  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+     << r.bad_pixel_threshold << "/255 | cracks | parallax px mean | parallax px max |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const ModeResult& m : r.modes) {
     md << "| " << m.name << " | " << fmt("%.2f", m.wall.median) << " | " << fmt("%.2f", m.wall.p95) << " | "
        << fmt("%.2f", m.wall.p99) << " | " << fmt("%.2f", m.wall.max) << " | " << fmt("%.2f", m.gpu.median)
@@ -152,9 +174,10 @@ std::string markdownTable(const BenchResult& r) {
       const auto psnr = [](double v) { return v >= kPsnrCapDb ? std::string("identical") : fmt("%.2f", v); };
       md << psnr(m.psnr_db_mean) << " | " << psnr(m.psnr_db_min) << " | " << fmt("%.4f", m.ssim_mean) << " | "
          << fmt("%.3f", 100.0 * m.bad_pixel_share_mean) << "% | " << fmt("%.3f", 100.0 * m.crack_share_mean)
-         << "% |\n";
+         << "% | " << (m.has_parallax ? fmt("%.2f", m.parallax_px_mean) : std::string("n/a")) << " | "
+         << (m.has_parallax ? fmt("%.2f", m.parallax_px_max) : std::string("n/a")) << " |\n";
     } else {
-      md << "n/a | n/a | n/a | n/a | n/a |\n";
+      md << "n/a | n/a | n/a | n/a | n/a | n/a | n/a |\n";
     }
   }
   return md.str();
@@ -290,7 +313,9 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
           image::ImageMetrics e = image::compareImages(reference, frame, options.bad_pixel_threshold);
           if (!(e.psnr_db < kPsnrCapDb)) e.psnr_db = kPsnrCapDb;  // +inf (identical) and above the cap
           mode_result.errors.push_back(e);
-          mode_result.crack_shares.push_back(crackShare(reference_ids, target.readIds()));
+          const image::IdImage ids = target.readIds();
+          mode_result.crack_shares.push_back(crackShare(reference_ids, ids));
+          mode_result.parallax_px.push_back(frameParallax(reference_ids, ids, scene.objects.size()));
         }
         if (sample) {
           const std::string name = "frames/" + tag + "_" + fileSafe(mode_result.name) + ".png";
@@ -365,7 +390,11 @@ void writeBenchJson(const BenchResult& r, const std::string& file) {
       e["ssim_mean"] = m.ssim_mean;
       e["bad_pixel_share_mean"] = m.bad_pixel_share_mean;
       e["crack_share_mean"] = m.crack_share_mean;
+      e["parallax_p99_px_mean"] = m.has_parallax ? Json(m.parallax_px_mean) : Json(nullptr);
+      e["parallax_p99_px_max"] = m.has_parallax ? Json(m.parallax_px_max) : Json(nullptr);
     } else {
+      e["parallax_p99_px_mean"] = nullptr;
+      e["parallax_p99_px_max"] = nullptr;
       e["psnr_db_mean"] = nullptr;
       e["psnr_db_min"] = nullptr;
       e["ssim_mean"] = nullptr;
@@ -398,7 +427,8 @@ void writeBenchMarkdown(const BenchResult& r, const std::string& file) {
 
 void writeFramesCsv(const BenchResult& r, const std::string& file) {
   std::ostringstream out;
-  out << "frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,psnr_db,ssim,bad_pixel_share\n";
+  out << "frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,psnr_db,ssim,bad_pixel_share,"
+         "parallax_p99_px\n";
   char line[512];
   for (size_t k = 0; k < r.frame_indices.size(); ++k) {
     for (const ModeResult& m : r.modes) {
@@ -410,10 +440,11 @@ void writeFramesCsv(const BenchResult& r, const std::string& file) {
       out << line;
       if (k < m.errors.size()) {
         const image::ImageMetrics& e = m.errors[k];
-        std::snprintf(line, sizeof(line), "%.4f,%.6f,%.6f\n", e.psnr_db, e.ssim, e.bad_pixel_share);
-        out << line;
+        const double p = k < m.parallax_px.size() ? m.parallax_px[k] : std::numeric_limits<double>::quiet_NaN();
+        std::snprintf(line, sizeof(line), "%.4f,%.6f,%.6f,", e.psnr_db, e.ssim, e.bad_pixel_share);
+        out << line << (std::isnan(p) ? std::string() : fmt("%.3f", p)) << "\n";
       } else {
-        out << ",,\n";
+        out << ",,,\n";
       }
     }
   }
