@@ -59,9 +59,11 @@ struct BakeArgs {
   float pvs_spacing = 2.0f;
   int pvs_face = 128;
   float near_radius = 0.0f;
+  std::string landmarks;
+  double landmark_boost = 2.0;
 };
 
-std::vector<uint32_t> parseCells(const std::string& text) {
+std::vector<uint32_t> parseCells(const std::string& text, const char* what = "--cells") {
   std::vector<uint32_t> cells;
   std::stringstream ss(text);
   for (std::string item; std::getline(ss, item, ',');) {
@@ -73,7 +75,7 @@ std::vector<uint32_t> parseCells(const std::string& text) {
       used = 0;
     }
     if (used == 0 || used != item.size() || v >= 0xffffffffUL)
-      throw Error("--cells", "expected comma-separated half-edge ids, got '" + item + "'");
+      throw Error(what, "expected comma-separated ids, got '" + item + "'");
     cells.push_back(uint32_t(v));
   }
   return cells;
@@ -113,6 +115,8 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
   options.pvs.spacing = args.pvs_spacing;
   options.pvs.face_size = args.pvs_face;
   options.near_radius = args.near_radius;
+  if (!args.landmarks.empty()) options.landmarks = parseCells(args.landmarks, "--landmarks");
+  options.events.landmark_boost = args.landmark_boost;
   std::string baked, online;
   for (const std::string& s : spec.baked()) baked += (baked.empty() ? "" : ",") + s;
   for (const std::string& s : spec.online()) online += (online.empty() ? "" : ",") + s;
@@ -326,6 +330,10 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
   cmd->add_option("--pvs-spacing", args->pvs_spacing, "PVS: metres between sample points along the cell")
       ->capture_default_str();
   cmd->add_option("--pvs-face", args->pvs_face, "PVS: cube face size, pixels")->capture_default_str();
+  cmd->add_option("--landmarks", args->landmarks, "MMI layering: object ids of landmarks (comma-separated), whose "
+                                                  "visibility-event weights are boosted");
+  cmd->add_option("--landmark-boost", args->landmark_boost, "MMI layering: weight factor of landmark relations (>= 1)")
+      ->capture_default_str();
   cmd->add_option("--near-radius", args->near_radius, "Near/far by distance to the street (metres) instead of the "
                                                       "local model (0)")
       ->capture_default_str();

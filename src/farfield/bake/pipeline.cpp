@@ -128,6 +128,7 @@ nlohmann::json pipelineOptionsToJson(const PipelineOptions& o) {
           {"representative_points",
            o.events.points == urban::RepresentativePoints::HullVertices ? "hull" : "footprint"},
           {"landmark_boost", o.events.landmark_boost},
+          {"landmarks", o.landmarks},
           {"layer_order", o.layer_order == urban::LayerOrder::Given ? "given" : "nearest-first"},
           {"layer_choice", o.layer_choice == urban::LayerChoice::SmallestArea ? "smallest-area" : "least-growth"},
           {"layer_mesh", layerMeshName(o.mesh)},
@@ -163,6 +164,13 @@ PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::stri
   number("near_radius", o.near_radius);
   number("landmark_boost", o.events.landmark_boost);
   number("grid_cells", o.grid_cells);
+  if (j.contains("landmarks")) {
+    if (!j["landmarks"].is_array()) throw Error(source, "pipeline option \"landmarks\" must be an array of ids");
+    for (const nlohmann::json& id : j["landmarks"]) {
+      if (!id.is_number_unsigned()) throw Error(source, "pipeline option \"landmarks\" must hold object ids");
+      o.landmarks.push_back(id.get<uint32_t>());
+    }
+  }
   if (const std::string p = text("representative_points"); p == "hull")
     o.events.points = urban::RepresentativePoints::HullVertices;
   if (text("layer_order") == "given") o.layer_order = urban::LayerOrder::Given;
@@ -184,6 +192,8 @@ void validatePipelineOptions(const PipelineOptions& o) {
   if (o.frame_width < 1) throw Error("--frame-width", "must be at least 1 pixel");
   if (o.grid_cells < 1 || o.grid_cells > o.base.resolution)
     throw Error("--grid-cells", "must be 1.." + std::to_string(o.base.resolution) + " (the impostor resolution)");
+  if (!(o.events.landmark_boost >= 1.0) || !std::isfinite(o.events.landmark_boost))
+    throw Error("--landmark-boost", "must be a finite number >= 1");
   if (!(o.near_radius >= 0.0f) || !std::isfinite(o.near_radius))
     throw Error("--near-radius", "must be a finite number of metres >= 0");
 }
@@ -212,6 +222,10 @@ PipelineRunner::PipelineRunner(const scene::Scene& scene, const gpu::GpuScene& g
                                 " objects but the scene has " + std::to_string(scene.objects.size()));
   // Square frames: the horizontal field of view is the vertical one.
   threshold_ = urban::layerThreshold(options_.error_px, degToRad(double(options_.base.fov_deg)), options_.frame_width);
+  for (uint32_t id : options_.landmarks)
+    if (id == 0 || id > scene.objects.size())
+      throw Error("--landmarks", "object id " + std::to_string(id) + " out of range 1.." +
+                                     std::to_string(scene.objects.size()));
   ground_ = std::make_unique<GroundHeight>(scene, cells.assignment().shared);
 }
 
@@ -322,6 +336,7 @@ void PipelineRunner::runMmi(CellWork& work) {
   for (uint32_t id : far) {
     urban::EventObject o;
     o.footprint = footprintOf(scene_.objects[id - 1]);
+    o.landmark = std::find(options_.landmarks.begin(), options_.landmarks.end(), id) != options_.landmarks.end();
     if (o.footprint.empty()) o.footprint = {work.segment.q};  // no geometry: a point, it joins any layer
     objects.push_back(std::move(o));
   }

@@ -71,6 +71,7 @@ struct PipelineOptions {
   urban::PvsOptions pvs;                 // sample spacing, cube face size
   float near_radius = 0.0f;              // near/far by distance (metres) instead of the local model when > 0
   urban::VisibilityEventOptions events;  // representative points, landmark boost
+  std::vector<uint32_t> landmarks;       // object ids whose event weights are boosted (section 4.2)
   urban::LayerOrder layer_order = urban::LayerOrder::NearestFirst;
   urban::LayerChoice layer_choice = urban::LayerChoice::LeastGrowth;
   LayerMesh mesh = LayerMesh::Grid;
