@@ -109,6 +109,20 @@ TEST(ParallaxError, AbsentObjectCostsTheDiagonal) {
   EXPECT_EQ(e.mismatched, 25u + 2u);
   EXPECT_NEAR(e.max_px, 50.0, 1e-12);  // sqrt(40^2 + 30^2)
   EXPECT_NEAR(e.mean_px, 50.0, 1e-12);
+  // skip_absent: both objects are absent from the other image, so no pixel is measured.
+  ParallaxOptions skip;
+  skip.skip_absent = true;
+  const ParallaxError s = parallaxError(ref, tst, skip);
+  EXPECT_EQ(s.mismatched, 0u);
+  EXPECT_EQ(s.absent, 25u + 2u);
+  EXPECT_EQ(s.max_px, 0.0);
+  // An object present in both but shifted by 3 still counts; the absent one is left out.
+  const image::IdImage ref2 = draw(40, 30, {{2, 5, 5, 10, 10}, {4, 30, 5, 32, 7}});
+  const image::IdImage tst2 = draw(40, 30, {{2, 8, 5, 13, 10}});
+  const ParallaxError s2 = parallaxError(ref2, tst2, skip);
+  EXPECT_EQ(s2.absent, 4u);
+  EXPECT_EQ(s2.mismatched, 3u * 5u * 2u);
+  EXPECT_NEAR(s2.max_px, 3.0, 1e-12);
 }
 
 TEST(ParallaxError, IgnoredIdsCountAsBackground) {

@@ -560,6 +560,10 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
         CellWork& w = job->work;
         if (bake_mmi) {
           runner_ptr->buildMeshes(w);
+          // The construction is timed per cell: each view gets an equal share.
+          size_t views = w.single_views.size();
+          for (const auto& layer : w.layer_views) views += layer.size();
+          const double build_share = views ? w.build_ms / double(views) : 0.0;
           for (size_t l = 0; l < w.layer_views.size(); ++l)
             for (size_t v = 0; v < w.layer_views[l].size(); ++v) {
               store::StoredView& sv = w.result.layers[l].views[v];
@@ -567,8 +571,7 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
                   store::writeLayerView(out_dir, store::layerFileStem(w.cell, "mmi", l, v), w.layer_views[l][v]);
               sv.texture = written.texture;
               sv.mesh = written.mesh;
-              sv.build_ms = w.build_ms / double(w.layer_views.size() * w.layer_views[l].size() +
-                                                w.single_views.size());
+              sv.build_ms = build_share;
             }
           for (size_t v = 0; v < w.single_views.size(); ++v) {
             store::StoredView& sv = w.result.single.views[v];
@@ -576,6 +579,7 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
                 store::writeLayerView(out_dir, store::layerFileStem(w.cell, "smi", 0, v), w.single_views[v]);
             sv.texture = written.texture;
             sv.mesh = written.mesh;
+            sv.build_ms = build_share;
           }
         }
         PipelineCellReport r;

@@ -161,7 +161,7 @@ struct PipelineReport {
 };
 
 // The paper's storage estimate (section 5.1) for the cells baked, next to the bytes written: images of
-// resolution^2 x 3 bytes and meshes of a (grid+1)^2-vertex grid of float positions per layer view, with the mean
+// resolution^2 x 3 bytes and meshes of grid^2 float xyz positions (the paper's 10.8 kB for 30 x 30) per layer view, with the mean
 // layer count measured here and with the paper's worst case of 3 layers; the bytes of the textures (PNG) and meshes
 // actually written, and their uncompressed size.
 nlohmann::json storageReport(const store::StoreIndex& index, const std::string& dir, const PipelineOptions& options);

@@ -114,7 +114,9 @@ double crackShare(const image::IdImage& reference, const image::IdImage& frame) 
 double frameParallax(const image::IdImage& reference, const image::IdImage& frame, size_t object_count) {
   for (uint32_t id : frame.pixels())
     if (id > object_count) return std::numeric_limits<double>::quiet_NaN();
-  return parallaxError(reference, frame).percentile_px;
+  ParallaxOptions options;
+  options.skip_absent = true;  // impostor triangles carry their majority object's id: small objects may be absent
+  return parallaxError(reference, frame, options).percentile_px;
 }
 
 std::string shellQuote(const std::string& s) {

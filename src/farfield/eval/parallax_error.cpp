@@ -116,6 +116,7 @@ void squaredDistances(int width, const std::vector<uint32_t>& features, const st
 struct Displacements {
   std::vector<uint32_t> pixels;  // mismatching pixels, row-major ascending
   std::vector<double> px;        // their displacements
+  size_t absent = 0;             // pixels left out by ParallaxOptions::skip_absent
 };
 
 Displacements computeDisplacements(const image::IdImage& reference, const image::IdImage& test,
@@ -145,6 +146,7 @@ Displacements computeDisplacements(const image::IdImage& reference, const image:
   }
   const size_t n = out.pixels.size();
   std::vector<int64_t> d2(n, 0);
+  std::vector<uint8_t> measured(n, 0), absent(n, 0);
   if (n == 0) return out;
 
   const int64_t w = reference.width(), h = reference.height();
@@ -172,17 +174,36 @@ Displacements computeDisplacements(const image::IdImage& reference, const image:
     for (const auto& [id, list] : queries[side]) {
       const std::vector<uint32_t>& f = features[id];
       if (f.empty()) {  // the object is not in the other image at all
-        for (uint32_t q : list) d2[q] = std::max(d2[q], diagonal2);
+        for (uint32_t q : list) {
+          if (options.skip_absent)
+            absent[q] = 1;
+          else
+            d2[q] = std::max(d2[q], diagonal2);
+        }
         continue;
       }
       query_pixels.resize(list.size());
       for (size_t k = 0; k < list.size(); ++k) query_pixels[k] = out.pixels[list[k]];
       squaredDistances(reference.width(), f, query_pixels, dist);
-      for (size_t k = 0; k < list.size(); ++k) d2[list[k]] = std::max(d2[list[k]], dist[k]);
+      for (size_t k = 0; k < list.size(); ++k) {
+        d2[list[k]] = std::max(d2[list[k]], dist[k]);
+        measured[list[k]] = 1;
+      }
     }
   }
+  // With skip_absent, a pixel none of whose sides could be measured leaves the statistics (counted as absent).
+  size_t kept = 0;
   out.px.resize(n);
-  for (size_t k = 0; k < n; ++k) out.px[k] = std::sqrt(double(d2[k]));
+  for (size_t k = 0; k < n; ++k) {
+    if (options.skip_absent && absent[k] && !measured[k]) {
+      ++out.absent;
+      continue;
+    }
+    out.pixels[kept] = out.pixels[k];
+    out.px[kept++] = std::sqrt(double(d2[k]));
+  }
+  out.pixels.resize(kept);
+  out.px.resize(kept);
   return out;
 }
 
@@ -193,6 +214,7 @@ ParallaxError parallaxError(const image::IdImage& reference, const image::IdImag
   const Displacements d = computeDisplacements(reference, test, options);
   ParallaxError e;
   e.mismatched = d.pixels.size();
+  e.absent = d.absent;
   if (e.mismatched == 0) return e;
   e.share = double(e.mismatched) / double(reference.pixelCount());
   double sum = 0.0;

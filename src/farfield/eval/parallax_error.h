@@ -29,10 +29,16 @@ struct ParallaxOptions {
   // Percentile of the mismatching pixels' displacements, in (0, 1]; linear interpolation between closest ranks
   // (eval::percentile's rule, frame_stats.h).
   double percentile = 0.99;
+  // An object absent from the other image altogether gives no distance on that side instead of the diagonal; a
+  // pixel left with no side measured does not count (ParallaxError::absent). For impostors whose triangles carry one
+  // object id each (a coarse grid): a small object that is no triangle's majority never appears in their item
+  // buffer, and its pixels say nothing about displacement (the crack and PSNR measures see it).
+  bool skip_absent = false;
 };
 
 struct ParallaxError {
-  size_t mismatched = 0;      // mismatching pixels (see above)
+  size_t mismatched = 0;      // mismatching pixels (see above), those left out by skip_absent excluded
+  size_t absent = 0;          // pixels left out by skip_absent
   double share = 0.0;         // mismatched / all pixels
   double mean_px = 0.0;       // mean displacement over the mismatching pixels (0 when none)
   double percentile_px = 0.0; // ParallaxOptions::percentile of the displacements (0 when none)

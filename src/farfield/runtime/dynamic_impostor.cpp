@@ -128,10 +128,10 @@ DynamicImpostor::DynamicImpostor(gpu::Renderer& renderer, std::span<const gpu::D
   clear.a = 0.0f;
   target.clear(clear);
   if (!items.empty()) renderer.draw(camera_, items, target);
-  // The readback is the one wait for the GPU. No id image: the layer is drawn with one object id (appendDrawItems),
-  // so per-triangle ids would cost a readback and a pass over the mesh for nothing.
+  // The readback is the one wait for the GPU. The id image only when the triangles are to carry object ids.
   const image::ColorImage color = target.readColor();
   const image::DepthImage depth = target.readDepth();
+  const image::IdImage ids = options.object_ids ? target.readIds() : image::IdImage();
 
   const QuantizedDepth quantized = quantizeDepth(depth, camera_, options.depth_bits);
   data_pixels_ = quantized.data_pixels;
@@ -139,9 +139,11 @@ DynamicImpostor::DynamicImpostor(gpu::Renderer& renderer, std::span<const gpu::D
   depth_far_ = quantized.far_m;
   impostor::GridMeshOptions grid;
   grid.grid_spacing_px = double(options.grid_px);
-  const impostor::DepthMeshImpostor mesh = impostor::buildGridMesh(color, quantized.window_depth, camera_, grid);
+  const impostor::DepthMeshImpostor mesh = impostor::buildGridMesh(color, quantized.window_depth, camera_, grid,
+                                                                   options.object_ids ? &ids : nullptr);
   impostor::GpuImpostorOptions upload;
   upload.projective_texture = true;
+  upload.split_by_object_id = options.object_ids;
   impostor_ = std::make_unique<impostor::GpuImpostor>(mesh, upload);
   update_ms_ = clock.milliseconds();
 }

@@ -32,6 +32,9 @@ struct DynamicImpostorOptions {
   int grid_px = 8;
   // Depth quantisation, bits (1..16); 8 as in the paper.
   int depth_bits = 8;
+  // Give each triangle the id of the object it shows (an id readback and one mesh per object id), so item buffers
+  // tell the objects apart as with the baked layers; otherwise the whole impostor draws with appendDrawItems' id.
+  bool object_ids = false;
 };
 
 // Schaufler's error angle (radians) of an image of the objects within `bounds` captured from `capture_eye`, seen
