@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Table 1 of Decoret et al. 1999 for our city (docs/BENCHMARKS.md): a procedural city, a camera path through it, the
-# extractor pipeline (PVS, near/far split, multi-mesh impostors and the single mesh) baked for the cells the path
-# visits, and the walkthrough benchmark of full, local, visible, smi, mmi and mmi-dynamic against full-geometry
-# reference frames. A second, slow path (a pedestrian standing and walking) shows the dynamic updates, which fast
-# motion turns off.
+# Table 1 of Decoret et al. 1999 for our city (docs/BENCHMARKS.md): a procedural city, camera paths through it, the
+# extractor pipeline (PVS, near/far split, multi-mesh impostors and the single mesh) baked for the cells the paths
+# visit, and the walkthrough benchmark of full, local, visible, smi, mmi and mmi-dynamic against full-geometry
+# reference frames:
+#   drive-edge      a drive (1 m per frame), near geometry = the blocks touching the street (the paper's local model)
+#   drive-junction  the same drive, near geometry = also the blocks around both end junctions (--local junction)
+#   walk-edge       a pedestrian walk (5 cm per frame): slow enough for dynamic updates, which fast motion turns off
 # Usage: scripts/bench_mmi.sh FARFIELD OUT BLOCKS DETAIL [FRAMES] [LAYER_MESH] [BUDGET_MS]
 set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
@@ -12,21 +14,19 @@ BLOCKS=${3:-400}
 DETAIL=${4:-2}
 FRAMES=${5:-300}
 LAYER_MESH=${6:-grid}
-BUDGET=${7:-100}
+BUDGET=${7:-50}
 mkdir -p "$OUT"
 "$FARFIELD" gen city --blocks "$BLOCKS" --detail "$DETAIL" --seed 1 -o "$OUT/city.glb" | tee "$OUT/gen.txt"
-# A drive at 10 m/s sampled at 10 frames per second: 1 m per frame, a few cells.
-"$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 10 --seed 1 --car -o "$OUT/path.json" \
-  | tee "$OUT/path.txt"
-# A walk at 1.4 m/s, 30 frames per second: slow enough for dynamic updates to live several frames.
+"$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 10 --seed 1 --car -o "$OUT/drive.json" \
+  | tee "$OUT/drive.txt"
 "$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --seed 1 -o "$OUT/walk.json" | tee "$OUT/walk.txt"
-"$FARFIELD" bake "$OUT/city.glb" --pipeline pvs,near-far,mmi --layer-mesh "$LAYER_MESH" --pvs-spacing 5 \
-  --path "$OUT/path.json" --list -o "$OUT/imp" | tee "$OUT/bake.txt"
-"$FARFIELD" bake "$OUT/city.glb" --pipeline pvs,near-far,mmi --layer-mesh "$LAYER_MESH" --pvs-spacing 5 \
-  --path "$OUT/walk.json" --list -o "$OUT/imp-walk" | tee "$OUT/bake-walk.txt"
-"$FARFIELD" bench "$OUT/city.glb" --path "$OUT/path.json" --impostors "$OUT/imp" \
-  --modes full,local,visible,smi,mmi,mmi-dynamic --mode-option frame_budget_ms="$BUDGET" \
-  --reference --size 512x512 -o "$OUT/bench-drive" | tee "$OUT/bench-drive.txt"
-"$FARFIELD" bench "$OUT/city.glb" --path "$OUT/walk.json" --impostors "$OUT/imp-walk" \
-  --modes full,local,visible,smi,mmi,mmi-dynamic --mode-option frame_budget_ms="$BUDGET" \
-  --reference --size 512x512 -o "$OUT/bench-walk" | tee "$OUT/bench-walk.txt"
+run() {  # name path local
+  "$FARFIELD" bake "$OUT/city.glb" --pipeline pvs,near-far,mmi --local "$3" --layer-mesh "$LAYER_MESH" \
+    --pvs-spacing 5 --path "$OUT/$2.json" --list -o "$OUT/imp-$1" | tee "$OUT/bake-$1.txt"
+  "$FARFIELD" bench "$OUT/city.glb" --path "$OUT/$2.json" --impostors "$OUT/imp-$1" \
+    --modes full,local,visible,smi,mmi,mmi-dynamic --mode-option frame_budget_ms="$BUDGET" \
+    --reference --size 512x512 -o "$OUT/bench-$1" | tee "$OUT/bench-$1.txt"
+}
+run drive-edge drive edge
+run drive-junction drive junction
+run walk-edge walk edge

@@ -3,6 +3,7 @@
 
   frame_time.png  wall-clock frame time per frame, one line per mode (GPU time dashed when measured)
   error.png       PSNR and share of bad pixels per frame, one line per mode (only with --reference runs)
+  parallax.png    parallax error (99th percentile, pixels) per frame, for the modes where it was measured
 
 Usage: plot_bench.py OUTDIR
 Exit codes: 0 plots written, 2 bad input (missing or malformed frames.csv), 3 matplotlib not available.
@@ -17,7 +18,7 @@ import sys
 def read_frames(path):
     """Rows of frames.csv grouped by mode, in file order: {mode: {"frame": [...], "wall_ms": [...], ...}}."""
     numeric = ["frame", "path_frame", "wall_ms", "gpu_ms", "triangles", "draw_calls", "objects",
-               "psnr_db", "ssim", "bad_pixel_share"]
+               "psnr_db", "ssim", "bad_pixel_share", "parallax_p99_px"]
     modes = {}
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
@@ -124,6 +125,24 @@ def main(argv):
         fig.savefig(os.path.join(out_dir, "error.png"), dpi=110)
         plt.close(fig)
         written.append("error.png")
+
+    measured = {name: s for name, s in modes.items() if has_values(s["parallax_p99_px"])}
+    if measured:
+        fig, ax = plt.subplots(figsize=(10, 4.0))
+        for i, (name, s) in enumerate(modes.items()):
+            if name in measured:
+                ax.plot(x_of(s), s["parallax_p99_px"], label=name, color=colors[i % len(colors)], linewidth=1.2)
+        ax.set_xlabel("camera path frame")
+        ax.set_ylabel("parallax error, 99th pct (px)")
+        ax.set_title("Visibility error from object ids: how far objects are drawn from where they are seen")
+        ax.set_ylim(bottom=0)
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small", ncol=2)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out_dir, "parallax.png"), dpi=110)
+        plt.close(fig)
+        written.append("parallax.png")
 
     for name in written:
         print("wrote %s" % os.path.join(out_dir, name))

@@ -182,6 +182,8 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
                 megabytes(st["written_bytes"].get<double>()).c_str(),
                 megabytes(st["written_texture_bytes"].get<double>()).c_str(),
                 megabytes(st["written_mesh_bytes"].get<double>()).c_str());
+    std::printf("  plus per-texel object ids (for measurement): %s\n",
+                megabytes(st.value("written_id_bytes", 0.0)).c_str());
   }
   std::printf("\nwall:          %.1f s for %zu cells (%.2f s per cell)\n", report.wall_s, report.cells.size(),
               report.cells.empty() ? 0.0 : report.wall_s / double(report.cells.size()));

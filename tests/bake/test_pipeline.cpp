@@ -428,7 +428,7 @@ TEST_F(PipelineBakeTest, BakedCellsHoldAConsistentPvsSplitAndLayering) {
 TEST_F(PipelineBakeTest, StorageReportCountsTheBytesWritten) {
   const BakedCity& b = bakedCity();
   const store::StoreIndex index = store::readIndex(b.full_dir);
-  uint64_t textures = 0, meshes = 0;
+  uint64_t textures = 0, meshes = 0, ids = 0;
   size_t layers = 0, views = 0;
   std::set<std::string> referenced;
   for (const store::CellEntry& e : index.cells) {
@@ -437,7 +437,11 @@ TEST_F(PipelineBakeTest, StorageReportCountsTheBytesWritten) {
     auto add = [&](const store::StoredView& v) {
       textures += fileBytes(b.full_dir, v.texture);
       meshes += fileBytes(b.full_dir, v.mesh);
+      ids += fileBytes(b.full_dir, v.ids);
       if (!v.texture.empty()) referenced.insert(v.texture);
+      if (!v.ids.empty()) referenced.insert(v.ids);
+      // A view with data carries its per-texel object ids.
+      EXPECT_EQ(v.ids.empty(), v.texture.empty()) << v.mesh;
       referenced.insert(v.mesh);
     };
     for (const store::StoredLayer& l : e.pipeline->layers)
@@ -459,7 +463,8 @@ TEST_F(PipelineBakeTest, StorageReportCountsTheBytesWritten) {
   EXPECT_EQ(s.at("written_texture_bytes").get<uint64_t>(), textures);
   EXPECT_EQ(s.at("written_mesh_bytes").get<uint64_t>(), meshes);
   EXPECT_EQ(s.at("written_bytes").get<uint64_t>(), textures + meshes);
-  EXPECT_EQ(on_disk, textures + meshes);
+  EXPECT_EQ(s.at("written_id_bytes").get<uint64_t>(), ids);
+  EXPECT_EQ(on_disk, textures + meshes + ids);
   EXPECT_GT(textures, 0u);
   EXPECT_EQ(b.full_report.storage, s);
   EXPECT_EQ(s.at("cells").get<size_t>(), index.cells.size());

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "farfield/core/error.h"
+#include "farfield/eval/frame_stats.h"
 
 namespace farfield::eval {
 namespace {
@@ -268,6 +269,37 @@ TEST(ParallaxError, RejectsBadInput) {
   EXPECT_THROW(parallaxError(a, a, opt), Error);
   const image::IdImage empty;
   EXPECT_EQ(parallaxError(empty, empty).mismatched, 0u);
+}
+
+}  // namespace
+}  // namespace farfield::eval
+
+namespace farfield::eval {
+namespace {
+
+// The percentile over object pixels: a 10x10 object shifted by 2 has 20 + 20 mismatching pixels among 120 object
+// pixels; its 99th percentile is 2 while a single far-off stray pixel in a large correct image hardly moves it.
+TEST(ParallaxError, ObjectPercentileCountsAgreeingPixelsAsZero) {
+  const image::IdImage ref = draw(60, 40, {{3, 10, 10, 20, 20}});
+  const image::IdImage tst = draw(60, 40, {{3, 12, 10, 22, 20}});
+  const ParallaxError e = parallaxError(ref, tst);
+  EXPECT_EQ(e.object_pixels, 120u);
+  EXPECT_EQ(e.mismatched, 40u);
+  EXPECT_NEAR(e.object_percentile_px, 2.0, 1e-12);
+  // Brute force of the rank rule: 80 zeros and 40 twos, 99th percentile by linear interpolation.
+  std::vector<double> all(80, 0.0);
+  all.insert(all.end(), 40, 2.0);
+  EXPECT_DOUBLE_EQ(e.object_percentile_px, percentile(all, 99.0));
+
+  // A big correct object plus one stray pixel of it 30 px away: percentile_px (mismatched only) is the stray's,
+  // the object percentile stays 0.
+  image::IdImage big_ref = draw(60, 40, {{5, 0, 0, 30, 40}});
+  image::IdImage big_tst = big_ref;
+  big_tst.at(59, 0) = 5;
+  const ParallaxError s = parallaxError(big_ref, big_tst);
+  EXPECT_EQ(s.mismatched, 1u);
+  EXPECT_NEAR(s.percentile_px, 30.0, 1e-12);
+  EXPECT_EQ(s.object_percentile_px, 0.0);
 }
 
 }  // namespace

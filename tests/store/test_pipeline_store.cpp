@@ -369,6 +369,11 @@ impostor::DepthMeshImpostor smallView(int size) {
   auto texture = std::make_shared<image::ColorImage>(size, size, image::Rgba8(10, 20, 30, 255));
   texture->at(1, 2) = image::Rgba8(200, 0, 0, 0);
   imp.texture = texture;
+  // Per-texel ids with every byte of the 32 bits in use (the PNG packing must keep all four).
+  auto ids = std::make_shared<image::IdImage>(size, size, 0u);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) ids->at(x, y) = (x + y) % 3 == 0 ? 0u : 0x01020304u * uint32_t(x + 1) + uint32_t(y);
+  imp.ids = ids;
   imp.camera = oddCamera(0.0f);
   imp.camera.width = imp.camera.height = size;
   return imp;
@@ -394,6 +399,9 @@ TEST(PipelineStoreTest, LayerViewsRoundTripAndDamageIsDetected) {
   EXPECT_EQ(back.triangle_ids, view.triangle_ids);
   ASSERT_TRUE(back.texture);
   EXPECT_EQ(back.texture->pixels(), view.texture->pixels());
+  EXPECT_EQ(stored.ids, stem + ".ids.png");
+  ASSERT_TRUE(back.ids);
+  EXPECT_EQ(back.ids->pixels(), view.ids->pixels());
   expectSameCamera(back.camera, view.camera, "loaded view");
 
   // An empty view: a mesh file with zero counts and no texture.

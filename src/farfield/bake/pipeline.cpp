@@ -440,7 +440,7 @@ void PipelineRunner::buildMeshes(CellWork& work) const {
 
 nlohmann::json storageReport(const store::StoreIndex& index, const std::string& dir, const PipelineOptions& options) {
   size_t cells = 0, layers = 0, layer_views = 0, single_views = 0;
-  uint64_t texture_bytes = 0, mesh_bytes = 0, raw_texture_bytes = 0;
+  uint64_t texture_bytes = 0, mesh_bytes = 0, raw_texture_bytes = 0, id_bytes = 0;
   auto file_bytes = [&](const std::string& name) -> uint64_t {
     if (name.empty()) return 0;
     std::error_code ec;
@@ -450,6 +450,7 @@ nlohmann::json storageReport(const store::StoreIndex& index, const std::string& 
   auto count_view = [&](const store::StoredView& v) {
     texture_bytes += file_bytes(v.texture);
     mesh_bytes += file_bytes(v.mesh);
+    id_bytes += file_bytes(v.ids);
     if (!v.texture.empty()) raw_texture_bytes += uint64_t(v.camera.width) * uint64_t(v.camera.height) * 4;
   };
   for (const store::CellEntry& c : index.cells) {
@@ -483,6 +484,7 @@ nlohmann::json storageReport(const store::StoreIndex& index, const std::string& 
   j["written_texture_bytes"] = texture_bytes;
   j["written_mesh_bytes"] = mesh_bytes;
   j["written_bytes"] = texture_bytes + mesh_bytes;
+  j["written_id_bytes"] = id_bytes;  // per-texel object ids: for measurement (item buffers), not for the picture
   j["uncompressed_texture_bytes"] = raw_texture_bytes;
   j["single_mesh_views"] = single_views;
   return j;
@@ -571,6 +573,7 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
                   store::writeLayerView(out_dir, store::layerFileStem(w.cell, "mmi", l, v), w.layer_views[l][v]);
               sv.texture = written.texture;
               sv.mesh = written.mesh;
+              sv.ids = written.ids;
               sv.build_ms = build_share;
             }
           for (size_t v = 0; v < w.single_views.size(); ++v) {
@@ -579,6 +582,7 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
                 store::writeLayerView(out_dir, store::layerFileStem(w.cell, "smi", 0, v), w.single_views[v]);
             sv.texture = written.texture;
             sv.mesh = written.mesh;
+            sv.ids = written.ids;
             sv.build_ms = build_share;
           }
         }

@@ -116,7 +116,21 @@ double frameParallax(const image::IdImage& reference, const image::IdImage& fram
     if (id > object_count) return std::numeric_limits<double>::quiet_NaN();
   ParallaxOptions options;
   options.skip_absent = true;  // impostor triangles carry their majority object's id: small objects may be absent
-  return parallaxError(reference, frame, options).percentile_px;
+  return parallaxError(reference, frame, options).object_percentile_px;
+}
+
+// Parallax error per pixel as a picture: black where the object is right, dark red to yellow for 1 to 32+ pixels.
+image::ColorImage parallaxHeatmap(const image::IdImage& reference, const image::IdImage& frame) {
+  ParallaxOptions options;
+  options.skip_absent = true;
+  const image::Image<float> map = parallaxErrorMap(reference, frame, options);
+  image::ColorImage out(map.width(), map.height(), image::Rgba8(0, 0, 0, 255));
+  for (size_t i = 0; i < map.pixelCount(); ++i) {
+    const float t = std::min(1.0f, map.pixels()[i] / 32.0f);
+    if (map.pixels()[i] <= 0.0f) continue;
+    out.pixels()[i] = image::Rgba8(uint8_t(96 + 159 * t), uint8_t(255 * t * t), 0, 255);
+  }
+  return out;
 }
 
 std::string shellQuote(const std::string& s) {
@@ -153,9 +167,10 @@ std::string markdownHeader(const BenchResult& r) {
     md << "- error against full-geometry reference frames: PSNR (identical frames are capped at "
        << fmt("%.0f", kPsnrCapDb) << " dB), SSIM, share of pixels off by more than " << r.bad_pixel_threshold
        << "/255; cracks = share of pixels where the reference shows geometry and the mode's frame shows sky "
-          "(object ids); parallax = 99th percentile of the distance (pixels) from each pixel whose object differs "
-          "from the reference's to where the reference shows that object (object ids, eval/parallax_error.h), mean "
-          "and worst over the frames; n/a for modes whose impostors carry no object ids.\n";
+          "(object ids); parallax = 99th percentile, over the pixels that show an object, of the distance (pixels) "
+          "from each pixel to where the reference shows the object drawn there (0 where the objects agree; object "
+          "ids, eval/parallax_error.h), mean and worst over the frames; n/a for modes whose impostors carry no object "
+          "ids.\n";
   else
     md << "- no reference frames (run with --reference for image error).\n";
   return md.str();
@@ -311,11 +326,12 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
       mode_result.order.push_back(int(j));
       if (options.reference || sample) {
         const image::ColorImage frame = target.readColor();
+        image::IdImage ids;
         if (options.reference) {
           image::ImageMetrics e = image::compareImages(reference, frame, options.bad_pixel_threshold);
           if (!(e.psnr_db < kPsnrCapDb)) e.psnr_db = kPsnrCapDb;  // +inf (identical) and above the cap
           mode_result.errors.push_back(e);
-          const image::IdImage ids = target.readIds();
+          ids = target.readIds();
           mode_result.crack_shares.push_back(crackShare(reference_ids, ids));
           mode_result.parallax_px.push_back(frameParallax(reference_ids, ids, scene.objects.size()));
         }
@@ -327,6 +343,11 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
             const std::string diff = "frames/" + tag + "_" + fileSafe(mode_result.name) + "_diff.png";
             image::writePng((out_dir / diff).string(), image::diffHeatmap(reference, frame));
             sample_frame.diff_png[mode_result.name] = diff;
+            if (!std::isnan(mode_result.parallax_px.back())) {
+              // Where objects are drawn away from where the reference shows them: the parallax error per pixel.
+              const std::string par = "frames/" + tag + "_" + fileSafe(mode_result.name) + "_parallax.png";
+              image::writePng((out_dir / par).string(), parallaxHeatmap(reference_ids, ids));
+            }
           }
         }
       }
@@ -475,7 +496,7 @@ std::vector<std::string> runPlotScript(const std::string& out_dir, const std::st
     if (!c.empty() && std::find(candidates.begin(), candidates.end(), c) == candidates.end())
       candidates.push_back(c);
   // The script's own names; removed first so that a failed run cannot pass off stale plots as new.
-  const std::vector<std::string> names{"frame_time.png", "error.png"};
+  const std::vector<std::string> names{"frame_time.png", "error.png", "parallax.png"};
   for (const std::string& n : names) fs::remove(fs::path(out_dir) / n);
   // Probe quietly for an interpreter with matplotlib (python3 on PATH may be a virtual environment without it,
   // while the system one has it), then run the script once with the first that has it.

@@ -73,9 +73,10 @@ struct ModeResult {
   // geometry (object id != 0) and the mode's frame shows sky (id 0); bench.json "crack_share_mean".
   std::vector<double> crack_shares;
   double crack_share_mean = 0.0;
-  // Parallax error (eval/parallax_error.h): per frame, with a reference, the 99th percentile of how far (pixels) the
-  // mismatching pixels' objects are from where the reference shows them; NaN for frames whose item buffer holds ids
-  // that are no scene object (impostors drawn with one id of their own). bench.json "parallax_p99_px_mean"/"_max".
+  // Parallax error (eval/parallax_error.h): per frame, with a reference, the 99th percentile over the pixels that
+  // show an object of how far (pixels) that object is from where the reference shows it (object_percentile_px); NaN
+  // for frames whose item buffer holds ids that are no scene object (impostors drawn with one id of their own).
+  // bench.json "parallax_p99_px_mean"/"_max".
   std::vector<double> parallax_px;
   bool has_parallax = false;   // at least one frame measured
   double parallax_px_mean = 0.0;

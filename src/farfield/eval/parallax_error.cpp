@@ -117,6 +117,7 @@ struct Displacements {
   std::vector<uint32_t> pixels;  // mismatching pixels, row-major ascending
   std::vector<double> px;        // their displacements
   size_t absent = 0;             // pixels left out by ParallaxOptions::skip_absent
+  size_t object_pixels = 0;      // pixels where either image shows an object (not background, not ignored)
 };
 
 Displacements computeDisplacements(const image::IdImage& reference, const image::IdImage& test,
@@ -138,6 +139,7 @@ Displacements computeDisplacements(const image::IdImage& reference, const image:
   // test. Values are indices into out.pixels, ascending (hence row-major).
   std::unordered_map<uint32_t, std::vector<uint32_t>> queries[2];
   for (size_t p = 0; p < ref.size(); ++p) {
+    out.object_pixels += (ref[p] != 0 || tst[p] != 0) ? 1 : 0;
     if (ref[p] == tst[p]) continue;  // agreeing ids, or both background/ignored
     const uint32_t index = uint32_t(out.pixels.size());
     out.pixels.push_back(uint32_t(p));
@@ -228,6 +230,15 @@ ParallaxError parallaxError(const image::IdImage& reference, const image::IdImag
   e.worst_x = int(d.pixels[worst] % uint32_t(reference.width()));
   e.worst_y = int(d.pixels[worst] / uint32_t(reference.width()));
   e.percentile_px = percentile(d.px, options.percentile * 100.0);
+  // Over the object pixels, the agreeing ones at 0: the same rank rule on the zeros followed by the sorted
+  // displacements (pixels left out as absent are not object pixels of either measure).
+  const size_t objects = d.object_pixels - d.absent;
+  e.object_pixels = objects;
+  if (objects > 0) {
+    std::vector<double> all(objects - e.mismatched, 0.0);
+    all.insert(all.end(), d.px.begin(), d.px.end());
+    e.object_percentile_px = percentile(all, options.percentile * 100.0);
+  }
   return e;
 }
 

@@ -43,6 +43,11 @@ struct ParallaxError {
   double mean_px = 0.0;       // mean displacement over the mismatching pixels (0 when none)
   double percentile_px = 0.0; // ParallaxOptions::percentile of the displacements (0 when none)
   double max_px = 0.0;        // largest displacement (0 when none)
+  // The percentile over every object pixel (where either image shows a counted object; agreeing pixels count as 0
+  // displacement): "this share of what is drawn lies within this many pixels of its place". Robust when few pixels
+  // mismatch, where percentile_px is the tail of the mismatching pixels alone. 0 without object pixels.
+  size_t object_pixels = 0;
+  double object_percentile_px = 0.0;
   int worst_x = -1, worst_y = -1;  // a pixel with the largest displacement (first in row order), -1 when none
 };
 

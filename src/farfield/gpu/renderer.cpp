@@ -23,7 +23,7 @@ enum Variant : int { kShadedPlain = 0, kShadedTextured = 1, kItemBuffer = 2, kVa
 struct Locations {
   int view_proj = -1, model = -1, normal_matrix = -1, object_id = -1;
   int base_color = -1, unlit = -1, light_dir = -1, light_color = -1, ambient = -1;
-  int projective_texture = -1, texture_projection = -1;
+  int projective_texture = -1, texture_projection = -1, has_ids = -1;
 };
 
 const GpuMaterial& defaultMaterial() {
@@ -59,6 +59,7 @@ struct Renderer::Impl {
       l.ambient = p.uniformLocation("u_ambient");
       l.projective_texture = p.uniformLocation("u_projective_texture");
       l.texture_projection = p.uniformLocation("u_texture_projection");
+      l.has_ids = p.uniformLocation("u_has_ids");
     }
   }
 };
@@ -164,6 +165,10 @@ FrameStats Renderer::draw(const Camera& camera, std::span<const DrawItem> items,
       if (variant == kShadedTextured && material.texture->handle() != current_texture) {
         current_texture = material.texture->handle();
         glBindTextureUnit(0, current_texture);
+      }
+      if (variant == kShadedTextured) {
+        glUniform1i(l.has_ids, material.id_texture ? 1 : 0);
+        if (material.id_texture) glBindTextureUnit(1, material.id_texture->handle());
       }
       const int want_cull = material.double_sided ? 0 : 1;
       if (want_cull != cull) {

@@ -30,6 +30,10 @@ struct GpuMaterial {
   // whatever the depths of its triangle's vertices.
   bool projective_texture = false;
   Mat4 texture_projection{1.0f};
+  // Per-texel object ids (R32UI, read at the same texture coordinate as `texture`, nearest texel; only with a
+  // texture): the id buffer gets the texel's id instead of DrawItem::object_id where it is not 0. An impostor drawn
+  // with the ids of its capture then tells, pixel by pixel, which object it shows (bench: parallax error).
+  const Texture* id_texture = nullptr;
 };
 
 struct DrawItem {

@@ -83,6 +83,15 @@ Texture Texture::fromImage(const image::ColorImage& image, bool mipmaps) {
   return texture;
 }
 
+Texture Texture::fromIds(const image::IdImage& ids) {
+  if (ids.empty()) throw Error("texture", "id image is empty");
+  Texture texture(ids.width(), ids.height(), TextureFormat::R32UI, false);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(texture.handle_, 0, 0, 0, ids.width(), ids.height(), GL_RED_INTEGER, GL_UNSIGNED_INT,
+                      ids.pixels().data());
+  return texture;
+}
+
 Texture::~Texture() {
   if (handle_) glDeleteTextures(1, &handle_);
 }

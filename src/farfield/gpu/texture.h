@@ -23,6 +23,8 @@ class Texture {
   Texture(const Texture&) = delete;
   Texture& operator=(const Texture&) = delete;
 
+  // R32UI texture of object ids (nearest, clamped): per-texel ids of an impostor (GpuMaterial::id_texture).
+  static Texture fromIds(const image::IdImage& ids);
   void upload(const image::ColorImage& image);  // RGBA8 textures; regenerates mipmaps if it has them
   void setClampToEdge();
   void bind(int unit) const;

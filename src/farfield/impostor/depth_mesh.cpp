@@ -232,6 +232,7 @@ DepthMeshImpostor buildDepthMesh(const image::ColorImage& color, const image::De
   // crossings and midpoints of those), so a short search suffices; a vertex beyond it is counted and dropped.
   assembleMesh(triangulation.vertices, kept, sampler, std::max(0, options.contour_dilation_px) + 2, camera, ids, out);
   if (!out.empty()) out.texture = impostorTexture(color, mask);
+  if (!out.empty() && ids) out.ids = impostorIds(*ids, mask);
   out.stats.reprojection_ms = step.milliseconds();
   out.stats.total_ms = total.milliseconds();
   return out;

@@ -57,6 +57,11 @@ GpuImpostor::GpuImpostor(const DepthMeshImpostor& impostor, const GpuImpostorOpt
     material_->texture = texture_.get();
     material_->projective_texture = options.projective_texture;
     material_->texture_projection = textureProjection(impostor.camera);
+    if (options.id_texture && impostor.ids && impostor.ids->width() == impostor.texture->width() &&
+        impostor.ids->height() == impostor.texture->height()) {
+      id_texture_ = std::make_unique<gpu::Texture>(gpu::Texture::fromIds(*impostor.ids));
+      material_->id_texture = id_texture_.get();
+    }
   }
   if (options.split_by_object_id && impostor.triangle_ids.size() == impostor.mesh.triangleCount()) {
     for (IdMesh& part : splitByObjectId(impostor.mesh, impostor.triangle_ids)) {
@@ -76,7 +81,7 @@ void GpuImpostor::appendDrawItems(std::vector<gpu::DrawItem>& out, uint32_t obje
 }
 
 size_t GpuImpostor::gpuBytes() const {
-  size_t bytes = texture_ ? texture_->byteSize() : 0;
+  size_t bytes = (texture_ ? texture_->byteSize() : 0) + (id_texture_ ? id_texture_->byteSize() : 0);
   for (const gpu::GpuMesh& m : meshes_) bytes += m.byteSize();
   return bytes;
 }

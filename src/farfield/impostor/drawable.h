@@ -41,6 +41,9 @@ struct GpuImpostorOptions {
   // Texture coordinates projected from the creation camera (gpu::GpuMaterial::projective_texture) instead of the
   // mesh's interpolated uvs: exact in the creation view whatever the triangles' depth range.
   bool projective_texture = true;
+  // Upload the impostor's per-texel ids (DepthMeshImpostor::ids) as the material's id texture, so item buffers show
+  // the object of every impostor pixel (finer than split_by_object_id's per-triangle majority, and one draw call).
+  bool id_texture = false;
 };
 
 // The impostor on the GPU: its texture (bilinear, clamped at the edges so the image border does not wrap) and its
@@ -60,6 +63,7 @@ class GpuImpostor {
   std::vector<gpu::GpuMesh> meshes_;
   std::vector<uint32_t> ids_;  // per mesh, 0 = use appendDrawItems' object_id
   std::unique_ptr<gpu::Texture> texture_;
+  std::unique_ptr<gpu::Texture> id_texture_;
   std::unique_ptr<gpu::GpuMaterial> material_;
   uint64_t triangles_ = 0;
 };

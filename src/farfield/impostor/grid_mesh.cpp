@@ -78,6 +78,7 @@ DepthMeshImpostor buildGridMesh(const image::ColorImage& color, const image::Dep
   step.restart();
   assembleMesh(points, triangles, sampler, -1, camera, ids, out);
   out.texture = impostorTexture(color, mask);
+  if (ids) out.ids = impostorIds(*ids, mask);
   out.stats.reprojection_ms = step.milliseconds();
   out.stats.total_ms = total.milliseconds();
   return out;

@@ -26,6 +26,30 @@ std::shared_ptr<const image::ColorImage> impostorTexture(const image::ColorImage
   return texture;
 }
 
+std::shared_ptr<const image::IdImage> impostorIds(const image::IdImage& ids, const image::Image<uint8_t>& mask) {
+  auto out = std::make_shared<image::IdImage>(ids);
+  for (size_t i = 0; i < out->pixelCount(); ++i)
+    if (!mask.pixels()[i]) out->pixels()[i] = 0;
+  // Grown by two texels into the background: the colour texture's alpha is filtered bilinearly, so a pixel at the
+  // silhouette can pass the alpha test where the nearest id texel is background; it gets its neighbour's id.
+  const int w = out->width(), h = out->height();
+  for (int pass = 0; pass < 2; ++pass) {
+    const image::IdImage before = *out;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (before.at(x, y) != 0) continue;
+        for (int dy = -1; dy <= 1 && out->at(x, y) == 0; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx, ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= w || ny >= h || before.at(nx, ny) == 0) continue;
+            out->at(x, y) = before.at(nx, ny);
+            break;
+          }
+      }
+  }
+  return out;
+}
+
 void assembleMesh(const std::vector<DVec2>& points, const std::vector<std::array<uint32_t, 3>>& triangles,
                   const DepthSampler& sampler, int max_search_px, const Camera& camera, const image::IdImage* ids,
                   DepthMeshImpostor& out) {

@@ -56,6 +56,9 @@ struct DepthMeshImpostor {
   std::shared_ptr<const image::ColorImage> texture;
   Camera camera;                        // creation camera
   std::vector<uint32_t> triangle_ids;   // per triangle, majority object id of its pixels (empty without ids)
+  // Per-texel object ids of the texture (0 away from the data), when the capture had ids: drawn as an id texture
+  // (GpuImpostorOptions::id_texture), item buffers show the object of every impostor pixel.
+  std::shared_ptr<const image::IdImage> ids;
   ImpostorBuildStats stats;
 
   bool empty() const { return mesh.indices.empty(); }
@@ -71,6 +74,9 @@ Mat4 textureProjection(const Camera& camera);
 // The impostor texture: colour with alpha from the data mask.
 std::shared_ptr<const image::ColorImage> impostorTexture(const image::ColorImage& color,
                                                          const image::Image<uint8_t>& mask);
+// The capture's ids where the mask marks data, grown by two texels into the background, 0 elsewhere
+// (DepthMeshImpostor::ids).
+std::shared_ptr<const image::IdImage> impostorIds(const image::IdImage& ids, const image::Image<uint8_t>& mask);
 
 // Reprojects 2D triangles (image coordinates, either orientation) to the impostor mesh: each vertex used by a
 // triangle gets the sampler's window depth (DepthSampler's rule, searching at most max_search_px for data; < 0: no

@@ -143,7 +143,7 @@ DynamicImpostor::DynamicImpostor(gpu::Renderer& renderer, std::span<const gpu::D
                                                                    options.object_ids ? &ids : nullptr);
   impostor::GpuImpostorOptions upload;
   upload.projective_texture = true;
-  upload.split_by_object_id = options.object_ids;
+  upload.id_texture = options.object_ids;
   impostor_ = std::make_unique<impostor::GpuImpostor>(mesh, upload);
   update_ms_ = clock.milliseconds();
 }

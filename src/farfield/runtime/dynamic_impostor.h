@@ -32,8 +32,8 @@ struct DynamicImpostorOptions {
   int grid_px = 8;
   // Depth quantisation, bits (1..16); 8 as in the paper.
   int depth_bits = 8;
-  // Give each triangle the id of the object it shows (an id readback and one mesh per object id), so item buffers
-  // tell the objects apart as with the baked layers; otherwise the whole impostor draws with appendDrawItems' id.
+  // Read the capture's ids back and draw them as an id texture, so item buffers show the object of every pixel as
+  // with the baked layers; otherwise the whole impostor draws with appendDrawItems' id.
   bool object_ids = false;
 };
 

@@ -185,7 +185,7 @@ std::unique_ptr<MmiMode::Cell> MmiMode::loadCell(const store::CellEntry& entry) 
   if (kind_ == MmiKind::Local || kind_ == MmiKind::Visible) return cell;
 
   impostor::GpuImpostorOptions gpu_options;
-  gpu_options.split_by_object_id = object_ids_;
+  gpu_options.id_texture = object_ids_;  // per-pixel object ids in item buffers, one draw call per view
   const bool single = kind_ == MmiKind::Smi;
   const std::vector<store::StoredLayer> layers = single ? std::vector<store::StoredLayer>{record.single}
                                                         : record.layers;

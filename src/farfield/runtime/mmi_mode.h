@@ -12,8 +12,8 @@
 // Mode options (--mode-option key=value; `farfield bench --impostors DIR` sets impostor_dir):
 //   impostor_dir=DIR        the pipeline store (mmi_dir=DIR overrides it for these modes)
 //   impostor_cache=N        cells kept loaded (least recently used evicted), default 16
-//   impostor_ids=object|layer  draw each impostor triangle with the id of the object it shows (default; item
-//                           buffers then tell objects apart) or one id per layer (fewer draw calls)
+//   impostor_ids=object|layer  item buffers show, per impostor pixel, the object captured there (default: the
+//                           views' per-texel ids as an id texture) or one id per layer
 //   cell_lookup=street|nearest  as for the depth-mesh mode
 //   mmi-dynamic only:
 //   frame_budget_ms=MS      the desired frame time (default 33.3: 30 Hz)

@@ -121,7 +121,7 @@ class JsonReader {
 };
 
 nlohmann::json viewJson(const StoredView& v) {
-  return {{"camera", cameraJson(v.camera)}, {"texture", v.texture},         {"mesh", v.mesh},
+  return {{"camera", cameraJson(v.camera)}, {"texture", v.texture},         {"mesh", v.mesh}, {"ids", v.ids},
           {"triangles", v.triangles},       {"vertices", v.vertices},       {"data_pixels", v.data_pixels},
           {"render_ms", v.render_ms},       {"build_ms", v.build_ms}};
 }
@@ -173,6 +173,7 @@ StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::s
     view.camera = r.camera(views[v], at);
     view.texture = r.relativeFile(views[v], "texture", at, true);
     view.mesh = r.relativeFile(views[v], "mesh", at, false);
+    if (views[v].contains("ids")) view.ids = r.relativeFile(views[v], "ids", at, true);
     view.triangles = size_t(r.count(views[v], "triangles", at));
     view.vertices = size_t(r.count(views[v], "vertices", at));
     view.data_pixels = size_t(r.count(views[v], "data_pixels", at));
@@ -538,6 +539,16 @@ StoredView writeLayerView(const std::string& dir, const std::string& stem, const
     out.texture = stem + ".png";
     image::writePng(joinPath(dir, out.texture), *view.texture);
   }
+  if (!view.empty() && view.ids) {
+    // 32-bit ids in the four 8-bit channels: PNG keeps them exactly and compresses the large runs of one id.
+    image::ColorImage packed(view.ids->width(), view.ids->height());
+    for (size_t i = 0; i < packed.pixelCount(); ++i) {
+      const uint32_t id = view.ids->pixels()[i];
+      packed.pixels()[i] = image::Rgba8(uint8_t(id), uint8_t(id >> 8), uint8_t(id >> 16), uint8_t(id >> 24));
+    }
+    out.ids = stem + ".ids.png";
+    image::writePng(joinPath(dir, out.ids), packed);
+  }
   return out;
 }
 
@@ -557,6 +568,20 @@ impostor::DepthMeshImpostor loadLayerView(const std::string& dir, const StoredVi
                                   std::to_string(texture->height()) + " but the creation camera is " +
                                   std::to_string(view.camera.width) + "x" + std::to_string(view.camera.height));
   out.texture = std::move(texture);
+  if (!view.ids.empty()) {
+    const std::string ids_file = joinPath(dir, view.ids);
+    const image::ColorImage packed = image::readPng(ids_file);
+    if (packed.width() != view.camera.width || packed.height() != view.camera.height)
+      throw Error(ids_file, "id image is " + std::to_string(packed.width()) + "x" + std::to_string(packed.height()) +
+                                " but the creation camera is " + std::to_string(view.camera.width) + "x" +
+                                std::to_string(view.camera.height));
+    auto ids = std::make_shared<image::IdImage>(packed.width(), packed.height(), 0u);
+    for (size_t i = 0; i < packed.pixelCount(); ++i) {
+      const image::Rgba8 c = packed.pixels()[i];
+      ids->pixels()[i] = uint32_t(c.r) | uint32_t(c.g) << 8 | uint32_t(c.b) << 16 | uint32_t(c.a) << 24;
+    }
+    out.ids = std::move(ids);
+  }
   return out;
 }
 

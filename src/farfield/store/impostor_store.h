@@ -32,6 +32,7 @@
 //                          "layers": [{"objects": [...], "views": [VIEW, ...]}, ...],   // nearest layer first
 //                          "single": {"objects": [...], "views": [VIEW, ...]}}}          // the single mesh
 //   with VIEW = {"camera": {...}, "texture": "cells/e000012.mmi.00.0.png", "mesh": "cells/e000012.mmi.00.0.ffmesh",
+//                "ids": "cells/e000012.mmi.00.0.ids.png" (optional),
 //                "triangles": 540, "vertices": 300, "data_pixels": 81234, "render_ms": 20.1, "build_ms": 3.2}
 //   (each part present when its stage was baked). Version 1 indexes are still read.
 //   Cells are sorted by half-edge id, each at most once. Numbers are JSON numbers (floats written with enough digits
@@ -83,6 +84,8 @@ struct StoredView {
   Camera camera;
   std::string texture;     // relative to the store directory; "" when the view has no data
   std::string mesh;        // relative to the store directory (an empty view has a mesh file with zero counts)
+  std::string ids;         // per-texel object ids, PNG with each id's 4 bytes (little-endian) in R, G, B, A; ""
+                           // when none (drawn as an id texture: item buffers then show every pixel's object)
   size_t triangles = 0;
   size_t vertices = 0;
   size_t data_pixels = 0;

@@ -1,7 +1,8 @@
 #version 450 core
 // Farfield mesh fragment shader: colour to attachment 0, object id to attachment 1 (R32UI).
 // Shaded: lit colour = albedo * (ambient + light_color * max(dot(n, -light_dir), 0)), unlit colour = albedo, where
-// albedo = base colour (times the texture with FF_TEXTURED, texels with alpha < 0.5 are cut out).
+// albedo = base colour (times the texture with FF_TEXTURED, texels with alpha < 0.5 are cut out). With FF_TEXTURED
+// and u_has_ids, the id is the texel's of u_ids at the same texture coordinate (impostors: per-pixel object ids).
 // FF_ITEM_BUFFER: a flat false colour of the object id, no texture sampling.
 
 in vec3 v_world;
@@ -33,6 +34,8 @@ uniform vec3 u_light_color;
 uniform float u_ambient;
 #ifdef FF_TEXTURED
 layout(binding = 0) uniform sampler2D u_texture;
+uniform int u_has_ids;  // 1: object ids per texel in u_ids (0 texels keep u_object_id)
+layout(binding = 1) uniform usampler2D u_ids;
 #endif
 
 void main() {
@@ -41,6 +44,14 @@ void main() {
   const vec2 uv = u_projective_texture != 0 ? v_uv_projected.xy / v_uv_projected.w : v_uv;
   albedo *= texture(u_texture, uv);
   if (albedo.a < 0.5) discard;
+#endif
+  uint id = u_object_id;
+#ifdef FF_TEXTURED
+  if (u_has_ids != 0) {
+    const ivec2 size = textureSize(u_ids, 0);
+    const uint texel = texelFetch(u_ids, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0).r;
+    if (texel != 0u) id = texel;
+  }
 #endif
   vec3 rgb = albedo.rgb;
   if (u_unlit == 0) {
@@ -55,7 +66,7 @@ void main() {
     rgb *= vec3(u_ambient) + u_light_color * max(dot(n, -u_light_dir), 0.0);
   }
   o_color = vec4(rgb, albedo.a);
-  o_id = u_object_id;
+  o_id = id;
 }
 
 #endif
