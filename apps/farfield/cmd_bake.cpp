@@ -97,7 +97,12 @@ Summary summarize(std::vector<double> v) {
 
 std::string megabytes(double bytes) {
   char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.1f MB", bytes / 1e6);
+  if (bytes >= 1e9)
+    std::snprintf(buf, sizeof(buf), "%.2f GB", bytes / 1e9);
+  else if (bytes >= 1e6)
+    std::snprintf(buf, sizeof(buf), "%.1f MB", bytes / 1e6);
+  else
+    std::snprintf(buf, sizeof(buf), "%.1f kB", bytes / 1e3);
   return buf;
 }
 
@@ -184,6 +189,10 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
                 megabytes(st["written_mesh_bytes"].get<double>()).c_str());
     std::printf("  plus per-texel object ids (for measurement): %s\n",
                 megabytes(st.value("written_id_bytes", 0.0)).c_str());
+    if (st.contains("city_cells"))
+      std::printf("  whole city (%zu cells): estimate %s, written at this rate %s\n", st["city_cells"].get<size_t>(),
+                  megabytes(st["estimate_bytes_city"].get<double>()).c_str(),
+                  megabytes(st["projected_written_bytes_city"].get<double>()).c_str());
   }
   std::printf("\nwall:          %.1f s for %zu cells (%.2f s per cell)\n", report.wall_s, report.cells.size(),
               report.cells.empty() ? 0.0 : report.wall_s / double(report.cells.size()));
@@ -203,7 +212,15 @@ void runBakeCommand(const BakeArgs& args) {
   options.scene_label = args.scene;
   if (args.out_dir.empty()) throw Error("-o", "an output directory is needed");
 
-  // Cheap inputs first: streets and path fail before the scene is loaded.
+  // Cheap inputs first: pipeline options, streets and path fail before the scene is loaded.
+  if (!args.pipeline.empty()) {
+    bake::parsePipeline(args.pipeline, args.online);
+    bake::parseLayerMesh(args.layer_mesh);
+    bake::parseLayerViews(args.views);
+    if (!args.landmarks.empty()) parseCells(args.landmarks, "--landmarks");
+  } else if (!args.online.empty()) {
+    throw Error("--online", "needs --pipeline (the online stages are a tail of the pipeline)");
+  }
   const std::string streets_file = args.streets.empty() ? gen::streetsPathFor(args.scene) : args.streets;
   urban::StreetGraph graph = urban::StreetGraph::load(streets_file);
   gen::CameraPath path;

@@ -77,6 +77,22 @@ Camera cellCamera(const urban::CellMap& cells, uint32_t cell, const BakeOptions&
   return impostor::creationCamera(eye, at, o, options.near_plane, options.far_plane);
 }
 
+CellSelection selectCells(const urban::CellMap& cells, std::vector<uint32_t> half_edges) {
+  if (half_edges.empty())
+    for (uint32_t e = 0; e < cells.cellCount(); ++e) half_edges.push_back(e);
+  CellSelection out;
+  std::set<uint32_t> seen;
+  for (uint32_t e : half_edges) {
+    if (e >= cells.cellCount())
+      throw Error("cell " + std::to_string(e), "no such half-edge (the street graph has " +
+                                                   std::to_string(cells.cellCount()) + ")");
+    if (!seen.insert(e).second) continue;
+    (cells.degenerate(e) ? out.skipped_degenerate : out.todo).push_back(e);
+  }
+  out.requested = seen.size();
+  return out;
+}
+
 std::vector<uint32_t> cellsOnPath(const urban::CellMap& cells, const gen::CameraPath& path) {
   std::vector<uint32_t> order;
   std::set<uint32_t> seen;
@@ -98,23 +114,10 @@ BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urb
   report.store_dir = out_dir;
 
   // The cells: requested order without repeats; degenerate ones reported and skipped.
-  if (half_edges.empty())
-    for (uint32_t e = 0; e < cells.cellCount(); ++e) half_edges.push_back(e);
-  std::vector<uint32_t> todo;
-  {
-    std::set<uint32_t> seen;
-    for (uint32_t e : half_edges) {
-      if (e >= cells.cellCount())
-        throw Error("cell " + std::to_string(e), "no such half-edge (the street graph has " +
-                                                     std::to_string(cells.cellCount()) + ")");
-      if (!seen.insert(e).second) continue;
-      if (cells.degenerate(e))
-        report.skipped_degenerate.push_back(e);
-      else
-        todo.push_back(e);
-    }
-    report.requested = seen.size();
-  }
+  CellSelection selection = selectCells(cells, std::move(half_edges));
+  const std::vector<uint32_t> todo = std::move(selection.todo);
+  report.skipped_degenerate = std::move(selection.skipped_degenerate);
+  report.requested = selection.requested;
 
   const GroundHeight ground_height(scene, cells.assignment().shared);
   const auto ground = [&](float x, float y) { return ground_height.at(x, y, 0.0f); };

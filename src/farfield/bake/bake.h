@@ -86,6 +86,15 @@ Camera cellCamera(const urban::CellMap& cells, uint32_t cell, const BakeOptions&
 BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urban::CellMap& cells,
                      std::vector<uint32_t> half_edges, const BakeOptions& options, const std::string& out_dir);
 
+// The cells a bake works on: the requested half-edges (empty = every cell) in order without repeats, the degenerate
+// ones apart. Throws farfield::Error naming the id for one out of range.
+struct CellSelection {
+  std::vector<uint32_t> todo;
+  std::vector<uint32_t> skipped_degenerate;
+  size_t requested = 0;  // distinct cells asked for
+};
+CellSelection selectCells(const urban::CellMap& cells, std::vector<uint32_t> half_edges);
+
 // The cells a camera path visits (CellMap::lookup of each frame's eye and view direction), in order of first visit.
 std::vector<uint32_t> cellsOnPath(const urban::CellMap& cells, const gen::CameraPath& path);
 

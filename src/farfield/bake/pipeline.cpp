@@ -438,7 +438,8 @@ void PipelineRunner::buildMeshes(CellWork& work) const {
 // ---------------------------------------------------------------------------------------------------------------
 // Storage (section 5.1)
 
-nlohmann::json storageReport(const store::StoreIndex& index, const std::string& dir, const PipelineOptions& options) {
+nlohmann::json storageReport(const store::StoreIndex& index, const std::string& dir, const PipelineOptions& options,
+                             size_t city_cells) {
   size_t cells = 0, layers = 0, layer_views = 0, single_views = 0;
   uint64_t texture_bytes = 0, mesh_bytes = 0, raw_texture_bytes = 0, id_bytes = 0;
   auto file_bytes = [&](const std::string& name) -> uint64_t {
@@ -487,6 +488,11 @@ nlohmann::json storageReport(const store::StoreIndex& index, const std::string& 
   j["written_id_bytes"] = id_bytes;  // per-texel object ids: for measurement (item buffers), not for the picture
   j["uncompressed_texture_bytes"] = raw_texture_bytes;
   j["single_mesh_views"] = single_views;
+  if (city_cells > 0 && cells > 0) {
+    j["city_cells"] = city_cells;
+    j["estimate_bytes_city"] = double(city_cells) * mean_layers * double(views) * (image + grid);
+    j["projected_written_bytes_city"] = double(city_cells) * double(texture_bytes + mesh_bytes) / double(cells);
+  }
   return j;
 }
 
@@ -514,20 +520,10 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
   Stopwatch wall;
   PipelineReport report;
   report.store_dir = out_dir;
-  if (half_edges.empty())
-    for (uint32_t e = 0; e < cells.cellCount(); ++e) half_edges.push_back(e);
-  std::vector<uint32_t> todo;
-  {
-    std::set<uint32_t> seen;
-    for (uint32_t e : half_edges) {
-      if (e >= cells.cellCount())
-        throw Error("cell " + std::to_string(e), "no such half-edge (the street graph has " +
-                                                     std::to_string(cells.cellCount()) + ")");
-      if (!seen.insert(e).second) continue;
-      (cells.degenerate(e) ? report.skipped_degenerate : todo).push_back(e);
-    }
-    report.requested = seen.size();
-  }
+  CellSelection selection = selectCells(cells, std::move(half_edges));
+  const std::vector<uint32_t> todo = std::move(selection.todo);
+  report.skipped_degenerate = std::move(selection.skipped_degenerate);
+  report.requested = selection.requested;
   {
     std::error_code ec;
     fs::create_directories(fs::path(out_dir) / "cells", ec);
@@ -670,7 +666,7 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
   index.online = spec.online();
   index.options = {{"pipeline", pipelineOptionsToJson(options)}, {"block_margin", cells.options().block_margin}};
   index.cells = std::move(entries);
-  index.storage = storageReport(index, out_dir, options);
+  index.storage = storageReport(index, out_dir, options, cells.cellCount());
   store::writeIndex(out_dir, index);
 
   report.cells = std::move(records);

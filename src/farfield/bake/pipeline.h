@@ -163,8 +163,10 @@ struct PipelineReport {
 // The paper's storage estimate (section 5.1) for the cells baked, next to the bytes written: images of
 // resolution^2 x 3 bytes and meshes of grid^2 float xyz positions (the paper's 10.8 kB for 30 x 30) per layer view, with the mean
 // layer count measured here and with the paper's worst case of 3 layers; the bytes of the textures (PNG) and meshes
-// actually written, and their uncompressed size.
-nlohmann::json storageReport(const store::StoreIndex& index, const std::string& dir, const PipelineOptions& options);
+// actually written, and their uncompressed size. With city_cells > 0 (every cell of the street graph), the same
+// estimate and the bytes written per cell scaled to the whole city.
+nlohmann::json storageReport(const store::StoreIndex& index, const std::string& dir, const PipelineOptions& options,
+                             size_t city_cells = 0);
 
 // Bakes the baked stages of `spec` for the given cells (empty = all) into the store `out_dir`: GL stages and captures
 // on the calling thread, meshes and files on worker threads, a progress bar. The store holds what the bench modes
