@@ -1,14 +1,6 @@
 // Parallel bake of cell impostors (Sillion et al. 1997, sections 4.1-4.2): one capture per cell on the GL thread,
-// the constructions on worker threads.
-//
-// Why a producer/consumer instead of a parallel loop: the capture needs the one OpenGL context, which is current on
-// one thread only, while the constructions are pure CPU work without shared state (buildDepthMesh and buildGridMesh
-// say so). A tbb::concurrent_bounded_queue between the two bounds the captures in flight (each is colour, depth and
-// ids at the impostor resolution: 3 MB at 512x512), and lets the GL thread block when the workers fall behind instead
-// of rendering ahead without limit. The queue carries a null job per worker to stop them.
+// the constructions and files on worker threads (bake/gl_workers.h).
 #include "farfield/bake/bake.h"
-
-#include <oneapi/tbb/concurrent_queue.h>
 
 #include <algorithm>
 #include <atomic>
@@ -20,6 +12,7 @@
 #include <set>
 #include <thread>
 
+#include "farfield/bake/gl_workers.h"
 #include "farfield/bake/ground_height.h"
 #include "farfield/core/error.h"
 #include "farfield/core/progress.h"
@@ -147,106 +140,62 @@ BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urb
   }
   cells.graph().save((std::filesystem::path(out_dir) / store::kStreetsFile).string());
 
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const size_t workers = options.workers > 0 ? size_t(options.workers) : size_t(std::max(1u, hw - 1));
+  const size_t workers = workerCount(options.workers);
   report.workers = workers;
 
-  tbb::concurrent_bounded_queue<std::shared_ptr<Job>> queue;
-  queue.set_capacity(std::ptrdiff_t(std::max<size_t>(1, options.queue_capacity)));
   std::mutex results_mutex;
   std::vector<CellBake> records;
   std::vector<store::CellEntry> entries;
-  std::exception_ptr worker_error;
-  std::atomic<bool> failed{false};
-  std::unique_ptr<Progress> progress;
-  if (options.progress) progress = std::make_unique<Progress>("bake", todo.size());
-
-  auto work = [&] {
-    for (;;) {
-      std::shared_ptr<Job> job;
-      queue.pop(job);
-      if (!job) return;
-      if (failed.load()) continue;  // drain without work after an error
-      try {
-        std::map<std::string, impostor::DepthMeshImpostor> built;
-        for (const std::string& technique : options.techniques) {
-          Stopwatch t;
-          if (technique == kDepthMesh) {
-            impostor::DepthMeshOptions o = options.depth_mesh;
-            o.resolution = options.resolution;
-            o.fov_y = job->capture.camera.fov_y;
-            built[technique] = impostor::buildDepthMesh(job->capture, o);
-          } else {
-            built[technique] = impostor::buildGridMesh(job->capture, options.grid_mesh);
-          }
-          job->record.build_ms[technique] = t.milliseconds();
-          job->record.triangles[technique] = built[technique].mesh.triangleCount();
-        }
-        Stopwatch t;
-        std::map<std::string, const impostor::DepthMeshImpostor*> pointers;
-        for (const auto& [technique, imp] : built) pointers[technique] = &imp;
-        store::writeCell(out_dir, job->entry, pointers);
-        for (auto& [technique, stored] : job->entry.impostors) stored.build_ms = job->record.build_ms[technique];
-        job->record.write_ms = t.milliseconds();
-        {
-          std::lock_guard<std::mutex> lock(results_mutex);
-          records.push_back(job->record);
-          entries.push_back(std::move(job->entry));
-        }
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(results_mutex);
-        if (!worker_error) worker_error = std::current_exception();
-        failed = true;
-      }
-      if (progress) progress->advance();
+  context.makeCurrent();
+  gpu::GpuScene gpu_scene(scene);
+  gpu::Renderer renderer;
+  const auto produce = [&](const std::function<bool(std::shared_ptr<Job>)>& push) {
+    for (uint32_t cell : todo) {
+      auto job = std::make_shared<Job>();
+      const Camera camera = cellCamera(cells, cell, options, ground);
+      const std::vector<uint32_t> distant = cells.distantObjects(cell);
+      job->capture = impostor::captureView(renderer, gpu_scene, distant, camera, options.capture);
+      job->record.half_edge = cell;
+      job->record.render_ms = job->capture.render_ms;
+      job->record.data_pixels = job->capture.data_pixels;
+      job->record.distant_objects = distant.size();
+      job->entry.half_edge = cell;
+      job->entry.camera = camera;
+      job->entry.local_objects = cells.localObjects(cell);
+      job->record.local_objects = job->entry.local_objects.size();
+      job->entry.distant_objects = distant.size();
+      job->entry.data_pixels = job->capture.data_pixels;
+      job->entry.render_ms = job->capture.render_ms;
+      if (!push(std::move(job))) return;
     }
   };
-
-  std::vector<std::thread> pool;
-  for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
-  // Whatever happens on this thread, the workers are stopped and joined before leaving.
-  struct Joiner {
-    tbb::concurrent_bounded_queue<std::shared_ptr<Job>>& queue;
-    std::vector<std::thread>& pool;
-    ~Joiner() {
-      for (size_t i = 0; i < pool.size(); ++i) queue.push(nullptr);
-      for (std::thread& t : pool) t.join();
-    }
-  };
-  std::exception_ptr producer_error;
-  {
-    Joiner joiner{queue, pool};
-    try {
-      context.makeCurrent();
-      gpu::GpuScene gpu_scene(scene);
-      gpu::Renderer renderer;
-      for (uint32_t cell : todo) {
-        if (failed.load()) break;
-        auto job = std::make_shared<Job>();
-        const Camera camera = cellCamera(cells, cell, options, ground);
-        const std::vector<uint32_t> distant = cells.distantObjects(cell);
-        job->capture = impostor::captureView(renderer, gpu_scene, distant, camera, options.capture);
-        job->record.half_edge = cell;
-        job->record.render_ms = job->capture.render_ms;
-        job->record.data_pixels = job->capture.data_pixels;
-        job->record.distant_objects = distant.size();
-        job->entry.half_edge = cell;
-        job->entry.camera = camera;
-        job->entry.local_objects = cells.localObjects(cell);
-        job->record.local_objects = job->entry.local_objects.size();
-        job->entry.distant_objects = distant.size();
-        job->entry.data_pixels = job->capture.data_pixels;
-        job->entry.render_ms = job->capture.render_ms;
-        queue.push(std::move(job));
+  const auto consume = [&](Job& job) {
+    std::map<std::string, impostor::DepthMeshImpostor> built;
+    for (const std::string& technique : options.techniques) {
+      Stopwatch t;
+      if (technique == kDepthMesh) {
+        impostor::DepthMeshOptions o = options.depth_mesh;
+        o.resolution = options.resolution;
+        o.fov_y = job.capture.camera.fov_y;
+        built[technique] = impostor::buildDepthMesh(job.capture, o);
+      } else {
+        built[technique] = impostor::buildGridMesh(job.capture, options.grid_mesh);
       }
-    } catch (...) {
-      producer_error = std::current_exception();
-      failed = true;
+      job.record.build_ms[technique] = t.milliseconds();
+      job.record.triangles[technique] = built[technique].mesh.triangleCount();
     }
-  }
-  if (progress) progress->finish();
-  if (producer_error) std::rethrow_exception(producer_error);
-  if (worker_error) std::rethrow_exception(worker_error);
+    Stopwatch t;
+    std::map<std::string, const impostor::DepthMeshImpostor*> pointers;
+    for (const auto& [technique, imp] : built) pointers[technique] = &imp;
+    store::writeCell(out_dir, job.entry, pointers);
+    for (auto& [technique, stored] : job.entry.impostors) stored.build_ms = job.record.build_ms[technique];
+    job.record.write_ms = t.milliseconds();
+    std::lock_guard<std::mutex> lock(results_mutex);
+    records.push_back(job.record);
+    entries.push_back(std::move(job.entry));
+  };
+  produceAndConsume<Job>(workers, options.queue_capacity, options.progress ? "bake" : "", todo.size(), produce,
+                         consume);
 
   std::sort(records.begin(), records.end(), [](const CellBake& a, const CellBake& b) {
     return a.half_edge < b.half_edge;

@@ -1,9 +1,7 @@
 // The extractor pipeline (Decoret et al. 1999, sections 4-5): PVS sampling, near/far segmentation, layering by
 // visibility events and one meshed impostor per layer, baked in parallel like bake.cpp (GL stages and captures on
-// the calling thread, meshes and files on worker threads through a bounded queue).
+// the calling thread, meshes and files on worker threads: bake/gl_workers.h).
 #include "farfield/bake/pipeline.h"
-
-#include <oneapi/tbb/concurrent_queue.h>
 
 #include <algorithm>
 #include <atomic>
@@ -15,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "farfield/bake/gl_workers.h"
 #include "farfield/core/error.h"
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
@@ -533,124 +532,74 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
 
   const std::vector<std::string> baked = spec.baked();
   const bool bake_mmi = contains(baked, kStageMmi);
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const size_t workers = options.base.workers > 0 ? size_t(options.base.workers) : size_t(std::max(1u, hw - 1));
+  const size_t workers = workerCount(options.base.workers);
   report.workers = workers;
 
-  tbb::concurrent_bounded_queue<std::shared_ptr<PipelineJob>> queue;
-  queue.set_capacity(std::ptrdiff_t(std::max<size_t>(1, options.base.queue_capacity)));
   std::mutex results_mutex;
   std::vector<store::CellEntry> entries;
   std::vector<PipelineCellReport> records;
-  std::exception_ptr worker_error;
-  std::atomic<bool> failed{false};
-  std::unique_ptr<Progress> progress;
-  if (options.base.progress) progress = std::make_unique<Progress>("bake pipeline", todo.size());
-  PipelineRunner* runner_ptr = nullptr;  // set on the GL thread before the first job is queued
-
-  auto work_fn = [&] {
-    for (;;) {
-      std::shared_ptr<PipelineJob> job;
-      queue.pop(job);
-      if (!job) return;
-      if (failed.load()) continue;
-      try {
-        CellWork& w = job->work;
-        if (bake_mmi) {
-          runner_ptr->buildMeshes(w);
-          // The construction is timed per cell: each view gets an equal share.
-          size_t views = w.single_views.size();
-          for (const auto& layer : w.layer_views) views += layer.size();
-          const double build_share = views ? w.build_ms / double(views) : 0.0;
-          for (size_t l = 0; l < w.layer_views.size(); ++l)
-            for (size_t v = 0; v < w.layer_views[l].size(); ++v) {
-              store::StoredView& sv = w.result.layers[l].views[v];
-              const store::StoredView written =
-                  store::writeLayerView(out_dir, store::layerFileStem(w.cell, "mmi", l, v), w.layer_views[l][v]);
-              sv.texture = written.texture;
-              sv.mesh = written.mesh;
-              sv.ids = written.ids;
-              sv.build_ms = build_share;
-            }
-          for (size_t v = 0; v < w.single_views.size(); ++v) {
-            store::StoredView& sv = w.result.single.views[v];
-            const store::StoredView written =
-                store::writeLayerView(out_dir, store::layerFileStem(w.cell, "smi", 0, v), w.single_views[v]);
-            sv.texture = written.texture;
-            sv.mesh = written.mesh;
-            sv.ids = written.ids;
-            sv.build_ms = build_share;
-          }
-        }
-        PipelineCellReport r;
-        r.half_edge = w.cell;
-        r.pvs = w.result.pvs.size();
-        r.near = w.result.near.size();
-        r.far = w.result.far.size();
-        r.layers = w.result.layers.size();
-        for (const store::StoredLayer& l : w.result.layers)
-          for (const store::StoredView& v : l.views) r.layer_triangles += v.triangles;
-        for (const store::StoredView& v : w.result.single.views) r.single_triangles += v.triangles;
-        r.pvs_ms = w.result.pvs_ms;
-        r.weights_ms = w.result.weights_ms;
-        r.capture_ms = w.capture_ms;
-        r.build_ms = w.build_ms;
-        job->entry.pipeline = std::move(w.result);
-        job->work.layer_views.clear();
-        job->work.single_views.clear();
-        std::lock_guard<std::mutex> lock(results_mutex);
-        records.push_back(r);
-        entries.push_back(std::move(job->entry));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(results_mutex);
-        if (!worker_error) worker_error = std::current_exception();
-        failed = true;
-      }
-      if (progress) progress->advance();
+  context.makeCurrent();
+  gpu::GpuScene gpu_scene(scene);
+  PipelineRunner runner(scene, gpu_scene, cells, options);  // outlives the workers, which build meshes with it
+  const auto produce = [&](const std::function<bool(std::shared_ptr<PipelineJob>)>& push) {
+    for (uint32_t cell : todo) {
+      auto job = std::make_shared<PipelineJob>();
+      job->work = runner.start(cell);
+      for (const std::string& stage : baked) runner.runStage(stage, job->work);
+      store::CellEntry& e = job->entry;
+      e.half_edge = cell;
+      e.camera = job->work.street_camera;
+      e.local_objects = cells.localObjects(cell);
+      e.distant_objects = cells.distantObjects(cell).size();
+      e.render_ms = job->work.capture_ms;
+      if (!push(std::move(job))) return;
     }
   };
-
-  std::vector<std::thread> pool;
-  struct Joiner {
-    tbb::concurrent_bounded_queue<std::shared_ptr<PipelineJob>>& queue;
-    std::vector<std::thread>& pool;
-    ~Joiner() {
-      for (size_t i = 0; i < pool.size(); ++i) queue.push(nullptr);
-      for (std::thread& t : pool) t.join();
+  const auto consume = [&](PipelineJob& job) {
+    CellWork& w = job.work;
+    if (bake_mmi) {
+      runner.buildMeshes(w);
+      // The construction is timed per cell: each view gets an equal share.
+      size_t views = w.single_views.size();
+      for (const auto& layer : w.layer_views) views += layer.size();
+      const double build_share = views ? w.build_ms / double(views) : 0.0;
+      const auto write = [&](store::StoredView& record, const impostor::DepthMeshImpostor& view, const char* kind,
+                             size_t layer, size_t index) {
+        const store::StoredView written =
+            store::writeLayerView(out_dir, store::layerFileStem(w.cell, kind, layer, index), view);
+        record.texture = written.texture;
+        record.mesh = written.mesh;
+        record.ids = written.ids;
+        record.build_ms = build_share;
+      };
+      for (size_t l = 0; l < w.layer_views.size(); ++l)
+        for (size_t v = 0; v < w.layer_views[l].size(); ++v)
+          write(w.result.layers[l].views[v], w.layer_views[l][v], "mmi", l, v);
+      for (size_t v = 0; v < w.single_views.size(); ++v) write(w.result.single.views[v], w.single_views[v], "smi", 0, v);
     }
+    PipelineCellReport r;
+    r.half_edge = w.cell;
+    r.pvs = w.result.pvs.size();
+    r.near = w.result.near.size();
+    r.far = w.result.far.size();
+    r.layers = w.result.layers.size();
+    for (const store::StoredLayer& l : w.result.layers)
+      for (const store::StoredView& v : l.views) r.layer_triangles += v.triangles;
+    for (const store::StoredView& v : w.result.single.views) r.single_triangles += v.triangles;
+    r.pvs_ms = w.result.pvs_ms;
+    r.weights_ms = w.result.weights_ms;
+    r.capture_ms = w.capture_ms;
+    r.build_ms = w.build_ms;
+    job.entry.pipeline = std::move(w.result);
+    w.layer_views.clear();
+    w.single_views.clear();
+    std::lock_guard<std::mutex> lock(results_mutex);
+    records.push_back(r);
+    entries.push_back(std::move(job.entry));
   };
-  std::exception_ptr producer_error;
-  double threshold = 0.0;
-  {
-    context.makeCurrent();
-    gpu::GpuScene gpu_scene(scene);
-    PipelineRunner runner(scene, gpu_scene, cells, options);
-    threshold = runner.threshold();
-    runner_ptr = &runner;
-    for (size_t w = 0; w < workers; ++w) pool.emplace_back(work_fn);
-    Joiner joiner{queue, pool};  // declared after the runner: the workers stop before it is destroyed
-    try {
-      for (uint32_t cell : todo) {
-        if (failed.load()) break;
-        auto job = std::make_shared<PipelineJob>();
-        job->work = runner.start(cell);
-        for (const std::string& stage : baked) runner.runStage(stage, job->work);
-        store::CellEntry& e = job->entry;
-        e.half_edge = cell;
-        e.camera = job->work.street_camera;
-        e.local_objects = cells.localObjects(cell);
-        e.distant_objects = cells.distantObjects(cell).size();
-        e.render_ms = job->work.capture_ms;
-        queue.push(std::move(job));
-      }
-    } catch (...) {
-      producer_error = std::current_exception();
-      failed = true;
-    }
-  }
-  if (progress) progress->finish();
-  if (producer_error) std::rethrow_exception(producer_error);
-  if (worker_error) std::rethrow_exception(worker_error);
+  produceAndConsume<PipelineJob>(workers, options.base.queue_capacity,
+                                 options.base.progress ? "bake pipeline" : "", todo.size(), produce, consume);
+  const double threshold = runner.threshold();
 
   std::sort(entries.begin(), entries.end(),
             [](const store::CellEntry& a, const store::CellEntry& b) { return a.half_edge < b.half_edge; });
