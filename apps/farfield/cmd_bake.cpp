@@ -52,7 +52,8 @@ struct BakeArgs {
   std::string pipeline;
   std::string online;
   double error_px = 10.0;
-  int frame_width = 512;
+  std::string frame_size = "640x360";
+  float frame_fov = 60.0f;
   std::string layer_mesh = "grid";
   int grid_cells = 30;
   std::string views = "street";
@@ -113,7 +114,10 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
   bake::PipelineOptions options;
   options.base = base;
   options.error_px = args.error_px;
-  options.frame_width = args.frame_width;
+  const IVec2 frame = parseSize("--frame-size", args.frame_size);
+  options.frame_width = frame.x;
+  options.frame_height = frame.y;
+  options.frame_fov_deg = args.frame_fov;
   options.mesh = bake::parseLayerMesh(args.layer_mesh);
   options.grid_cells = args.grid_cells;
   options.views = bake::parseLayerViews(args.views);
@@ -126,8 +130,10 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
   for (const std::string& s : spec.baked()) baked += (baked.empty() ? "" : ",") + s;
   for (const std::string& s : spec.online()) online += (online.empty() ? "" : ",") + s;
   std::printf("pipeline:      baked [%s], online [%s]\n", baked.c_str(), online.empty() ? "" : online.c_str());
-  std::printf("layers:        error %.1f px in %d-px frames, %s mesh (%d x %d grid), %s view(s), %dx%d images\n",
-              options.error_px, options.frame_width, bake::layerMeshName(options.mesh), options.grid_cells,
+  std::printf("layers:        error %.1f px in %dx%d frames at %.0f deg, %s mesh (%d x %d grid), %s view(s), "
+              "%dx%d images\n",
+              options.error_px, options.frame_width, options.frame_height, double(options.frame_fov_deg),
+              bake::layerMeshName(options.mesh), options.grid_cells,
               options.grid_cells, bake::layerViewsName(options.views), options.base.resolution,
               options.base.resolution);
   const bake::PipelineReport report = bake::bakePipeline(gpu::sharedHeadlessContext(), scene, cells, requested,
@@ -337,9 +343,12 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
                                                 "from pvs, near-far, mmi, e.g. pvs,near-far,mmi");
   cmd->add_option("--online", args->online, "Pipeline stages left to the runtime (the pipeline's tail: mmi or "
                                             "near-far,mmi); the rest is baked");
-  cmd->add_option("--error-px", args->error_px, "MMI layering: largest de-occlusion error, pixels")
+  cmd->add_option("--error-px", args->error_px, "Error bound, pixels: the layering threshold and the bound the "
+                                                "validity regions are computed for")
       ->capture_default_str();
-  cmd->add_option("--frame-width", args->frame_width, "MMI layering: width of the final frames, pixels")
+  cmd->add_option("--frame-size", args->frame_size, "Error bound: size WxH of the walkthrough's frames")
+      ->capture_default_str();
+  cmd->add_option("--frame-fov", args->frame_fov, "Error bound: vertical field of view of the walkthrough, degrees")
       ->capture_default_str();
   cmd->add_option("--layer-mesh", args->layer_mesh, "Mesh of each layer: grid (regular grid) or depth-mesh")
       ->capture_default_str();

@@ -15,6 +15,7 @@
 
 #include "farfield/bake/bake.h"
 #include "farfield/bake/pipeline.h"
+#include "farfield/core/error_bound.h"
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gen/city.h"
@@ -125,14 +126,27 @@ struct BakedCity {
   double full_s = 0.0, online_s = 0.0;
 };
 
+// Runs `call`, which must throw farfield::Error whose message holds every one of `parts`.
+template <typename F>
+void expectErrorMentions(F call, const std::vector<std::string>& parts) {
+  try {
+    call();
+    ADD_FAILURE() << "expected farfield::Error mentioning " << parts.back();
+  } catch (const Error& e) {
+    for (const std::string& part : parts)
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' in: " << e.what();
+  }
+}
+
 PipelineOptions smallOptions() {
   PipelineOptions o;
   o.base.resolution = 128;
   o.base.progress = false;
   o.pvs.spacing = 8.0f;
   o.pvs.face_size = 64;
-  o.error_px = 10.0;  // T = 10 px of a 512-px, 60-degree frame: 0.0204 rad, the paper's setting
+  o.error_px = 10.0;  // 10 px in 512 x 512 frames at 60 degrees, the paper's setting
   o.frame_width = 512;
+  o.frame_height = 512;
   o.grid_cells = 30;
   return o;
 }
@@ -285,7 +299,7 @@ TEST_F(PipelineBakeTest, BakedCellsHoldAConsistentPvsSplitAndLayering) {
   ASSERT_EQ(index.cells.size(), b.full_report.cells.size());
   ASSERT_EQ(index.cells.size(), b.visited.size() - b.full_report.skipped_degenerate.size());
   const double threshold = b.full_report.threshold_rad;
-  EXPECT_NEAR(threshold, 10.0 * degToRad(60.0) / 512.0, 1e-9);
+  EXPECT_NEAR(threshold, (ErrorBound{10.0, 512, 512, degToRad(60.0)}).angle(), 1e-12);
 
   const scene::Scene& scene = b.city.scene;
   const size_t n = scene.objects.size();
@@ -561,9 +575,51 @@ TEST_F(PipelineBakeTest, OptionsSurviveTheIndexAndBadOptionsAreErrors) {
   EXPECT_EQ(back.pvs.spacing, o.pvs.spacing);
   EXPECT_EQ(back.pvs.face_size, o.pvs.face_size);
   EXPECT_EQ(back.grid_cells, o.grid_cells);
+  EXPECT_EQ(back.frame_height, o.frame_height);
+  EXPECT_EQ(back.frame_fov_deg, o.frame_fov_deg);
+  EXPECT_EQ(back.validity.step, o.validity.step);
+  EXPECT_EQ(back.validity.laterals, o.validity.laterals);
+  EXPECT_EQ(back.validity.below, o.validity.below);
+  EXPECT_EQ(back.base.capture.detect_seen_from_below, o.base.capture.detect_seen_from_below);
   EXPECT_THROW(pipelineOptionsFromJson({{"error_px", "ten"}}, "x"), Error);
   EXPECT_THROW(pipelineOptionsFromJson({{"layer_mesh", "voxels"}}, "x"), Error);
   EXPECT_THROW(pipelineOptionsFromJson(nlohmann::json::array(), "x"), Error);
+  // Saved whole, read back strictly: every key missing, changed to a wrong type or joined by an unknown one is an
+  // error naming it; no silent default.
+  const nlohmann::json whole = pipelineOptionsToJson(o);
+  for (const auto& [key, value] : whole.items()) {
+    nlohmann::json j = whole;
+    j.erase(key);
+    expectErrorMentions([&] { pipelineOptionsFromJson(j, "idx"); }, {"idx", key});
+    j = whole;
+    j[key] = nlohmann::json::array({"?"});
+    expectErrorMentions([&] { pipelineOptionsFromJson(j, "idx"); }, {"idx", key});
+  }
+  {
+    nlohmann::json j = whole;
+    j["error_pixels"] = 3;
+    expectErrorMentions([&] { pipelineOptionsFromJson(j, "idx"); }, {"idx", "unknown", "error_pixels"});
+    j = whole;
+    j["validity"]["stride"] = 3;
+    expectErrorMentions([&] { pipelineOptionsFromJson(j, "idx"); }, {"idx", "unknown", "stride"});
+    j = whole;
+    j["grid_cells"] = 2.5;
+    expectErrorMentions([&] { pipelineOptionsFromJson(j, "idx"); }, {"idx", "grid_cells", "integer"});
+    j = whole;
+    j["layer_order"] = "random";
+    expectErrorMentions([&] { pipelineOptionsFromJson(j, "idx"); }, {"idx", "layer_order", "random"});
+  }
+  {
+    // A version 2 store had no frame height, frame field of view or validity sampling: square frames at fov_deg.
+    nlohmann::json v2 = whole;
+    v2.erase("frame_height");
+    v2.erase("frame_fov_deg");
+    v2.erase("validity");
+    EXPECT_THROW(pipelineOptionsFromJson(v2, "idx"), Error);
+    const PipelineOptions old = pipelineOptionsFromJson(v2, "idx", 2);
+    EXPECT_EQ(old.frame_height, old.frame_width);
+    EXPECT_EQ(old.frame_fov_deg, o.base.fov_deg);
+  }
 
   const std::string dir = test::scratchDir("pipeline_bad").string();
   const auto bake = [&](const PipelineOptions& options, std::vector<uint32_t> cells) {
@@ -633,8 +689,11 @@ TEST_F(PipelineBakeTest, SixViewsLayerTheWholeFarSetAndCoverTheStreetView) {
       if (v.ids)
         for (uint32_t id : v.ids->pixels()) ++street_pixels[id];
     }
-    for (const auto& [id, pixels] : street_pixels)
-      if (id != 0 && pixels >= 100) EXPECT_TRUE(in_faces.count(id)) << "object " << id << " (" << pixels << " px)";
+    for (const auto& [id, pixels] : street_pixels) {
+      if (id != 0 && pixels >= 100) {
+        EXPECT_TRUE(in_faces.count(id)) << "object " << id << " (" << pixels << " px)";
+      }
+    }
   }
   EXPECT_GT(six_layered, 0u);
   EXPECT_GT(street_layered, 0u);

@@ -4,6 +4,8 @@
 // and options.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -179,7 +181,7 @@ uint32_t cellWithMostLayers(const store::StoreIndex& index, size_t* layers) {
 // updates. So the path starts 10% along the street (the warm-up and frame 0 update layers there), then jumps to 70%
 // along it and stays: the jump is fast motion, so frame 1 drops every dynamic layer and shows the pre-computed MMI
 // alone; from frame 2 on, one layer per frame is re-rendered.
-TEST_F(MmiModeTest, StandingStillTheDynamicImpostorsApproachTheReference) {
+TEST_F(MmiModeTest, StandingStillTheDynamicImpostorsReplaceInvalidLayersWithinTheBound) {
   const MmiCity& s = mmiCity();
   const store::StoreIndex index = store::readIndex(s.store);
   size_t layers = 0;
@@ -214,14 +216,23 @@ TEST_F(MmiModeTest, StandingStillTheDynamicImpostorsApproachTheReference) {
   EXPECT_EQ(dynamic->info.at("fallback_frames"), 0.0);
   EXPECT_GE(dynamic->info.at("fast_motion_frames"), 1.0);  // the jump
   EXPECT_EQ(dynamic->info.at("updates_skipped_for_budget"), 0.0);
-  // Frame 1 (after the jump) is the pre-computed MMI.
+  // Frame 1 (after the jump) is the mmi mode's frame: every dynamic impostor is dropped and each layer is drawn as
+  // its baked views where their validity region holds the eye, as geometry elsewhere.
   EXPECT_EQ(dynamic->errors[1].psnr_db, mmi->errors[1].psnr_db);
   EXPECT_EQ(dynamic->frames[1].triangles, mmi->frames[1].triangles);
-  // Then it only gets better, clearly so by the end.
-  for (size_t k = 1; k + 1 < dynamic->errors.size(); ++k)
-    EXPECT_GE(dynamic->errors[k + 1].psnr_db, dynamic->errors[k].psnr_db - 0.5) << "frame " << k + 1;
-  EXPECT_GT(dynamic->errors.back().psnr_db, dynamic->errors[1].psnr_db + 1.0);
-  EXPECT_GT(dynamic->errors.back().psnr_db, mmi->errors.back().psnr_db + 1.0);
+  // Then layers are re-rendered from the viewer's own eye, one per frame: fresh images, close to the reference, with
+  // their parallax under the bound (the mmi mode keeps it with geometry where its layers are not valid).
+  const double bound = dynamic->info.at("error_bound_px");
+  for (size_t k = 2; k < dynamic->errors.size(); ++k) {
+    EXPECT_GE(dynamic->errors[k].psnr_db, 40.0) << "frame " << k;
+    if (k < dynamic->parallax_px.size() && !std::isnan(dynamic->parallax_px[k])) {
+      EXPECT_LE(dynamic->parallax_px[k], bound) << "frame " << k;
+    }
+    if (k < mmi->parallax_px.size() && !std::isnan(mmi->parallax_px[k])) {
+      EXPECT_LE(mmi->parallax_px[k], bound) << "frame " << k;
+    }
+  }
+  EXPECT_GT(dynamic->info.at("mean_dynamic_layers"), 0.0);
   // Rendered from the viewer's own eye, the refreshed layers open no cracks (pixels where the reference shows geometry
   // and the frame's id buffer shows sky).
   // (This caught dynamic layers drawn with object id 0, the sky's, in item buffers: 21-24% cracks at 60 dB.)

@@ -1,4 +1,4 @@
-// Pipeline stores (index version 2, per-cell "pipeline" records of Decoret et al. 1999's extractor pipeline): the index
+// Pipeline stores (index version 3, per-cell "pipeline" records of Decoret et al. 1999's extractor pipeline): the index
 // round trip keeps every field; every kind of damage to a record gives a farfield::Error naming the element; layer
 // views whose files disagree with the index are refused.
 #include <gtest/gtest.h>
@@ -47,6 +47,21 @@ StoredView oddView(uint32_t half_edge, size_t layer, size_t view, double seed, b
   return v;
 }
 
+// A validity region with no round numbers in it.
+impostor::ValidityRegion oddRegion(float seed) {
+  impostor::ValidityRegion r;
+  r.origin = Vec3(10.125f + seed, -3.3333333f, 1.7000001f);
+  r.end = Vec3(60.1f, -3.3f * seed, 1.6999999f);
+  r.half_width = 5.4000001f;
+  r.below = 0.6f;
+  r.above = 0.3f;
+  r.back = 2.0f;
+  r.step = 1.0f + 0.1f * seed;
+  r.laterals = 3;
+  r.envelope = {0.0f, 0.00012345f, 0.0012345f * seed, 0.0123456f * seed, 0.0f, 3.1415926f};
+  return r;
+}
+
 // A fully baked cell: PVS, split, two layers (the second with six views, one of them empty) and the single mesh.
 CellEntry fullCell(uint32_t half_edge) {
   CellEntry e;
@@ -75,7 +90,10 @@ CellEntry fullCell(uint32_t half_edge) {
   StoredLayer far_layer;
   far_layer.objects = {7, 11, 20};
   for (size_t v = 0; v < 6; ++v) far_layer.views.push_back(oddView(half_edge, 1, v, 2.0 + double(v), v != 3));
+  near_layer.validity = oddRegion(1.0f);
+  far_layer.validity = oddRegion(2.0f);
   p.layers = {near_layer, far_layer};
+  p.single.validity = oddRegion(3.0f);
   p.single.objects = p.far;
   p.single.views = {oddView(half_edge, 0, 0, 9.0)};
   p.single.views[0].mesh = layerFileStem(half_edge, "smi", 0, 0) + ".ffmesh";
@@ -145,6 +163,18 @@ void expectSameLayer(const StoredLayer& a, const StoredLayer& b, const std::stri
     EXPECT_EQ(x.render_ms, y.render_ms) << at;
     EXPECT_EQ(x.build_ms, y.build_ms) << at;
   }
+  ASSERT_EQ(a.validity.has_value(), b.validity.has_value()) << where;
+  if (!a.validity) return;
+  const impostor::ValidityRegion &x = *a.validity, &y = *b.validity;
+  EXPECT_EQ(x.origin, y.origin) << where;
+  EXPECT_EQ(x.end, y.end) << where;
+  EXPECT_EQ(x.half_width, y.half_width) << where;
+  EXPECT_EQ(x.below, y.below) << where;
+  EXPECT_EQ(x.above, y.above) << where;
+  EXPECT_EQ(x.back, y.back) << where;
+  EXPECT_EQ(x.step, y.step) << where;
+  EXPECT_EQ(x.laterals, y.laterals) << where;
+  EXPECT_EQ(x.envelope, y.envelope) << where;
 }
 
 void expectSameIndex(const StoreIndex& a, const StoreIndex& b) {
@@ -205,7 +235,7 @@ TEST(PipelineStoreTest, IndexRoundTripKeepsEveryField) {
   const StoreIndex read = readIndex(dir);
   expectSameIndex(read, index);
   EXPECT_EQ(read.version, kIndexVersion);
-  EXPECT_EQ(kIndexVersion, 2);
+  EXPECT_EQ(kIndexVersion, 3);
 
   // A store with the mmi stage left online: cells have pvs and split, no mmi.
   StoreIndex online = pipelineIndex();
@@ -348,10 +378,37 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
   // Versions.
   {
     nlohmann::json j = good;
-    j["version"] = 3;
-    expectIndexError(j, {"version", "3"});
+    j["version"] = kIndexVersion + 1;
+    expectIndexError(j, {"version", std::to_string(kIndexVersion + 1)});
+    j["version"] = 0;
+    expectIndexError(j, {"version", "0"});
     j["version"] = 1;  // still read
     EXPECT_NO_THROW(indexFromJson(j, "v1"));
+    // Version 2 had no validity regions: read without them; version 3 requires them where a layer has views.
+    cell0(j)["mmi"]["layers"][0].erase("validity");
+    j["version"] = 2;
+    EXPECT_NO_THROW(indexFromJson(j, "v2"));
+    j["version"] = 3;
+    expectIndexError(j, {"layers[0]", "validity"});
+  }
+  // Validity regions.
+  {
+    nlohmann::json j = good;
+    cell0(j)["mmi"]["layers"][1]["validity"]["envelope"] = {0.1, 0.2, 0.0, 0.1, 0.2, 0.15};
+    expectIndexError(j, {"layers[1]", "validity", "decrease"});
+    cell0(j)["mmi"]["layers"][1]["validity"]["envelope"] = {0.1, 0.2, 0.0, 0.1, 0.2};
+    expectIndexError(j, {"layers[1]", "validity", "rows"});
+    cell0(j)["mmi"]["layers"][1]["validity"]["laterals"] = 2;
+    expectIndexError(j, {"layers[1]", "validity", "laterals"});
+    j = good;
+    cell0(j)["mmi"]["single"]["validity"]["step"] = 0.0;
+    expectIndexError(j, {"single", "validity", "step"});
+    j = good;
+    cell0(j)["mmi"]["layers"][0]["validity"]["envelope"] = {-0.1};
+    expectIndexError(j, {"layers[0]", "validity", "envelope"});
+    j = good;
+    cell0(j)["mmi"]["layers"][0]["validity"].erase("origin");
+    expectIndexError(j, {"layers[0]", "validity", "origin"});
   }
 }
 

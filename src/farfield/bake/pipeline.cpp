@@ -7,6 +7,9 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <initializer_list>
+#include <limits>
+#include <type_traits>
 #include <filesystem>
 #include <mutex>
 #include <set>
@@ -121,6 +124,15 @@ nlohmann::json pipelineOptionsToJson(const PipelineOptions& o) {
           {"detect_seen_from_below", o.base.capture.detect_seen_from_below},
           {"error_px", o.error_px},
           {"frame_width", o.frame_width},
+          {"frame_height", o.frame_height},
+          {"frame_fov_deg", o.frame_fov_deg},
+          {"validity",
+           {{"step", o.validity.step},
+            {"back", o.validity.back},
+            {"width_share", o.validity.width_share},
+            {"laterals", o.validity.laterals},
+            {"below", o.validity.below},
+            {"above", o.validity.above}}},
           {"pvs_spacing", o.pvs.spacing},
           {"pvs_face_size", o.pvs.face_size},
           {"near_radius", o.near_radius},
@@ -136,47 +148,120 @@ nlohmann::json pipelineOptionsToJson(const PipelineOptions& o) {
           {"single_mesh", o.single_mesh}};
 }
 
-PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::string& source) {
-  PipelineOptions o;
-  if (!j.is_object()) throw Error(source, "pipeline options must be an object");
-  auto number = [&](const char* key, auto& out) {
-    if (!j.contains(key)) return;
-    if (!j[key].is_number()) throw Error(source, std::string("pipeline option \"") + key + "\" must be a number");
-    out = j[key].get<std::remove_reference_t<decltype(out)>>();
-  };
-  auto text = [&](const char* key) -> std::string {
-    if (!j.contains(key)) return {};
-    if (!j[key].is_string()) throw Error(source, std::string("pipeline option \"") + key + "\" must be a string");
-    return j[key].get<std::string>();
-  };
-  number("resolution", o.base.resolution);
-  number("fov_deg", o.base.fov_deg);
-  number("eye_height", o.base.eye_height);
-  number("near", o.base.near_plane);
-  number("far", o.base.far_plane);
-  if (j.contains("detect_seen_from_below") && j["detect_seen_from_below"].is_boolean())
-    o.base.capture.detect_seen_from_below = j["detect_seen_from_below"].get<bool>();
-  number("error_px", o.error_px);
-  number("frame_width", o.frame_width);
-  number("pvs_spacing", o.pvs.spacing);
-  number("pvs_face_size", o.pvs.face_size);
-  number("near_radius", o.near_radius);
-  number("landmark_boost", o.events.landmark_boost);
-  number("grid_cells", o.grid_cells);
-  if (j.contains("landmarks")) {
-    if (!j["landmarks"].is_array()) throw Error(source, "pipeline option \"landmarks\" must be an array of ids");
-    for (const nlohmann::json& id : j["landmarks"]) {
-      if (!id.is_number_unsigned()) throw Error(source, "pipeline option \"landmarks\" must hold object ids");
-      o.landmarks.push_back(id.get<uint32_t>());
-    }
+namespace {
+
+// Strict reading of one JSON object of options: every key the caller asks for must be there with the right type,
+// and keys() lists the ones that were never asked for (unknown keys are errors, not ignored).
+class StrictOptions {
+ public:
+  StrictOptions(const nlohmann::json& j, std::string where) : j_(j), where_(std::move(where)) {
+    if (!j_.is_object()) throw Error(where_, "pipeline options must be an object");
   }
-  if (const std::string p = text("representative_points"); p == "hull")
-    o.events.points = urban::RepresentativePoints::HullVertices;
-  if (text("layer_order") == "given") o.layer_order = urban::LayerOrder::Given;
-  if (text("layer_choice") == "smallest-area") o.layer_choice = urban::LayerChoice::SmallestArea;
-  if (const std::string m = text("layer_mesh"); !m.empty()) o.mesh = parseLayerMesh(m, source + ": layer_mesh");
-  if (const std::string v = text("views"); !v.empty()) o.views = parseLayerViews(v, source + ": views");
-  if (j.contains("single_mesh") && j["single_mesh"].is_boolean()) o.single_mesh = j["single_mesh"].get<bool>();
+  bool has(const char* key) const { return j_.contains(key); }
+  const nlohmann::json& at(const char* key) {
+    const auto it = j_.find(key);
+    if (it == j_.end()) throw Error(where_, std::string("pipeline option \"") + key + "\" is missing");
+    seen_.push_back(key);
+    return *it;
+  }
+  template <typename T>
+  void number(const char* key, T& out) {
+    const nlohmann::json& v = at(key);
+    if (!v.is_number()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be a number");
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) throw Error(where_, std::string("pipeline option \"") + key + "\" is not finite");
+    if constexpr (std::is_integral_v<T>) {
+      if (d != std::floor(d) || d < double(std::numeric_limits<T>::min()) || d > double(std::numeric_limits<T>::max()))
+        throw Error(where_, std::string("pipeline option \"") + key + "\" must be an integer in range");
+    }
+    out = T(d);
+  }
+  std::string text(const char* key) {
+    const nlohmann::json& v = at(key);
+    if (!v.is_string()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be a string");
+    return v.get<std::string>();
+  }
+  bool boolean(const char* key) {
+    const nlohmann::json& v = at(key);
+    if (!v.is_boolean()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be true or false");
+    return v.get<bool>();
+  }
+  // One of `names` (the first maps to 0, ...).
+  size_t choice(const char* key, std::initializer_list<const char*> names) {
+    const std::string v = text(key);
+    size_t i = 0;
+    std::string list;
+    for (const char* n : names) {
+      if (v == n) return i;
+      list += (i++ ? ", " : "") + std::string(n);
+    }
+    throw Error(where_, std::string("pipeline option \"") + key + "\": unknown value '" + v + "' (expected " + list + ")");
+  }
+  void rejectUnknown() const {
+    for (const auto& [key, value] : j_.items())
+      if (std::find(seen_.begin(), seen_.end(), key) == seen_.end())
+        throw Error(where_, "unknown pipeline option \"" + key + "\"");
+  }
+
+ private:
+  const nlohmann::json& j_;
+  std::string where_;
+  std::vector<std::string> seen_;
+};
+
+}  // namespace
+
+PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::string& source, int store_version) {
+  PipelineOptions o;
+  StrictOptions r(j, source);
+  r.number("resolution", o.base.resolution);
+  r.number("fov_deg", o.base.fov_deg);
+  r.number("eye_height", o.base.eye_height);
+  r.number("near", o.base.near_plane);
+  r.number("far", o.base.far_plane);
+  o.base.capture.detect_seen_from_below = r.boolean("detect_seen_from_below");
+  r.number("error_px", o.error_px);
+  r.number("frame_width", o.frame_width);
+  if (store_version >= 3 || r.has("frame_height")) {
+    r.number("frame_height", o.frame_height);
+    r.number("frame_fov_deg", o.frame_fov_deg);
+    StrictOptions v(r.at("validity"), source + ": validity");
+    v.number("step", o.validity.step);
+    v.number("back", o.validity.back);
+    v.number("width_share", o.validity.width_share);
+    v.number("laterals", o.validity.laterals);
+    v.number("below", o.validity.below);
+    v.number("above", o.validity.above);
+    v.rejectUnknown();
+  } else {
+    // Version 2 meant square frames of frame_width with the capture's field of view.
+    o.frame_height = o.frame_width;
+    o.frame_fov_deg = o.base.fov_deg;
+  }
+  r.number("pvs_spacing", o.pvs.spacing);
+  r.number("pvs_face_size", o.pvs.face_size);
+  r.number("near_radius", o.near_radius);
+  o.events.points = r.choice("representative_points", {"footprint", "hull"}) == 1
+                        ? urban::RepresentativePoints::HullVertices
+                        : urban::RepresentativePoints::FootprintVertices;
+  r.number("landmark_boost", o.events.landmark_boost);
+  const nlohmann::json& landmarks = r.at("landmarks");
+  if (!landmarks.is_array()) throw Error(source, "pipeline option \"landmarks\" must be an array of ids");
+  for (const nlohmann::json& id : landmarks) {
+    if (!id.is_number_unsigned() || id.get<uint64_t>() > std::numeric_limits<uint32_t>::max())
+      throw Error(source, "pipeline option \"landmarks\" must hold object ids");
+    o.landmarks.push_back(id.get<uint32_t>());
+  }
+  o.layer_order = r.choice("layer_order", {"nearest-first", "given"}) == 1 ? urban::LayerOrder::Given
+                                                                            : urban::LayerOrder::NearestFirst;
+  o.layer_choice = r.choice("layer_choice", {"least-growth", "smallest-area"}) == 1
+                       ? urban::LayerChoice::SmallestArea
+                       : urban::LayerChoice::LeastGrowth;
+  o.mesh = parseLayerMesh(r.text("layer_mesh"), source + ": layer_mesh");
+  r.number("grid_cells", o.grid_cells);
+  o.views = parseLayerViews(r.text("views"), source + ": views");
+  o.single_mesh = r.boolean("single_mesh");
+  r.rejectUnknown();
   return o;
 }
 
@@ -188,7 +273,12 @@ namespace {
 void validatePipelineOptions(const PipelineOptions& o) {
   if (!(o.error_px > 0.0) || !std::isfinite(o.error_px))
     throw Error("--error-px", "must be a positive number of pixels");
-  if (o.frame_width < 1) throw Error("--frame-width", "must be at least 1 pixel");
+  if (o.frame_width < 1 || o.frame_height < 1) throw Error("--frame-size", "must be at least 1 x 1 pixels");
+  if (!(o.frame_fov_deg > 0.0f && o.frame_fov_deg < 180.0f)) throw Error("--frame-fov", "must be in (0, 180) degrees");
+  const ValidityOptions& v = o.validity;
+  if (!(v.step > 0.0f) || !(v.back >= 0.0f) || v.laterals < 1 || v.laterals % 2 == 0 || !(v.below >= 0.0f) ||
+      !(v.above >= 0.0f) || !(v.width_share >= 0.0f))
+    throw Error("validity options", "need step > 0, back, below, above, width share >= 0 and an odd lateral count");
   if (o.grid_cells < 1 || o.grid_cells > o.base.resolution)
     throw Error("--grid-cells", "must be 1.." + std::to_string(o.base.resolution) + " (the impostor resolution)");
   if (!(o.events.landmark_boost >= 1.0) || !std::isfinite(o.events.landmark_boost))
@@ -219,8 +309,7 @@ PipelineRunner::PipelineRunner(const scene::Scene& scene, const gpu::GpuScene& g
   if (cells.objectCount() != scene.objects.size())
     throw Error("pipeline", "the cell map was made for " + std::to_string(cells.objectCount()) +
                                 " objects but the scene has " + std::to_string(scene.objects.size()));
-  // Square frames: the horizontal field of view is the vertical one.
-  threshold_ = urban::layerThreshold(options_.error_px, degToRad(double(options_.base.fov_deg)), options_.frame_width);
+  threshold_ = bound().angle();
   for (uint32_t id : options_.landmarks)
     if (id == 0 || id > scene.objects.size())
       throw Error("--landmarks", "object id " + std::to_string(id) + " out of range 1.." +
@@ -229,6 +318,11 @@ PipelineRunner::PipelineRunner(const scene::Scene& scene, const gpu::GpuScene& g
 }
 
 PipelineRunner::~PipelineRunner() = default;
+
+ErrorBound PipelineRunner::bound() const {
+  return ErrorBound{options_.error_px, options_.frame_width, options_.frame_height,
+                    degToRad(double(options_.frame_fov_deg))};
+}
 
 CellWork PipelineRunner::start(uint32_t cell) const {
   const auto ground = [this](float x, float y) { return ground_->at(x, y, 0.0f); };
@@ -431,6 +525,20 @@ void PipelineRunner::buildMeshes(CellWork& work) const {
   }
   work.layer_captures.clear();
   work.single_captures.clear();
+  // Validity regions (bake/validity_region.h): the scan runs up to a few times the bake's bound so that a runtime
+  // asking for a looser bound than the bake's still finds the region it may use.
+  const double stop = std::max(4.0 * threshold_, 0.05);
+  const float street_width = cells_.graph().width(work.cell);
+  auto region = [&](const store::StoredLayer& layer) {
+    std::vector<ValidityObject> objects;
+    objects.reserve(layer.objects.size());
+    for (uint32_t id : layer.objects)
+      objects.push_back({scene_.objects[id - 1].world_bounds, footprintOf(scene_.objects[id - 1])});
+    return computeValidityRegion(work.p_eye, work.q_eye, street_width, objects, stop, options_.validity);
+  };
+  for (store::StoredLayer& layer : work.result.layers)
+    if (!layer.views.empty()) layer.validity = region(layer);
+  if (!work.result.single.views.empty()) work.result.single.validity = region(work.result.single);
   work.build_ms = timer.milliseconds();
 }
 

@@ -22,6 +22,8 @@
 
 #include "farfield/bake/bake.h"
 #include "farfield/bake/ground_height.h"
+#include "farfield/bake/validity_region.h"
+#include "farfield/core/error_bound.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/impostor/impostor_mesh.h"
@@ -64,10 +66,14 @@ const char* layerViewsName(LayerViews views);
 
 struct PipelineOptions {
   BakeOptions base;  // resolution, field of view, eye height, planes, capture, workers, progress, scene label
-  // Layering threshold: the user's pixel error in final frames frame_width pixels wide with the horizontal field of
-  // view base.fov_deg (the paper: 10 px at 512 x 512). T = error_px * fov_x / frame_width.
+  // The error bound (core/error_bound.h): error_px pixels in final frames frame_width x frame_height with the vertical
+  // field of view frame_fov_deg (the walkthrough's frames, not the captures). Its angle is the layering threshold T
+  // (the paper: 10 px at 512 x 512) and the bound the validity regions are reported against.
   double error_px = 10.0;
-  int frame_width = 512;
+  int frame_width = 640;
+  int frame_height = 360;
+  float frame_fov_deg = 60.0f;
+  ValidityOptions validity;              // sampling of the validity regions (bake/validity_region.h)
   urban::PvsOptions pvs;                 // sample spacing, cube face size
   float near_radius = 0.0f;              // near/far by distance (metres) instead of the local model when > 0
   urban::VisibilityEventOptions events;  // representative points, landmark boost
@@ -123,6 +129,7 @@ class PipelineRunner {
   void runStages(const std::vector<std::string>& stages, CellWork& work);
 
   const PipelineOptions& options() const { return options_; }
+  ErrorBound bound() const;
   double threshold() const { return threshold_; }
 
  private:
@@ -176,8 +183,11 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
                             const PipelineOptions& options, const std::string& out_dir);
 
 // Options of a pipeline store as recorded in its index (index.options["pipeline"]), and back: the runtime re-creates
-// the runner for online stages from them.
+// the runner for online stages from them. Saved whole and read back strictly: a missing key, an unknown key or a
+// value of the wrong type or out of range is a farfield::Error naming `source` and the key. Stores of version 2
+// lacked frame_height, frame_fov_deg and validity: with store_version 2 those take the values version 2 meant
+// (square frames of frame_width at fov_deg; default sampling); every other key is still required.
 nlohmann::json pipelineOptionsToJson(const PipelineOptions& options);
-PipelineOptions pipelineOptionsFromJson(const nlohmann::json& json, const std::string& source);
+PipelineOptions pipelineOptionsFromJson(const nlohmann::json& json, const std::string& source, int store_version = 3);
 
 }  // namespace farfield::bake

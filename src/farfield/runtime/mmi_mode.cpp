@@ -7,6 +7,7 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/core/error_bound.h"
 #include "farfield/core/timer.h"
 #include "farfield/runtime/impostor_mode.h"
 
@@ -33,11 +34,6 @@ double numberOption(const eval::ModeContext& context, const std::string& key, do
 
 bool contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
-}
-
-// Horizontal field of view of a camera, radians.
-double horizontalFov(const Camera& camera) {
-  return 2.0 * std::atan(std::tan(double(camera.fov_y) * 0.5) * double(camera.width) / double(camera.height));
 }
 
 }  // namespace
@@ -88,6 +84,7 @@ MmiMode::MmiMode(MmiKind kind, const eval::ModeContext& context) : kind_(kind) {
   dynamic_options_.grid_px = int(numberOption(context, "dynamic_grid_px", dynamic_options_.grid_px, 1.0));
   max_updates_ = positiveOption(context, "dynamic_max_updates", max_updates_);
   min_lifetime_frames_ = numberOption(context, "dynamic_min_lifetime", min_lifetime_frames_, 0.0);
+  error_px_ = numberOption(context, "error_px", 0.0, 0.0);
 }
 
 MmiMode::~MmiMode() = default;
@@ -132,17 +129,20 @@ void MmiMode::prepare(const eval::ModeContext& context) {
                                                    : true;
     if (needs) online_stages_.push_back(s);
   }
+  const nlohmann::json stored_options =
+      index_.options.contains("pipeline") ? index_.options["pipeline"] : nlohmann::json::object();
+  const bake::PipelineOptions pipeline_options =
+      bake::pipelineOptionsFromJson(stored_options, index_file + ": options.pipeline", index_.version);
+  if (error_px_ <= 0.0) error_px_ = pipeline_options.error_px;
   if (!online_stages_.empty()) {
     urban::CellOptions cell_options;
     cell_options.local = urban::parseLocalModel(index_.local_model, index_file + ": local_model");
     if (index_.options.contains("block_margin") && index_.options["block_margin"].is_number())
       cell_options.block_margin = index_.options["block_margin"].get<float>();
     cell_map_ = std::make_unique<urban::CellMap>(graph_, scene, cell_options);
-    const nlohmann::json options =
-        index_.options.contains("pipeline") ? index_.options["pipeline"] : nlohmann::json::object();
-    runner_ = std::make_unique<bake::PipelineRunner>(scene, *context.gpu_scene, *cell_map_,
-                                                     bake::pipelineOptionsFromJson(options, index_file));
+    runner_ = std::make_unique<bake::PipelineRunner>(scene, *context.gpu_scene, *cell_map_, pipeline_options);
   }
+  invalid_object_.assign(scene.objects.size() + 1, 0);
   object_triangles_.assign(scene.objects.size() + 1, 0);
   for (const scene::Object& o : scene.objects)
     for (const scene::Part& p : o.parts) object_triangles_[o.id] += scene.meshes[p.mesh].triangleCount();
@@ -192,6 +192,7 @@ std::unique_ptr<MmiMode::Cell> MmiMode::loadCell(const store::CellEntry& entry) 
   for (size_t l = 0; l < layers.size(); ++l) {
     Layer layer;
     layer.objects = layers[l].objects;
+    layer.validity = layers[l].validity;
     for (uint32_t id : layer.objects) {
       layer.bounds.expand(scene.objects[id - 1].world_bounds);
       layer.geometry_triangles += object_triangles_[id];
@@ -244,11 +245,45 @@ void MmiMode::frame(eval::FrameContext& frame) {
   ids_.clear();
   context_->bvh->queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
   Cell* current = nullptr;
+  // Layers whose validity region does not hold this viewpoint under the bound become geometry.
+  bound_rad_ = ErrorBound::forCamera(error_px_, camera).angle();
+  std::vector<uint8_t> layer_valid;
   if (entry) {
     ++visited_[half_edge];
     current = &cell(half_edge);
-    ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [&](uint32_t id) { return !current->geometry_mask[id]; }),
+    // Fast motion and stale dynamic impostors first: a layer that loses its dynamic impostor is judged by its
+    // baked views' validity below.
+    if (kind_ == MmiKind::MmiDynamic) dropStaleDynamic(camera, *current);
+    layer_valid.assign(current->layers.size(), 1);
+    bool any_invalid = false;
+    for (size_t l = 0; l < current->layers.size(); ++l) {
+      const Layer& layer = current->layers[l];
+      if (layer.dynamic || layer.views.empty()) continue;
+      if (!layer.validity) {
+        ++unchecked_layer_draws_;
+        continue;
+      }
+      if (layer.validity->valid(camera.eye, bound_rad_)) continue;
+      layer_valid[l] = 0;
+      any_invalid = true;
+      ++invalid_layer_draws_;
+      for (uint32_t id : layer.objects) invalid_object_[id] = 1;
+    }
+    if (any_invalid) ++invalid_frames_;
+    uint64_t invalid_triangles = 0;
+    ids_.erase(std::remove_if(ids_.begin(), ids_.end(),
+                              [&](uint32_t id) {
+                                if (current->geometry_mask[id]) return false;
+                                if (!invalid_object_[id]) return true;
+                                invalid_triangles += object_triangles_[id];
+                                return false;
+                              }),
                ids_.end());
+    invalid_triangles_sum_ += double(invalid_triangles);
+    if (any_invalid)
+      for (size_t l = 0; l < current->layers.size(); ++l)
+        if (!layer_valid[l])
+          for (uint32_t id : current->layers[l].objects) invalid_object_[id] = 0;
   } else {
     ++fallback_frames_;  // not baked: everything in the frustum, as the culled mode
   }
@@ -266,6 +301,7 @@ void MmiMode::frame(eval::FrameContext& frame) {
   for (size_t l = 0; l < current->layers.size(); ++l) {
     const Layer& layer = current->layers[l];
     const uint32_t id = layer_id_base_ + uint32_t(l);
+    if (!layer_valid[l]) continue;  // drawn as geometry above
     if (layer.dynamic) {
       layer.dynamic->appendDrawItems(frame.items(), id);
       impostor_triangles_sum_ += double(layer.dynamic->triangleCount());
@@ -281,9 +317,8 @@ void MmiMode::frame(eval::FrameContext& frame) {
 
 // Section 5.5. The order of the steps: fast motion first (it drops every dynamic impostor), then validity of the
 // ones kept, then the prediction of this frame's cost, then updates in decreasing error angle while they fit.
-void MmiMode::updateDynamic(eval::FrameContext& frame, Cell& cell, uint64_t frame_triangles, size_t frame_draws) {
-  const Camera& camera = frame.camera();
-  dynamic_threshold_rad_ = dynamic_error_px_ * horizontalFov(camera) / double(camera.width);
+void MmiMode::dropStaleDynamic(const Camera& camera, Cell& cell) {
+  dynamic_threshold_rad_ = ErrorBound::forCamera(dynamic_error_px_, camera).angle();
   const double threshold = dynamic_threshold_rad_;
 
   // Fast motion: the error a fresh impostor of the nearest layer would gather per frame at this speed.
@@ -298,11 +333,17 @@ void MmiMode::updateDynamic(eval::FrameContext& frame, Cell& cell, uint64_t fram
   if (fast) {
     ++fast_frames_;
     for (Layer& layer : cell.layers) layer.dynamic.reset();
-    return;
   }
   for (Layer& layer : cell.layers)
     if (layer.dynamic && (!layer.dynamic->covers(camera) || layer.dynamic->errorAngle(camera.eye) > threshold))
       layer.dynamic.reset();
+  fast_ = fast;
+}
+
+void MmiMode::updateDynamic(eval::FrameContext& frame, Cell& cell, uint64_t frame_triangles, size_t frame_draws) {
+  if (fast_) return;
+  const Camera& camera = frame.camera();
+  const double threshold = dynamic_threshold_rad_;
 
   // Predicted frame time of what would be drawn now.
   double triangles = double(frame_triangles);
@@ -396,6 +437,12 @@ std::map<std::string, double> MmiMode::info() const {
     const double f = impostor_frames_ ? double(impostor_frames_) : 1.0;
     out["mean_impostor_triangles"] = impostor_triangles_sum_ / f;
     out["mean_layers"] = layers_sum_ / f;
+    out["error_bound_px"] = error_px_;
+    out["error_bound_rad"] = bound_rad_;
+    out["invalid_layer_draws"] = double(invalid_layer_draws_);
+    out["unchecked_layer_draws"] = double(unchecked_layer_draws_);
+    out["frames_with_invalid_layers"] = double(invalid_frames_);
+    out["mean_invalid_layer_triangles"] = invalid_triangles_sum_ / n;
   }
   if (kind_ == MmiKind::MmiDynamic) {
     out["frame_budget_ms"] = budget_ms_;

@@ -15,6 +15,8 @@
 //   impostor_ids=object|layer  item buffers show, per impostor pixel, the object captured there (default: the
 //                           views' per-texel ids as an id texture) or one id per layer
 //   cell_lookup=street|nearest  as for the depth-mesh mode
+//   error_px=PX             the error bound in pixels of this walk's frames (default: the bake's --error-px); the
+//                           bound's angle follows from the frame size and field of view (core/error_bound.h)
 //   mmi-dynamic only:
 //   frame_budget_ms=MS      the desired frame time (default 33.3: 30 Hz)
 //   dynamic_error_px=PX     a layer is refreshed when its error angle exceeds PX pixels (default 2)
@@ -25,7 +27,12 @@
 //                           frames at the current speed, every layer falls back to its MMI (default 3)
 //
 // Cells: the cell is looked up per frame as in the depth-mesh mode. Its record is read (and its impostors uploaded)
-// the first time the viewer enters it, inside that frame. When the store left stages to the runtime (`bake
+// the first time the viewer enters it, inside that frame.
+//
+// The error bound: a layer (or the single mesh) is drawn as an impostor only where its validity region, computed at
+// bake time (bake/validity_region.h), says its error stays under the bound; elsewhere its objects are drawn as
+// geometry (frustum-culled), counted in info() as invalid layer draws. Stores without validity regions (version 2)
+// draw every layer and count it as unchecked. When the store left stages to the runtime (`bake
 // --online mmi`), they run then, with the bake's code (PipelineRunner), and their time counts in that frame. A cell
 // the store does not hold falls back to frustum-culled full geometry (counted).
 //
@@ -41,6 +48,7 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -79,6 +87,7 @@ class MmiMode final : public eval::Mode {
     uint64_t geometry_triangles = 0;                    // of its objects as geometry
     std::vector<std::unique_ptr<impostor::GpuImpostor>> views;
     std::vector<Vec3> view_eyes;                        // creation eyes of the views
+    std::optional<impostor::ValidityRegion> validity;   // from the bake (absent in version 2 stores)
     std::unique_ptr<DynamicImpostor> dynamic;
   };
   struct Cell {
@@ -90,6 +99,9 @@ class MmiMode final : public eval::Mode {
   };
   Cell& cell(uint32_t half_edge);
   std::unique_ptr<Cell> loadCell(const store::CellEntry& entry);
+  // Section 5.5 in two steps around the validity pass: drops the dynamic impostors that fast motion or their own
+  // error angle made stale, then (after the frame's geometry is known) schedules updates into the budget.
+  void dropStaleDynamic(const Camera& camera, Cell& cell);
   void updateDynamic(eval::FrameContext& frame, Cell& cell, uint64_t frame_triangles, size_t frame_draws);
 
   MmiKind kind_;
@@ -103,6 +115,9 @@ class MmiMode final : public eval::Mode {
   DynamicImpostorOptions dynamic_options_;
   size_t max_updates_ = 1;
   double min_lifetime_frames_ = 3.0;
+  double error_px_ = 0.0;        // 0 until prepare(): the option, or the bake's bound
+  double bound_rad_ = 0.0;       // of the last frame
+  std::vector<uint8_t> invalid_object_;  // per object id: in a layer drawn as geometry this frame
 
   const eval::ModeContext* context_ = nullptr;
   store::StoreIndex index_;
@@ -119,6 +134,7 @@ class MmiMode final : public eval::Mode {
   CostModel cost_;
   double dynamic_threshold_rad_ = 0.0;
   bool has_previous_ = false;
+  bool fast_ = false;  // this frame is fast motion (dropStaleDynamic)
   Vec3 previous_eye_{0.0f};
 
   // Statistics.
@@ -127,6 +143,8 @@ class MmiMode final : public eval::Mode {
   std::map<uint32_t, size_t> visited_;
   double geometry_triangles_sum_ = 0.0, impostor_triangles_sum_ = 0.0, layers_sum_ = 0.0;
   size_t impostor_frames_ = 0;
+  size_t invalid_layer_draws_ = 0, unchecked_layer_draws_ = 0, invalid_frames_ = 0;
+  double invalid_triangles_sum_ = 0.0;  // geometry triangles drawn for invalid layers
   size_t updates_ = 0, fast_frames_ = 0, skipped_for_budget_ = 0;
   double update_ms_total_ = 0.0, update_ms_max_ = 0.0, dynamic_layers_sum_ = 0.0;
   double predicted_ms_sum_ = 0.0, predicted_update_error_ms_ = 0.0;

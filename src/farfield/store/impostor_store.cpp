@@ -129,7 +129,15 @@ nlohmann::json viewJson(const StoredView& v) {
 nlohmann::json layerJson(const StoredLayer& l) {
   nlohmann::json views = nlohmann::json::array();
   for (const StoredView& v : l.views) views.push_back(viewJson(v));
-  return {{"objects", l.objects}, {"views", std::move(views)}};
+  nlohmann::json j = {{"objects", l.objects}, {"views", std::move(views)}};
+  if (l.validity) {
+    const impostor::ValidityRegion& v = *l.validity;
+    j["validity"] = {{"origin", vec3Json(v.origin)}, {"end", vec3Json(v.end)}, {"half_width", v.half_width},
+                     {"below", v.below},             {"above", v.above},     {"back", v.back},
+                     {"step", v.step},               {"laterals", v.laterals},
+                     {"envelope", v.envelope}};
+  }
+  return j;
 }
 
 nlohmann::json pipelineJson(const CellPipeline& p) {
@@ -162,7 +170,42 @@ std::vector<uint32_t> readIds(const JsonReader& r, const nlohmann::json& j, cons
   return ids;
 }
 
-StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::string& where, size_t scene_objects) {
+impostor::ValidityRegion readValidity(const JsonReader& r, const nlohmann::json& j, const std::string& where) {
+  const nlohmann::json& m = r.member(j, "validity", where);
+  const std::string at = where + ": validity";
+  impostor::ValidityRegion v;
+  v.origin = r.vec3(m, "origin", at);
+  v.end = r.vec3(m, "end", at);
+  auto non_negative = [&](const char* key) {
+    const double x = r.number(m, key, at);
+    if (x < 0.0) r.fail(at, std::string("\"") + key + "\" must be >= 0");
+    return float(x);
+  };
+  v.half_width = non_negative("half_width");
+  v.below = non_negative("below");
+  v.above = non_negative("above");
+  v.back = non_negative("back");
+  v.step = non_negative("step");
+  if (!(v.step > 0.0f)) r.fail(at, "\"step\" must be > 0");
+  const uint64_t laterals = r.count(m, "laterals", at);
+  if (laterals < 1 || laterals % 2 == 0 || laterals > 1001) r.fail(at, "\"laterals\" must be an odd count 1..1001");
+  v.laterals = int(laterals);
+  const nlohmann::json& envelope = r.member(m, "envelope", at);
+  if (!envelope.is_array()) r.fail(at, "\"envelope\" must be an array of angles");
+  if (envelope.size() % laterals != 0) r.fail(at, "\"envelope\" must hold \"laterals\" rows of equal length");
+  const size_t row = envelope.size() / laterals;
+  for (size_t i = 0; i < envelope.size(); ++i) {
+    const nlohmann::json& e = envelope[i];
+    if (!e.is_number() || !(e.get<double>() >= 0.0) || !(e.get<double>() <= kPi + 1e-6))
+      r.fail(at, "\"envelope\" must hold angles in [0, pi]");
+    if (i % row != 0 && e.get<float>() < v.envelope.back()) r.fail(at, "\"envelope\" rows must not decrease");
+    v.envelope.push_back(e.get<float>());
+  }
+  return v;
+}
+
+StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::string& where, size_t scene_objects,
+                      bool require_validity) {
   StoredLayer layer;
   layer.objects = readIds(r, j, "objects", where, scene_objects);
   const nlohmann::json& views = r.member(j, "views", where);
@@ -182,11 +225,12 @@ StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::s
     if (view.triangles > 0 && view.texture.empty()) r.fail(at, "has triangles but no texture");
     layer.views.push_back(std::move(view));
   }
+  if (j.contains("validity") || (require_validity && !layer.views.empty())) layer.validity = readValidity(r, j, where);
   return layer;
 }
 
 CellPipeline readPipeline(const JsonReader& r, const nlohmann::json& j, const std::string& where,
-                          size_t scene_objects) {
+                          size_t scene_objects, bool require_validity) {
   if (!j.is_object()) r.fail(where, "expected an object");
   CellPipeline p;
   if (j.contains("pvs")) {
@@ -213,8 +257,9 @@ CellPipeline readPipeline(const JsonReader& r, const nlohmann::json& j, const st
     const nlohmann::json& layers = r.member(m, "layers", at);
     if (!layers.is_array()) r.fail(at, "\"layers\" must be an array");
     for (size_t l = 0; l < layers.size(); ++l)
-      p.layers.push_back(readLayer(r, layers[l], at + ".layers[" + std::to_string(l) + "]", scene_objects));
-    p.single = readLayer(r, r.member(m, "single", at), at + ".single", scene_objects);
+      p.layers.push_back(
+          readLayer(r, layers[l], at + ".layers[" + std::to_string(l) + "]", scene_objects, require_validity));
+    p.single = readLayer(r, r.member(m, "single", at), at + ".single", scene_objects, require_validity);
   }
   return p;
 }
@@ -278,8 +323,8 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
   if (r.text(j, "format", "top level") != kIndexFormat)
     r.fail("\"format\"", std::string("expected \"") + kIndexFormat + "\"");
   const uint64_t version = r.count(j, "version", "top level");
-  if (version != 1 && version != uint64_t(kIndexVersion))
-    r.fail("\"version\"", "unsupported version " + std::to_string(version) + " (this build reads version " +
+  if (version < 1 || version > uint64_t(kIndexVersion))
+    r.fail("\"version\"", "unsupported version " + std::to_string(version) + " (this build reads versions 1.." +
                               std::to_string(kIndexVersion) + ")");
   index.version = int(version);
   for (const char* key : {"pipeline", "online"}) {
@@ -348,7 +393,8 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
       if (s.triangles > 0 && e.texture.empty()) r.fail(at, "has triangles but the cell has no texture");
       e.impostors[technique] = std::move(s);
     }
-    if (c.contains("pipeline")) e.pipeline = readPipeline(r, c["pipeline"], where + ": pipeline", index.scene_objects);
+    if (c.contains("pipeline")) e.pipeline = readPipeline(r, c["pipeline"], where + ": pipeline", index.scene_objects,
+                                                                index.version >= 3);
     index.cells.push_back(std::move(e));
   }
   return index;

@@ -35,6 +35,11 @@
 //                "ids": "cells/e000012.mmi.00.0.ids.png" (optional),
 //                "triangles": 540, "vertices": 300, "data_pixels": 81234, "render_ms": 20.1, "build_ms": 3.2}
 //   (each part present when its stage was baked). Version 1 indexes are still read.
+//   Version 3 adds to every layer and to "single" (when it has views) the validity region of its views
+//   (impostor/validity.h), computed at bake time:
+//     "validity": {"origin": [x,y,z], "end": [x,y,z], "half_width": 5.4, "below": 0.6, "above": 0.3, "back": 2,
+//                  "step": 1, "envelope": [0, 0.0004, ...]}          // radians, non-decreasing
+//   and requires the pipeline options in "options.pipeline" whole (bake/pipeline.h); version 2 is still read.
 //   Cells are sorted by half-edge id, each at most once. Numbers are JSON numbers (floats written with enough digits
 //   to read back exactly).
 //
@@ -62,10 +67,11 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/impostor/impostor_mesh.h"
+#include "farfield/impostor/validity.h"
 
 namespace farfield::store {
 
-inline constexpr int kIndexVersion = 2;  // 1 (Sillion only) is still read
+inline constexpr int kIndexVersion = 3;  // 1 (Sillion only) and 2 (pipeline, no validity regions) are still read
 inline constexpr uint32_t kMeshVersion = 1;
 inline constexpr char kIndexFormat[] = "farfield-impostor-store";
 inline constexpr char kIndexFile[] = "index.json";
@@ -98,6 +104,9 @@ struct StoredView {
 struct StoredLayer {
   std::vector<uint32_t> objects;  // object ids, ascending
   std::vector<StoredView> views;
+  // Where the layer's views may be drawn under an error bound (impostor/validity.h); version 3 stores have one for
+  // every layer with views, version 2 stores none (the runtime then counts the layer as unchecked).
+  std::optional<impostor::ValidityRegion> validity;
 };
 
 // What the extractor pipeline (farfield/bake/pipeline.h) found for a cell. Each part is present when its stage ran

@@ -1,0 +1,47 @@
+// Bake-time validity regions of a street cell's impostors (DESIGN.md, "the two promises": each impostor carries the
+// viewpoints where its reprojection error stays under the bound, computed at bake time and never guessed at run
+// time). See impostor/validity.h for the region and the per-object closed form.
+//
+// The error of an impostor captured from E (the cell's start at eye height), seen from a viewpoint V, is bounded by
+// the larger of two terms:
+//   - per object: impostor::parallaxBound(E, V, box), the parallax between the points one texel stands for;
+//   - between objects of one impostor (rubber sheets and de-occlusion between them): Decoret et al.'s
+//     visibility-event weight of the pair for the segment [E, V] (urban::computeEventGraph), the largest change of
+//     the pair's relative angle while the viewer moves from E to V, with the paper's closed forms. A multi-mesh
+//     layer keeps these under the layering threshold T along the cell by construction; off the centreline, and for
+//     the single mesh, this term is what limits the region.
+// Viewpoints are sampled every `step` metres along the cell (s in [-back, length]), at `laterals` offsets across
+// it within the street's half width and at three heights; the envelope is the running maximum along s. Scanning stops
+// after the first sample above `stop_rad` (what lies beyond is outside the region).
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "farfield/core/bounds.h"
+#include "farfield/core/polygon2d.h"
+#include "farfield/impostor/validity.h"
+
+namespace farfield::bake {
+
+struct ValidityOptions {
+  float step = 1.0f;             // metres between samples along the cell
+  float back = 2.0f;             // metres before the cell's start that the region also covers
+  float width_share = 0.9f;      // region half width = share x the street's half width (walkers keep within 90%)
+  int laterals = 5;              // samples across the street, odd (includes the centreline)
+  float below = 0.6f;            // metres below the eye line (a car's 1.2 m eye under a pedestrian's 1.7 m bake)
+  float above = 0.3f;            // metres above it
+};
+
+struct ValidityObject {
+  Box3 box;           // world bounds
+  Polygon2 footprint; // ground-plane outline (visibility events); a box's rectangle when the object has none
+};
+
+// The region of one impostor captured from `p_eye` for a cell ending at `q_eye` on a street `street_width` metres
+// wide. stop_rad > 0: the scan stops after the first envelope value above it.
+impostor::ValidityRegion computeValidityRegion(const Vec3& p_eye, const Vec3& q_eye, float street_width,
+                                               std::span<const ValidityObject> objects, double stop_rad,
+                                               const ValidityOptions& options = {});
+
+}  // namespace farfield::bake
