@@ -1,10 +1,13 @@
 // farfield render SCENE --eye x,y,z --at x,y,z [--up x,y,z] --fov DEG --size WxH -o frame.png
 //                [--depth depth.pfm] [--ids ids.png]
+// Timed (wall and GPU ms of the second of two renders); the allocator is set up for timing first
+// (farfield/core/allocator.h).
 #include <cstdio>
 #include <memory>
 
 #include "cli_util.h"
 #include "command.h"
+#include "farfield/core/allocator.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/image/png_io.h"
@@ -29,6 +32,7 @@ struct RenderArgs {
 };
 
 void runRender(const RenderArgs& args) {
+  const AllocatorSettings allocator = configureTimingAllocator();
   scene::Scene scene = scene::loadScene(args.scene);
   Camera camera;
   camera.eye = parseVec3("--eye", args.eye);
@@ -68,6 +72,7 @@ void runRender(const RenderArgs& args) {
   std::printf("objects:    %u\n", stats.objects);
   std::printf("wall ms:    %.3f\n", stats.wall_ms);
   std::printf("gpu ms:     %.3f\n", stats.gpu_ms);
+  std::printf("malloc:     %s\n", allocator.description.c_str());
 }
 
 const RegisterCommand reg("render", [](CLI::App& app) {

@@ -384,6 +384,7 @@ struct QualityRow {
 };
 
 void runTerrainBench(const BenchArgs& args) {
+  configureTimingAllocator();  // farfield/core/allocator.h (through eval/bench.h): frame times, not page faults
   const IVec2 size = parseSize("--size", args.size);
   if (!(args.epsilon > 0.0)) throw Error("--epsilon", "must be positive (pixels)");
   if (!(args.high_error > 0.0f && args.low_error >= args.high_error))

@@ -1,12 +1,13 @@
 // farfield walk SCENE --path path.json --mode full|culled|... [--size WxH] [--frames N] [--csv frames.csv]
 //               [--frames-dir DIR --every K] [--mode-option key=value]...
 // One mode along a camera path: per-frame wall time (to glFinish), GPU time, triangles, draw calls, objects drawn;
-// prints median, p95, p99 and max.
+// prints median, p95, p99 and max. The allocator is set up for timing first (farfield/core/allocator.h).
 #include <cstdio>
 #include <memory>
 
 #include "cli_util.h"
 #include "command.h"
+#include "farfield/core/allocator.h"
 #include "farfield/core/error.h"
 #include "farfield/eval/mode.h"
 #include "farfield/eval/walk.h"
@@ -33,6 +34,7 @@ struct WalkArgs {
 };
 
 void runWalkCommand(const WalkArgs& args) {
+  const AllocatorSettings allocator = configureTimingAllocator();
   eval::WalkOptions options;
   const IVec2 size = parseSize("--size", args.size);
   options.width = size.x;
@@ -59,6 +61,7 @@ void runWalkCommand(const WalkArgs& args) {
   }
   std::printf("scene:           %s\n", args.scene.c_str());
   std::printf("path:            %s\n", args.path.c_str());
+  std::printf("malloc:          %s\n", allocator.description.c_str());
   std::fputs(eval::formatWalkSummary(result).c_str(), stdout);
   if (!args.csv.empty()) std::printf("csv:             %s\n", args.csv.c_str());
   if (!result.written_frames.empty())
