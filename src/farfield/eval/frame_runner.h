@@ -19,7 +19,7 @@ namespace farfield::eval {
 struct FrameRecord {
   size_t path_frame = 0;  // index into the camera path
   double wall_ms = 0.0;   // from Mode::frame() to glFinish, CPU wall clock
-  double gpu_ms = 0.0;    // GL_TIME_ELAPSED from the clear through the last pass
+  double gpu_ms = 0.0;    // gpu::GpuTimer from the clear through the last pass (the CPU clock to glFinish on llvmpipe)
   uint64_t triangles = 0;
   uint32_t draw_calls = 0;
   uint32_t objects = 0;   // objects drawn (distinct per pass; see FrameContext::addStats)

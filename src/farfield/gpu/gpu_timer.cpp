@@ -3,28 +3,51 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <string>
 
 namespace farfield::gpu {
 
-GpuTimer::GpuTimer() { glCreateQueries(GL_TIME_ELAPSED, 1, &query_); }
+bool currentRendererIsSoftware() {
+  const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string renderer = name ? name : "";
+  return renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos ||
+         renderer.find("swrast") != std::string::npos;
+}
+
+GpuTimer::GpuTimer(Source source) : source_(source) {
+  if (source_ == Source::Auto) source_ = currentRendererIsSoftware() ? Source::CpuClock : Source::Query;
+  if (source_ == Source::Query) glCreateQueries(GL_TIME_ELAPSED, 1, &query_);
+}
 
 GpuTimer::~GpuTimer() {
   if (query_) glDeleteQueries(1, &query_);
 }
 
 void GpuTimer::begin() {
+  if (source_ == Source::CpuClock) {
+    // Earlier work (uploads, another pass) must not be counted: a software rasterizer would do it inside our span.
+    glFinish();
+    since_begin_.restart();
+    return;
+  }
   since_begin_.restart();
   glBeginQuery(GL_TIME_ELAPSED, query_);
 }
 
 void GpuTimer::end() {
-  glEndQuery(GL_TIME_ELAPSED);
+  if (source_ == Source::CpuClock) {
+    glFinish();  // the work is done when the rasterizer threads are
+    cpu_clock_ms_ = since_begin_.milliseconds();
+  } else {
+    glEndQuery(GL_TIME_ELAPSED);
+  }
   ended_ = true;
 }
 
 double GpuTimer::elapsedMs() const {
   // A query that never ran has no result; asking for it would be a GL error.
   if (!ended_) return 0.0;
+  if (source_ == Source::CpuClock) return cpu_clock_ms_;
   GLuint64 ns = 0;
   glGetQueryObjectui64v(query_, GL_QUERY_RESULT, &ns);
   // llvmpipe records a query's start per rasterizer thread; a thread that got no work between begin and end
