@@ -3,7 +3,9 @@
 
   frame_time.png  wall-clock frame time per frame, one line per mode (GPU time dashed when measured)
   error.png       PSNR and share of bad pixels per frame, one line per mode (only with --reference runs)
-  parallax.png    parallax error (99th percentile, pixels) per frame, for the modes where it was measured
+  parallax.png    parallax error (99th percentile, pixels) per frame, for the modes where it was measured, with the
+                  error bound of each mode that has one (bench.json) and the frames over it marked
+  popping.png     popping per frame (the mode's image change beyond the reference's, 8-bit units; --reference runs)
 
 Usage: plot_bench.py OUTDIR
 Exit codes: 0 plots written, 2 bad input (missing or malformed frames.csv), 3 matplotlib not available.
@@ -18,7 +20,7 @@ import sys
 def read_frames(path):
     """Rows of frames.csv grouped by mode, in file order: {mode: {"frame": [...], "wall_ms": [...], ...}}."""
     numeric = ["frame", "path_frame", "wall_ms", "gpu_ms", "triangles", "draw_calls", "objects",
-               "psnr_db", "ssim", "bad_pixel_share", "parallax_p99_px"]
+               "psnr_db", "ssim", "bad_pixel_share", "parallax_p99_px", "popping"]
     modes = {}
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
@@ -74,15 +76,18 @@ def main(argv):
         print("plot_bench.py: %s has no frames" % csv_path, file=sys.stderr)
         return 2
 
-    threshold, cap = 8, 99
+    threshold, cap, bounds = 8, 99, {}
     try:
         import json
         with open(os.path.join(out_dir, "bench.json")) as f:
             info = json.load(f)
         threshold = info.get("bad_pixel_threshold", threshold)
         cap = info.get("psnr_cap_db", cap)
-    except (OSError, ValueError):
-        pass  # bench.json is optional here: the labels fall back to the defaults
+        for name, m in (info.get("modes") or {}).items():
+            if isinstance(m, dict) and isinstance(m.get("error_bound_px"), (int, float)):
+                bounds[name] = float(m["error_bound_px"])
+    except (OSError, ValueError, AttributeError):
+        pass  # bench.json is optional here: the labels fall back to the defaults, no bound lines
 
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
 
@@ -131,7 +136,15 @@ def main(argv):
         fig, ax = plt.subplots(figsize=(10, 4.0))
         for i, (name, s) in enumerate(modes.items()):
             if name in measured:
-                ax.plot(x_of(s), s["parallax_p99_px"], label=name, color=colors[i % len(colors)], linewidth=1.2)
+                color = colors[i % len(colors)]
+                ax.plot(x_of(s), s["parallax_p99_px"], label=name, color=color, linewidth=1.2)
+                if name in bounds:
+                    bound = bounds[name]
+                    ax.axhline(bound, color=color, linewidth=0.8, linestyle=":", label="%s bound %g px" % (name, bound))
+                    over = [(x, v) for x, v in zip(x_of(s), s["parallax_p99_px"]) if not math.isnan(v) and v > bound]
+                    if over:
+                        ax.scatter([x for x, _ in over], [v for _, v in over], color=color, marker="x", s=18,
+                                   label="%s over bound (%d)" % (name, len(over)))
         ax.set_xlabel("camera path frame")
         ax.set_ylabel("parallax error, 99th pct (px)")
         ax.set_title("Visibility error from object ids: how far objects are drawn from where they are seen")
@@ -143,6 +156,24 @@ def main(argv):
         fig.savefig(os.path.join(out_dir, "parallax.png"), dpi=110)
         plt.close(fig)
         written.append("parallax.png")
+
+    popped = {name: s for name, s in modes.items() if has_values(s["popping"])}
+    if popped:
+        fig, ax = plt.subplots(figsize=(10, 4.0))
+        for i, (name, s) in enumerate(modes.items()):
+            if name in popped:
+                ax.plot(x_of(s), s["popping"], label=name, color=colors[i % len(colors)], linewidth=1.2)
+        ax.set_xlabel("camera path frame")
+        ax.set_ylabel("popping (mean |RGB change| beyond the reference's, /255)")
+        ax.set_title("Popping: frame-to-frame image change beyond the reference's own change")
+        ax.set_ylim(bottom=0)
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small", ncol=2)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out_dir, "popping.png"), dpi=110)
+        plt.close(fig)
+        written.append("popping.png")
 
     for name in written:
         print("wrote %s" % os.path.join(out_dir, name))

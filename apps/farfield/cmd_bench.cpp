@@ -1,10 +1,11 @@
 // farfield bench SCENE --path path.json --modes full,culled,... [--reference] [--size WxH] [--frames N]
 //                [--stride K] [--samples K] -o OUTDIR [--report FILE] [--no-plots] [--plot-script FILE]
-//                [--python EXE] [--mode-option key=value]... [--impostors DIR]
+//                [--python EXE] [--mode-option key=value]... [--impostors DIR] [--error-px PX]
 // The walkthrough benchmark (see farfield/eval/bench.h): all modes interleaved over the same frames, with
 // bench.json, bench.md, frames.csv, plots, sample frames and a report in OUTDIR. --impostors DIR is the impostor
 // store of `farfield bake` for the depth-mesh and grid-mesh modes (the mode option impostor_dir; see
-// farfield/runtime/impostor_mode.h).
+// farfield/runtime/impostor_mode.h). --error-px is the error bound the frames are checked against (default: each
+// mode's own). The allocator is set up for timing first (farfield/core/allocator.h).
 #include <unistd.h>
 
 #include <cstdio>
@@ -15,6 +16,7 @@
 
 #include "cli_util.h"
 #include "command.h"
+#include "farfield/core/allocator.h"
 #include "farfield/core/error.h"
 #include "farfield/eval/bench.h"
 #include "farfield/eval/mode.h"
@@ -46,6 +48,7 @@ struct BenchArgs {
   std::string impostors;
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
+  double error_px = 0.0;  // 0 = not given
 };
 
 std::vector<std::string> splitModes(const std::string& text) {
@@ -80,6 +83,7 @@ std::string findPlotScript() {
 }
 
 void runBenchCommand(const BenchArgs& args) {
+  const AllocatorSettings allocator = configureTimingAllocator();
   eval::BenchOptions options;
   const IVec2 size = parseSize("--size", args.size);
   options.width = size.x;
@@ -100,6 +104,10 @@ void runBenchCommand(const BenchArgs& args) {
     throw Error("--near/--far", "need 0 < near < far");
   options.near_plane = args.near_plane;
   options.far_plane = args.far_plane;
+  if (args.error_px != 0.0) {
+    if (!(args.error_px > 0.0)) throw Error("--error-px", "must be a positive number of pixels");
+    options.error_px = args.error_px;
+  }
   // Cheap checks first: unknown modes or a bad path fail before the scene is loaded.
   eval::checkModeNames(options.modes);
   const gen::CameraPath path = gen::loadCameraPath(args.path);
@@ -123,11 +131,13 @@ void runBenchCommand(const BenchArgs& args) {
   eval::writeReport(result, args.out_dir, report);
 
   std::printf("renderer: %s\n", result.renderer.c_str());
+  std::printf("malloc:   %s\n", allocator.description.c_str());
   std::printf("frames:   %zu of %zu (size %dx%d)\n", result.frame_indices.size(), result.path_frames, result.width,
               result.height);
   if (result.baseline_added) std::printf("note:     \"full\" was not asked for; it ran anyway as the baseline\n");
-  std::printf("\n%-16s %10s %10s %10s %10s %12s %9s %10s %8s %12s\n", "mode", "median ms", "p95 ms", "p99 ms",
-              "max ms", "triangles", "speedup", "PSNR dB", "cracks", "parallax px");
+  std::printf("\n%-16s %10s %10s %10s %10s %12s %9s %10s %8s %12s %12s %9s\n", "mode", "median ms", "p95 ms",
+              "p99 ms", "max ms", "triangles", "speedup", "PSNR dB", "cracks", "parallax px", "over bound",
+              "popping max");
   for (const eval::ModeResult& m : result.modes) {
     char psnr[32] = "n/a";
     if (m.has_errors) {
@@ -140,8 +150,16 @@ void runBenchCommand(const BenchArgs& args) {
     if (m.has_errors) std::snprintf(cracks, sizeof(cracks), "%.3f%%", 100.0 * m.crack_share_mean);
     char parallax[32] = "n/a";
     if (m.has_parallax) std::snprintf(parallax, sizeof(parallax), "%.2f", m.parallax_px_mean);
-    std::printf("%-16s %10.3f %10.3f %10.3f %10.3f %12.0f %8.2fx %10s %8s %12s\n", m.name.c_str(), m.wall.median,
-                m.wall.p95, m.wall.p99, m.wall.max, m.mean_triangles, m.speedup_vs_full, psnr, cracks, parallax);
+    char over[48] = "-";
+    if (m.error_bound_px && m.frames_checked > 0)
+      std::snprintf(over, sizeof(over), "%zu/%zu", m.frames_over_bound, m.frames_checked);
+    else if (m.error_bound_px)
+      std::snprintf(over, sizeof(over), "n/a");
+    char popping[32] = "n/a";
+    if (m.has_popping) std::snprintf(popping, sizeof(popping), "%.3f", m.popping_summary.max);
+    std::printf("%-16s %10.3f %10.3f %10.3f %10.3f %12.0f %8.2fx %10s %8s %12s %12s %12s\n", m.name.c_str(),
+                m.wall.median, m.wall.p95, m.wall.p99, m.wall.max, m.mean_triangles, m.speedup_vs_full, psnr, cracks,
+                parallax, over, popping);
   }
   std::printf("\nwrote %s/{bench.json,bench.md,frames.csv}", args.out_dir.c_str());
   for (const std::string& p : result.plots) std::printf(", %s", p.c_str());
@@ -175,6 +193,9 @@ const RegisterCommand reg("bench", [](CLI::App& app) {
   cmd->add_option("--impostors", args->impostors,
                   "Impostor store of farfield bake for the depth-mesh and grid-mesh modes (= --mode-option "
                   "impostor_dir=DIR)");
+  cmd->add_option("--error-px", args->error_px,
+                  "Error bound, pixels: frames whose parallax p99 exceeds it are counted (default: the bound each "
+                  "mode reports, if any)");
   cmd->add_option("--near", args->near_plane, "Near plane, metres")->capture_default_str();
   cmd->add_option("--far", args->far_plane, "Far plane, metres")->capture_default_str();
   cmd->callback([args] { runBenchCommand(*args); });

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -115,6 +116,164 @@ TEST(Bench, JsonHasEveryKeyForEveryMode) {
   // 1 ground quad (2 triangles) + 25 boxes (12 each), every frame.
   EXPECT_DOUBLE_EQ(full.at("mean_triangles").get<double>(), 302.0);
   EXPECT_LT(culled.at("mean_triangles").get<double>(), 302.0);
+  // No bound anywhere; popping measured (frames 2 and 3) and 0 for modes that draw what the reference draws.
+  for (const char* mode : {"full", "culled"}) {
+    const auto& m = j.at("modes").at(mode);
+    EXPECT_TRUE(m.at("error_bound_px").is_null()) << mode;
+    EXPECT_TRUE(m.at("frames_over_bound").is_null()) << mode;
+    EXPECT_DOUBLE_EQ(m.at("popping_max").get<double>(), 0.0) << mode;
+  }
+  // The allocator settings of the run are stated (this test binary never configures them: the defaults).
+  ASSERT_TRUE(j.at("allocator").is_object());
+  EXPECT_EQ(j.at("allocator").at("applied"), false);
+  EXPECT_NE(j.at("allocator").at("description").get<std::string>().find("defaults"), std::string::npos);
+}
+
+// summarizeModeResult over made-up frames: which bound applies and which frames break it.
+ModeResult madeUpFrames(std::vector<double> parallax) {
+  ModeResult m;
+  m.name = "made-up";
+  for (size_t k = 0; k < parallax.size(); ++k) {
+    FrameRecord f;
+    f.path_frame = k;
+    f.wall_ms = 1.0 + double(k);
+    m.frames.push_back(f);
+    m.errors.push_back(image::ImageMetrics{40.0, 1.0, 0.99, 0.01});
+    m.crack_shares.push_back(0.0);
+  }
+  m.parallax_px = std::move(parallax);
+  return m;
+}
+
+TEST(BenchBound, FramesOverTheGivenBound) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  ModeResult m = madeUpFrames({0.5, 2.0, nan, 1.0, 3.5});
+  summarizeModeResult(m, 1.0);
+  ASSERT_TRUE(m.error_bound_px.has_value());
+  EXPECT_DOUBLE_EQ(*m.error_bound_px, 1.0);
+  EXPECT_EQ(m.error_bound_source, "--error-px");
+  // 1.0 px is within a 1.0 px bound; the frame whose parallax could not be measured is not checked.
+  EXPECT_EQ(m.over_bound, (std::vector<int>{0, 1, -1, 0, 1}));
+  EXPECT_EQ(m.frames_over_bound, 2u);
+  EXPECT_EQ(m.frames_checked, 4u);
+}
+
+TEST(BenchBound, TheModesOwnBoundUnlessOneIsGiven) {
+  ModeResult m = madeUpFrames({0.5, 2.0, 0.1});
+  m.info["error_bound_px"] = 0.25;
+  summarizeModeResult(m, std::nullopt);
+  ASSERT_TRUE(m.error_bound_px.has_value());
+  EXPECT_DOUBLE_EQ(*m.error_bound_px, 0.25);
+  EXPECT_EQ(m.error_bound_source, "mode");
+  EXPECT_EQ(m.over_bound, (std::vector<int>{1, 1, 0}));
+  EXPECT_EQ(m.frames_over_bound, 2u);
+  // --error-px wins over the mode's.
+  summarizeModeResult(m, 3.0);
+  EXPECT_EQ(m.error_bound_source, "--error-px");
+  EXPECT_EQ(m.frames_over_bound, 0u);
+  EXPECT_EQ(m.frames_checked, 3u);
+  // Neither: no bound, nothing checked.
+  m.info.clear();
+  summarizeModeResult(m, std::nullopt);
+  EXPECT_FALSE(m.error_bound_px.has_value());
+  EXPECT_EQ(m.over_bound, (std::vector<int>{-1, -1, -1}));
+  EXPECT_EQ(m.frames_checked, 0u);
+  // Without a reference there is no parallax: a bound checks nothing.
+  ModeResult plain;
+  plain.frames.resize(2);
+  summarizeModeResult(plain, 1.0);
+  EXPECT_EQ(plain.frames_checked, 0u);
+  EXPECT_EQ(plain.over_bound, (std::vector<int>{-1, -1}));
+}
+
+// A representation switch: until path frame kSwitchFrame the mode draws the scene from a camera 1 m above the
+// frame's (an "impostor" with parallax), from then on the scene itself. It reports a 1 px error bound.
+constexpr size_t kSwitchFrame = 5;
+class SwitchMode final : public Mode {
+ public:
+  std::string name() const override { return "test-switch"; }
+  void prepare(const ModeContext& context) override { items_ = context.gpu_scene->drawItems(); }
+  void frame(FrameContext& frame) override {
+    if (frame.pathFrame() >= kSwitchFrame) {
+      frame.submit(items_);
+      return;
+    }
+    Camera raised = frame.camera();
+    raised.eye.z += 1.0f;
+    raised.at.z += 1.0f;
+    gpu::RenderTarget& target = frame.beginOwnPass();
+    frame.addStats(frame.renderer().draw(raised, items_, target));
+  }
+  std::map<std::string, double> info() const override { return {{"error_bound_px", 1.0}}; }
+
+ private:
+  std::vector<gpu::DrawItem> items_;
+};
+const RegisterMode register_switch("test-switch", "test: a representation switch at path frame 5",
+                                   [](const ModeContext&) { return std::make_unique<SwitchMode>(); });
+
+TEST(BenchBound, ASwitchPopsOnceAndItsFramesBeforeBreakTheBound) {
+  const fs::path dir = test::scratchDir("eval_bench_switch");
+  const scene::Scene scene = scene::builtinScene("cubes");
+  BenchOptions options;
+  options.modes = {"test-switch"};
+  options.width = 96;
+  options.height = 64;
+  options.frames = 10;
+  options.reference = true;
+  options.samples = 0;
+  BenchResult result = runBench(gpu::sharedHeadlessContext(), scene, test::sideWalkPath(16), options);
+  const ModeResult* m = result.mode("test-switch");
+  ASSERT_NE(m, nullptr);
+  ASSERT_EQ(m->popping.size(), 10u);
+  ASSERT_EQ(m->over_bound.size(), 10u);
+  // The bound is the mode's; the raised frames break it, the exact ones keep it.
+  ASSERT_TRUE(m->error_bound_px.has_value());
+  EXPECT_EQ(m->error_bound_source, "mode");
+  for (size_t k = 0; k < 10; ++k)
+    EXPECT_EQ(m->over_bound[k], k < kSwitchFrame ? 1 : 0) << "frame " << k << ": " << m->parallax_px[k] << " px";
+  EXPECT_EQ(m->frames_over_bound, kSwitchFrame);
+  EXPECT_EQ(m->frames_checked, 10u);
+  // Popping peaks at the switch; after it the mode draws what the reference does (0 exactly).
+  EXPECT_TRUE(std::isnan(m->popping[0]));
+  for (size_t k = 1; k < 10; ++k) {
+    if (k == kSwitchFrame) continue;
+    EXPECT_LT(m->popping[k], m->popping[kSwitchFrame] / 4.0) << k;
+    if (k > kSwitchFrame) {
+      EXPECT_EQ(m->popping[k], 0.0) << k;
+    }
+  }
+  EXPECT_GT(m->popping[kSwitchFrame], 1.0);
+  EXPECT_DOUBLE_EQ(m->popping_summary.max, m->popping[kSwitchFrame]);
+  // "full" draws the reference: no popping, no bound.
+  EXPECT_DOUBLE_EQ(result.mode("full")->popping_summary.max, 0.0);
+  EXPECT_FALSE(result.mode("full")->error_bound_px.has_value());
+
+  // A bound given for the run applies to every mode and shows in every output.
+  options.error_px = 50.0;
+  result = runBench(gpu::sharedHeadlessContext(), scene, test::sideWalkPath(16), options);
+  EXPECT_EQ(result.mode("test-switch")->frames_over_bound, 0u);
+  EXPECT_EQ(result.mode("full")->error_bound_source, "--error-px");
+  writeBenchOutputs(result, dir.string());
+  const nlohmann::json j = nlohmann::json::parse(readText(dir / "bench.json"));
+  EXPECT_DOUBLE_EQ(j.at("modes").at("full").at("error_bound_px").get<double>(), 50.0);
+  EXPECT_EQ(j.at("modes").at("test-switch").at("frames_over_bound"), 0);
+  EXPECT_EQ(j.at("modes").at("test-switch").at("frames_checked_against_bound"), 10);
+  EXPECT_GT(j.at("modes").at("test-switch").at("popping_max").get<double>(), 1.0);
+  const std::string md = readText(dir / "bench.md");
+  EXPECT_NE(md.find("| 50.00 | 0 of 10 |"), std::string::npos) << md;
+  const auto csv = lines(readText(dir / "frames.csv"));
+  ASSERT_EQ(csv.size(), 1u + 10u * 2u);
+  for (size_t i = 1; i < csv.size(); ++i) {
+    std::vector<std::string> cells;
+    std::stringstream row(csv[i]);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    ASSERT_GE(cells.size(), 14u) << csv[i];
+    EXPECT_EQ(cells[13], "0") << csv[i];  // over_bound
+  }
+
+  options.error_px = -1.0;
+  EXPECT_THROW(runBench(gpu::sharedHeadlessContext(), scene, test::sideWalkPath(4), options), Error);
 }
 
 TEST(Bench, FramesAreInterleavedWithRotatingOrder) {
@@ -141,7 +300,15 @@ TEST(Bench, CsvMarkdownAndSampleFrames) {
   const auto csv = lines(readText(run.dir / "frames.csv"));
   ASSERT_EQ(csv.size(), 1u + 3u * 2u);
   EXPECT_EQ(csv[0].rfind("frame,path_frame,mode,order,wall_ms,gpu_ms,triangles", 0), 0u);
-  for (size_t i = 1; i < csv.size(); ++i) EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 12) << csv[i];
+  EXPECT_NE(csv[0].find(",parallax_p99_px,over_bound,popping"), std::string::npos) << csv[0];
+  for (size_t i = 1; i < csv.size(); ++i) {
+    EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 14) << csv[i];
+    // No bound for full and culled (no --error-px, neither reports one): the over_bound column says "-".
+    EXPECT_NE(csv[i].find(",-,"), std::string::npos) << csv[i];
+  }
+  // Popping: empty for the first measured frame, a number after (0 here: both modes draw what the reference does).
+  EXPECT_EQ(csv[1].back(), ',') << csv[1];
+  EXPECT_NE(csv.back().back(), ',') << csv.back();
 
   const std::string md = readText(run.dir / "bench.md");
   EXPECT_NE(md.find("| mode |"), std::string::npos);
@@ -149,6 +316,9 @@ TEST(Bench, CsvMarkdownAndSampleFrames) {
   EXPECT_NE(md.find("| culled |"), std::string::npos);
   EXPECT_NE(md.find("baseline"), std::string::npos);  // says that full was added
   EXPECT_NE(md.find("99 dB"), std::string::npos);     // says how identical frames are stored
+  EXPECT_NE(md.find("frames over bound"), std::string::npos);
+  EXPECT_NE(md.find("popping max"), std::string::npos);
+  EXPECT_NE(md.find("- allocator: "), std::string::npos);
 
   // Two evenly spaced samples out of three frames: the first and the last.
   ASSERT_EQ(run.result.samples.size(), 2u);

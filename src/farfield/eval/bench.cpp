@@ -25,7 +25,9 @@
 #include "farfield/core/progress.h"
 #include "farfield/image/png_io.h"
 #include "farfield/scene/bvh.h"
+#include "farfield/core/allocator.h"
 #include "farfield/eval/parallax_error.h"
+#include "farfield/eval/temporal_error.h"
 
 namespace fs = std::filesystem;
 
@@ -66,38 +68,6 @@ std::set<size_t> samplePositions(size_t n, int samples) {
   for (int i = 0; i < samples; ++i)
     positions.insert(size_t(std::llround(double(i) * double(n - 1) / double(samples - 1))));
   return positions;
-}
-
-void summarizeMode(ModeResult& m) {
-  summarizeFrames(m);
-  m.has_errors = !m.errors.empty();
-  if (m.has_errors) {
-    double psnr_sum = 0.0, ssim_sum = 0.0, bad_sum = 0.0;
-    m.psnr_db_min = kPsnrCapDb;
-    for (const image::ImageMetrics& e : m.errors) {
-      psnr_sum += e.psnr_db;
-      ssim_sum += e.ssim;
-      bad_sum += e.bad_pixel_share;
-      m.psnr_db_min = std::min(m.psnr_db_min, e.psnr_db);
-    }
-    const double n = double(m.errors.size());
-    m.psnr_db_mean = psnr_sum / n;
-    m.ssim_mean = ssim_sum / n;
-    m.bad_pixel_share_mean = bad_sum / n;
-    double crack_sum = 0.0;
-    for (double c : m.crack_shares) crack_sum += c;
-    m.crack_share_mean = m.crack_shares.empty() ? 0.0 : crack_sum / double(m.crack_shares.size());
-    double parallax_sum = 0.0;
-    size_t parallax_frames = 0;
-    for (double p : m.parallax_px) {
-      if (std::isnan(p)) continue;
-      parallax_sum += p;
-      ++parallax_frames;
-      m.parallax_px_max = std::max(m.parallax_px_max, p);
-    }
-    m.has_parallax = parallax_frames > 0;
-    m.parallax_px_mean = parallax_frames ? parallax_sum / double(parallax_frames) : 0.0;
-  }
 }
 
 // Share of pixels where the reference shows geometry and the frame the sky (both id images of the same size).
@@ -158,6 +128,7 @@ std::string markdownHeader(const BenchResult& r) {
   md << "- machine: " << r.machine.hostname << ", " << r.machine.cpu << " (" << r.machine.logical_cores
      << " logical cores), " << r.machine.os << "\n";
   md << "- date: " << r.date << "\n";
+  md << "- allocator: " << r.allocator << "\n";
   md << "- frame time: CPU wall clock from the mode's selection through every pass to glFinish; modes run "
         "interleaved (each frame every mode in turn, the order rotated per frame) after one untimed warm-up frame "
         "each; percentiles interpolate linearly between closest ranks.\n";
@@ -170,18 +141,33 @@ std::string markdownHeader(const BenchResult& r) {
           "(object ids); parallax = 99th percentile, over the pixels that show an object, of the distance (pixels) "
           "from each pixel to where the reference shows the object drawn there (0 where the objects agree; object "
           "ids, eval/parallax_error.h), mean and worst over the frames; n/a for modes whose impostors carry no object "
-          "ids.\n";
+          "ids.\n"
+       << "- frames over bound = frames whose parallax (99th percentile, px) exceeds the error bound: --error-px "
+          "when given, else the bound the mode reports (marked (mode)); \"-\" = no bound; counted over the frames "
+          "whose parallax could be measured. Popping = how much the mode's image changes between consecutive measured "
+          "frames beyond the reference's own change (mean absolute RGB difference, 8-bit units, clamped at 0; "
+          "eval/temporal_error.h): a representation switch that pops shows as a peak.\n";
   else
     md << "- no reference frames (run with --reference for image error).\n";
   return md.str();
+}
+
+// "bound px | frames over bound": "-" without a bound; "k of n" frames checked (n/a when none could be).
+std::string boundCells(const ModeResult& m) {
+  if (!m.error_bound_px) return "- | -";
+  std::string bound = fmt("%.2f", *m.error_bound_px) + (m.error_bound_source == "mode" ? " (mode)" : "");
+  if (m.frames_checked == 0) return bound + " | n/a";
+  return bound + " | " + std::to_string(m.frames_over_bound) + " of " + std::to_string(m.frames_checked);
 }
 
 std::string markdownTable(const BenchResult& r) {
   std::ostringstream md;
   md << "| mode | median ms | p95 ms | p99 ms | max ms | GPU median ms | triangles | draw calls | objects | "
         "speedup vs full | PSNR mean dB | PSNR min dB | SSIM mean | pixels > "
-     << r.bad_pixel_threshold << "/255 | cracks | parallax px mean | parallax px max |\n";
-  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+     << r.bad_pixel_threshold << "/255 | cracks | parallax px mean | parallax px max | bound px | frames over bound | "
+        "popping mean | popping p99 | popping max |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "---:|\n";
   for (const ModeResult& m : r.modes) {
     md << "| " << m.name << " | " << fmt("%.2f", m.wall.median) << " | " << fmt("%.2f", m.wall.p95) << " | "
        << fmt("%.2f", m.wall.p99) << " | " << fmt("%.2f", m.wall.max) << " | " << fmt("%.2f", m.gpu.median)
@@ -192,9 +178,15 @@ std::string markdownTable(const BenchResult& r) {
       md << psnr(m.psnr_db_mean) << " | " << psnr(m.psnr_db_min) << " | " << fmt("%.4f", m.ssim_mean) << " | "
          << fmt("%.3f", 100.0 * m.bad_pixel_share_mean) << "% | " << fmt("%.3f", 100.0 * m.crack_share_mean)
          << "% | " << (m.has_parallax ? fmt("%.2f", m.parallax_px_mean) : std::string("n/a")) << " | "
-         << (m.has_parallax ? fmt("%.2f", m.parallax_px_max) : std::string("n/a")) << " |\n";
+         << (m.has_parallax ? fmt("%.2f", m.parallax_px_max) : std::string("n/a")) << " | "
+         << boundCells(m) << " | ";
+      if (m.has_popping)
+        md << fmt("%.3f", m.popping_summary.mean) << " | " << fmt("%.3f", m.popping_summary.p99) << " | "
+           << fmt("%.3f", m.popping_summary.max) << " |\n";
+      else
+        md << "n/a | n/a | n/a |\n";
     } else {
-      md << "n/a | n/a | n/a | n/a | n/a | n/a | n/a |\n";
+      md << "n/a | n/a | n/a | n/a | n/a | n/a | n/a | " << boundCells(m) << " | n/a | n/a | n/a |\n";
     }
   }
   return md.str();
@@ -249,6 +241,8 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
   if (options.width < 1 || options.height < 1) throw Error("--size", "width and height must be positive");
   if (options.bad_pixel_threshold < 0 || options.bad_pixel_threshold > 255)
     throw Error("bad pixel threshold", "must be 0..255 (8-bit units)");
+  if (options.error_px && !(std::isfinite(*options.error_px) && *options.error_px > 0.0))
+    throw Error("--error-px", "the error bound must be a positive number of pixels");
 
   BenchResult result;
   result.scene = options.scene_label;
@@ -262,6 +256,9 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
   result.height = options.height;
   result.date = isoDateUtc();
   result.machine = machineInfo();
+  const AllocatorSettings allocator = currentAllocatorSettings();
+  result.allocator = allocator.description;
+  result.allocator_applied = allocator.applied;
   result.reference = options.reference;
   result.baseline_added =
       std::find(options.modes.begin(), options.modes.end(), "full") == options.modes.end();
@@ -304,6 +301,9 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
   const std::set<size_t> sample_at = save_samples ? samplePositions(result.frame_indices.size(), options.samples)
                                                   : std::set<size_t>{};
   const fs::path out_dir(options.out_dir);
+  // The previous measured frame of the reference and of each mode, for the popping error.
+  image::ColorImage previous_reference;
+  std::vector<image::ColorImage> previous_frame(mode_count);
   Progress progress("bench", result.frame_indices.size() * mode_count);
   for (size_t k = 0; k < result.frame_indices.size(); ++k) {
     const size_t path_frame = result.frame_indices[k];
@@ -325,7 +325,7 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
       mode_result.frames.push_back(runner.run(*modes[m], camera, path_frame));
       mode_result.order.push_back(int(j));
       if (options.reference || sample) {
-        const image::ColorImage frame = target.readColor();
+        image::ColorImage frame = target.readColor();
         image::IdImage ids;
         if (options.reference) {
           image::ImageMetrics e = image::compareImages(reference, frame, options.bad_pixel_threshold);
@@ -334,6 +334,9 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
           ids = target.readIds();
           mode_result.crack_shares.push_back(crackShare(reference_ids, ids));
           mode_result.parallax_px.push_back(frameParallax(reference_ids, ids, scene.objects.size()));
+          mode_result.popping.push_back(
+              k == 0 ? std::numeric_limits<double>::quiet_NaN()
+                     : poppingError(previous_frame[m], frame, previous_reference, reference));
         }
         if (sample) {
           const std::string name = "frames/" + tag + "_" + fileSafe(mode_result.name) + ".png";
@@ -350,6 +353,7 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
             }
           }
         }
+        if (options.reference) previous_frame[m] = std::move(frame);
       }
       progress.advance();
     }
@@ -360,16 +364,80 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
       }
       result.samples.push_back(std::move(sample_frame));
     }
+    if (options.reference) previous_reference = std::move(reference);
   }
   progress.finish();
 
   for (size_t m = 0; m < mode_count; ++m) {
-    summarizeMode(result.modes[m]);
-    result.modes[m].info = modes[m]->info();
+    result.modes[m].info = modes[m]->info();  // first: it may hold the mode's error bound
+    summarizeModeResult(result.modes[m], options.error_px);
   }
   const double full_median = result.modes.front().wall.median;
   for (ModeResult& m : result.modes) m.speedup_vs_full = m.wall.median > 0.0 ? full_median / m.wall.median : 0.0;
   return result;
+}
+
+void summarizeModeResult(ModeResult& m, std::optional<double> error_px) {
+  summarizeFrames(m);
+  m.has_errors = !m.errors.empty();
+  m.psnr_db_mean = m.psnr_db_min = m.ssim_mean = m.bad_pixel_share_mean = m.crack_share_mean = 0.0;
+  m.parallax_px_mean = m.parallax_px_max = 0.0;
+  m.has_parallax = false;
+  if (m.has_errors) {
+    double psnr_sum = 0.0, ssim_sum = 0.0, bad_sum = 0.0;
+    m.psnr_db_min = kPsnrCapDb;
+    for (const image::ImageMetrics& e : m.errors) {
+      psnr_sum += e.psnr_db;
+      ssim_sum += e.ssim;
+      bad_sum += e.bad_pixel_share;
+      m.psnr_db_min = std::min(m.psnr_db_min, e.psnr_db);
+    }
+    const double n = double(m.errors.size());
+    m.psnr_db_mean = psnr_sum / n;
+    m.ssim_mean = ssim_sum / n;
+    m.bad_pixel_share_mean = bad_sum / n;
+    double crack_sum = 0.0;
+    for (double c : m.crack_shares) crack_sum += c;
+    m.crack_share_mean = m.crack_shares.empty() ? 0.0 : crack_sum / double(m.crack_shares.size());
+    double parallax_sum = 0.0;
+    size_t parallax_frames = 0;
+    for (double p : m.parallax_px) {
+      if (std::isnan(p)) continue;
+      parallax_sum += p;
+      ++parallax_frames;
+      m.parallax_px_max = std::max(m.parallax_px_max, p);
+    }
+    m.has_parallax = parallax_frames > 0;
+    m.parallax_px_mean = parallax_frames ? parallax_sum / double(parallax_frames) : 0.0;
+  }
+
+  // The bound: the run's, else the mode's own.
+  m.error_bound_px.reset();
+  m.error_bound_source.clear();
+  if (error_px) {
+    m.error_bound_px = *error_px;
+    m.error_bound_source = "--error-px";
+  } else if (auto it = m.info.find("error_bound_px"); it != m.info.end() && std::isfinite(it->second) &&
+                                                        it->second > 0.0) {
+    m.error_bound_px = it->second;
+    m.error_bound_source = "mode";
+  }
+  m.over_bound.assign(m.frames.size(), -1);
+  m.frames_over_bound = m.frames_checked = 0;
+  if (m.error_bound_px) {
+    for (size_t k = 0; k < m.frames.size() && k < m.parallax_px.size(); ++k) {
+      if (std::isnan(m.parallax_px[k])) continue;
+      m.over_bound[k] = m.parallax_px[k] > *m.error_bound_px ? 1 : 0;
+      m.frames_over_bound += size_t(m.over_bound[k]);
+      ++m.frames_checked;
+    }
+  }
+
+  std::vector<double> popping;
+  for (double p : m.popping)
+    if (!std::isnan(p)) popping.push_back(p);
+  m.has_popping = !popping.empty();
+  m.popping_summary = summarize(popping);
 }
 
 void writeBenchJson(const BenchResult& r, const std::string& file) {
@@ -393,6 +461,7 @@ void writeBenchJson(const BenchResult& r, const std::string& file) {
   j["percentiles"] = "linear interpolation between closest ranks";
   j["psnr_cap_db"] = kPsnrCapDb;
   j["bad_pixel_threshold"] = r.bad_pixel_threshold;
+  j["allocator"] = {{"applied", r.allocator_applied}, {"description", r.allocator}};
   Json modes = Json::object();
   for (const ModeResult& m : r.modes) {
     Json e;
@@ -415,7 +484,13 @@ void writeBenchJson(const BenchResult& r, const std::string& file) {
       e["crack_share_mean"] = m.crack_share_mean;
       e["parallax_p99_px_mean"] = m.has_parallax ? Json(m.parallax_px_mean) : Json(nullptr);
       e["parallax_p99_px_max"] = m.has_parallax ? Json(m.parallax_px_max) : Json(nullptr);
+      e["popping_mean"] = m.has_popping ? Json(m.popping_summary.mean) : Json(nullptr);
+      e["popping_p99"] = m.has_popping ? Json(m.popping_summary.p99) : Json(nullptr);
+      e["popping_max"] = m.has_popping ? Json(m.popping_summary.max) : Json(nullptr);
     } else {
+      e["popping_mean"] = nullptr;
+      e["popping_p99"] = nullptr;
+      e["popping_max"] = nullptr;
       e["parallax_p99_px_mean"] = nullptr;
       e["parallax_p99_px_max"] = nullptr;
       e["psnr_db_mean"] = nullptr;
@@ -424,6 +499,11 @@ void writeBenchJson(const BenchResult& r, const std::string& file) {
       e["bad_pixel_share_mean"] = nullptr;
       e["crack_share_mean"] = nullptr;
     }
+    e["error_bound_px"] = m.error_bound_px ? Json(*m.error_bound_px) : Json(nullptr);
+    e["error_bound_source"] = m.error_bound_px ? Json(m.error_bound_source) : Json(nullptr);
+    const bool checked = m.error_bound_px && m.frames_checked > 0;
+    e["frames_over_bound"] = checked ? Json(m.frames_over_bound) : Json(nullptr);
+    e["frames_checked_against_bound"] = m.frames_checked;
     Json info = Json::object();
     for (const auto& [key, value] : m.info) info[key] = value;
     e["info"] = info;
@@ -451,7 +531,7 @@ void writeBenchMarkdown(const BenchResult& r, const std::string& file) {
 void writeFramesCsv(const BenchResult& r, const std::string& file) {
   std::ostringstream out;
   out << "frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,psnr_db,ssim,bad_pixel_share,"
-         "parallax_p99_px\n";
+         "parallax_p99_px,over_bound,popping\n";
   char line[512];
   for (size_t k = 0; k < r.frame_indices.size(); ++k) {
     for (const ModeResult& m : r.modes) {
@@ -465,10 +545,18 @@ void writeFramesCsv(const BenchResult& r, const std::string& file) {
         const image::ImageMetrics& e = m.errors[k];
         const double p = k < m.parallax_px.size() ? m.parallax_px[k] : std::numeric_limits<double>::quiet_NaN();
         std::snprintf(line, sizeof(line), "%.4f,%.6f,%.6f,", e.psnr_db, e.ssim, e.bad_pixel_share);
-        out << line << (std::isnan(p) ? std::string() : fmt("%.3f", p)) << "\n";
+        out << line << (std::isnan(p) ? std::string() : fmt("%.3f", p)) << ",";
       } else {
-        out << ",,,\n";
+        out << ",,,,";
       }
+      // over_bound: "-" without a bound, empty when not checked, else 1 or 0.
+      if (!m.error_bound_px)
+        out << "-";
+      else if (k < m.over_bound.size() && m.over_bound[k] >= 0)
+        out << m.over_bound[k];
+      out << ",";
+      const double pop = k < m.popping.size() ? m.popping[k] : std::numeric_limits<double>::quiet_NaN();
+      out << (std::isnan(pop) ? std::string() : fmt("%.4f", pop)) << "\n";
     }
   }
   writeText(file, out.str());
@@ -496,7 +584,7 @@ std::vector<std::string> runPlotScript(const std::string& out_dir, const std::st
     if (!c.empty() && std::find(candidates.begin(), candidates.end(), c) == candidates.end())
       candidates.push_back(c);
   // The script's own names; removed first so that a failed run cannot pass off stale plots as new.
-  const std::vector<std::string> names{"frame_time.png", "error.png", "parallax.png"};
+  const std::vector<std::string> names{"frame_time.png", "error.png", "parallax.png", "popping.png"};
   for (const std::string& n : names) fs::remove(fs::path(out_dir) / n);
   // Probe quietly for an interpreter with matplotlib (python3 on PATH may be a virtual environment without it,
   // while the system one has it), then run the script once with the first that has it.

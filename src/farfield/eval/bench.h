@@ -15,15 +15,27 @@
 //    "modes": {"full": {"median_ms", "p95_ms", "p99_ms", "max_ms", "mean_ms", "gpu_median_ms", "gpu_p95_ms",
 //                       "mean_triangles", "mean_draw_calls", "mean_objects", "speedup_vs_full",
 //                       "psnr_db_mean", "psnr_db_min", "ssim_mean", "bad_pixel_share_mean", "crack_share_mean",
-//                       "info": {...}}, ...}}
+//                       "parallax_p99_px_mean", "parallax_p99_px_max", "error_bound_px", "error_bound_source",
+//                       "frames_over_bound", "frames_checked_against_bound", "popping_mean", "popping_p99",
+//                       "popping_max", "info": {...}}, ...},
+//    "allocator": {"applied": bool, "description": "..."}}
 // speedup_vs_full = median_ms(full) / median_ms(mode). PSNR of identical frames is infinite; it is stored capped at
-// kPsnrCapDb (per frame, before the mean and min). Without a reference the five error keys are null.
+// kPsnrCapDb (per frame, before the mean and min). Without a reference the error keys are null.
+//
+// The error bound (DESIGN.md, "the two promises"): with a reference, a frame of a mode is *over the bound* when its
+// parallax error (99th percentile, pixels) exceeds the bound: BenchOptions::error_px when given (`--error-px`), else
+// the mode's info()["error_bound_px"] (the impostor modes report their database's bound), else there is none
+// ("error_bound_px": null, frames.csv shows "-"). Frames whose parallax cannot be measured are not checked
+// ("frames_checked_against_bound" counts those that were). Popping (eval/temporal_error.h) is the mode's image change
+// between consecutive measured frames beyond the reference's, in 8-bit units.
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "farfield/core/allocator.h"  // BenchResult reports the allocator; timed commands configure it first
 #include "farfield/eval/frame_runner.h"
 #include "farfield/eval/frame_stats.h"
 #include "farfield/gen/camera_path.h"
@@ -50,6 +62,9 @@ struct BenchOptions {
   std::string path_label;       // e.g. the path file
   float near_plane = 0.5f;      // metres
   float far_plane = 20000.0f;
+  // The error bound every mode's parallax error is checked against (pixels, > 0); unset = each mode's own
+  // info()["error_bound_px"], if any.
+  std::optional<double> error_px;
 };
 
 struct ModeResult {
@@ -81,8 +96,25 @@ struct ModeResult {
   bool has_parallax = false;   // at least one frame measured
   double parallax_px_mean = 0.0;
   double parallax_px_max = 0.0;
+  // The error bound (see the top of this file): its value and where it came from ("--error-px", "mode"), unset
+  // without one. over_bound per frame: 1 parallax above the bound, 0 within it, -1 not checked (no bound, no
+  // reference, parallax not measurable). Counts over the frames.
+  std::optional<double> error_bound_px;
+  std::string error_bound_source;
+  std::vector<int> over_bound;
+  size_t frames_over_bound = 0;
+  size_t frames_checked = 0;
+  // Popping (eval/temporal_error.h): per frame, with a reference, NaN for the first measured frame. The summary is
+  // over the frames that have a value.
+  std::vector<double> popping;
+  bool has_popping = false;
+  FrameSummary popping_summary;
   std::map<std::string, double> info;  // Mode::info()
 };
+
+// Fills a mode's summaries from its per-frame records (wall, GPU, image error, parallax, bound, popping). Reads
+// `info` for the mode's own bound when error_px is unset. runBench calls it; public for tests.
+void summarizeModeResult(ModeResult& mode, std::optional<double> error_px);
 
 struct SampleFrame {
   size_t path_frame = 0;
@@ -109,6 +141,8 @@ struct BenchResult {
   std::string renderer;
   std::string date;  // ISO 8601 UTC
   MachineInfo machine;
+  std::string allocator;          // core/allocator.h: currentAllocatorSettings().description during the run
+  bool allocator_applied = false;
   bool reference = false;
   bool baseline_added = false;  // "full" was not asked for and was added as the baseline
   int bad_pixel_threshold = 8;
@@ -128,13 +162,15 @@ void writeBenchJson(const BenchResult& result, const std::string& file);
 // A markdown table (one row per mode) with a short header (scene, size, frames, renderer, date, notes).
 void writeBenchMarkdown(const BenchResult& result, const std::string& file);
 // One row per frame per mode: frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,
-// psnr_db,ssim,bad_pixel_share (error columns empty without a reference).
+// psnr_db,ssim,bad_pixel_share,parallax_p99_px,over_bound,popping (error columns empty without a reference;
+// over_bound is 1 or 0, "-" without a bound, empty when not measured; popping is empty for the first frame).
 void writeFramesCsv(const BenchResult& result, const std::string& file);
 // bench.json, bench.md and frames.csv into out_dir (created if missing).
 void writeBenchOutputs(const BenchResult& result, const std::string& out_dir);
 
-// Runs `PYTHON SCRIPT OUT_DIR` (tools/plot_bench.py) to draw frame_time.png and error.png from frames.csv. PYTHON
-// is the first of: the given interpreter, $FF_PYTHON, python3, /usr/bin/python3 that can import matplotlib.
+// Runs `PYTHON SCRIPT OUT_DIR` (tools/plot_bench.py) to draw frame_time.png, error.png, parallax.png and
+// popping.png (the last three with a reference) from frames.csv. PYTHON is the first of: the given interpreter,
+// $FF_PYTHON, python3, /usr/bin/python3 that can import matplotlib.
 // Returns the plots written (relative to out_dir); warns (never throws) when none could be drawn.
 std::vector<std::string> runPlotScript(const std::string& out_dir, const std::string& script,
                                        const std::string& python = "");
