@@ -290,6 +290,11 @@ TEST(Bench, FramesAreInterleavedWithRotatingOrder) {
       positions.insert(m.order[k]);
     }
     EXPECT_EQ(positions, (std::set<int>{0, 1}));  // each mode once per frame
+    // GPU time on every frame, whatever the mode's position (it alternated between near 0 and the real value).
+    for (const ModeResult& m : run.result.modes) {
+      EXPECT_GT(m.frames[k].gpu_ms, 0.0) << m.name << " frame " << k;
+      EXPECT_LE(m.frames[k].gpu_ms, m.frames[k].wall_ms) << m.name << " frame " << k;
+    }
     // The first mode of frame k is mode k mod 2: the order rotates by one each frame.
     EXPECT_EQ(run.result.modes[k % 2].order[k], 0);
   }
