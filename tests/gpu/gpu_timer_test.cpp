@@ -57,9 +57,9 @@ TEST_F(GpuTest, TimerPicksTheClockForASoftwareRasterizer) {
 }
 
 // The bench's pattern: frames drawn in turn into two targets (the reference, then the modes) with one timer each,
-// some after a frame into the same target, some after a frame into the other. Every frame's GPU time must be most of
-// its wall time: the work is rendering. (llvmpipe's own GL_TIME_ELAPSED gave a few percent of it whenever the
-// previous frame had drawn into the same target.)
+// some after a frame into the same target, some after a frame into the other. Every frame has a GPU time within its
+// wall time, and on a software rasterizer most of it: the work is rendering. (llvmpipe's own GL_TIME_ELAPSED gave
+// 15-30 percent of it exactly on the frames drawn after a frame into the same target.)
 TEST_F(GpuTest, TimerCoversEveryFrameOfAHeavyDraw) {
   const HeavyDraw heavy;
   RenderTarget a(256, 256), b(256, 256);
@@ -79,7 +79,11 @@ TEST_F(GpuTest, TimerCoversEveryFrameOfAHeavyDraw) {
     EXPECT_GT(stats.triangles, 600000u);
     EXPECT_GT(ms, 0.0) << "frame " << frame;
     EXPECT_LE(ms, wall_ms) << "frame " << frame;
-    EXPECT_GE(ms, 0.5 * wall_ms) << "frame " << frame << ": " << ms << " ms of " << wall_ms << " ms wall";
+    // On a software rasterizer the draw is CPU work in this process: nearly all of the wall time. (A hardware GPU
+    // may finish such a draw in a fraction of the submission and synchronisation time.)
+    if (currentRendererIsSoftware()) {
+      EXPECT_GE(ms, 0.5 * wall_ms) << "frame " << frame << ": " << ms << " ms of " << wall_ms << " ms wall";
+    }
   }
 }
 
@@ -93,8 +97,10 @@ TEST_F(GpuTest, RendererGpuTimeOnConsecutiveFrames) {
     const FrameStats stats = renderer.render(heavy.camera, heavy.items, target);
     EXPECT_GT(stats.gpu_ms, 0.0) << "frame " << frame;
     EXPECT_LE(stats.gpu_ms, stats.wall_ms) << "frame " << frame;
-    EXPECT_GE(stats.gpu_ms, 0.5 * stats.wall_ms)
-        << "frame " << frame << ": " << stats.gpu_ms << " ms of " << stats.wall_ms << " ms wall";
+    if (currentRendererIsSoftware()) {
+      EXPECT_GE(stats.gpu_ms, 0.5 * stats.wall_ms)
+          << "frame " << frame << ": " << stats.gpu_ms << " ms of " << stats.wall_ms << " ms wall";
+    }
   }
 }
 
