@@ -1,5 +1,6 @@
 // farfield bake SCENE [--streets city.streets.json] --technique depth-mesh|grid-mesh|both [--local edge|junction]
-//                [--pipeline pvs,near-far,mmi [--online mmi] [--error-px 10] [--layer-mesh grid|depth-mesh]
+//                [--pipeline pvs,near-far,mmi [--online mmi] [--error-px 10] [--frame-size 640x360] [--frame-fov 60]
+//                 [--station-spacing 20] [--layer-mesh grid|depth-mesh]
 //                 [--grid-cells 30] [--views street|six] [--pvs-spacing M] [--pvs-face PX] [--near-radius M]]
 //                [--resolution 512] [--fov DEG] [--eye-height M] [--path path.json] [--cell-lookup street|nearest]
 //                [--cells E,E,...] [--limit N] [--workers N]
@@ -54,6 +55,7 @@ struct BakeArgs {
   double error_px = 10.0;
   std::string frame_size = "640x360";
   float frame_fov = 60.0f;
+  float station_spacing = 20.0f;
   std::string layer_mesh = "grid";
   int grid_cells = 30;
   std::string views = "street";
@@ -118,6 +120,7 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
   options.frame_width = frame.x;
   options.frame_height = frame.y;
   options.frame_fov_deg = args.frame_fov;
+  options.station_spacing = args.station_spacing;
   options.mesh = bake::parseLayerMesh(args.layer_mesh);
   options.grid_cells = args.grid_cells;
   options.views = bake::parseLayerViews(args.views);
@@ -349,6 +352,9 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
   cmd->add_option("--frame-size", args->frame_size, "Error bound: size WxH of the walkthrough's frames")
       ->capture_default_str();
   cmd->add_option("--frame-fov", args->frame_fov, "Error bound: vertical field of view of the walkthrough, degrees")
+      ->capture_default_str();
+  cmd->add_option("--station-spacing", args->station_spacing, "Capture stations along each cell, metres apart "
+                                                              "(0: the cell's start only); unneeded ones are dropped")
       ->capture_default_str();
   cmd->add_option("--layer-mesh", args->layer_mesh, "Mesh of each layer: grid (regular grid) or depth-mesh")
       ->capture_default_str();

@@ -47,6 +47,7 @@ TEST_F(MmiParallaxTest, MmiStaysUnderThePixelThresholdAlongTheCellWhileTheSingle
   options.mesh = LayerMesh::Grid;
   options.grid_cells = 30;
   options.views = LayerViews::Street;
+  options.station_spacing = 0.0f;  // the paper's one capture per cell
   options.pvs.face_size = 64;
   options.pvs.spacing = 10.0f;
 

@@ -138,6 +138,26 @@ void expectErrorMentions(F call, const std::vector<std::string>& parts) {
   }
 }
 
+// A layer captured with LayerViews::Street from its stations: one view and one validity region per station, the
+// first at the cell's start, the others on the cell at increasing distances, each region's origin its station's eye.
+void expectStations(const store::StoredLayer& layer, const Vec3& p_eye, const Vec3& q_eye) {
+  ASSERT_FALSE(layer.validity.empty());
+  ASSERT_EQ(layer.views.size(), layer.validity.size());
+  float last = -1.0f;
+  for (size_t v = 0; v < layer.views.size(); ++v) {
+    const store::StoredView& view = layer.views[v];
+    ASSERT_EQ(view.station, v);
+    EXPECT_EQ(layer.validity[v].origin, view.camera.eye);
+    const float along = glm::length(Vec2(view.camera.eye) - Vec2(p_eye));
+    EXPECT_GT(along, last);
+    EXPECT_LT(along, glm::length(Vec2(q_eye) - Vec2(p_eye)));
+    if (v == 0) {
+      EXPECT_LT(glm::length(view.camera.eye - p_eye), 1e-3f);
+    }
+    last = along;
+  }
+}
+
 PipelineOptions smallOptions() {
   PipelineOptions o;
   o.base.resolution = 128;
@@ -354,7 +374,7 @@ TEST_F(PipelineBakeTest, BakedCellsHoldAConsistentPvsSplitAndLayering) {
       EXPECT_TRUE(strictlyAscending(l.objects));
       EXPECT_FALSE(l.objects.empty());
       layered.insert(layered.end(), l.objects.begin(), l.objects.end());
-      EXPECT_EQ(l.views.size(), 1u);  // LayerViews::Street
+      expectStations(l, e.camera.eye, q_eye);
     }
     std::sort(layered.begin(), layered.end());
     EXPECT_TRUE(strictlyAscending(layered)) << "an object is in two layers";
@@ -370,7 +390,7 @@ TEST_F(PipelineBakeTest, BakedCellsHoldAConsistentPvsSplitAndLayering) {
       }
     }
     EXPECT_EQ(p.single.objects, layered);
-    EXPECT_EQ(p.single.views.size(), 1u);
+    expectStations(p.single, e.camera.eye, q_eye);
 
     // Visibility-event weights, recomputed: every pair within a layer is at most T; and the greedy layering never
     // opens a layer it did not need, so every two layers hold a pair above T.
@@ -417,7 +437,8 @@ TEST_F(PipelineBakeTest, BakedCellsHoldAConsistentPvsSplitAndLayering) {
     for (const store::StoredLayer& l : p.layers)
       for (const store::StoredView& v : l.views) {
         const impostor::DepthMeshImpostor imp = store::loadLayerView(b.full_dir, v);
-        EXPECT_EQ(imp.camera.eye, street.eye);
+        EXPECT_EQ(imp.camera.eye, v.camera.eye);
+        EXPECT_EQ(imp.camera.eye, l.validity.at(v.station).origin);
         if (v.data_pixels > 0) {
           EXPECT_GT(v.triangles, 0u);
         }
@@ -615,6 +636,7 @@ TEST_F(PipelineBakeTest, OptionsSurviveTheIndexAndBadOptionsAreErrors) {
     v2.erase("frame_height");
     v2.erase("frame_fov_deg");
     v2.erase("validity");
+    v2.erase("station_spacing");
     EXPECT_THROW(pipelineOptionsFromJson(v2, "idx"), Error);
     const PipelineOptions old = pipelineOptionsFromJson(v2, "idx", 2);
     EXPECT_EQ(old.frame_height, old.frame_width);
@@ -664,10 +686,13 @@ TEST_F(PipelineBakeTest, SixViewsLayerTheWholeFarSetAndCoverTheStreetView) {
     street_runner.runStages(stages, w1);
     std::vector<uint32_t> layered;
     for (const store::StoredLayer& l : w6.result.layers) {
-      ASSERT_EQ(l.views.size(), 6u);
+      ASSERT_EQ(l.views.size(), 6u * l.validity.size());  // six cube faces per station
       for (const store::StoredView& v : l.views) {
         EXPECT_NEAR(v.camera.fov_y, float(kPi / 2.0), 1e-6f);
-        EXPECT_EQ(v.camera.eye, w6.street_camera.eye);
+        EXPECT_EQ(v.camera.eye, l.validity.at(v.station).origin);
+        if (v.station == 0) {
+          EXPECT_EQ(v.camera.eye, w6.street_camera.eye);
+        }
       }
       layered.insert(layered.end(), l.objects.begin(), l.objects.end());
     }
@@ -681,10 +706,15 @@ TEST_F(PipelineBakeTest, SixViewsLayerTheWholeFarSetAndCoverTheStreetView) {
     // 100 pixels.
     std::map<uint32_t, size_t> street_pixels;
     std::set<uint32_t> in_faces;
-    for (const impostor::DepthMeshImpostor& v : w6.single_views)
-      if (v.ids)
+    // Station 0 of both (the cell's start; the other stations are kept or dropped by their own validity).
+    for (size_t k = 0; k < w6.single_views.size(); ++k) {
+      const impostor::DepthMeshImpostor& v = w6.single_views[k];
+      if (w6.result.single.views[k].station == 0 && v.ids)
         for (uint32_t id : v.ids->pixels()) in_faces.insert(id);
-    for (const impostor::DepthMeshImpostor& v : w1.single_views) {
+    }
+    for (size_t k = 0; k < w1.single_views.size(); ++k) {
+      const impostor::DepthMeshImpostor& v = w1.single_views[k];
+      if (w1.result.single.views[k].station != 0) continue;
       street_layered += v.empty() ? 0 : 1;
       if (v.ids)
         for (uint32_t id : v.ids->pixels()) ++street_pixels[id];

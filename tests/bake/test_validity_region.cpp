@@ -1,5 +1,6 @@
 // Validity regions (bake/validity_region.h) against brute-force sampling of viewpoints: in the constructed street,
-// a frame drawn the way the runtime draws it (an impostor where its region holds the viewpoint under the bound, its
+// a frame drawn the way the runtime draws it (an impostor where its region holds the viewpoint under the bound where
+// the impostor appears in the frame, ErrorBound::angleWithin(frameRadius(...)); its
 // objects as geometry elsewhere) keeps the parallax error under the bound at every sampled viewpoint of the street,
 // across it and at other eye heights; drawing the impostors everywhere instead breaks the bound (so the regions are
 // what keeps it), and the regions are not empty (impostors are still drawn beyond the capture point).
@@ -28,17 +29,17 @@ namespace {
 TEST(ValidityRegionOptions, BadOptionsAreErrors) {
   ValidityOptions even;
   even.laterals = 4;
-  EXPECT_THROW(computeValidityRegion(Vec3(0, 0, 2), Vec3(10, 0, 2), 12.0f, {}, 0.1, even), Error);
+  EXPECT_THROW(computeValidityRegion(Vec3(0, 0, 2), Vec3(10, 0, 2), 12.0f, {}, {}, {}, 0.1, even), Error);
   ValidityOptions zero_step;
   zero_step.step = 0.0f;
-  EXPECT_THROW(computeValidityRegion(Vec3(0, 0, 2), Vec3(10, 0, 2), 12.0f, {}, 0.1, zero_step), Error);
-  EXPECT_THROW(computeValidityRegion(Vec3(0, 0, 2), Vec3(10, 0, 2), 12.0f, {}, 0.0), Error);
+  EXPECT_THROW(computeValidityRegion(Vec3(0, 0, 2), Vec3(10, 0, 2), 12.0f, {}, {}, {}, 0.1, zero_step), Error);
+  EXPECT_THROW(computeValidityRegion(Vec3(0, 0, 2), Vec3(10, 0, 2), 12.0f, {}, {}, {}, 0.0), Error);
 }
 
 // Without objects nothing can be wrong: the region covers the whole cell with a zero envelope.
 TEST(ValidityRegionOptions, EmptyImpostorIsValidAlongTheWholeCell) {
-  const impostor::ValidityRegion r = computeValidityRegion(Vec3(0, 0, 2), Vec3(10, 0, 2), 12.0f, {}, 0.1);
-  ASSERT_EQ(r.laterals, 5);
+  const impostor::ValidityRegion r = computeValidityRegion(Vec3(0, 0, 2), Vec3(10, 0, 2), 12.0f, {}, {}, {}, 0.1);
+  ASSERT_EQ(r.laterals, ValidityOptions{}.laterals);
   ASSERT_EQ(r.samples(), 11u);
   EXPECT_EQ(*std::max_element(r.envelope.begin(), r.envelope.end()), 0.0f);
   EXPECT_TRUE(r.valid(Vec3(10, 5, 2), 0.0));
@@ -70,24 +71,46 @@ TEST_F(ValidityRegionTest, RuntimeRuleKeepsTheBoundAtSampledViewpoints) {
   const store::CellPipeline& r = work.result;
   ASSERT_TRUE(r.has_mmi);
   ASSERT_GE(r.layers.size(), 2u);
-  for (const store::StoredLayer& layer : r.layers) ASSERT_TRUE(layer.validity.has_value());
-  ASSERT_TRUE(r.single.validity.has_value());
+  for (const store::StoredLayer& layer : r.layers) ASSERT_FALSE(layer.validity.empty());
+  ASSERT_FALSE(r.single.validity.empty());
 
   const ErrorBound bound{options.error_px, options.frame_width, options.frame_height, degToRad(60.0)};
   const double theta = bound.angle();
+  // A layer (or the single mesh) as the runtime holds it: its objects and bounds, per station a region, per view
+  // its impostor and station.
   struct Drawn {
     std::vector<uint32_t> objects;
-    const impostor::ValidityRegion* region = nullptr;
-    std::unique_ptr<impostor::GpuImpostor> impostor;
+    Box3 bounds;
+    const std::vector<impostor::ValidityRegion>* regions = nullptr;
+    std::vector<std::unique_ptr<impostor::GpuImpostor>> views;
+    std::vector<uint32_t> stations;
+  };
+  const auto boundsOf = [&](const std::vector<uint32_t>& ids) {
+    Box3 b;
+    for (uint32_t id : ids) b.expand(s.scene.objects[id - 1].world_bounds);
+    return b;
   };
   impostor::GpuImpostorOptions split;
   split.split_by_object_id = true;
+  const auto drawn = [&](const store::StoredLayer& layer, const std::vector<impostor::DepthMeshImpostor>& views) {
+    Drawn d;
+    d.objects = layer.objects;
+    d.bounds = boundsOf(layer.objects);
+    d.regions = &layer.validity;
+    EXPECT_EQ(views.size(), layer.views.size());
+    for (size_t v = 0; v < views.size(); ++v) {
+      d.views.push_back(std::make_unique<impostor::GpuImpostor>(views[v], split));
+      d.stations.push_back(layer.views[v].station);
+    }
+    return d;
+  };
   std::vector<Drawn> mmi, smi;
-  for (size_t l = 0; l < r.layers.size(); ++l)
-    mmi.push_back({r.layers[l].objects, &*r.layers[l].validity,
-                   std::make_unique<impostor::GpuImpostor>(work.layer_views[l][0], split)});
-  smi.push_back({r.single.objects, &*r.single.validity,
-                 std::make_unique<impostor::GpuImpostor>(work.single_views[0], split)});
+  size_t stations = 0;
+  for (size_t l = 0; l < r.layers.size(); ++l) {
+    mmi.push_back(drawn(r.layers[l], work.layer_views[l]));
+    stations += r.layers[l].validity.size();
+  }
+  smi.push_back(drawn(r.single, work.single_views));
 
   std::vector<uint32_t> reference_ids{s.ground};
   reference_ids.insert(reference_ids.end(), r.far.begin(), r.far.end());
@@ -95,12 +118,25 @@ TEST_F(ValidityRegionTest, RuntimeRuleKeepsTheBoundAtSampledViewpoints) {
   gpu_scene.appendDrawItems(reference_ids, reference_items);
   // The runtime's rule (runtime/mmi_mode.cpp), or every impostor whatever its region (`ignore_regions`).
   size_t impostors_drawn_beyond_start = 0;
-  auto frame_items = [&](const std::vector<Drawn>& set, const Vec3& eye, bool ignore_regions, double s_along) {
+  auto frame_items = [&](const std::vector<Drawn>& set, const Camera& camera, bool ignore_regions, double s_along) {
     std::vector<uint32_t> geometry{s.ground};
     std::vector<gpu::DrawItem> items;
     for (const Drawn& d : set) {
-      if (ignore_regions || d.region->valid(eye, theta)) {
-        d.impostor->appendDrawItems(items);
+      // The station with the smallest error under the bound where the layer appears, as runtime/mmi_mode.cpp does.
+      const double limit = bound.angleWithin(frameRadius(camera, d.bounds));
+      int station = -1;
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j < d.regions->size(); ++j) {
+        const double e = (*d.regions)[j].errorAt(camera.eye);
+        if (e <= limit && e < best) {
+          best = e;
+          station = int(j);
+        }
+      }
+      if (ignore_regions) station = 0;
+      if (station >= 0) {
+        for (size_t v = 0; v < d.views.size(); ++v)
+          if (d.stations[v] == uint32_t(station)) d.views[v]->appendDrawItems(items);
         if (!ignore_regions && s_along >= 10.0) ++impostors_drawn_beyond_start;
       } else {
         geometry.insert(geometry.end(), d.objects.begin(), d.objects.end());
@@ -121,7 +157,7 @@ TEST_F(ValidityRegionTest, RuntimeRuleKeepsTheBoundAtSampledViewpoints) {
   metric.ignore_ids = {s.ground};
   metric.percentile = 0.99;
 
-  const float half_width = mmi[0].region->half_width;
+  const float half_width = (*mmi[0].regions)[0].half_width;
   double worst_kept = 0.0, worst_ignored = 0.0;
   size_t viewpoints = 0;
   for (float along : {-1.5f, 0.0f, 10.0f, 20.0f, 30.0f, 40.0f, 50.0f})
@@ -136,10 +172,10 @@ TEST_F(ValidityRegionTest, RuntimeRuleKeepsTheBoundAtSampledViewpoints) {
         const image::IdImage reference = ids(camera, reference_items, gpu::RenderMode::ItemBuffer);
         for (const std::vector<Drawn>* set : {&mmi, &smi}) {
           const double kept =
-              eval::parallaxError(reference, ids(camera, frame_items(*set, camera.eye, false, along), gpu::RenderMode::Shaded), metric)
+              eval::parallaxError(reference, ids(camera, frame_items(*set, camera, false, along), gpu::RenderMode::Shaded), metric)
                   .percentile_px;
           const double ignored =
-              eval::parallaxError(reference, ids(camera, frame_items(*set, camera.eye, true, along), gpu::RenderMode::Shaded), metric)
+              eval::parallaxError(reference, ids(camera, frame_items(*set, camera, true, along), gpu::RenderMode::Shaded), metric)
                   .percentile_px;
           EXPECT_LE(kept, options.error_px) << (set == &mmi ? "mmi" : "smi") << " at s " << along << " l " << across
                                             << " dz " << dz;
@@ -148,11 +184,15 @@ TEST_F(ValidityRegionTest, RuntimeRuleKeepsTheBoundAtSampledViewpoints) {
         }
         ++viewpoints;
       }
-  std::printf("%zu viewpoints: worst p99 parallax %.2f px with the regions, %.2f px drawing every impostor; %zu "
-              "impostor draws 10 m or more into the cell; reach at the bound: mmi layers",
-              viewpoints, worst_kept, worst_ignored, impostors_drawn_beyond_start);
-  for (const Drawn& d : mmi) std::printf(" %.0f m", d.region->reach(theta));
-  std::printf(", smi %.0f m\n", smi[0].region->reach(theta));
+  std::printf("%zu viewpoints: worst p99 parallax %.2f px with the regions, %.2f px drawing every impostor from the "
+              "cell's start; %zu impostor draws 10 m or more into the cell; %zu layer stations for %zu layers; reach "
+              "at the bound (stations' centreline):",
+              viewpoints, worst_kept, worst_ignored, impostors_drawn_beyond_start, stations, r.layers.size());
+  for (const Drawn& d : mmi)
+    for (const impostor::ValidityRegion& region : *d.regions) std::printf(" %.0f m", region.reach(theta));
+  std::printf("; smi:");
+  for (const impostor::ValidityRegion& region : *smi[0].regions) std::printf(" %.0f m", region.reach(theta));
+  std::printf("\n");
   EXPECT_GT(worst_ignored, options.error_px);  // the regions are what keeps the bound here
   EXPECT_GT(impostors_drawn_beyond_start, 0u);  // and they do not simply turn every impostor off
 }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "farfield/core/bounds.h"
 #include "farfield/core/camera.h"
 #include "farfield/core/error.h"
 
@@ -61,6 +62,44 @@ TEST(ErrorBound, CornerPixelIsTheSmallestAgainstProjection) {
   const double r = std::hypot(320.0, 180.0);
   EXPECT_NEAR(step_angle(640.0 - 320.0 / r, 360.0 - 180.0 / r, 320.0 / r, 180.0 / r), b.cornerPixelAngle(),
               0.01 * b.cornerPixelAngle());
+}
+
+// Inside a circle around the centre a pixel spans more angle: from 1 / f at the centre down to the corner's value.
+TEST(ErrorBound, PixelAngleWithinARadius) {
+  const ErrorBound b{10.0, 640, 360, degToRad(60.0)};
+  EXPECT_DOUBLE_EQ(b.pixelAngleWithin(0.0), b.centrePixelAngle());
+  EXPECT_DOUBLE_EQ(b.pixelAngleWithin(1e9), b.cornerPixelAngle());
+  const double f = b.focalPixels();
+  EXPECT_NEAR(b.pixelAngleWithin(f), 0.5 / f, 1e-12);  // 45 degrees off axis: cos^2 = 1/2
+  EXPECT_GT(b.angleWithin(100.0), b.angleWithin(200.0));
+  EXPECT_GT(b.angleWithin(200.0), b.angle());
+}
+
+TEST(ErrorBound, FrameRadiusOfABox) {
+  Camera cam;
+  cam.eye = Vec3(0.0f);
+  cam.at = Vec3(0.0f, 1.0f, 0.0f);
+  cam.width = 640;
+  cam.height = 360;
+  // A small box straight ahead: near the centre.
+  EXPECT_LT(frameRadius(cam, Box3{Vec3(-0.5f, 99.5f, -0.5f), Vec3(0.5f, 100.5f, 0.5f)}), 3.0);
+  // A box across the whole view: the half diagonal (clamped to the frame).
+  EXPECT_NEAR(frameRadius(cam, Box3{Vec3(-500, 10, -500), Vec3(500, 20, 500)}), std::hypot(320.0, 180.0), 1e-6);
+  // Part of it behind the eye: the half diagonal.
+  EXPECT_NEAR(frameRadius(cam, Box3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}), std::hypot(320.0, 180.0), 1e-6);
+  // Brute force: the farthest projected sample point of the box inside the frame is never beyond the radius.
+  const Box3 box{Vec3(20, 60, -3), Vec3(35, 80, 12)};
+  const double r = frameRadius(cam, box);
+  double farthest = 0.0;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j)
+      for (int k = 0; k <= 10; ++k) {
+        const Vec3 p = cam.project(box.lo + Vec3(i, j, k) * 0.1f * box.extent());
+        if (p.x >= 0 && p.x <= 640 && p.y >= 0 && p.y <= 360)
+          farthest = std::max(farthest, std::hypot(double(p.x) - 320.0, double(p.y) - 180.0));
+      }
+  EXPECT_GT(farthest, 0.0);
+  EXPECT_LE(farthest, r + 1e-3);
 }
 
 TEST(ErrorBound, Validate) {

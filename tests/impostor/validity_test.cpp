@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include "farfield/core/camera.h"
+#include "farfield/impostor/grid_mesh.h"
+
 namespace farfield::impostor {
 namespace {
 
@@ -78,6 +81,80 @@ TEST(ParallaxBound, MotionAlongTheViewAxisIsCheaperThanAcross) {
   EXPECT_LT(along, 0.2 * across);
   std::mt19937 rng(7);
   EXPECT_GE(along, bruteForceParallax(capture, capture + Vec3(50, 0, 0), box, 2000, rng));
+}
+
+// A capture whose depth has a slanted wall, a step to a nearer box and sky: the grid mesh's triangles cut across the
+// step (rubber sheets) and follow the wall. Brute force: points sampled on every triangle, each showing the texel its
+// capture ray passes through (projective texturing), seen from random eyes: the angle between the point and what its
+// texel shows (the texel's captured point) never exceeds triangleErrorBound, up to the texel's own size.
+TEST(TriangleError, NeverBelowBruteForceOnAGridMesh) {
+  Camera camera;
+  camera.eye = Vec3(0.0f, 0.0f, 2.0f);
+  camera.at = Vec3(0.0f, 100.0f, 2.0f);
+  camera.width = camera.height = 64;
+  camera.near_plane = 1.0f;
+  camera.far_plane = 1000.0f;
+  image::ColorImage color(64, 64, image::Rgba8(0, 0, 0, 0));
+  image::DepthImage depth(64, 64, 0.0f);
+  auto ray = [&](double px, double py) {
+    const Vec3 p = camera.unproject(float(px), float(py), 0.5f);
+    return glm::normalize(DVec3(p) - DVec3(camera.eye));
+  };
+  for (int y = 8; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      // Wall receding from 30 m (left) to 90 m (right) along the view axis; a box at 15 m in the middle.
+      double along = 30.0 + 60.0 * x / 63.0;
+      if (x >= 24 && x < 40 && y >= 30) along = 15.0;
+      const DVec3 u = ray(x + 0.5, y + 0.5);
+      const DVec3 forward = glm::normalize(DVec3(camera.at) - DVec3(camera.eye));
+      const Vec3 world = Vec3(DVec3(camera.eye) + u * (along / glm::dot(u, forward)));
+      depth.at(x, y) = camera.project(world).z;
+      color.at(x, y) = image::Rgba8(200, 200, 200, 255);
+    }
+  GridMeshOptions options;
+  options.grid_spacing_px = 8.0;
+  const DepthMeshImpostor grid = buildGridMesh(color, depth, camera, options);
+  const std::vector<TriangleError> errors = triangleErrors(grid, depth, camera);
+  ASSERT_EQ(errors.size(), grid.mesh.triangleCount());
+  ASSERT_GT(errors.size(), 50u);
+
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::uniform_real_distribution<float> step(-6.0f, 6.0f);
+  const double texel = 2.0 * std::tan(0.5 * double(camera.fov_y)) / 64.0;  // angle of a texel at the centre
+  size_t checked = 0;
+  double largest_bound = 0.0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Vec3 eye = camera.eye + Vec3(step(rng), step(rng) * 0.5f, step(rng) * 0.1f);
+    for (size_t t = 0; t < grid.mesh.triangleCount(); ++t) {
+      const double bound = triangleErrorBound(camera.eye, eye, errors[t]);
+      largest_bound = std::max(largest_bound, bound);
+      const Vec3 a = grid.mesh.positions[grid.mesh.indices[3 * t]];
+      const Vec3 b = grid.mesh.positions[grid.mesh.indices[3 * t + 1]];
+      const Vec3 c = grid.mesh.positions[grid.mesh.indices[3 * t + 2]];
+      for (int k = 0; k < 12; ++k) {
+        double wa = unit(rng), wb = unit(rng);
+        if (wa + wb > 1.0) {
+          wa = 1.0 - wa;
+          wb = 1.0 - wb;
+        }
+        const DVec3 x = wa * DVec3(a) + wb * DVec3(b) + (1.0 - wa - wb) * DVec3(c);
+        const Vec3 pixel = camera.project(Vec3(x));
+        const int px = int(std::floor(pixel.x)), py = int(std::floor(pixel.y));
+        if (px < 0 || py < 0 || px >= 64 || py >= 64 || depth.at(px, py) <= 0.0f) continue;  // cut by alpha
+        const DVec3 shown(camera.unproject(float(px) + 0.5f, float(py) + 0.5f, depth.at(px, py)));
+        const DVec3 to_x = glm::normalize(x - DVec3(eye)), to_shown = glm::normalize(shown - DVec3(eye));
+        const double angle = std::acos(std::clamp(glm::dot(to_x, to_shown), -1.0, 1.0));
+        // Up to the texel's own extent (the point and the texel centre are up to a texel apart from the capture
+        // eye), magnified by the distance ratio.
+        const double slack = 1.5 * texel * glm::length(x - DVec3(camera.eye)) / glm::length(x - DVec3(eye));
+        ASSERT_LE(angle, bound + slack) << "triangle " << t << " trial " << trial;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 10000u);
+  EXPECT_GT(largest_bound, 0.05);  // the rubber sheets across the step are charged
 }
 
 TEST(ValidityRegion, LocalFrameAndEnvelopeLookup) {

@@ -90,10 +90,12 @@ CellEntry fullCell(uint32_t half_edge) {
   StoredLayer far_layer;
   far_layer.objects = {7, 11, 20};
   for (size_t v = 0; v < 6; ++v) far_layer.views.push_back(oddView(half_edge, 1, v, 2.0 + double(v), v != 3));
-  near_layer.validity = oddRegion(1.0f);
-  far_layer.validity = oddRegion(2.0f);
+  near_layer.validity = {oddRegion(1.0f)};
+  // The far layer from two stations, three views each.
+  for (size_t v = 3; v < 6; ++v) far_layer.views[v].station = 1;
+  far_layer.validity = {oddRegion(2.0f), oddRegion(2.5f)};
   p.layers = {near_layer, far_layer};
-  p.single.validity = oddRegion(3.0f);
+  p.single.validity = {oddRegion(3.0f)};
   p.single.objects = p.far;
   p.single.views = {oddView(half_edge, 0, 0, 9.0)};
   p.single.views[0].mesh = layerFileStem(half_edge, "smi", 0, 0) + ".ffmesh";
@@ -163,18 +165,20 @@ void expectSameLayer(const StoredLayer& a, const StoredLayer& b, const std::stri
     EXPECT_EQ(x.render_ms, y.render_ms) << at;
     EXPECT_EQ(x.build_ms, y.build_ms) << at;
   }
-  ASSERT_EQ(a.validity.has_value(), b.validity.has_value()) << where;
-  if (!a.validity) return;
-  const impostor::ValidityRegion &x = *a.validity, &y = *b.validity;
-  EXPECT_EQ(x.origin, y.origin) << where;
-  EXPECT_EQ(x.end, y.end) << where;
-  EXPECT_EQ(x.half_width, y.half_width) << where;
-  EXPECT_EQ(x.below, y.below) << where;
-  EXPECT_EQ(x.above, y.above) << where;
-  EXPECT_EQ(x.back, y.back) << where;
-  EXPECT_EQ(x.step, y.step) << where;
-  EXPECT_EQ(x.laterals, y.laterals) << where;
-  EXPECT_EQ(x.envelope, y.envelope) << where;
+  for (size_t v = 0; v < a.views.size(); ++v) EXPECT_EQ(a.views[v].station, b.views[v].station) << where;
+  ASSERT_EQ(a.validity.size(), b.validity.size()) << where;
+  for (size_t k = 0; k < a.validity.size(); ++k) {
+    const impostor::ValidityRegion &x = a.validity[k], &y = b.validity[k];
+    EXPECT_EQ(x.origin, y.origin) << where;
+    EXPECT_EQ(x.end, y.end) << where;
+    EXPECT_EQ(x.half_width, y.half_width) << where;
+    EXPECT_EQ(x.below, y.below) << where;
+    EXPECT_EQ(x.above, y.above) << where;
+    EXPECT_EQ(x.back, y.back) << where;
+    EXPECT_EQ(x.step, y.step) << where;
+    EXPECT_EQ(x.laterals, y.laterals) << where;
+    EXPECT_EQ(x.envelope, y.envelope) << where;
+  }
 }
 
 void expectSameIndex(const StoreIndex& a, const StoreIndex& b) {
@@ -394,21 +398,27 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
   // Validity regions.
   {
     nlohmann::json j = good;
-    cell0(j)["mmi"]["layers"][1]["validity"]["envelope"] = {0.1, 0.2, 0.0, 0.1, 0.2, 0.15};
+    cell0(j)["mmi"]["layers"][1]["validity"][0]["envelope"] = {0.1, 0.2, 0.0, 0.1, 0.2, 0.15};
     expectIndexError(j, {"layers[1]", "validity", "decrease"});
-    cell0(j)["mmi"]["layers"][1]["validity"]["envelope"] = {0.1, 0.2, 0.0, 0.1, 0.2};
+    cell0(j)["mmi"]["layers"][1]["validity"][0]["envelope"] = {0.1, 0.2, 0.0, 0.1, 0.2};
     expectIndexError(j, {"layers[1]", "validity", "rows"});
-    cell0(j)["mmi"]["layers"][1]["validity"]["laterals"] = 2;
+    cell0(j)["mmi"]["layers"][1]["validity"][0]["laterals"] = 2;
     expectIndexError(j, {"layers[1]", "validity", "laterals"});
     j = good;
-    cell0(j)["mmi"]["single"]["validity"]["step"] = 0.0;
+    cell0(j)["mmi"]["single"]["validity"][0]["step"] = 0.0;
     expectIndexError(j, {"single", "validity", "step"});
     j = good;
-    cell0(j)["mmi"]["layers"][0]["validity"]["envelope"] = {-0.1};
+    cell0(j)["mmi"]["layers"][0]["validity"][0]["envelope"] = {-0.1};
     expectIndexError(j, {"layers[0]", "validity", "envelope"});
     j = good;
-    cell0(j)["mmi"]["layers"][0]["validity"].erase("origin");
+    cell0(j)["mmi"]["layers"][0]["validity"][0].erase("origin");
     expectIndexError(j, {"layers[0]", "validity", "origin"});
+    j = good;
+    cell0(j)["mmi"]["layers"][1]["validity"].erase(1);  // two stations, one region
+    expectIndexError(j, {"layers[1]", "validity", "station"});
+    j = good;
+    cell0(j)["mmi"]["layers"][1]["views"][4].erase("station");
+    expectIndexError(j, {"layers[1]", "views[4]", "station"});
   }
 }
 

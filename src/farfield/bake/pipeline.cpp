@@ -126,6 +126,7 @@ nlohmann::json pipelineOptionsToJson(const PipelineOptions& o) {
           {"frame_width", o.frame_width},
           {"frame_height", o.frame_height},
           {"frame_fov_deg", o.frame_fov_deg},
+          {"station_spacing", o.station_spacing},
           {"validity",
            {{"step", o.validity.step},
             {"back", o.validity.back},
@@ -225,6 +226,7 @@ PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::stri
   if (store_version >= 3 || r.has("frame_height")) {
     r.number("frame_height", o.frame_height);
     r.number("frame_fov_deg", o.frame_fov_deg);
+    r.number("station_spacing", o.station_spacing);
     StrictOptions v(r.at("validity"), source + ": validity");
     v.number("step", o.validity.step);
     v.number("back", o.validity.back);
@@ -237,6 +239,7 @@ PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::stri
     // Version 2 meant square frames of frame_width with the capture's field of view.
     o.frame_height = o.frame_width;
     o.frame_fov_deg = o.base.fov_deg;
+    o.station_spacing = 0.0f;  // one capture at the cell's start
   }
   r.number("pvs_spacing", o.pvs.spacing);
   r.number("pvs_face_size", o.pvs.face_size);
@@ -275,6 +278,8 @@ void validatePipelineOptions(const PipelineOptions& o) {
     throw Error("--error-px", "must be a positive number of pixels");
   if (o.frame_width < 1 || o.frame_height < 1) throw Error("--frame-size", "must be at least 1 x 1 pixels");
   if (!(o.frame_fov_deg > 0.0f && o.frame_fov_deg < 180.0f)) throw Error("--frame-fov", "must be in (0, 180) degrees");
+  if (!(o.station_spacing >= 0.0f) || !std::isfinite(o.station_spacing))
+    throw Error("--station-spacing", "must be a finite number of metres >= 0");
   const ValidityOptions& v = o.validity;
   if (!(v.step > 0.0f) || !(v.back >= 0.0f) || v.laterals < 1 || v.laterals % 2 == 0 || !(v.below >= 0.0f) ||
       !(v.above >= 0.0f) || !(v.width_share >= 0.0f))
@@ -399,10 +404,23 @@ void PipelineRunner::runNearFar(CellWork& work) const {
   work.candidates = work.result.far;
 }
 
-std::vector<Camera> PipelineRunner::viewCameras(const CellWork& work) const {
-  if (options_.views == LayerViews::Street) return {work.street_camera};
-  return urban::cubeFaceCameras(work.street_camera.eye, options_.base.resolution, options_.base.near_plane,
-                                options_.base.far_plane);
+std::vector<Vec3> PipelineRunner::stationEyes(const CellWork& work) const {
+  std::vector<Vec3> eyes{work.p_eye};
+  const float length = glm::length(Vec2(work.q_eye) - Vec2(work.p_eye));
+  if (options_.station_spacing > 0.0f)
+    for (float s = options_.station_spacing; s < length - 0.5f * options_.station_spacing; s += options_.station_spacing)
+      eyes.push_back(work.p_eye + (s / length) * (work.q_eye - work.p_eye));
+  return eyes;
+}
+
+std::vector<Camera> PipelineRunner::viewCameras(const CellWork& work, const Vec3& eye) const {
+  if (options_.views == LayerViews::Street) {
+    Camera camera = work.street_camera;
+    camera.at += eye - camera.eye;
+    camera.eye = eye;
+    return {camera};
+  }
+  return urban::cubeFaceCameras(eye, options_.base.resolution, options_.base.near_plane, options_.base.far_plane);
 }
 
 // Sections 4.1-4.3: the event graph over the far objects' footprints, the greedy layering with T, then per layer and
@@ -414,7 +432,7 @@ void PipelineRunner::runMmi(CellWork& work) {
   // Only the far objects some view shows are layered: with the street view, the PVS (360 degrees) also holds what
   // lies behind the viewer, which no street-facing layer could hold. Moving forward along the cell keeps the view
   // inside the frustum from P (a cone translated along its axis stays inside itself), so P's frustum is enough.
-  const std::vector<Camera> cameras = viewCameras(work);
+  const std::vector<Camera> cameras = viewCameras(work, work.p_eye);
   std::vector<Frustum> frusta;
   for (const Camera& camera : cameras) frusta.push_back(Frustum::fromMatrix(camera.viewProjection()));
   std::vector<uint32_t> far;
@@ -468,20 +486,81 @@ void PipelineRunner::runMmi(CellWork& work) {
   work.result.single.objects = far;
 
   Stopwatch capture_timer;
-  // Only the objects in a view's frustum are drawn into it (the renderer does not cull).
-  auto capture = [&](const std::vector<uint32_t>& ids, size_t view) {
+  // Every station's views, station-major (view k of station j is capture j * views_per_station + k). Only the
+  // objects in a view's frustum are drawn into it (the renderer does not cull).
+  std::vector<Camera> station_cameras;
+  for (const Vec3& eye : stationEyes(work))
+    for (const Camera& camera : viewCameras(work, eye)) station_cameras.push_back(camera);
+  work.views_per_station = cameras.size();
+  auto capture = [&](const std::vector<uint32_t>& ids, const Camera& camera) {
+    const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
     std::vector<uint32_t> seen;
     for (uint32_t id : ids)
-      if (frusta[view].intersects(scene_.objects[id - 1].world_bounds)) seen.push_back(id);
-    return impostor::captureView(renderer_, gpu_scene_, seen, cameras[view], options_.base.capture);
+      if (frustum.intersects(scene_.objects[id - 1].world_bounds)) seen.push_back(id);
+    return impostor::captureView(renderer_, gpu_scene_, seen, camera, options_.base.capture);
   };
   work.layer_captures.assign(work.result.layers.size(), {});
   for (size_t l = 0; l < work.result.layers.size(); ++l)
-    for (size_t v = 0; v < cameras.size(); ++v) work.layer_captures[l].push_back(capture(work.result.layers[l].objects, v));
+    for (const Camera& camera : station_cameras)
+      work.layer_captures[l].push_back(capture(work.result.layers[l].objects, camera));
   work.single_captures.clear();
   if (options_.single_mesh)
-    for (size_t v = 0; v < cameras.size(); ++v) work.single_captures.push_back(capture(far, v));
+    for (const Camera& camera : station_cameras) work.single_captures.push_back(capture(far, camera));
   work.capture_ms = capture_timer.milliseconds();
+}
+
+// Stations are placed every station_spacing metres; a layer whose first station's region already reaches far needs
+// no more. Along the centreline each station covers [s_j - back, s_j + reach_j] at the bake's bound; the greedy
+// interval cover from the cell's start keeps the fewest stations that cover as much of the cell as they can, and
+// drops the rest with their views (geometry is what a viewpoint no kept station covers gets anyway).
+void PipelineRunner::pruneStations(store::StoredLayer& layer, std::vector<impostor::DepthMeshImpostor>& views,
+                                   const CellWork& work) const {
+  const size_t stations = layer.validity.size();
+  if (stations <= 1) return;
+  const Vec2 start(work.p_eye);
+  std::vector<double> from(stations), to(stations);
+  for (size_t j = 0; j < stations; ++j) {
+    const impostor::ValidityRegion& r = layer.validity[j];
+    const double at = glm::length(Vec2(r.origin) - start);
+    from[j] = at - double(r.back);
+    to[j] = at + r.reach(threshold_);  // -inf when not valid even at the station
+  }
+  const double length = glm::length(Vec2(work.q_eye) - start);
+  std::vector<uint8_t> keep(stations, 0);
+  keep[0] = 1;  // the cell's start: the runtime enters there
+  double covered = to[0];
+  while (covered < length) {
+    size_t best = stations;
+    for (size_t j = 1; j < stations; ++j)
+      if (!keep[j] && from[j] <= std::max(covered, 0.0) + 1e-6 && to[j] > covered && (best == stations || to[j] > to[best]))
+        best = j;
+    if (best == stations) {
+      // A gap no station covers: the next station that covers anything beyond it starts a new run.
+      for (size_t j = 1; j < stations; ++j)
+        if (!keep[j] && to[j] > covered && from[j] > covered && (best == stations || from[j] < from[best])) best = j;
+      if (best == stations) break;
+    }
+    keep[best] = 1;
+    covered = to[best];
+  }
+  std::vector<uint32_t> renumber(stations, 0);
+  std::vector<impostor::ValidityRegion> kept_regions;
+  for (size_t j = 0; j < stations; ++j)
+    if (keep[j]) {
+      renumber[j] = uint32_t(kept_regions.size());
+      kept_regions.push_back(std::move(layer.validity[j]));
+    }
+  std::vector<store::StoredView> kept_records;
+  std::vector<impostor::DepthMeshImpostor> kept_views;
+  for (size_t v = 0; v < layer.views.size(); ++v)
+    if (keep[layer.views[v].station]) {
+      kept_records.push_back(std::move(layer.views[v]));
+      kept_records.back().station = renumber[kept_records.back().station];
+      kept_views.push_back(std::move(views[v]));
+    }
+  layer.validity = std::move(kept_regions);
+  layer.views = std::move(kept_records);
+  views = std::move(kept_views);
 }
 
 void PipelineRunner::buildMeshes(CellWork& work) const {
@@ -523,22 +602,41 @@ void PipelineRunner::buildMeshes(CellWork& work) const {
     sv.data_pixels = work.single_captures[v].data_pixels;
     sv.render_ms = work.single_captures[v].render_ms;
   }
-  work.layer_captures.clear();
-  work.single_captures.clear();
-  // Validity regions (bake/validity_region.h): the scan runs up to a few times the bake's bound so that a runtime
-  // asking for a looser bound than the bake's still finds the region it may use.
+  // Validity regions (bake/validity_region.h), per station from its views' triangles and captured depth. The scan
+  // runs up to a few times the bake's bound so that a runtime asking for a looser bound still finds its region.
   const double stop = std::max(4.0 * threshold_, 0.05);
   const float street_width = cells_.graph().width(work.cell);
-  auto region = [&](const store::StoredLayer& layer) {
-    std::vector<ValidityObject> objects;
-    objects.reserve(layer.objects.size());
-    for (uint32_t id : layer.objects)
-      objects.push_back({scene_.objects[id - 1].world_bounds, footprintOf(scene_.objects[id - 1])});
-    return computeValidityRegion(work.p_eye, work.q_eye, street_width, objects, stop, options_.validity);
+  const size_t per_station = std::max<size_t>(1, work.views_per_station);
+  auto regions = [&](store::StoredLayer& layer, std::vector<impostor::DepthMeshImpostor>& views,
+                     const std::vector<impostor::ImpostorCapture>& captures) {
+    if (views.empty()) return;
+    std::vector<Polygon2> footprints;
+    std::vector<Box3> bounds;
+    for (uint32_t id : layer.objects) {
+      footprints.push_back(footprintOf(scene_.objects[id - 1]));
+      bounds.push_back(scene_.objects[id - 1].world_bounds);
+    }
+    std::erase_if(footprints, [](const Polygon2& f) { return f.empty(); });
+    const size_t stations = views.size() / per_station;
+    layer.validity.clear();
+    for (size_t j = 0; j < stations; ++j) {
+      std::vector<impostor::TriangleError> triangles;
+      for (size_t v = j * per_station; v < (j + 1) * per_station; ++v) {
+        const std::vector<impostor::TriangleError> t =
+            impostor::triangleErrors(views[v], captures[v].depth, captures[v].camera);
+        triangles.insert(triangles.end(), t.begin(), t.end());
+        layer.views[v].station = uint32_t(j);
+      }
+      layer.validity.push_back(computeValidityRegion(captures[j * per_station].camera.eye, work.q_eye, street_width,
+                                                     bounds, triangles, footprints, stop, options_.validity));
+    }
+    pruneStations(layer, views, work);
   };
-  for (store::StoredLayer& layer : work.result.layers)
-    if (!layer.views.empty()) layer.validity = region(layer);
-  if (!work.result.single.views.empty()) work.result.single.validity = region(work.result.single);
+  for (size_t l = 0; l < work.result.layers.size(); ++l)
+    regions(work.result.layers[l], work.layer_views[l], work.layer_captures[l]);
+  regions(work.result.single, work.single_views, work.single_captures);
+  work.layer_captures.clear();
+  work.single_captures.clear();
   work.build_ms = timer.milliseconds();
 }
 

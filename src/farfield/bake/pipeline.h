@@ -74,6 +74,10 @@ struct PipelineOptions {
   int frame_height = 360;
   float frame_fov_deg = 60.0f;
   ValidityOptions validity;              // sampling of the validity regions (bake/validity_region.h)
+  // Capture stations along the cell, metres apart (0: the cell's start only, as in the paper). Each layer is captured
+  // from every station; stations a layer does not need (its earlier stations' validity regions already cover the
+  // cell at the bound) are dropped.
+  float station_spacing = 20.0f;
   urban::PvsOptions pvs;                 // sample spacing, cube face size
   float near_radius = 0.0f;              // near/far by distance (metres) instead of the local model when > 0
   urban::VisibilityEventOptions events;  // representative points, landmark boost
@@ -100,6 +104,7 @@ struct CellWork {
   // Captures waiting for their meshes (the bake builds them on worker threads).
   std::vector<std::vector<impostor::ImpostorCapture>> layer_captures;
   std::vector<impostor::ImpostorCapture> single_captures;
+  size_t views_per_station = 1;       // 1 (street) or 6 (cube faces); captures are station-major
   double capture_ms = 0.0;
   double build_ms = 0.0;
 };
@@ -136,7 +141,10 @@ class PipelineRunner {
   void runPvs(CellWork& work);
   void runNearFar(CellWork& work) const;
   void runMmi(CellWork& work);
-  std::vector<Camera> viewCameras(const CellWork& work) const;  // the layers' creation cameras
+  std::vector<Vec3> stationEyes(const CellWork& work) const;    // capture stations along the cell, start first
+  std::vector<Camera> viewCameras(const CellWork& work, const Vec3& eye) const;  // a station's creation cameras
+  void pruneStations(store::StoredLayer& layer, std::vector<impostor::DepthMeshImpostor>& views,
+                     const CellWork& work) const;
 
   const scene::Scene& scene_;
   const gpu::GpuScene& gpu_scene_;

@@ -9,8 +9,10 @@
 namespace farfield::bake {
 
 impostor::ValidityRegion computeValidityRegion(const Vec3& p_eye, const Vec3& q_eye, float street_width,
-                                               std::span<const ValidityObject> objects, double stop_rad,
-                                               const ValidityOptions& options) {
+                                               std::span<const Box3> objects,
+                                               std::span<const impostor::TriangleError> triangles,
+                                               std::span<const Polygon2> footprints,
+                                               double stop_rad, const ValidityOptions& options) {
   if (!(options.step > 0.0f) || !(options.back >= 0.0f) || options.laterals < 1 || options.laterals % 2 == 0 ||
       !(options.below >= 0.0f) || !(options.above >= 0.0f) || !(options.width_share >= 0.0f))
     throw Error("validity options", "step > 0, back >= 0, an odd number of laterals, below, above and width share >= 0");
@@ -30,15 +32,12 @@ impostor::ValidityRegion computeValidityRegion(const Vec3& p_eye, const Vec3& q_
   const DVec2 across(-axis.y, axis.x);
   const double slope = length > 0.0 ? (double(q_eye.z) - p_eye.z) / length : 0.0;
 
-  std::vector<urban::EventObject> events(objects.size());
-  for (size_t i = 0; i < objects.size(); ++i) {
-    events[i].footprint = objects[i].footprint;
-    if (events[i].footprint.empty()) {
-      const Box3& b = objects[i].box;
-      events[i].footprint = {{b.lo.x, b.lo.y}, {b.hi.x, b.lo.y}, {b.hi.x, b.hi.y}, {b.lo.x, b.hi.y}};
-    }
+  std::vector<urban::EventObject> events(footprints.size());
+  for (size_t i = 0; i < footprints.size(); ++i) {
+    if (footprints[i].empty()) throw Error("validity", "object " + std::to_string(i) + " has an empty footprint");
+    events[i].footprint = footprints[i];
   }
-  const bool pairs = objects.size() >= 2;
+  const bool pairs = events.size() >= 2;
 
   // The error at one viewpoint on the ground, the largest over the heights.
   auto error_at = [&](double s, double l) {
@@ -46,8 +45,12 @@ impostor::ValidityRegion computeValidityRegion(const Vec3& p_eye, const Vec3& q_
     double worst = 0.0;
     for (double dz : {-double(options.below), 0.0, double(options.above)}) {
       const Vec3 v(float(ground.x), float(ground.y), float(double(p_eye.z) + slope * s + dz));
-      for (const ValidityObject& o : objects) {
-        worst = std::max(worst, impostor::parallaxBound(p_eye, v, o.box));
+      for (const Box3& box : objects) {
+        worst = std::max(worst, impostor::parallaxBound(p_eye, v, box));
+        if (worst > stop_rad) return worst;
+      }
+      for (const impostor::TriangleError& triangle : triangles) {
+        worst = std::max(worst, impostor::triangleErrorBound(p_eye, v, triangle));
         if (worst > stop_rad) return worst;
       }
     }

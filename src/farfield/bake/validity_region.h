@@ -3,8 +3,13 @@
 // time). See impostor/validity.h for the region and the per-object closed form.
 //
 // The error of an impostor captured from E (the cell's start at eye height), seen from a viewpoint V, is bounded by
-// the larger of two terms:
-//   - per object: impostor::parallaxBound(E, V, box), the parallax between the points one texel stands for;
+// the largest of three terms:
+//   - per object: impostor::parallaxBound(E, V, bounds), which covers what the capture could not hold: the parts of
+//     the object hidden or seen at a grazing angle from E (its side faces, which a lateral step reveals) lie on
+//     capture rays inside its bounds, behind the captured surface. The brute-force test of this file fails without
+//     it (30 px at 20 m along and 5 m across the constructed street's cell, where the mesh terms alone said 10);
+//   - per mesh triangle: impostor::triangleErrorBound(E, V, ...) over impostor::triangleErrors(), the parallax
+//     between where a texel is drawn (its capture ray meets the triangle) and where what it shows lies;
 //   - between objects of one impostor (rubber sheets and de-occlusion between them): Decoret et al.'s
 //     visibility-event weight of the pair for the segment [E, V] (urban::computeEventGraph), the largest change of
 //     the pair's relative angle while the viewer moves from E to V, with the paper's closed forms. A multi-mesh
@@ -28,20 +33,18 @@ struct ValidityOptions {
   float step = 1.0f;             // metres between samples along the cell
   float back = 2.0f;             // metres before the cell's start that the region also covers
   float width_share = 0.9f;      // region half width = share x the street's half width (walkers keep within 90%)
-  int laterals = 5;              // samples across the street, odd (includes the centreline)
+  int laterals = 9;              // samples across the street, odd (includes the centreline)
   float below = 0.6f;            // metres below the eye line (a car's 1.2 m eye under a pedestrian's 1.7 m bake)
   float above = 0.3f;            // metres above it
 };
 
-struct ValidityObject {
-  Box3 box;           // world bounds
-  Polygon2 footprint; // ground-plane outline (visibility events); a box's rectangle when the object has none
-};
-
 // The region of one impostor captured from `p_eye` for a cell ending at `q_eye` on a street `street_width` metres
-// wide. stop_rad > 0: the scan stops after the first envelope value above it.
+// wide: `objects` (world bounds) for the per-object term, `triangles` for the per-triangle term, `footprints` of its
+// objects for the events between them (none: no pair term). stop_rad > 0: each line's scan stops after the first envelope value above it.
 impostor::ValidityRegion computeValidityRegion(const Vec3& p_eye, const Vec3& q_eye, float street_width,
-                                               std::span<const ValidityObject> objects, double stop_rad,
-                                               const ValidityOptions& options = {});
+                                               std::span<const Box3> objects,
+                                               std::span<const impostor::TriangleError> triangles,
+                                               std::span<const Polygon2> footprints,
+                                               double stop_rad, const ValidityOptions& options = {});
 
 }  // namespace farfield::bake

@@ -19,6 +19,8 @@
 namespace farfield {
 
 struct Camera;
+template <typename V>
+struct BoxT;
 
 struct ErrorBound {
   double pixels = 10.0;
@@ -33,8 +35,13 @@ struct ErrorBound {
   double fovX() const;                  // horizontal field of view, radians
   double centrePixelAngle() const;      // 1 / f, radians
   double cornerPixelAngle() const;      // cos^2(half diagonal field of view) / f, radians: the smallest pixel
+  // The smallest pixel angle within `radius_px` pixels of the image centre: cos^2(atan(r / f)) / f (r clamped to the
+  // half diagonal). What lies inside a smaller circle may move by a larger angle for the same pixel count.
+  double pixelAngleWithin(double radius_px) const;
   // The angle no impostor error may exceed: pixels * cornerPixelAngle().
   double angle() const;
+  // The same for something that covers only the part of the frame within `radius_px` of its centre.
+  double angleWithin(double radius_px) const { return pixels * pixelAngleWithin(radius_px); }
   // Pixels that an angular error `radians` can span at most anywhere in the frame: radians / cornerPixelAngle().
   double pixelsOf(double radians) const;
 
@@ -42,5 +49,10 @@ struct ErrorBound {
   // outside (0, 180) degrees.
   void validate(const std::string& what = "error bound") const;
 };
+
+// Distance in pixels from the centre of the camera's frame to the farthest point of the frame that `box` can cover
+// (its projected corners' rectangle clamped to the frame); the half diagonal when part of the box is behind the eye
+// plane. With ErrorBound::angleWithin() it gives the bound of an impostor where it is drawn.
+double frameRadius(const Camera& camera, const BoxT<Vec3>& box);
 
 }  // namespace farfield

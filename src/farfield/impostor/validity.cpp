@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "farfield/core/camera.h"
+#include "farfield/core/check.h"
+
 namespace farfield::impostor {
 
 namespace {
@@ -54,6 +57,100 @@ double parallaxBound(const Vec3& capture_eye, const Vec3& eye, const Box3& box) 
   double integral = std::max(0.0, std::min(d_star, d_max) - d_min) / (r_box * r_box);
   if (d_max > d_star) integral += 1.0 / (std::max(d_star, d_min) - s) - 1.0 / (d_max - s);
   return std::min(kPi, s * sin_max * integral);
+}
+
+std::vector<TriangleError> triangleErrors(const DepthMeshImpostor& impostor, const image::DepthImage& depth,
+                                          const Camera& camera) {
+  FF_CHECK(depth.width() == camera.width && depth.height() == camera.height);
+  const scene::Mesh& mesh = impostor.mesh;
+  const int w = depth.width(), h = depth.height();
+  // The capture camera's basis, once (Camera::unproject inverts the view matrix per call).
+  const DVec3 e(camera.eye);
+  const DVec3 forward = glm::normalize(DVec3(camera.at) - e);
+  const DVec3 right = glm::normalize(glm::cross(forward, DVec3(camera.up)));
+  const DVec3 up = glm::cross(right, forward);
+  const double tan_y = std::tan(0.5 * double(camera.fov_y)), tan_x = tan_y * double(w) / double(h);
+  auto ray = [&](double px, double py) {  // unit direction through image point (px, py), row 0 at the top
+    return glm::normalize(forward + (2.0 * px / w - 1.0) * tan_x * right + (1.0 - 2.0 * py / h) * tan_y * up);
+  };
+  std::vector<TriangleError> out;
+  out.reserve(mesh.triangleCount());
+  for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+    DVec3 x[3];
+    DVec2 uv[3];
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t i = mesh.indices[3 * t + size_t(k)];
+      x[k] = DVec3(mesh.positions[i]);
+      uv[k] = DVec2(double(mesh.uvs[i].x) * w, double(mesh.uvs[i].y) * h);  // texels
+    }
+    const DVec3 normal = glm::cross(x[1] - x[0], x[2] - x[0]);
+    const double plane = glm::dot(normal, x[0] - e);
+    std::vector<DVec3> directions;
+    double near = std::numeric_limits<double>::infinity(), gap = 0.0;
+    for (const DVec3& v : x) {
+      near = std::min(near, glm::length(v - e));
+      directions.push_back(glm::normalize(v - e));
+    }
+    const double area = (uv[1].x - uv[0].x) * (uv[2].y - uv[0].y) - (uv[2].x - uv[0].x) * (uv[1].y - uv[0].y);
+    const double sign = area >= 0.0 ? 1.0 : -1.0;
+    auto inside = [&](const DVec2& p) {
+      for (int k = 0; k < 3; ++k) {
+        const DVec2 a = uv[k], edge = uv[(k + 1) % 3] - a;
+        if (sign * (edge.x * (p.y - a.y) - edge.y * (p.x - a.x)) < -0.75 * glm::length(edge)) return false;
+      }
+      return true;
+    };
+    const int x0 = std::max(0, int(std::floor(std::min({uv[0].x, uv[1].x, uv[2].x}) - 1.0)));
+    const int x1 = std::min(w - 1, int(std::ceil(std::max({uv[0].x, uv[1].x, uv[2].x}))));
+    const int y0 = std::max(0, int(std::floor(std::min({uv[0].y, uv[1].y, uv[2].y}) - 1.0)));
+    const int y1 = std::min(h - 1, int(std::ceil(std::max({uv[0].y, uv[1].y, uv[2].y}))));
+    for (int py = y0; py <= y1; ++py)
+      for (int px = x0; px <= x1; ++px) {
+        const float z = depth.at(px, py);
+        if (!(z > 0.0f) || !inside(DVec2(px + 0.5, py + 0.5))) continue;
+        const DVec3 u = ray(px + 0.5, py + 0.5);
+        directions.push_back(u);
+        // P: the captured point (linear depth is along the view axis); Q: the ray meets the triangle's plane.
+        const double p_dist = double(camera.linearDepth(z)) / glm::dot(u, forward);
+        const double un = glm::dot(u, normal);
+        const double q_dist = un != 0.0 ? plane / un : -1.0;
+        near = std::min(near, p_dist);
+        if (q_dist > 0.0) {
+          near = std::min(near, q_dist);
+          gap = std::max(gap, std::abs(1.0 / p_dist - 1.0 / q_dist));
+        } else {
+          gap = std::numeric_limits<double>::infinity();  // the ray misses the plane: anything can be drawn there
+        }
+      }
+    TriangleError r;
+    DVec3 axis(0.0);
+    for (const DVec3& d : directions) axis += d;
+    axis = glm::length(axis) > 0.0 ? glm::normalize(axis) : forward;
+    double half_angle = 0.0;
+    for (const DVec3& d : directions) half_angle = std::max(half_angle, std::acos(std::clamp(glm::dot(d, axis), -1.0, 1.0)));
+    r.axis = Vec3(axis);
+    r.half_angle = float(half_angle) * 1.0001f + 1e-6f;
+    r.near_m = float(near) * 0.9999f;
+    r.inv_depth_gap = std::isfinite(gap) ? float(gap) * 1.0001f + 1e-7f : float(1.0 / std::max(near, 1e-6));
+    out.push_back(r);
+  }
+  return out;
+}
+
+// The chord [Q, P] lies on one capture ray at distances d1 < d2 >= near_m; seen from eye = E + t (|t| = s) it
+// subtends at most the integral over [d1, d2] of s sin(phi) / r(d)^2 with r(d) >= d - s (as in parallaxBound), which
+// is (d2 - d1) / ((d1 - s)(d2 - s)) = (1/d1 - 1/d2) * d1 d2 / ((d1 - s)(d2 - s)) <= gap * (near / (near - s))^2.
+// A ray that misses the triangle's plane gets gap = 1 / near (P anywhere beyond near on it): the chord to infinity.
+double triangleErrorBound(const Vec3& capture_eye, const Vec3& eye, const TriangleError& triangle) {
+  const DVec3 t = DVec3(eye) - DVec3(capture_eye);
+  const double s = glm::length(t);
+  if (s == 0.0) return 0.0;
+  const double near = double(triangle.near_m);
+  if (s >= near) return kPi;
+  const double phi_c = std::acos(std::clamp(glm::dot(t / s, DVec3(triangle.axis)), -1.0, 1.0));
+  const double sin_max = maxSin(phi_c - double(triangle.half_angle), phi_c + double(triangle.half_angle));
+  const double k = near / (near - s);
+  return std::min(kPi, s * sin_max * double(triangle.inv_depth_gap) * k * k);
 }
 
 Vec3 ValidityRegion::local(const Vec3& eye) const {

@@ -2,7 +2,8 @@
 // error bound (DESIGN.md, "the two promises"; the lecture's "impostor validity", Schaufler's error angle; Decoret et
 // al. 1999, section 4.1, for the events between objects of one impostor).
 //
-// parallaxBound() is the per-object term: a closed-form upper bound of the angle, seen from a new eye, between two
+// parallaxBound() bounds the error of anything drawn from a box of the scene (Schaufler's metric made tight); the
+// finer triangleErrorBound() follows a meshed impostor's own triangles. Both are closed-form upper bounds of the angle, seen from a new eye, between two
 // points of an object that one ray of the capture eye met (one texel of the image, drawn at one depth). It refines
 // Schaufler's s (1/d_min - 1/d_max) with the direction of motion (motion along the ray shows no parallax) and with
 // the distance from the new eye to the object, and stays a true upper bound for any motion (derivation in the .cpp).
@@ -20,12 +21,38 @@
 
 #include "farfield/core/bounds.h"
 #include "farfield/core/math.h"
+#include "farfield/image/image.h"
+#include "farfield/impostor/impostor_mesh.h"
 
 namespace farfield::impostor {
 
 // Upper bound (radians, capped at pi) of the angle between two points of `box` on one ray from `capture_eye`, seen
 // from `eye`. 0 when eye == capture_eye or the box is empty; pi when `eye` or `capture_eye` lies in the box.
 double parallaxBound(const Vec3& capture_eye, const Vec3& eye, const Box3& box);
+
+// The error record of one triangle of a meshed impostor drawn with projective texturing (GpuImpostorOptions::
+// projective_texture, the default): a fragment at a point X of the triangle shows the texel whose capture ray goes
+// through X, so the texel is drawn where its ray meets the triangle (Q) while what it shows lies on the same ray at
+// its captured depth (P). The error seen from a new eye is the angle between Q and P: the parallax of two points on
+// one capture ray, which depends only on their inverse distances from the capture eye and on the direction of
+// motion. Per triangle, over its data texels (texels whose centre lies in its texture-space triangle, with half a
+// texel of tolerance):
+struct TriangleError {
+  Vec3 axis{0.0f, 0.0f, 1.0f};  // unit direction from the capture eye towards the triangle
+  float half_angle = 0.0f;      // radians: the directions of its vertices and texels lie within it of axis
+  float near_m = 0.0f;          // smallest distance from the capture eye to a vertex, a P or a Q
+  float inv_depth_gap = 0.0f;   // largest |1 / |P - E| - 1 / |Q - E||, 1/metres (1 / near_m for a ray that grazes
+                                // the triangle's plane)
+};
+// Records of every triangle (in mesh order). `depth` is the capture's window depth (0 = background) and `camera`
+// its camera; the sizes must agree (FF_CHECK).
+std::vector<TriangleError> triangleErrors(const DepthMeshImpostor& impostor, const image::DepthImage& depth,
+                                          const Camera& camera);
+// Upper bound (radians, capped at pi) of the angle between Q and P of any texel of the triangle, seen from `eye`:
+// with s = |eye - capture_eye| < near_m and sin(phi) bounded over the cone,
+//     s sin(phi)max * inv_depth_gap * (near_m / (near_m - s))^2
+// (the integral of s sin(phi) / r^2 along the ray, r >= d - s; derivation in the .cpp). 0 at the capture eye.
+double triangleErrorBound(const Vec3& capture_eye, const Vec3& eye, const TriangleError& triangle);
 
 struct ValidityRegion {
   Vec3 origin{0.0f};          // capture eye (the cell's start at eye height)

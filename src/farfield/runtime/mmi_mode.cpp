@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
@@ -205,6 +206,7 @@ std::unique_ptr<MmiMode::Cell> MmiMode::loadCell(const store::CellEntry& entry) 
         imp = store::loadLayerView(dir_, layers[l].views[v]);
       if (imp.empty()) continue;
       layer.view_eyes.push_back(imp.camera.eye);
+      layer.view_station.push_back(layers[l].views[v].station);
       layer.views.push_back(std::make_unique<impostor::GpuImpostor>(imp, gpu_options));
       cell->impostor_triangles += layer.views.back()->triangleCount();
     }
@@ -246,25 +248,38 @@ void MmiMode::frame(eval::FrameContext& frame) {
   context_->bvh->queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
   Cell* current = nullptr;
   // Layers whose validity region does not hold this viewpoint under the bound become geometry.
-  bound_rad_ = ErrorBound::forCamera(error_px_, camera).angle();
-  std::vector<uint8_t> layer_valid;
+  const ErrorBound bound = ErrorBound::forCamera(error_px_, camera);
+  bound_rad_ = bound.angle();
+  // Per layer: the station drawn, kAllViews (no validity regions: every view, unchecked) or kGeometry.
+  constexpr int kAllViews = -1, kGeometry = -2;
+  std::vector<int>& layer_station = layer_station_;
   if (entry) {
     ++visited_[half_edge];
     current = &cell(half_edge);
     // Fast motion and stale dynamic impostors first: a layer that loses its dynamic impostor is judged by its
     // baked views' validity below.
     if (kind_ == MmiKind::MmiDynamic) dropStaleDynamic(camera, *current);
-    layer_valid.assign(current->layers.size(), 1);
+    layer_station.assign(current->layers.size(), kAllViews);
     bool any_invalid = false;
     for (size_t l = 0; l < current->layers.size(); ++l) {
       const Layer& layer = current->layers[l];
       if (layer.dynamic || layer.views.empty()) continue;
-      if (!layer.validity) {
+      if (layer.validity.empty()) {
         ++unchecked_layer_draws_;
         continue;
       }
-      if (layer.validity->valid(camera.eye, bound_rad_)) continue;
-      layer_valid[l] = 0;
+      // The bound where the layer is drawn: a layer near the frame's centre may move by a larger angle per pixel.
+      const double theta = bound.angleWithin(frameRadius(camera, layer.bounds));
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j < layer.validity.size(); ++j) {
+        const double e = layer.validity[j].errorAt(camera.eye);
+        if (e <= theta && e < best) {
+          best = e;
+          layer_station[l] = int(j);
+        }
+      }
+      if (layer_station[l] >= 0) continue;
+      layer_station[l] = kGeometry;
       any_invalid = true;
       ++invalid_layer_draws_;
       for (uint32_t id : layer.objects) invalid_object_[id] = 1;
@@ -282,7 +297,7 @@ void MmiMode::frame(eval::FrameContext& frame) {
     invalid_triangles_sum_ += double(invalid_triangles);
     if (any_invalid)
       for (size_t l = 0; l < current->layers.size(); ++l)
-        if (!layer_valid[l])
+        if (layer_station[l] == kGeometry)
           for (uint32_t id : current->layers[l].objects) invalid_object_[id] = 0;
   } else {
     ++fallback_frames_;  // not baked: everything in the frustum, as the culled mode
@@ -301,16 +316,17 @@ void MmiMode::frame(eval::FrameContext& frame) {
   for (size_t l = 0; l < current->layers.size(); ++l) {
     const Layer& layer = current->layers[l];
     const uint32_t id = layer_id_base_ + uint32_t(l);
-    if (!layer_valid[l]) continue;  // drawn as geometry above
+    if (layer_station[l] == kGeometry) continue;  // drawn as geometry above
     if (layer.dynamic) {
       layer.dynamic->appendDrawItems(frame.items(), id);
       impostor_triangles_sum_ += double(layer.dynamic->triangleCount());
       dynamic_layers_sum_ += 1.0;
       continue;
     }
-    for (const auto& view : layer.views) {
-      view->appendDrawItems(frame.items(), id);
-      impostor_triangles_sum_ += double(view->triangleCount());
+    for (size_t v = 0; v < layer.views.size(); ++v) {
+      if (layer_station[l] >= 0 && layer.view_station[v] != uint32_t(layer_station[l])) continue;
+      layer.views[v]->appendDrawItems(frame.items(), id);
+      impostor_triangles_sum_ += double(layer.views[v]->triangleCount());
     }
   }
 }

@@ -29,9 +29,10 @@
 // Cells: the cell is looked up per frame as in the depth-mesh mode. Its record is read (and its impostors uploaded)
 // the first time the viewer enters it, inside that frame.
 //
-// The error bound: a layer (or the single mesh) is drawn as an impostor only where its validity region, computed at
-// bake time (bake/validity_region.h), says its error stays under the bound; elsewhere its objects are drawn as
-// geometry (frustum-culled), counted in info() as invalid layer draws. Stores without validity regions (version 2)
+// The error bound: a layer (or the single mesh) is drawn as an impostor only where the validity region of one of its
+// capture stations, computed at bake time (bake/validity_region.h), says its error stays under the bound where the
+// layer appears in the frame (ErrorBound::angleWithin); the station with the smallest error is drawn. Elsewhere its
+// objects are drawn as geometry (frustum-culled), counted in info() as invalid layer draws. Stores without validity regions (version 2)
 // draw every layer and count it as unchecked. When the store left stages to the runtime (`bake
 // --online mmi`), they run then, with the bake's code (PipelineRunner), and their time counts in that frame. A cell
 // the store does not hold falls back to frustum-culled full geometry (counted).
@@ -87,7 +88,8 @@ class MmiMode final : public eval::Mode {
     uint64_t geometry_triangles = 0;                    // of its objects as geometry
     std::vector<std::unique_ptr<impostor::GpuImpostor>> views;
     std::vector<Vec3> view_eyes;                        // creation eyes of the views
-    std::optional<impostor::ValidityRegion> validity;   // from the bake (absent in version 2 stores)
+    std::vector<uint32_t> view_station;                 // capture station of each view
+    std::vector<impostor::ValidityRegion> validity;     // per station, from the bake (none in version 2 stores)
     std::unique_ptr<DynamicImpostor> dynamic;
   };
   struct Cell {
@@ -118,6 +120,7 @@ class MmiMode final : public eval::Mode {
   double error_px_ = 0.0;        // 0 until prepare(): the option, or the bake's bound
   double bound_rad_ = 0.0;       // of the last frame
   std::vector<uint8_t> invalid_object_;  // per object id: in a layer drawn as geometry this frame
+  std::vector<int> layer_station_;       // per layer of the current cell: the station drawn this frame
 
   const eval::ModeContext* context_ = nullptr;
   store::StoreIndex index_;

@@ -123,19 +123,21 @@ class JsonReader {
 nlohmann::json viewJson(const StoredView& v) {
   return {{"camera", cameraJson(v.camera)}, {"texture", v.texture},         {"mesh", v.mesh}, {"ids", v.ids},
           {"triangles", v.triangles},       {"vertices", v.vertices},       {"data_pixels", v.data_pixels},
-          {"render_ms", v.render_ms},       {"build_ms", v.build_ms}};
+          {"render_ms", v.render_ms},       {"build_ms", v.build_ms},       {"station", v.station}};
 }
 
 nlohmann::json layerJson(const StoredLayer& l) {
   nlohmann::json views = nlohmann::json::array();
   for (const StoredView& v : l.views) views.push_back(viewJson(v));
   nlohmann::json j = {{"objects", l.objects}, {"views", std::move(views)}};
-  if (l.validity) {
-    const impostor::ValidityRegion& v = *l.validity;
-    j["validity"] = {{"origin", vec3Json(v.origin)}, {"end", vec3Json(v.end)}, {"half_width", v.half_width},
-                     {"below", v.below},             {"above", v.above},     {"back", v.back},
-                     {"step", v.step},               {"laterals", v.laterals},
-                     {"envelope", v.envelope}};
+  if (!l.validity.empty()) {
+    nlohmann::json regions = nlohmann::json::array();
+    for (const impostor::ValidityRegion& v : l.validity)
+      regions.push_back({{"origin", vec3Json(v.origin)}, {"end", vec3Json(v.end)}, {"half_width", v.half_width},
+                         {"below", v.below},             {"above", v.above},     {"back", v.back},
+                         {"step", v.step},               {"laterals", v.laterals},
+                         {"envelope", v.envelope}});
+    j["validity"] = std::move(regions);
   }
   return j;
 }
@@ -170,9 +172,7 @@ std::vector<uint32_t> readIds(const JsonReader& r, const nlohmann::json& j, cons
   return ids;
 }
 
-impostor::ValidityRegion readValidity(const JsonReader& r, const nlohmann::json& j, const std::string& where) {
-  const nlohmann::json& m = r.member(j, "validity", where);
-  const std::string at = where + ": validity";
+impostor::ValidityRegion readValidity(const JsonReader& r, const nlohmann::json& m, const std::string& at) {
   impostor::ValidityRegion v;
   v.origin = r.vec3(m, "origin", at);
   v.end = r.vec3(m, "end", at);
@@ -222,10 +222,23 @@ StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::s
     view.data_pixels = size_t(r.count(views[v], "data_pixels", at));
     view.render_ms = r.number(views[v], "render_ms", at);
     view.build_ms = r.number(views[v], "build_ms", at);
+    if (require_validity || views[v].contains("station")) {
+      const uint64_t station = r.count(views[v], "station", at);
+      if (station > 1000) r.fail(at, "\"station\" must be 0..1000");
+      view.station = uint32_t(station);
+    }
     if (view.triangles > 0 && view.texture.empty()) r.fail(at, "has triangles but no texture");
     layer.views.push_back(std::move(view));
   }
-  if (j.contains("validity") || (require_validity && !layer.views.empty())) layer.validity = readValidity(r, j, where);
+  uint32_t stations = 0;
+  for (const StoredView& view : layer.views) stations = std::max(stations, view.station + 1);
+  if (j.contains("validity") || (require_validity && !layer.views.empty())) {
+    const nlohmann::json& list = r.member(j, "validity", where);
+    if (!list.is_array() || list.size() != stations)
+      r.fail(where, "\"validity\" must be an array with one region per station (" + std::to_string(stations) + ")");
+    for (size_t k = 0; k < list.size(); ++k)
+      layer.validity.push_back(readValidity(r, list[k], where + ": validity[" + std::to_string(k) + "]"));
+  }
   return layer;
 }
 

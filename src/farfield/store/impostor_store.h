@@ -35,10 +35,11 @@
 //                "ids": "cells/e000012.mmi.00.0.ids.png" (optional),
 //                "triangles": 540, "vertices": 300, "data_pixels": 81234, "render_ms": 20.1, "build_ms": 3.2}
 //   (each part present when its stage was baked). Version 1 indexes are still read.
-//   Version 3 adds to every layer and to "single" (when it has views) the validity region of its views
-//   (impostor/validity.h), computed at bake time:
-//     "validity": {"origin": [x,y,z], "end": [x,y,z], "half_width": 5.4, "below": 0.6, "above": 0.3, "back": 2,
-//                  "step": 1, "envelope": [0, 0.0004, ...]}          // radians, non-decreasing
+//   Version 3 captures each layer (and the single mesh) from one or more stations along the cell (the cell's start
+//   first), gives every VIEW its "station" index, and adds to every layer and to "single" (when it has views) the
+//   validity region of each station's views (impostor/validity.h), computed at bake time:
+//     "validity": [{"origin": [x,y,z], "end": [x,y,z], "half_width": 5.4, "below": 0.6, "above": 0.3, "back": 2,
+//                   "step": 1, "laterals": 9, "envelope": [0, 0.0004, ...]}, ...]   // radians, one per station
 //   and requires the pipeline options in "options.pipeline" whole (bake/pipeline.h); version 2 is still read.
 //   Cells are sorted by half-edge id, each at most once. Numbers are JSON numbers (floats written with enough digits
 //   to read back exactly).
@@ -97,6 +98,7 @@ struct StoredView {
   size_t data_pixels = 0;
   double render_ms = 0.0;  // capture (GL thread)
   double build_ms = 0.0;   // mesh construction (worker thread)
+  uint32_t station = 0;    // the capture station along the cell (version 3; 0 = the cell's start)
 };
 
 // One layer of a cell's far geometry: objects among which only negligible visibility events occur (w_ij <= T for
@@ -104,9 +106,10 @@ struct StoredView {
 struct StoredLayer {
   std::vector<uint32_t> objects;  // object ids, ascending
   std::vector<StoredView> views;
-  // Where the layer's views may be drawn under an error bound (impostor/validity.h); version 3 stores have one for
-  // every layer with views, version 2 stores none (the runtime then counts the layer as unchecked).
-  std::optional<impostor::ValidityRegion> validity;
+  // Per capture station, where its views may be drawn under an error bound (impostor/validity.h): version 3 stores
+  // have one per station of every layer with views (views name their station), version 2 stores none (the runtime
+  // then counts the layer as unchecked).
+  std::vector<impostor::ValidityRegion> validity;
 };
 
 // What the extractor pipeline (farfield/bake/pipeline.h) found for a cell. Each part is present when its stage ran
