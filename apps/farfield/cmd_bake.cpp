@@ -1,6 +1,6 @@
 // farfield bake SCENE [--streets city.streets.json] --technique depth-mesh|grid-mesh|both [--local edge|junction]
 //                [--pipeline pvs,near-far,mmi [--online mmi] [--error-px 10] [--frame-size 640x360] [--frame-fov 60]
-//                 [--station-spacing 20] [--layer-mesh grid|depth-mesh]
+//                 [--station-spacing 5] [--layer-mesh grid|depth-mesh]
 //                 [--grid-cells 30] [--views street|six] [--pvs-spacing M] [--pvs-face PX] [--near-radius M]]
 //                [--resolution 512] [--fov DEG] [--eye-height M] [--path path.json] [--cell-lookup street|nearest]
 //                [--cells E,E,...] [--limit N] [--workers N]
@@ -55,7 +55,7 @@ struct BakeArgs {
   double error_px = 10.0;
   std::string frame_size = "640x360";
   float frame_fov = 60.0f;
-  float station_spacing = 20.0f;
+  float station_spacing = 5.0f;
   std::string layer_mesh = "grid";
   int grid_cells = 30;
   std::string views = "street";

@@ -77,7 +77,7 @@ struct PipelineOptions {
   // Capture stations along the cell, metres apart (0: the cell's start only, as in the paper). Each layer is captured
   // from every station; stations a layer does not need (its earlier stations' validity regions already cover the
   // cell at the bound) are dropped.
-  float station_spacing = 20.0f;
+  float station_spacing = 5.0f;
   urban::PvsOptions pvs;                 // sample spacing, cube face size
   float near_radius = 0.0f;              // near/far by distance (metres) instead of the local model when > 0
   urban::VisibilityEventOptions events;  // representative points, landmark boost
