@@ -1,0 +1,145 @@
+// Benchmark modes of Chen et al. 1999, LOD-sprite terrain (section 3 and section 5's future work).
+#include "farfield/eval/terrain_modes.h"
+
+#include <algorithm>
+#include <exception>
+#include <stdexcept>
+
+#include "farfield/core/error.h"
+
+namespace farfield::eval {
+namespace {
+
+float parseFloatOption(const ModeContext& context, const std::string& key, float fallback) {
+  const std::string text = context.option(key);
+  if (text.empty()) return fallback;
+  try {
+    size_t used = 0;
+    const float v = std::stof(text, &used);
+    if (used != text.size() || !(v > 0.0f)) throw std::invalid_argument(text);
+    return v;
+  } catch (const std::exception&) {
+    throw Error("--mode-option " + key, "expected a positive number, got '" + text + "'");
+  }
+}
+
+// `terrain bench` sets the run; under `farfield bench` the first terrain mode loads it from the mode options.
+std::shared_ptr<TerrainRun> runFor(const ModeContext& context, const std::string& mode) {
+  std::shared_ptr<TerrainRun>& run = currentTerrainRun();
+  if (!run) {
+    auto loaded = std::make_shared<TerrainRun>();
+    loaded->data = terrain::TerrainData::load(context.requireOption("terrain", mode));
+    loaded->high_error = parseFloatOption(context, "high_error", loaded->high_error);
+    loaded->low_error = parseFloatOption(context, "low_error", loaded->low_error);
+    loaded->epsilon = parseFloatOption(context, "epsilon", float(loaded->epsilon));
+    if (context.renderer) loaded->sky = context.renderer->light().sky_color;
+    run = std::move(loaded);
+  }
+  return run;
+}
+
+}  // namespace
+
+gpu::TerrainRenderer& TerrainRun::gpuRenderer() {
+  if (!renderer) {
+    Vec2 scale, offset;
+    terrain::texCoordTransform(data->hf, scale, offset);
+    renderer = std::make_unique<gpu::TerrainRenderer>(data->lod->positions(), data->texture, scale, offset);
+  }
+  return *renderer;
+}
+
+std::shared_ptr<TerrainRun>& currentTerrainRun() {
+  static std::shared_ptr<TerrainRun> run;
+  return run;
+}
+
+void LodMode::prepare(const ModeContext& context) {
+  run_ = runFor(context, name_);
+  run_->gpuRenderer();
+}
+
+void LodMode::frame(FrameContext& frame) {
+  gpu::RenderTarget& target = frame.beginOwnPass();
+  const float error = high_ ? run_->high_error : run_->low_error;
+  frame.addStats(terrain::renderLodFrame(*run_->data->lod, run_->gpuRenderer(), frame.camera(),
+                                         terrain::LodSettings{error, true, false}, target, mesh_));
+}
+
+std::map<std::string, double> LodMode::info() const {
+  return {{"pixel_error", high_ ? run_->high_error : run_->low_error}};
+}
+
+terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon) {
+  terrain::LodSpriteOptions o;
+  o.epsilon = epsilon;
+  o.high_error = run.high_error;
+  o.low_error = run.low_error;
+  o.sky_color = run.sky;
+  if (variant == SpriteVariant::Predict) o.predict = true;
+  if (variant == SpriteVariant::Cache) o.cache_size = 8;
+  return o;
+}
+
+bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant) {
+  if (mode_name == "lod-sprite") variant = SpriteVariant::Paper;
+  else if (mode_name == "lod-sprite-predict") variant = SpriteVariant::Predict;
+  else if (mode_name == "lod-sprite-cache") variant = SpriteVariant::Cache;
+  else return false;
+  return true;
+}
+
+void SpriteMode::prepare(const ModeContext& context) {
+  run_ = runFor(context, name_);
+  const terrain::LodSpriteOptions o = spriteOptions(*run_, variant_, epsilon_ > 0.0 ? epsilon_ : run_->epsilon);
+  sprite_ = std::make_unique<terrain::LodSpriteRenderer>(*run_->data->lod, run_->gpuRenderer(), context.width,
+                                                         context.height, o);
+}
+
+void SpriteMode::frame(FrameContext& frame) {
+  // A path frame at or before the last one starts a new pass (the harness's warm-up frame was the first pass).
+  if (started_ && frame.pathFrame() <= last_frame_) {
+    sprite_->reset();
+    run_->logs[name_].clear();
+  }
+  started_ = true;
+  last_frame_ = frame.pathFrame();
+  gpu::RenderTarget& target = frame.beginOwnPass();
+  SpriteLog log;
+  log.path_frame = frame.pathFrame();
+  frame.addStats(sprite_->render(frame.camera(), target, &log.info));
+  run_->logs[name_].push_back(log);
+}
+
+std::map<std::string, double> SpriteMode::info() const {
+  const terrain::LodSpriteCounters& c = sprite_->counters();
+  const double frames = double(std::max<size_t>(c.frames, 1));
+  return {{"epsilon_px", sprite_->options().epsilon},
+          {"frames", double(c.frames)},
+          {"keyframes", double(c.fresh_keyframes)},
+          {"keyframe_fraction", double(c.fresh_keyframes) / frames},
+          {"high_resolution_renders", double(c.highResolutionRenders())},
+          {"predicted_rendered", double(c.predicted_rendered)},
+          {"predicted_used", double(c.predicted_used)},
+          {"predicted_discarded", double(c.predicted_discarded)},
+          {"cache_hits", double(c.cache_hits)}};
+}
+
+void registerTerrainModes() {
+  registerMode("high", "terrain: high-resolution quadtree LOD (--mode-option terrain=DEM)",
+               [](const ModeContext&) { return std::make_unique<LodMode>("high", true); });
+  registerMode("low", "terrain: low-resolution quadtree LOD (--mode-option terrain=DEM)",
+               [](const ModeContext&) { return std::make_unique<LodMode>("low", false); });
+  registerMode("lod-sprite", "terrain: LOD-sprite, Chen et al. 1999 (--mode-option terrain=DEM, epsilon=PX)",
+               [](const ModeContext&) { return std::make_unique<SpriteMode>("lod-sprite", SpriteVariant::Paper); });
+  registerMode("lod-sprite-predict", "terrain: LOD-sprite with keyframes rendered ahead (section 5)",
+               [](const ModeContext&) {
+                 return std::make_unique<SpriteMode>("lod-sprite-predict", SpriteVariant::Predict);
+               });
+  registerMode("lod-sprite-cache", "terrain: LOD-sprite with a cache of 8 keyframes (section 5)",
+               [](const ModeContext&) {
+                 return std::make_unique<SpriteMode>("lod-sprite-cache", SpriteVariant::Cache);
+               });
+}
+
+}  // namespace farfield::eval

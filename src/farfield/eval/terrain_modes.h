@@ -1,0 +1,110 @@
+// The terrain benchmark modes of Chen et al. 1999 (LOD-sprite terrain): "high" and "low" (the quadtree LOD mesh at
+// two pixel thresholds, original texture), "lod-sprite" (the paper, section 3), "lod-sprite-predict" and
+// "lod-sprite-cache" (section 5's future work: keyframes rendered ahead; a cache of 8 keyframes).
+//
+// The modes of one run share one TerrainRun: the terrain, its GPU buffers, the thresholds and the per-frame logs of
+// the sprite modes. `farfield terrain bench` (terrain_bench.h) sets it with ScopedTerrainRun; under `farfield bench`
+// the first terrain mode loads it from the mode options: terrain=DEM (required), high_error=, low_error=, epsilon=
+// (pixels, positive).
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "farfield/core/math.h"
+#include "farfield/eval/mode.h"
+#include "farfield/gpu/terrain_renderer.h"
+#include "farfield/terrain/lod_sprite.h"
+#include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_data.h"
+
+namespace farfield::eval {
+
+// One frame of a sprite mode: its path frame and what the LOD-sprite renderer decided and drew.
+struct SpriteLog {
+  size_t path_frame = 0;
+  terrain::LodSpriteFrameInfo info;
+};
+
+// What the terrain modes of one run share.
+struct TerrainRun {
+  std::unique_ptr<terrain::TerrainData> data;
+  std::unique_ptr<gpu::TerrainRenderer> renderer;  // made by the first gpuRenderer() (needs a current context)
+  float high_error = 1.0f;  // LOD thresholds, pixels
+  float low_error = 4.0f;
+  double epsilon = 1.0;     // LOD-sprite error threshold, pixels
+  Vec4 sky{0.62f, 0.74f, 0.88f, 1.0f};
+  std::map<std::string, std::vector<SpriteLog>> logs;  // sprite mode name -> frames of its last pass
+
+  gpu::TerrainRenderer& gpuRenderer();
+};
+
+// The run the terrain modes use; null when none is set (the first terrain mode then loads one from its options).
+std::shared_ptr<TerrainRun>& currentTerrainRun();
+
+// Sets the current run for its lifetime and clears it afterwards (also when an exception leaves the scope).
+class ScopedTerrainRun {
+ public:
+  explicit ScopedTerrainRun(std::shared_ptr<TerrainRun> run) { currentTerrainRun() = std::move(run); }
+  ~ScopedTerrainRun() { currentTerrainRun().reset(); }
+  ScopedTerrainRun(const ScopedTerrainRun&) = delete;
+  ScopedTerrainRun& operator=(const ScopedTerrainRun&) = delete;
+};
+
+// `high` and `low`: the LOD mesh with the original texture.
+class LodMode : public Mode {
+ public:
+  LodMode(std::string name, bool high) : name_(std::move(name)), high_(high) {}
+  std::string name() const override { return name_; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::map<std::string, double> info() const override;
+
+ private:
+  std::string name_;
+  bool high_;
+  std::shared_ptr<TerrainRun> run_;
+  terrain::LodMesh mesh_;
+};
+
+enum class SpriteVariant { Paper, Predict, Cache };
+
+// The LOD-sprite options of a variant with the run's thresholds (epsilon, pixels, > 0); the one place the
+// variants are defined, shared by the modes and the terrain bench's quality pass.
+terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon);
+// "lod-sprite" -> Paper, "lod-sprite-predict" -> Predict, "lod-sprite-cache" -> Cache; false for other names.
+bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant);
+
+// `lod-sprite` and its section 5 variants. Each pass over the path (the harness's warm-up frame is one) starts
+// from scratch, so the measured pass renders its own first keyframe. epsilon 0 = the run's.
+class SpriteMode : public Mode {
+ public:
+  SpriteMode(std::string name, SpriteVariant variant, double epsilon = 0.0)
+      : name_(std::move(name)), variant_(variant), epsilon_(epsilon) {}
+  std::string name() const override { return name_; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  // epsilon_px, frames, keyframes (fresh), keyframe_fraction, high_resolution_renders, predicted_rendered,
+  // predicted_used, predicted_discarded, cache_hits (of the last pass).
+  std::map<std::string, double> info() const override;
+  terrain::LodSpriteRenderer& sprite() { return *sprite_; }
+
+ private:
+  std::string name_;
+  SpriteVariant variant_;
+  double epsilon_;
+  std::shared_ptr<TerrainRun> run_;
+  std::unique_ptr<terrain::LodSpriteRenderer> sprite_;
+  bool started_ = false;
+  size_t last_frame_ = 0;
+};
+
+// Adds high, low, lod-sprite, lod-sprite-predict and lod-sprite-cache to the mode registry (mode.h). Idempotent.
+// Called by runTerrainBench and by the executable at start-up (the eval library is static: a static registration
+// object in it would be dropped by the linker).
+void registerTerrainModes();
+
+}  // namespace farfield::eval
