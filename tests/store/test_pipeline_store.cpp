@@ -5,7 +5,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
+#include <tuple>
 
 #include "farfield/core/error.h"
 #include "farfield/image/png_io.h"
@@ -44,6 +46,20 @@ StoredView oddView(uint32_t half_edge, size_t layer, size_t view, double seed, b
   v.data_pixels = with_data ? 4321 + size_t(seed) : 0;
   v.render_ms = 1.0 / 3.0 + seed;
   v.build_ms = 2.0 / 7.0 + seed;
+  // File checks with every byte of the CRC in use (no file behind them: the index round trip only).
+  const auto check = [&](uint32_t salt) {
+    FileCheck c;
+    c.crc32 = 0xfedcba98u - salt - uint32_t(seed * 1000.0);
+    c.bytes = 123456789012ull + salt;
+    c.known = true;
+    return c;
+  };
+  v.mesh_check = check(1);
+  if (with_data) {
+    v.texture_check = check(2);
+    v.ids = stem + ".ids.png";
+    v.ids_check = check(3);
+  }
   return v;
 }
 
@@ -100,6 +116,8 @@ CellEntry fullCell(uint32_t half_edge) {
   p.single.views = {oddView(half_edge, 0, 0, 9.0)};
   p.single.views[0].mesh = layerFileStem(half_edge, "smi", 0, 0) + ".ffmesh";
   p.single.views[0].texture = layerFileStem(half_edge, "smi", 0, 0) + ".png";
+  p.single.views[0].ids = "";  // a view without per-texel ids
+  p.single.views[0].ids_check = {};
   e.pipeline = p;
   return e;
 }
@@ -120,6 +138,11 @@ CellEntry onlineCell(uint32_t half_edge) {
 
 StoreIndex pipelineIndex() {
   StoreIndex index;
+  index.generation = 4000000007ull;  // more digits than the names' six
+  index.streets = streetsFileName(index.generation);
+  index.streets_check.crc32 = 0x89abcdefu;
+  index.streets_check.bytes = 31337;
+  index.streets_check.known = true;
   index.techniques = {};  // a pipeline store has no Sillion techniques
   index.scene = "city.glb";
   index.scene_objects = kSceneObjects;
@@ -137,6 +160,12 @@ StoreIndex pipelineIndex() {
   pvs_only.pipeline->far.clear();
   index.cells.push_back(pvs_only);
   return index;
+}
+
+void expectSameCheck(const FileCheck& a, const FileCheck& b, const std::string& where) {
+  EXPECT_EQ(a.known, b.known) << where;
+  EXPECT_EQ(a.crc32, b.crc32) << where;
+  EXPECT_EQ(a.bytes, b.bytes) << where;
 }
 
 void expectSameCamera(const Camera& a, const Camera& b, const std::string& where) {
@@ -159,6 +188,10 @@ void expectSameLayer(const StoredLayer& a, const StoredLayer& b, const std::stri
     expectSameCamera(x.camera, y.camera, at);
     EXPECT_EQ(x.texture, y.texture) << at;
     EXPECT_EQ(x.mesh, y.mesh) << at;
+    EXPECT_EQ(x.ids, y.ids) << at;
+    expectSameCheck(x.texture_check, y.texture_check, at + " texture");
+    expectSameCheck(x.mesh_check, y.mesh_check, at + " mesh");
+    expectSameCheck(x.ids_check, y.ids_check, at + " ids");
     EXPECT_EQ(x.triangles, y.triangles) << at;
     EXPECT_EQ(x.vertices, y.vertices) << at;
     EXPECT_EQ(x.data_pixels, y.data_pixels) << at;
@@ -183,8 +216,10 @@ void expectSameLayer(const StoredLayer& a, const StoredLayer& b, const std::stri
 
 void expectSameIndex(const StoreIndex& a, const StoreIndex& b) {
   EXPECT_EQ(a.version, b.version);
+  EXPECT_EQ(a.generation, b.generation);
   EXPECT_EQ(a.techniques, b.techniques);
   EXPECT_EQ(a.streets, b.streets);
+  expectSameCheck(a.streets_check, b.streets_check, "streets");
   EXPECT_EQ(a.scene, b.scene);
   EXPECT_EQ(a.scene_objects, b.scene_objects);
   EXPECT_EQ(a.local_model, b.local_model);
@@ -233,11 +268,17 @@ TEST(PipelineStoreTest, IndexRoundTripKeepsEveryField) {
   expectSameIndex(indexFromJson(indexToJson(index), "memory"), index);
   const std::string text = indexToJson(index).dump(1);
   expectSameIndex(indexFromJson(nlohmann::json::parse(text), "text"), index);
-  // And through the files.
+  // And through the files (readIndex checks the streets file: it must be there).
   const std::string dir = test::scratchDir("pipeline_store_round_trip").string();
-  writeIndex(dir, index);
+  StoreIndex with_streets = index;
+  writeStreets(dir, with_streets, "{\"junctions\": [], \"streets\": []}\n");
+  EXPECT_EQ(with_streets.streets, "g4000000007.streets.json");
+  writeIndex(dir, with_streets);
   const StoreIndex read = readIndex(dir);
-  expectSameIndex(read, index);
+  expectSameIndex(read, with_streets);
+  // The record names (not stored) are set from where each view is.
+  EXPECT_EQ(read.cells[0].pipeline->layers[1].views[2].record, "cell 4: mmi layer 1 view 2");
+  EXPECT_EQ(read.cells[1].pipeline->single.views[0].record, "cell 9: single mesh view 0");
   EXPECT_EQ(read.version, kIndexVersion);
   EXPECT_EQ(kIndexVersion, 3);
 
@@ -395,6 +436,55 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
     j["version"] = 3;
     expectIndexError(j, {"layers[0]", "validity"});
   }
+  // File checks and the generation: version 3 requires them, naming what is missing; version 2 reads without them.
+  {
+    using Node = std::function<nlohmann::json&(nlohmann::json&)>;
+    const std::vector<std::tuple<Node, std::string, std::vector<std::string>>> needed{
+        {[](nlohmann::json& j) -> nlohmann::json& { return j; }, "streets_crc32", {"top level"}},
+        {[](nlohmann::json& j) -> nlohmann::json& { return j; }, "streets_bytes", {"top level"}},
+        {[](nlohmann::json& j) -> nlohmann::json& { return j; }, "generation", {"top level"}},
+        {[&](nlohmann::json& j) -> nlohmann::json& { return cell0(j)["mmi"]["layers"][0]["views"][0]; },
+         "mesh_crc32", {"cells[0]", "layers[0]", "views[0]"}},
+        {[&](nlohmann::json& j) -> nlohmann::json& { return cell0(j)["mmi"]["layers"][1]["views"][2]; },
+         "texture_bytes", {"cells[0]", "layers[1]", "views[2]"}},
+        {[&](nlohmann::json& j) -> nlohmann::json& { return cell0(j)["mmi"]["layers"][1]["views"][5]; },
+         "ids_crc32", {"cells[0]", "layers[1]", "views[5]"}},
+        {[&](nlohmann::json& j) -> nlohmann::json& { return cell0(j)["mmi"]["single"]["views"][0]; },
+         "texture_crc32", {"cells[0]", "single", "views[0]"}},
+    };
+    for (const auto& [node, key, element] : needed) {
+      SCOPED_TRACE(key);
+      nlohmann::json j = good;
+      ASSERT_TRUE(node(j).contains(key));
+      node(j).erase(key);
+      std::vector<std::string> parts = element;
+      parts.push_back("missing \"" + key + "\"");
+      expectIndexError(j, parts);
+      // Version 2 needs no checks (but a check it has must be whole).
+      j["version"] = 2;
+      const std::string file_key = key.substr(0, key.rfind('_'));
+      if (key != "generation") {
+        ASSERT_TRUE(node(j).contains(file_key + "_crc32") || node(j).contains(file_key + "_bytes"));
+        expectIndexError(j, {"missing \"" + key + "\""});
+        node(j).erase(file_key + "_crc32");
+        node(j).erase(file_key + "_bytes");
+      }
+      EXPECT_NO_THROW(indexFromJson(j, "v2"));
+    }
+    // A check that is not a CRC-32 or a size.
+    nlohmann::json j = good;
+    cell0(j)["mmi"]["layers"][0]["views"][0]["mesh_crc32"] = uint64_t(1) << 32;
+    expectIndexError(j, {"views[0]", "mesh_crc32", "CRC-32"});
+    cell0(j)["mmi"]["layers"][0]["views"][0]["mesh_crc32"] = -1;
+    expectIndexError(j, {"views[0]", "mesh_crc32"});
+    j = good;
+    cell0(j)["mmi"]["layers"][0]["views"][0]["mesh_bytes"] = "12";
+    expectIndexError(j, {"views[0]", "mesh_bytes"});
+    // An empty view names no file and needs no check.
+    j = good;
+    ASSERT_FALSE(cell0(j)["mmi"]["layers"][1]["views"][3].contains("texture_crc32"));
+    EXPECT_NO_THROW(indexFromJson(j, "good"));
+  }
   // Validity regions.
   {
     nlohmann::json j = good;
@@ -492,6 +582,9 @@ TEST(PipelineStoreTest, LayerViewsRoundTripAndDamageIsDetected) {
       EXPECT_NE(msg.find(what), std::string::npos) << msg;
     }
   };
+  // The files carry their checks, and loading names the record.
+  EXPECT_TRUE(stored.mesh_check.known && stored.texture_check.known && stored.ids_check.known);
+  EXPECT_EQ(stored.mesh_check.bytes, fs::file_size(fs::path(dir) / stored.mesh));
   // Counts in the index that disagree with the file.
   StoredView wrong = stored;
   wrong.triangles = 5;
@@ -502,20 +595,28 @@ TEST(PipelineStoreTest, LayerViewsRoundTripAndDamageIsDetected) {
   // An empty view in the index whose mesh has data.
   wrong = empty_stored;
   wrong.mesh = stored.mesh;
+  wrong.mesh_check = stored.mesh_check;
   expect_error([&] { loadLayerView(dir, wrong); }, mesh_file, "the index says 0");
-  // The mesh of another view with different counts put in its place.
+  // The mesh of another view with different counts put in its place: its size differs from the index's; with an
+  // index whose checks match it (written for it), the counts still disagree.
   {
     impostor::DepthMeshImpostor other = view;
     other.mesh.indices.resize(6);
     other.triangle_ids.resize(2);
-    writeMesh(mesh_file, other);
-    expect_error([&] { loadLayerView(dir, stored); }, mesh_file, "holds 2 triangles");
+    wrong = stored;
+    wrong.record = "cell 7: mmi layer 2 view 5";
+    wrong.mesh_check = writeMesh(mesh_file, other);
+    expect_error([&] { loadLayerView(dir, stored); }, mesh_file, "truncated: ");
+    expect_error([&] { loadLayerView(dir, wrong); }, mesh_file, "cell 7: mmi layer 2 view 5 mesh: holds 2 triangles");
     writeMesh(mesh_file, view);
     EXPECT_NO_THROW(loadLayerView(dir, stored));
   }
   // A texture of the wrong size (a readable PNG) and a missing one.
   image::writePng(texture_file, image::ColorImage(24, 23));
-  expect_error([&] { loadLayerView(dir, stored); }, texture_file, "24x23");
+  expect_error([&] { loadLayerView(dir, stored); }, texture_file, "layer view texture: ");
+  wrong = stored;
+  wrong.texture_check = {};  // as in a version 2 index
+  expect_error([&] { loadLayerView(dir, wrong); }, texture_file, "24x23");
   fs::remove(texture_file);
   expect_error([&] { loadLayerView(dir, stored); }, texture_file, "");
   // A missing mesh.

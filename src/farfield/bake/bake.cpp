@@ -138,7 +138,11 @@ BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urb
     std::filesystem::create_directories(out_dir, ec);
     if (ec) throw Error(out_dir, "cannot create the store directory: " + ec.message());
   }
-  cells.graph().save((std::filesystem::path(out_dir) / store::kStreetsFile).string());
+  // A new generation of files next to those of the store being replaced (which stays readable until the new index
+  // is in place: store/impostor_store.h).
+  index.generation = store::nextGeneration(out_dir);
+  const uint64_t generation = index.generation;
+  store::writeStreets(out_dir, index, cells.graph().toJson().dump() + "\n");
 
   const size_t workers = workerCount(options.workers);
   report.workers = workers;
@@ -187,7 +191,7 @@ BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urb
     Stopwatch t;
     std::map<std::string, const impostor::DepthMeshImpostor*> pointers;
     for (const auto& [technique, imp] : built) pointers[technique] = &imp;
-    store::writeCell(out_dir, job.entry, pointers);
+    store::writeCell(out_dir, job.entry, pointers, generation);
     for (auto& [technique, stored] : job.entry.impostors) stored.build_ms = job.record.build_ms[technique];
     job.record.write_ms = t.milliseconds();
     std::lock_guard<std::mutex> lock(results_mutex);

@@ -734,7 +734,12 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
     fs::create_directories(fs::path(out_dir) / "cells", ec);
     if (ec) throw Error(out_dir, "cannot create the store directory: " + ec.message());
   }
-  cells.graph().save((fs::path(out_dir) / store::kStreetsFile).string());
+  // A new generation of files next to those of the store being replaced (which stays readable until the new index
+  // is in place: store/impostor_store.h).
+  store::StoreIndex index;
+  index.generation = store::nextGeneration(out_dir);
+  const uint64_t generation = index.generation;
+  store::writeStreets(out_dir, index, cells.graph().toJson().dump() + "\n");
 
   const std::vector<std::string> baked = spec.baked();
   const bool bake_mmi = contains(baked, kStageMmi);
@@ -772,10 +777,13 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
       const auto write = [&](store::StoredView& record, const impostor::DepthMeshImpostor& view, const char* kind,
                              size_t layer, size_t index) {
         const store::StoredView written =
-            store::writeLayerView(out_dir, store::layerFileStem(w.cell, kind, layer, index), view);
+            store::writeLayerView(out_dir, store::layerFileStem(w.cell, kind, layer, index, generation), view);
         record.texture = written.texture;
+        record.texture_check = written.texture_check;
         record.mesh = written.mesh;
+        record.mesh_check = written.mesh_check;
         record.ids = written.ids;
+        record.ids_check = written.ids_check;
         record.build_ms = build_share;
       };
       for (size_t l = 0; l < w.layer_views.size(); ++l)
@@ -812,7 +820,6 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
   std::sort(records.begin(), records.end(),
             [](const PipelineCellReport& a, const PipelineCellReport& b) { return a.half_edge < b.half_edge; });
 
-  store::StoreIndex index;
   index.scene = options.base.scene_label;
   index.scene_objects = scene.objects.size();
   index.local_model = urban::localModelName(cells.options().local);

@@ -3,16 +3,29 @@
 // Why a raw binary mesh instead of glTF: the runtime loads an impostor inside a frame when the viewer enters a new
 // cell, so the load must be a few reads and a validation pass, and the format must be trivial to check for
 // truncation (the size is fixed by the counts in the header). glTF export of impostors is a later issue's.
+//
+// Why generations instead of writing over the old files: a bake killed half-way must leave the store it replaces
+// readable, and a reader must never see an index whose files belong to another bake. New data files get names the
+// old index does not use, the index is renamed over the old one last (the one atomic step), and only then are the old
+// files removed. Why CRC-32 per file and not per store: the runtime loads one view at a time inside a frame, so each
+// file must be checkable alone, before it is parsed.
 #include "farfield/store/impostor_store.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <functional>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "farfield/core/error.h"
 #include "farfield/image/png_io.h"
@@ -30,6 +43,115 @@ constexpr size_t kMeshHeaderBytes = 24;
 
 std::string joinPath(const std::string& dir, const std::string& relative) {
   return (fs::path(dir) / relative).string();
+}
+
+// ---- Integrity: checks, atomic writes -------------------------------------------------------------------------
+
+std::function<void(const char*, const std::string&)>& fileHook() {
+  static std::function<void(const char*, const std::string&)> hook;
+  return hook;
+}
+
+void fileOperation(const char* operation, const std::string& path) {
+  if (fileHook()) fileHook()(operation, path);
+}
+
+[[noreturn]] void systemError(const std::string& path, const std::string& what, int error) {
+  throw Error(path, what + ": " + std::strerror(error));
+}
+
+std::string parentDirectory(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  return parent.empty() ? "." : parent.string();
+}
+
+void syncFile(const std::string& path, bool directory) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | (directory ? O_DIRECTORY : 0));
+  if (fd < 0) systemError(path, "cannot open to sync", errno);
+  if (::fsync(fd) != 0) {
+    const int error = errno;
+    ::close(fd);
+    systemError(path, "fsync failed", error);
+  }
+  ::close(fd);
+}
+
+void syncDirectory(const std::string& dir) {
+  fileOperation("sync-dir", dir);
+  syncFile(dir, true);
+}
+
+std::string tempName(const std::string& path) { return path + ".tmp"; }
+
+// fsync a finished temporary file and rename it over its target.
+void commitTemp(const std::string& tmp, const std::string& path, bool sync_directory) {
+  fileOperation("fsync", tmp);
+  syncFile(tmp, false);
+  fileOperation("rename", path);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) systemError(path, "cannot rename " + tmp + " over it", errno);
+  if (sync_directory) syncDirectory(parentDirectory(path));
+}
+
+std::string readWholeFile(const std::string& path, const std::string& record) {
+  const std::string prefix = record.empty() ? "" : record + ": ";
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) systemError(path, prefix + "cannot open", errno);
+  std::string bytes;
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && st.st_size > 0) bytes.reserve(size_t(st.st_size));
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof(buffer));
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int error = errno;
+      ::close(fd);
+      systemError(path, prefix + "read failed", error);
+    }
+    bytes.append(buffer, size_t(n));
+  }
+  ::close(fd);
+  return bytes;
+}
+
+std::string hex32(uint32_t v) {
+  char buf[16];
+  std::snprintf(buf, sizeof(buf), "%08x", v);
+  return buf;
+}
+
+std::string generationPrefix(uint64_t generation) {
+  if (generation == 0) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "g%06llu.", static_cast<unsigned long long>(generation));
+  return buf;
+}
+
+// The generation in a store file name "gG.<rest>" (0 when the name has none).
+uint64_t generationOf(const std::string& name) {
+  if (name.size() < 3 || name[0] != 'g') return 0;
+  size_t k = 1;
+  uint64_t g = 0;
+  while (k < name.size() && name[k] >= '0' && name[k] <= '9' && k < 19) g = g * 10 + uint64_t(name[k++] - '0');
+  return k >= 7 && k < name.size() && name[k] == '.' ? g : 0;
+}
+
+// Names the store writes: cells/eNNNNNN.* (versions 1, 2), cells/gG.*, streets.json, gG.streets.json, index.json.tmp
+// and the temporaries of all of them. `relative` is relative to the store directory.
+bool isStoreFileName(const std::string& relative) {
+  std::string name = relative;
+  if (name.size() > 4 && name.compare(name.size() - 4, 4, ".tmp") == 0) name.resize(name.size() - 4);
+  if (name.rfind("cells/", 0) == 0) {
+    const std::string file = name.substr(6);
+    if (file.find('/') != std::string::npos) return false;
+    if (generationOf(file) > 0) return true;
+    return file.size() > 8 && file[0] == 'e' && file[7] == '.' &&
+           std::all_of(file.begin() + 1, file.begin() + 7, [](char c) { return c >= '0' && c <= '9'; });
+  }
+  if (name == kStreetsFile || name == kIndexFile) return true;
+  const uint64_t g = generationOf(name);
+  return g > 0 && name == streetsFileName(g);
 }
 
 nlohmann::json vec3Json(const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
@@ -120,15 +242,42 @@ class JsonReader {
   std::string source_;
 };
 
-nlohmann::json viewJson(const StoredView& v) {
-  return {{"camera", cameraJson(v.camera)}, {"texture", v.texture},         {"mesh", v.mesh}, {"ids", v.ids},
-          {"triangles", v.triangles},       {"vertices", v.vertices},       {"data_pixels", v.data_pixels},
-          {"render_ms", v.render_ms},       {"build_ms", v.build_ms},       {"station", v.station}};
+// "KEY_crc32" and "KEY_bytes" next to a file name (version 3, non-empty names with a known check).
+void putCheck(nlohmann::json& j, const std::string& key, const std::string& file, const FileCheck& check,
+              bool with_checks) {
+  if (!with_checks || file.empty() || !check.known) return;
+  j[key + "_crc32"] = check.crc32;
+  j[key + "_bytes"] = check.bytes;
 }
 
-nlohmann::json layerJson(const StoredLayer& l) {
+// The check of the file named by j[key]: required for non-empty names in version 3 indexes, read whenever present.
+FileCheck readCheck(const JsonReader& r, const nlohmann::json& j, const std::string& key, const std::string& where,
+                    const std::string& file, bool required) {
+  FileCheck check;
+  const std::string crc_key = key + "_crc32", bytes_key = key + "_bytes";
+  if (file.empty() || (!required && !j.contains(crc_key) && !j.contains(bytes_key))) return check;
+  const uint64_t crc = r.count(j, crc_key.c_str(), where);
+  if (crc > 0xffffffffu) r.fail(where, "\"" + crc_key + "\" must be a CRC-32 (0..4294967295)");
+  check.crc32 = uint32_t(crc);
+  check.bytes = r.count(j, bytes_key.c_str(), where);
+  check.known = true;
+  return check;
+}
+
+nlohmann::json viewJson(const StoredView& v, bool with_checks) {
+  nlohmann::json j = {{"camera", cameraJson(v.camera)}, {"texture", v.texture},   {"mesh", v.mesh},
+                      {"ids", v.ids},                   {"triangles", v.triangles}, {"vertices", v.vertices},
+                      {"data_pixels", v.data_pixels},   {"render_ms", v.render_ms}, {"build_ms", v.build_ms},
+                      {"station", v.station}};
+  putCheck(j, "texture", v.texture, v.texture_check, with_checks);
+  putCheck(j, "mesh", v.mesh, v.mesh_check, with_checks);
+  putCheck(j, "ids", v.ids, v.ids_check, with_checks);
+  return j;
+}
+
+nlohmann::json layerJson(const StoredLayer& l, bool with_checks) {
   nlohmann::json views = nlohmann::json::array();
-  for (const StoredView& v : l.views) views.push_back(viewJson(v));
+  for (const StoredView& v : l.views) views.push_back(viewJson(v, with_checks));
   nlohmann::json j = {{"objects", l.objects}, {"views", std::move(views)}};
   if (!l.validity.empty()) {
     nlohmann::json regions = nlohmann::json::array();
@@ -142,16 +291,16 @@ nlohmann::json layerJson(const StoredLayer& l) {
   return j;
 }
 
-nlohmann::json pipelineJson(const CellPipeline& p) {
+nlohmann::json pipelineJson(const CellPipeline& p, bool with_checks) {
   nlohmann::json j = nlohmann::json::object();
   if (p.has_pvs) j["pvs"] = {{"ids", p.pvs}, {"samples", p.pvs_samples}, {"ms", p.pvs_ms}};
   if (p.has_split) j["split"] = {{"near", p.near}, {"far", p.far}};
   if (p.has_mmi) {
     nlohmann::json layers = nlohmann::json::array();
-    for (const StoredLayer& l : p.layers) layers.push_back(layerJson(l));
+    for (const StoredLayer& l : p.layers) layers.push_back(layerJson(l, with_checks));
     j["mmi"] = {{"threshold_rad", p.threshold_rad}, {"event_edges", p.event_edges},
                 {"max_weight_rad", p.max_weight_rad}, {"weights_ms", p.weights_ms},
-                {"layers", std::move(layers)},       {"single", layerJson(p.single)}};
+                {"layers", std::move(layers)},       {"single", layerJson(p.single, with_checks)}};
   }
   return j;
 }
@@ -205,7 +354,7 @@ impostor::ValidityRegion readValidity(const JsonReader& r, const nlohmann::json&
 }
 
 StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::string& where, size_t scene_objects,
-                      bool require_validity) {
+                      bool require_validity, bool require_checks, const std::string& record) {
   StoredLayer layer;
   layer.objects = readIds(r, j, "objects", where, scene_objects);
   const nlohmann::json& views = r.member(j, "views", where);
@@ -217,6 +366,10 @@ StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::s
     view.texture = r.relativeFile(views[v], "texture", at, true);
     view.mesh = r.relativeFile(views[v], "mesh", at, false);
     if (views[v].contains("ids")) view.ids = r.relativeFile(views[v], "ids", at, true);
+    view.texture_check = readCheck(r, views[v], "texture", at, view.texture, require_checks);
+    view.mesh_check = readCheck(r, views[v], "mesh", at, view.mesh, require_checks);
+    view.ids_check = readCheck(r, views[v], "ids", at, view.ids, require_checks);
+    view.record = record + " view " + std::to_string(v);
     view.triangles = size_t(r.count(views[v], "triangles", at));
     view.vertices = size_t(r.count(views[v], "vertices", at));
     view.data_pixels = size_t(r.count(views[v], "data_pixels", at));
@@ -243,7 +396,8 @@ StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::s
 }
 
 CellPipeline readPipeline(const JsonReader& r, const nlohmann::json& j, const std::string& where,
-                          size_t scene_objects, bool require_validity) {
+                          size_t scene_objects, bool require_validity, bool require_checks, uint32_t half_edge) {
+  const std::string cell = "cell " + std::to_string(half_edge) + ": ";
   if (!j.is_object()) r.fail(where, "expected an object");
   CellPipeline p;
   if (j.contains("pvs")) {
@@ -270,9 +424,10 @@ CellPipeline readPipeline(const JsonReader& r, const nlohmann::json& j, const st
     const nlohmann::json& layers = r.member(m, "layers", at);
     if (!layers.is_array()) r.fail(at, "\"layers\" must be an array");
     for (size_t l = 0; l < layers.size(); ++l)
-      p.layers.push_back(
-          readLayer(r, layers[l], at + ".layers[" + std::to_string(l) + "]", scene_objects, require_validity));
-    p.single = readLayer(r, r.member(m, "single", at), at + ".single", scene_objects, require_validity);
+      p.layers.push_back(readLayer(r, layers[l], at + ".layers[" + std::to_string(l) + "]", scene_objects,
+                                   require_validity, require_checks, cell + "mmi layer " + std::to_string(l)));
+    p.single = readLayer(r, r.member(m, "single", at), at + ".single", scene_objects, require_validity,
+                         require_checks, cell + "single mesh");
   }
   return p;
 }
@@ -291,10 +446,13 @@ bool StoreIndex::hasTechnique(const std::string& technique) const {
 
 nlohmann::json indexToJson(const StoreIndex& index) {
   nlohmann::json j;
+  const bool with_checks = index.version >= 3;
   j["format"] = kIndexFormat;
   j["version"] = index.version;
+  if (with_checks) j["generation"] = index.generation;
   j["techniques"] = index.techniques;
   j["streets"] = index.streets;
+  putCheck(j, "streets", index.streets, index.streets_check, with_checks);
   j["scene"] = index.scene;
   j["scene_objects"] = index.scene_objects;
   j["local_model"] = index.local_model;
@@ -315,14 +473,17 @@ nlohmann::json indexToJson(const StoreIndex& index) {
     cell["data_pixels"] = c.data_pixels;
     cell["render_ms"] = c.render_ms;
     cell["texture"] = c.texture;
+    putCheck(cell, "texture", c.texture, c.texture_check, with_checks);
     nlohmann::json imps = nlohmann::json::object();
-    for (const auto& [technique, imp] : c.impostors)
+    for (const auto& [technique, imp] : c.impostors) {
       imps[technique] = {{"mesh", imp.mesh},
                          {"triangles", imp.triangles},
                          {"vertices", imp.vertices},
                          {"build_ms", imp.build_ms}};
+      putCheck(imps[technique], "mesh", imp.mesh, imp.mesh_check, with_checks);
+    }
     cell["impostors"] = std::move(imps);
-    if (c.pipeline) cell["pipeline"] = pipelineJson(*c.pipeline);
+    if (c.pipeline) cell["pipeline"] = pipelineJson(*c.pipeline, with_checks);
     cells.push_back(std::move(cell));
   }
   j["cells"] = std::move(cells);
@@ -340,6 +501,8 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
     r.fail("\"version\"", "unsupported version " + std::to_string(version) + " (this build reads versions 1.." +
                               std::to_string(kIndexVersion) + ")");
   index.version = int(version);
+  const bool require_checks = index.version >= 3;
+  if (require_checks) index.generation = r.count(j, "generation", "top level");
   for (const char* key : {"pipeline", "online"}) {
     if (!j.contains(key)) continue;
     const nlohmann::json& list = j[key];
@@ -362,6 +525,7 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
     index.techniques.push_back(t.get<std::string>());
   }
   index.streets = r.relativeFile(j, "streets", "top level", false);
+  index.streets_check = readCheck(r, j, "streets", "top level", index.streets, require_checks);
   if (j.contains("scene") && j["scene"].is_string()) index.scene = j["scene"].get<std::string>();
   index.scene_objects = size_t(r.count(j, "scene_objects", "top level"));
   index.local_model = r.text(j, "local_model", "top level");
@@ -392,6 +556,7 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
     e.data_pixels = size_t(r.count(c, "data_pixels", where));
     e.render_ms = r.number(c, "render_ms", where);
     e.texture = r.relativeFile(c, "texture", where, true);
+    e.texture_check = readCheck(r, c, "texture", where, e.texture, require_checks);
     const nlohmann::json& imps = r.member(c, "impostors", where);
     if (!imps.is_object()) r.fail(where, "\"impostors\" must be an object (technique -> impostor)");
     for (const std::string& technique : index.techniques) {
@@ -400,51 +565,123 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
       const nlohmann::json& imp = imps[technique];
       StoredImpostor s;
       s.mesh = r.relativeFile(imp, "mesh", at, false);
+      s.mesh_check = readCheck(r, imp, "mesh", at, s.mesh, require_checks);
       s.triangles = size_t(r.count(imp, "triangles", at));
       s.vertices = size_t(r.count(imp, "vertices", at));
       s.build_ms = r.number(imp, "build_ms", at);
       if (s.triangles > 0 && e.texture.empty()) r.fail(at, "has triangles but the cell has no texture");
       e.impostors[technique] = std::move(s);
     }
-    if (c.contains("pipeline")) e.pipeline = readPipeline(r, c["pipeline"], where + ": pipeline", index.scene_objects,
-                                                                index.version >= 3);
+    if (c.contains("pipeline"))
+      e.pipeline = readPipeline(r, c["pipeline"], where + ": pipeline", index.scene_objects, index.version >= 3,
+                                require_checks, e.half_edge);
     index.cells.push_back(std::move(e));
   }
   return index;
 }
 
-void writeIndex(const std::string& dir, const StoreIndex& index) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw Error(dir, "cannot create the store directory: " + ec.message());
-  const std::string file = joinPath(dir, kIndexFile);
-  // Written to a temporary name first so that an interrupted bake never leaves a half-written index.
-  const std::string tmp = file + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw Error(tmp, "cannot open for writing");
-    out << indexToJson(index).dump(1) << "\n";
-    if (!out) throw Error(tmp, "write failed");
+namespace {
+
+// Every file a version 3 index names must come with its check (a file written outside the store's writers has none).
+void requireChecks(const StoreIndex& index, const std::string& file) {
+  const auto need = [&](const std::string& name, const FileCheck& check, const std::string& record) {
+    if (!name.empty() && !check.known)
+      throw Error(file, record + ": no size and CRC-32 for " + name +
+                            " (a version 3 index needs them: write the file with the store's writers)");
+  };
+  need(index.streets, index.streets_check, "streets");
+  for (const CellEntry& c : index.cells) {
+    const std::string cell = "cell " + std::to_string(c.half_edge);
+    need(c.texture, c.texture_check, cell + " texture");
+    for (const auto& [technique, imp] : c.impostors) need(imp.mesh, imp.mesh_check, cell + " " + technique + " mesh");
+    if (!c.pipeline) continue;
+    const auto layer = [&](const StoredLayer& l, const std::string& what) {
+      for (size_t v = 0; v < l.views.size(); ++v) {
+        const std::string at = cell + ": " + what + " view " + std::to_string(v);
+        need(l.views[v].texture, l.views[v].texture_check, at + " texture");
+        need(l.views[v].mesh, l.views[v].mesh_check, at + " mesh");
+        need(l.views[v].ids, l.views[v].ids_check, at + " ids");
+      }
+    };
+    for (size_t l = 0; l < c.pipeline->layers.size(); ++l)
+      layer(c.pipeline->layers[l], "mmi layer " + std::to_string(l));
+    layer(c.pipeline->single, "single mesh");
   }
-  fs::rename(tmp, file, ec);
-  if (ec) throw Error(file, "cannot replace the index: " + ec.message());
 }
 
-StoreIndex readIndex(const std::string& dir) {
-  const std::string file = joinPath(dir, kIndexFile);
-  if (!fs::is_directory(dir)) throw Error(dir, "impostor store directory not found");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(file, "cannot open (is this an impostor store written by farfield bake?)");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file, std::string("not valid JSON: ") + e.what());
+// The files an index names (and the index itself), relative to the store directory.
+std::set<std::string> referencedFiles(const StoreIndex& index) {
+  std::set<std::string> out{kIndexFile};
+  const auto add = [&](const std::string& name) {
+    if (!name.empty()) out.insert(fs::path(name).lexically_normal().generic_string());
+  };
+  add(index.streets);
+  for (const CellEntry& c : index.cells) {
+    add(c.texture);
+    for (const auto& [technique, imp] : c.impostors) add(imp.mesh);
+    if (!c.pipeline) continue;
+    std::vector<const StoredLayer*> layers{&c.pipeline->single};
+    for (const StoredLayer& l : c.pipeline->layers) layers.push_back(&l);
+    for (const StoredLayer* l : layers)
+      for (const StoredView& v : l->views) {
+        add(v.texture);
+        add(v.mesh);
+        add(v.ids);
+      }
   }
-  return indexFromJson(j, file);
+  return out;
 }
 
-void writeMesh(const std::string& file, const impostor::DepthMeshImpostor& impostor) {
+// After the new index is in place: the files with store names it does not name (older generations, temporaries of
+// a killed bake) go. In name order, so that the sequence of file operations is reproducible.
+void removeStaleFiles(const std::string& dir, const StoreIndex& index) {
+  const std::set<std::string> keep = referencedFiles(index);
+  const auto sweep = [&](const fs::path& folder, const std::string& prefix) {
+    std::error_code ec;
+    fs::directory_iterator it(folder, ec);
+    if (ec) return;
+    std::vector<fs::path> stale;
+    for (const fs::directory_entry& f : it) {
+      std::error_code type_ec;
+      if (!f.is_regular_file(type_ec)) continue;
+      const std::string relative = prefix + f.path().filename().string();
+      if (!keep.count(relative) && isStoreFileName(relative)) stale.push_back(f.path());
+    }
+    std::sort(stale.begin(), stale.end());
+    for (const fs::path& p : stale) {
+      fileOperation("remove", p.string());
+      std::error_code remove_ec;
+      if (!fs::remove(p, remove_ec) && remove_ec)
+        throw Error(p.string(), "cannot remove a file the new index does not name: " + remove_ec.message());
+    }
+  };
+  sweep(fs::path(dir) / "cells", "cells/");
+  sweep(fs::path(dir), "");
+}
+
+// A version 3 index (or any carrying "checksum"): the checksum matches its content and the file is exactly the
+// writer's text, so a damaged byte anywhere, whitespace included, is reported.
+void checkIndexText(const nlohmann::json& j, const std::string& text, const std::string& file) {
+  if (!j.is_object()) return;  // indexFromJson names it
+  const auto version = j.find("version");
+  const bool required = version != j.end() && version->is_number_integer() && version->get<int64_t>() == 3;
+  const auto checksum = j.find("checksum");
+  if (checksum == j.end()) {
+    if (required)
+      throw Error(file, "top level: missing \"checksum\" (a version 3 index carries the CRC-32 of its content)");
+    return;
+  }
+  if (!checksum->is_number_unsigned() || checksum->get<uint64_t>() > 0xffffffffu)
+    throw Error(file, "top level: \"checksum\" must be a CRC-32 (0..4294967295)");
+  const uint32_t stored = checksum->get<uint32_t>(), actual = indexChecksum(j);
+  if (stored != actual)
+    throw Error(file, "checksum mismatch: the index's content has CRC-32 " + hex32(actual) + ", \"checksum\" says " +
+                          hex32(stored) + " (the index is damaged)");
+  if (text != j.dump(1) + "\n")
+    throw Error(file, "not the text the store writer wrote for its content (truncated, edited or damaged)");
+}
+
+std::string meshBytes(const impostor::DepthMeshImpostor& impostor, const std::string& file) {
   const scene::Mesh& m = impostor.mesh;
   const uint32_t v = uint32_t(m.positions.size()), i = uint32_t(m.indices.size());
   const uint32_t t = uint32_t(impostor.triangle_ids.size());
@@ -453,51 +690,48 @@ void writeMesh(const std::string& file, const impostor::DepthMeshImpostor& impos
   if (i % 3 != 0) throw Error(file, "index count is not a multiple of 3");
   if (t != 0 && t != i / 3) throw Error(file, "triangle id count must be 0 or one per triangle");
   if (!m.uvs.empty() && m.uvs.size() != m.positions.size()) throw Error(file, "uv count differs from vertex count");
-  std::ofstream out(file, std::ios::binary);
-  if (!out) throw Error(file, "cannot open for writing");
+  std::string out;
+  out.reserve(kMeshHeaderBytes + 20 * size_t(v) + 4 * size_t(i) + 4 * size_t(t));
+  const auto put = [&](const void* data, size_t bytes) { out.append(static_cast<const char*>(data), bytes); };
   const uint32_t header[4] = {kMeshVersion, v, i, t};
-  out.write(kMeshMagic, sizeof(kMeshMagic));
-  out.write(reinterpret_cast<const char*>(header), sizeof(header));
-  out.write(reinterpret_cast<const char*>(m.positions.data()), std::streamsize(sizeof(Vec3) * v));
-  if (m.uvs.empty()) {
-    const std::vector<Vec2> zeros(v, Vec2(0.0f));
-    out.write(reinterpret_cast<const char*>(zeros.data()), std::streamsize(sizeof(Vec2) * v));
-  } else {
-    out.write(reinterpret_cast<const char*>(m.uvs.data()), std::streamsize(sizeof(Vec2) * v));
-  }
-  out.write(reinterpret_cast<const char*>(m.indices.data()), std::streamsize(sizeof(uint32_t) * i));
-  out.write(reinterpret_cast<const char*>(impostor.triangle_ids.data()), std::streamsize(sizeof(uint32_t) * t));
-  if (!out) throw Error(file, "write failed");
+  put(kMeshMagic, sizeof(kMeshMagic));
+  put(header, sizeof(header));
+  put(m.positions.data(), sizeof(Vec3) * v);
+  if (m.uvs.empty())
+    out.append(sizeof(Vec2) * v, '\0');
+  else
+    put(m.uvs.data(), sizeof(Vec2) * v);
+  put(m.indices.data(), sizeof(uint32_t) * i);
+  put(impostor.triangle_ids.data(), sizeof(uint32_t) * t);
+  return out;
 }
 
-impostor::DepthMeshImpostor readMesh(const std::string& file) {
+impostor::DepthMeshImpostor meshFromBytes(const std::string& bytes, const std::string& file,
+                                          const std::string& record) {
   static_assert(sizeof(Vec3) == 12 && sizeof(Vec2) == 8);
-  std::ifstream in(file, std::ios::binary | std::ios::ate);
-  if (!in) throw Error(file, "cannot open impostor mesh");
-  const std::streamoff size = in.tellg();
-  in.seekg(0);
-  if (size < std::streamoff(kMeshHeaderBytes))
-    throw Error(file, "truncated: " + std::to_string(size) + " bytes, shorter than the 24-byte header");
+  const std::string at = record.empty() ? "" : record + ": ";
+  const uint64_t size = bytes.size();
+  if (size < kMeshHeaderBytes)
+    throw Error(file, at + "truncated: " + std::to_string(size) + " bytes, shorter than the 24-byte header");
   char magic[8];
   uint32_t header[4];
-  in.read(magic, sizeof(magic));
-  in.read(reinterpret_cast<char*>(header), sizeof(header));
-  if (!in) throw Error(file, "cannot read the header");
+  std::memcpy(magic, bytes.data(), sizeof(magic));
+  std::memcpy(header, bytes.data() + sizeof(magic), sizeof(header));
   if (std::memcmp(magic, kMeshMagic, sizeof(magic)) != 0)
-    throw Error(file, "bad magic: not a Farfield impostor mesh (expected \"FFIMESH\")");
+    throw Error(file, at + "bad magic: not a Farfield impostor mesh (expected \"FFIMESH\")");
   if (header[0] != kMeshVersion)
-    throw Error(file, "unsupported mesh version " + std::to_string(header[0]) + " (this build reads version " +
+    throw Error(file, at + "unsupported mesh version " + std::to_string(header[0]) + " (this build reads version " +
                           std::to_string(kMeshVersion) + ")");
   const uint64_t v = header[1], i = header[2], t = header[3];
-  if (i % 3 != 0) throw Error(file, "index count " + std::to_string(i) + " is not a multiple of 3");
+  if (i % 3 != 0) throw Error(file, at + "index count " + std::to_string(i) + " is not a multiple of 3");
   if (t != 0 && t != i / 3)
-    throw Error(file, "triangle id count " + std::to_string(t) + " must be 0 or " + std::to_string(i / 3));
+    throw Error(file, at + "triangle id count " + std::to_string(t) + " must be 0 or " + std::to_string(i / 3));
   const uint64_t expected = kMeshHeaderBytes + 20 * v + 4 * i + 4 * t;
-  if (uint64_t(size) < expected)
-    throw Error(file, "truncated: " + std::to_string(size) + " bytes, the header's counts need " +
+  if (size < expected)
+    throw Error(file, at + "truncated: " + std::to_string(size) + " bytes, the header's counts need " +
                           std::to_string(expected));
-  if (uint64_t(size) > expected)
-    throw Error(file, "trailing data: " + std::to_string(size) + " bytes, the header's counts need " +
+  if (size > expected)
+    throw Error(file, at + "trailing data: " + std::to_string(size) + " bytes, the header's counts need " +
                           std::to_string(expected));
   impostor::DepthMeshImpostor out;
   scene::Mesh& m = out.mesh;
@@ -505,17 +739,21 @@ impostor::DepthMeshImpostor readMesh(const std::string& file) {
   m.uvs.resize(v);
   m.indices.resize(i);
   out.triangle_ids.resize(t);
-  in.read(reinterpret_cast<char*>(m.positions.data()), std::streamsize(12 * v));
-  in.read(reinterpret_cast<char*>(m.uvs.data()), std::streamsize(8 * v));
-  in.read(reinterpret_cast<char*>(m.indices.data()), std::streamsize(4 * i));
-  in.read(reinterpret_cast<char*>(out.triangle_ids.data()), std::streamsize(4 * t));
-  if (!in) throw Error(file, "read failed");
+  const char* p = bytes.data() + kMeshHeaderBytes;
+  const auto take = [&](void* dst, size_t n) {
+    std::memcpy(dst, p, n);
+    p += n;
+  };
+  take(m.positions.data(), 12 * v);
+  take(m.uvs.data(), 8 * v);
+  take(m.indices.data(), 4 * i);
+  take(out.triangle_ids.data(), 4 * t);
   for (uint64_t k = 0; k < v; ++k)
     if (!isFinite(m.positions[k]) || !isFinite(m.uvs[k]))
-      throw Error(file, "vertex " + std::to_string(k) + ": non-finite position or uv");
+      throw Error(file, at + "vertex " + std::to_string(k) + ": non-finite position or uv");
   for (uint64_t k = 0; k < i; ++k)
     if (m.indices[k] >= v)
-      throw Error(file, "index " + std::to_string(k) + " is " + std::to_string(m.indices[k]) +
+      throw Error(file, at + "index " + std::to_string(k) + " is " + std::to_string(m.indices[k]) +
                             ", out of range for " + std::to_string(v) + " vertices");
   m.computeBounds();
   out.stats.triangles = m.triangleCount();
@@ -523,35 +761,206 @@ impostor::DepthMeshImpostor readMesh(const std::string& file) {
   return out;
 }
 
-std::string textureFileName(uint32_t half_edge) {
-  char buf[48];
-  std::snprintf(buf, sizeof(buf), "cells/e%06u.png", half_edge);
-  return buf;
+// PNG through a temporary name (image::writePng writes to a path); the check is taken from the bytes written.
+FileCheck writePngAtomic(const std::string& path, const image::ColorImage& image) {
+  const std::string tmp = tempName(path);
+  fileOperation("create", tmp);
+  image::writePng(tmp, image);
+  const FileCheck check = fileCheck(readWholeFile(tmp, ""));
+  commitTemp(tmp, path, false);
+  return check;
 }
 
-std::string meshFileName(uint32_t half_edge, const std::string& technique) {
-  char buf[48];
-  std::snprintf(buf, sizeof(buf), "cells/e%06u.", half_edge);
-  return buf + technique + ".ffmesh";
+// A PNG named by the index: checked, then decoded; errors name the record too.
+image::ColorImage readCheckedPng(const std::string& path, const FileCheck& check, const std::string& record) {
+  if (check.known) readCheckedFile(path, check, record);
+  try {
+    return image::readPng(path);
+  } catch (const Error& e) {
+    throw Error(record + ": " + e.what());
+  }
 }
 
-void writeCell(const std::string& dir, CellEntry& entry,
-               const std::map<std::string, const impostor::DepthMeshImpostor*>& impostors) {
+void createCellsDirectory(const std::string& dir) {
   std::error_code ec;
   fs::create_directories(fs::path(dir) / "cells", ec);
   if (ec) throw Error(dir, "cannot create the cells directory: " + ec.message());
+}
+
+}  // namespace
+
+uint32_t indexChecksum(const nlohmann::json& index_json) {
+  nlohmann::json content = index_json;
+  if (content.is_object()) content.erase("checksum");
+  return fileCheck(content.dump()).crc32;
+}
+
+std::string indexFileText(nlohmann::json j) {
+  if (j.is_object() && j.contains("version") && j["version"].is_number() && j["version"].get<double>() >= 3.0)
+    j["checksum"] = indexChecksum(j);
+  return j.dump(1) + "\n";
+}
+
+void writeIndex(const std::string& dir, const StoreIndex& index) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw Error(dir, "cannot create the store directory: " + ec.message());
+  const std::string file = joinPath(dir, kIndexFile);
+  if (index.version >= 3) requireChecks(index, file);
+  const std::string text = indexFileText(indexToJson(index));
+  // The data files were renamed into place without a directory sync: their directories are synced once here, before
+  // the index that names them is renamed over the old one.
+  const fs::path cells = fs::path(dir) / "cells";
+  if (fs::is_directory(cells, ec)) syncDirectory(cells.string());
+  syncDirectory(dir);
+  writeFileAtomic(file, text, true);
+  removeStaleFiles(dir, index);
+}
+
+StoreIndex readIndex(const std::string& dir) {
+  const std::string file = joinPath(dir, kIndexFile);
+  if (!fs::is_directory(dir)) throw Error(dir, "impostor store directory not found");
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec))
+    throw Error(file, "cannot open (is this an impostor store written by farfield bake?)");
+  const std::string text = readWholeFile(file, "");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(file, std::string("not valid JSON: ") + e.what());
+  }
+  checkIndexText(j, text, file);
+  StoreIndex index = indexFromJson(j, file);
+  if (index.streets_check.known)
+    readCheckedFile(joinPath(dir, index.streets), index.streets_check, "streets (the street graph of the cells)");
+  return index;
+}
+
+uint64_t nextGeneration(const std::string& dir) {
+  uint64_t top = 0;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(readWholeFile(joinPath(dir, kIndexFile), ""));
+    if (j.is_object() && j.contains("generation") && j["generation"].is_number_unsigned())
+      top = j["generation"].get<uint64_t>();
+  } catch (const std::exception&) {
+    // No index, or a damaged one: the file names decide.
+  }
+  for (const fs::path& folder : {fs::path(dir), fs::path(dir) / "cells"}) {
+    std::error_code ec;
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec))
+      top = std::max(top, generationOf(it->path().filename().string()));
+  }
+  return top + 1;
+}
+
+std::string streetsFileName(uint64_t generation) { return generationPrefix(generation) + kStreetsFile; }
+
+void writeStreets(const std::string& dir, StoreIndex& index, std::string_view text) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw Error(dir, "cannot create the store directory: " + ec.message());
+  index.streets = streetsFileName(index.generation);
+  index.streets_check = writeFileAtomic(joinPath(dir, index.streets), text, false);
+}
+
+FileCheck fileCheck(std::string_view bytes) {
+  FileCheck check;
+  check.bytes = bytes.size();
+  check.crc32 = uint32_t(crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
+  check.known = true;
+  return check;
+}
+
+FileCheck writeFileAtomic(const std::string& path, std::string_view bytes, bool sync_directory) {
+  const std::string tmp = tempName(path);
+  fileOperation("create", tmp);
+  struct Descriptor {
+    int fd;
+    ~Descriptor() {
+      if (fd >= 0) ::close(fd);
+    }
+  } file{::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644)};
+  if (file.fd < 0) systemError(tmp, "cannot open for writing", errno);
+  const auto write_all = [&](std::string_view part) {
+    while (!part.empty()) {
+      const ssize_t n = ::write(file.fd, part.data(), part.size());
+      if (n < 0) {
+        if (errno == EINTR) continue;
+        systemError(tmp, "write failed (disk full?)", errno);
+      }
+      part.remove_prefix(size_t(n));
+    }
+  };
+  const size_t half = bytes.size() / 2;
+  write_all(bytes.substr(0, half));
+  fileOperation("write", tmp);  // a crash here leaves a torn temporary file, never a torn NAME
+  write_all(bytes.substr(half));
+  fileOperation("fsync", tmp);
+  if (::fsync(file.fd) != 0) systemError(tmp, "fsync failed", errno);
+  const int fd = file.fd;
+  file.fd = -1;
+  if (::close(fd) != 0) systemError(tmp, "write failed (close)", errno);
+  fileOperation("rename", path);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) systemError(path, "cannot rename " + tmp + " over it", errno);
+  if (sync_directory) syncDirectory(parentDirectory(path));
+  return fileCheck(bytes);
+}
+
+std::string readCheckedFile(const std::string& path, const FileCheck& check, const std::string& record) {
+  std::string bytes = readWholeFile(path, record);
+  if (!check.known) return bytes;
+  const std::string at = record.empty() ? "" : record + ": ";
+  if (bytes.size() < check.bytes)
+    throw Error(path, at + "truncated: " + std::to_string(bytes.size()) + " of " + std::to_string(check.bytes) +
+                          " bytes");
+  if (bytes.size() > check.bytes)
+    throw Error(path, at + "too long: " + std::to_string(bytes.size()) + " bytes, the index says " +
+                          std::to_string(check.bytes));
+  const uint32_t crc = fileCheck(bytes).crc32;
+  if (crc != check.crc32)
+    throw Error(path, at + "checksum mismatch: CRC-32 " + hex32(crc) + ", the index says " + hex32(check.crc32));
+  return bytes;
+}
+
+void setFileOperationHook(std::function<void(const char* operation, const std::string& path)> hook) {
+  fileHook() = std::move(hook);
+}
+
+FileCheck writeMesh(const std::string& file, const impostor::DepthMeshImpostor& impostor) {
+  return writeFileAtomic(file, meshBytes(impostor, file), false);
+}
+
+impostor::DepthMeshImpostor readMesh(const std::string& file) { return meshFromBytes(readWholeFile(file, ""), file, ""); }
+
+std::string textureFileName(uint32_t half_edge, uint64_t generation) {
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "e%06u.png", half_edge);
+  return "cells/" + generationPrefix(generation) + buf;
+}
+
+std::string meshFileName(uint32_t half_edge, const std::string& technique, uint64_t generation) {
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "e%06u.", half_edge);
+  return "cells/" + generationPrefix(generation) + buf + technique + ".ffmesh";
+}
+
+void writeCell(const std::string& dir, CellEntry& entry,
+               const std::map<std::string, const impostor::DepthMeshImpostor*>& impostors, uint64_t generation) {
+  createCellsDirectory(dir);
   entry.texture.clear();
+  entry.texture_check = {};
   const image::ColorImage* written = nullptr;
   for (const auto& [technique, imp] : impostors) {
     StoredImpostor& s = entry.impostors[technique];
-    s.mesh = meshFileName(entry.half_edge, technique);
+    s.mesh = meshFileName(entry.half_edge, technique, generation);
     s.triangles = imp->mesh.triangleCount();
     s.vertices = imp->mesh.vertexCount();
-    writeMesh(joinPath(dir, s.mesh), *imp);
+    s.mesh_check = writeMesh(joinPath(dir, s.mesh), *imp);
     if (imp->empty() || !imp->texture) continue;
     if (!written) {
-      entry.texture = textureFileName(entry.half_edge);
-      image::writePng(joinPath(dir, entry.texture), *imp->texture);
+      entry.texture = textureFileName(entry.half_edge, generation);
+      entry.texture_check = writePngAtomic(joinPath(dir, entry.texture), *imp->texture);
       written = imp->texture.get();
     } else if (written->width() != imp->texture->width() || written->height() != imp->texture->height() ||
                written->pixels() != imp->texture->pixels()) {
@@ -572,31 +981,33 @@ impostor::DepthMeshImpostor loadImpostor(const std::string& dir, const CellEntry
   StoredView view;
   view.camera = entry.camera;
   view.texture = entry.texture;
+  view.texture_check = entry.texture_check;
   view.mesh = it->second.mesh;
+  view.mesh_check = it->second.mesh_check;
   view.triangles = it->second.triangles;
   view.vertices = it->second.vertices;
+  view.record = "cell " + std::to_string(entry.half_edge) + " " + technique;
   return loadLayerView(dir, view);
 }
 
-std::string layerFileStem(uint32_t half_edge, const std::string& kind, size_t layer, size_t view) {
+std::string layerFileStem(uint32_t half_edge, const std::string& kind, size_t layer, size_t view,
+                          uint64_t generation) {
   char buf[64];
-  std::snprintf(buf, sizeof(buf), "cells/e%06u.%s.%02zu.%zu", half_edge, kind.c_str(), layer, view);
-  return buf;
+  std::snprintf(buf, sizeof(buf), "e%06u.%s.%02zu.%zu", half_edge, kind.c_str(), layer, view);
+  return "cells/" + generationPrefix(generation) + buf;
 }
 
 StoredView writeLayerView(const std::string& dir, const std::string& stem, const impostor::DepthMeshImpostor& view) {
-  std::error_code ec;
-  fs::create_directories(fs::path(dir) / "cells", ec);
-  if (ec) throw Error(dir, "cannot create the cells directory: " + ec.message());
+  createCellsDirectory(dir);
   StoredView out;
   out.camera = view.camera;
   out.mesh = stem + ".ffmesh";
   out.triangles = view.mesh.triangleCount();
   out.vertices = view.mesh.vertexCount();
-  writeMesh(joinPath(dir, out.mesh), view);
+  out.mesh_check = writeMesh(joinPath(dir, out.mesh), view);
   if (!view.empty() && view.texture) {
     out.texture = stem + ".png";
-    image::writePng(joinPath(dir, out.texture), *view.texture);
+    out.texture_check = writePngAtomic(joinPath(dir, out.texture), *view.texture);
   }
   if (!view.empty() && view.ids) {
     // 32-bit ids in the four 8-bit channels: PNG keeps them exactly and compresses the large runs of one id.
@@ -606,34 +1017,37 @@ StoredView writeLayerView(const std::string& dir, const std::string& stem, const
       packed.pixels()[i] = image::Rgba8(uint8_t(id), uint8_t(id >> 8), uint8_t(id >> 16), uint8_t(id >> 24));
     }
     out.ids = stem + ".ids.png";
-    image::writePng(joinPath(dir, out.ids), packed);
+    out.ids_check = writePngAtomic(joinPath(dir, out.ids), packed);
   }
   return out;
 }
 
 impostor::DepthMeshImpostor loadLayerView(const std::string& dir, const StoredView& view) {
+  const std::string record = view.record.empty() ? "layer view" : view.record;
   const std::string mesh_file = joinPath(dir, view.mesh);
-  impostor::DepthMeshImpostor out = readMesh(mesh_file);
+  impostor::DepthMeshImpostor out =
+      meshFromBytes(readCheckedFile(mesh_file, view.mesh_check, record + " mesh"), mesh_file, record + " mesh");
   if (out.mesh.triangleCount() != view.triangles || out.mesh.vertexCount() != view.vertices)
-    throw Error(mesh_file, "holds " + std::to_string(out.mesh.triangleCount()) + " triangles and " +
+    throw Error(mesh_file, record + " mesh: holds " + std::to_string(out.mesh.triangleCount()) + " triangles and " +
                                std::to_string(out.mesh.vertexCount()) + " vertices, the index says " +
                                std::to_string(view.triangles) + " and " + std::to_string(view.vertices));
   out.camera = view.camera;
   if (out.empty()) return out;
   const std::string texture_file = joinPath(dir, view.texture);
-  auto texture = std::make_shared<image::ColorImage>(image::readPng(texture_file));
+  auto texture =
+      std::make_shared<image::ColorImage>(readCheckedPng(texture_file, view.texture_check, record + " texture"));
   if (texture->width() != view.camera.width || texture->height() != view.camera.height)
-    throw Error(texture_file, "texture is " + std::to_string(texture->width()) + "x" +
+    throw Error(texture_file, record + " texture: " + std::to_string(texture->width()) + "x" +
                                   std::to_string(texture->height()) + " but the creation camera is " +
                                   std::to_string(view.camera.width) + "x" + std::to_string(view.camera.height));
   out.texture = std::move(texture);
   if (!view.ids.empty()) {
     const std::string ids_file = joinPath(dir, view.ids);
-    const image::ColorImage packed = image::readPng(ids_file);
+    const image::ColorImage packed = readCheckedPng(ids_file, view.ids_check, record + " ids");
     if (packed.width() != view.camera.width || packed.height() != view.camera.height)
-      throw Error(ids_file, "id image is " + std::to_string(packed.width()) + "x" + std::to_string(packed.height()) +
-                                " but the creation camera is " + std::to_string(view.camera.width) + "x" +
-                                std::to_string(view.camera.height));
+      throw Error(ids_file, record + " ids: id image is " + std::to_string(packed.width()) + "x" +
+                                std::to_string(packed.height()) + " but the creation camera is " +
+                                std::to_string(view.camera.width) + "x" + std::to_string(view.camera.height));
     auto ids = std::make_shared<image::IdImage>(packed.width(), packed.height(), 0u);
     for (size_t i = 0; i < packed.pixelCount(); ++i) {
       const image::Rgba8 c = packed.pixels()[i];
