@@ -757,6 +757,29 @@ TEST(StoreIntegrityTest, Version3IndexWithoutChecksumsIsAnErrorNamingWhatIsMissi
   j = good;
   j["cells"][0]["pipeline"]["mmi"]["single"]["views"][0].erase("mesh_bytes");
   expect_missing(j, {"cells[0]: pipeline.mmi.single: views[0]", "missing \"mesh_bytes\""});
+  // A whole check gone (as in a version 2 index relabelled 3), and the generation.
+  j = good;
+  j["cells"][0]["pipeline"]["mmi"]["layers"][0]["views"][0].erase("texture_crc32");
+  j["cells"][0]["pipeline"]["mmi"]["layers"][0]["views"][0].erase("texture_bytes");
+  expect_missing(j, {"cells[0]: pipeline.mmi.layers[0]: views[0]", "missing \"texture_crc32\""});
+  j = good;
+  j.erase("streets_crc32");
+  j.erase("streets_bytes");
+  expect_missing(j, {"top level", "missing \"streets_crc32\""});
+  j = good;
+  j["cells"][0]["impostors"]["depth-mesh"].erase("mesh_crc32");
+  j["cells"][0]["impostors"]["depth-mesh"].erase("mesh_bytes");
+  expect_missing(j, {"cells[0]: impostors.depth-mesh", "missing \"mesh_crc32\""});
+  j = good;
+  j.erase("generation");
+  expect_missing(j, {"top level", "missing \"generation\""});
+  // The same index labelled version 2 (which has no index checksum either) is read without them.
+  j["version"] = 2;
+  j.erase("checksum");
+  j["cells"][0]["impostors"]["depth-mesh"].erase("mesh_crc32");
+  j["cells"][0]["impostors"]["depth-mesh"].erase("mesh_bytes");
+  writeBytes(file, indexFileText(j));
+  EXPECT_NO_THROW(readIndex(dir));
   // The index's own checksum.
   writeBytes(file, good.dump(1) + "\n");
   EXPECT_NO_THROW(readIndex(dir));
