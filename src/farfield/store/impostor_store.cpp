@@ -24,7 +24,6 @@
 #include <cstring>
 #include <functional>
 #include <filesystem>
-#include <fstream>
 #include <set>
 
 #include "farfield/core/error.h"
