@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -291,6 +293,220 @@ TEST_F(GpuTest, GpuSceneDrawItemsForChosenObjects) {
     if (m.texture && images.insert(m.texture.get()).second) texture_bytes += m.texture->pixelCount() * 4;
   EXPECT_GE(gpu_scene.gpuBytes(), mesh_bytes + texture_bytes);
   EXPECT_LE(gpu_scene.gpuBytes(), mesh_bytes + texture_bytes * 4 / 3 + 16);
+}
+
+// A small "city": blocks of boxes as single meshes (two parts each: walls and a flat ground slab), under object
+// transforms that turn, scale and mirror them, plus a double-sided sheet; small clusters so culling has units to drop.
+class CulledItemsTest : public GpuTest {
+ protected:
+  void SetUp() override {
+    GpuTest::SetUp();
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    scene::Material plain;
+    plain.base_color = Vec4(0.8f, 0.7f, 0.6f, 1.0f);
+    const uint32_t walls = scene_.addMaterial(plain);
+    plain.base_color = Vec4(0.3f, 0.6f, 0.3f, 1.0f);
+    const uint32_t slab = scene_.addMaterial(plain);
+    plain.base_color = Vec4(0.2f, 0.3f, 0.9f, 1.0f);
+    plain.double_sided = true;
+    const uint32_t sheet = scene_.addMaterial(plain);
+    for (int b = 0; b < 6; ++b) {
+      scene::Mesh block;
+      for (int i = 0; i < 40; ++i) {
+        const Vec3 lo(u(rng) * 16.0f, u(rng) * 16.0f, 0.0f);
+        const Vec3 size(0.5f + u(rng) * 3.0f, 0.5f + u(rng) * 3.0f, 1.0f + u(rng) * 8.0f);
+        block.append(scene::makeBox(Vec3(0.0f), size),
+                     glm::rotate(glm::translate(Mat4(1.0f), lo), 0.4f * float(i % 3), Vec3(0, 0, 1)));
+      }
+      block.computeBounds();
+      scene::Object object;
+      object.name = "block " + std::to_string(b);
+      object.parts.push_back({scene_.addMesh(std::move(block)), walls});
+      object.parts.push_back({scene_.addMesh(scene::makeBox(Vec3(-1, -1, -0.2f), Vec3(17, 17, 0))), slab});
+      Mat4 m = glm::translate(Mat4(1.0f), Vec3(float(b % 3) * 22.0f - 30.0f, float(b / 3) * 22.0f - 20.0f, 0.0f));
+      if (b == 1) m = glm::rotate(m, 0.7f, Vec3(0, 0, 1));
+      if (b == 2) m = glm::scale(m, Vec3(1.3f, 0.8f, 1.1f));
+      if (b == 4) m = glm::scale(glm::translate(m, Vec3(16.0f, 0.0f, 0.0f)), Vec3(-1.0f, 1.0f, 1.0f));  // mirrored
+      object.transform = m;
+      scene_.addObject(std::move(object));
+    }
+    scene::Object object;
+    object.name = "sheet";
+    scene::Mesh sheet_mesh;
+    for (int i = 0; i < 8; ++i)
+      sheet_mesh.append(scene::makeGroundQuad(Vec2(float(i) * 3.0f, 0.0f), Vec2(float(i) * 3.0f + 3.0f, 2.0f)));
+    object.parts.push_back({scene_.addMesh(std::move(sheet_mesh)), sheet});
+    object.transform = glm::rotate(glm::translate(Mat4(1.0f), Vec3(-20.0f, 30.0f, 6.0f)), 1.2f, Vec3(1, 0, 0));
+    scene_.addObject(std::move(object));
+    GpuSceneOptions options;
+    options.cluster_triangles = 24;
+    options.min_facing_triangles = 2;
+    options.bridge_triangles = 0;
+    gpu_scene_ = std::make_unique<GpuScene>(scene_, options);
+    options.bridge_triangles = 30;
+    bridged_scene_ = std::make_unique<GpuScene>(scene_, options);
+  }
+
+  Camera randomCamera(std::mt19937& rng) const {
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    Camera camera;
+    camera.width = 96;
+    camera.height = 64;
+    camera.near_plane = 0.2f;
+    camera.far_plane = 300.0f;
+    camera.fov_y = float(degToRad(35.0 + 30.0 * (u(rng) + 1.0)));
+    // Inside the blocks at street height, above them, and outside looking in.
+    const float r = 50.0f * (u(rng) + 1.0f);
+    camera.eye = Vec3(r * u(rng), r * u(rng), 1.5f + 15.0f * (u(rng) + 1.0f));
+    camera.at = camera.eye + Vec3(u(rng), u(rng), 0.6f * u(rng) - 0.2f);
+    return camera;
+  }
+
+  uint64_t triangleCount(const std::vector<DrawItem>& items) const {
+    uint64_t n = 0;
+    for (const DrawItem& item : items) n += item.triangleCount();
+    return n;
+  }
+
+  scene::Scene scene_;
+  std::unique_ptr<GpuScene> gpu_scene_;
+  std::unique_ptr<GpuScene> bridged_scene_;  // the same, drawing small culled clusters between drawn ones
+};
+
+TEST_F(CulledItemsTest, CulledFramesAreIdenticalToAllItemsFromRandomCameras) {
+  Renderer renderer;
+  RenderTarget target(96, 64);
+  const std::vector<DrawItem> all = gpu_scene_->drawItems();
+  const uint64_t all_triangles = triangleCount(all);
+  std::mt19937 rng(5);
+  uint64_t frustum_triangles = 0, camera_triangles = 0;
+  int frames_with_pixels = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const Camera camera = randomCamera(rng);
+    // The bridged scene's items draw from its own meshes: compared against its own full frame.
+    std::vector<DrawItem> by_frustum, by_camera, bridged;
+    gpu_scene_->appendDrawItems({}, by_frustum, Frustum::fromMatrix(camera.viewProjection()));
+    gpu_scene_->appendDrawItems({}, by_camera, camera);
+    bridged_scene_->appendDrawItems({}, bridged, camera);
+    frustum_triangles += triangleCount(by_frustum);
+    camera_triangles += triangleCount(by_camera);
+    const std::vector<DrawItem> bridged_all = bridged_scene_->drawItems();
+    for (RenderMode mode : {RenderMode::Shaded, RenderMode::ItemBuffer}) {
+      for (const auto* items : {&by_frustum, &by_camera, &bridged}) {
+        renderer.render(camera, items == &bridged ? bridged_all : all, target, mode);
+        const image::ColorImage want_color = target.readColor();
+        const image::IdImage want_ids = target.readIds();
+        if (items == &by_frustum)
+          frames_with_pixels += std::count_if(want_ids.pixels().begin(), want_ids.pixels().end(),
+                                              [](uint32_t id) { return id != 0; }) > 0;
+        const char* what = items == &by_frustum ? ", frustum" : items == &by_camera ? ", camera" : ", bridged";
+        const FrameStats stats = renderer.render(camera, *items, target, mode);
+        EXPECT_EQ(stats.triangles, triangleCount(*items));
+        ASSERT_TRUE(target.readIds().pixels() == want_ids.pixels()) << "trial " << trial << what;
+        ASSERT_TRUE(target.readColor().pixels() == want_color.pixels()) << "trial " << trial << what;
+      }
+    }
+  }
+  // Not vacuous: most frames show something, and each overload drops a good share of what is out of its reach.
+  EXPECT_GT(frames_with_pixels, 60);
+  EXPECT_LT(frustum_triangles, 60 * all_triangles * 3 / 4);
+  EXPECT_LT(camera_triangles, frustum_triangles * 3 / 4);
+}
+
+TEST_F(CulledItemsTest, DropsClustersOutOfView) {
+  // Looking down at a corner of the first block (at x, y from -31 to -12) with a narrow view: a corner of it in view.
+  Camera camera;
+  camera.width = 96;
+  camera.height = 64;
+  camera.fov_y = float(degToRad(12.0));
+  camera.eye = Vec3(-28.0f, -18.0f, 40.0f);
+  camera.at = Vec3(-28.0f, -18.0f, 0.0f);
+  camera.up = Vec3(0.0f, 1.0f, 0.0f);
+  const uint32_t first[] = {1};
+  std::vector<DrawItem> all, culled;
+  gpu_scene_->appendDrawItems(first, all);
+  gpu_scene_->appendDrawItems(first, culled, Frustum::fromMatrix(camera.viewProjection()));
+  EXPECT_GT(triangleCount(culled), 0u);
+  EXPECT_LT(triangleCount(culled), triangleCount(all) / 3);
+  // Drawn as ranges of the same meshes.
+  for (const DrawItem& item : culled) {
+    EXPECT_GT(item.index_count, 0u);
+    EXPECT_LE(item.first_index + item.index_count, item.mesh->indexCount());
+  }
+}
+
+TEST_F(CulledItemsTest, ClustersHoldEveryTriangleOnceAndItemsKeepObjectIds) {
+  for (uint32_t m = 0; m < scene_.meshes.size(); ++m) {
+    uint64_t sum = 0;
+    uint32_t next = 0;
+    for (const MeshCluster& cluster : gpu_scene_->clusters(m)) {
+      EXPECT_EQ(cluster.first_index, next);
+      next += cluster.index_count;
+      sum += cluster.index_count / 3;
+    }
+    EXPECT_EQ(sum, scene_.meshes[m].triangleCount()) << "mesh " << m;
+    EXPECT_EQ(next, gpu_scene_->meshes()[m].indexCount());
+  }
+  EXPECT_GT(gpu_scene_->clusters(0).size(), 10u);
+
+  // A frustum around everything keeps every triangle, as whole parts (the runs of clusters merge).
+  Camera far_camera;
+  far_camera.eye = Vec3(0.0f, -400.0f, 300.0f);
+  far_camera.at = Vec3(0.0f, 0.0f, 0.0f);
+  far_camera.far_plane = 2000.0f;
+  std::vector<DrawItem> all = gpu_scene_->drawItems(), culled;
+  gpu_scene_->appendDrawItems({}, culled, Frustum::fromMatrix(far_camera.viewProjection()));
+  EXPECT_EQ(triangleCount(culled), triangleCount(all));
+  EXPECT_EQ(culled.size(), all.size());
+
+  // Items of chosen objects, from many cameras: each names its object, with its transform, and one of its parts.
+  std::mt19937 rng(9);
+  const uint32_t ids[] = {2, 5, 7};
+  for (int trial = 0; trial < 30; ++trial) {
+    const Camera camera = randomCamera(rng);
+    std::vector<DrawItem> items;
+    gpu_scene_->appendDrawItems(ids, items, camera);
+    for (const DrawItem& item : items) {
+      ASSERT_TRUE(item.object_id == 2 || item.object_id == 5 || item.object_id == 7) << item.object_id;
+      const scene::Object& object = scene_.object(item.object_id);
+      EXPECT_EQ(item.transform, object.transform);
+      const bool of_object = std::any_of(object.parts.begin(), object.parts.end(), [&](const scene::Part& part) {
+        return &gpu_scene_->meshes()[part.mesh] == item.mesh;
+      });
+      EXPECT_TRUE(of_object);
+    }
+  }
+  const uint32_t bad[] = {uint32_t(scene_.objects.size() + 1)};
+  std::vector<DrawItem> items;
+  EXPECT_THROW(gpu_scene_->appendDrawItems(bad, items, far_camera), Error);
+}
+
+TEST_F(GpuTest, DrawItemIndexRangeDrawsOnlyThoseTriangles) {
+  // The unit cube face by face (two triangles, six indices each): the faces seen cover what the whole cube covers,
+  // with the same ids, and the faces turned away cover nothing.
+  const GpuMesh cube(scene::makeUnitCube());
+  GpuMaterial material;
+  Camera camera = test::testCamera(Vec3(2.0f, -3.0f, 2.5f), Vec3(0.0f));
+  RenderTarget target(camera.width, camera.height);
+  Renderer renderer;
+  const DrawItem whole{&cube, &material, Mat4(1.0f), 1};
+  EXPECT_EQ(renderer.render(camera, {&whole, 1}, target).triangles, 12u);
+  const auto covered = [](const image::IdImage& ids) {
+    return std::count_if(ids.pixels().begin(), ids.pixels().end(), [](uint32_t id) { return id != 0; });
+  };
+  const long whole_covered = covered(target.readIds());
+  long sum = 0;
+  int faces_seen = 0;
+  for (uint32_t face = 0; face < 6; ++face) {
+    const DrawItem part{&cube, &material, Mat4(1.0f), 1, 6 * face, 6};
+    EXPECT_EQ(renderer.render(camera, {&part, 1}, target).triangles, 2u);
+    const long c = covered(target.readIds());
+    sum += c;
+    faces_seen += c > 0;
+  }
+  EXPECT_EQ(faces_seen, 3);
+  EXPECT_EQ(sum, whole_covered);
 }
 
 }  // namespace

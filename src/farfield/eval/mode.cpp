@@ -89,7 +89,8 @@ class FullMode final : public Mode {
   std::vector<gpu::DrawItem> items_;
 };
 
-// View-frustum culling of object bounds through the BVH; what a plain renderer does before any impostor.
+// View-frustum culling: object bounds through the BVH, then the clusters of those objects' meshes (GpuScene's
+// culling units: in the frustum and not all facing away); what a plain renderer does before any impostor.
 class CulledMode final : public Mode {
  public:
   explicit CulledMode(const ModeContext& context) : gpu_scene_(context.gpu_scene), bvh_(context.bvh) {}
@@ -101,7 +102,7 @@ class CulledMode final : public Mode {
     if (ids_.empty()) return;
     // Same order as "full" (ascending ids), so objects at equal depth resolve the same way in both modes.
     std::sort(ids_.begin(), ids_.end());
-    gpu_scene_->appendDrawItems(ids_, frame.items());
+    gpu_scene_->appendDrawItems(ids_, frame.items(), frame.camera());
   }
 
  private:

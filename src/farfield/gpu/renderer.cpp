@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <unordered_map>
 
+#include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
 #include "farfield/gpu/gpu_timer.h"
@@ -143,6 +145,9 @@ FrameStats Renderer::draw(const Camera& camera, std::span<const DrawItem> items,
   for (uint32_t index : im.order) {
     const DrawItem& item = items[index];
     if (!item.mesh || item.mesh->indexCount() == 0 || item.mesh->vertexArray() == 0) continue;
+    const uint32_t index_count = item.index_count ? item.index_count : item.mesh->indexCount();
+    FF_CHECK(index_count % 3 == 0 && item.first_index <= item.mesh->indexCount() &&
+             index_count <= item.mesh->indexCount() - item.first_index);
     const GpuMaterial& material = materialOf(item);
     const int variant = variantOf(material);
     const Locations& l = im.locations[variant];
@@ -195,8 +200,9 @@ FrameStats Renderer::draw(const Camera& camera, std::span<const DrawItem> items,
       current_vao = item.mesh->vertexArray();
       glBindVertexArray(current_vao);
     }
-    glDrawElements(GL_TRIANGLES, GLsizei(item.mesh->indexCount()), GL_UNSIGNED_INT, nullptr);
-    stats.triangles += item.mesh->triangleCount();
+    glDrawElements(GL_TRIANGLES, GLsizei(index_count), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(uintptr_t(item.first_index) * sizeof(uint32_t)));
+    stats.triangles += index_count / 3;
     ++stats.draw_calls;
     im.ids.push_back(item.object_id);
   }
@@ -211,11 +217,20 @@ FrameStats Renderer::draw(const Camera& camera, std::span<const DrawItem> items,
 
 // ---------------------------------------------------------------------------------------------------------------
 
-GpuScene::GpuScene(const scene::Scene& scene) : scene_(&scene) {
+GpuScene::GpuScene(const scene::Scene& scene, const GpuSceneOptions& options)
+    : scene_(&scene), bridge_indices_(3 * options.bridge_triangles) {
   meshes_.reserve(scene.meshes.size());
+  clusters_.reserve(scene.meshes.size());
+  facing_.reserve(scene.meshes.size());
   for (size_t i = 0; i < scene.meshes.size(); ++i) {
     try {
-      meshes_.emplace_back(scene.meshes[i]);
+      // Only the GPU copy is reordered: clusters become contiguous index ranges of the one buffer (over short
+      // vertex ranges), so culling costs no memory and a whole-mesh draw stays one draw call.
+      ClusteredIndices clustered =
+          clusterTriangles(scene.meshes[i], options.cluster_triangles, options.min_facing_triangles);
+      meshes_.emplace_back(reorderedMesh(scene.meshes[i], clustered));
+      clusters_.push_back(std::move(clustered.clusters));
+      facing_.push_back(std::move(clustered.facing));
     } catch (const Error& e) {
       throw Error("scene mesh " + std::to_string(i), e.what());
     }
@@ -249,28 +264,86 @@ GpuScene::GpuScene(const scene::Scene& scene) : scene_(&scene) {
   }
 }
 
-void GpuScene::appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out) const {
+const scene::Object& GpuScene::checkedObject(uint32_t id) const {
   const auto& objects = scene_->objects;
+  if (id == 0 || id > objects.size())
+    throw Error("object id " + std::to_string(id),
+                "out of range (the scene has " + std::to_string(objects.size()) + " objects, ids from 1)");
+  return objects[id - 1];
+}
+
+void GpuScene::checkParts(const scene::Object& object) const {
+  for (const scene::Part& part : object.parts)
+    if (part.mesh >= meshes_.size() || part.material >= materials_.size())
+      throw Error("object " + std::to_string(object.id) + " ('" + object.name + "')",
+                  "part refers to mesh " + std::to_string(part.mesh) + " / material " +
+                      std::to_string(part.material) + " of " + std::to_string(meshes_.size()) + " / " +
+                      std::to_string(materials_.size()));
+}
+
+void GpuScene::appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out) const {
   auto append = [&](const scene::Object& object) {
-    for (const scene::Part& part : object.parts) {
-      if (part.mesh >= meshes_.size() || part.material >= materials_.size())
-        throw Error("object " + std::to_string(object.id) + " ('" + object.name + "')",
-                    "part refers to mesh " + std::to_string(part.mesh) + " / material " +
-                        std::to_string(part.material) + " of " + std::to_string(meshes_.size()) + " / " +
-                        std::to_string(materials_.size()));
+    checkParts(object);
+    for (const scene::Part& part : object.parts)
       out.push_back({&meshes_[part.mesh], &materials_[part.material], object.transform, object.id});
+  };
+  if (ids.empty()) {
+    for (const auto& object : scene_->objects) append(object);
+    return;
+  }
+  for (uint32_t id : ids) append(checkedObject(id));
+}
+
+void GpuScene::appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out,
+                               const Frustum& frustum) const {
+  appendCulled(ids, out, frustum, nullptr);
+}
+
+void GpuScene::appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out,
+                               const Camera& camera) const {
+  appendCulled(ids, out, Frustum::fromMatrix(camera.viewProjection()), &camera.eye);
+}
+
+void GpuScene::appendCulled(std::span<const uint32_t> ids, std::vector<DrawItem>& out, const Frustum& frustum,
+                            const Vec3* eye) const {
+  auto append = [&](const scene::Object& object) {
+    checkParts(object);
+    // The planes in the object's own space (a world plane p met by the point M x is the plane p M in x), so the
+    // clusters' mesh-space boxes are tested as they are, without growing them into world-axis boxes.
+    Frustum local;
+    for (size_t k = 0; k < frustum.planes.size(); ++k) local.planes[k] = frustum.planes[k] * object.transform;
+    // The eye in the object's own space, for the facing test; only for affine transforms (a mirror is fine: the
+    // renderer flips the front face with it, so facing is decided in mesh space as without it).
+    const Mat4& m = object.transform;
+    const bool affine = m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f && m[3][3] == 1.0f;
+    const bool test_facing = eye && affine && glm::determinant(Mat3(m)) != 0.0f;
+    const Vec3 local_eye = test_facing ? Vec3(glm::inverse(m) * Vec4(*eye, 1.0f)) : Vec3(0.0f);
+    for (const scene::Part& part : object.parts) {
+      const GpuMesh* mesh = &meshes_[part.mesh];
+      const GpuMaterial* material = &materials_[part.material];
+      const bool facing = test_facing && !material->double_sided;
+      const std::vector<FacingGroup>& groups = facing_[part.mesh];
+      // Whether this part's last item may still grow, and where its indices end.
+      bool open = false;
+      uint32_t open_end = 0;
+      for (const MeshCluster& cluster : clusters_[part.mesh]) {
+        const bool drawn = local.intersects(cluster.bounds) && !(facing && facesAway(cluster, groups, local_eye));
+        if (!drawn) continue;
+        if (open && cluster.first_index - open_end <= bridge_indices_) {
+          out.back().index_count = cluster.first_index + cluster.index_count - out.back().first_index;
+        } else {
+          out.push_back({mesh, material, object.transform, object.id, cluster.first_index, cluster.index_count});
+          open = true;
+        }
+        open_end = cluster.first_index + cluster.index_count;
+      }
     }
   };
   if (ids.empty()) {
-    for (const auto& object : objects) append(object);
+    for (const auto& object : scene_->objects) append(object);
     return;
   }
-  for (uint32_t id : ids) {
-    if (id == 0 || id > objects.size())
-      throw Error("object id " + std::to_string(id), "out of range (the scene has " +
-                                                         std::to_string(objects.size()) + " objects, ids from 1)");
-    append(objects[id - 1]);
-  }
+  for (uint32_t id : ids) append(checkedObject(id));
 }
 
 std::vector<DrawItem> GpuScene::drawItems() const {
@@ -282,6 +355,7 @@ std::vector<DrawItem> GpuScene::drawItems() const {
 size_t GpuScene::gpuBytes() const {
   size_t bytes = 0;
   for (const auto& m : meshes_) bytes += m.byteSize();
+  // The clusters' bounds and ranges live in CPU memory and are not counted.
   for (const auto& t : textures_) bytes += t.byteSize();
   return bytes;
 }
