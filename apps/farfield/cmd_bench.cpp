@@ -4,7 +4,7 @@
 // The walkthrough benchmark (see farfield/eval/bench.h): all modes interleaved over the same frames, with
 // bench.json, bench.md, frames.csv, plots, sample frames and a report in OUTDIR. --impostors DIR is the impostor
 // store of `farfield bake` for the depth-mesh and grid-mesh modes (the mode option impostor_dir; see
-// farfield/runtime/impostor_mode.h). --error-px is the error bound the frames are checked against (default: each
+// farfield/eval/impostor_mode.h). --error-px is the error bound the frames are checked against (default: each
 // mode's own). The allocator is set up for timing first (farfield/core/allocator.h).
 #include <unistd.h>
 
@@ -22,7 +22,7 @@
 #include "farfield/eval/mode.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gpu/context.h"
-#include "farfield/runtime/impostor_mode.h"
+#include "farfield/eval/impostor_mode.h"
 #include "farfield/scene/import.h"
 
 namespace fs = std::filesystem;
@@ -167,7 +167,7 @@ void runBenchCommand(const BenchArgs& args) {
 }
 
 const RegisterCommand reg("bench", [](CLI::App& app) {
-  runtime::registerModes();  // the impostor modes (depth-mesh, grid-mesh), before the mode list below
+  eval::registerImpostorModes();  // the impostor modes (depth-mesh, grid-mesh), before the mode list below
   auto args = std::make_shared<BenchArgs>();
   auto* cmd = app.add_subcommand("bench", "Walkthrough benchmark: modes interleaved over a camera path, with "
                                           "frame-time statistics, image error, plots and a report.");

@@ -13,7 +13,7 @@
 #include "farfield/eval/walk.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gpu/context.h"
-#include "farfield/runtime/impostor_mode.h"
+#include "farfield/eval/impostor_mode.h"
 #include "farfield/scene/import.h"
 
 namespace farfield::app {
@@ -69,7 +69,7 @@ void runWalkCommand(const WalkArgs& args) {
 }
 
 const RegisterCommand reg("walk", [](CLI::App& app) {
-  runtime::registerModes();  // the impostor modes (depth-mesh, grid-mesh), before the mode list below
+  eval::registerImpostorModes();  // the impostor modes (depth-mesh, grid-mesh), before the mode list below
   auto args = std::make_shared<WalkArgs>();
   auto* cmd = app.add_subcommand("walk", "Walk a camera path with one mode; per-frame times and a summary.");
   cmd->add_option("scene", args->scene, "Scene file (glTF, OBJ, ...) or builtin:NAME")->required();

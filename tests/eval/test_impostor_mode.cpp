@@ -12,14 +12,14 @@
 #include "farfield/gen/city.h"
 #include "farfield/gpu/context.h"
 #include "farfield/image/metrics.h"
-#include "farfield/runtime/impostor_mode.h"
+#include "farfield/eval/impostor_mode.h"
 #include "farfield/store/impostor_store.h"
 #include "farfield/urban/cells.h"
 #include "support/test_support.h"
 
 namespace fs = std::filesystem;
 
-namespace farfield::runtime {
+namespace farfield::eval {
 namespace {
 
 constexpr int kFrameSize = 192;
@@ -67,24 +67,24 @@ const SmallCity& smallCity() {
   return *s;
 }
 
-eval::BenchResult runModes(const SmallCity& s, std::vector<std::string> modes, const std::string& store) {
-  registerModes();
-  eval::BenchOptions options;
+BenchResult runModes(const SmallCity& s, std::vector<std::string> modes, const std::string& store) {
+  registerImpostorModes();
+  BenchOptions options;
   options.modes = std::move(modes);
   options.width = options.height = kFrameSize;
   options.reference = true;
   options.samples = 0;
   options.mode_options["impostor_dir"] = store;
-  return eval::runBench(gpu::sharedHeadlessContext(), s.city.scene, s.path, options);
+  return runBench(gpu::sharedHeadlessContext(), s.city.scene, s.path, options);
 }
 
 TEST(ImpostorModeTest, DepthMeshWalkHasBoundedErrorAndDrawsFarFewerTrianglesThanFull) {
   const SmallCity& s = smallCity();
   ASSERT_GE(s.visited.size(), 2u) << "the walk should cross at least one junction";
-  const eval::BenchResult r = runModes(s, {"full", "depth-mesh", "grid-mesh"}, s.store);
-  const eval::ModeResult* full = r.mode("full");
-  const eval::ModeResult* depth = r.mode("depth-mesh");
-  const eval::ModeResult* grid = r.mode("grid-mesh");
+  const BenchResult r = runModes(s, {"full", "depth-mesh", "grid-mesh"}, s.store);
+  const ModeResult* full = r.mode("full");
+  const ModeResult* depth = r.mode("depth-mesh");
+  const ModeResult* grid = r.mode("grid-mesh");
   ASSERT_TRUE(full && depth && grid);
   ASSERT_EQ(depth->frames.size(), s.path.frames.size());
 
@@ -132,7 +132,7 @@ TEST(ImpostorModeTest, LocalModelAloneIsMuchWorseThanWithTheImpostor) {
   gpu::RenderTarget target(kFrameSize, kFrameSize);
   double psnr_sum = 0.0;
   for (size_t i = 0; i < s.path.frames.size(); ++i) {
-    const Camera camera = eval::pathCamera(s.path, i, kFrameSize, kFrameSize);
+    const Camera camera = pathCamera(s.path, i, kFrameSize, kFrameSize);
     renderer.render(camera, gpu_scene.drawItems(), target);
     const image::ColorImage full = target.readColor();
     const uint32_t cell = graph.nearestOrientedEdge(Vec2(camera.eye), Vec2(camera.at - camera.eye));
@@ -144,7 +144,7 @@ TEST(ImpostorModeTest, LocalModelAloneIsMuchWorseThanWithTheImpostor) {
     psnr_sum += std::min(99.0, image::compareImages(full, target.readColor(), 8).psnr_db);
   }
   const double local_only = psnr_sum / double(s.path.frames.size());
-  const eval::BenchResult r = runModes(s, {"depth-mesh"}, s.store);
+  const BenchResult r = runModes(s, {"depth-mesh"}, s.store);
   const double with_impostor = r.mode("depth-mesh")->psnr_db_mean;
   std::printf("local model alone: PSNR %.2f dB; with the depth-mesh impostor: %.2f dB\n", local_only, with_impostor);
   EXPECT_GT(with_impostor, local_only + 3.0);
@@ -154,10 +154,10 @@ TEST(ImpostorModeTest, LocalModelAloneIsMuchWorseThanWithTheImpostor) {
 // the street ends no longer show magnified impostor buildings. Measured: 34.2 dB mean, 26.0 dB min (edge: 27.4, 17.3).
 TEST(ImpostorModeTest, JunctionLocalModelReducesTheErrorAtStreetEnds) {
   const SmallCity& s = smallCity();
-  const eval::BenchResult edge = runModes(s, {"depth-mesh"}, s.store);
-  const eval::BenchResult junction = runModes(s, {"depth-mesh"}, s.junction_store);
-  const eval::ModeResult* e = edge.mode("depth-mesh");
-  const eval::ModeResult* j = junction.mode("depth-mesh");
+  const BenchResult edge = runModes(s, {"depth-mesh"}, s.store);
+  const BenchResult junction = runModes(s, {"depth-mesh"}, s.junction_store);
+  const ModeResult* e = edge.mode("depth-mesh");
+  const ModeResult* j = junction.mode("depth-mesh");
   std::printf("depth-mesh, local model edge: PSNR %.2f (min %.2f) dB, %.0f triangles; junction: %.2f (min %.2f) dB, "
               "%.0f triangles\n",
               e->psnr_db_mean, e->psnr_db_min, e->mean_triangles, j->psnr_db_mean, j->psnr_db_min, j->mean_triangles);
@@ -181,9 +181,9 @@ TEST(ImpostorModeTest, CellsWithoutImpostorFallBackToCulledGeometry) {
     expected_fallbacks += cells.lookup(f.eye, f.at - f.eye) != s.visited.front() ? 1 : 0;
   ASSERT_GT(expected_fallbacks, 0u);
 
-  const eval::BenchResult r = runModes(s, {"culled", "depth-mesh"}, dir);
-  const eval::ModeResult* depth = r.mode("depth-mesh");
-  const eval::ModeResult* culled = r.mode("culled");
+  const BenchResult r = runModes(s, {"culled", "depth-mesh"}, dir);
+  const ModeResult* depth = r.mode("depth-mesh");
+  const ModeResult* culled = r.mode("culled");
   EXPECT_EQ(depth->info.at("fallback_frames"), double(expected_fallbacks));
   EXPECT_EQ(depth->info.at("impostor_loads"), 1.0);
   // Fallback frames are the culled mode's frames: identical images and triangle counts.
@@ -197,16 +197,16 @@ TEST(ImpostorModeTest, CellsWithoutImpostorFallBackToCulledGeometry) {
 
 TEST(ImpostorModeTest, BadStoresAreErrors) {
   const SmallCity& s = smallCity();
-  registerModes();
-  eval::ModeContext context;
+  registerImpostorModes();
+  ModeContext context;
   context.scene = &s.city.scene;
-  EXPECT_THROW(eval::createMode("depth-mesh", context), Error);  // no impostor_dir
+  EXPECT_THROW(createMode("depth-mesh", context), Error);  // no impostor_dir
   context.options["impostor_dir"] = s.store;
   context.options["impostor_cache"] = "zero";
-  EXPECT_THROW(eval::createMode("depth-mesh", context), Error);
+  EXPECT_THROW(createMode("depth-mesh", context), Error);
   context.options.erase("impostor_cache");
   context.options["impostor_dir"] = (fs::path(s.store) / "missing").string();
-  auto mode = eval::createMode("depth-mesh", context);
+  auto mode = createMode("depth-mesh", context);
   EXPECT_THROW(mode->prepare(context), Error);
 
   // A store of the depth mesh only has no grid-mesh impostors.
@@ -218,7 +218,7 @@ TEST(ImpostorModeTest, BadStoresAreErrors) {
   bake::bakeCells(gpu::sharedHeadlessContext(), s.city.scene, cells, {s.visited.front()}, b, dir);
   context.options["impostor_dir"] = dir;
   try {
-    eval::createMode("grid-mesh", context)->prepare(context);
+    createMode("grid-mesh", context)->prepare(context);
     ADD_FAILURE() << "expected farfield::Error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("no grid-mesh impostors"), std::string::npos) << e.what();
@@ -229,7 +229,7 @@ TEST(ImpostorModeTest, BadStoresAreErrors) {
   context.scene = &other;
   context.options["impostor_dir"] = s.store;
   try {
-    eval::createMode("depth-mesh", context)->prepare(context);
+    createMode("depth-mesh", context)->prepare(context);
     ADD_FAILURE() << "expected farfield::Error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("baked for a scene with"), std::string::npos) << e.what();
@@ -238,7 +238,7 @@ TEST(ImpostorModeTest, BadStoresAreErrors) {
   context.scene = &s.city.scene;
   context.options["impostor_dir"] = "/nonexistent";
   context.options["depth_mesh_dir"] = s.store;
-  EXPECT_NO_THROW(eval::createMode("depth-mesh", context)->prepare(context));
+  EXPECT_NO_THROW(createMode("depth-mesh", context)->prepare(context));
 }
 
 TEST(ImpostorCacheTest, EvictsTheLeastRecentlyUsed) {
@@ -258,4 +258,4 @@ TEST(ImpostorCacheTest, EvictsTheLeastRecentlyUsed) {
 }
 
 }  // namespace
-}  // namespace farfield::runtime
+}  // namespace farfield::eval

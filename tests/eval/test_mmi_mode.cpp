@@ -18,15 +18,15 @@
 #include "farfield/eval/frame_runner.h"
 #include "farfield/gen/city.h"
 #include "farfield/gpu/context.h"
-#include "farfield/runtime/impostor_mode.h"
-#include "farfield/runtime/mmi_mode.h"
+#include "farfield/eval/impostor_mode.h"
+#include "farfield/eval/mmi_mode.h"
 #include "farfield/store/impostor_store.h"
 #include "farfield/urban/cells.h"
 #include "support/test_support.h"
 
 namespace fs = std::filesystem;
 
-namespace farfield::runtime {
+namespace farfield::eval {
 namespace {
 
 constexpr int kFrameSize = 192;
@@ -77,17 +77,17 @@ const MmiCity& mmiCity() {
   return *s;
 }
 
-eval::BenchResult runModes(const gen::CameraPath& path, std::vector<std::string> modes, const std::string& store,
+BenchResult runModes(const gen::CameraPath& path, std::vector<std::string> modes, const std::string& store,
                            std::map<std::string, std::string> extra = {}) {
-  registerModes();
-  eval::BenchOptions options;
+  registerImpostorModes();
+  BenchOptions options;
   options.modes = std::move(modes);
   options.width = options.height = kFrameSize;
   options.reference = true;
   options.samples = 0;
   options.mode_options = std::move(extra);
   options.mode_options["impostor_dir"] = store;
-  return eval::runBench(gpu::sharedHeadlessContext(), mmiCity().city.scene, path, options);
+  return runBench(gpu::sharedHeadlessContext(), mmiCity().city.scene, path, options);
 }
 
 class MmiModeTest : public ::testing::Test {
@@ -98,19 +98,19 @@ class MmiModeTest : public ::testing::Test {
 TEST_F(MmiModeTest, TheFiveModesRunOverTheBakedWalk) {
   const MmiCity& s = mmiCity();
   ASSERT_GE(s.visited.size(), 2u) << "the walk should cross at least one junction";
-  const eval::BenchResult r = runModes(s.path, {"culled", "local", "visible", "smi", "mmi", "mmi-dynamic"}, s.store);
-  const eval::ModeResult* full = r.mode("full");
-  const eval::ModeResult* culled = r.mode("culled");
-  const eval::ModeResult* local = r.mode("local");
-  const eval::ModeResult* visible = r.mode("visible");
-  const eval::ModeResult* smi = r.mode("smi");
-  const eval::ModeResult* mmi = r.mode("mmi");
-  const eval::ModeResult* dynamic = r.mode("mmi-dynamic");
+  const BenchResult r = runModes(s.path, {"culled", "local", "visible", "smi", "mmi", "mmi-dynamic"}, s.store);
+  const ModeResult* full = r.mode("full");
+  const ModeResult* culled = r.mode("culled");
+  const ModeResult* local = r.mode("local");
+  const ModeResult* visible = r.mode("visible");
+  const ModeResult* smi = r.mode("smi");
+  const ModeResult* mmi = r.mode("mmi");
+  const ModeResult* dynamic = r.mode("mmi-dynamic");
   ASSERT_TRUE(full && culled && local && visible && smi && mmi && dynamic);
   ASSERT_EQ(mmi->frames.size(), s.path.frames.size());
 
   // Every frame found its cell baked; each cell was read once.
-  for (const eval::ModeResult* m : {local, visible, smi, mmi, dynamic}) {
+  for (const ModeResult* m : {local, visible, smi, mmi, dynamic}) {
     EXPECT_EQ(m->info.at("fallback_frames"), 0.0) << m->name;
     EXPECT_EQ(m->info.at("cells_visited"), double(s.visited.size())) << m->name;
     EXPECT_EQ(m->info.at("cell_loads"), double(s.visited.size())) << m->name;
@@ -144,7 +144,7 @@ TEST_F(MmiModeTest, TheFiveModesRunOverTheBakedWalk) {
               mmi->frames.size(), s.visited.size(), full->mean_triangles, culled->mean_triangles,
               visible->mean_triangles, local->mean_triangles, smi->mean_triangles, mmi->mean_triangles,
               dynamic->mean_triangles);
-  for (const eval::ModeResult* m : {culled, visible, local, smi, mmi, dynamic})
+  for (const ModeResult* m : {culled, visible, local, smi, mmi, dynamic})
     std::printf("  %-12s PSNR %6.2f dB (min %6.2f), SSIM %.3f, cracks %.3f%%, median %.2f ms\n", m->name.c_str(),
                 m->psnr_db_mean, m->psnr_db_min, m->ssim_mean, 100.0 * m->crack_share_mean, m->wall.median);
   std::printf("  mmi-dynamic: updates %.0f, fast-motion frames %.0f, skipped for budget %.0f\n",
@@ -198,11 +198,11 @@ TEST_F(MmiModeTest, StandingStillTheDynamicImpostorsReplaceInvalidLayersWithinTh
   ASSERT_EQ(s.cells->lookup(start, dir), cell);
   ASSERT_EQ(s.cells->lookup(still, dir), cell);
 
-  const eval::BenchResult r =
+  const BenchResult r =
       runModes(path, {"mmi", "mmi-dynamic"}, s.store,
                {{"frame_budget_ms", "10000"}, {"dynamic_max_updates", "1"}});
-  const eval::ModeResult* mmi = r.mode("mmi");
-  const eval::ModeResult* dynamic = r.mode("mmi-dynamic");
+  const ModeResult* mmi = r.mode("mmi");
+  const ModeResult* dynamic = r.mode("mmi-dynamic");
   ASSERT_TRUE(mmi && dynamic);
   ASSERT_EQ(dynamic->errors.size(), 9u);
   std::printf("cell %u (%zu layers), standing at 70%%: mmi %.2f dB; mmi-dynamic per frame:", cell, layers,
@@ -245,9 +245,9 @@ TEST_F(MmiModeTest, StandingStillTheDynamicImpostorsReplaceInvalidLayersWithinTh
 // every layer falls back to its pre-computed MMI and nothing is updated: such frames are the mmi mode's frames.
 TEST_F(MmiModeTest, FastMotionFallsBackToThePrecomputedLayers) {
   const MmiCity& s = mmiCity();
-  const eval::BenchResult r = runModes(s.path, {"mmi", "mmi-dynamic"}, s.store, {{"frame_budget_ms", "10000"}});
-  const eval::ModeResult* mmi = r.mode("mmi");
-  const eval::ModeResult* dynamic = r.mode("mmi-dynamic");
+  const BenchResult r = runModes(s.path, {"mmi", "mmi-dynamic"}, s.store, {{"frame_budget_ms", "10000"}});
+  const ModeResult* mmi = r.mode("mmi");
+  const ModeResult* dynamic = r.mode("mmi-dynamic");
   ASSERT_TRUE(mmi && dynamic);
   const double fast = dynamic->info.at("fast_motion_frames");
   const double updates = dynamic->info.at("updates");
@@ -263,13 +263,40 @@ TEST_F(MmiModeTest, FastMotionFallsBackToThePrecomputedLayers) {
   }
 }
 
+// The contract's fallback: under a bound no impostor can keep (a ten-thousandth of a pixel), every layer and the single
+// mesh are drawn as their objects' geometry, so each frame is the geometry of the cell's potentially visible set:
+// no impostor triangle, no parallax, and the image of the `visible` mode (near and far objects as geometry).
+TEST_F(MmiModeTest, WhereNoImpostorIsValidTheObjectsAreDrawnAsGeometry) {
+  const MmiCity& s = mmiCity();
+  const BenchResult strict = runModes(s.path, {"visible", "smi", "mmi"}, s.store, {{"error_px", "0.0001"}});
+  const BenchResult loose = runModes(s.path, {"mmi"}, s.store);
+  const ModeResult* visible = strict.mode("visible");
+  ASSERT_TRUE(visible && strict.mode("smi") && strict.mode("mmi") && loose.mode("mmi"));
+  for (const char* name : {"smi", "mmi"}) {
+    const ModeResult* m = strict.mode(name);
+    SCOPED_TRACE(name);
+    EXPECT_EQ(m->info.at("mean_impostor_triangles"), 0.0);
+    EXPECT_GT(m->info.at("invalid_layer_draws"), 0.0);
+    EXPECT_EQ(m->info.at("unchecked_layer_draws"), 0.0);
+    EXPECT_EQ(m->info.at("error_bound_px"), 0.0001);
+    ASSERT_EQ(m->errors.size(), visible->errors.size());
+    for (size_t k = 0; k < m->errors.size(); ++k) {
+      EXPECT_NEAR(m->errors[k].psnr_db, visible->errors[k].psnr_db, 1e-9) << "frame " << k;
+      EXPECT_NEAR(m->crack_shares[k], visible->crack_shares[k], 1e-12) << "frame " << k;
+    }
+  }
+  // At the bake's bound the same store draws impostors (the check above is not vacuous).
+  EXPECT_GT(loose.mode("mmi")->info.at("mean_impostor_triangles"), 0.0);
+  EXPECT_EQ(loose.mode("mmi")->info.at("error_bound_px"), pipelineOptions().error_px);
+}
+
 // `bake --online mmi`: the store holds the PVS and the split; the mode runs the mmi stage when it enters a cell.
 TEST_F(MmiModeTest, OnlineStoreRunsTheMissingStagesAndMatchesTheBakedStore) {
   const MmiCity& s = mmiCity();
-  const eval::BenchResult baked = runModes(s.path, {"mmi"}, s.store);
-  const eval::BenchResult online = runModes(s.path, {"mmi", "local"}, s.online_store);
-  const eval::ModeResult* b = baked.mode("mmi");
-  const eval::ModeResult* o = online.mode("mmi");
+  const BenchResult baked = runModes(s.path, {"mmi"}, s.store);
+  const BenchResult online = runModes(s.path, {"mmi", "local"}, s.online_store);
+  const ModeResult* b = baked.mode("mmi");
+  const ModeResult* o = online.mode("mmi");
   ASSERT_TRUE(b && o);
   std::printf("mmi: baked store %.2f dB, %.0f triangles; online store %.2f dB, %.0f triangles, %.0f online runs "
               "(%.1f ms each)\n",
@@ -287,11 +314,11 @@ TEST_F(MmiModeTest, OnlineStoreRunsTheMissingStagesAndMatchesTheBakedStore) {
 
 TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
   const MmiCity& s = mmiCity();
-  registerModes();
-  eval::ModeContext context;
+  registerImpostorModes();
+  ModeContext context;
   context.scene = &s.city.scene;
   for (const char* mode : {"local", "visible", "smi", "mmi", "mmi-dynamic"})
-    EXPECT_THROW(eval::createMode(mode, context), Error) << mode;  // no impostor_dir
+    EXPECT_THROW(createMode(mode, context), Error) << mode;  // no impostor_dir
 
   context.options["impostor_dir"] = s.store;
   for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
@@ -304,20 +331,20 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
            {"impostor_ids", "triangle"},
            {"impostor_cache", "0"},
            {"cell_lookup", "closest"}}) {
-    eval::ModeContext bad = context;
+    ModeContext bad = context;
     bad.options[key] = value;
     try {
-      eval::createMode("mmi-dynamic", bad);
+      createMode("mmi-dynamic", bad);
       ADD_FAILURE() << key << "=" << value << " should be an error";
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   }
-  EXPECT_NO_THROW(eval::createMode("mmi-dynamic", context));
+  EXPECT_NO_THROW(createMode("mmi-dynamic", context));
 
   // Modes need a GL context and the harness's resources to prepare.
   gpu::sharedHeadlessContext().makeCurrent();
-  eval::ModeRunResources run(s.city.scene, kFrameSize, kFrameSize, context.options);
+  ModeRunResources run(s.city.scene, kFrameSize, kFrameSize, context.options);
 
   // A Sillion store (bake::bakeCells) has no pipeline records.
   const std::string sillion = test::scratchDir("mmi_mode_sillion").string();
@@ -328,7 +355,7 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
   run.context.options["impostor_dir"] = sillion;
   for (const char* mode : {"local", "visible", "smi", "mmi", "mmi-dynamic"}) {
     try {
-      eval::createMode(mode, run.context)->prepare(run.context);
+      createMode(mode, run.context)->prepare(run.context);
       ADD_FAILURE() << mode << " should refuse a store without pipeline data";
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find("pipeline"), std::string::npos) << e.what();
@@ -342,11 +369,11 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
   bake::bakePipeline(gpu::sharedHeadlessContext(), s.city.scene, *s.cells, {s.visited.front()},
                      bake::parsePipeline("pvs,near-far"), po, no_mmi);
   run.context.options["impostor_dir"] = no_mmi;
-  EXPECT_NO_THROW(eval::createMode("local", run.context)->prepare(run.context));
-  EXPECT_NO_THROW(eval::createMode("visible", run.context)->prepare(run.context));
+  EXPECT_NO_THROW(createMode("local", run.context)->prepare(run.context));
+  EXPECT_NO_THROW(createMode("visible", run.context)->prepare(run.context));
   for (const char* mode : {"smi", "mmi", "mmi-dynamic"}) {
     try {
-      eval::createMode(mode, run.context)->prepare(run.context);
+      createMode(mode, run.context)->prepare(run.context);
       ADD_FAILURE() << mode << " should refuse a pipeline without mmi";
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find("mmi"), std::string::npos) << e.what();
@@ -354,18 +381,18 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
   }
   // A missing directory, and a scene other than the one baked.
   run.context.options["impostor_dir"] = (fs::path(s.store) / "missing").string();
-  EXPECT_THROW(eval::createMode("mmi", run.context)->prepare(run.context), Error);
+  EXPECT_THROW(createMode("mmi", run.context)->prepare(run.context), Error);
   scene::Scene other = s.city.scene;
   other.objects.pop_back();
-  eval::ModeContext other_context = run.context;
+  ModeContext other_context = run.context;
   other_context.scene = &other;
   other_context.options["impostor_dir"] = s.store;
-  EXPECT_THROW(eval::createMode("mmi", other_context)->prepare(other_context), Error);
+  EXPECT_THROW(createMode("mmi", other_context)->prepare(other_context), Error);
   // mmi_dir overrides impostor_dir for these modes.
   run.context.options["impostor_dir"] = "/nonexistent";
   run.context.options["mmi_dir"] = s.store;
-  EXPECT_NO_THROW(eval::createMode("mmi", run.context)->prepare(run.context));
+  EXPECT_NO_THROW(createMode("mmi", run.context)->prepare(run.context));
 }
 
 }  // namespace
-}  // namespace farfield::runtime
+}  // namespace farfield::eval

@@ -8,7 +8,7 @@
 //
 // The stages are composed from the CLI (`farfield bake --pipeline pvs,near-far,mmi`). Where the pipeline splits
 // between preprocessing and online computation is an option (`--online mmi`, or `--online near-far,mmi`): the bake
-// runs and stores the stages before the split; the runtime (farfield/runtime/mmi_mode.h) runs the others with the same
+// runs and stores the stages before the split; the runtime (farfield/runtime/walkthrough.h) runs the others with the same
 // code when the viewer enters a cell, inside that frame, so their cost shows in the frame times. A stage that is
 // skipped leaves its input as it is: without `pvs` every object is a candidate; `mmi` needs `near-far` before it.
 #pragma once

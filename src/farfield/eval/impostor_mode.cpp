@@ -1,11 +1,11 @@
 // Local model + cell impostor per frame (Sillion et al. 1997, section 3: "always draw the combination of the
 // impostors of the current cell and its local model, to obtain a view of the entire model").
 //
-// Why registerModes() instead of a static RegisterMode object: the runtime library is static and nothing in an
+// Why registerImpostorModes() instead of a static RegisterMode object: the eval library is static and nothing in an
 // executable refers to this file's symbols except through the registry, so the linker would drop the object file
 // together with its static initialiser and the modes would silently be missing. A function the executable calls
 // pulls the file in for certain.
-#include "farfield/runtime/impostor_mode.h"
+#include "farfield/eval/impostor_mode.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -14,46 +14,28 @@
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
-#include "farfield/runtime/mmi_mode.h"
+#include "farfield/eval/mmi_mode.h"
 
 namespace fs = std::filesystem;
 
-namespace farfield::runtime {
+namespace farfield::eval {
 
 namespace {
 constexpr size_t kDefaultCache = 16;
 }
 
-void registerModes() {
-  eval::registerMode("depth-mesh",
+void registerImpostorModes() {
+  registerMode("depth-mesh",
                      "local model (blocks touching the street) + the cell's textured depth-mesh impostor "
                      "(Sillion 1997); --impostors DIR",
-                     [](const eval::ModeContext& c) { return std::make_unique<ImpostorMode>("depth-mesh", c); });
-  eval::registerMode("grid-mesh",
+                     [](const ModeContext& c) { return std::make_unique<ImpostorMode>("depth-mesh", c); });
+  registerMode("grid-mesh",
                      "local model + the cell's regular-grid mesh impostor (baseline); --impostors DIR",
-                     [](const eval::ModeContext& c) { return std::make_unique<ImpostorMode>("grid-mesh", c); });
+                     [](const ModeContext& c) { return std::make_unique<ImpostorMode>("grid-mesh", c); });
   registerMmiModes();
 }
 
-OpenStore openStore(const std::string& dir, const scene::Scene& scene, const std::string& lookup_option) {
-  OpenStore out;
-  out.index = store::readIndex(dir);
-  out.index_file = (fs::path(dir) / store::kIndexFile).string();
-  if (out.index.scene_objects != scene.objects.size())
-    throw Error(out.index_file, "was baked for a scene with " + std::to_string(out.index.scene_objects) +
-                                    " objects, but this scene has " + std::to_string(scene.objects.size()));
-  out.graph = urban::StreetGraph::load((fs::path(dir) / out.index.streets).string());
-  out.locator = urban::CellLocator(
-      out.graph, urban::parseCellLookup(lookup_option.empty() ? out.index.cell_lookup : lookup_option,
-                                        lookup_option.empty() ? out.index_file + ": cell_lookup" : "cell_lookup"));
-  for (const store::CellEntry& e : out.index.cells)
-    if (e.half_edge >= out.graph.halfEdgeCount())
-      throw Error(out.index_file,
-                  "cell " + std::to_string(e.half_edge) + " is not a half-edge of " + out.index.streets);
-  return out;
-}
-
-size_t positiveOption(const eval::ModeContext& context, const std::string& key, size_t fallback) {
+size_t positiveOption(const ModeContext& context, const std::string& key, size_t fallback) {
   const std::string text = context.option(key, std::to_string(fallback));
   try {
     size_t used = 0;
@@ -104,7 +86,7 @@ size_t ImpostorCache::gpuBytes() const {
 // ---------------------------------------------------------------------------------------------------------------
 // ImpostorMode
 
-ImpostorMode::ImpostorMode(std::string technique, const eval::ModeContext& context)
+ImpostorMode::ImpostorMode(std::string technique, const ModeContext& context)
     : technique_(std::move(technique)) {
   std::string key = technique_;
   std::replace(key.begin(), key.end(), '-', '_');
@@ -123,11 +105,11 @@ ImpostorMode::ImpostorMode(std::string technique, const eval::ModeContext& conte
 
 ImpostorMode::~ImpostorMode() = default;
 
-void ImpostorMode::prepare(const eval::ModeContext& context) {
+void ImpostorMode::prepare(const ModeContext& context) {
   scene_ = context.scene;
   gpu_scene_ = context.gpu_scene;
   bvh_ = context.bvh;
-  OpenStore opened = openStore(dir_, *scene_, lookup_option_);
+  runtime::OpenStore opened = runtime::openStore(dir_, *scene_, lookup_option_);
   index_ = std::move(opened.index);
   graph_ = std::move(opened.graph);
   locator_ = std::move(opened.locator);
@@ -154,7 +136,7 @@ void ImpostorMode::prepare(const eval::ModeContext& context) {
   });
 }
 
-void ImpostorMode::frame(eval::FrameContext& frame) {
+void ImpostorMode::frame(FrameContext& frame) {
   const Camera& camera = frame.camera();
   const Vec3 view = camera.at - camera.eye;
   const uint32_t cell = locator_.lookup(graph_, camera.eye, view);
@@ -172,7 +154,8 @@ void ImpostorMode::frame(eval::FrameContext& frame) {
   if (cell != urban::kNone) ++visited_[cell];
 
   ids_.clear();
-  bvh_->queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
+  const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  bvh_->queryFrustum(frustum, ids_);
   if (current_entry_) {
     ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [&](uint32_t id) { return !local_mask_[id]; }),
                ids_.end());
@@ -181,7 +164,7 @@ void ImpostorMode::frame(eval::FrameContext& frame) {
   }
   std::sort(ids_.begin(), ids_.end());
   // GpuScene::appendDrawItems takes an empty list as "all objects": nothing visible must draw nothing.
-  if (!ids_.empty()) gpu_scene_->appendDrawItems(ids_, frame.items());
+  if (!ids_.empty()) gpu_scene_->appendDrawItems(ids_, frame.items(), camera);
   for (uint32_t id : ids_) local_triangles_sum_ += double(object_triangles_[id]);
   local_objects_sum_ += double(ids_.size());
 
@@ -214,4 +197,4 @@ std::map<std::string, double> ImpostorMode::info() const {
   return out;
 }
 
-}  // namespace farfield::runtime
+}  // namespace farfield::eval

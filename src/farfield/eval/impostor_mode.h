@@ -31,30 +31,21 @@
 #include <vector>
 
 #include "farfield/eval/mode.h"
+#include "farfield/runtime/database.h"
 #include "farfield/impostor/drawable.h"
 #include "farfield/store/impostor_store.h"
 #include "farfield/urban/cells.h"
 #include "farfield/urban/street_graph.h"
 
-namespace farfield::runtime {
+namespace farfield::eval {
 
 // Registers "depth-mesh" and "grid-mesh", and the pipeline-store modes of mmi_mode.h (local, visible, smi, mmi,
 // mmi-dynamic), into eval's mode registry (idempotent). Executables call it before they
 // list or create modes (see the .cpp for why registration is not a static object).
-void registerModes();
+void registerImpostorModes();
 
-// An impostor store opened for a walkthrough: its index, street graph and cell locator. Checks that the store was
-// baked for a scene with as many objects as `scene` and that its cells are half-edges of its graph; lookup_option
-// ("" = the store's rule, else street or nearest) picks the cell lookup. Throws farfield::Error naming the file.
-struct OpenStore {
-  store::StoreIndex index;
-  std::string index_file;
-  urban::StreetGraph graph;
-  urban::CellLocator locator;
-};
-OpenStore openStore(const std::string& dir, const scene::Scene& scene, const std::string& lookup_option);
 // A positive integer mode option (e.g. impostor_cache); throws farfield::Error naming the option.
-size_t positiveOption(const eval::ModeContext& context, const std::string& key, size_t fallback);
+size_t positiveOption(const ModeContext& context, const std::string& key, size_t fallback);
 
 // Least-recently-used cache of GPU impostors by cell. Needs a current context for get() and for destruction.
 class ImpostorCache {
@@ -87,15 +78,15 @@ class ImpostorCache {
   double load_ms_max_ = 0.0;
 };
 
-class ImpostorMode final : public eval::Mode {
+class ImpostorMode final : public Mode {
  public:
   // technique: "depth-mesh" or "grid-mesh" (the mode's name).
-  ImpostorMode(std::string technique, const eval::ModeContext& context);
+  ImpostorMode(std::string technique, const ModeContext& context);
   ~ImpostorMode() override;
 
   std::string name() const override { return technique_; }
-  void prepare(const eval::ModeContext& context) override;
-  void frame(eval::FrameContext& frame) override;
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
   // frames, impostor_loads (the warm-up frame's included), impostor_load_ms_max/mean, cache_evictions,
   // fallback_frames (no impostor baked for the cell), cells_visited, cell_changes, baked_cells,
   // mean_impostor_triangles (frames with an impostor), mean_geometry_triangles and mean_geometry_objects (the culled
@@ -134,4 +125,4 @@ class ImpostorMode final : public eval::Mode {
   size_t peak_gpu_bytes_ = 0;
 };
 
-}  // namespace farfield::runtime
+}  // namespace farfield::eval

@@ -1,0 +1,480 @@
+#include "farfield/runtime/walkthrough.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+#include "farfield/core/error_bound.h"
+#include "farfield/core/timer.h"
+#include "farfield/runtime/database.h"
+
+namespace farfield::runtime {
+
+namespace {
+
+bool contains(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+}  // namespace
+
+const char* representationName(Representation representation) {
+  switch (representation) {
+    case Representation::Local: return "local";
+    case Representation::Visible: return "visible";
+    case Representation::Smi: return "smi";
+    case Representation::Mmi: return "mmi";
+    case Representation::MmiDynamic: return "mmi-dynamic";
+  }
+  return "?";
+}
+
+struct Walkthrough::Layer {
+  std::vector<uint32_t> objects;
+  Box3 bounds;                                        // world bounds of its objects
+  std::vector<std::unique_ptr<impostor::GpuImpostor>> views;
+  std::vector<Vec3> view_eyes;                        // creation eyes of the views
+  std::vector<uint32_t> view_station;                 // capture station of each view
+  std::vector<impostor::ValidityRegion> validity;     // per station (none in version 2 databases)
+  std::unique_ptr<DynamicImpostor> dynamic;
+};
+
+struct Walkthrough::Cell {
+  std::vector<uint8_t> geometry_mask;  // per object id: always drawn as geometry with this cell
+  std::vector<Layer> layers;           // MMI layers, or the single mesh as one layer (Smi)
+  bool online = false;                 // stages run at load time
+};
+
+Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const scene::Bvh& bvh,
+                         gpu::Renderer& renderer, WalkthroughOptions options)
+    : scene_(scene), gpu_scene_(gpu_scene), bvh_(bvh), renderer_(renderer), options_(std::move(options)) {
+  const Representation kind = options_.representation;
+  const std::string me = std::string("walkthrough '") + representationName(kind) + "'";
+  if (options_.database.empty())
+    throw Error(me, "needs an impostor database: a directory written by farfield bake --pipeline pvs,near-far,mmi");
+  if (options_.cache_cells < 1) throw Error(me, "the cell cache must hold at least one cell");
+  if (!(options_.error_px >= 0.0) || !std::isfinite(options_.error_px))
+    throw Error(me, "error bound must be a finite number of pixels >= 0");
+  OpenStore opened = openStore(options_.database, scene, options_.cell_lookup);
+  index_ = std::move(opened.index);
+  graph_ = std::move(opened.graph);
+  locator_ = std::move(opened.locator);
+  const std::string& index_file = opened.index_file;
+  if (index_.pipeline.empty())
+    throw Error(index_file, "holds no pipeline data (" + me + " needs a store baked with farfield bake --pipeline "
+                            "pvs,near-far,mmi)");
+  {
+    // The stage lists must make a valid pipeline (known stages, in order, online a tail).
+    std::string stages, online;
+    for (const std::string& st : index_.pipeline) stages += (stages.empty() ? "" : ",") + st;
+    for (const std::string& st : index_.online) online += (online.empty() ? "" : ",") + st;
+    try {
+      bake::parsePipeline(stages, online);
+    } catch (const Error& e) {
+      throw Error(index_file, std::string("bad \"pipeline\"/\"online\": ") + e.what());
+    }
+  }
+  std::vector<std::string> baked;
+  for (const std::string& s : index_.pipeline)
+    if (!contains(index_.online, s)) baked.push_back(s);
+  const char* needed = kind == Representation::Visible ? bake::kStagePvs
+                       : kind == Representation::Local ? bake::kStageNearFar
+                                                       : bake::kStageMmi;
+  if (!contains(index_.pipeline, needed))
+    throw Error(index_file, "its pipeline has no " + std::string(needed) + " stage, which " + me + " needs");
+  if (kind == Representation::Visible && !contains(baked, bake::kStagePvs))
+    throw Error(index_file, me + " needs the pvs stage baked");
+  for (const std::string& s : index_.online) {
+    // Stages this representation needs that the bake left to the runtime.
+    const bool needs = kind == Representation::Local     ? s == bake::kStageNearFar
+                       : kind == Representation::Visible ? false
+                                                         : true;
+    if (needs) online_stages_.push_back(s);
+  }
+  const nlohmann::json stored_options =
+      index_.options.contains("pipeline") ? index_.options["pipeline"] : nlohmann::json::object();
+  const bake::PipelineOptions pipeline_options =
+      bake::pipelineOptionsFromJson(stored_options, index_file + ": options.pipeline", index_.version);
+  if (options_.error_px <= 0.0) options_.error_px = pipeline_options.error_px;
+  if (!online_stages_.empty()) {
+    urban::CellOptions cell_options;
+    cell_options.local = urban::parseLocalModel(index_.local_model, index_file + ": local_model");
+    if (index_.options.contains("block_margin") && index_.options["block_margin"].is_number())
+      cell_options.block_margin = index_.options["block_margin"].get<float>();
+    cell_map_ = std::make_unique<urban::CellMap>(graph_, scene, cell_options);
+    runner_ = std::make_unique<bake::PipelineRunner>(scene, gpu_scene, *cell_map_, pipeline_options);
+  }
+  invalid_object_.assign(scene.objects.size() + 1, 0);
+  object_triangles_.assign(scene.objects.size() + 1, 0);
+  for (const scene::Object& o : scene.objects)
+    for (const scene::Part& p : o.parts) object_triangles_[o.id] += scene.meshes[p.mesh].triangleCount();
+  layer_id_base_ = uint32_t(scene.objects.size() + 1);
+  if (kind == Representation::MmiDynamic) {
+    // A few tenths of a second on llvmpipe: cap the triangles per workload so big scenes calibrate as fast.
+    CalibrationOptions calibration;
+    calibration.max_triangles = 400000;
+    // From where the walkthrough looks: the creation cameras of up to three stored cells (street level, along the
+    // street). An overview of the city overdraws differently and mispredicted street frames by a factor of several.
+    for (size_t k = 0; k < 3 && k < index_.cells.size(); ++k) {
+      Camera view = index_.cells[k * (index_.cells.size() - 1) / 2].camera;
+      view.width = options_.width;
+      view.height = options_.height;
+      calibration.views.push_back(view);
+    }
+    cost_ = calibrateCostModel(renderer_, gpu_scene_, calibration);
+  }
+}
+
+Walkthrough::~Walkthrough() = default;
+
+std::unique_ptr<Walkthrough::Cell> Walkthrough::loadCell(const store::CellEntry& entry) {
+  if (!entry.pipeline)
+    throw Error(options_.database, "cell " + std::to_string(entry.half_edge) + " has no pipeline record");
+  const Representation kind = options_.representation;
+  store::CellPipeline record = *entry.pipeline;
+  bake::CellWork work;
+  auto cell = std::make_unique<Cell>();
+  if (!online_stages_.empty()) {
+    Stopwatch timer;
+    work = runner_->resume(entry.half_edge, record);
+    runner_->runStages(online_stages_, work);
+    record = work.result;
+    stats_.online_ms_total += timer.milliseconds();
+    ++stats_.online_runs;
+    cell->online = true;
+  }
+  cell->geometry_mask.assign(scene_.objects.size() + 1, 0);
+  const std::vector<uint32_t>& geometry = kind == Representation::Visible ? record.pvs : record.near;
+  for (uint32_t id : geometry) cell->geometry_mask[id] = 1;
+  if (kind == Representation::Local || kind == Representation::Visible) return cell;
+
+  impostor::GpuImpostorOptions gpu_options;
+  gpu_options.id_texture = options_.object_ids;  // per-pixel object ids in item buffers, one draw call per view
+  const bool single = kind == Representation::Smi;
+  const std::vector<store::StoredLayer> layers = single ? std::vector<store::StoredLayer>{record.single}
+                                                        : record.layers;
+  for (size_t l = 0; l < layers.size(); ++l) {
+    Layer layer;
+    layer.objects = layers[l].objects;
+    layer.validity = layers[l].validity;
+    for (uint32_t id : layer.objects) layer.bounds.expand(scene_.objects[id - 1].world_bounds);
+    for (size_t v = 0; v < layers[l].views.size(); ++v) {
+      impostor::DepthMeshImpostor imp;
+      if (cell->online)
+        imp = single ? std::move(work.single_views[v]) : std::move(work.layer_views[l][v]);
+      else
+        imp = store::loadLayerView(options_.database, layers[l].views[v]);
+      if (imp.empty()) continue;
+      layer.view_eyes.push_back(imp.camera.eye);
+      layer.view_station.push_back(layers[l].views[v].station);
+      layer.views.push_back(std::make_unique<impostor::GpuImpostor>(imp, gpu_options));
+    }
+    cell->layers.push_back(std::move(layer));
+  }
+  return cell;
+}
+
+Walkthrough::Cell& Walkthrough::cell(uint32_t half_edge, bool* loaded) {
+  *loaded = false;
+  const auto it = cells_.find(half_edge);
+  if (it != cells_.end()) {
+    order_.remove(half_edge);
+    order_.push_front(half_edge);
+    return *it->second;
+  }
+  const store::CellEntry* entry = index_.find(half_edge);
+  FF_CHECK(entry != nullptr);
+  Stopwatch timer;
+  std::unique_ptr<Cell> fresh = loadCell(*entry);
+  const double ms = timer.milliseconds();
+  *loaded = true;
+  ++stats_.loads;
+  stats_.load_ms_total += ms;
+  stats_.load_ms_max = std::max(stats_.load_ms_max, ms);
+  while (cells_.size() >= options_.cache_cells && !order_.empty()) {
+    cells_.erase(order_.back());
+    order_.pop_back();
+    ++stats_.evictions;
+  }
+  order_.push_front(half_edge);
+  return *(cells_[half_edge] = std::move(fresh));
+}
+
+const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<void()>& before_gpu_work) {
+  FramePlan& plan = plan_;
+  plan.items.clear();
+  plan.layers.clear();
+  plan.report = {};
+  FrameReport& report = plan.report;
+  ++stats_.frames;
+  const uint32_t half_edge = locator_.lookup(graph_, camera.eye, camera.at - camera.eye);
+  const store::CellEntry* entry = half_edge == urban::kNone ? nullptr : index_.find(half_edge);
+  report.cell = half_edge;
+  report.baked = entry != nullptr;
+  const ErrorBound bound = ErrorBound::forCamera(options_.error_px, camera);
+  report.bound_px = options_.error_px;
+  report.bound_rad = bound.angle();
+  const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  ids_.clear();
+  bvh_.queryFrustum(frustum, ids_);
+  Cell* current = nullptr;
+  if (entry) {
+    ++stats_.visited[half_edge];
+    current = &cell(half_edge, &report.loaded);
+    // Fast motion and stale dynamic impostors first: a layer that loses its dynamic impostor is judged by its
+    // baked views' validity below.
+    if (options_.representation == Representation::MmiDynamic) dropStaleDynamic(camera, *current);
+    for (size_t l = 0; l < current->layers.size(); ++l) {
+      const Layer& layer = current->layers[l];
+      const uint32_t index = uint32_t(l);
+      if (layer.dynamic) {
+        plan.layers.push_back(LayerAsDynamic{index});
+        continue;
+      }
+      if (layer.validity.empty()) {
+        plan.layers.push_back(LayerUnchecked{index});
+        ++report.layers_unchecked;
+        continue;
+      }
+      // The bound where the layer is drawn: a layer near the frame's centre may move by a larger angle per pixel.
+      const double theta = bound.angleWithin(frameRadius(camera, layer.bounds));
+      LayerAsImpostor best{index, 0, std::numeric_limits<double>::infinity(), theta};
+      for (size_t j = 0; j < layer.validity.size(); ++j) {
+        const double e = layer.validity[j].errorAt(camera.eye);
+        if (e <= theta && e < best.error_rad) {
+          best.error_rad = e;
+          best.station = uint32_t(j);
+        }
+      }
+      if (best.error_rad <= theta) {
+        plan.layers.push_back(best);
+        continue;
+      }
+      plan.layers.push_back(LayerAsGeometry{index, 0});
+      ++report.layers_as_geometry;
+      for (uint32_t id : layer.objects) invalid_object_[id] = 1;
+    }
+    // Geometry: the cell's near objects and the objects of layers drawn as geometry, in the frustum.
+    ids_.erase(std::remove_if(ids_.begin(), ids_.end(),
+                              [&](uint32_t id) { return !current->geometry_mask[id] && !invalid_object_[id]; }),
+               ids_.end());
+    std::sort(ids_.begin(), ids_.end());
+    for (LayerDecision& decision : plan.layers)
+      if (auto* g = std::get_if<LayerAsGeometry>(&decision)) {
+        for (uint32_t id : current->layers[g->layer].objects) {
+          if (invalid_object_[id] && std::binary_search(ids_.begin(), ids_.end(), id))
+            g->triangles += object_triangles_[id];
+          invalid_object_[id] = 0;
+        }
+      }
+  } else {
+    ++stats_.fallback_frames;  // not baked: everything in the frustum, as the culled mode
+  }
+  std::sort(ids_.begin(), ids_.end());
+  // GpuScene::appendDrawItems takes an empty list as "all objects".
+  if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera);
+  for (const gpu::DrawItem& item : plan.items) report.geometry_triangles += item.triangleCount();
+  stats_.geometry_triangles += double(report.geometry_triangles);
+  if (report.layers_as_geometry > 0) ++stats_.invalid_frames;
+  stats_.invalid_layer_draws += report.layers_as_geometry;
+  stats_.unchecked_layer_draws += report.layers_unchecked;
+  for (const LayerDecision& decision : plan.layers)
+    if (const auto* g = std::get_if<LayerAsGeometry>(&decision)) stats_.invalid_triangles += double(g->triangles);
+  if (!current || current->layers.empty()) return plan;
+
+  if (options_.representation == Representation::MmiDynamic) {
+    updateDynamic(camera, *current, before_gpu_work);
+    // A layer re-rendered in this frame is drawn so at once (one drawn as geometry keeps its geometry this frame).
+    for (LayerDecision& decision : plan.layers) {
+      if (std::holds_alternative<LayerAsGeometry>(decision)) continue;
+      const uint32_t l = std::visit([](const auto& d) { return d.layer; }, decision);
+      if (current->layers[l].dynamic) decision = LayerAsDynamic{l};
+    }
+  }
+  ++stats_.impostor_frames;
+  stats_.layers += double(current->layers.size());
+  for (const LayerDecision& decision : plan.layers) {
+    const auto draw_views = [&](uint32_t l, const LayerAsImpostor* station) {
+      const Layer& layer = current->layers[l];
+      for (size_t v = 0; v < layer.views.size(); ++v) {
+        if (station && layer.view_station[v] != station->station) continue;
+        layer.views[v]->appendDrawItems(plan.items, layer_id_base_ + l);
+        report.impostor_triangles += layer.views[v]->triangleCount();
+      }
+    };
+    if (const auto* i = std::get_if<LayerAsImpostor>(&decision)) draw_views(i->layer, i);
+    if (const auto* u = std::get_if<LayerUnchecked>(&decision)) draw_views(u->layer, nullptr);
+    if (const auto* d = std::get_if<LayerAsDynamic>(&decision)) {
+      const Layer& layer = current->layers[d->layer];
+      layer.dynamic->appendDrawItems(plan.items, layer_id_base_ + d->layer);
+      report.impostor_triangles += layer.dynamic->triangleCount();
+      stats_.dynamic_layers += 1.0;
+    }
+  }
+  stats_.impostor_triangles += double(report.impostor_triangles);
+  return plan;
+}
+
+// Section 5.5, first step: fast motion drops every dynamic impostor; a kept one must still cover the view and stay
+// under its error angle.
+void Walkthrough::dropStaleDynamic(const Camera& camera, Cell& cell) {
+  dynamic_threshold_rad_ = ErrorBound::forCamera(options_.dynamic_error_px, camera).angle();
+  const double threshold = dynamic_threshold_rad_;
+  // Fast motion: the error a fresh impostor of the nearest layer would gather per frame at this speed.
+  bool fast = false;
+  if (has_previous_) {
+    double growth = 0.0;
+    for (const Layer& layer : cell.layers) growth = std::max(growth, errorAngle(previous_eye_, camera.eye, layer.bounds));
+    fast = growth * options_.min_lifetime_frames > threshold;
+  }
+  previous_eye_ = camera.eye;
+  has_previous_ = true;
+  if (fast) {
+    ++stats_.fast_frames;
+    for (Layer& layer : cell.layers) layer.dynamic.reset();
+  }
+  for (Layer& layer : cell.layers)
+    if (layer.dynamic && (!layer.dynamic->covers(camera) || layer.dynamic->errorAngle(camera.eye) > threshold))
+      layer.dynamic.reset();
+  fast_ = fast;
+  plan_.report.fast_motion = fast;
+}
+
+// Section 5.5, second step: the prediction of this frame's cost, then updates in decreasing error angle while they
+// fit in what is left of the budget. An update is drawn from the next frame on (this frame's plan is made).
+void Walkthrough::updateDynamic(const Camera& camera, Cell& cell, const std::function<void()>& before_gpu_work) {
+  if (fast_) return;
+  FrameReport& report = plan_.report;
+  const double threshold = dynamic_threshold_rad_;
+  double triangles = double(report.geometry_triangles);
+  double draws = double(plan_.items.size());
+  for (const LayerDecision& decision : plan_.layers) {
+    if (std::holds_alternative<LayerAsGeometry>(decision)) continue;
+    const Layer& layer = cell.layers[std::visit([](const auto& d) { return d.layer; }, decision)];
+    if (layer.dynamic) {
+      triangles += double(layer.dynamic->triangleCount());
+      draws += 1.0;
+    } else {
+      for (const auto& view : layer.views) triangles += double(view->triangleCount());
+      draws += double(layer.views.size());
+    }
+  }
+  const double pixels = double(camera.width) * double(camera.height);
+  const double predicted = cost_.predict(triangles, draws, pixels);
+  report.predicted_ms = predicted;
+  report.over_budget = predicted > options_.frame_budget_ms;
+  if (report.over_budget) ++stats_.over_budget_frames;
+  stats_.predicted_ms += predicted;
+  ++stats_.predicted_frames;
+  double left = options_.frame_budget_ms - predicted;
+
+  // Candidates: layers whose drawn representation is off by more than the threshold, worst first.
+  std::vector<std::pair<double, size_t>> candidates;
+  for (size_t l = 0; l < cell.layers.size(); ++l) {
+    const Layer& layer = cell.layers[l];
+    double error = 0.0;
+    if (layer.dynamic) {
+      error = layer.dynamic->errorAngle(camera.eye);
+    } else {
+      error = std::numeric_limits<double>::infinity();
+      for (const Vec3& eye : layer.view_eyes) error = std::min(error, errorAngle(eye, camera.eye, layer.bounds));
+      if (layer.view_eyes.empty()) error = 0.0;  // nothing of it in the baked views: nothing to refresh
+    }
+    if (error > threshold) candidates.emplace_back(error, l);
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+
+  const Camera capture = DynamicImpostor::captureCamera(camera, options_.dynamic);
+  const Frustum frustum = Frustum::fromMatrix(capture.viewProjection());
+  const double capture_pixels = double(capture.width) * double(capture.height);
+  bool started = false;
+  for (const auto& [error, l] : candidates) {
+    if (report.updates >= options_.max_updates) break;
+    Layer& layer = cell.layers[l];
+    ids_.clear();
+    uint64_t layer_triangles = 0;
+    for (uint32_t id : layer.objects)
+      if (frustum.intersects(scene_.objects[id - 1].world_bounds)) {
+        ids_.push_back(id);
+        layer_triangles += object_triangles_[id];
+      }
+    if (ids_.empty()) continue;
+    std::vector<gpu::DrawItem> items;
+    gpu_scene_.appendDrawItems(ids_, items);
+    const double cost =
+        cost_.predict(double(layer_triangles), double(items.size()), capture_pixels) + update_overhead_ms_;
+    if (cost > left) {
+      ++stats_.skipped_for_budget;
+      continue;
+    }
+    if (!started && before_gpu_work) before_gpu_work();
+    started = true;
+    layer.dynamic = std::make_unique<DynamicImpostor>(renderer_, items, camera, layer.bounds, options_.dynamic);
+    const double actual = layer.dynamic->updateMs();
+    // What the model does not see (readback, quantisation, meshing, upload), learnt as a running mean.
+    const double render_part = cost - update_overhead_ms_;
+    update_overhead_ms_ = stats_.updates == 0 ? std::max(0.0, actual - render_part)
+                                              : 0.8 * update_overhead_ms_ + 0.2 * std::max(0.0, actual - render_part);
+    stats_.predicted_update_error_ms += std::abs(actual - cost);
+    left -= actual;
+    ++report.updates;
+    ++stats_.updates;
+    stats_.update_ms_total += actual;
+    stats_.update_ms_max = std::max(stats_.update_ms_max, actual);
+    report.update_stats.triangles += layer_triangles;
+    report.update_stats.draw_calls += uint32_t(items.size());
+    report.update_stats.objects += uint32_t(ids_.size());
+  }
+}
+
+std::map<std::string, double> Walkthrough::statistics() const {
+  std::map<std::string, double> out;
+  const Statistics& s = stats_;
+  const double n = s.frames ? double(s.frames) : 1.0;
+  out["frames"] = double(s.frames);
+  out["fallback_frames"] = double(s.fallback_frames);
+  out["cells_visited"] = double(s.visited.size());
+  out["baked_cells"] = double(index_.cells.size());
+  out["cell_loads"] = double(s.loads);
+  out["cell_load_ms_max"] = s.load_ms_max;
+  out["cell_load_ms_mean"] = s.loads ? s.load_ms_total / double(s.loads) : 0.0;
+  out["cache_evictions"] = double(s.evictions);
+  out["online_runs"] = double(s.online_runs);
+  out["online_ms_mean"] = s.online_runs ? s.online_ms_total / double(s.online_runs) : 0.0;
+  out["mean_geometry_triangles"] = s.geometry_triangles / n;
+  const Representation kind = options_.representation;
+  if (kind != Representation::Local && kind != Representation::Visible) {
+    const double f = s.impostor_frames ? double(s.impostor_frames) : 1.0;
+    out["mean_impostor_triangles"] = s.impostor_triangles / f;
+    out["mean_layers"] = s.layers / f;
+    out["error_bound_px"] = options_.error_px;
+    out["invalid_layer_draws"] = double(s.invalid_layer_draws);
+    out["unchecked_layer_draws"] = double(s.unchecked_layer_draws);
+    out["frames_with_invalid_layers"] = double(s.invalid_frames);
+    out["mean_invalid_layer_triangles"] = s.invalid_triangles / n;
+  }
+  if (kind == Representation::MmiDynamic) {
+    out["frame_budget_ms"] = options_.frame_budget_ms;
+    out["dynamic_threshold_rad"] = dynamic_threshold_rad_;
+    out["updates"] = double(s.updates);
+    out["update_ms_mean"] = s.updates ? s.update_ms_total / double(s.updates) : 0.0;
+    out["update_ms_max"] = s.update_ms_max;
+    out["update_prediction_error_ms_mean"] = s.updates ? s.predicted_update_error_ms / double(s.updates) : 0.0;
+    out["updates_skipped_for_budget"] = double(s.skipped_for_budget);
+    out["fast_motion_frames"] = double(s.fast_frames);
+    out["frames_predicted_over_budget"] = double(s.over_budget_frames);
+    out["mean_dynamic_layers"] = s.impostor_frames ? s.dynamic_layers / double(s.impostor_frames) : 0.0;
+    // Frames that were not fast motion (the prediction is made only where updates are considered).
+    out["predicted_frame_ms_mean"] = s.predicted_frames ? s.predicted_ms / double(s.predicted_frames) : 0.0;
+    out["cost_base_ms"] = cost_.base_ms;
+    out["cost_ms_per_mtriangle"] = cost_.ms_per_mtriangle;
+    out["cost_ms_per_draw"] = cost_.ms_per_draw;
+    out["cost_ms_per_mpixel"] = cost_.ms_per_mpixel;
+    out["cost_fit_r2"] = cost_.r2;
+  }
+  return out;
+}
+
+}  // namespace farfield::runtime

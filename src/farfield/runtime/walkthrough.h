@@ -1,0 +1,187 @@
+// The walkthrough an engine embeds (DESIGN.md, "runtime"): it opens a scene and an impostor database baked by
+// `farfield bake --pipeline` and turns each frame's camera into a FramePlan, the draw items of the frame (geometry
+// and impostors) with what was decided for every layer and why, keeping the two promises:
+//   - the error bound: a layer (or the single mesh) is drawn as an impostor only where the validity region of one of
+//     its capture stations, computed at bake time (bake/validity_region.h), says its error stays under the bound
+//     where the layer appears in the frame (ErrorBound::angleWithin); the station with the smallest error is drawn,
+//     and the layer's objects are drawn as geometry where none holds the eye (reported per frame);
+//   - the frame budget (Representation::MmiDynamic): a cost model fitted on this machine (runtime/cost_model.h)
+//     predicts the frame's time, and the time left under the budget re-renders the front-most layers from the
+//     viewer's eye (Decoret et al. 1999, section 5.5; runtime/dynamic_impostor.h), most wrong first.
+// It needs no benchmark harness: eval's bench modes (local, visible, smi, mmi, mmi-dynamic) are thin adapters over
+// it, and examples/embed_walkthrough.cpp drives it from a plain render loop.
+//
+// Cells: the viewer's cell (oriented street edge) is looked up per frame (urban::CellLocator). Its record is read and
+// its impostors uploaded the first time the viewer enters it, inside that frame, and kept in an LRU cache of cells.
+// When the database left stages to the runtime (`bake --online mmi`) they run then. A cell the database does not
+// hold falls back to frustum-culled full geometry (reported).
+//
+// Contract: construct and call plan() with the OpenGL context current on the calling thread; the scene, its GPU copy,
+// its BVH and the renderer must outlive the walkthrough. Throws farfield::Error naming the file for a database that
+// is missing, damaged (store/impostor_store.h) or baked for another scene, and for bad options.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <list>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <variant>
+#include <vector>
+
+#include "farfield/bake/pipeline.h"
+#include "farfield/core/camera.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/impostor/drawable.h"
+#include "farfield/impostor/validity.h"
+#include "farfield/runtime/cost_model.h"
+#include "farfield/runtime/dynamic_impostor.h"
+#include "farfield/scene/bvh.h"
+#include "farfield/store/impostor_store.h"
+#include "farfield/urban/cells.h"
+#include "farfield/urban/street_graph.h"
+
+namespace farfield::runtime {
+
+// What stands for a cell's far objects.
+enum class Representation {
+  Local,       // nothing: the cell's near geometry only (the upper bound of the frame rate)
+  Visible,     // the cell's potentially visible set as geometry (what any image-based method must beat)
+  Smi,         // the single-mesh impostor of the far objects
+  Mmi,         // the multi-mesh impostor, one mesh per layer (Decoret et al. 1999)
+  MmiDynamic,  // mmi, with front-most layers re-rendered under the frame budget (section 5.5)
+};
+const char* representationName(Representation representation);
+
+struct WalkthroughOptions {
+  std::string database;                        // directory written by `farfield bake --pipeline`
+  Representation representation = Representation::Mmi;
+  double error_px = 0.0;                       // the bound in pixels of the frames; 0 = the database's
+  size_t cache_cells = 16;                     // cells kept loaded (least recently used evicted), >= 1
+  bool object_ids = true;                      // impostors carry per-texel object ids (item buffers show objects)
+  std::string cell_lookup;                     // "street" or "nearest"; "" = the database's
+  // MmiDynamic.
+  double frame_budget_ms = 1000.0 / 30.0;
+  double dynamic_error_px = 2.0;               // a dynamic impostor is refreshed beyond this error
+  DynamicImpostorOptions dynamic;
+  size_t max_updates = 1;                      // layer updates per frame at most
+  double min_lifetime_frames = 3.0;            // fast motion: every layer falls back to its baked views
+  int width = 640;                             // frame size the cost model is calibrated for (MmiDynamic)
+  int height = 360;
+};
+
+// One entry of a frame's plan: what was drawn for one layer of the current cell.
+struct LayerAsImpostor {   // a baked station's views, valid under the bound
+  uint32_t layer = 0;
+  uint32_t station = 0;
+  double error_rad = 0.0;  // the region's error at the eye
+  double bound_rad = 0.0;  // the bound where the layer appears
+};
+struct LayerAsGeometry {   // no station holds the eye under the bound: its objects as geometry
+  uint32_t layer = 0;
+  uint64_t triangles = 0;  // of its objects whose bounds meet the frustum (before culling per cluster)
+};
+struct LayerUnchecked {    // a version 2 database has no validity regions: every view drawn, the bound unchecked
+  uint32_t layer = 0;
+};
+struct LayerAsDynamic {    // a dynamic impostor rendered from a recent eye (MmiDynamic)
+  uint32_t layer = 0;
+};
+using LayerDecision = std::variant<LayerAsImpostor, LayerAsGeometry, LayerUnchecked, LayerAsDynamic>;
+
+// What a frame could not promise, and why.
+struct FrameReport {
+  uint32_t cell = urban::kNone;   // half-edge, kNone outside the street graph
+  bool baked = false;             // false: the database does not hold the cell (frustum-culled geometry)
+  bool loaded = false;            // the cell was read (and its online stages run) in this frame
+  double bound_px = 0.0;
+  double bound_rad = 0.0;         // at the frame's corner pixel (ErrorBound::angle)
+  size_t layers_as_geometry = 0;  // the error bound is kept by drawing these as geometry
+  size_t layers_unchecked = 0;    // the bound cannot be checked (no validity regions)
+  uint64_t geometry_triangles = 0;  // drawn (after culling per cluster)
+  uint64_t impostor_triangles = 0;
+  double predicted_ms = 0.0;      // MmiDynamic: the cost model's prediction before updates (0 otherwise)
+  bool over_budget = false;       // MmiDynamic: the prediction exceeded the budget
+  bool fast_motion = false;       // MmiDynamic: every dynamic impostor dropped
+  size_t updates = 0;             // MmiDynamic: layers re-rendered in this frame
+  gpu::FrameStats update_stats;   // what the updates drew (not in items)
+};
+
+struct FramePlan {
+  std::vector<gpu::DrawItem> items;   // the frame's main pass: geometry and impostors
+  std::vector<LayerDecision> layers;  // per layer of the current cell
+  FrameReport report;
+};
+
+class Walkthrough {
+ public:
+  Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const scene::Bvh& bvh,
+              gpu::Renderer& renderer, WalkthroughOptions options);
+  ~Walkthrough();
+  Walkthrough(const Walkthrough&) = delete;
+  Walkthrough& operator=(const Walkthrough&) = delete;
+
+  // The frame for `camera` (its size and field of view set the bound's angle). before_gpu_work, when given, is called
+  // once before the walkthrough renders anything itself in this frame (dynamic updates into their own targets), so a
+  // host can start its frame timer or clear its target first. The plan stays valid until the next call.
+  const FramePlan& plan(const Camera& camera, const std::function<void()>& before_gpu_work = {});
+
+  const WalkthroughOptions& options() const { return options_; }
+  double errorBoundPx() const { return options_.error_px; }
+  const store::StoreIndex& database() const { return index_; }
+  // Totals over the frames so far (the bench's info()).
+  std::map<std::string, double> statistics() const;
+
+ private:
+  struct Layer;
+  struct Cell;
+  Cell& cell(uint32_t half_edge, bool* loaded);
+  std::unique_ptr<Cell> loadCell(const store::CellEntry& entry);
+  void dropStaleDynamic(const Camera& camera, Cell& cell);
+  void updateDynamic(const Camera& camera, Cell& cell, const std::function<void()>& before_gpu_work);
+
+  const scene::Scene& scene_;
+  const gpu::GpuScene& gpu_scene_;
+  const scene::Bvh& bvh_;
+  gpu::Renderer& renderer_;
+  WalkthroughOptions options_;
+
+  store::StoreIndex index_;
+  urban::StreetGraph graph_;
+  urban::CellLocator locator_;
+  std::unique_ptr<urban::CellMap> cell_map_;        // for online stages
+  std::unique_ptr<bake::PipelineRunner> runner_;    // for online stages
+  std::vector<std::string> online_stages_;
+  std::list<uint32_t> order_;                       // LRU of loaded cells, most recent first
+  std::unordered_map<uint32_t, std::unique_ptr<Cell>> cells_;
+  std::vector<uint64_t> object_triangles_;
+  std::vector<uint32_t> ids_;
+  std::vector<uint8_t> invalid_object_;             // per object id: in a layer drawn as geometry this frame
+  uint32_t layer_id_base_ = 0;
+  CostModel cost_;
+  double dynamic_threshold_rad_ = 0.0;
+  bool has_previous_ = false;
+  bool fast_ = false;
+  Vec3 previous_eye_{0.0f};
+  double update_overhead_ms_ = 0.0;  // update time the cost model does not see (readback, meshing), running mean
+  FramePlan plan_;
+
+  struct Statistics {
+    size_t frames = 0, fallback_frames = 0, loads = 0, evictions = 0, online_runs = 0;
+    double load_ms_max = 0.0, load_ms_total = 0.0, online_ms_total = 0.0;
+    std::map<uint32_t, size_t> visited;
+    double geometry_triangles = 0.0, impostor_triangles = 0.0, layers = 0.0;
+    size_t impostor_frames = 0;
+    size_t invalid_layer_draws = 0, unchecked_layer_draws = 0, invalid_frames = 0;
+    double invalid_triangles = 0.0;
+    size_t updates = 0, fast_frames = 0, skipped_for_budget = 0, over_budget_frames = 0;
+    double update_ms_total = 0.0, update_ms_max = 0.0, dynamic_layers = 0.0;
+    double predicted_ms = 0.0, predicted_update_error_ms = 0.0;
+    size_t predicted_frames = 0;
+  } stats_;
+};
+
+}  // namespace farfield::runtime

@@ -1,0 +1,31 @@
+# End to end through the command line and examples/embed_walkthrough: a small city, a drive, a pipeline bake of the
+# cells it visits, then the example embeds the walkthrough over the database and renders the drive. Run by ctest with
+# -DFARFIELD=<binary> -DEXAMPLE=<embed_walkthrough binary> -DWORK=<scratch dir>.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+
+function(run_ok)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${ARGN}: exit code ${rc}\nstdout: ${out}\nstderr: ${err}")
+  endif()
+  set(LAST_OUT "${out}" PARENT_SCOPE)
+endfunction()
+
+run_ok(${FARFIELD} gen city --blocks 12 --detail 0 --seed 4 -o ${WORK}/city.glb)
+run_ok(${FARFIELD} path street ${WORK}/city.streets.json --frames 20 --fps 5 --seed 4 --car -o ${WORK}/drive.json)
+run_ok(${FARFIELD} bake ${WORK}/city.glb --pipeline pvs,near-far,mmi --resolution 128 --pvs-face 32 --pvs-spacing 10
+       --path ${WORK}/drive.json -o ${WORK}/imp)
+run_ok(${EXAMPLE} ${WORK}/city.glb ${WORK}/imp ${WORK}/drive.json 4 ${WORK}/last.png)
+if(NOT LAST_OUT MATCHES "error bound: 4.00 px" OR NOT LAST_OUT MATCHES "layers drawn as impostors [0-9]+ times")
+  message(FATAL_ERROR "embed_walkthrough did not report its plan:\n${LAST_OUT}")
+endif()
+if(NOT EXISTS ${WORK}/last.png)
+  message(FATAL_ERROR "embed_walkthrough did not write its frame")
+endif()
+# A database that is not there is a clear error, exit code 2.
+execute_process(COMMAND ${EXAMPLE} ${WORK}/city.glb ${WORK}/nothing ${WORK}/drive.json RESULT_VARIABLE rc
+                ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "error: .*nothing")
+  message(FATAL_ERROR "a missing database: exit code ${rc}, stderr: ${err}")
+endif()

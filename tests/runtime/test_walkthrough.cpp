@@ -1,0 +1,149 @@
+// runtime::Walkthrough driven the way an engine drives it, without the benchmark harness: a small baked city, the
+// plan of every frame of a drive rendered with the renderer. Under a bound no impostor keeps, every layer is drawn as
+// geometry and the frame is exactly the geometry of the cell's near and layered objects; under the bake's bound some
+// layers are impostors, each inside its region (error under the bound reported with it); bad options are errors.
+#include "farfield/runtime/walkthrough.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <variant>
+
+#include "farfield/bake/bake.h"
+#include "farfield/bake/pipeline.h"
+#include "farfield/core/error.h"
+#include "farfield/gen/city.h"
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/render_target.h"
+#include "support/test_support.h"
+
+namespace farfield::runtime {
+namespace {
+
+struct BakedCity {
+  gen::City city;
+  std::unique_ptr<urban::CellMap> cells;
+  gen::CameraPath path;
+  std::string store;
+};
+
+const BakedCity& bakedCity() {
+  static const BakedCity* s = [] {
+    auto* c = new BakedCity;
+    gen::CityOptions o;
+    o.blocks = 16;
+    o.detail = 0;
+    o.seed = 5;
+    c->city = gen::generateCity(o);
+    c->cells = std::make_unique<urban::CellMap>(c->city.streets, c->city.scene);
+    gen::StreetWalkOptions walk;
+    walk.frames = 10;
+    walk.walker = gen::Walker::Car;
+    walk.fps = 2.0f;
+    walk.seed = 4;
+    c->path = gen::streetWalk(c->city.streets, walk);
+    bake::PipelineOptions options;
+    options.base.resolution = 192;
+    options.base.progress = false;
+    options.pvs.spacing = 8.0f;
+    options.pvs.face_size = 64;
+    c->store = test::scratchDir("walkthrough_store").string();
+    bake::bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, *c->cells, bake::cellsOnPath(*c->cells, c->path),
+                       bake::parsePipeline("pvs,near-far,mmi"), options, c->store);
+    return c;
+  }();
+  return *s;
+}
+
+class WalkthroughTest : public ::testing::Test {
+ protected:
+  void SetUp() override { gpu::sharedHeadlessContext(); }
+};
+
+TEST_F(WalkthroughTest, WhereNoImpostorIsValidThePlanIsTheGeometryOfTheCell) {
+  const BakedCity& s = bakedCity();
+  const scene::Scene& scene = s.city.scene;
+  const gpu::GpuScene gpu_scene(scene);
+  const scene::Bvh bvh(scene);
+  gpu::Renderer renderer;
+  gpu::RenderTarget target(160, 96), reference_target(160, 96);
+  WalkthroughOptions options;
+  options.database = s.store;
+  options.error_px = 1e-4;
+  Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
+  const store::StoreIndex index = store::readIndex(s.store);
+  size_t frames = 0;
+  for (size_t f = 0; f < s.path.frames.size(); ++f) {
+    const Camera camera = s.path.camera(f, 160, 96);
+    const FramePlan& plan = walkthrough.plan(camera);
+    const store::CellEntry* entry = index.find(plan.report.cell);
+    if (!entry) continue;  // not baked: frustum-culled geometry
+    ++frames;
+    EXPECT_TRUE(plan.report.baked);
+    EXPECT_EQ(plan.report.layers_as_geometry, plan.layers.size());
+    EXPECT_EQ(plan.report.impostor_triangles, 0u);
+    for (const LayerDecision& d : plan.layers) EXPECT_TRUE(std::holds_alternative<LayerAsGeometry>(d));
+    // What the plan must show: the cell's near objects and every layered object, as geometry.
+    std::vector<uint32_t> ids = entry->pipeline->near;
+    for (const store::StoredLayer& layer : entry->pipeline->layers)
+      ids.insert(ids.end(), layer.objects.begin(), layer.objects.end());
+    std::sort(ids.begin(), ids.end());
+    std::vector<gpu::DrawItem> reference;
+    gpu_scene.appendDrawItems(ids, reference);
+    renderer.render(camera, plan.items, target);
+    renderer.render(camera, reference, reference_target);
+    EXPECT_EQ(target.readIds().pixels(), reference_target.readIds().pixels()) << "frame " << f;
+    EXPECT_EQ(target.readColor().pixels(), reference_target.readColor().pixels()) << "frame " << f;
+  }
+  EXPECT_GT(frames, 3u);
+}
+
+TEST_F(WalkthroughTest, UnderTheBakesBoundImpostorsAreDrawnOnlyInsideTheirRegions) {
+  const BakedCity& s = bakedCity();
+  const scene::Scene& scene = s.city.scene;
+  const gpu::GpuScene gpu_scene(scene);
+  const scene::Bvh bvh(scene);
+  gpu::Renderer renderer;
+  WalkthroughOptions options;
+  options.database = s.store;
+  Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
+  EXPECT_EQ(walkthrough.errorBoundPx(), bake::PipelineOptions{}.error_px);  // the database's bound
+  size_t impostors = 0;
+  for (size_t f = 0; f < s.path.frames.size(); ++f) {
+    const Camera camera = s.path.camera(f, 160, 96);
+    const FramePlan& plan = walkthrough.plan(camera);
+    for (const LayerDecision& d : plan.layers) {
+      ASSERT_FALSE(std::holds_alternative<LayerUnchecked>(d));  // a version 3 database has regions
+      if (const auto* i = std::get_if<LayerAsImpostor>(&d)) {
+        ++impostors;
+        EXPECT_LE(i->error_rad, i->bound_rad);
+        EXPECT_GE(i->bound_rad, plan.report.bound_rad);  // the frame's corner pixel is the strictest
+      }
+    }
+  }
+  EXPECT_GT(impostors, 0u);
+  EXPECT_EQ(walkthrough.statistics().at("frames"), double(s.path.frames.size()));
+}
+
+TEST_F(WalkthroughTest, BadOptionsAreErrors) {
+  const BakedCity& s = bakedCity();
+  const gpu::GpuScene gpu_scene(s.city.scene);
+  const scene::Bvh bvh(s.city.scene);
+  gpu::Renderer renderer;
+  WalkthroughOptions none;
+  EXPECT_THROW(Walkthrough(s.city.scene, gpu_scene, bvh, renderer, none), Error);
+  WalkthroughOptions missing;
+  missing.database = test::scratchDir("walkthrough_missing").string() + "/nothing";
+  EXPECT_THROW(Walkthrough(s.city.scene, gpu_scene, bvh, renderer, missing), Error);
+  WalkthroughOptions negative;
+  negative.database = s.store;
+  negative.error_px = -1.0;
+  EXPECT_THROW(Walkthrough(s.city.scene, gpu_scene, bvh, renderer, negative), Error);
+  WalkthroughOptions no_cache;
+  no_cache.database = s.store;
+  no_cache.cache_cells = 0;
+  EXPECT_THROW(Walkthrough(s.city.scene, gpu_scene, bvh, renderer, no_cache), Error);
+}
+
+}  // namespace
+}  // namespace farfield::runtime
