@@ -40,13 +40,13 @@ def rows(out):
                     fmt(m.get("psnr_db_mean"), ".1f"), 100.0 * (m.get("crack_share_mean") or 0.0),
                     fmt(m.get("parallax_p99_px_mean"), ".2f"), fmt(m.get("parallax_p99_px_max"), ".1f"),
                     "-" if name == "culled" else "%s of %d" % (over, checked),
-                    fmt(info.get("mean_geometry_triangles", m.get("mean_triangles")), ",.0f"),
+                    fmt(m.get("mean_triangles"), ",.0f"),
                     "-" if name == "culled" else "%.1f MB" % (store_bytes(store) / 1e6))
 
 
 def main():
     print("| city | path | bound px | mode | median ms | p99 ms | vs full | vs culled | PSNR dB | cracks | "
-          "parallax p99 mean / max px | frames over bound | geometry triangles | store |")
+          "parallax p99 mean / max px | frames over bound | triangles drawn | store |")
     print("|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for out in sys.argv[1:]:
         for row in rows(out):
