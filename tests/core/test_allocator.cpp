@@ -16,18 +16,6 @@ using namespace farfield;
 
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool kSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-constexpr bool kSanitizer = true;
-#else
-constexpr bool kSanitizer = false;
-#endif
-#else
-constexpr bool kSanitizer = false;
-#endif
-
 #if defined(__GLIBC__)
 // What glibc's heap does, seen through mallinfo2 (bytes): the heap's growth when it must ask the kernel for more,
 // whether a freed top is kept, and whether a large block is mmapped.
@@ -117,7 +105,7 @@ TEST(Allocator, CurrentSettingsBeforeAnyCallSayDefaults) {
 
 #if defined(__GLIBC__)
 TEST(Allocator, TimingSettingsChangeWhatTheHeapDoes) {
-  if (kSanitizer) GTEST_SKIP() << "a sanitizer's allocator ignores mallopt";
+  if (kSanitizerBuild) GTEST_SKIP() << "a sanitizer's allocator ignores mallopt";
   const HeapProbe plain = probeInChild(false);
   const HeapProbe timed = probeInChild(true);
   ASSERT_TRUE(timed.applied);
@@ -133,7 +121,7 @@ TEST(Allocator, TimingSettingsChangeWhatTheHeapDoes) {
 }
 
 TEST(Allocator, ReportsWhatItSetAndRemembersIt) {
-  if (kSanitizer) GTEST_SKIP() << "a sanitizer's allocator ignores mallopt";
+  if (kSanitizerBuild) GTEST_SKIP() << "a sanitizer's allocator ignores mallopt";
   const pid_t pid = fork();
   if (pid == 0) {
     const AllocatorSettings s = configureTimingAllocator();

@@ -12,18 +12,6 @@
 namespace farfield {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool kSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-constexpr bool kSanitizer = true;
-#else
-constexpr bool kSanitizer = false;
-#endif
-#else
-constexpr bool kSanitizer = false;
-#endif
-
 std::mutex g_mutex;
 std::optional<AllocatorSettings> g_last;
 
@@ -40,7 +28,7 @@ AllocatorSettings apply() {
     s.description = "C library malloc defaults (FF_ALLOCATOR=default)" + tunablesNote();
     return s;
   }
-  if (kSanitizer) {
+  if (kSanitizerBuild) {
     s.description = "sanitizer allocator (mallopt has no effect); malloc settings left alone";
     return s;
   }

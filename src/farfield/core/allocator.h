@@ -10,6 +10,20 @@
 
 namespace farfield {
 
+// Whether this build runs under a sanitizer, whose allocator ignores mallopt (the settings below are then not applied).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+inline constexpr bool kSanitizerBuild = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+inline constexpr bool kSanitizerBuild = true;
+#else
+inline constexpr bool kSanitizerBuild = false;
+#endif
+#else
+inline constexpr bool kSanitizerBuild = false;
+#endif
+
+
 struct AllocatorSettings {
   bool applied = false;          // the settings are in effect (glibc, every mallopt call accepted)
   size_t trim_threshold = 0;     // bytes of free memory at a heap top before it is given back (M_TRIM_THRESHOLD)
