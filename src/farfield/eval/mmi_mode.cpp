@@ -84,9 +84,8 @@ void MmiMode::frame(FrameContext& frame) {
 }
 
 std::map<std::string, double> MmiMode::info() const {
-  std::map<std::string, double> out = walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
-  if (walkthrough_) out["error_bound_px"] = walkthrough_->errorBoundPx();
-  return out;
+  // The walkthrough reports its bound (error_bound_px) for the representations that draw impostors only.
+  return walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
 }
 
 }  // namespace farfield::eval
