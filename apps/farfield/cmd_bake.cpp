@@ -110,10 +110,10 @@ std::string megabytes(double bytes) {
 }
 
 // The extractor pipeline (bake/pipeline.h): per cell PVS, near/far split, layers and their impostors.
-void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const scene::Scene& scene,
+void runPipelineBake(const BakeArgs& args, const extract::BakeOptions& base, const scene::Scene& scene,
                      const urban::CellMap& cells, const std::vector<uint32_t>& requested) {
-  const bake::PipelineSpec spec = bake::parsePipeline(args.pipeline, args.online);
-  bake::PipelineOptions options;
+  const extract::PipelineSpec spec = extract::parsePipeline(args.pipeline, args.online);
+  extract::PipelineOptions options;
   options.base = base;
   options.error_px = args.error_px;
   const IVec2 frame = parseSize("--frame-size", args.frame_size);
@@ -121,9 +121,9 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
   options.frame_height = frame.y;
   options.frame_fov_deg = args.frame_fov;
   options.station_spacing = args.station_spacing;
-  options.mesh = bake::parseLayerMesh(args.layer_mesh);
+  options.mesh = extract::parseLayerMesh(args.layer_mesh);
   options.grid_cells = args.grid_cells;
-  options.views = bake::parseLayerViews(args.views);
+  options.views = extract::parseLayerViews(args.views);
   options.pvs.spacing = args.pvs_spacing;
   options.pvs.face_size = args.pvs_face;
   options.near_radius = args.near_radius;
@@ -136,8 +136,8 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
   std::printf("layers:        error %.1f px in %dx%d frames at %.0f deg, %s mesh (%d x %d grid), %s view(s), "
               "%dx%d images\n",
               options.error_px, options.frame_width, options.frame_height, double(options.frame_fov_deg),
-              bake::layerMeshName(options.mesh), options.grid_cells,
-              options.grid_cells, bake::layerViewsName(options.views), options.base.resolution,
+              extract::layerMeshName(options.mesh), options.grid_cells,
+              options.grid_cells, extract::layerViewsName(options.views), options.base.resolution,
               options.base.resolution);
   const bake::PipelineReport report = bake::bakePipeline(gpu::sharedHeadlessContext(), scene, cells, requested,
                                                          spec, options, args.out_dir);
@@ -209,8 +209,8 @@ void runPipelineBake(const BakeArgs& args, const bake::BakeOptions& base, const 
 }
 
 void runBakeCommand(const BakeArgs& args) {
-  bake::BakeOptions options;
-  options.techniques = bake::parseTechniques(args.technique);
+  extract::BakeOptions options;
+  options.techniques = extract::parseTechniques(args.technique);
   urban::CellOptions cell_options;
   cell_options.local = urban::parseLocalModel(args.local);
   cell_options.lookup = urban::parseCellLookup(args.lookup, "--cell-lookup");
@@ -223,9 +223,9 @@ void runBakeCommand(const BakeArgs& args) {
 
   // Cheap inputs first: pipeline options, streets and path fail before the scene is loaded.
   if (!args.pipeline.empty()) {
-    bake::parsePipeline(args.pipeline, args.online);
-    bake::parseLayerMesh(args.layer_mesh);
-    bake::parseLayerViews(args.views);
+    extract::parsePipeline(args.pipeline, args.online);
+    extract::parseLayerMesh(args.layer_mesh);
+    extract::parseLayerViews(args.views);
     if (!args.landmarks.empty()) parseCells(args.landmarks, "--landmarks");
   } else if (!args.online.empty()) {
     throw Error("--online", "needs --pipeline (the online stages are a tail of the pipeline)");

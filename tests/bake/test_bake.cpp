@@ -8,7 +8,7 @@
 #include <random>
 
 #include "farfield/bake/bake.h"
-#include "farfield/bake/ground_height.h"
+#include "farfield/extract/ground_height.h"
 #include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/render_target.h"
@@ -20,6 +20,7 @@
 #include "support/test_support.h"
 
 namespace farfield::bake {
+using namespace farfield::extract;
 namespace {
 
 using urban::CellMap;

@@ -17,10 +17,11 @@
 #include "farfield/image/png_io.h"
 #include "farfield/impostor/drawable.h"
 #include "farfield/scene/builtin.h"
-#include "bake/constructed_street.h"
+#include "extract/constructed_street.h"
 #include "support/test_support.h"
 
 namespace farfield::bake {
+using namespace farfield::extract;
 namespace {
 
 class MmiParallaxTest : public ::testing::Test {

@@ -30,6 +30,7 @@
 namespace fs = std::filesystem;
 
 namespace farfield::bake {
+using namespace farfield::extract;
 namespace {
 
 // ---------------------------------------------------------------------------------------------------------------

@@ -51,8 +51,8 @@ const SmallCity& smallCity() {
     const urban::CellMap cells(c->city.streets, c->city.scene);
     c->visited = bake::cellsOnPath(cells, c->path);
     c->store = test::scratchDir("runtime_small_city").string();
-    bake::BakeOptions b;
-    b.techniques = {bake::kDepthMesh, bake::kGridMesh};
+    extract::BakeOptions b;
+    b.techniques = {extract::kDepthMesh, extract::kGridMesh};
     b.resolution = 256;
     b.progress = false;
     bake::bakeCells(gpu::sharedHeadlessContext(), c->city.scene, cells, c->visited, b, c->store);
@@ -171,8 +171,8 @@ TEST(ImpostorModeTest, CellsWithoutImpostorFallBackToCulledGeometry) {
   // A store with the first visited cell only.
   const std::string dir = test::scratchDir("runtime_one_cell").string();
   const urban::CellMap cells(s.city.streets, s.city.scene);
-  bake::BakeOptions b;
-  b.techniques = {bake::kDepthMesh};
+  extract::BakeOptions b;
+  b.techniques = {extract::kDepthMesh};
   b.resolution = 64;
   b.progress = false;
   bake::bakeCells(gpu::sharedHeadlessContext(), s.city.scene, cells, {s.visited.front()}, b, dir);
@@ -212,7 +212,7 @@ TEST(ImpostorModeTest, BadStoresAreErrors) {
   // A store of the depth mesh only has no grid-mesh impostors.
   const std::string dir = test::scratchDir("runtime_depth_only").string();
   const urban::CellMap cells(s.city.streets, s.city.scene);
-  bake::BakeOptions b;
+  extract::BakeOptions b;
   b.resolution = 32;
   b.progress = false;
   bake::bakeCells(gpu::sharedHeadlessContext(), s.city.scene, cells, {s.visited.front()}, b, dir);

@@ -41,8 +41,8 @@ struct MmiCity {
   std::string store, online_store;
 };
 
-bake::PipelineOptions pipelineOptions() {
-  bake::PipelineOptions o;
+extract::PipelineOptions pipelineOptions() {
+  extract::PipelineOptions o;
   o.base.resolution = 256;
   o.base.progress = false;
   o.pvs.spacing = 8.0f;
@@ -68,10 +68,10 @@ const MmiCity& mmiCity() {
     c->visited = bake::cellsOnPath(*c->cells, c->path);
     c->store = test::scratchDir("mmi_mode_store").string();
     bake::bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, *c->cells, c->visited,
-                       bake::parsePipeline("pvs,near-far,mmi"), pipelineOptions(), c->store);
+                       extract::parsePipeline("pvs,near-far,mmi"), pipelineOptions(), c->store);
     c->online_store = test::scratchDir("mmi_mode_online_store").string();
     bake::bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, *c->cells, c->visited,
-                       bake::parsePipeline("pvs,near-far,mmi", "mmi"), pipelineOptions(), c->online_store);
+                       extract::parsePipeline("pvs,near-far,mmi", "mmi"), pipelineOptions(), c->online_store);
     return c;
   }();
   return *s;
@@ -348,7 +348,7 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
 
   // A Sillion store (bake::bakeCells) has no pipeline records.
   const std::string sillion = test::scratchDir("mmi_mode_sillion").string();
-  bake::BakeOptions b;
+  extract::BakeOptions b;
   b.resolution = 32;
   b.progress = false;
   bake::bakeCells(gpu::sharedHeadlessContext(), s.city.scene, *s.cells, {s.visited.front()}, b, sillion);
@@ -363,11 +363,11 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
   }
   // A pipeline without the mmi stage serves local and visible, not the impostor modes.
   const std::string no_mmi = test::scratchDir("mmi_mode_no_mmi").string();
-  bake::PipelineOptions po = pipelineOptions();
+  extract::PipelineOptions po = pipelineOptions();
   po.base.resolution = 32;
   po.grid_cells = 8;
   bake::bakePipeline(gpu::sharedHeadlessContext(), s.city.scene, *s.cells, {s.visited.front()},
-                     bake::parsePipeline("pvs,near-far"), po, no_mmi);
+                     extract::parsePipeline("pvs,near-far"), po, no_mmi);
   run.context.options["impostor_dir"] = no_mmi;
   EXPECT_NO_THROW(createMode("local", run.context)->prepare(run.context));
   EXPECT_NO_THROW(createMode("visible", run.context)->prepare(run.context));

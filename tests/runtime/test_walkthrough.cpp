@@ -42,14 +42,14 @@ const BakedCity& bakedCity() {
     walk.fps = 2.0f;
     walk.seed = 4;
     c->path = gen::streetWalk(c->city.streets, walk);
-    bake::PipelineOptions options;
+    extract::PipelineOptions options;
     options.base.resolution = 192;
     options.base.progress = false;
     options.pvs.spacing = 8.0f;
     options.pvs.face_size = 64;
     c->store = test::scratchDir("walkthrough_store").string();
     bake::bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, *c->cells, bake::cellsOnPath(*c->cells, c->path),
-                       bake::parsePipeline("pvs,near-far,mmi"), options, c->store);
+                       extract::parsePipeline("pvs,near-far,mmi"), options, c->store);
     return c;
   }();
   return *s;
@@ -107,7 +107,7 @@ TEST_F(WalkthroughTest, UnderTheBakesBoundImpostorsAreDrawnOnlyInsideTheirRegion
   WalkthroughOptions options;
   options.database = s.store;
   Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
-  EXPECT_EQ(walkthrough.errorBoundPx(), bake::PipelineOptions{}.error_px);  // the database's bound
+  EXPECT_EQ(walkthrough.errorBoundPx(), extract::PipelineOptions{}.error_px);  // the database's bound
   size_t impostors = 0;
   for (size_t f = 0; f < s.path.frames.size(); ++f) {
     const Camera camera = s.path.camera(f, 160, 96);

@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "farfield/bake/gl_workers.h"
-#include "farfield/bake/ground_height.h"
+#include "farfield/extract/ground_height.h"
 #include "farfield/core/error.h"
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
@@ -22,28 +22,13 @@
 
 namespace farfield::bake {
 
-std::vector<std::string> parseTechniques(const std::string& text, const std::string& what) {
-  if (text == kDepthMesh) return {kDepthMesh};
-  if (text == kGridMesh) return {kGridMesh};
-  if (text == "both") return {kDepthMesh, kGridMesh};
-  throw Error(what, "unknown technique '" + text + "' (expected depth-mesh, grid-mesh or both)");
-}
+using extract::BakeOptions;
+using extract::kDepthMesh;
+using extract::kGridMesh;
+
 
 namespace {
 
-void validateOptions(const BakeOptions& o) {
-  if (o.techniques.empty()) throw Error("bake options", "no technique given");
-  for (const std::string& t : o.techniques)
-    if (t != kDepthMesh && t != kGridMesh)
-      throw Error("bake options", "unknown technique '" + t + "' (expected depth-mesh or grid-mesh)");
-  if (o.resolution < 8 || o.resolution > 8192)
-    throw Error("--resolution", "must be 8..8192 pixels, got " + std::to_string(o.resolution));
-  if (!(o.fov_deg > 1.0f && o.fov_deg < 170.0f))
-    throw Error("--fov", "must be between 1 and 170 degrees, got " + std::to_string(o.fov_deg));
-  if (!std::isfinite(o.eye_height)) throw Error("--eye-height", "must be finite");
-  if (!(o.near_plane > 0.0f && o.far_plane > o.near_plane)) throw Error("bake options", "need 0 < near < far");
-  if (o.workers < 0) throw Error("--workers", "must be 0 (automatic) or more");
-}
 
 struct Job {
   CellBake record;
@@ -53,22 +38,6 @@ struct Job {
 
 }  // namespace
 
-Camera cellCamera(const urban::CellMap& cells, uint32_t cell, const BakeOptions& options,
-                  const std::function<float(float, float)>& ground) {
-  if (cell >= cells.cellCount())
-    throw Error("cell " + std::to_string(cell), "no such half-edge (the street graph has " +
-                                                    std::to_string(cells.cellCount()) + ")");
-  if (cells.degenerate(cell))
-    throw Error("cell " + std::to_string(cell), "street too short (" + std::to_string(cells.graph().length(cell)) +
-                                                    " m) to place a creation camera along it");
-  const Vec2 a = cells.graph().originPosition(cell), b = cells.graph().destinationPosition(cell);
-  const Vec3 eye(a, ground(a.x, a.y) + options.eye_height);
-  const Vec3 at(b, ground(b.x, b.y) + options.eye_height);
-  impostor::DepthMeshOptions o = options.depth_mesh;
-  o.resolution = options.resolution;
-  o.fov_y = float(degToRad(double(options.fov_deg)));
-  return impostor::creationCamera(eye, at, o, options.near_plane, options.far_plane);
-}
 
 CellSelection selectCells(const urban::CellMap& cells, std::vector<uint32_t> half_edges) {
   if (half_edges.empty())
@@ -98,7 +67,7 @@ std::vector<uint32_t> cellsOnPath(const urban::CellMap& cells, const gen::Camera
 
 BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urban::CellMap& cells,
                      std::vector<uint32_t> half_edges, const BakeOptions& options, const std::string& out_dir) {
-  validateOptions(options);
+  extract::validateBakeOptions(options);
   if (cells.objectCount() != scene.objects.size())
     throw Error("bake", "the cell map was made for " + std::to_string(cells.objectCount()) +
                             " objects but the scene has " + std::to_string(scene.objects.size()));
@@ -112,7 +81,7 @@ BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urb
   report.skipped_degenerate = std::move(selection.skipped_degenerate);
   report.requested = selection.requested;
 
-  const GroundHeight ground_height(scene, cells.assignment().shared);
+  const extract::GroundHeight ground_height(scene, cells.assignment().shared);
   const auto ground = [&](float x, float y) { return ground_height.at(x, y, 0.0f); };
 
   store::StoreIndex index;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "farfield/core/camera.h"
+#include "farfield/extract/bake_options.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gpu/context.h"
 #include "farfield/impostor/capture.h"
@@ -25,31 +26,6 @@
 
 namespace farfield::bake {
 
-inline constexpr char kDepthMesh[] = "depth-mesh";
-inline constexpr char kGridMesh[] = "grid-mesh";
-
-// "depth-mesh", "grid-mesh" or "both" -> the list of techniques; throws farfield::Error naming `what` otherwise.
-std::vector<std::string> parseTechniques(const std::string& text, const std::string& what = "--technique");
-
-struct BakeOptions {
-  std::vector<std::string> techniques{kDepthMesh};  // built from each capture (one capture per cell)
-  int resolution = 512;      // impostor image width = height, pixels
-  // Vertical = horizontal field of view of the creation camera. The walker's 60 degrees: on the default city's
-  // 600 m drive (10 cells, 100 frames, 512 x 512) wider captures lose more to the coarser texture than they gain in
-  // coverage (depth-mesh PSNR 36.8 dB at 60, 36.5 at 75, 35.6 at 90, 35.4 at 110 degrees; cracks 1.1% for all):
-  // with the street cell lookup the view rarely turns far from the street's direction within a cell.
-  float fov_deg = 60.0f;
-  float eye_height = 1.7f;   // metres above the ground under the edge's ends (a pedestrian)
-  float near_plane = 0.5f;   // metres
-  float far_plane = 20000.0f;
-  impostor::CaptureOptions capture;
-  impostor::DepthMeshOptions depth_mesh;  // its resolution and fov_y are overridden by the two above
-  impostor::GridMeshOptions grid_mesh;
-  int workers = 0;            // CPU threads building meshes; 0 = hardware threads - 1, at least 1
-  size_t queue_capacity = 2;  // captures waiting for a worker
-  bool progress = true;       // progress bar on stderr (also off with FF_PROGRESS=0)
-  std::string scene_label;    // recorded in the store's index
-};
 
 // One baked cell.
 struct CellBake {
@@ -72,19 +48,13 @@ struct BakeReport {
   std::string store_dir;
 };
 
-// Where the creation camera of a cell stands and looks: at the edge origin, `eye_height` above the ground there,
-// looking at the edge end at the same height above the ground there. `ground` gives the ground height at (x, y).
-// Throws farfield::Error for a degenerate cell.
-Camera cellCamera(const urban::CellMap& cells, uint32_t cell, const BakeOptions& options,
-                  const std::function<float(float, float)>& ground);
-
 // Bakes the given cells (half-edge ids; duplicates ignored; empty = every cell) into the store directory `out_dir`
 // (created; index.json, streets.json and cells/ are (over)written). Makes `context` current on the calling thread.
 // Cells shorter than min_cell_length are skipped and reported. The ground height under the cameras comes from the
 // shared objects of the segmentation (the ground; see ground_height.h). Throws farfield::Error for bad options, ids
 // out of range or files that cannot be written.
 BakeReport bakeCells(gpu::Context& context, const scene::Scene& scene, const urban::CellMap& cells,
-                     std::vector<uint32_t> half_edges, const BakeOptions& options, const std::string& out_dir);
+                     std::vector<uint32_t> half_edges, const extract::BakeOptions& options, const std::string& out_dir);
 
 // The cells a bake works on: the requested half-edges (empty = every cell) in order without repeats, the degenerate
 // ones apart. Throws farfield::Error naming the id for one out of range.

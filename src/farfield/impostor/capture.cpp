@@ -32,7 +32,7 @@ ImpostorCapture captureView(gpu::Renderer& renderer, const gpu::GpuScene& scene,
 
   gpu::RenderTarget target(camera.width, camera.height);
   // Clear + draw, not Renderer::render: render() starts a GPU timer query, which cannot nest in the one a timed
-  // frame has running when the runtime captures online (bake/pipeline.h). The readbacks wait for the GPU anyway.
+  // frame has running when the runtime captures online (extract/pipeline_options.h). The readbacks wait for the GPU anyway.
   const auto pass = [&](gpu::RenderMode mode) {
     target.bind();
     target.clear(mode == gpu::RenderMode::ItemBuffer ? Vec4(0.0f, 0.0f, 0.0f, 1.0f) : renderer.light().sky_color);

@@ -71,7 +71,7 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
     for (const std::string& st : index_.pipeline) stages += (stages.empty() ? "" : ",") + st;
     for (const std::string& st : index_.online) online += (online.empty() ? "" : ",") + st;
     try {
-      bake::parsePipeline(stages, online);
+      extract::parsePipeline(stages, online);
     } catch (const Error& e) {
       throw Error(index_file, std::string("bad \"pipeline\"/\"online\": ") + e.what());
     }
@@ -79,24 +79,24 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
   std::vector<std::string> baked;
   for (const std::string& s : index_.pipeline)
     if (!contains(index_.online, s)) baked.push_back(s);
-  const char* needed = kind == Representation::Visible ? bake::kStagePvs
-                       : kind == Representation::Local ? bake::kStageNearFar
-                                                       : bake::kStageMmi;
+  const char* needed = kind == Representation::Visible ? extract::kStagePvs
+                       : kind == Representation::Local ? extract::kStageNearFar
+                                                       : extract::kStageMmi;
   if (!contains(index_.pipeline, needed))
     throw Error(index_file, "its pipeline has no " + std::string(needed) + " stage, which " + me + " needs");
-  if (kind == Representation::Visible && !contains(baked, bake::kStagePvs))
+  if (kind == Representation::Visible && !contains(baked, extract::kStagePvs))
     throw Error(index_file, me + " needs the pvs stage baked");
   for (const std::string& s : index_.online) {
     // Stages this representation needs that the bake left to the runtime.
-    const bool needs = kind == Representation::Local     ? s == bake::kStageNearFar
+    const bool needs = kind == Representation::Local     ? s == extract::kStageNearFar
                        : kind == Representation::Visible ? false
                                                          : true;
     if (needs) online_stages_.push_back(s);
   }
   const nlohmann::json stored_options =
       index_.options.contains("pipeline") ? index_.options["pipeline"] : nlohmann::json::object();
-  const bake::PipelineOptions pipeline_options =
-      bake::pipelineOptionsFromJson(stored_options, index_file + ": options.pipeline", index_.version);
+  const extract::PipelineOptions pipeline_options =
+      extract::pipelineOptionsFromJson(stored_options, index_file + ": options.pipeline", index_.version);
   if (options_.error_px <= 0.0) options_.error_px = pipeline_options.error_px;
   if (!online_stages_.empty()) {
     urban::CellOptions cell_options;
@@ -104,7 +104,7 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
     if (index_.options.contains("block_margin") && index_.options["block_margin"].is_number())
       cell_options.block_margin = index_.options["block_margin"].get<float>();
     cell_map_ = std::make_unique<urban::CellMap>(graph_, scene, cell_options);
-    runner_ = std::make_unique<bake::PipelineRunner>(scene, gpu_scene, *cell_map_, pipeline_options);
+    runner_ = std::make_unique<extract::PipelineRunner>(scene, gpu_scene, *cell_map_, pipeline_options);
   }
   invalid_object_.assign(scene.objects.size() + 1, 0);
   object_triangles_.assign(scene.objects.size() + 1, 0);
@@ -134,7 +134,7 @@ std::unique_ptr<Walkthrough::Cell> Walkthrough::loadCell(const store::CellEntry&
     throw Error(options_.database, "cell " + std::to_string(entry.half_edge) + " has no pipeline record");
   const Representation kind = options_.representation;
   store::CellPipeline record = *entry.pipeline;
-  bake::CellWork work;
+  extract::CellWork work;
   auto cell = std::make_unique<Cell>();
   if (!online_stages_.empty()) {
     Stopwatch timer;

@@ -2,7 +2,7 @@
 // `farfield bake --pipeline` and turns each frame's camera into a FramePlan, the draw items of the frame (geometry
 // and impostors) with what was decided for every layer and why, keeping the two promises:
 //   - the error bound: a layer (or the single mesh) is drawn as an impostor only where the validity region of one of
-//     its capture stations, computed at bake time (bake/validity_region.h), says its error stays under the bound
+//     its capture stations, computed at bake time (extract/validity_region.h), says its error stays under the bound
 //     where the layer appears in the frame (ErrorBound::angleWithin); the station with the smallest error is drawn,
 //     and the layer's objects are drawn as geometry where none holds the eye (reported per frame);
 //   - the frame budget (Representation::MmiDynamic): a cost model fitted on this machine (runtime/cost_model.h)
@@ -32,7 +32,7 @@
 #include <variant>
 #include <vector>
 
-#include "farfield/bake/pipeline.h"
+#include "farfield/extract/pipeline_runner.h"
 #include "farfield/core/camera.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/impostor/drawable.h"
@@ -153,7 +153,7 @@ class Walkthrough {
   urban::StreetGraph graph_;
   urban::CellLocator locator_;
   std::unique_ptr<urban::CellMap> cell_map_;        // for online stages
-  std::unique_ptr<bake::PipelineRunner> runner_;    // for online stages
+  std::unique_ptr<extract::PipelineRunner> runner_;    // for online stages
   std::vector<std::string> online_stages_;
   std::list<uint32_t> order_;                       // LRU of loaded cells, most recent first
   std::unordered_map<uint32_t, std::unique_ptr<Cell>> cells_;

@@ -29,7 +29,7 @@
 //               "impostors": {"depth-mesh": {"mesh": "cells/g000003.e000012.depth-mesh.ffmesh", "mesh_crc32": 5,
 //                                            "mesh_bytes": 6024, "triangles": 1034, "vertices": 560,
 //                                            "build_ms": 40.1}, ...}}, ...]}
-//   Version 2 adds, for stores written by `farfield bake --pipeline` (bake/pipeline.h): top-level "pipeline" (the
+//   Version 2 adds, for stores written by `farfield bake --pipeline` (extract/pipeline_options.h): top-level "pipeline" (the
 //   stages, e.g. ["pvs", "near-far", "mmi"]), "online" (the stages left to the runtime) and "storage" (section 5.1's
 //   estimate next to the bytes written); "techniques" may then be empty. Each cell gets
 //     "pipeline": {"pvs": {"ids": [...], "samples": 31, "ms": 4000},
@@ -48,7 +48,7 @@
 //   validity region of each station's views (impostor/validity.h), computed at bake time:
 //     "validity": [{"origin": [x,y,z], "end": [x,y,z], "half_width": 5.4, "below": 0.6, "above": 0.3, "back": 2,
 //                   "step": 1, "laterals": 9, "envelope": [0, 0.0004, ...]}, ...]   // radians, one per station
-//   and requires the pipeline options in "options.pipeline" whole (bake/pipeline.h).
+//   and requires the pipeline options in "options.pipeline" whole (extract/pipeline_options.h).
 //   Version 3 also makes the store trustworthy (SQLite's rules: a checksum per record, a write is atomic or did not
 //   happen) and requires:
 //   - next to every non-empty file name KEY ("streets", "texture", "mesh", "ids"): "KEY_crc32" (zlib's CRC-32 of the
@@ -155,7 +155,7 @@ struct StoredLayer {
   std::vector<impostor::ValidityRegion> validity;
 };
 
-// What the extractor pipeline (farfield/bake/pipeline.h) found for a cell. Each part is present when its stage ran
+// What the extractor pipeline (farfield/extract/pipeline_runner.h) found for a cell. Each part is present when its stage ran
 // in the bake; stages run online (index "online") leave theirs for the runtime.
 struct CellPipeline {
   bool has_pvs = false;

@@ -1,10 +1,10 @@
-// Validity regions (bake/validity_region.h) against brute-force sampling of viewpoints: in the constructed street,
+// Validity regions (extract/validity_region.h) against brute-force sampling of viewpoints: in the constructed street,
 // a frame drawn the way the runtime draws it (an impostor where its region holds the viewpoint under the bound where
 // the impostor appears in the frame, ErrorBound::angleWithin(frameRadius(...)); its
 // objects as geometry elsewhere) keeps the parallax error under the bound at every sampled viewpoint of the street,
 // across it and at other eye heights; drawing the impostors everywhere instead breaks the bound (so the regions are
 // what keeps it), and the regions are not empty (impostors are still drawn beyond the capture point).
-#include "farfield/bake/validity_region.h"
+#include "farfield/extract/validity_region.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <limits>
 #include <vector>
 
-#include "bake/constructed_street.h"
-#include "farfield/bake/pipeline.h"
+#include "extract/constructed_street.h"
+#include "farfield/extract/pipeline_runner.h"
 #include "farfield/core/error.h"
 #include "farfield/core/error_bound.h"
 #include "farfield/eval/parallax_error.h"
@@ -23,7 +23,7 @@
 #include "farfield/gpu/renderer.h"
 #include "farfield/impostor/drawable.h"
 
-namespace farfield::bake {
+namespace farfield::extract {
 namespace {
 
 TEST(ValidityRegionOptions, BadOptionsAreErrors) {
@@ -198,4 +198,4 @@ TEST_F(ValidityRegionTest, RuntimeRuleKeepsTheBoundAtSampledViewpoints) {
 }
 
 }  // namespace
-}  // namespace farfield::bake
+}  // namespace farfield::extract

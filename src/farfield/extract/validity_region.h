@@ -27,7 +27,7 @@
 #include "farfield/core/polygon2d.h"
 #include "farfield/impostor/validity.h"
 
-namespace farfield::bake {
+namespace farfield::extract {
 
 struct ValidityOptions {
   float step = 1.0f;             // metres between samples along the cell
@@ -47,4 +47,4 @@ impostor::ValidityRegion computeValidityRegion(const Vec3& p_eye, const Vec3& q_
                                                std::span<const Polygon2> footprints,
                                                double stop_rad, const ValidityOptions& options = {});
 
-}  // namespace farfield::bake
+}  // namespace farfield::extract

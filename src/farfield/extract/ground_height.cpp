@@ -1,13 +1,13 @@
 // Ground height queries for the bake's creation cameras: a uniform grid over the ground's upward-facing triangles,
 // counting sort into flat arrays (the city's ground is one large mesh of a few thousand to a few hundred thousand
 // triangles; a cell is queried twice per baked impostor).
-#include "farfield/bake/ground_height.h"
+#include "farfield/extract/ground_height.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace farfield::bake {
+namespace farfield::extract {
 
 GroundHeight::GroundHeight(const scene::Scene& scene, std::span<const uint32_t> object_ids) {
   for (uint32_t id : object_ids) {
@@ -72,4 +72,4 @@ float GroundHeight::at(float x, float y, float fallback) const {
   return std::isfinite(best) ? best : fallback;
 }
 
-}  // namespace farfield::bake
+}  // namespace farfield::extract

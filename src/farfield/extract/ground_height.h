@@ -10,7 +10,7 @@
 #include "farfield/core/math.h"
 #include "farfield/scene/scene.h"
 
-namespace farfield::bake {
+namespace farfield::extract {
 
 class GroundHeight {
  public:
@@ -37,4 +37,4 @@ class GroundHeight {
   std::vector<uint32_t> items_;  // triangle indices
 };
 
-}  // namespace farfield::bake
+}  // namespace farfield::extract

@@ -1,4 +1,4 @@
-#include "farfield/bake/validity_region.h"
+#include "farfield/extract/validity_region.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include "farfield/core/error.h"
 #include "farfield/urban/visibility_events.h"
 
-namespace farfield::bake {
+namespace farfield::extract {
 
 impostor::ValidityRegion computeValidityRegion(const Vec3& p_eye, const Vec3& q_eye, float street_width,
                                                std::span<const Box3> objects,
@@ -84,4 +84,4 @@ impostor::ValidityRegion computeValidityRegion(const Vec3& p_eye, const Vec3& q_
   return region;
 }
 
-}  // namespace farfield::bake
+}  // namespace farfield::extract

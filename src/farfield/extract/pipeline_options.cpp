@@ -1,0 +1,280 @@
+#include "farfield/extract/pipeline_options.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <initializer_list>
+#include <limits>
+#include <type_traits>
+#include <set>
+#include <sstream>
+
+#include "farfield/core/error.h"
+#include "farfield/core/progress.h"
+#include "farfield/core/timer.h"
+#include "farfield/impostor/depth_mesh.h"
+#include "farfield/impostor/grid_mesh.h"
+
+namespace farfield::extract {
+
+// ---------------------------------------------------------------------------------------------------------------
+// Parsing
+
+namespace {
+
+const std::vector<std::string>& knownStages() {
+  static const std::vector<std::string> stages{kStagePvs, kStageNearFar, kStageMmi};
+  return stages;
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) out.push_back(item);
+  if (!text.empty() && text.back() == ',') out.emplace_back();
+  return out;
+}
+
+size_t stageRank(const std::string& stage) {
+  const auto& k = knownStages();
+  return size_t(std::find(k.begin(), k.end(), stage) - k.begin());
+}
+
+bool contains(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+}  // namespace
+
+std::vector<std::string> PipelineSpec::baked() const {
+  return {stages.begin(), stages.begin() + std::ptrdiff_t(std::min(online_from, stages.size()))};
+}
+
+std::vector<std::string> PipelineSpec::online() const {
+  return {stages.begin() + std::ptrdiff_t(std::min(online_from, stages.size())), stages.end()};
+}
+
+PipelineSpec parsePipeline(const std::string& stages_text, const std::string& online_text) {
+  PipelineSpec spec;
+  if (stages_text.empty()) throw Error("--pipeline", "no stages given (expected e.g. pvs,near-far,mmi)");
+  for (const std::string& s : splitList(stages_text)) {
+    if (stageRank(s) == knownStages().size())
+      throw Error("--pipeline", "unknown stage '" + s + "' (known: pvs, near-far, mmi)");
+    if (contains(spec.stages, s)) throw Error("--pipeline", "stage '" + s + "' is listed twice");
+    if (!spec.stages.empty() && stageRank(s) < stageRank(spec.stages.back()))
+      throw Error("--pipeline", "stage '" + s + "' must come before '" + spec.stages.back() +
+                                    "' (the order is pvs, near-far, mmi)");
+    spec.stages.push_back(s);
+  }
+  if (contains(spec.stages, kStageMmi) && !contains(spec.stages, kStageNearFar))
+    throw Error("--pipeline", "mmi needs near-far before it (the impostors stand for the far geometry)");
+  spec.online_from = spec.stages.size();
+  if (!online_text.empty()) {
+    const std::vector<std::string> online = splitList(online_text);
+    for (const std::string& s : online) {
+      if (!contains(spec.stages, s)) throw Error("--online", "stage '" + s + "' is not in the pipeline");
+      if (s == kStagePvs)
+        throw Error("--online", "pvs cannot run online: it renders hundreds of 360-degree views per cell");
+    }
+    const size_t from = spec.stages.size() - online.size();
+    for (size_t i = 0; i < online.size(); ++i)
+      if (from + i >= spec.stages.size() || spec.stages[from + i] != online[i])
+        throw Error("--online", "the online stages must be the end of the pipeline, in its order (e.g. mmi, or "
+                                "near-far,mmi)");
+    spec.online_from = from;
+  }
+  return spec;
+}
+
+LayerMesh parseLayerMesh(const std::string& text, const std::string& what) {
+  if (text == "grid") return LayerMesh::Grid;
+  if (text == "depth-mesh") return LayerMesh::DepthMesh;
+  throw Error(what, "unknown layer mesh '" + text + "' (expected grid or depth-mesh)");
+}
+
+const char* layerMeshName(LayerMesh mesh) { return mesh == LayerMesh::Grid ? "grid" : "depth-mesh"; }
+
+LayerViews parseLayerViews(const std::string& text, const std::string& what) {
+  if (text == "street") return LayerViews::Street;
+  if (text == "six") return LayerViews::Six;
+  throw Error(what, "unknown views '" + text + "' (expected street or six)");
+}
+
+const char* layerViewsName(LayerViews views) { return views == LayerViews::Street ? "street" : "six"; }
+
+// ---------------------------------------------------------------------------------------------------------------
+// Options as JSON
+
+nlohmann::json pipelineOptionsToJson(const PipelineOptions& o) {
+  return {{"resolution", o.base.resolution},
+          {"fov_deg", o.base.fov_deg},
+          {"eye_height", o.base.eye_height},
+          {"near", o.base.near_plane},
+          {"far", o.base.far_plane},
+          {"detect_seen_from_below", o.base.capture.detect_seen_from_below},
+          {"error_px", o.error_px},
+          {"frame_width", o.frame_width},
+          {"frame_height", o.frame_height},
+          {"frame_fov_deg", o.frame_fov_deg},
+          {"station_spacing", o.station_spacing},
+          {"validity",
+           {{"step", o.validity.step},
+            {"back", o.validity.back},
+            {"width_share", o.validity.width_share},
+            {"laterals", o.validity.laterals},
+            {"below", o.validity.below},
+            {"above", o.validity.above}}},
+          {"pvs_spacing", o.pvs.spacing},
+          {"pvs_face_size", o.pvs.face_size},
+          {"near_radius", o.near_radius},
+          {"representative_points",
+           o.events.points == urban::RepresentativePoints::HullVertices ? "hull" : "footprint"},
+          {"landmark_boost", o.events.landmark_boost},
+          {"landmarks", o.landmarks},
+          {"layer_order", o.layer_order == urban::LayerOrder::Given ? "given" : "nearest-first"},
+          {"layer_choice", o.layer_choice == urban::LayerChoice::SmallestArea ? "smallest-area" : "least-growth"},
+          {"layer_mesh", layerMeshName(o.mesh)},
+          {"grid_cells", o.grid_cells},
+          {"views", layerViewsName(o.views)},
+          {"single_mesh", o.single_mesh}};
+}
+
+namespace {
+
+// Strict reading of one JSON object of options: every key the caller asks for must be there with the right type,
+// and keys() lists the ones that were never asked for (unknown keys are errors, not ignored).
+class StrictOptions {
+ public:
+  StrictOptions(const nlohmann::json& j, std::string where) : j_(j), where_(std::move(where)) {
+    if (!j_.is_object()) throw Error(where_, "pipeline options must be an object");
+  }
+  bool has(const char* key) const { return j_.contains(key); }
+  const nlohmann::json& at(const char* key) {
+    const auto it = j_.find(key);
+    if (it == j_.end()) throw Error(where_, std::string("pipeline option \"") + key + "\" is missing");
+    seen_.push_back(key);
+    return *it;
+  }
+  template <typename T>
+  void number(const char* key, T& out) {
+    const nlohmann::json& v = at(key);
+    if (!v.is_number()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be a number");
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) throw Error(where_, std::string("pipeline option \"") + key + "\" is not finite");
+    if constexpr (std::is_integral_v<T>) {
+      if (d != std::floor(d) || d < double(std::numeric_limits<T>::min()) || d > double(std::numeric_limits<T>::max()))
+        throw Error(where_, std::string("pipeline option \"") + key + "\" must be an integer in range");
+    }
+    out = T(d);
+  }
+  std::string text(const char* key) {
+    const nlohmann::json& v = at(key);
+    if (!v.is_string()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be a string");
+    return v.get<std::string>();
+  }
+  bool boolean(const char* key) {
+    const nlohmann::json& v = at(key);
+    if (!v.is_boolean()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be true or false");
+    return v.get<bool>();
+  }
+  // One of `names` (the first maps to 0, ...).
+  size_t choice(const char* key, std::initializer_list<const char*> names) {
+    const std::string v = text(key);
+    size_t i = 0;
+    std::string list;
+    for (const char* n : names) {
+      if (v == n) return i;
+      list += (i++ ? ", " : "") + std::string(n);
+    }
+    throw Error(where_, std::string("pipeline option \"") + key + "\": unknown value '" + v + "' (expected " + list + ")");
+  }
+  void rejectUnknown() const {
+    for (const auto& [key, value] : j_.items())
+      if (std::find(seen_.begin(), seen_.end(), key) == seen_.end())
+        throw Error(where_, "unknown pipeline option \"" + key + "\"");
+  }
+
+ private:
+  const nlohmann::json& j_;
+  std::string where_;
+  std::vector<std::string> seen_;
+};
+
+}  // namespace
+
+PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::string& source, int store_version) {
+  PipelineOptions o;
+  StrictOptions r(j, source);
+  r.number("resolution", o.base.resolution);
+  r.number("fov_deg", o.base.fov_deg);
+  r.number("eye_height", o.base.eye_height);
+  r.number("near", o.base.near_plane);
+  r.number("far", o.base.far_plane);
+  o.base.capture.detect_seen_from_below = r.boolean("detect_seen_from_below");
+  r.number("error_px", o.error_px);
+  r.number("frame_width", o.frame_width);
+  if (store_version >= 3 || r.has("frame_height")) {
+    r.number("frame_height", o.frame_height);
+    r.number("frame_fov_deg", o.frame_fov_deg);
+    r.number("station_spacing", o.station_spacing);
+    StrictOptions v(r.at("validity"), source + ": validity");
+    v.number("step", o.validity.step);
+    v.number("back", o.validity.back);
+    v.number("width_share", o.validity.width_share);
+    v.number("laterals", o.validity.laterals);
+    v.number("below", o.validity.below);
+    v.number("above", o.validity.above);
+    v.rejectUnknown();
+  } else {
+    // Version 2 meant square frames of frame_width with the capture's field of view.
+    o.frame_height = o.frame_width;
+    o.frame_fov_deg = o.base.fov_deg;
+    o.station_spacing = 0.0f;  // one capture at the cell's start
+  }
+  r.number("pvs_spacing", o.pvs.spacing);
+  r.number("pvs_face_size", o.pvs.face_size);
+  r.number("near_radius", o.near_radius);
+  o.events.points = r.choice("representative_points", {"footprint", "hull"}) == 1
+                        ? urban::RepresentativePoints::HullVertices
+                        : urban::RepresentativePoints::FootprintVertices;
+  r.number("landmark_boost", o.events.landmark_boost);
+  const nlohmann::json& landmarks = r.at("landmarks");
+  if (!landmarks.is_array()) throw Error(source, "pipeline option \"landmarks\" must be an array of ids");
+  for (const nlohmann::json& id : landmarks) {
+    if (!id.is_number_unsigned() || id.get<uint64_t>() > std::numeric_limits<uint32_t>::max())
+      throw Error(source, "pipeline option \"landmarks\" must hold object ids");
+    o.landmarks.push_back(id.get<uint32_t>());
+  }
+  o.layer_order = r.choice("layer_order", {"nearest-first", "given"}) == 1 ? urban::LayerOrder::Given
+                                                                            : urban::LayerOrder::NearestFirst;
+  o.layer_choice = r.choice("layer_choice", {"least-growth", "smallest-area"}) == 1
+                       ? urban::LayerChoice::SmallestArea
+                       : urban::LayerChoice::LeastGrowth;
+  o.mesh = parseLayerMesh(r.text("layer_mesh"), source + ": layer_mesh");
+  r.number("grid_cells", o.grid_cells);
+  o.views = parseLayerViews(r.text("views"), source + ": views");
+  o.single_mesh = r.boolean("single_mesh");
+  r.rejectUnknown();
+  return o;
+}
+
+void validatePipelineOptions(const PipelineOptions& o) {
+  if (!(o.error_px > 0.0) || !std::isfinite(o.error_px))
+    throw Error("--error-px", "must be a positive number of pixels");
+  if (o.frame_width < 1 || o.frame_height < 1) throw Error("--frame-size", "must be at least 1 x 1 pixels");
+  if (!(o.frame_fov_deg > 0.0f && o.frame_fov_deg < 180.0f)) throw Error("--frame-fov", "must be in (0, 180) degrees");
+  if (!(o.station_spacing >= 0.0f) || !std::isfinite(o.station_spacing))
+    throw Error("--station-spacing", "must be a finite number of metres >= 0");
+  const ValidityOptions& v = o.validity;
+  if (!(v.step > 0.0f) || !(v.back >= 0.0f) || v.laterals < 1 || v.laterals % 2 == 0 || !(v.below >= 0.0f) ||
+      !(v.above >= 0.0f) || !(v.width_share >= 0.0f))
+    throw Error("validity options", "need step > 0, back, below, above, width share >= 0 and an odd lateral count");
+  if (o.grid_cells < 1 || o.grid_cells > o.base.resolution)
+    throw Error("--grid-cells", "must be 1.." + std::to_string(o.base.resolution) + " (the impostor resolution)");
+  if (!(o.events.landmark_boost >= 1.0) || !std::isfinite(o.events.landmark_boost))
+    throw Error("--landmark-boost", "must be a finite number >= 1");
+  if (!(o.near_radius >= 0.0f) || !std::isfinite(o.near_radius))
+    throw Error("--near-radius", "must be a finite number of metres >= 0");
+}
+
+}  // namespace farfield::extract

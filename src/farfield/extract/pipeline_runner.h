@@ -1,0 +1,91 @@
+// The extractor stages run on one cell (Decoret et al. 1999, section 5.2): the bake runs the stages before the
+// pipeline's split, the runtime (runtime/walkthrough.h) the others when the viewer enters a cell, with this same code.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "farfield/core/error_bound.h"
+#include "farfield/extract/ground_height.h"
+#include "farfield/extract/pipeline_options.h"
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/impostor/impostor_mesh.h"
+#include "farfield/scene/scene.h"
+#include "farfield/store/impostor_store.h"
+#include "farfield/urban/cells.h"
+#include "farfield/urban/layering.h"
+#include "farfield/urban/pvs.h"
+#include "farfield/urban/visibility_events.h"
+
+namespace farfield::extract {
+
+// What flows down the pipeline for one cell.
+struct CellWork {
+  uint32_t cell = 0;
+  urban::CellSegment segment;         // the street centreline [PQ] on the ground plane
+  Vec3 p_eye{0.0f}, q_eye{0.0f};      // its ends at eye height above the ground
+  Camera street_camera;               // at P looking towards Q (cellCamera)
+  std::vector<uint32_t> candidates;   // objects entering the next stage (ascending); all objects at the start
+  store::CellPipeline result;         // the stages' results (the store's per-cell record)
+  // From the mmi stage, before they are written or uploaded: per layer, per view; and the single mesh's views.
+  std::vector<std::vector<impostor::DepthMeshImpostor>> layer_views;
+  std::vector<impostor::DepthMeshImpostor> single_views;
+  // Captures waiting for their meshes (the bake builds them on worker threads).
+  std::vector<std::vector<impostor::ImpostorCapture>> layer_captures;
+  std::vector<impostor::ImpostorCapture> single_captures;
+  size_t views_per_station = 1;       // 1 (street) or 6 (cube faces); captures are station-major
+  double capture_ms = 0.0;
+  double build_ms = 0.0;
+};
+
+// Runs stages on cells. Holds the scene, its GPU copy, the cell map and the options (all must outlive it), the ground
+// height, a renderer and (made on first use) the PVS sampler. Needs the OpenGL context current on the calling thread
+// for construction and for every GL stage.
+class PipelineRunner {
+ public:
+  PipelineRunner(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const urban::CellMap& cells,
+                 const PipelineOptions& options);
+  ~PipelineRunner();
+
+  // A cell's work record: segment, eye points, street camera, all objects as candidates. Throws farfield::Error for
+  // a degenerate cell or an id out of range.
+  CellWork start(uint32_t cell) const;
+  // Rebuilds a cell's work record from stored results (the stages the bake ran), to continue online.
+  CellWork resume(uint32_t cell, const store::CellPipeline& stored) const;
+
+  // The GL side of one stage (pvs: sampling; near-far: the split; mmi: layering and captures). Throws
+  // farfield::Error for an unknown stage or a missing input (mmi before near-far).
+  void runStage(const std::string& stage, CellWork& work);
+  // The CPU side of the mmi stage: meshes from the captures (grid or depth mesh). Thread-safe (no GL, no shared
+  // state); frees the captures.
+  void buildMeshes(CellWork& work) const;
+  // Every stage in order, the meshes included (the runtime's online path).
+  void runStages(const std::vector<std::string>& stages, CellWork& work);
+
+  const PipelineOptions& options() const { return options_; }
+  ErrorBound bound() const;
+  double threshold() const { return threshold_; }
+
+ private:
+  void runPvs(CellWork& work);
+  void runNearFar(CellWork& work) const;
+  void runMmi(CellWork& work);
+  std::vector<Vec3> stationEyes(const CellWork& work) const;    // capture stations along the cell, start first
+  std::vector<Camera> viewCameras(const CellWork& work, const Vec3& eye) const;  // a station's creation cameras
+  void pruneStations(store::StoredLayer& layer, std::vector<impostor::DepthMeshImpostor>& views,
+                     const CellWork& work) const;
+
+  const scene::Scene& scene_;
+  const gpu::GpuScene& gpu_scene_;
+  const urban::CellMap& cells_;
+  PipelineOptions options_;
+  double threshold_ = 0.0;
+  std::unique_ptr<GroundHeight> ground_;
+  gpu::Renderer renderer_;
+  std::unique_ptr<urban::PvsSampler> pvs_;
+};
+
+}  // namespace farfield::extract
