@@ -329,7 +329,8 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
            {"dynamic_max_updates", "0"},
            {"dynamic_min_lifetime", "nan"},
            {"impostor_ids", "triangle"},
-           {"impostor_cache", "0"},
+           {"gpu_budget_mb", "0"},
+           {"read_ahead", "maybe"},
            {"cell_lookup", "closest"}}) {
     ModeContext bad = context;
     bad.options[key] = value;

@@ -11,8 +11,6 @@ namespace farfield::eval {
 
 namespace {
 
-constexpr size_t kDefaultCache = 16;
-
 double numberOption(const ModeContext& context, const std::string& key, double fallback, double lo) {
   const std::string text = context.option(key);
   if (text.empty()) return fallback;
@@ -51,7 +49,10 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
     throw Error(std::string("mode '") + runtime::representationName(representation) + "'",
                 "needs a pipeline store: farfield bench --impostors DIR (or --mode-option impostor_dir=DIR), baked "
                 "with farfield bake --pipeline pvs,near-far,mmi");
-  o.cache_cells = positiveOption(context, "impostor_cache", kDefaultCache);
+  o.gpu_budget_bytes = uint64_t(numberOption(context, "gpu_budget_mb", double(o.gpu_budget_bytes >> 20), 1.0) * 1048576.0);
+  const std::string ahead = context.option("read_ahead", "on");
+  if (ahead != "on" && ahead != "off") throw Error("--mode-option read_ahead", "expected on or off, got '" + ahead + "'");
+  o.read_ahead = ahead == "on";
   const std::string ids = context.option("impostor_ids", "object");
   if (ids != "object" && ids != "layer")
     throw Error("--mode-option impostor_ids", "expected object or layer, got '" + ids + "'");

@@ -13,7 +13,8 @@
 //
 // Mode options (--mode-option key=value; `farfield bench --impostors DIR` sets impostor_dir):
 //   impostor_dir=DIR        the pipeline store (mmi_dir=DIR overrides it for these modes)
-//   impostor_cache=N        cells kept loaded (least recently used evicted), default 16
+//   gpu_budget_mb=MB        GPU bytes of resident impostors, least recently used cells evicted (default 512)
+//   read_ahead=on|off       read the cells ahead of the viewer on a background thread (default on)
 //   impostor_ids=object|layer  item buffers show, per impostor pixel, the object captured there (default: the
 //                           views' per-texel ids as an id texture) or one id per layer
 //   cell_lookup=street|nearest  as for the depth-mesh mode

@@ -45,6 +45,7 @@ struct Walkthrough::Cell {
   std::vector<uint8_t> geometry_mask;  // per object id: always drawn as geometry with this cell
   std::vector<Layer> layers;           // MMI layers, or the single mesh as one layer (Smi)
   bool online = false;                 // stages run at load time
+  uint64_t gpu_bytes = 0;              // of its impostors
 };
 
 Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const scene::Bvh& bvh,
@@ -54,7 +55,6 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
   const std::string me = std::string("walkthrough '") + representationName(kind) + "'";
   if (options_.database.empty())
     throw Error(me, "needs an impostor database: a directory written by farfield bake --pipeline pvs,near-far,mmi");
-  if (options_.cache_cells < 1) throw Error(me, "the cell cache must hold at least one cell");
   if (!(options_.error_px >= 0.0) || !std::isfinite(options_.error_px))
     throw Error(me, "error bound must be a finite number of pixels >= 0");
   OpenStore opened = openStore(options_.database, scene, options_.cell_lookup);
@@ -106,6 +106,14 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
     cell_map_ = std::make_unique<urban::CellMap>(graph_, scene, cell_options);
     runner_ = std::make_unique<extract::PipelineRunner>(scene, gpu_scene, *cell_map_, pipeline_options);
   }
+  const bool draws_impostors = kind != Representation::Local && kind != Representation::Visible;
+  if (online_stages_.empty() && draws_impostors) {
+    store::CellReader::Options reader;
+    reader.layers = kind != Representation::Smi;
+    reader.single = kind == Representation::Smi;
+    reader.budget_bytes = options_.read_ahead_bytes;
+    reader_ = std::make_unique<store::CellReader>(options_.database, index_, reader);
+  }
   invalid_object_.assign(scene.objects.size() + 1, 0);
   object_triangles_.assign(scene.objects.size() + 1, 0);
   for (const scene::Object& o : scene.objects)
@@ -155,6 +163,8 @@ std::unique_ptr<Walkthrough::Cell> Walkthrough::loadCell(const store::CellEntry&
   const bool single = kind == Representation::Smi;
   const std::vector<store::StoredLayer> layers = single ? std::vector<store::StoredLayer>{record.single}
                                                         : record.layers;
+  std::shared_ptr<store::CellViews> read;
+  if (!cell->online) read = reader_->take(entry.half_edge, &plan_.report.read);
   for (size_t l = 0; l < layers.size(); ++l) {
     Layer layer;
     layer.objects = layers[l].objects;
@@ -165,11 +175,12 @@ std::unique_ptr<Walkthrough::Cell> Walkthrough::loadCell(const store::CellEntry&
       if (cell->online)
         imp = single ? std::move(work.single_views[v]) : std::move(work.layer_views[l][v]);
       else
-        imp = store::loadLayerView(options_.database, layers[l].views[v]);
+        imp = std::move(single ? read->single[v] : read->layers[l][v]);
       if (imp.empty()) continue;
       layer.view_eyes.push_back(imp.camera.eye);
       layer.view_station.push_back(layers[l].views[v].station);
       layer.views.push_back(std::make_unique<impostor::GpuImpostor>(imp, gpu_options));
+      cell->gpu_bytes += layer.views.back()->gpuBytes();
     }
     cell->layers.push_back(std::move(layer));
   }
@@ -193,13 +204,33 @@ Walkthrough::Cell& Walkthrough::cell(uint32_t half_edge, bool* loaded) {
   ++stats_.loads;
   stats_.load_ms_total += ms;
   stats_.load_ms_max = std::max(stats_.load_ms_max, ms);
-  while (cells_.size() >= options_.cache_cells && !order_.empty()) {
-    cells_.erase(order_.back());
-    order_.pop_back();
+  resident_bytes_ += fresh->gpu_bytes;
+  order_.push_front(half_edge);
+  Cell& out = *(cells_[half_edge] = std::move(fresh));
+  evict(half_edge);
+  return out;
+}
+
+// Least recently used cells leave the GPU until the resident bytes fit the budget; `keep` (the current cell) stays.
+void Walkthrough::evict(uint32_t keep) {
+  while (resident_bytes_ > options_.gpu_budget_bytes && order_.size() > 1) {
+    const uint32_t victim = order_.back() == keep ? *std::next(order_.rbegin()) : order_.back();
+    const auto it = cells_.find(victim);
+    resident_bytes_ -= it->second->gpu_bytes;
+    cells_.erase(it);
+    order_.remove(victim);
     ++stats_.evictions;
   }
-  order_.push_front(half_edge);
-  return *(cells_[half_edge] = std::move(fresh));
+}
+
+// The cells the viewer may enter next: the streets leaving the junction ahead (the way back included). Queued once
+// per cell change; what was queued for an earlier cell and not started is dropped (the viewer went elsewhere).
+void Walkthrough::readAhead(uint32_t half_edge) {
+  if (!reader_ || !options_.read_ahead || half_edge == ahead_of_) return;
+  ahead_of_ = half_edge;
+  reader_->cancelQueued();
+  for (uint32_t next : graph_.outgoing(graph_.destination(half_edge)))
+    if (next != half_edge && !cells_.count(next)) reader_->prefetch(next);
 }
 
 const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<void()>& before_gpu_work) {
@@ -223,6 +254,7 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   if (entry) {
     ++stats_.visited[half_edge];
     current = &cell(half_edge, &report.loaded);
+    readAhead(half_edge);
     // Fast motion and stale dynamic impostors first: a layer that loses its dynamic impostor is judged by its
     // baked views' validity below.
     if (options_.representation == Representation::MmiDynamic) dropStaleDynamic(camera, *current);
@@ -272,6 +304,10 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   } else {
     ++stats_.fallback_frames;  // not baked: everything in the frustum, as the culled mode
   }
+  report.resident_bytes = resident_bytes_;
+  report.over_gpu_budget = resident_bytes_ > options_.gpu_budget_bytes;
+  stats_.resident_bytes_max = std::max(stats_.resident_bytes_max, resident_bytes_);
+  if (report.over_gpu_budget) ++stats_.over_gpu_budget_frames;
   std::sort(ids_.begin(), ids_.end());
   // GpuScene::appendDrawItems takes an empty list as "all objects".
   if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera);
@@ -441,6 +477,18 @@ std::map<std::string, double> Walkthrough::statistics() const {
   out["cell_load_ms_max"] = s.load_ms_max;
   out["cell_load_ms_mean"] = s.loads ? s.load_ms_total / double(s.loads) : 0.0;
   out["cache_evictions"] = double(s.evictions);
+  out["gpu_budget_bytes"] = double(options_.gpu_budget_bytes);
+  out["resident_bytes_max"] = double(s.resident_bytes_max);
+  out["frames_over_gpu_budget"] = double(s.over_gpu_budget_frames);
+  if (reader_) {
+    const store::CellReader::Stats r = reader_->stats();
+    out["cells_read_ahead"] = double(r.read_ahead);
+    out["cells_entered_ready"] = double(r.taken_ready);
+    out["cells_entered_waiting"] = double(r.taken_waited);
+    out["cells_entered_cold"] = double(r.taken_cold);
+    out["read_ahead_dropped"] = double(r.dropped);
+    out["read_ahead_wait_ms_total"] = r.wait_ms_total;
+  }
   out["online_runs"] = double(s.online_runs);
   out["online_ms_mean"] = s.online_runs ? s.online_ms_total / double(s.online_runs) : 0.0;
   out["mean_geometry_triangles"] = s.geometry_triangles / n;

@@ -11,10 +11,12 @@
 // It needs no benchmark harness: eval's bench modes (local, visible, smi, mmi, mmi-dynamic) are thin adapters over
 // it, and examples/embed_walkthrough.cpp drives it from a plain render loop.
 //
-// Cells: the viewer's cell (oriented street edge) is looked up per frame (urban::CellLocator). Its record is read and
-// its impostors uploaded the first time the viewer enters it, inside that frame, and kept in an LRU cache of cells.
-// When the database left stages to the runtime (`bake --online mmi`) they run then. A cell the database does not
-// hold falls back to frustum-culled full geometry (reported).
+// Cells: the viewer's cell (oriented street edge) is looked up per frame (urban::CellLocator). The cells it may enter
+// next (the streets leaving the junction ahead, the way back included) are read ahead on a background thread
+// (store/cell_reader.h); a cell's impostors are uploaded when the viewer enters it, inside that frame, and stay
+// resident on the GPU under a byte budget, least recently used evicted first. When the database left stages to the
+// runtime (`bake --online mmi`) they run on entry instead. A cell the database does not hold falls back to
+// frustum-culled full geometry (reported).
 //
 // Contract: construct and call plan() with the OpenGL context current on the calling thread; the scene, its GPU copy,
 // its BVH and the renderer must outlive the walkthrough. Throws farfield::Error naming the file for a database that
@@ -40,6 +42,7 @@
 #include "farfield/runtime/cost_model.h"
 #include "farfield/runtime/dynamic_impostor.h"
 #include "farfield/scene/bvh.h"
+#include "farfield/store/cell_reader.h"
 #include "farfield/store/impostor_store.h"
 #include "farfield/urban/cells.h"
 #include "farfield/urban/street_graph.h"
@@ -60,7 +63,11 @@ struct WalkthroughOptions {
   std::string database;                        // directory written by `farfield bake --pipeline`
   Representation representation = Representation::Mmi;
   double error_px = 0.0;                       // the bound in pixels of the frames; 0 = the database's
-  size_t cache_cells = 16;                     // cells kept loaded (least recently used evicted), >= 1
+  // GPU bytes of resident impostors (textures, id textures, meshes); least recently used cells are evicted beyond
+  // it. The current cell stays even when it alone exceeds the budget (reported as over_gpu_budget).
+  uint64_t gpu_budget_bytes = uint64_t(512) << 20;
+  bool read_ahead = true;                      // read the cells ahead on a background thread
+  uint64_t read_ahead_bytes = uint64_t(256) << 20;  // decoded bytes of cells read ahead and not yet entered
   bool object_ids = true;                      // impostors carry per-texel object ids (item buffers show objects)
   std::string cell_lookup;                     // "street" or "nearest"; "" = the database's
   // MmiDynamic.
@@ -97,6 +104,9 @@ struct FrameReport {
   uint32_t cell = urban::kNone;   // half-edge, kNone outside the street graph
   bool baked = false;             // false: the database does not hold the cell (frustum-culled geometry)
   bool loaded = false;            // the cell was read (and its online stages run) in this frame
+  const char* read = "";          // when loaded: "ready" (read ahead), "waited" (read ahead, unfinished), "cold"
+  uint64_t resident_bytes = 0;    // GPU bytes of resident impostors after this frame's loads and evictions
+  bool over_gpu_budget = false;   // the current cell alone exceeds gpu_budget_bytes
   double bound_px = 0.0;
   double bound_rad = 0.0;         // at the frame's corner pixel (ErrorBound::angle)
   size_t layers_as_geometry = 0;  // the error bound is kept by drawing these as geometry
@@ -140,6 +150,8 @@ class Walkthrough {
   struct Cell;
   Cell& cell(uint32_t half_edge, bool* loaded);
   std::unique_ptr<Cell> loadCell(const store::CellEntry& entry);
+  void readAhead(uint32_t half_edge);
+  void evict(uint32_t keep);
   void dropStaleDynamic(const Camera& camera, Cell& cell);
   void updateDynamic(const Camera& camera, Cell& cell, const std::function<void()>& before_gpu_work);
 
@@ -155,7 +167,10 @@ class Walkthrough {
   std::unique_ptr<urban::CellMap> cell_map_;        // for online stages
   std::unique_ptr<extract::PipelineRunner> runner_;    // for online stages
   std::vector<std::string> online_stages_;
+  std::unique_ptr<store::CellReader> reader_;        // read ahead (none with online stages)
   std::list<uint32_t> order_;                       // LRU of loaded cells, most recent first
+  uint64_t resident_bytes_ = 0;
+  uint32_t ahead_of_ = urban::kNone;                // the cell whose successors were last queued
   std::unordered_map<uint32_t, std::unique_ptr<Cell>> cells_;
   std::vector<uint64_t> object_triangles_;
   std::vector<uint32_t> ids_;
@@ -170,7 +185,8 @@ class Walkthrough {
   FramePlan plan_;
 
   struct Statistics {
-    size_t frames = 0, fallback_frames = 0, loads = 0, evictions = 0, online_runs = 0;
+    size_t frames = 0, fallback_frames = 0, loads = 0, evictions = 0, online_runs = 0, over_gpu_budget_frames = 0;
+    uint64_t resident_bytes_max = 0;
     double load_ms_max = 0.0, load_ms_total = 0.0, online_ms_total = 0.0;
     std::map<uint32_t, size_t> visited;
     double geometry_triangles = 0.0, impostor_triangles = 0.0, layers = 0.0;
