@@ -93,11 +93,15 @@ TEST(ObjectHierarchy, LevelsAndLeafSize) {
   EXPECT_EQ(one.nodes().size(), 1u);
   const ObjectHierarchy deep = ObjectHierarchy::build(items, {.max_levels = 20});
   for (const HierarchyNode& n : deep.nodes()) {
-    if (n.children[0] < 0) EXPECT_EQ(n.count, 1u);  // split down to single objects
+    if (n.children[0] < 0) {
+      EXPECT_EQ(n.count, 1u);  // split down to single objects
+    }
   }
   const ObjectHierarchy coarse = ObjectHierarchy::build(items, {.max_levels = 20, .min_objects_to_split = 8});
   for (const HierarchyNode& n : coarse.nodes()) {
-    if (n.children[0] >= 0) EXPECT_GE(n.count, 8u);
+    if (n.children[0] >= 0) {
+      EXPECT_GE(n.count, 8u);
+    }
   }
   EXPECT_TRUE(ObjectHierarchy::build(std::vector<HierarchyItem>{}).nodes().empty());
   EXPECT_THROW(ObjectHierarchy::build(items, {.max_levels = 0}), Error);
