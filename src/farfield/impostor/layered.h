@@ -1,0 +1,142 @@
+// Layered impostors for a shaft view cell (Jeschke et al. 2005, sections 4 and 6.2; the lecture's "hardware assisted
+// image warping" and "single vs layered"): alpha-tested textured quads perpendicular to the shaft's axis, each holding
+// the part of an object cluster between two depths, spaced so that the parallax seen from the shaft stays under the
+// error bound.
+//
+// Frame of a plan: depth z = dot(x - apex, axis), metres, growing towards the viewers. The capture eye E sits on the
+// axis at the shaft's minimum distance (E = apex + min_distance * axis) and looks at the apex with a pinhole camera,
+// so its near and far planes are planes of constant z: the slab of layer i is [z_lo_i, z_hi_i] and its quad lies in
+// the plane z = depth_i (the slab's centre), textured with the slab's objects as E sees them, cut open by the slab's
+// planes (LayeredOptions::solid_slices). layered.cpp says why a perspective capture from E and not an orthographic one
+// along the axis, and derives the spacing.
+//
+// The promise: a point of the cluster is drawn where E's ray through it meets its layer's plane. From every viewpoint
+// of the shaft the angle between the two is at most error_angle <= bound.angle() (unless the plan is layers_capped).
+// Neighbouring layers show a point of their common slab boundary up to 2 * error_angle apart (in opposite directions
+// from its true place), so a crack between them can be twice the bound wide; LayeredOptions::bound_cracks halves the
+// spacing when that matters.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "farfield/core/bounds.h"
+#include "farfield/core/error_bound.h"
+#include "farfield/core/math.h"
+#include "farfield/core/shaft.h"
+#include "farfield/gpu/gpu_mesh.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/gpu/texture.h"
+#include "farfield/image/image.h"
+
+namespace farfield::impostor {
+
+struct LayeredOptions {
+  // Texel size, in pixels of the bound's frame (its smallest, corner pixel), seen from the nearest viewpoint of the
+  // shaft; never coarser than the bound's angle (a texel is at most min(texel_pixels, bound.pixels) pixels).
+  double texel_pixels = 1.0;
+  int max_texture_size = 1024;  // per side, 1..16384; a layer that would need more gets coarser texels
+  int max_layers = 64;          // a plan that needs more keeps this many and says so (layers_capped)
+  int layer_count = 0;          // > 0: exactly this many layers whatever the bound (experiments, tests); 0: from it
+  bool bound_cracks = false;    // half the spacing: the crack between neighbouring layers also stays under the bound
+  bool id_textures = true;      // per-texel object ids (R32UI, 4 bytes a texel more) so item buffers name objects
+  // Capture with every material double-sided: a slab that cuts a closed object open shows its inside, so each layer
+  // holds the object's cross-section. Without it a layer holds only the faces turned towards the capture eye, and the
+  // faces other viewpoints of the shaft see (a wall along the axis, seen edge-on from the eye) are missing.
+  bool solid_slices = true;
+  int dilate_texels = 2;        // colour spread into the transparent texels around the data (no fringe of the
+                                // clear colour under bilinear filtering); 0..16
+};
+
+struct LayerPlan {
+  float z_lo = 0.0f, z_hi = 0.0f;  // the slab, metres along the axis from the apex
+  float depth = 0.0f;              // the quad's plane: the slab's centre
+  float half_u = 0.0f;             // the quad's half extents along LayeredPlan::right and ::up (metres)
+  float half_v = 0.0f;
+  int width = 0, height = 0;       // texels
+  float fov_y = 0.0f;              // the capture camera's vertical field of view (radians) that images the quad
+};
+
+struct LayeredPlan {
+  Shaft shaft;
+  Box3 box;                   // the cluster's bounds (world)
+  Vec3 capture_eye{0.0f};     // on the axis at min_distance
+  Vec3 right{1.0f, 0.0f, 0.0f}, up{0.0f, 0.0f, 1.0f};  // the capture camera's image axes (unit, world)
+  Vec3 camera_up{0.0f, 0.0f, 1.0f};                     // the up vector given to the capture camera
+  float z_lo = 0.0f, z_hi = 0.0f;  // the box's depth range along the axis
+  double radius = 0.0;        // metres: bounds |x - apex| for every point drawn or captured (r' in layered.cpp)
+  double parallax_per_metre = 0.0;  // K: the error angle (radians) per metre between a point and its layer plane
+  double max_spacing = 0.0;   // metres: the widest slab the bound allows (+inf for a flat box)
+  double spacing = 0.0;       // metres: the slabs' width (z_hi - z_lo) / layer count
+  double error_angle = 0.0;   // radians: K * spacing / 2, the parallax bound from any viewpoint of the shaft
+  double bound_angle = 0.0;   // radians: bound.angle()
+  bool layers_capped = false; // the bound needed more than max_layers: error_angle > bound_angle
+  double texel_angle = 0.0;   // radians: the largest texel seen from the nearest viewpoint (min_distance - radius)
+  bool resolution_capped = false;  // a layer hit max_texture_size: texel_angle exceeds the wanted one
+  bool id_textures = true;
+  int dilate_texels = 2;
+  bool solid_slices = true;
+  std::vector<LayerPlan> layers;  // far to near (increasing depth)
+
+  // Estimates before generation (the placement optimiser's memory and render cost).
+  uint64_t texels = 0;             // sum of width * height
+  size_t texture_bytes = 0;        // colour (+ ids) textures
+  size_t mesh_bytes = 0;           // quads' vertex and index buffers
+  size_t bytes() const { return texture_bytes + mesh_bytes; }
+  uint32_t quads() const { return uint32_t(layers.size()); }  // = draw calls
+  double fill_pixels = 0.0;        // pixels the quads cover from the nearest viewpoint on the axis (fill-rate cost)
+
+  bool keepsBound() const { return !layers_capped && error_angle <= bound_angle; }
+};
+
+// Plans the layers of the cluster `box` for the viewpoints of `shaft` under `bound`. Pure arithmetic, no GL. Throws
+// farfield::Error naming the input for an empty or non-finite box, a shaft that is not valid (see Shaft::make) or
+// whose minimum distance does not clear the cluster (min_distance <= radius: viewpoints inside or next to it), a bound
+// that fails ErrorBound::validate or has no pixels, and options out of range.
+LayeredPlan planLayered(const Box3& box, const Shaft& shaft, const ErrorBound& bound,
+                        const LayeredOptions& options = {});
+
+struct Layer {
+  image::ColorImage color;  // RGBA, alpha 255 where the slab's objects cover the texel, 0 elsewhere
+  image::IdImage ids;       // object ids (0 = none); empty without plan.id_textures
+  size_t data_texels = 0;   // covered texels
+  double render_ms = 0.0;
+};
+
+struct LayeredImpostor {
+  LayeredPlan plan;
+  std::vector<Layer> layers;  // as plan.layers
+  double capture_ms = 0.0;
+  size_t cpuBytes() const;    // the images' pixels
+};
+
+// Renders the objects `object_ids` (1-based, at least one) of `scene` once per layer of `plan`, clipped to the layer's
+// slab by the capture camera's near and far planes. Needs a current context. Throws farfield::Error for an empty id
+// list, an id the scene does not have, or an object whose bounds leave plan.box.
+LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& scene,
+                               std::span<const uint32_t> object_ids, const LayeredPlan& plan);
+
+// The layers on the GPU: per layer a 4-vertex quad (normal = the axis, uvs over the texture) and an unlit,
+// double-sided, textured material; the renderer's alpha test cuts out texels with alpha below 0.5 and its depth test
+// composes the layers (and any geometry around them), so the draw order does not change the image. Needs a current
+// context. Movable; draw items point into it.
+class GpuLayeredImpostor {
+ public:
+  explicit GpuLayeredImpostor(const LayeredImpostor& impostor);
+  GpuLayeredImpostor(GpuLayeredImpostor&&) noexcept = default;
+  GpuLayeredImpostor& operator=(GpuLayeredImpostor&&) noexcept = default;
+
+  // Appends one item per layer, far to near; object_id is written where a layer has no id texture.
+  void appendDrawItems(std::vector<gpu::DrawItem>& out, uint32_t object_id = 0) const;
+  uint32_t quads() const { return uint32_t(meshes_.size()); }
+  size_t gpuBytes() const;  // measured: the textures' and buffers' sizes
+
+ private:
+  std::vector<gpu::GpuMesh> meshes_;
+  std::vector<std::unique_ptr<gpu::Texture>> textures_, id_textures_;
+  std::vector<std::unique_ptr<gpu::GpuMaterial>> materials_;
+};
+
+}  // namespace farfield::impostor
