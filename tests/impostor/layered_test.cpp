@@ -396,6 +396,7 @@ TEST_F(ImpostorGpuTest, LayeredCaptureRejectsObjectsNotInTheSceneOrOutsideTheBox
   EXPECT_THROW(captureLayered(*renderer_, scene, missing, plan), Error);
   EXPECT_THROW(captureLayered(*renderer_, scene, zero, plan), Error);
   EXPECT_THROW(captureLayered(*renderer_, scene, none, plan), Error);
+  EXPECT_THROW(captureLayered(*renderer_, scene, c.ids, LayeredPlan{}), Error);
   // A plan for a box holding only the first object, asked to capture the second one too.
   const LayeredPlan part = planLayered(c.s.boxes[0], c.shaft, testBound());
   const std::vector<uint32_t> two = {c.ids[0], c.ids[1]};

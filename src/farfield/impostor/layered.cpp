@@ -286,7 +286,7 @@ void dilateColors(image::ColorImage& color, int rings) {
 LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& scene,
                                std::span<const uint32_t> object_ids, const LayeredPlan& plan) {
   if (object_ids.empty()) throw Error("layered impostor objects", "the cluster lists no object");
-  FF_CHECK(!plan.layers.empty());
+  if (plan.layers.empty()) throw Error("layered impostor plan", "has no layers (make it with planLayered)");
   std::vector<gpu::DrawItem> items;
   try {
     scene.appendDrawItems(object_ids, items);

@@ -86,7 +86,9 @@ struct LayeredPlan {
   size_t mesh_bytes = 0;           // quads' vertex and index buffers
   size_t bytes() const { return texture_bytes + mesh_bytes; }
   uint32_t quads() const { return uint32_t(layers.size()); }  // = draw calls
-  double fill_pixels = 0.0;        // pixels the quads cover from the nearest viewpoint on the axis (fill-rate cost)
+  // Pixels of the bound's frame the quads cover (transparent texels included: the fill-rate cost of an alpha test)
+  // from the nearest viewpoint on the axis, each quad capped at the frame.
+  double fill_pixels = 0.0;
 
   bool keepsBound() const { return !layers_capped && error_angle <= bound_angle; }
 };
@@ -114,7 +116,7 @@ struct LayeredImpostor {
 
 // Renders the objects `object_ids` (1-based, at least one) of `scene` once per layer of `plan`, clipped to the layer's
 // slab by the capture camera's near and far planes. Needs a current context. Throws farfield::Error for an empty id
-// list, an id the scene does not have, or an object whose bounds leave plan.box.
+// list, an id the scene does not have, an object whose bounds leave plan.box, or a plan without layers.
 LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& scene,
                                std::span<const uint32_t> object_ids, const LayeredPlan& plan);
 
