@@ -39,6 +39,14 @@ expect_error("badpath.json" path street ${WORK}/badpath.json -o ${WORK}/p.json)
 expect_error("--blocks" gen city --blocks 5 -o ${WORK}/c.glb)
 expect_error("badpath.json" walk builtin:cubes --path ${WORK}/badpath.json --mode full)
 expect_error("nopath.json" bench builtin:cubes --path ${WORK}/nopath.json --modes full -o ${WORK}/b)
+# A mode option no mode of the run reads (a typo) is refused, after the modes are made.
+execute_process(COMMAND ${FARFIELD} path orbit builtin:cubes --frames 2 -o ${WORK}/orbit.json RESULT_VARIABLE rc
+                OUTPUT_QUIET)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "farfield path orbit failed: ${rc}")
+endif()
+expect_error("--mode-option erorr_px" bench builtin:cubes --path ${WORK}/orbit.json --modes full,culled
+             --mode-option erorr_px=2 -o ${WORK}/b)
 expect_error("--pipeline" bake builtin:cubes --pipeline pvs,bogus -o ${WORK}/imp)
 expect_error("--pipeline" bake builtin:cubes --pipeline mmi -o ${WORK}/imp)
 expect_error("--online" bake builtin:cubes --pipeline pvs,near-far,mmi --online pvs -o ${WORK}/imp)

@@ -26,6 +26,7 @@
 #include "farfield/image/png_io.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/core/allocator.h"
+#include "farfield/eval/mode_options.h"
 #include "farfield/eval/parallax_error.h"
 #include "farfield/eval/temporal_error.h"
 
@@ -284,6 +285,7 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
   std::vector<std::unique_ptr<Mode>> modes;
   for (const std::string& name : names) modes.push_back(createMode(name, mode_context));
   for (auto& mode : modes) mode->prepare(mode_context);
+  checkEveryOptionRead(mode_context);
   const std::vector<gpu::DrawItem> reference_items = gpu_scene.drawItems();
 
   const size_t mode_count = modes.size();

@@ -7,6 +7,8 @@
 // pulls the file in for certain.
 #include "farfield/eval/impostor_mode.h"
 
+#include "farfield/eval/mode_options.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <functional>
@@ -33,18 +35,6 @@ void registerImpostorModes() {
                      "local model + the cell's regular-grid mesh impostor (baseline); --impostors DIR",
                      [](const ModeContext& c) { return std::make_unique<ImpostorMode>("grid-mesh", c); });
   registerMmiModes();
-}
-
-size_t positiveOption(const ModeContext& context, const std::string& key, size_t fallback) {
-  const std::string text = context.option(key, std::to_string(fallback));
-  try {
-    size_t used = 0;
-    const long long n = std::stoll(text, &used);
-    if (used != text.size() || n < 1) throw std::invalid_argument("range");
-    return size_t(n);
-  } catch (const std::exception&) {
-    throw Error("--mode-option " + key, "expected a positive integer, got '" + text + "'");
-  }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -94,11 +84,8 @@ ImpostorMode::ImpostorMode(std::string technique, const ModeContext& context)
   if (dir_.empty())
     throw Error("mode '" + technique_ + "'", "needs an impostor store: farfield bench --impostors DIR (or "
                                              "--mode-option impostor_dir=DIR), baked with farfield bake");
-  cache_capacity_ = positiveOption(context, "impostor_cache", kDefaultCache);
-  const std::string projective = context.option("impostor_projective", "1");
-  if (projective != "0" && projective != "1")
-    throw Error("--mode-option impostor_projective", "expected 0 or 1, got '" + projective + "'");
-  projective_ = projective == "1";
+  cache_capacity_ = countOption(context, "impostor_cache", kDefaultCache);
+  projective_ = switchOption(context, "impostor_projective", true);
   lookup_option_ = context.option("cell_lookup");
   if (!lookup_option_.empty()) urban::parseCellLookup(lookup_option_, "--mode-option cell_lookup");
 }

@@ -44,9 +44,6 @@ namespace farfield::eval {
 // list or create modes (see the .cpp for why registration is not a static object).
 void registerImpostorModes();
 
-// A positive integer mode option (e.g. impostor_cache); throws farfield::Error naming the option.
-size_t positiveOption(const ModeContext& context, const std::string& key, size_t fallback);
-
 // Least-recently-used cache of GPU impostors by cell. Needs a current context for get() and for destruction.
 class ImpostorCache {
  public:

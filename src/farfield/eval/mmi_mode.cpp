@@ -6,25 +6,9 @@
 
 #include "farfield/core/error.h"
 #include "farfield/eval/impostor_mode.h"
+#include "farfield/eval/mode_options.h"
 
 namespace farfield::eval {
-
-namespace {
-
-double numberOption(const ModeContext& context, const std::string& key, double fallback, double lo) {
-  const std::string text = context.option(key);
-  if (text.empty()) return fallback;
-  try {
-    size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used != text.size() || !std::isfinite(v) || v < lo) throw std::invalid_argument("range");
-    return v;
-  } catch (const std::exception&) {
-    throw Error("--mode-option " + key, "expected a number >= " + std::to_string(lo) + ", got '" + text + "'");
-  }
-}
-
-}  // namespace
 
 void registerMmiModes() {
   const auto add = [](runtime::Representation kind, const char* description) {
@@ -50,21 +34,16 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
                 "needs a pipeline store: farfield bench --impostors DIR (or --mode-option impostor_dir=DIR), baked "
                 "with farfield bake --pipeline pvs,near-far,mmi");
   o.gpu_budget_bytes = uint64_t(numberOption(context, "gpu_budget_mb", double(o.gpu_budget_bytes >> 20), 1.0) * 1048576.0);
-  const std::string ahead = context.option("read_ahead", "on");
-  if (ahead != "on" && ahead != "off") throw Error("--mode-option read_ahead", "expected on or off, got '" + ahead + "'");
-  o.read_ahead = ahead == "on";
-  const std::string ids = context.option("impostor_ids", "object");
-  if (ids != "object" && ids != "layer")
-    throw Error("--mode-option impostor_ids", "expected object or layer, got '" + ids + "'");
-  o.object_ids = ids == "object";
+  o.read_ahead = switchOption(context, "read_ahead", true);
+  o.object_ids = choiceOption(context, "impostor_ids", "object", {"object", "layer"}) == "object";
   o.dynamic.object_ids = o.object_ids;
   o.cell_lookup = context.option("cell_lookup");
   if (!o.cell_lookup.empty()) urban::parseCellLookup(o.cell_lookup, "--mode-option cell_lookup");
   o.frame_budget_ms = numberOption(context, "frame_budget_ms", o.frame_budget_ms, 0.0);
   o.dynamic_error_px = numberOption(context, "dynamic_error_px", o.dynamic_error_px, 0.0);
-  o.dynamic.resolution = int(numberOption(context, "dynamic_resolution", 0.0, 0.0));
-  o.dynamic.grid_px = int(numberOption(context, "dynamic_grid_px", o.dynamic.grid_px, 1.0));
-  o.max_updates = positiveOption(context, "dynamic_max_updates", o.max_updates);
+  o.dynamic.resolution = int(countOption(context, "dynamic_resolution", 0, 0));
+  o.dynamic.grid_px = int(countOption(context, "dynamic_grid_px", size_t(o.dynamic.grid_px), 1));
+  o.max_updates = countOption(context, "dynamic_max_updates", o.max_updates);
   o.min_lifetime_frames = numberOption(context, "dynamic_min_lifetime", o.min_lifetime_frames, 0.0);
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);
 }

@@ -9,11 +9,13 @@
 namespace farfield::eval {
 
 std::string ModeContext::option(const std::string& key, const std::string& fallback) const {
+  read_keys->insert(key);
   auto it = options.find(key);
   return it == options.end() ? fallback : it->second;
 }
 
 const std::string& ModeContext::requireOption(const std::string& key, const std::string& mode_name) const {
+  read_keys->insert(key);
   auto it = options.find(key);
   if (it == options.end())
     throw Error("mode '" + mode_name + "'", "needs the option '" + key + "' (--mode-option " + key + "=VALUE)");

@@ -15,6 +15,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -39,6 +40,9 @@ struct ModeContext {
   // Free-form options of the run ("--mode-option key=value"), e.g. {"impostor_dir": "baked/city"}. A mode reads
   // the keys it knows; keys are shared by all modes of a run.
   std::map<std::string, std::string> options;
+  // Keys the modes asked for (option(), requireOption()), shared by the copies of a context: see
+  // eval/mode_options.h, checkEveryOptionRead.
+  std::shared_ptr<std::set<std::string>> read_keys = std::make_shared<std::set<std::string>>();
 
   // The option's value, or fallback when absent.
   std::string option(const std::string& key, const std::string& fallback = {}) const;

@@ -6,22 +6,10 @@
 #include <stdexcept>
 
 #include "farfield/core/error.h"
+#include "farfield/eval/mode_options.h"
 
 namespace farfield::eval {
 namespace {
-
-float parseFloatOption(const ModeContext& context, const std::string& key, float fallback) {
-  const std::string text = context.option(key);
-  if (text.empty()) return fallback;
-  try {
-    size_t used = 0;
-    const float v = std::stof(text, &used);
-    if (used != text.size() || !(v > 0.0f)) throw std::invalid_argument(text);
-    return v;
-  } catch (const std::exception&) {
-    throw Error("--mode-option " + key, "expected a positive number, got '" + text + "'");
-  }
-}
 
 // `terrain bench` sets the run; under `farfield bench` the first terrain mode loads it from the mode options.
 std::shared_ptr<TerrainRun> runFor(const ModeContext& context, const std::string& mode) {
@@ -29,9 +17,9 @@ std::shared_ptr<TerrainRun> runFor(const ModeContext& context, const std::string
   if (!run) {
     auto loaded = std::make_shared<TerrainRun>();
     loaded->data = terrain::TerrainData::load(context.requireOption("terrain", mode));
-    loaded->high_error = parseFloatOption(context, "high_error", loaded->high_error);
-    loaded->low_error = parseFloatOption(context, "low_error", loaded->low_error);
-    loaded->epsilon = parseFloatOption(context, "epsilon", float(loaded->epsilon));
+    loaded->high_error = float(positiveOption(context, "high_error", loaded->high_error));
+    loaded->low_error = float(positiveOption(context, "low_error", loaded->low_error));
+    loaded->epsilon = positiveOption(context, "epsilon", loaded->epsilon);
     if (context.renderer) loaded->sky = context.renderer->light().sky_color;
     run = std::move(loaded);
   }
