@@ -1,19 +1,19 @@
-// farfield bake SCENE [--streets city.streets.json] --technique depth-mesh|grid-mesh|both [--local edge|junction]
-//                [--pipeline pvs,near-far,mmi [--online mmi] [--error-px 10] [--frame-size 640x360] [--frame-fov 60]
-//                 [--station-spacing 5] [--layer-mesh grid|depth-mesh]
-//                 [--grid-cells 30] [--views street|six] [--pvs-spacing M] [--pvs-face PX] [--near-radius M]]
-//                [--resolution 512] [--fov DEG] [--eye-height M] [--path path.json] [--cell-lookup street|nearest]
-//                [--cells E,E,...] [--limit N] [--workers N]
-//                [--list] -o city.imp/
-// Bakes one impostor per viewing cell (oriented street edge, Sillion et al. 1997) into an impostor store directory
-// (farfield/store/impostor_store.h): captures on the GL thread, constructions on the other core(s), with a progress
-// bar; prints the bake time per impostor (render vs build) and the polygons per impostor. `--technique both` builds
-// the depth mesh and the grid mesh from the same capture into one store, which `farfield bench --impostors DIR` uses
-// for both the depth-mesh and the grid-mesh modes. With --pipeline it runs the extractor pipeline of Decoret et al.
-// 1999 instead (bake/pipeline.h): PVS, near/far split, multi-mesh impostors and the single mesh of the same far
-// objects, which the bench modes local, visible, smi, mmi and mmi-dynamic read.
+// farfield bake SCENE [--streets city.streets.json] [--local edge|junction] [--cell-lookup street|nearest]
+//                (--pipeline pvs,near-far,single,mmi [--online mmi] | --technique depth-mesh|grid-mesh)
+//                [--error-px 10] [--frame-size 640x360] [--frame-fov 60] [--station-spacing 5]
+//                [--layer-mesh grid|depth-mesh] [--grid-cells 30] [--views street|six] [--pvs-spacing M]
+//                [--pvs-face PX] [--near-radius M] [--landmarks IDS] [--landmark-boost X]
+//                [--resolution 512] [--fov DEG] [--eye-height M] [--path path.json]
+//                [--cells E,E,...] [--limit N] [--workers N] [--list] -o city.imp/
+// Runs the extractor pipeline (bake/pipeline.h, Decoret et al. 1999) over a city's viewing cells (oriented street
+// edges) into an impostor store directory (farfield/store/impostor_store.h): PVS, near/far split, the single mesh of
+// the far objects and the multi-mesh impostors, captures on the GL thread, meshes on the other core(s), with a
+// progress bar. `--technique depth-mesh|grid-mesh` (also the default without --pipeline) is Sillion et al. 1997's
+// cell impostor, which is the pipeline's single stage: `--pipeline near-far,single --layer-mesh depth-mesh|grid
+// --station-spacing 0` (one capture at each cell's start); it says so.
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <numeric>
 #include <sstream>
@@ -24,6 +24,7 @@
 #include "command.h"
 #include "farfield/bake/bake.h"
 #include "farfield/bake/pipeline.h"
+#include "farfield/extract/pipeline_options.h"
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gen/city.h"
@@ -37,7 +38,7 @@ namespace {
 struct BakeArgs {
   std::string scene;
   std::string streets;
-  std::string technique = "depth-mesh";
+  std::string technique;  // Sillion's cell impostor: an alias of --pipeline near-far,single (the default)
   std::string local = "edge";
   std::string lookup = "street";
   int resolution = 512;
@@ -49,7 +50,7 @@ struct BakeArgs {
   int workers = 0;
   bool list = false;
   std::string out_dir;
-  // Extractor pipeline (Decoret 1999): --pipeline pvs,near-far,mmi and its options.
+  // Extractor pipeline (Decoret 1999): --pipeline pvs,near-far,single,mmi and its options.
   std::string pipeline;
   std::string online;
   double error_px = 10.0;
@@ -110,11 +111,14 @@ std::string megabytes(double bytes) {
 }
 
 // The extractor pipeline (bake/pipeline.h): per cell PVS, near/far split, layers and their impostors.
-void runPipelineBake(const BakeArgs& args, const extract::BakeOptions& base, const scene::Scene& scene,
-                     const urban::CellMap& cells, const std::vector<uint32_t>& requested) {
-  const extract::PipelineSpec spec = extract::parsePipeline(args.pipeline, args.online);
+// The pipeline and its options from the arguments (--technique resolved into them by runBakeCommand).
+extract::PipelineOptions pipelineOptions(const BakeArgs& args) {
   extract::PipelineOptions options;
-  options.base = base;
+  options.base.resolution = args.resolution;
+  options.base.fov_deg = args.fov_deg;
+  options.base.eye_height = args.eye_height;
+  options.base.workers = args.workers;
+  options.base.scene_label = args.scene;
   options.error_px = args.error_px;
   const IVec2 frame = parseSize("--frame-size", args.frame_size);
   options.frame_width = frame.x;
@@ -129,6 +133,12 @@ void runPipelineBake(const BakeArgs& args, const extract::BakeOptions& base, con
   options.near_radius = args.near_radius;
   if (!args.landmarks.empty()) options.landmarks = parseCells(args.landmarks, "--landmarks");
   options.events.landmark_boost = args.landmark_boost;
+  extract::validatePipelineOptions(options);
+  return options;
+}
+
+void runPipelineBake(const BakeArgs& args, const extract::PipelineSpec& spec, const extract::PipelineOptions& options,
+                     const scene::Scene& scene, const urban::CellMap& cells, const std::vector<uint32_t>& requested) {
   std::string baked, online;
   for (const std::string& s : spec.baked()) baked += (baked.empty() ? "" : ",") + s;
   for (const std::string& s : spec.online()) online += (online.empty() ? "" : ",") + s;
@@ -208,28 +218,37 @@ void runPipelineBake(const BakeArgs& args, const extract::BakeOptions& base, con
   std::printf("wrote %s/index.json\n", args.out_dir.c_str());
 }
 
-void runBakeCommand(const BakeArgs& args) {
-  extract::BakeOptions options;
-  options.techniques = extract::parseTechniques(args.technique);
+// --technique depth-mesh|grid-mesh (Sillion 1997) is the pipeline near-far,single with that mesh and one capture
+// station at each cell's start; `given` tells which options the user set (they must not contradict the alias).
+void resolveTechnique(BakeArgs& args, const std::function<bool(const char*)>& given) {
+  if (args.pipeline.empty() && args.technique.empty()) args.technique = extract::kDepthMesh;
+  if (args.technique.empty()) return;
+  if (!args.pipeline.empty())
+    throw Error("--technique", "is an alias of --pipeline " + std::string(extract::kTechniquePipeline) +
+                                   "; give one or the other");
+  const extract::LayerMesh mesh = extract::techniqueMesh(args.technique);
+  for (const char* option : {"--layer-mesh", "--station-spacing", "--online"})
+    if (given(option))
+      throw Error(option, "--technique " + args.technique + " sets it; use --pipeline " +
+                              extract::kTechniquePipeline + " with " + option + " instead");
+  args.pipeline = extract::kTechniquePipeline;
+  args.layer_mesh = extract::layerMeshName(mesh);
+  args.station_spacing = 0.0f;
+  std::printf("technique:     %s is Sillion 1997's cell impostor, the pipeline's single stage: --pipeline %s "
+              "--layer-mesh %s --station-spacing 0\n",
+              args.technique.c_str(), extract::kTechniquePipeline, args.layer_mesh.c_str());
+}
+
+void runBakeCommand(BakeArgs args, const std::function<bool(const char*)>& given) {
   urban::CellOptions cell_options;
   cell_options.local = urban::parseLocalModel(args.local);
   cell_options.lookup = urban::parseCellLookup(args.lookup, "--cell-lookup");
-  options.resolution = args.resolution;
-  options.fov_deg = args.fov_deg;
-  options.eye_height = args.eye_height;
-  options.workers = args.workers;
-  options.scene_label = args.scene;
   if (args.out_dir.empty()) throw Error("-o", "an output directory is needed");
 
   // Cheap inputs first: pipeline options, streets and path fail before the scene is loaded.
-  if (!args.pipeline.empty()) {
-    extract::parsePipeline(args.pipeline, args.online);
-    extract::parseLayerMesh(args.layer_mesh);
-    extract::parseLayerViews(args.views);
-    if (!args.landmarks.empty()) parseCells(args.landmarks, "--landmarks");
-  } else if (!args.online.empty()) {
-    throw Error("--online", "needs --pipeline (the online stages are a tail of the pipeline)");
-  }
+  resolveTechnique(args, given);
+  const extract::PipelineSpec spec = extract::parsePipeline(args.pipeline, args.online);
+  const extract::PipelineOptions options = pipelineOptions(args);
   const std::string streets_file = args.streets.empty() ? gen::streetsPathFor(args.scene) : args.streets;
   urban::StreetGraph graph = urban::StreetGraph::load(streets_file);
   gen::CameraPath path;
@@ -259,73 +278,20 @@ void runBakeCommand(const BakeArgs& args) {
               urban::localModelName(cell_options.local), urban::cellLookupName(cell_options.lookup), in_blocks, a.shared.size(), a.without_footprint,
               a.outside_blocks, a.too_large);
 
-  if (!args.pipeline.empty()) {
-    runPipelineBake(args, options, scene, cells, requested);
-    return;
-  }
-  const bake::BakeReport report =
-      bake::bakeCells(gpu::sharedHeadlessContext(), scene, cells, requested, options, args.out_dir);
-
-  std::printf("cells:         %zu requested, %zu baked, %zu skipped (street shorter than %.2f m)\n",
-              report.requested, report.cells.size(), report.skipped_degenerate.size(),
-              double(cell_options.min_cell_length));
-  for (uint32_t e : report.skipped_degenerate)
-    std::printf("  skipped cell %u: street %u is %.4f m long\n", e, e / 2, double(cells.graph().length(e)));
-  std::printf("threads:       1 GL thread (captures) + %zu worker(s) (constructions)\n", report.workers);
-  std::printf("impostors:     %dx%d, fov %.0f deg, eye %.2f m above the ground\n", options.resolution,
-              options.resolution, double(options.fov_deg), double(options.eye_height));
-
-  if (args.list) {
-    std::printf("\n%8s %10s %10s", "cell", "render ms", "pixels");
-    for (const std::string& t : options.techniques) std::printf(" %14s %12s", (t + " ms").c_str(), "triangles");
-    std::printf("\n");
-    for (const bake::CellBake& c : report.cells) {
-      std::printf("%8u %10.1f %10zu", c.half_edge, c.render_ms, c.data_pixels);
-      for (const std::string& t : options.techniques)
-        std::printf(" %14.1f %12zu", c.build_ms.at(t), c.triangles.at(t));
-      std::printf("\n");
-    }
-  }
-
-  if (!report.cells.empty()) {
-    std::printf("\nper impostor        %10s %10s %10s\n", "mean", "median", "max");
-    auto row = [](const char* label, const Summary& s, const char* format) {
-      char buf[3][32];
-      std::snprintf(buf[0], sizeof(buf[0]), format, s.mean);
-      std::snprintf(buf[1], sizeof(buf[1]), format, s.median);
-      std::snprintf(buf[2], sizeof(buf[2]), format, s.max);
-      std::printf("%-19s %10s %10s %10s\n", label, buf[0], buf[1], buf[2]);
-    };
-    std::vector<double> render, write;
-    for (const bake::CellBake& c : report.cells) {
-      render.push_back(c.render_ms);
-      write.push_back(c.write_ms);
-    }
-    row("render ms", summarize(render), "%.1f");
-    for (const std::string& t : options.techniques) {
-      std::vector<double> build, tris;
-      for (const bake::CellBake& c : report.cells) {
-        build.push_back(c.build_ms.at(t));
-        tris.push_back(double(c.triangles.at(t)));
-      }
-      row((t + " build ms").c_str(), summarize(build), "%.1f");
-      row((t + " polygons").c_str(), summarize(tris), "%.0f");
-    }
-    row("write ms", summarize(write), "%.1f");
-  }
-  std::printf("\nwall:          %.1f s for %zu impostors (%.2f s per cell)\n", report.wall_s, report.cells.size(),
-              report.cells.empty() ? 0.0 : report.wall_s / double(report.cells.size()));
-  std::printf("wrote %s/index.json\n", args.out_dir.c_str());
+  runPipelineBake(args, spec, options, scene, cells, requested);
 }
 
 const RegisterCommand reg("bake", [](CLI::App& app) {
   auto args = std::make_shared<BakeArgs>();
-  auto* cmd = app.add_subcommand("bake", "Bake one impostor per street cell (oriented edge) into an impostor store "
-                                         "directory (Sillion 1997 textured depth meshes, or the grid-mesh baseline).");
+  auto* cmd = app.add_subcommand("bake", "Run the extractor pipeline (Decoret 1999: pvs, near-far, single, mmi) over "
+                                         "the street cells (oriented edges) into an impostor store directory; "
+                                         "--technique depth-mesh|grid-mesh is Sillion 1997's cell impostor, the "
+                                         "pipeline near-far,single.");
   cmd->add_option("scene", args->scene, "Scene file (the city .glb)")->required();
   cmd->add_option("--streets", args->streets, "Street graph JSON (default: the .streets.json next to the scene)");
-  cmd->add_option("--technique", args->technique, "depth-mesh, grid-mesh or both (one capture, both meshes)")
-      ->capture_default_str();
+  cmd->add_option("--technique", args->technique, "Sillion 1997's cell impostor: depth-mesh or grid-mesh, an alias of "
+                                                  "--pipeline near-far,single --layer-mesh depth-mesh|grid "
+                                                  "--station-spacing 0 (the default without --pipeline)");
   cmd->add_option("--local", args->local, "Local model: edge (blocks touching the street) or junction (also the "
                                           "blocks around both end junctions)")
       ->capture_default_str();
@@ -342,10 +308,10 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
   cmd->add_option("--workers", args->workers, "Worker threads for the constructions (0 = cores - 1, at least 1)")
       ->capture_default_str();
   cmd->add_flag("--list", args->list, "Print one line per baked cell");
-  cmd->add_option("--pipeline", args->pipeline, "Extractor pipeline (Decoret 1999) instead of --technique: stages "
-                                                "from pvs, near-far, mmi, e.g. pvs,near-far,mmi");
-  cmd->add_option("--online", args->online, "Pipeline stages left to the runtime (the pipeline's tail: mmi or "
-                                            "near-far,mmi); the rest is baked");
+  cmd->add_option("--pipeline", args->pipeline, "Extractor pipeline (Decoret 1999): stages from pvs, near-far, single, "
+                                                "mmi in that order, e.g. pvs,near-far,single,mmi");
+  cmd->add_option("--online", args->online, "Pipeline stages left to the runtime (the pipeline's tail: mmi, or "
+                                            "single,mmi, or near-far,single,mmi); the rest is baked");
   cmd->add_option("--error-px", args->error_px, "Error bound, pixels: the layering threshold and the bound the "
                                                 "validity regions are computed for")
       ->capture_default_str();
@@ -356,7 +322,8 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
   cmd->add_option("--station-spacing", args->station_spacing, "Capture stations along each cell, metres apart "
                                                               "(0: the cell's start only); unneeded ones are dropped")
       ->capture_default_str();
-  cmd->add_option("--layer-mesh", args->layer_mesh, "Mesh of each layer: grid (regular grid) or depth-mesh")
+  cmd->add_option("--layer-mesh", args->layer_mesh, "Mesh of each layer and of the single mesh: grid (regular grid) "
+                                                  "or depth-mesh")
       ->capture_default_str();
   cmd->add_option("--grid-cells", args->grid_cells, "Regular grid layer mesh: cells per side")->capture_default_str();
   cmd->add_option("--views", args->views, "Views per layer: street (along the cell) or six (360 degrees)")
@@ -372,7 +339,9 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
                                                       "local model (0)")
       ->capture_default_str();
   cmd->add_option("-o,--output", args->out_dir, "Impostor store directory")->required();
-  cmd->callback([args] { runBakeCommand(*args); });
+  cmd->callback([args, cmd] {
+    runBakeCommand(*args, [cmd](const char* option) { return cmd->count(option) > 0; });
+  });
 });
 
 }  // namespace

@@ -1,6 +1,7 @@
-// Bake: creation cameras, empty distant models, degenerate streets, determinism across worker counts, cells on a
-// path, ground height; and the baked impostor plus the local model reproduce the full render from the creation
-// viewpoint.
+// Sillion's bake, which is the pipeline near-far,single with one station per cell (`farfield bake --technique`):
+// creation cameras, empty distant models, degenerate streets, determinism across worker counts, cells on a path,
+// ground height; and the baked impostor plus the local model reproduce the full render from the creation viewpoint,
+// where its validity region lets the runtime draw it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <random>
 
 #include "farfield/bake/bake.h"
+#include "farfield/bake/pipeline.h"
 #include "farfield/extract/ground_height.h"
 #include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
@@ -57,12 +59,28 @@ TwoBlocks twoBlocks() {
   return t;
 }
 
-BakeOptions smallOptions() {
-  BakeOptions o;
-  o.techniques = {kDepthMesh, kGridMesh};
-  o.resolution = 128;
-  o.progress = false;
+// Sillion's bake as it is now: the pipeline near-far,single with one capture station at each cell's start
+// (`farfield bake --technique depth-mesh|grid-mesh`).
+PipelineOptions sillionOptions(LayerMesh mesh = LayerMesh::DepthMesh) {
+  PipelineOptions o;
+  o.base.resolution = 128;
+  o.base.progress = false;
+  o.mesh = mesh;
+  o.station_spacing = 0.0f;
   return o;
+}
+
+PipelineReport bakeSillion(const scene::Scene& scene, const CellMap& cells, std::vector<uint32_t> half_edges,
+                           const PipelineOptions& options, const std::string& dir) {
+  return bakePipeline(gpu::sharedHeadlessContext(), scene, cells, std::move(half_edges),
+                      parsePipeline(kTechniquePipeline), options, dir);
+}
+
+// The one view of a cell's single mesh (one station, the street view).
+const store::StoredView& onlyView(const store::CellEntry& entry) {
+  EXPECT_TRUE(entry.pipeline && entry.pipeline->has_single);
+  EXPECT_EQ(entry.pipeline->single.views.size(), 1u);
+  return entry.pipeline->single.views.at(0);
 }
 
 class BakeGpuTest : public ::testing::Test {
@@ -74,40 +92,58 @@ TEST_F(BakeGpuTest, EmptyDistantModelGivesEmptyImpostorAndDegenerateStreetIsRepo
   const TwoBlocks t = twoBlocks();
   const CellMap cells(t.graph, t.scene);
   const std::string dir = test::scratchDir("bake_two_blocks").string();
-  const BakeReport report = bakeCells(gpu::sharedHeadlessContext(), t.scene, cells, {}, smallOptions(), dir);
+  const PipelineReport report = bakeSillion(t.scene, cells, {}, sillionOptions(), dir);
   EXPECT_EQ(report.requested, 16u);
   EXPECT_EQ(report.skipped_degenerate, (std::vector<uint32_t>{14, 15}));
   ASSERT_EQ(report.cells.size(), 14u);
 
   const store::StoreIndex index = store::readIndex(dir);
   ASSERT_EQ(index.cells.size(), 14u);
+  EXPECT_EQ(index.pipeline, (std::vector<std::string>{"near-far", "single"}));
+  EXPECT_TRUE(index.techniques.empty());  // no Sillion record kind: the single stage's record
   EXPECT_EQ(index.find(14), nullptr);
   EXPECT_EQ(index.scene_objects, 3u);
+  for (const store::CellEntry& e : index.cells) {
+    ASSERT_TRUE(e.pipeline);
+    EXPECT_FALSE(e.pipeline->has_mmi);
+    EXPECT_FALSE(e.pipeline->has_pvs);
+  }
   // Street 5 lies between the two blocks: its local model is everything, its distant model nothing.
   for (uint32_t e : {10u, 11u}) {
     const store::CellEntry* entry = index.find(e);
     ASSERT_NE(entry, nullptr);
     EXPECT_EQ(entry->local_objects, (std::vector<uint32_t>{1, 2, 3}));
-    EXPECT_EQ(entry->distant_objects, 0u);
-    EXPECT_EQ(entry->data_pixels, 0u);
-    for (const char* technique : {kDepthMesh, kGridMesh}) {
-      EXPECT_EQ(entry->impostors.at(technique).triangles, 0u);
-      EXPECT_TRUE(store::loadImpostor(dir, *entry, technique).empty());
-    }
+    EXPECT_EQ(entry->pipeline->near, (std::vector<uint32_t>{1, 2, 3}));
+    EXPECT_TRUE(entry->pipeline->far.empty());
+    EXPECT_TRUE(entry->pipeline->single.objects.empty());
+    const store::StoredView& view = onlyView(*entry);
+    EXPECT_EQ(view.triangles, 0u);
+    EXPECT_EQ(view.data_pixels, 0u);
+    EXPECT_TRUE(store::loadLayerView(dir, view).empty());
   }
   // Street 0 (0,0) -> (60,0) borders the left block only: the tower is its distant model, seen ahead on the left.
   const store::CellEntry* e0 = index.find(0);
   ASSERT_NE(e0, nullptr);
   EXPECT_EQ(e0->local_objects, (std::vector<uint32_t>{1, 2}));
-  EXPECT_EQ(e0->distant_objects, 1u);
-  EXPECT_GT(e0->data_pixels, 100u);
-  EXPECT_GT(e0->impostors.at(kDepthMesh).triangles, 0u);
-  EXPECT_GT(e0->impostors.at(kGridMesh).triangles, 0u);
-  // Its creation camera: at the edge origin, 1.7 m above the flat ground, looking at the edge end.
-  EXPECT_NEAR(glm::length(e0->camera.eye - Vec3(0, 0, 1.7f)), 0.0f, 1e-4f);
-  EXPECT_NEAR(glm::length(e0->camera.at - Vec3(60, 0, 1.7f)), 0.0f, 1e-4f);
-  EXPECT_NEAR(e0->camera.fov_y, float(degToRad(60.0)), 1e-6f);
-  EXPECT_EQ(e0->camera.width, 128);
+  EXPECT_EQ(e0->pipeline->near, (std::vector<uint32_t>{1, 2}));
+  EXPECT_EQ(e0->pipeline->far, (std::vector<uint32_t>{3}));
+  EXPECT_EQ(e0->pipeline->single.objects, (std::vector<uint32_t>{3}));
+  const store::StoredView& v0 = onlyView(*e0);
+  EXPECT_GT(v0.data_pixels, 100u);
+  EXPECT_GT(v0.triangles, 0u);
+  // Its creation camera: at the edge origin, 1.7 m above the flat ground, looking at the edge end; one station
+  // (the paper's one capture per cell) with its validity region there.
+  EXPECT_NEAR(glm::length(v0.camera.eye - Vec3(0, 0, 1.7f)), 0.0f, 1e-4f);
+  EXPECT_NEAR(glm::length(v0.camera.at - Vec3(60, 0, 1.7f)), 0.0f, 1e-4f);
+  EXPECT_NEAR(v0.camera.fov_y, float(degToRad(60.0)), 1e-6f);
+  EXPECT_EQ(v0.camera.width, 128);
+  EXPECT_EQ(v0.station, 0u);
+  ASSERT_EQ(e0->pipeline->single.validity.size(), 1u);
+  EXPECT_EQ(e0->pipeline->single.validity[0].origin, v0.camera.eye);
+  EXPECT_EQ(e0->camera.eye, v0.camera.eye);
+  // The mesh kind is recorded with the options (the bench's depth-mesh mode checks it).
+  EXPECT_EQ(pipelineOptionsFromJson(index.options.at("pipeline"), "index").mesh, LayerMesh::DepthMesh);
+  EXPECT_EQ(pipelineOptionsFromJson(index.options.at("pipeline"), "index").station_spacing, 0.0f);
   // A copy of the street graph travels with the store.
   EXPECT_EQ(StreetGraph::load((std::filesystem::path(dir) / index.streets).string()).streetCount(), 8u);
 }
@@ -115,78 +151,88 @@ TEST_F(BakeGpuTest, EmptyDistantModelGivesEmptyImpostorAndDegenerateStreetIsRepo
 TEST_F(BakeGpuTest, ImpostorPlusLocalModelReproducesTheFullRenderFromTheCreationViewpoint) {
   const TwoBlocks t = twoBlocks();
   const CellMap cells(t.graph, t.scene);
-  const std::string dir = test::scratchDir("bake_creation_view").string();
-  BakeOptions options = smallOptions();
-  options.resolution = 256;
-  options.fov_deg = 60.0f;
-  bakeCells(gpu::sharedHeadlessContext(), t.scene, cells, {0, 1, 4}, options, dir);
-  const store::StoreIndex index = store::readIndex(dir);
-  ASSERT_EQ(index.cells.size(), 3u);
+  for (const LayerMesh mesh : {LayerMesh::DepthMesh, LayerMesh::Grid}) {
+    SCOPED_TRACE(layerMeshName(mesh));
+    const std::string dir = test::scratchDir(std::string("bake_creation_view_") + layerMeshName(mesh)).string();
+    PipelineOptions options = sillionOptions(mesh);
+    options.base.resolution = 256;
+    options.base.fov_deg = 60.0f;
+    const PipelineReport report = bakeSillion(t.scene, cells, {0, 1, 4}, options, dir);
+    const store::StoreIndex index = store::readIndex(dir);
+    ASSERT_EQ(index.cells.size(), 3u);
 
-  gpu::GpuScene gpu_scene(t.scene);
-  gpu::Renderer renderer;
-  gpu::RenderTarget target(256, 256);
-  for (const store::CellEntry& entry : index.cells) {
-    const Camera& camera = entry.camera;
-    renderer.render(camera, gpu_scene.drawItems(), target);
+    gpu::GpuScene gpu_scene(t.scene);
+    gpu::Renderer renderer;
+    gpu::RenderTarget target(256, 256);
+    for (const store::CellEntry& entry : index.cells) {
+      const store::StoredView& view = onlyView(entry);
+      const Camera& camera = view.camera;
+      renderer.render(camera, gpu_scene.drawItems(), target);
+      const image::ColorImage full = target.readColor();
+      const impostor::GpuImpostor imp(store::loadLayerView(dir, view));
+      std::vector<gpu::DrawItem> items;
+      gpu_scene.appendDrawItems(entry.pipeline->near, items);
+      imp.appendDrawItems(items, 99);
+      renderer.render(camera, items, target);
+      const image::ColorImage composed = target.readColor();
+      const image::ImageMetrics m = image::compareImages(full, composed, 8);
+      // The bar for an impostor seen from its creation viewpoint.
+      EXPECT_GE(m.psnr_db, mesh == LayerMesh::DepthMesh ? 35.0 : 30.0) << "cell " << entry.half_edge;
+      EXPECT_LE(m.bad_pixel_share, 0.01) << "cell " << entry.half_edge;
+      // And the runtime may draw it there: at its creation eye the validity region is within the bake's bound.
+      const impostor::ValidityRegion& region = entry.pipeline->single.validity.at(0);
+      EXPECT_TRUE(region.valid(camera.eye, report.threshold_rad)) << "cell " << entry.half_edge;
+    }
+    // Without the impostor, cell 0 loses the tower: the check above can fail.
+    const store::CellEntry& e0 = *index.find(0);
+    const Camera& c0 = onlyView(e0).camera;
+    renderer.render(c0, gpu_scene.drawItems(), target);
     const image::ColorImage full = target.readColor();
-    const impostor::GpuImpostor imp(store::loadImpostor(dir, entry, kDepthMesh));
-    std::vector<gpu::DrawItem> items;
-    gpu_scene.appendDrawItems(entry.local_objects, items);
-    imp.appendDrawItems(items, 99);
-    renderer.render(camera, items, target);
-    const image::ColorImage composed = target.readColor();
-    const image::ImageMetrics m = image::compareImages(full, composed, 8);
-    // The bar for an impostor seen from its creation viewpoint.
-    EXPECT_GE(m.psnr_db, 35.0) << "cell " << entry.half_edge;
-    EXPECT_LE(m.bad_pixel_share, 0.01) << "cell " << entry.half_edge;
+    std::vector<gpu::DrawItem> local;
+    gpu_scene.appendDrawItems(e0.pipeline->near, local);
+    renderer.render(c0, local, target);
+    EXPECT_LT(image::compareImages(full, target.readColor(), 8).psnr_db, 30.0);
   }
-  // Without the impostor, cell 0 loses the tower: the check above can fail.
-  const store::CellEntry& e0 = *index.find(0);
-  renderer.render(e0.camera, gpu_scene.drawItems(), target);
-  const image::ColorImage full = target.readColor();
-  std::vector<gpu::DrawItem> local;
-  gpu_scene.appendDrawItems(e0.local_objects, local);
-  renderer.render(e0.camera, local, target);
-  EXPECT_LT(image::compareImages(full, target.readColor(), 8).psnr_db, 30.0);
 }
 
 TEST_F(BakeGpuTest, ResultDoesNotDependOnTheNumberOfWorkers) {
   const TwoBlocks t = twoBlocks();
   const CellMap cells(t.graph, t.scene);
-  BakeOptions options = smallOptions();
-  options.resolution = 64;
-  options.workers = 1;
-  const BakeReport one =
-      bakeCells(gpu::sharedHeadlessContext(), t.scene, cells, {}, options, test::scratchDir("bake_w1").string());
-  options.workers = 3;
-  options.queue_capacity = 1;
-  const BakeReport three =
-      bakeCells(gpu::sharedHeadlessContext(), t.scene, cells, {}, options, test::scratchDir("bake_w3").string());
+  PipelineOptions options = sillionOptions();
+  options.base.resolution = 64;
+  options.base.workers = 1;
+  const std::string one_dir = test::scratchDir("bake_w1").string(), three_dir = test::scratchDir("bake_w3").string();
+  bakeSillion(t.scene, cells, {}, options, one_dir);
+  options.base.workers = 3;
+  options.base.queue_capacity = 1;
+  const PipelineReport three = bakeSillion(t.scene, cells, {}, options, three_dir);
   EXPECT_EQ(three.workers, 3u);
-  ASSERT_EQ(one.cells.size(), three.cells.size());
-  for (size_t i = 0; i < one.cells.size(); ++i) {
-    EXPECT_EQ(one.cells[i].half_edge, three.cells[i].half_edge);
-    EXPECT_EQ(one.cells[i].triangles, three.cells[i].triangles) << "cell " << one.cells[i].half_edge;
+  const store::StoreIndex a = store::readIndex(one_dir);
+  const store::StoreIndex b = store::readIndex(three_dir);
+  ASSERT_EQ(a.cells.size(), b.cells.size());
+  size_t with_triangles = 0;
+  for (size_t i = 0; i < a.cells.size(); ++i) {
+    EXPECT_EQ(a.cells[i].half_edge, b.cells[i].half_edge);
+    EXPECT_EQ(onlyView(a.cells[i]).triangles, onlyView(b.cells[i]).triangles) << "cell " << a.cells[i].half_edge;
+    EXPECT_EQ(a.cells[i].pipeline->single.validity.at(0).envelope, b.cells[i].pipeline->single.validity.at(0).envelope);
+    with_triangles += onlyView(a.cells[i]).triangles > 0 ? 1 : 0;
   }
+  EXPECT_GT(with_triangles, 0u);
 }
 
 TEST_F(BakeGpuTest, BadRequestsAreErrors) {
   const TwoBlocks t = twoBlocks();
   const CellMap cells(t.graph, t.scene);
   const std::string dir = test::scratchDir("bake_bad").string();
-  EXPECT_THROW(bakeCells(gpu::sharedHeadlessContext(), t.scene, cells, {99}, smallOptions(), dir), Error);
-  BakeOptions options = smallOptions();
-  options.fov_deg = 180.0f;
-  EXPECT_THROW(bakeCells(gpu::sharedHeadlessContext(), t.scene, cells, {0}, options, dir), Error);
-  options = smallOptions();
-  options.techniques = {"billboard"};
-  EXPECT_THROW(bakeCells(gpu::sharedHeadlessContext(), t.scene, cells, {0}, options, dir), Error);
-  EXPECT_THROW(parseTechniques("depth"), Error);
-  EXPECT_EQ(parseTechniques("both"), (std::vector<std::string>{kDepthMesh, kGridMesh}));
+  EXPECT_THROW(bakeSillion(t.scene, cells, {99}, sillionOptions(), dir), Error);
+  PipelineOptions options = sillionOptions();
+  options.base.fov_deg = 180.0f;
+  EXPECT_THROW(bakeSillion(t.scene, cells, {0}, options, dir), Error);
+  EXPECT_THROW(techniqueMesh("billboard"), Error);
+  EXPECT_THROW(techniqueMesh("both"), Error);
   // A cell map of another scene.
   scene::Scene other;
-  EXPECT_THROW(bakeCells(gpu::sharedHeadlessContext(), other, cells, {0}, smallOptions(), dir), Error);
+  EXPECT_THROW(bakeSillion(other, cells, {0}, sillionOptions(), dir), Error);
 }
 
 TEST(BakeTest, CellsOnPathInOrderOfFirstVisit) {

@@ -55,10 +55,10 @@ TEST_F(MmiParallaxTest, MmiStaysUnderThePixelThresholdAlongTheCellWhileTheSingle
   const gpu::GpuScene gpu_scene(s.scene);
   PipelineRunner runner(s.scene, gpu_scene, cells, options);
   CellWork work = runner.start(s.cell);
-  runner.runStages({kStagePvs, kStageNearFar, kStageMmi}, work);
+  runner.runStages({kStagePvs, kStageNearFar, kStageSingle, kStageMmi}, work);
 
   const store::CellPipeline& r = work.result;
-  ASSERT_TRUE(r.has_pvs && r.has_split && r.has_mmi);
+  ASSERT_TRUE(r.has_pvs && r.has_split && r.has_single && r.has_mmi);
   EXPECT_EQ(r.far, (std::vector<uint32_t>{s.near_left, s.far_left, s.near_right, s.far_right}));
   // The test is only meaningful when each near building and the one it hides are in different layers, which they
   // must be: their visibility-event weight is far above T.

@@ -33,6 +33,18 @@ namespace farfield::bake {
 using namespace farfield::extract;
 namespace {
 
+// Runs `call`, which must throw farfield::Error whose message holds every one of `parts`.
+template <typename F>
+void expectErrorMentions(F call, const std::vector<std::string>& parts) {
+  try {
+    call();
+    ADD_FAILURE() << "expected farfield::Error mentioning " << parts.back();
+  } catch (const Error& e) {
+    for (const std::string& part : parts)
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' in: " << e.what();
+  }
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // parsePipeline
 
@@ -84,6 +96,23 @@ TEST(PipelineParseTest, AcceptsTheValidPipelinesAndSplits) {
   s = parsePipeline("near-far,mmi", "near-far,mmi");
   EXPECT_TRUE(s.baked().empty());
   EXPECT_EQ(s.online(), (V{"near-far", "mmi"}));
+
+  // The single stage: after near-far, before mmi; alone (Sillion's cell impostor) or with mmi, online like mmi.
+  s = parsePipeline("near-far,single");
+  EXPECT_EQ(s.stages, (V{"near-far", "single"}));
+  s = parsePipeline("pvs,near-far,single");
+  EXPECT_EQ(s.stages, (V{"pvs", "near-far", "single"}));
+  s = parsePipeline("pvs,near-far,single,mmi");
+  EXPECT_EQ(s.stages, (V{"pvs", "near-far", "single", "mmi"}));
+  s = parsePipeline(kTechniquePipeline);
+  EXPECT_EQ(s.stages, (V{"near-far", "single"}));
+  s = parsePipeline("pvs,near-far,single,mmi", "mmi");
+  EXPECT_EQ(s.baked(), (V{"pvs", "near-far", "single"}));
+  s = parsePipeline("pvs,near-far,single,mmi", "single,mmi");
+  EXPECT_EQ(s.online(), (V{"single", "mmi"}));
+  s = parsePipeline("near-far,single", "single");
+  EXPECT_EQ(s.baked(), (V{"near-far"}));
+  EXPECT_EQ(s.online(), (V{"single"}));
 }
 
 TEST(PipelineParseTest, RejectsBadPipelinesAndSplits) {
@@ -109,6 +138,25 @@ TEST(PipelineParseTest, RejectsBadPipelinesAndSplits) {
   expectParseError("pvs,near-far", "mmi", "not in the pipeline");
   expectParseError("pvs,near-far,mmi", "smi", "--online");
   expectParseError("pvs,near-far,mmi", "mmi,", "--online");
+  // The single stage: one order (pvs, near-far, single, mmi), near-far before it, online only as part of the tail.
+  expectParseError("pvs,near-far,mmi,single", "", "the order is pvs, near-far, single, mmi");
+  expectParseError("pvs,near-far,mmi,single", "", "'single' must come before 'mmi'");
+  expectParseError("single,near-far", "", "--pipeline");
+  expectParseError("single", "", "single needs near-far");
+  expectParseError("pvs,single", "", "single needs near-far");
+  expectParseError("near-far,single,single", "", "twice");
+  expectParseError("pvs,near-far,single,mmi", "single", "--online");  // not the tail
+  expectParseError("pvs,near-far,single,mmi", "mmi,single", "--online");
+  expectParseError("near-far,mmi", "single", "not in the pipeline");
+}
+
+TEST(PipelineParseTest, TechniquesAreTheSingleStageWithTheirMesh) {
+  EXPECT_EQ(techniqueMesh("depth-mesh"), LayerMesh::DepthMesh);
+  EXPECT_EQ(techniqueMesh("grid-mesh"), LayerMesh::Grid);
+  // "both" made one store of two meshes from one capture; a store now holds one mesh kind.
+  expectErrorMentions([] { techniqueMesh("both"); }, {"--technique", "both", "twice"});
+  expectErrorMentions([] { techniqueMesh("depth"); }, {"--technique", "depth"});
+  expectErrorMentions([] { techniqueMesh("grid", "mode 'x'"); }, {"mode 'x'", "grid"});
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -116,7 +164,8 @@ TEST(PipelineParseTest, RejectsBadPipelinesAndSplits) {
 
 // A 16-block city of plain boxes with one object per building (several objects per block: layers with several
 // members, pairs with and without visibility events), a 24-frame drive (5 m per frame), and the cells it visits
-// baked twice with the full pipeline: all stages baked, and with the mmi stage left online. Built once for the suite.
+// baked twice with the full pipeline: all stages baked, and with the single and mmi stages left online. Built once
+// for the suite.
 struct BakedCity {
   gen::City city;
   std::unique_ptr<urban::CellMap> cells;
@@ -126,18 +175,6 @@ struct BakedCity {
   PipelineReport full_report, online_report;
   double full_s = 0.0, online_s = 0.0;
 };
-
-// Runs `call`, which must throw farfield::Error whose message holds every one of `parts`.
-template <typename F>
-void expectErrorMentions(F call, const std::vector<std::string>& parts) {
-  try {
-    call();
-    ADD_FAILURE() << "expected farfield::Error mentioning " << parts.back();
-  } catch (const Error& e) {
-    for (const std::string& part : parts)
-      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' in: " << e.what();
-  }
-}
 
 // A layer captured with LayerViews::Street from its stations: one view and one validity region per station, the
 // first at the cell's start, the others on the cell at increasing distances, each region's origin its station's eye.
@@ -193,10 +230,11 @@ const BakedCity& bakedCity() {
     c->online_dir = test::scratchDir("pipeline_online").string();
     auto t0 = std::chrono::steady_clock::now();
     c->full_report = bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, *c->cells, c->visited,
-                                  parsePipeline("pvs,near-far,mmi"), c->options, c->full_dir);
+                                  parsePipeline("pvs,near-far,single,mmi"), c->options, c->full_dir);
     auto t1 = std::chrono::steady_clock::now();
     c->online_report = bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, *c->cells, c->visited,
-                                    parsePipeline("pvs,near-far,mmi", "mmi"), c->options, c->online_dir);
+                                    parsePipeline("pvs,near-far,single,mmi", "single,mmi"), c->options,
+                                    c->online_dir);
     auto t2 = std::chrono::steady_clock::now();
     c->full_s = std::chrono::duration<double>(t1 - t0).count();
     c->online_s = std::chrono::duration<double>(t2 - t1).count();
@@ -314,7 +352,7 @@ TEST_F(PipelineBakeTest, BakedCellsHoldAConsistentPvsSplitAndLayering) {
   ASSERT_GE(b.visited.size(), 2u);
   const store::StoreIndex index = store::readIndex(b.full_dir);
   EXPECT_EQ(index.version, store::kIndexVersion);
-  EXPECT_EQ(index.pipeline, (std::vector<std::string>{"pvs", "near-far", "mmi"}));
+  EXPECT_EQ(index.pipeline, (std::vector<std::string>{"pvs", "near-far", "single", "mmi"}));
   EXPECT_TRUE(index.online.empty());
   EXPECT_EQ(index.scene_objects, b.city.scene.objects.size());
   ASSERT_EQ(index.cells.size(), b.full_report.cells.size());
@@ -332,7 +370,7 @@ TEST_F(PipelineBakeTest, BakedCellsHoldAConsistentPvsSplitAndLayering) {
     SCOPED_TRACE("cell " + std::to_string(e.half_edge));
     ASSERT_TRUE(e.pipeline);
     const store::CellPipeline& p = *e.pipeline;
-    ASSERT_TRUE(p.has_pvs && p.has_split && p.has_mmi);
+    ASSERT_TRUE(p.has_pvs && p.has_split && p.has_single && p.has_mmi);
     EXPECT_EQ(e.local_objects, b.cells->localObjects(e.half_edge));
 
     // PVS: ids in range, ascending; near and far partition it.
@@ -515,19 +553,21 @@ TEST_F(PipelineBakeTest, StorageReportCountsTheBytesWritten) {
               s.at("estimate_bytes_measured_layers").get<double>(), s.at("estimate_bytes_3_layers").get<double>());
 }
 
-TEST_F(PipelineBakeTest, OnlineMmiStoreHoldsPvsAndSplitAndTheRuntimeFinishesItIdentically) {
+TEST_F(PipelineBakeTest, OnlineSingleAndMmiStoreHoldsPvsAndSplitAndTheRuntimeFinishesItIdentically) {
   const BakedCity& b = bakedCity();
   const store::StoreIndex full = store::readIndex(b.full_dir);
   const store::StoreIndex online = store::readIndex(b.online_dir);
-  EXPECT_EQ(online.pipeline, (std::vector<std::string>{"pvs", "near-far", "mmi"}));
-  EXPECT_EQ(online.online, (std::vector<std::string>{"mmi"}));
+  EXPECT_EQ(online.pipeline, (std::vector<std::string>{"pvs", "near-far", "single", "mmi"}));
+  EXPECT_EQ(online.online, (std::vector<std::string>{"single", "mmi"}));
   ASSERT_EQ(online.cells.size(), full.cells.size());
   for (const store::CellEntry& e : online.cells) {
     ASSERT_TRUE(e.pipeline);
     EXPECT_TRUE(e.pipeline->has_pvs);
     EXPECT_TRUE(e.pipeline->has_split);
     EXPECT_FALSE(e.pipeline->has_mmi) << "cell " << e.half_edge;
+    EXPECT_FALSE(e.pipeline->has_single) << "cell " << e.half_edge;
     EXPECT_TRUE(e.pipeline->layers.empty());
+    EXPECT_TRUE(e.pipeline->single.views.empty());
   }
   // No image or mesh written, and the storage report says so.
   size_t files = 0;
@@ -563,9 +603,18 @@ TEST_F(PipelineBakeTest, OnlineMmiStoreHoldsPvsAndSplitAndTheRuntimeFinishesItId
       for (size_t v = 0; v < r.layers[l].views.size(); ++v)
         EXPECT_EQ(r.layers[l].views[v].triangles, baked->pipeline->layers[l].views[v].triangles) << "layer " << l;
     }
+    ASSERT_TRUE(r.has_single);
     EXPECT_EQ(r.single.objects, baked->pipeline->single.objects);
+    ASSERT_EQ(r.single.views.size(), baked->pipeline->single.views.size());
+    for (size_t v = 0; v < r.single.views.size(); ++v) {
+      EXPECT_EQ(r.single.views[v].triangles, baked->pipeline->single.views[v].triangles) << "single view " << v;
+      EXPECT_EQ(r.single.views[v].station, baked->pipeline->single.views[v].station) << "single view " << v;
+    }
+    EXPECT_EQ(r.single.validity.size(), baked->pipeline->single.validity.size());
     EXPECT_EQ(work.layer_views.size(), r.layers.size());
+    EXPECT_EQ(work.single_views.size(), r.single.views.size());
     EXPECT_TRUE(work.layer_captures.empty());  // buildMeshes ran and freed them
+    EXPECT_TRUE(work.single_captures.empty());
   }
 }
 
@@ -581,7 +630,6 @@ TEST_F(PipelineBakeTest, OptionsSurviveTheIndexAndBadOptionsAreErrors) {
   o.layer_choice = urban::LayerChoice::SmallestArea;
   o.events.points = urban::RepresentativePoints::HullVertices;
   o.events.landmark_boost = 3.0;
-  o.single_mesh = false;
   const PipelineOptions back = pipelineOptionsFromJson(nlohmann::json::parse(pipelineOptionsToJson(o).dump()), "x");
   EXPECT_EQ(back.base.resolution, o.base.resolution);
   EXPECT_EQ(back.error_px, o.error_px);
@@ -593,7 +641,6 @@ TEST_F(PipelineBakeTest, OptionsSurviveTheIndexAndBadOptionsAreErrors) {
   EXPECT_EQ(back.layer_choice, o.layer_choice);
   EXPECT_EQ(back.events.points, o.events.points);
   EXPECT_EQ(back.events.landmark_boost, o.events.landmark_boost);
-  EXPECT_EQ(back.single_mesh, o.single_mesh);
   EXPECT_EQ(back.pvs.spacing, o.pvs.spacing);
   EXPECT_EQ(back.pvs.face_size, o.pvs.face_size);
   EXPECT_EQ(back.grid_cells, o.grid_cells);
@@ -639,15 +686,26 @@ TEST_F(PipelineBakeTest, OptionsSurviveTheIndexAndBadOptionsAreErrors) {
     v2.erase("validity");
     v2.erase("station_spacing");
     EXPECT_THROW(pipelineOptionsFromJson(v2, "idx"), Error);
+    // Versions 2 and 3 also said whether the mmi stage built the single mesh (now the single stage: the store's
+    // reader maps it); required there, a boolean, and unknown in version 4.
+    expectErrorMentions([&] { pipelineOptionsFromJson(v2, "idx", 2); }, {"idx", "single_mesh", "missing"});
+    v2["single_mesh"] = "yes";
+    expectErrorMentions([&] { pipelineOptionsFromJson(v2, "idx", 2); }, {"idx", "single_mesh", "true or false"});
+    v2["single_mesh"] = false;
     const PipelineOptions old = pipelineOptionsFromJson(v2, "idx", 2);
     EXPECT_EQ(old.frame_height, old.frame_width);
     EXPECT_EQ(old.frame_fov_deg, o.base.fov_deg);
+    nlohmann::json v3 = whole;
+    expectErrorMentions([&] { pipelineOptionsFromJson(v3, "idx", 3); }, {"idx", "single_mesh", "missing"});
+    v3["single_mesh"] = true;
+    EXPECT_EQ(pipelineOptionsFromJson(v3, "idx", 3).mesh, o.mesh);
+    expectErrorMentions([&] { pipelineOptionsFromJson(v3, "idx", 4); }, {"idx", "unknown", "single_mesh"});
   }
 
   const std::string dir = test::scratchDir("pipeline_bad").string();
   const auto bake = [&](const PipelineOptions& options, std::vector<uint32_t> cells) {
     bakePipeline(gpu::sharedHeadlessContext(), b.city.scene, *b.cells, std::move(cells),
-                 parsePipeline("pvs,near-far,mmi"), options, dir);
+                 parsePipeline("pvs,near-far,single,mmi"), options, dir);
   };
   PipelineOptions bad = smallOptions();
   bad.error_px = 0.0;
@@ -663,7 +721,8 @@ TEST_F(PipelineBakeTest, OptionsSurviveTheIndexAndBadOptionsAreErrors) {
   const gpu::GpuScene gpu_scene(b.city.scene);
   PipelineRunner runner(b.city.scene, gpu_scene, *b.cells, smallOptions());
   CellWork work = runner.start(b.visited.front());
-  EXPECT_THROW(runner.runStage(kStageMmi, work), Error);
+  expectErrorMentions([&] { runner.runStage(kStageMmi, work); }, {"mmi needs the near-far stage"});
+  expectErrorMentions([&] { runner.runStage(kStageSingle, work); }, {"single needs the near-far stage"});
   EXPECT_THROW(runner.runStage("smi", work), Error);
   EXPECT_THROW(runner.start(uint32_t(b.cells->cellCount())), Error);
 }
@@ -678,7 +737,7 @@ TEST_F(PipelineBakeTest, SixViewsLayerTheWholeFarSetAndCoverTheStreetView) {
   six.views = LayerViews::Six;
   PipelineRunner six_runner(b.city.scene, gpu_scene, *b.cells, six);
   PipelineRunner street_runner(b.city.scene, gpu_scene, *b.cells, smallOptions());
-  const std::vector<std::string> stages{kStagePvs, kStageNearFar, kStageMmi};
+  const std::vector<std::string> stages{kStagePvs, kStageNearFar, kStageSingle, kStageMmi};
   size_t six_layered = 0, street_layered = 0;
   for (uint32_t cell : b.visited) {
     SCOPED_TRACE("cell " + std::to_string(cell));
@@ -728,6 +787,40 @@ TEST_F(PipelineBakeTest, SixViewsLayerTheWholeFarSetAndCoverTheStreetView) {
   }
   EXPECT_GT(six_layered, 0u);
   EXPECT_GT(street_layered, 0u);
+}
+
+// The single mesh is the single stage's: with mmi after it, the same record as single alone (built once, by single),
+// and mmi alone builds none.
+TEST_F(PipelineBakeTest, TheSingleMeshIsBuiltByTheSingleStageOnly) {
+  const BakedCity& b = bakedCity();
+  const gpu::GpuScene gpu_scene(b.city.scene);
+  PipelineRunner runner(b.city.scene, gpu_scene, *b.cells, smallOptions());
+  const uint32_t cell = b.visited.front();
+  CellWork alone = runner.start(cell), both = runner.start(cell), mmi = runner.start(cell);
+  runner.runStages({kStageNearFar, kStageSingle}, alone);
+  runner.runStages({kStageNearFar, kStageSingle, kStageMmi}, both);
+  runner.runStages({kStageNearFar, kStageMmi}, mmi);
+  ASSERT_TRUE(alone.result.has_single && both.result.has_single && both.result.has_mmi);
+  EXPECT_FALSE(alone.result.has_mmi);
+  EXPECT_TRUE(alone.result.layers.empty());
+  EXPECT_FALSE(mmi.result.has_single);
+  EXPECT_TRUE(mmi.result.single.views.empty());
+  EXPECT_TRUE(mmi.single_views.empty());
+  ASSERT_FALSE(alone.result.single.views.empty());
+  EXPECT_EQ(alone.result.single.objects, both.result.single.objects);
+  ASSERT_EQ(alone.result.single.views.size(), both.result.single.views.size());
+  ASSERT_EQ(alone.single_views.size(), both.single_views.size());
+  for (size_t v = 0; v < alone.result.single.views.size(); ++v) {
+    EXPECT_EQ(alone.result.single.views[v].triangles, both.result.single.views[v].triangles);
+    EXPECT_EQ(alone.result.single.views[v].station, both.result.single.views[v].station);
+  }
+  ASSERT_EQ(alone.result.single.validity.size(), both.result.single.validity.size());
+  for (size_t j = 0; j < alone.result.single.validity.size(); ++j)
+    EXPECT_EQ(alone.result.single.validity[j].envelope, both.result.single.validity[j].envelope);
+  // The layers do not depend on whether the single stage ran.
+  ASSERT_EQ(both.result.layers.size(), mmi.result.layers.size());
+  for (size_t l = 0; l < both.result.layers.size(); ++l)
+    EXPECT_EQ(both.result.layers[l].objects, mmi.result.layers[l].objects);
 }
 
 }  // namespace

@@ -52,3 +52,11 @@ expect_error("--pipeline" bake builtin:cubes --pipeline mmi -o ${WORK}/imp)
 expect_error("--online" bake builtin:cubes --pipeline pvs,near-far,mmi --online pvs -o ${WORK}/imp)
 expect_error("--layer-mesh" bake builtin:cubes --pipeline pvs,near-far,mmi --layer-mesh voxels -o ${WORK}/imp)
 expect_error("--online" bake builtin:cubes --online mmi -o ${WORK}/imp)
+expect_error("the order is pvs, near-far, single, mmi" bake builtin:cubes --pipeline pvs,near-far,mmi,single
+             -o ${WORK}/imp)
+expect_error("single needs near-far" bake builtin:cubes --pipeline pvs,single -o ${WORK}/imp)
+# --technique is Sillion's cell impostor, the pipeline near-far,single: one mesh kind per store, no contradictions.
+expect_error("Bake twice" bake builtin:cubes --technique both -o ${WORK}/imp)
+expect_error("--technique" bake builtin:cubes --technique depth-mesh --pipeline near-far,single -o ${WORK}/imp)
+expect_error("--layer-mesh" bake builtin:cubes --technique grid-mesh --layer-mesh depth-mesh -o ${WORK}/imp)
+expect_error("--station-spacing" bake builtin:cubes --technique depth-mesh --station-spacing 5 -o ${WORK}/imp)

@@ -23,6 +23,13 @@ endif()
 if(NOT EXISTS ${WORK}/last.png)
   message(FATAL_ERROR "embed_walkthrough did not write its frame")
 endif()
+# Sillion's bake is the pipeline's single stage, and says so; the depth-mesh walk reads it through the walkthrough.
+run_ok(${FARFIELD} bake ${WORK}/city.glb --technique grid-mesh --resolution 64 --path ${WORK}/drive.json --limit 2
+       -o ${WORK}/sillion)
+if(NOT LAST_OUT MATCHES "--pipeline near-far,single --layer-mesh grid --station-spacing 0"
+   OR NOT LAST_OUT MATCHES "baked \\[near-far,single\\]")
+  message(FATAL_ERROR "bake --technique did not say it is the pipeline near-far,single:\n${LAST_OUT}")
+endif()
 # A database that is not there is a clear error, exit code 2.
 execute_process(COMMAND ${EXAMPLE} ${WORK}/city.glb ${WORK}/nothing ${WORK}/drive.json RESULT_VARIABLE rc
                 ERROR_VARIABLE err)

@@ -32,7 +32,8 @@ namespace {
 constexpr int kFrameSize = 192;
 
 // A 16-block city of plain boxes, a 12-frame drive at 5 m per frame, and the cells it visits baked with the full
-// pipeline (256 x 256 layer images), once with every stage baked and once with the mmi stage left online.
+// pipeline (256 x 256 layer images), once with every stage baked and once with the single and mmi stages left
+// online.
 struct MmiCity {
   gen::City city;
   std::unique_ptr<urban::CellMap> cells;
@@ -68,10 +69,11 @@ const MmiCity& mmiCity() {
     c->visited = bake::cellsOnPath(*c->cells, c->path);
     c->store = test::scratchDir("mmi_mode_store").string();
     bake::bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, *c->cells, c->visited,
-                       extract::parsePipeline("pvs,near-far,mmi"), pipelineOptions(), c->store);
+                       extract::parsePipeline("pvs,near-far,single,mmi"), pipelineOptions(), c->store);
     c->online_store = test::scratchDir("mmi_mode_online_store").string();
     bake::bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, *c->cells, c->visited,
-                       extract::parsePipeline("pvs,near-far,mmi", "mmi"), pipelineOptions(), c->online_store);
+                       extract::parsePipeline("pvs,near-far,single,mmi", "single,mmi"), pipelineOptions(),
+                       c->online_store);
     return c;
   }();
   return *s;
@@ -290,14 +292,23 @@ TEST_F(MmiModeTest, WhereNoImpostorIsValidTheObjectsAreDrawnAsGeometry) {
   EXPECT_EQ(loose.mode("mmi")->info.at("error_bound_px"), pipelineOptions().error_px);
 }
 
-// `bake --online mmi`: the store holds the PVS and the split; the mode runs the mmi stage when it enters a cell.
+// `bake --online single,mmi`: the store holds the PVS and the split; the mode runs the stage it draws (mmi or single,
+// not both) when it enters a cell.
 TEST_F(MmiModeTest, OnlineStoreRunsTheMissingStagesAndMatchesTheBakedStore) {
   const MmiCity& s = mmiCity();
-  const BenchResult baked = runModes(s.path, {"mmi"}, s.store);
-  const BenchResult online = runModes(s.path, {"mmi", "local"}, s.online_store);
+  const BenchResult baked = runModes(s.path, {"mmi", "smi"}, s.store);
+  const BenchResult online = runModes(s.path, {"mmi", "smi", "local"}, s.online_store);
+  for (const char* name : {"smi", "mmi"}) {
+    SCOPED_TRACE(name);
+    const ModeResult* b = baked.mode(name);
+    const ModeResult* o = online.mode(name);
+    ASSERT_TRUE(b && o);
+    EXPECT_EQ(o->info.at("online_runs"), double(s.visited.size()));
+    EXPECT_NEAR(o->psnr_db_mean, b->psnr_db_mean, 0.5);
+    EXPECT_NEAR(o->mean_triangles, b->mean_triangles, 0.01 * b->mean_triangles);
+  }
   const ModeResult* b = baked.mode("mmi");
   const ModeResult* o = online.mode("mmi");
-  ASSERT_TRUE(b && o);
   std::printf("mmi: baked store %.2f dB, %.0f triangles; online store %.2f dB, %.0f triangles, %.0f online runs "
               "(%.1f ms each)\n",
               b->psnr_db_mean, b->mean_triangles, o->psnr_db_mean, o->mean_triangles, o->info.at("online_runs"),
@@ -347,22 +358,9 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
   gpu::sharedHeadlessContext().makeCurrent();
   ModeRunResources run(s.city.scene, kFrameSize, kFrameSize, context.options);
 
-  // A Sillion store (bake::bakeCells) has no pipeline records.
-  const std::string sillion = test::scratchDir("mmi_mode_sillion").string();
-  extract::BakeOptions b;
-  b.resolution = 32;
-  b.progress = false;
-  bake::bakeCells(gpu::sharedHeadlessContext(), s.city.scene, *s.cells, {s.visited.front()}, b, sillion);
-  run.context.options["impostor_dir"] = sillion;
-  for (const char* mode : {"local", "visible", "smi", "mmi", "mmi-dynamic"}) {
-    try {
-      createMode(mode, run.context)->prepare(run.context);
-      ADD_FAILURE() << mode << " should refuse a store without pipeline data";
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("pipeline"), std::string::npos) << e.what();
-    }
-  }
-  // A pipeline without the mmi stage serves local and visible, not the impostor modes.
+  // (A store of Sillion records, which has no pipeline, is refused by every mode: tests/eval/test_impostor_mode.cpp.)
+  // A pipeline without the single and mmi stages serves local and visible, not the impostor modes, each of which
+  // names the stage it needs.
   const std::string no_mmi = test::scratchDir("mmi_mode_no_mmi").string();
   extract::PipelineOptions po = pipelineOptions();
   po.base.resolution = 32;
@@ -372,14 +370,22 @@ TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
   run.context.options["impostor_dir"] = no_mmi;
   EXPECT_NO_THROW(createMode("local", run.context)->prepare(run.context));
   EXPECT_NO_THROW(createMode("visible", run.context)->prepare(run.context));
-  for (const char* mode : {"smi", "mmi", "mmi-dynamic"}) {
+  for (const auto& [mode, stage] : std::vector<std::pair<std::string, std::string>>{
+           {"smi", "no single stage"}, {"mmi", "no mmi stage"}, {"mmi-dynamic", "no mmi stage"}}) {
     try {
       createMode(mode, run.context)->prepare(run.context);
-      ADD_FAILURE() << mode << " should refuse a pipeline without mmi";
+      ADD_FAILURE() << mode << " should refuse a pipeline without its stage";
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("mmi"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(stage), std::string::npos) << e.what();
     }
   }
+  // The single stage serves smi; mmi still needs its own.
+  const std::string single_only = test::scratchDir("mmi_mode_single_only").string();
+  bake::bakePipeline(gpu::sharedHeadlessContext(), s.city.scene, *s.cells, {s.visited.front()},
+                     extract::parsePipeline("pvs,near-far,single"), po, single_only);
+  run.context.options["impostor_dir"] = single_only;
+  EXPECT_NO_THROW(createMode("smi", run.context)->prepare(run.context));
+  EXPECT_THROW(createMode("mmi", run.context)->prepare(run.context), Error);
   // A missing directory, and a scene other than the one baked.
   run.context.options["impostor_dir"] = (fs::path(s.store) / "missing").string();
   EXPECT_THROW(createMode("mmi", run.context)->prepare(run.context), Error);

@@ -67,9 +67,9 @@ TEST_F(ValidityRegionTest, RuntimeRuleKeepsTheBoundAtSampledViewpoints) {
   const gpu::GpuScene gpu_scene(s.scene);
   PipelineRunner runner(s.scene, gpu_scene, cells, options);
   CellWork work = runner.start(s.cell);
-  runner.runStages({kStagePvs, kStageNearFar, kStageMmi}, work);
+  runner.runStages({kStagePvs, kStageNearFar, kStageSingle, kStageMmi}, work);
   const store::CellPipeline& r = work.result;
-  ASSERT_TRUE(r.has_mmi);
+  ASSERT_TRUE(r.has_mmi && r.has_single);
   ASSERT_GE(r.layers.size(), 2u);
   for (const store::StoredLayer& layer : r.layers) ASSERT_FALSE(layer.validity.empty());
   ASSERT_FALSE(r.single.validity.empty());

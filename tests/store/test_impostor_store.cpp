@@ -325,14 +325,17 @@ impostor::ValidityRegion simpleRegion() {
   return r;
 }
 
-// Writes `c` into dir the way the bake does (bake/bake.cpp, bake/pipeline.cpp): a new generation of files, the
-// streets first, then the cells, the index last. Version 2 writes the files with the names and index of that format.
+// Writes `c` into dir the way the bakes did and do (bake/pipeline.cpp; the Sillion records with store::writeCell as
+// the Sillion bake of stores up to version 3 did): a new generation of files, the streets first, then the cells, the
+// index last. Version 2 writes the files with the names and index of that format (the single mesh inside mmi, the
+// options saying the mmi stage built it).
 StoreIndex writeStore(const std::string& dir, const StoreContent& c, int version = kIndexVersion) {
   StoreIndex index = indexWith({});
   index.version = version;
   index.generation = version >= 3 ? nextGeneration(dir) : 0;
   const uint64_t g = index.generation;
-  index.pipeline = {"pvs", "near-far", "mmi"};
+  index.pipeline = {"pvs", "near-far", "single", "mmi"};
+  if (version <= 3) index.options = {{"pipeline", {{"single_mesh", true}}}};
   writeStreets(dir, index, c.streets);
   CellEntry a = entryFor(c.cell_a, c.depth.camera);
   writeCell(dir, a, {{"depth-mesh", &c.depth}, {"grid-mesh", &c.grid}}, g);
@@ -345,6 +348,7 @@ StoreIndex writeStore(const std::string& dir, const StoreContent& c, int version
                  writeLayerView(dir, layerFileStem(c.cell_a, "mmi", 0, 1, g), c.empty)};
   layer.validity = {simpleRegion()};
   p.layers = {layer};
+  p.has_single = true;
   p.single.objects = {2, 3};
   p.single.views = {writeLayerView(dir, layerFileStem(c.cell_a, "smi", 0, 0, g), c.single_view)};
   p.single.validity = {simpleRegion()};
@@ -686,7 +690,7 @@ TEST(StoreIntegrityTest, WriterErrorsLeaveTheOldStoreReadable) {
   }
 }
 
-TEST(StoreIntegrityTest, Version2StoresAreReadWithoutChecksumsAndRewrittenAsVersion3) {
+TEST(StoreIntegrityTest, Version2StoresAreReadWithoutChecksumsAndRewrittenAsTheCurrentVersion) {
   const std::string dir = test::scratchDir("store_v2").string();
   const StoreContent old_content = makeContent(1);
   const StoreIndex v2 = writeStore(dir, old_content, 2);
@@ -703,6 +707,15 @@ TEST(StoreIntegrityTest, Version2StoresAreReadWithoutChecksumsAndRewrittenAsVers
   EXPECT_FALSE(index.find(12)->texture_check.known);
   EXPECT_FALSE(index.find(12)->pipeline->layers[0].views[0].mesh_check.known);
   EXPECT_EQ(storedContent(dir), expectedContent(old_content));
+  // The version 2 layout (no single stage; the single mesh inside mmi, built by it: options.pipeline.single_mesh) is
+  // read as the single stage's record.
+  const nlohmann::json v2_json = nlohmann::json::parse(text);
+  EXPECT_EQ(v2_json.at("pipeline"), nlohmann::json({"pvs", "near-far", "mmi"}));
+  EXPECT_TRUE(v2_json.at("cells")[0].at("pipeline").at("mmi").contains("single"));
+  EXPECT_FALSE(v2_json.at("cells")[0].at("pipeline").contains("single"));
+  EXPECT_EQ(index.pipeline, (std::vector<std::string>{"pvs", "near-far", "single", "mmi"}));
+  EXPECT_TRUE(index.find(12)->pipeline->has_single);
+  EXPECT_EQ(index.find(12)->pipeline->single.views.size(), 1u);
   // A version 1 index is read too (the Sillion part).
   nlohmann::json j = nlohmann::json::parse(text);
   j["version"] = 1;
@@ -712,7 +725,8 @@ TEST(StoreIntegrityTest, Version2StoresAreReadWithoutChecksumsAndRewrittenAsVers
   EXPECT_EQ(readIndex(dir).version, 1);
   writeBytes((fs::path(dir) / kIndexFile).string(), text);
 
-  // A bake over it writes generation 1 of a version 3 store and removes the version 2 files; unrelated files stay.
+  // A bake over it writes generation 1 of a store of the current version and removes the version 2 files; unrelated
+  // files stay.
   writeBytes((fs::path(dir) / "notes.txt").string(), "mine");
   writeBytes((fs::path(dir) / "cells" / "README").string(), "mine too");
   const StoreContent new_content = makeContent(2);
@@ -728,7 +742,7 @@ TEST(StoreIntegrityTest, Version2StoresAreReadWithoutChecksumsAndRewrittenAsVers
 
 TEST(StoreIntegrityTest, Version3IndexWithoutChecksumsIsAnErrorNamingWhatIsMissing) {
   const std::string dir = test::scratchDir("store_v3_missing").string();
-  writeStore(dir, makeContent(1));
+  writeStore(dir, makeContent(1), 3);  // the layout of version 3 (the single mesh inside mmi), relabelled 2 below
   const std::string file = (fs::path(dir) / kIndexFile).string();
   const nlohmann::json good = nlohmann::json::parse(readBytes(file));
   const auto expect_missing = [&](nlohmann::json j, const std::vector<std::string>& parts) {

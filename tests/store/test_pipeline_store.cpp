@@ -111,6 +111,7 @@ CellEntry fullCell(uint32_t half_edge) {
   for (size_t v = 3; v < 6; ++v) far_layer.views[v].station = 1;
   far_layer.validity = {oddRegion(2.0f), oddRegion(2.5f)};
   p.layers = {near_layer, far_layer};
+  p.has_single = true;
   p.single.validity = {oddRegion(3.0f)};
   p.single.objects = p.far;
   p.single.views = {oddView(half_edge, 0, 0, 9.0)};
@@ -122,7 +123,7 @@ CellEntry fullCell(uint32_t half_edge) {
   return e;
 }
 
-// A cell whose mmi stage was left to the runtime.
+// A cell whose single and mmi stages were left to the runtime.
 CellEntry onlineCell(uint32_t half_edge) {
   CellEntry e = fullCell(half_edge);
   CellPipeline& p = *e.pipeline;
@@ -132,6 +133,7 @@ CellEntry onlineCell(uint32_t half_edge) {
   p.max_weight_rad = 0.0;
   p.weights_ms = 0.0;
   p.layers.clear();
+  p.has_single = false;
   p.single = {};
   return e;
 }
@@ -149,7 +151,7 @@ StoreIndex pipelineIndex() {
   index.local_model = "junction";
   index.cell_lookup = "nearest";
   index.options = {{"pipeline", {{"resolution", 128}, {"error_px", 10.5}}}, {"block_margin", 5.25}};
-  index.pipeline = {"pvs", "near-far", "mmi"};
+  index.pipeline = {"pvs", "near-far", "single", "mmi"};
   index.online = {};
   index.storage = {{"written_bytes", 123456789}, {"mean_layers", 2.3333333333333335}};
   index.cells = {fullCell(4), fullCell(9)};
@@ -250,6 +252,7 @@ void expectSameIndex(const StoreIndex& a, const StoreIndex& b) {
     EXPECT_EQ(p.has_split, q.has_split) << at;
     EXPECT_EQ(p.near, q.near) << at;
     EXPECT_EQ(p.far, q.far) << at;
+    EXPECT_EQ(p.has_single, q.has_single) << at;
     EXPECT_EQ(p.has_mmi, q.has_mmi) << at;
     EXPECT_EQ(p.threshold_rad, q.threshold_rad) << at;
     EXPECT_EQ(p.event_edges, q.event_edges) << at;
@@ -280,16 +283,22 @@ TEST(PipelineStoreTest, IndexRoundTripKeepsEveryField) {
   EXPECT_EQ(read.cells[0].pipeline->layers[1].views[2].record, "cell 4: mmi layer 1 view 2");
   EXPECT_EQ(read.cells[1].pipeline->single.views[0].record, "cell 9: single mesh view 0");
   EXPECT_EQ(read.version, kIndexVersion);
-  EXPECT_EQ(kIndexVersion, 3);
+  EXPECT_EQ(kIndexVersion, 4);
+  // Version 4: the single mesh is the single stage's record, beside mmi, which no longer holds it.
+  const nlohmann::json written = indexToJson(index);
+  EXPECT_TRUE(written["cells"][0]["pipeline"].contains("single"));
+  EXPECT_FALSE(written["cells"][0]["pipeline"]["mmi"].contains("single"));
+  EXPECT_EQ(written["pipeline"], nlohmann::json({"pvs", "near-far", "single", "mmi"}));
 
-  // A store with the mmi stage left online: cells have pvs and split, no mmi.
+  // A store with the single and mmi stages left online: cells have pvs and split, no single mesh, no mmi.
   StoreIndex online = pipelineIndex();
-  online.online = {"mmi"};
+  online.online = {"single", "mmi"};
   online.cells = {onlineCell(3), onlineCell(5)};
   const StoreIndex online_read = indexFromJson(nlohmann::json::parse(indexToJson(online).dump()), "online");
   expectSameIndex(online_read, online);
   ASSERT_TRUE(online_read.cells[0].pipeline);
   EXPECT_FALSE(online_read.cells[0].pipeline->has_mmi);
+  EXPECT_FALSE(online_read.cells[0].pipeline->has_single);
   EXPECT_TRUE(online_read.cells[0].pipeline->layers.empty());
 
   // A Sillion cell (no pipeline record) stays without one.
@@ -313,6 +322,73 @@ void expectIndexError(const nlohmann::json& j, const std::vector<std::string>& p
   }
 }
 
+// The index of pipelineIndex() as a version 2 or 3 bake wrote it: the mmi stage built the single mesh
+// (options.pipeline.single_mesh) and held it inside its record; "single" is no stage.
+StoreIndex legacyIndex(int version) {
+  StoreIndex index = pipelineIndex();
+  index.version = version;
+  index.options["pipeline"]["single_mesh"] = true;
+  return index;
+}
+nlohmann::json legacyJson(int version) { return indexToJson(legacyIndex(version)); }
+
+TEST(PipelineStoreTest, Version2And3SingleMeshInsideMmiIsReadAsTheSingleStage) {
+  for (const int version : {2, 3}) {
+    SCOPED_TRACE("version " + std::to_string(version));
+    const StoreIndex legacy = legacyIndex(version);
+    const nlohmann::json j = legacyJson(version);
+    // Written with that version's layout.
+    EXPECT_EQ(j["pipeline"], nlohmann::json({"pvs", "near-far", "mmi"}));
+    ASSERT_TRUE(j["cells"][0]["pipeline"]["mmi"].contains("single"));
+    EXPECT_FALSE(j["cells"][0]["pipeline"].contains("single"));
+    // Read as version 4 holds it: the stage list has single, each mmi record's single mesh is the single stage's.
+    const StoreIndex read = indexFromJson(j, "old");
+    EXPECT_EQ(read.version, version);
+    EXPECT_EQ(read.pipeline, (std::vector<std::string>{"pvs", "near-far", "single", "mmi"}));
+    for (size_t k = 0; k < 2; ++k) {
+      const CellPipeline& p = *read.cells[k].pipeline;
+      EXPECT_TRUE(p.has_single);
+      ASSERT_EQ(p.single.views.size(), 1u);
+      EXPECT_EQ(p.single.objects, legacy.cells[k].pipeline->single.objects);
+      EXPECT_EQ(p.single.views[0].mesh, legacy.cells[k].pipeline->single.views[0].mesh);
+    }
+    EXPECT_FALSE(read.cells[2].pipeline->has_single);  // the cell without mmi record has none
+    // mmi online: the single mesh was built online by it, so single is online too.
+    StoreIndex online = legacyIndex(version);
+    online.online = {"mmi"};
+    online.cells = {onlineCell(3)};
+    const StoreIndex online_read = indexFromJson(indexToJson(online), "old online");
+    EXPECT_EQ(online_read.pipeline, (std::vector<std::string>{"pvs", "near-far", "single", "mmi"}));
+    EXPECT_EQ(online_read.online, (std::vector<std::string>{"single", "mmi"}));
+    // single_mesh false: the mmi stage built no single mesh; no single stage.
+    nlohmann::json no_single = j;
+    no_single["options"]["pipeline"]["single_mesh"] = false;
+    const StoreIndex without = indexFromJson(no_single, "old");
+    EXPECT_EQ(without.pipeline, (std::vector<std::string>{"pvs", "near-far", "mmi"}));
+    EXPECT_FALSE(without.cells[0].pipeline->has_single);
+    EXPECT_TRUE(without.cells[0].pipeline->single.views.empty());
+    // single_mesh is required there, a boolean: not silently taken as either.
+    nlohmann::json bad = j;
+    bad["options"]["pipeline"].erase("single_mesh");
+    expectIndexError(bad, {"options", "pipeline", "single_mesh"});
+    bad["options"]["pipeline"]["single_mesh"] = 1;
+    expectIndexError(bad, {"options", "pipeline", "single_mesh"});
+    bad.erase("options");
+    expectIndexError(bad, {"options", "pipeline", "single_mesh"});
+    // Versions 2 and 3 had no single stage.
+    bad = j;
+    bad["pipeline"] = {"pvs", "near-far", "single", "mmi"};
+    expectIndexError(bad, {"\"pipeline\"", "single", "version " + std::to_string(version)});
+    bad = j;
+    bad["cells"][0]["pipeline"]["single"] = bad["cells"][0]["pipeline"]["mmi"]["single"];
+    expectIndexError(bad, {"cells[0]", "single", "no single stage"});
+    // The mmi record must still hold the single mesh.
+    bad = j;
+    bad["cells"][0]["pipeline"]["mmi"].erase("single");
+    expectIndexError(bad, {"pipeline.mmi", "single"});
+  }
+}
+
 TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
   const nlohmann::json good = indexToJson(pipelineIndex());
   ASSERT_NO_THROW(indexFromJson(good, "good"));
@@ -329,7 +405,7 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
       {{"split", "near"}, "pipeline.split"},
       {{"split", "far"}, "pipeline.split"},
       {{"mmi", "layers", "1", "objects"}, "layers[1]"},
-      {{"mmi", "single", "objects"}, "single"},
+      {{"single", "objects"}, "pipeline.single"},
   };
   for (const IdList& list : lists) {
     for (const uint64_t bad : {uint64_t(0), uint64_t(kSceneObjects + 1), uint64_t(1) << 40}) {
@@ -373,8 +449,8 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
     cell0(j)["mmi"]["layers"][0]["views"][0]["texture"] = "";
     expectIndexError(j, {"cells[0]", "layers[0]", "views[0]", "no texture"});
     j = good;
-    cell0(j)["mmi"]["single"]["views"][0]["texture"] = "";
-    expectIndexError(j, {"cells[0]", "single", "views[0]", "no texture"});
+    cell0(j)["single"]["views"][0]["texture"] = "";
+    expectIndexError(j, {"cells[0]", "pipeline.single", "views[0]", "no texture"});
     // The empty view of the far layer (no triangles, no texture) is fine.
     j = good;
     ASSERT_EQ(cell0(j)["mmi"]["layers"][1]["views"][3]["texture"], "");
@@ -401,8 +477,8 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
     cell0(j)["mmi"]["layers"][0]["views"][0]["camera"]["fov_y"] = 0.0;
     expectIndexError(j, {"layers[0]", "views[0]", "camera"});
     j = good;
-    cell0(j)["mmi"].erase("single");
-    expectIndexError(j, {"pipeline.mmi", "single"});
+    cell0(j)["mmi"]["single"] = cell0(j)["single"];  // the layout of versions 2 and 3
+    expectIndexError(j, {"pipeline.mmi", "single", "version 4"});
     j = good;
     cell0(j)["mmi"]["layers"] = 3;
     expectIndexError(j, {"pipeline.mmi", "layers"});
@@ -427,17 +503,21 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
     expectIndexError(j, {"version", std::to_string(kIndexVersion + 1)});
     j["version"] = 0;
     expectIndexError(j, {"version", "0"});
-    j["version"] = 1;  // still read
+    j = legacyJson(3);
+    j["version"] = 1;  // still read (with the layout of its time)
     EXPECT_NO_THROW(indexFromJson(j, "v1"));
     // Version 2 had no validity regions: read without them; version 3 requires them where a layer has views.
+    j = legacyJson(3);
     cell0(j)["mmi"]["layers"][0].erase("validity");
     j["version"] = 2;
     EXPECT_NO_THROW(indexFromJson(j, "v2"));
     j["version"] = 3;
     expectIndexError(j, {"layers[0]", "validity"});
   }
-  // File checks and the generation: version 3 requires them, naming what is missing; version 2 reads without them.
+  // File checks and the generation: version 3 (written with the layout of version 3: the single mesh inside mmi)
+  // requires them, naming what is missing; version 2 reads without them.
   {
+    const nlohmann::json good = legacyJson(3);
     using Node = std::function<nlohmann::json&(nlohmann::json&)>;
     const std::vector<std::tuple<Node, std::string, std::vector<std::string>>> needed{
         {[](nlohmann::json& j) -> nlohmann::json& { return j; }, "streets_crc32", {"top level"}},
@@ -485,6 +565,12 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
     ASSERT_FALSE(cell0(j)["mmi"]["layers"][1]["views"][3].contains("texture_crc32"));
     EXPECT_NO_THROW(indexFromJson(j, "good"));
   }
+  // Version 4's own single record needs its checks too.
+  {
+    nlohmann::json j = good;
+    cell0(j)["single"]["views"][0].erase("mesh_crc32");
+    expectIndexError(j, {"cells[0]", "pipeline.single", "views[0]", "missing \"mesh_crc32\""});
+  }
   // Validity regions.
   {
     nlohmann::json j = good;
@@ -495,8 +581,8 @@ TEST(PipelineStoreTest, CorruptedPipelineRecordsNameTheElement) {
     cell0(j)["mmi"]["layers"][1]["validity"][0]["laterals"] = 2;
     expectIndexError(j, {"layers[1]", "validity", "laterals"});
     j = good;
-    cell0(j)["mmi"]["single"]["validity"][0]["step"] = 0.0;
-    expectIndexError(j, {"single", "validity", "step"});
+    cell0(j)["single"]["validity"][0]["step"] = 0.0;
+    expectIndexError(j, {"pipeline.single", "validity", "step"});
     j = good;
     cell0(j)["mmi"]["layers"][0]["validity"][0]["envelope"] = {-0.1};
     expectIndexError(j, {"layers[0]", "validity", "envelope"});

@@ -1,6 +1,6 @@
-// The extractor pipeline (Decoret et al. 1999, sections 4-5): PVS sampling, near/far segmentation, layering by
-// visibility events and one meshed impostor per layer, baked in parallel like bake.cpp (GL stages and captures on
-// the calling thread, meshes and files on worker threads: bake/gl_workers.h).
+// The extractor pipeline (Decoret et al. 1999, sections 4-5): PVS sampling, near/far segmentation, the single mesh
+// (also Sillion et al. 1997's cell impostor), layering by visibility events and one meshed impostor per layer, baked
+// in parallel (GL stages and captures on the calling thread, meshes and files on worker threads: bake/gl_workers.h).
 #include "farfield/bake/pipeline.h"
 
 #include <algorithm>
@@ -49,7 +49,7 @@ nlohmann::json storageReport(const store::StoreIndex& index, const std::string& 
     if (!v.texture.empty()) raw_texture_bytes += uint64_t(v.camera.width) * uint64_t(v.camera.height) * 4;
   };
   for (const store::CellEntry& c : index.cells) {
-    if (!c.pipeline || !c.pipeline->has_mmi) continue;
+    if (!c.pipeline || !(c.pipeline->has_mmi || c.pipeline->has_single)) continue;
     ++cells;
     layers += c.pipeline->layers.size();
     for (const store::StoredLayer& l : c.pipeline->layers)
@@ -131,7 +131,8 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
   store::writeStreets(out_dir, index, cells.graph().toJson().dump() + "\n");
 
   const std::vector<std::string> baked = spec.baked();
-  const bool bake_mmi = std::find(baked.begin(), baked.end(), kStageMmi) != baked.end();
+  const bool bake_images = std::find(baked.begin(), baked.end(), kStageMmi) != baked.end() ||
+                           std::find(baked.begin(), baked.end(), kStageSingle) != baked.end();
   const size_t workers = workerCount(options.base.workers);
   report.workers = workers;
 
@@ -157,7 +158,7 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
   };
   const auto consume = [&](PipelineJob& job) {
     CellWork& w = job.work;
-    if (bake_mmi) {
+    if (bake_images) {
       runner.buildMeshes(w);
       // The construction is timed per cell: each view gets an equal share.
       size_t views = w.single_views.size();

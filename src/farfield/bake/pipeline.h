@@ -1,6 +1,7 @@
-// The pipeline bake (Decoret et al. 1999, section 5.2): the extractor stages of extract/ (pvs, near-far, mmi; see
+// The bake (Decoret et al. 1999, section 5.2): the extractor stages of extract/ (pvs, near-far, single, mmi; see
 // extract/pipeline_options.h) run over a city's cells, GL stages and captures on the calling thread, meshes and files
-// on worker threads, into an impostor store.
+// on worker threads, into an impostor store. Sillion et al. 1997's cell impostors (`farfield bake --technique`) are
+// the pipeline near-far,single with one capture station per cell.
 #pragma once
 
 #include <cstdint>
@@ -48,7 +49,8 @@ nlohmann::json storageReport(const store::StoreIndex& index, const std::string& 
 
 // Bakes the baked stages of `spec` for the given cells (empty = all) into the store `out_dir`: GL stages and captures
 // on the calling thread, meshes and files on worker threads, a progress bar. The store holds what the bench modes
-// local, visible, smi, mmi and mmi-dynamic need. Throws farfield::Error for bad options or unwritable files.
+// local, visible, smi (and depth-mesh, grid-mesh: the single stage), mmi and mmi-dynamic need. Throws
+// farfield::Error for bad options or unwritable files.
 PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, const urban::CellMap& cells,
                             std::vector<uint32_t> half_edges, const extract::PipelineSpec& spec,
                             const extract::PipelineOptions& options, const std::string& out_dir);

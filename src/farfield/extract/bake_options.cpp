@@ -6,18 +6,7 @@
 
 namespace farfield::extract {
 
-std::vector<std::string> parseTechniques(const std::string& text, const std::string& what) {
-  if (text == kDepthMesh) return {kDepthMesh};
-  if (text == kGridMesh) return {kGridMesh};
-  if (text == "both") return {kDepthMesh, kGridMesh};
-  throw Error(what, "unknown technique '" + text + "' (expected depth-mesh, grid-mesh or both)");
-}
-
 void validateBakeOptions(const BakeOptions& o) {
-  if (o.techniques.empty()) throw Error("bake options", "no technique given");
-  for (const std::string& t : o.techniques)
-    if (t != kDepthMesh && t != kGridMesh)
-      throw Error("bake options", "unknown technique '" + t + "' (expected depth-mesh or grid-mesh)");
   if (o.resolution < 8 || o.resolution > 8192)
     throw Error("--resolution", "must be 8..8192 pixels, got " + std::to_string(o.resolution));
   if (!(o.fov_deg > 1.0f && o.fov_deg < 170.0f))

@@ -11,19 +11,11 @@
 #include "farfield/core/camera.h"
 #include "farfield/impostor/capture.h"
 #include "farfield/impostor/depth_mesh.h"
-#include "farfield/impostor/grid_mesh.h"
 #include "farfield/urban/cells.h"
 
 namespace farfield::extract {
 
-inline constexpr char kDepthMesh[] = "depth-mesh";
-inline constexpr char kGridMesh[] = "grid-mesh";
-
-// "depth-mesh", "grid-mesh" or "both" -> the list of techniques; throws farfield::Error naming `what` otherwise.
-std::vector<std::string> parseTechniques(const std::string& text, const std::string& what = "--technique");
-
 struct BakeOptions {
-  std::vector<std::string> techniques{kDepthMesh};  // built from each capture (one capture per cell)
   int resolution = 512;      // impostor image width = height, pixels
   // Vertical = horizontal field of view of the creation camera. The walker's 60 degrees: on the default city's
   // 600 m drive (10 cells, 100 frames, 512 x 512) wider captures lose more to the coarser texture than they gain in
@@ -35,7 +27,6 @@ struct BakeOptions {
   float far_plane = 20000.0f;
   impostor::CaptureOptions capture;
   impostor::DepthMeshOptions depth_mesh;  // its resolution and fov_y are overridden by the two above
-  impostor::GridMeshOptions grid_mesh;
   int workers = 0;            // CPU threads building meshes; 0 = hardware threads - 1, at least 1
   size_t queue_capacity = 2;  // captures waiting for a worker
   bool progress = true;       // progress bar on stderr (also off with FF_PROGRESS=0)

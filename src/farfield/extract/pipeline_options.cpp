@@ -23,7 +23,7 @@ namespace farfield::extract {
 namespace {
 
 const std::vector<std::string>& knownStages() {
-  static const std::vector<std::string> stages{kStagePvs, kStageNearFar, kStageMmi};
+  static const std::vector<std::string> stages{kStagePvs, kStageNearFar, kStageSingle, kStageMmi};
   return stages;
 }
 
@@ -56,18 +56,20 @@ std::vector<std::string> PipelineSpec::online() const {
 
 PipelineSpec parsePipeline(const std::string& stages_text, const std::string& online_text) {
   PipelineSpec spec;
-  if (stages_text.empty()) throw Error("--pipeline", "no stages given (expected e.g. pvs,near-far,mmi)");
+  if (stages_text.empty()) throw Error("--pipeline", "no stages given (expected e.g. pvs,near-far,single,mmi)");
   for (const std::string& s : splitList(stages_text)) {
     if (stageRank(s) == knownStages().size())
-      throw Error("--pipeline", "unknown stage '" + s + "' (known: pvs, near-far, mmi)");
+      throw Error("--pipeline", "unknown stage '" + s + "' (known: pvs, near-far, single, mmi)");
     if (contains(spec.stages, s)) throw Error("--pipeline", "stage '" + s + "' is listed twice");
     if (!spec.stages.empty() && stageRank(s) < stageRank(spec.stages.back()))
       throw Error("--pipeline", "stage '" + s + "' must come before '" + spec.stages.back() +
-                                    "' (the order is pvs, near-far, mmi)");
+                                    "' (the order is pvs, near-far, single, mmi)");
     spec.stages.push_back(s);
   }
-  if (contains(spec.stages, kStageMmi) && !contains(spec.stages, kStageNearFar))
-    throw Error("--pipeline", "mmi needs near-far before it (the impostors stand for the far geometry)");
+  for (const char* image_stage : {kStageSingle, kStageMmi})
+    if (contains(spec.stages, image_stage) && !contains(spec.stages, kStageNearFar))
+      throw Error("--pipeline", std::string(image_stage) +
+                                    " needs near-far before it (the impostors stand for the far geometry)");
   spec.online_from = spec.stages.size();
   if (!online_text.empty()) {
     const std::vector<std::string> online = splitList(online_text);
@@ -80,7 +82,7 @@ PipelineSpec parsePipeline(const std::string& stages_text, const std::string& on
     for (size_t i = 0; i < online.size(); ++i)
       if (from + i >= spec.stages.size() || spec.stages[from + i] != online[i])
         throw Error("--online", "the online stages must be the end of the pipeline, in its order (e.g. mmi, or "
-                                "near-far,mmi)");
+                                "single,mmi)");
     spec.online_from = from;
   }
   return spec;
@@ -93,6 +95,16 @@ LayerMesh parseLayerMesh(const std::string& text, const std::string& what) {
 }
 
 const char* layerMeshName(LayerMesh mesh) { return mesh == LayerMesh::Grid ? "grid" : "depth-mesh"; }
+
+LayerMesh techniqueMesh(const std::string& technique, const std::string& what) {
+  if (technique == kDepthMesh) return LayerMesh::DepthMesh;
+  if (technique == kGridMesh) return LayerMesh::Grid;
+  if (technique == "both")
+    throw Error(what, "'both' is gone: a store holds one mesh kind. Bake twice (--technique depth-mesh -o A, "
+                      "--technique grid-mesh -o B; bench them with --mode-option depth_mesh_dir=A --mode-option "
+                      "grid_mesh_dir=B) or use --pipeline near-far,single --layer-mesh grid|depth-mesh");
+  throw Error(what, "unknown technique '" + technique + "' (expected depth-mesh or grid-mesh)");
+}
 
 LayerViews parseLayerViews(const std::string& text, const std::string& what) {
   if (text == "street") return LayerViews::Street;
@@ -135,8 +147,7 @@ nlohmann::json pipelineOptionsToJson(const PipelineOptions& o) {
           {"layer_choice", o.layer_choice == urban::LayerChoice::SmallestArea ? "smallest-area" : "least-growth"},
           {"layer_mesh", layerMeshName(o.mesh)},
           {"grid_cells", o.grid_cells},
-          {"views", layerViewsName(o.views)},
-          {"single_mesh", o.single_mesh}};
+          {"views", layerViewsName(o.views)}};
 }
 
 namespace {
@@ -253,12 +264,15 @@ PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::stri
   o.mesh = parseLayerMesh(r.text("layer_mesh"), source + ": layer_mesh");
   r.number("grid_cells", o.grid_cells);
   o.views = parseLayerViews(r.text("views"), source + ": views");
-  o.single_mesh = r.boolean("single_mesh");
+  // Versions 2 and 3: whether the mmi stage also built the single mesh. The store's reader made it the single stage
+  // (store::indexFromJson); here it must be there and be a boolean, as it was written.
+  if (store_version <= 3) r.boolean("single_mesh");
   r.rejectUnknown();
   return o;
 }
 
 void validatePipelineOptions(const PipelineOptions& o) {
+  validateBakeOptions(o.base);
   if (!(o.error_px > 0.0) || !std::isfinite(o.error_px))
     throw Error("--error-px", "must be a positive number of pixels");
   if (o.frame_width < 1 || o.frame_height < 1) throw Error("--frame-size", "must be at least 1 x 1 pixels");

@@ -3,14 +3,20 @@
 //
 //   pvs       visibility culling: the objects seen in 360-degree item buffers from points along the cell (5.3)
 //   near-far  segmentation of what is left into near geometry (drawn as polygons) and far geometry (5.4)
+//   single    image-based extraction of the far geometry as one meshed impostor per capture station and view: the
+//             single-mesh impostor (SMI), which is also Sillion et al. 1997's cell impostor (sections 4.1-4.2: one
+//             capture from the cell's start, `--station-spacing 0`, meshed as a depth mesh or a regular grid)
 //   mmi       image-based extraction of the far geometry: layering by visibility events (4.1-4.2), then one meshed
-//             impostor per layer and view (4.3, 5.1), and the single-mesh impostor of the same objects for comparison
+//             impostor per layer and view (4.3, 5.1)
 //
-// The stages are composed from the CLI (`farfield bake --pipeline pvs,near-far,mmi`). Where the pipeline splits
-// between preprocessing and online computation is an option (`--online mmi`, or `--online near-far,mmi`): the bake
-// runs and stores the stages before the split; the runtime (farfield/runtime/walkthrough.h) runs the others with the same
-// code when the viewer enters a cell, inside that frame, so their cost shows in the frame times. A stage that is
-// skipped leaves its input as it is: without `pvs` every object is a candidate; `mmi` needs `near-far` before it.
+// The stages are composed from the CLI (`farfield bake --pipeline pvs,near-far,single,mmi`; `farfield bake --technique
+// depth-mesh` is `--pipeline near-far,single --layer-mesh depth-mesh --station-spacing 0`). The order is pvs, near-far,
+// single, mmi; single and mmi both need near-far and are independent of each other (the SMI is built once, by
+// single). Where the pipeline splits between preprocessing and online computation is an option (`--online mmi`, or
+// `--online near-far,single,mmi`): the bake runs and stores the stages before the split; the runtime
+// (farfield/runtime/walkthrough.h) runs the others with the same code when the viewer enters a cell, inside that frame,
+// so their cost shows in the frame times. A stage that is skipped leaves its input as it is: without `pvs` every
+// object is a candidate.
 #pragma once
 
 #include <cstdint>
@@ -30,6 +36,7 @@ namespace farfield::extract {
 
 inline constexpr char kStagePvs[] = "pvs";
 inline constexpr char kStageNearFar[] = "near-far";
+inline constexpr char kStageSingle[] = "single";
 inline constexpr char kStageMmi[] = "mmi";
 
 // The stages of a pipeline and the split between bake and runtime.
@@ -39,15 +46,25 @@ struct PipelineSpec {
   std::vector<std::string> baked() const;
   std::vector<std::string> online() const;
 };
-// "pvs,near-far,mmi" and the online stages ("" = none; "mmi"; "near-far,mmi"). Throws farfield::Error naming
-// --pipeline / --online for an unknown or repeated stage, a wrong order (pvs, near-far, mmi), mmi without near-far,
-// online stages that are not the pipeline's tail, or pvs online (hundreds of renders: never inside a frame).
+// "pvs,near-far,single,mmi" and the online stages ("" = none; "mmi"; "single,mmi"). Throws farfield::Error naming
+// --pipeline / --online for an unknown or repeated stage, a wrong order (pvs, near-far, single, mmi), single or mmi
+// without near-far, online stages that are not the pipeline's tail, or pvs online (hundreds of renders: never inside
+// a frame).
 PipelineSpec parsePipeline(const std::string& stages, const std::string& online = "");
 
 enum class LayerMesh { Grid, DepthMesh };
 // "grid" or "depth-mesh"; throws farfield::Error naming `what`.
 LayerMesh parseLayerMesh(const std::string& text, const std::string& what = "--layer-mesh");
 const char* layerMeshName(LayerMesh mesh);
+
+// Sillion et al. 1997's cell impostor (`farfield bake --technique`, the bench modes of the same names) is the
+// pipeline's single stage: kTechniquePipeline with the technique's mesh and one capture station at the cell's start.
+inline constexpr char kDepthMesh[] = "depth-mesh";
+inline constexpr char kGridMesh[] = "grid-mesh";
+inline constexpr char kTechniquePipeline[] = "near-far,single";
+// "depth-mesh" -> LayerMesh::DepthMesh, "grid-mesh" -> LayerMesh::Grid; throws farfield::Error naming `what` for
+// anything else ("both" included: one store holds one mesh kind; bake twice).
+LayerMesh techniqueMesh(const std::string& technique, const std::string& what = "--technique");
 
 enum class LayerViews {
   Street,  // one view along the cell (the street direction), the default
@@ -79,7 +96,6 @@ struct PipelineOptions {
   LayerMesh mesh = LayerMesh::Grid;
   int grid_cells = 30;                   // regular grid: cells per side (section 5.1: 30 x 30)
   LayerViews views = LayerViews::Street;
-  bool single_mesh = true;               // also build the SMI of the far objects (the bench's "smi" mode)
 };
 
 // Throws farfield::Error naming the option (as the CLI spells it) for a value out of range.
@@ -89,8 +105,11 @@ void validatePipelineOptions(const PipelineOptions& options);
 // the runner for online stages from them. Saved whole and read back strictly: a missing key, an unknown key or a
 // value of the wrong type or out of range is a farfield::Error naming `source` and the key. Stores of version 2
 // lacked frame_height, frame_fov_deg and validity: with store_version 2 those take the values version 2 meant
-// (square frames of frame_width at fov_deg; default sampling); every other key is still required.
+// (square frames of frame_width at fov_deg; default sampling); every other key is still required. Stores of versions
+// 2 and 3 also have "single_mesh" (required there, a boolean; an error in version 4): the mmi stage then built the
+// single mesh too. It is not an option any more but the single stage: the store's reader maps it to that stage
+// (store/impostor_store.h, "Version 4"); here it is only checked.
 nlohmann::json pipelineOptionsToJson(const PipelineOptions& options);
-PipelineOptions pipelineOptionsFromJson(const nlohmann::json& json, const std::string& source, int store_version = 3);
+PipelineOptions pipelineOptionsFromJson(const nlohmann::json& json, const std::string& source, int store_version = 4);
 
 }  // namespace farfield::extract

@@ -87,6 +87,8 @@ void PipelineRunner::runStage(const std::string& stage, CellWork& work) {
     runPvs(work);
   else if (stage == kStageNearFar)
     runNearFar(work);
+  else if (stage == kStageSingle)
+    runSingle(work);
   else if (stage == kStageMmi)
     runMmi(work);
   else
@@ -94,10 +96,8 @@ void PipelineRunner::runStage(const std::string& stage, CellWork& work) {
 }
 
 void PipelineRunner::runStages(const std::vector<std::string>& stages, CellWork& work) {
-  for (const std::string& stage : stages) {
-    runStage(stage, work);
-    if (stage == kStageMmi) buildMeshes(work);
-  }
+  for (const std::string& stage : stages) runStage(stage, work);
+  if (work.layers_pending || work.single_pending) buildMeshes(work);
 }
 
 // Section 5.3: 360-degree item buffers from points spaced along the cell at eye height.
@@ -155,24 +155,61 @@ std::vector<Camera> PipelineRunner::viewCameras(const CellWork& work, const Vec3
   return urban::cubeFaceCameras(eye, options_.base.resolution, options_.base.near_plane, options_.base.far_plane);
 }
 
-// Sections 4.1-4.3: the event graph over the far objects' footprints, the greedy layering with T, then per layer and
-// view a capture of that layer's objects alone (so no layer hides another in its image: what the viewer uncovers
-// while walking the cell is in the layer behind), and the same for all far objects together (the single mesh).
-void PipelineRunner::runMmi(CellWork& work) {
+// Only the far objects some view shows are captured and layered: with the street view, the PVS (360 degrees) also
+// holds what lies behind the viewer, which no street-facing image could hold. Moving forward along the cell keeps the
+// view inside the frustum from P (a cone translated along its axis stays inside itself), so P's frustum is enough.
+std::vector<uint32_t> PipelineRunner::farInView(const CellWork& work, const char* stage) const {
   if (!work.result.has_split)
-    throw Error("pipeline", "cell " + std::to_string(work.cell) + ": mmi needs the near-far stage before it");
-  // Only the far objects some view shows are layered: with the street view, the PVS (360 degrees) also holds what
-  // lies behind the viewer, which no street-facing layer could hold. Moving forward along the cell keeps the view
-  // inside the frustum from P (a cone translated along its axis stays inside itself), so P's frustum is enough.
-  const std::vector<Camera> cameras = viewCameras(work, work.p_eye);
+    throw Error("pipeline", "cell " + std::to_string(work.cell) + ": " + stage +
+                                " needs the near-far stage before it");
   std::vector<Frustum> frusta;
-  for (const Camera& camera : cameras) frusta.push_back(Frustum::fromMatrix(camera.viewProjection()));
+  for (const Camera& camera : viewCameras(work, work.p_eye)) frusta.push_back(Frustum::fromMatrix(camera.viewProjection()));
   std::vector<uint32_t> far;
   for (uint32_t id : work.result.far) {
     const Box3& b = scene_.objects[id - 1].world_bounds;
     if (std::any_of(frusta.begin(), frusta.end(), [&](const Frustum& f) { return f.intersects(b); }))
       far.push_back(id);
   }
+  return far;
+}
+
+// Every station's views, station-major (view k of station j is capture j * views_per_station + k).
+std::vector<Camera> PipelineRunner::stationCameras(CellWork& work) const {
+  std::vector<Camera> cameras;
+  for (const Vec3& eye : stationEyes(work))
+    for (const Camera& camera : viewCameras(work, eye)) cameras.push_back(camera);
+  work.views_per_station = viewCameras(work, work.p_eye).size();
+  return cameras;
+}
+
+// Only the objects in the view's frustum are drawn into it (the renderer does not cull).
+impostor::ImpostorCapture PipelineRunner::capture(const std::vector<uint32_t>& ids, const Camera& camera) {
+  const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  std::vector<uint32_t> seen;
+  for (uint32_t id : ids)
+    if (frustum.intersects(scene_.objects[id - 1].world_bounds)) seen.push_back(id);
+  return impostor::captureView(renderer_, gpu_scene_, seen, camera, options_.base.capture);
+}
+
+// The single-mesh impostor (Decoret 1999's SMI; Sillion 1997's cell impostor with one station): all far objects in
+// view captured together, from every station, so nearer ones hide farther ones in one image.
+void PipelineRunner::runSingle(CellWork& work) {
+  const std::vector<uint32_t> far = farInView(work, kStageSingle);
+  Stopwatch capture_timer;
+  work.result.has_single = true;
+  work.result.single = {};
+  work.result.single.objects = far;
+  work.single_captures.clear();
+  for (const Camera& camera : stationCameras(work)) work.single_captures.push_back(capture(far, camera));
+  work.single_pending = true;
+  work.capture_ms += capture_timer.milliseconds();
+}
+
+// Sections 4.1-4.3: the event graph over the far objects' footprints, the greedy layering with T, then per layer and
+// view a capture of that layer's objects alone (so no layer hides another in its image: what the viewer uncovers
+// while walking the cell is in the layer behind).
+void PipelineRunner::runMmi(CellWork& work) {
+  const std::vector<uint32_t> far = farInView(work, kStageMmi);
   Stopwatch weights_timer;
   std::vector<urban::EventObject> objects;
   objects.reserve(far.size());
@@ -214,31 +251,15 @@ void PipelineRunner::runMmi(CellWork& work) {
     layer.objects = std::move(ids);
     work.result.layers.push_back(std::move(layer));
   }
-  work.result.single = {};
-  work.result.single.objects = far;
 
   Stopwatch capture_timer;
-  // Every station's views, station-major (view k of station j is capture j * views_per_station + k). Only the
-  // objects in a view's frustum are drawn into it (the renderer does not cull).
-  std::vector<Camera> station_cameras;
-  for (const Vec3& eye : stationEyes(work))
-    for (const Camera& camera : viewCameras(work, eye)) station_cameras.push_back(camera);
-  work.views_per_station = cameras.size();
-  auto capture = [&](const std::vector<uint32_t>& ids, const Camera& camera) {
-    const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
-    std::vector<uint32_t> seen;
-    for (uint32_t id : ids)
-      if (frustum.intersects(scene_.objects[id - 1].world_bounds)) seen.push_back(id);
-    return impostor::captureView(renderer_, gpu_scene_, seen, camera, options_.base.capture);
-  };
+  const std::vector<Camera> station_cameras = stationCameras(work);
   work.layer_captures.assign(work.result.layers.size(), {});
   for (size_t l = 0; l < work.result.layers.size(); ++l)
     for (const Camera& camera : station_cameras)
       work.layer_captures[l].push_back(capture(work.result.layers[l].objects, camera));
-  work.single_captures.clear();
-  if (options_.single_mesh)
-    for (const Camera& camera : station_cameras) work.single_captures.push_back(capture(far, camera));
-  work.capture_ms = capture_timer.milliseconds();
+  work.layers_pending = true;
+  work.capture_ms += capture_timer.milliseconds();
 }
 
 // Stations are placed every station_spacing metres; a layer whose first station's region already reaches far needs
@@ -308,31 +329,32 @@ void PipelineRunner::buildMeshes(CellWork& work) const {
     o.fov_y = capture.camera.fov_y;
     return impostor::buildDepthMesh(capture, o);
   };
-  work.layer_views.assign(work.layer_captures.size(), {});
-  for (size_t l = 0; l < work.layer_captures.size(); ++l)
-    for (const impostor::ImpostorCapture& c : work.layer_captures[l]) work.layer_views[l].push_back(build(c));
-  work.single_views.clear();
-  for (const impostor::ImpostorCapture& c : work.single_captures) work.single_views.push_back(build(c));
   // Counts into the record (file names are the bake's business).
-  for (size_t l = 0; l < work.layer_views.size(); ++l) {
-    work.result.layers[l].views.assign(work.layer_views[l].size(), {});
-    for (size_t v = 0; v < work.layer_views[l].size(); ++v) {
-      store::StoredView& sv = work.result.layers[l].views[v];
-      sv.camera = work.layer_captures[l][v].camera;
-      sv.triangles = work.layer_views[l][v].mesh.triangleCount();
-      sv.vertices = work.layer_views[l][v].mesh.vertexCount();
-      sv.data_pixels = work.layer_captures[l][v].data_pixels;
-      sv.render_ms = work.layer_captures[l][v].render_ms;
+  auto record = [](store::StoredView& sv, const impostor::ImpostorCapture& capture,
+                   const impostor::DepthMeshImpostor& view) {
+    sv.camera = capture.camera;
+    sv.triangles = view.mesh.triangleCount();
+    sv.vertices = view.mesh.vertexCount();
+    sv.data_pixels = capture.data_pixels;
+    sv.render_ms = capture.render_ms;
+  };
+  if (work.layers_pending) {
+    work.layer_views.assign(work.layer_captures.size(), {});
+    for (size_t l = 0; l < work.layer_captures.size(); ++l) {
+      work.result.layers[l].views.assign(work.layer_captures[l].size(), {});
+      for (size_t v = 0; v < work.layer_captures[l].size(); ++v) {
+        work.layer_views[l].push_back(build(work.layer_captures[l][v]));
+        record(work.result.layers[l].views[v], work.layer_captures[l][v], work.layer_views[l][v]);
+      }
     }
   }
-  work.result.single.views.assign(work.single_views.size(), {});
-  for (size_t v = 0; v < work.single_views.size(); ++v) {
-    store::StoredView& sv = work.result.single.views[v];
-    sv.camera = work.single_captures[v].camera;
-    sv.triangles = work.single_views[v].mesh.triangleCount();
-    sv.vertices = work.single_views[v].mesh.vertexCount();
-    sv.data_pixels = work.single_captures[v].data_pixels;
-    sv.render_ms = work.single_captures[v].render_ms;
+  if (work.single_pending) {
+    work.single_views.clear();
+    work.result.single.views.assign(work.single_captures.size(), {});
+    for (size_t v = 0; v < work.single_captures.size(); ++v) {
+      work.single_views.push_back(build(work.single_captures[v]));
+      record(work.result.single.views[v], work.single_captures[v], work.single_views[v]);
+    }
   }
   // Validity regions (extract/validity_region.h), per station from its views' triangles and captured depth. The scan
   // runs up to a few times the bake's bound so that a runtime asking for a looser bound still finds its region.
@@ -364,12 +386,14 @@ void PipelineRunner::buildMeshes(CellWork& work) const {
     }
     pruneStations(layer, views, work);
   };
-  for (size_t l = 0; l < work.result.layers.size(); ++l)
-    regions(work.result.layers[l], work.layer_views[l], work.layer_captures[l]);
-  regions(work.result.single, work.single_views, work.single_captures);
+  if (work.layers_pending)
+    for (size_t l = 0; l < work.result.layers.size(); ++l)
+      regions(work.result.layers[l], work.layer_views[l], work.layer_captures[l]);
+  if (work.single_pending) regions(work.result.single, work.single_views, work.single_captures);
   work.layer_captures.clear();
   work.single_captures.clear();
-  work.build_ms = timer.milliseconds();
+  work.layers_pending = work.single_pending = false;
+  work.build_ms += timer.milliseconds();
 }
 
 }  // namespace farfield::extract

@@ -30,14 +30,17 @@ struct CellWork {
   Camera street_camera;               // at P looking towards Q (cellCamera)
   std::vector<uint32_t> candidates;   // objects entering the next stage (ascending); all objects at the start
   store::CellPipeline result;         // the stages' results (the store's per-cell record)
-  // From the mmi stage, before they are written or uploaded: per layer, per view; and the single mesh's views.
+  // From the mmi stage (per layer, per view) and the single stage (per view), before they are written or uploaded.
   std::vector<std::vector<impostor::DepthMeshImpostor>> layer_views;
   std::vector<impostor::DepthMeshImpostor> single_views;
-  // Captures waiting for their meshes (the bake builds them on worker threads).
+  // Captures waiting for their meshes (the bake builds them on worker threads); each stage's flag is set by its GL
+  // side and cleared by buildMeshes, which builds only what is pending (a record resumed from a store keeps its
+  // stored views).
   std::vector<std::vector<impostor::ImpostorCapture>> layer_captures;
   std::vector<impostor::ImpostorCapture> single_captures;
+  bool layers_pending = false, single_pending = false;
   size_t views_per_station = 1;       // 1 (street) or 6 (cube faces); captures are station-major
-  double capture_ms = 0.0;
+  double capture_ms = 0.0;            // both image stages together
   double build_ms = 0.0;
 };
 
@@ -56,11 +59,13 @@ class PipelineRunner {
   // Rebuilds a cell's work record from stored results (the stages the bake ran), to continue online.
   CellWork resume(uint32_t cell, const store::CellPipeline& stored) const;
 
-  // The GL side of one stage (pvs: sampling; near-far: the split; mmi: layering and captures). Throws
-  // farfield::Error for an unknown stage or a missing input (mmi before near-far).
+  // The GL side of one stage (pvs: sampling; near-far: the split; single: captures of all far objects in view; mmi:
+  // layering and captures per layer). Throws farfield::Error for an unknown stage or a missing input (single or mmi
+  // before near-far).
   void runStage(const std::string& stage, CellWork& work);
-  // The CPU side of the mmi stage: meshes from the captures (grid or depth mesh). Thread-safe (no GL, no shared
-  // state); frees the captures.
+  // The CPU side of the single and mmi stages: meshes from the pending captures (grid or depth mesh), then the
+  // validity regions per capture station, dropping the stations not needed. Thread-safe (no GL, no shared state);
+  // frees the captures.
   void buildMeshes(CellWork& work) const;
   // Every stage in order, the meshes included (the runtime's online path).
   void runStages(const std::vector<std::string>& stages, CellWork& work);
@@ -72,7 +77,11 @@ class PipelineRunner {
  private:
   void runPvs(CellWork& work);
   void runNearFar(CellWork& work) const;
+  void runSingle(CellWork& work);
   void runMmi(CellWork& work);
+  std::vector<uint32_t> farInView(const CellWork& work, const char* stage) const;  // far objects a view shows
+  std::vector<Camera> stationCameras(CellWork& work) const;  // every station's views, station-major
+  impostor::ImpostorCapture capture(const std::vector<uint32_t>& ids, const Camera& camera);
   std::vector<Vec3> stationEyes(const CellWork& work) const;    // capture stations along the cell, start first
   std::vector<Camera> viewCameras(const CellWork& work, const Vec3& eye) const;  // a station's creation cameras
   void pruneStations(store::StoredLayer& layer, std::vector<impostor::DepthMeshImpostor>& views,

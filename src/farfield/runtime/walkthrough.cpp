@@ -79,8 +79,10 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
   std::vector<std::string> baked;
   for (const std::string& s : index_.pipeline)
     if (!contains(index_.online, s)) baked.push_back(s);
+  // Smi draws the single stage's mesh (version 2 and 3 stores read with the stage where their mmi stage built it).
   const char* needed = kind == Representation::Visible ? extract::kStagePvs
                        : kind == Representation::Local ? extract::kStageNearFar
+                       : kind == Representation::Smi   ? extract::kStageSingle
                                                        : extract::kStageMmi;
   if (!contains(index_.pipeline, needed))
     throw Error(index_file, "its pipeline has no " + std::string(needed) + " stage, which " + me + " needs");
@@ -90,7 +92,8 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
     // Stages this representation needs that the bake left to the runtime.
     const bool needs = kind == Representation::Local     ? s == extract::kStageNearFar
                        : kind == Representation::Visible ? false
-                                                         : true;
+                       : kind == Representation::Smi     ? s != extract::kStageMmi
+                                                         : s != extract::kStageSingle;
     if (needs) online_stages_.push_back(s);
   }
   const nlohmann::json stored_options =

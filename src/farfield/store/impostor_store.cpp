@@ -290,16 +290,20 @@ nlohmann::json layerJson(const StoredLayer& l, bool with_checks) {
   return j;
 }
 
-nlohmann::json pipelineJson(const CellPipeline& p, bool with_checks) {
+// Version 4: the single mesh is its own record; versions 2 and 3 kept it inside "mmi" (see the header).
+nlohmann::json pipelineJson(const CellPipeline& p, int version) {
+  const bool with_checks = version >= 3;
   nlohmann::json j = nlohmann::json::object();
   if (p.has_pvs) j["pvs"] = {{"ids", p.pvs}, {"samples", p.pvs_samples}, {"ms", p.pvs_ms}};
   if (p.has_split) j["split"] = {{"near", p.near}, {"far", p.far}};
+  if (p.has_single && version >= 4) j["single"] = layerJson(p.single, with_checks);
   if (p.has_mmi) {
     nlohmann::json layers = nlohmann::json::array();
     for (const StoredLayer& l : p.layers) layers.push_back(layerJson(l, with_checks));
     j["mmi"] = {{"threshold_rad", p.threshold_rad}, {"event_edges", p.event_edges},
                 {"max_weight_rad", p.max_weight_rad}, {"weights_ms", p.weights_ms},
-                {"layers", std::move(layers)},       {"single", layerJson(p.single, with_checks)}};
+                {"layers", std::move(layers)}};
+    if (version <= 3) j["mmi"]["single"] = layerJson(p.single, with_checks);
   }
   return j;
 }
@@ -394,8 +398,11 @@ StoredLayer readLayer(const JsonReader& r, const nlohmann::json& j, const std::s
   return layer;
 }
 
+// legacy_single (versions 2 and 3): the mmi stage built the single mesh too (options.pipeline.single_mesh), held in
+// "mmi.single": it becomes the single stage's record.
 CellPipeline readPipeline(const JsonReader& r, const nlohmann::json& j, const std::string& where,
-                          size_t scene_objects, bool require_validity, bool require_checks, uint32_t half_edge) {
+                          size_t scene_objects, int version, bool legacy_single, uint32_t half_edge) {
+  const bool require_validity = version >= 3, require_checks = version >= 3;
   const std::string cell = "cell " + std::to_string(half_edge) + ": ";
   if (!j.is_object()) r.fail(where, "expected an object");
   CellPipeline p;
@@ -425,8 +432,21 @@ CellPipeline readPipeline(const JsonReader& r, const nlohmann::json& j, const st
     for (size_t l = 0; l < layers.size(); ++l)
       p.layers.push_back(readLayer(r, layers[l], at + ".layers[" + std::to_string(l) + "]", scene_objects,
                                    require_validity, require_checks, cell + "mmi layer " + std::to_string(l)));
-    p.single = readLayer(r, r.member(m, "single", at), at + ".single", scene_objects, require_validity,
-                         require_checks, cell + "single mesh");
+    if (version <= 3) {
+      p.single = readLayer(r, r.member(m, "single", at), at + ".single", scene_objects, require_validity,
+                           require_checks, cell + "single mesh");
+      p.has_single = legacy_single;
+      if (!legacy_single) p.single = {};
+    } else if (m.contains("single")) {
+      r.fail(at, "a version 4 mmi record holds no \"single\" (the single mesh is the single stage's record)");
+    }
+  }
+  if (version >= 4 && j.contains("single")) {
+    p.has_single = true;
+    p.single = readLayer(r, j["single"], where + ".single", scene_objects, require_validity, require_checks,
+                         cell + "single mesh");
+  } else if (version <= 3 && j.contains("single")) {
+    r.fail(where + ".single", "a version " + std::to_string(version) + " record has no single stage");
   }
   return p;
 }
@@ -458,8 +478,13 @@ nlohmann::json indexToJson(const StoreIndex& index) {
   j["cell_lookup"] = index.cell_lookup;
   j["options"] = index.options;
   if (!index.pipeline.empty()) {
-    j["pipeline"] = index.pipeline;
-    j["online"] = index.online;
+    // Versions 2 and 3 had no single stage: the mmi stage built the single mesh (options.pipeline.single_mesh).
+    const auto stages = [&](std::vector<std::string> list) {
+      if (index.version <= 3) std::erase(list, std::string("single"));
+      return list;
+    };
+    j["pipeline"] = stages(index.pipeline);
+    j["online"] = stages(index.online);
     j["storage"] = index.storage;
   }
   nlohmann::json cells = nlohmann::json::array();
@@ -482,7 +507,7 @@ nlohmann::json indexToJson(const StoreIndex& index) {
       putCheck(imps[technique], "mesh", imp.mesh, imp.mesh_check, with_checks);
     }
     cell["impostors"] = std::move(imps);
-    if (c.pipeline) cell["pipeline"] = pipelineJson(*c.pipeline, with_checks);
+    if (c.pipeline) cell["pipeline"] = pipelineJson(*c.pipeline, index.version);
     cells.push_back(std::move(cell));
   }
   j["cells"] = std::move(cells);
@@ -530,6 +555,29 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
   index.local_model = r.text(j, "local_model", "top level");
   if (j.contains("cell_lookup")) index.cell_lookup = r.text(j, "cell_lookup", "top level");
   if (j.contains("options")) index.options = j["options"];
+  // Versions 2 and 3: the single mesh was built by the mmi stage when options.pipeline.single_mesh; it is the single
+  // stage now (see the header).
+  const auto has_stage = [](const std::vector<std::string>& list, const char* stage) {
+    return std::find(list.begin(), list.end(), stage) != list.end();
+  };
+  bool legacy_single = false;
+  if (index.version <= 3 && has_stage(index.pipeline, "single"))
+    r.fail("\"pipeline\"", "stage \"single\" is not a stage of version " + std::to_string(index.version) +
+                               " stores (it came with version 4)");
+  if (index.version <= 3 && has_stage(index.pipeline, "mmi")) {
+    const nlohmann::json& o = index.options;
+    const nlohmann::json* single_mesh = nullptr;
+    if (o.is_object() && o.contains("pipeline") && o["pipeline"].is_object() && o["pipeline"].contains("single_mesh"))
+      single_mesh = &o["pipeline"]["single_mesh"];
+    if (!single_mesh || !single_mesh->is_boolean())
+      r.fail("\"options\".pipeline", "a version " + std::to_string(index.version) +
+                                         " store with an mmi stage needs \"single_mesh\" (true or false): whether "
+                                         "that stage built the single mesh");
+    legacy_single = single_mesh->get<bool>();
+    if (legacy_single)
+      for (std::vector<std::string>* list : {&index.pipeline, &index.online})
+        if (has_stage(*list, "mmi")) list->insert(std::find(list->begin(), list->end(), "mmi"), "single");
+  }
   const nlohmann::json& cells = r.member(j, "cells", "top level");
   if (!cells.is_array()) r.fail("\"cells\"", "must be an array");
   for (size_t k = 0; k < cells.size(); ++k) {
@@ -572,8 +620,8 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
       e.impostors[technique] = std::move(s);
     }
     if (c.contains("pipeline"))
-      e.pipeline = readPipeline(r, c["pipeline"], where + ": pipeline", index.scene_objects, index.version >= 3,
-                                require_checks, e.half_edge);
+      e.pipeline = readPipeline(r, c["pipeline"], where + ": pipeline", index.scene_objects, index.version,
+                                legacy_single, e.half_edge);
     index.cells.push_back(std::move(e));
   }
   return index;
@@ -658,16 +706,17 @@ void removeStaleFiles(const std::string& dir, const StoreIndex& index) {
   sweep(fs::path(dir), "");
 }
 
-// A version 3 index (or any carrying "checksum"): the checksum matches its content and the file is exactly the
+// An index of version 3 or later (or any carrying "checksum"): the checksum matches its content and the file is exactly the
 // writer's text, so a damaged byte anywhere, whitespace included, is reported.
 void checkIndexText(const nlohmann::json& j, const std::string& text, const std::string& file) {
   if (!j.is_object()) return;  // indexFromJson names it
   const auto version = j.find("version");
-  const bool required = version != j.end() && version->is_number_integer() && version->get<int64_t>() == 3;
+  const bool required = version != j.end() && version->is_number_integer() && version->get<int64_t>() >= 3;
   const auto checksum = j.find("checksum");
   if (checksum == j.end()) {
     if (required)
-      throw Error(file, "top level: missing \"checksum\" (a version 3 index carries the CRC-32 of its content)");
+      throw Error(file, "top level: missing \"checksum\" (an index of version 3 or later carries the CRC-32 of its "
+                        "content)");
     return;
   }
   if (!checksum->is_number_unsigned() || checksum->get<uint64_t>() > 0xffffffffu)

@@ -60,8 +60,19 @@
 //   - "checksum": the CRC-32 of the index's compact dump (nlohmann::json::dump(), keys sorted) without "checksum";
 //     the file must be exactly the writer's form (indexFileText: dump(1) and a newline), so every truncation and
 //     byte flip of index.json is an error.
-//   Versions 1 (Sillion only) and 2 (pipeline, no validity regions, no checksums) are still read; any "checksum" or
-//   "KEY_crc32"/"KEY_bytes" they carry is checked too.
+//   Version 4 makes the single mesh a stage of its own (extract/pipeline_options.h, "single"; `farfield bake
+//   --technique depth-mesh|grid-mesh` is the pipeline near-far,single): the index's "pipeline" and "online" may name
+//   "single", each cell's pipeline record holds it beside "mmi" (present when the stage was baked),
+//     "pipeline": {..., "single": {"objects": [...], "views": [VIEW, ...], "validity": [...]}, "mmi": {...}}
+//   and "mmi" no longer holds "single"; options.pipeline has no "single_mesh".
+//   Versions 1 (Sillion only), 2 (pipeline, no validity regions, no checksums) and 3 are still read; any "checksum" or
+//   "KEY_crc32"/"KEY_bytes" they carry is checked too. A version 2 or 3 index is read as version 4 holds it: when its
+//   pipeline has "mmi", options.pipeline.single_mesh (required, a boolean) says whether that stage built the single
+//   mesh; if so, "single" joins "pipeline" (and "online", when mmi ran online) before "mmi", and each cell's
+//   "mmi.single" becomes its single stage's record (has_single). Written back as version 2 or 3 (tests of the old
+//   formats), the old layout is written. The Sillion records of versions 1-3 ("techniques", a cell's "texture" and
+//   "impostors") are still read and checked, but nothing writes them any more but writeCell (kept for the tests of
+//   the format) and nothing draws them: re-bake such a store with `farfield bake --technique`.
 //   Cells are sorted by half-edge id, each at most once. Numbers are JSON numbers (floats written with enough digits
 //   to read back exactly).
 //
@@ -101,8 +112,8 @@
 
 namespace farfield::store {
 
-inline constexpr int kIndexVersion = 3;  // 1 (Sillion only) and 2 (pipeline, no validity regions, no checksums) are
-                                         // still read
+inline constexpr int kIndexVersion = 4;  // 1 (Sillion only), 2 (pipeline, no validity regions, no checksums) and
+                                         // 3 (the single mesh inside mmi) are still read
 inline constexpr uint32_t kMeshVersion = 1;
 inline constexpr char kIndexFormat[] = "farfield-impostor-store";
 inline constexpr char kIndexFile[] = "index.json";
@@ -165,13 +176,14 @@ struct CellPipeline {
   bool has_split = false;
   std::vector<uint32_t> near;     // drawn as geometry (ascending)
   std::vector<uint32_t> far;      // replaced by image-based representations (ascending)
+  bool has_single = false;
+  StoredLayer single;             // the single-mesh impostor (SMI) of the far objects in view (the single stage)
   bool has_mmi = false;
   double threshold_rad = 0.0;     // T of the layering
   size_t event_edges = 0;         // edges of the visibility-event graph (w_ij > 0)
   double max_weight_rad = 0.0;
   double weights_ms = 0.0;        // event graph + layering
   std::vector<StoredLayer> layers;  // the multi-mesh impostor (MMI), nearest layer first
-  StoredLayer single;             // the single-mesh impostor (SMI) of the same far objects, for comparison
 };
 
 struct CellEntry {
