@@ -21,6 +21,8 @@ void registerMmiModes() {
   add(runtime::Representation::Visible, "the cell's potentially visible set, frustum-culled (Decoret 1999); --impostors DIR");
   add(runtime::Representation::Smi, "near geometry + single-mesh impostor of the far objects (Decoret 1999); --impostors DIR");
   add(runtime::Representation::Mmi, "near geometry + multi-mesh impostor, one mesh per layer (Decoret 1999); --impostors DIR");
+  add(runtime::Representation::Placed, "layered impostors placed per conservative problem view under a frame budget "
+                                       "(Jeschke 2005); --impostors DIR from farfield place");
   add(runtime::Representation::MmiDynamic, "mmi with dynamic updates of the front-most layers under a frame budget "
                                   "(Decoret 1999, 5.5); --impostors DIR, --mode-option frame_budget_ms=MS");
 }

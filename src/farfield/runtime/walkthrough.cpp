@@ -9,6 +9,7 @@
 #include "farfield/core/error_bound.h"
 #include "farfield/core/timer.h"
 #include "farfield/runtime/database.h"
+#include "farfield/runtime/walkthrough_placed.h"
 
 namespace farfield::runtime {
 
@@ -16,6 +17,14 @@ namespace {
 
 bool contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+// The cell layer a decision is about (the Placed alternatives have none and never reach the cell code).
+uint32_t layerOf(const LayerDecision& decision) {
+  return std::visit([](const auto& d) -> uint32_t {
+    if constexpr (requires { d.layer; }) return d.layer;
+    else return 0;
+  }, decision);
 }
 
 }  // namespace
@@ -27,6 +36,7 @@ const char* representationName(Representation representation) {
     case Representation::Smi: return "smi";
     case Representation::Mmi: return "mmi";
     case Representation::MmiDynamic: return "mmi-dynamic";
+    case Representation::Placed: return "placed";
   }
   return "?";
 }
@@ -57,6 +67,10 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
     throw Error(me, "needs an impostor database: a directory written by farfield bake --pipeline pvs,near-far,mmi");
   if (!(options_.error_px >= 0.0) || !std::isfinite(options_.error_px))
     throw Error(me, "error bound must be a finite number of pixels >= 0");
+  if (kind == Representation::Placed) {
+    openPlacement();
+    return;
+  }
   OpenStore opened = openStore(options_.database, scene, options_.cell_lookup);
   index_ = std::move(opened.index);
   graph_ = std::move(opened.graph);
@@ -124,7 +138,7 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
   layer_id_base_ = uint32_t(scene.objects.size() + 1);
   if (kind == Representation::MmiDynamic) {
     // A few tenths of a second on llvmpipe: cap the triangles per workload so big scenes calibrate as fast.
-    CalibrationOptions calibration;
+    gpu::CalibrationOptions calibration;
     calibration.max_triangles = 400000;
     // From where the walkthrough looks: the creation cameras of up to three stored cells (street level, along the
     // street). An overview of the city overdraws differently and mispredicted street frames by a factor of several.
@@ -134,7 +148,7 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
       view.height = options_.height;
       calibration.views.push_back(view);
     }
-    cost_ = calibrateCostModel(renderer_, gpu_scene_, calibration);
+    cost_ = gpu::calibrateCostModel(renderer_, gpu_scene_, calibration);
   }
 }
 
@@ -237,6 +251,7 @@ void Walkthrough::readAhead(uint32_t half_edge) {
 }
 
 const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<void()>& before_gpu_work) {
+  if (placed_) return planPlaced(camera);
   FramePlan& plan = plan_;
   plan.items.clear();
   plan.layers.clear();
@@ -328,7 +343,7 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
     // A layer re-rendered in this frame is drawn so at once (one drawn as geometry keeps its geometry this frame).
     for (LayerDecision& decision : plan.layers) {
       if (std::holds_alternative<LayerAsGeometry>(decision)) continue;
-      const uint32_t l = std::visit([](const auto& d) { return d.layer; }, decision);
+      const uint32_t l = layerOf(decision);
       if (current->layers[l].dynamic) decision = LayerAsDynamic{l};
     }
   }
@@ -391,7 +406,7 @@ void Walkthrough::updateDynamic(const Camera& camera, Cell& cell, const std::fun
   double draws = double(plan_.items.size());
   for (const LayerDecision& decision : plan_.layers) {
     if (std::holds_alternative<LayerAsGeometry>(decision)) continue;
-    const Layer& layer = cell.layers[std::visit([](const auto& d) { return d.layer; }, decision)];
+    const Layer& layer = cell.layers[layerOf(decision)];
     if (layer.dynamic) {
       triangles += double(layer.dynamic->triangleCount());
       draws += 1.0;
@@ -469,6 +484,7 @@ void Walkthrough::updateDynamic(const Camera& camera, Cell& cell, const std::fun
 }
 
 std::map<std::string, double> Walkthrough::statistics() const {
+  if (placed_) return placedStatistics();
   std::map<std::string, double> out;
   const Statistics& s = stats_;
   const double n = s.frames ? double(s.frames) : 1.0;

@@ -5,7 +5,7 @@
 //     its capture stations, computed at bake time (extract/validity_region.h), says its error stays under the bound
 //     where the layer appears in the frame (ErrorBound::angleWithin); the station with the smallest error is drawn,
 //     and the layer's objects are drawn as geometry where none holds the eye (reported per frame);
-//   - the frame budget (Representation::MmiDynamic): a cost model fitted on this machine (runtime/cost_model.h)
+//   - the frame budget (Representation::MmiDynamic): a cost model fitted on this machine (gpu/cost_model.h)
 //     predicts the frame's time, and the time left under the budget re-renders the front-most layers from the
 //     viewer's eye (Decoret et al. 1999, section 5.5; runtime/dynamic_impostor.h), most wrong first.
 // It needs no benchmark harness: eval's bench modes (local, visible, smi, mmi, mmi-dynamic) are thin adapters over
@@ -39,7 +39,7 @@
 #include "farfield/gpu/renderer.h"
 #include "farfield/impostor/drawable.h"
 #include "farfield/impostor/validity.h"
-#include "farfield/runtime/cost_model.h"
+#include "farfield/gpu/cost_model.h"
 #include "farfield/runtime/dynamic_impostor.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/store/cell_reader.h"
@@ -56,11 +56,14 @@ enum class Representation {
   Smi,         // the single-mesh impostor of the far objects
   Mmi,         // the multi-mesh impostor, one mesh per layer (Decoret et al. 1999)
   MmiDynamic,  // mmi, with front-most layers re-rendered under the frame budget (section 5.5)
+  Placed,      // a placement database (`farfield place`, Jeschke et al. 2005): per conservative problem view, the
+               // layered impostors of object clusters chosen to keep the frame under t_max; geometry elsewhere
 };
 const char* representationName(Representation representation);
 
 struct WalkthroughOptions {
-  std::string database;                        // directory written by `farfield bake --pipeline`
+  std::string database;                        // directory written by `farfield bake --pipeline` (or, for Placed,
+                                               // by `farfield place`)
   Representation representation = Representation::Mmi;
   double error_px = 0.0;                       // the bound in pixels of the frames; 0 = the database's
   // GPU bytes of resident impostors (textures, id textures, meshes); least recently used cells are evicted beyond
@@ -97,11 +100,24 @@ struct LayerUnchecked {    // a version 2 database has no validity regions: ever
 struct LayerAsDynamic {    // a dynamic impostor rendered from a recent eye (MmiDynamic)
   uint32_t layer = 0;
 };
-using LayerDecision = std::variant<LayerAsImpostor, LayerAsGeometry, LayerUnchecked, LayerAsDynamic>;
+struct ClusterAsImpostor {  // Placed: a layered impostor of an object cluster, valid where the eye is (its shaft)
+  uint32_t impostor = 0;     // id in the placement database
+  uint32_t objects = 0;      // objects it stands for
+  double error_rad = 0.0;    // its plan's parallax bound from anywhere in its shaft
+  double bound_rad = 0.0;    // the bound of this frame
+};
+struct ClusterAsGeometry {  // Placed: an impostor of the CPV that cannot keep this frame's bound (a narrower field of
+  uint32_t impostor = 0;     // view or a larger frame than placed for, or the eye outside its shaft): its objects
+  uint64_t triangles = 0;    // are drawn as geometry
+};
+using LayerDecision = std::variant<LayerAsImpostor, LayerAsGeometry, LayerUnchecked, LayerAsDynamic, ClusterAsImpostor,
+                                   ClusterAsGeometry>;
 
 // What a frame could not promise, and why.
 struct FrameReport {
   uint32_t cell = urban::kNone;   // half-edge, kNone outside the street graph
+  uint32_t cpv = urban::kNone;    // Placed: the conservative problem view holding the camera, kNone for none
+  double cpv_t_after_ms = 0.0;    // Placed: the placement's time bound of that CPV with its impostors
   bool baked = false;             // false: the database does not hold the cell (frustum-culled geometry)
   bool loaded = false;            // the cell was read (and its online stages run) in this frame
   const char* read = "";          // when loaded: "ready" (read ahead), "waited" (read ahead, unfinished), "cold"
@@ -122,7 +138,7 @@ struct FrameReport {
 
 struct FramePlan {
   std::vector<gpu::DrawItem> items;   // the frame's main pass: geometry and impostors
-  std::vector<LayerDecision> layers;  // per layer of the current cell
+  std::vector<LayerDecision> layers;  // per layer of the current cell, or per impostor of the current CPV (Placed)
   FrameReport report;
 };
 
@@ -148,6 +164,11 @@ class Walkthrough {
  private:
   struct Layer;
   struct Cell;
+  struct Placed;  // walkthrough_placed.cpp
+  void openPlacement();
+  const FramePlan& planPlaced(const Camera& camera);
+  std::map<std::string, double> placedStatistics() const;
+  std::unique_ptr<Placed> placed_;
   Cell& cell(uint32_t half_edge, bool* loaded);
   std::unique_ptr<Cell> loadCell(const store::CellEntry& entry);
   void readAhead(uint32_t half_edge);
@@ -176,7 +197,7 @@ class Walkthrough {
   std::vector<uint32_t> ids_;
   std::vector<uint8_t> invalid_object_;             // per object id: in a layer drawn as geometry this frame
   uint32_t layer_id_base_ = 0;
-  CostModel cost_;
+  gpu::CostModel cost_;
   double dynamic_threshold_rad_ = 0.0;
   bool has_previous_ = false;
   bool fast_ = false;

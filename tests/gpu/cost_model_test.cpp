@@ -15,9 +15,9 @@
 #include "farfield/core/timer.h"
 #include "farfield/gen/city.h"
 #include "farfield/gpu/context.h"
-#include "farfield/runtime/cost_model.h"
+#include "farfield/gpu/cost_model.h"
 
-namespace farfield::runtime {
+namespace farfield::gpu {
 namespace {
 
 // Workloads spread over the three terms independently (a small factorial design).
@@ -214,4 +214,4 @@ TEST(CostModelTest, CalibrationRejectsBadInput) {
 }
 
 }  // namespace
-}  // namespace farfield::runtime
+}  // namespace farfield::gpu

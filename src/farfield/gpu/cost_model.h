@@ -25,7 +25,7 @@
 
 #include "farfield/gpu/renderer.h"
 
-namespace farfield::runtime {
+namespace farfield::gpu {
 
 // One measured workload.
 struct CostSample {
@@ -93,4 +93,4 @@ struct CalibrationOptions {
 CostModel calibrateCostModel(gpu::Renderer& renderer, const gpu::GpuScene& gpu_scene,
                              const CalibrationOptions& options = {});
 
-}  // namespace farfield::runtime
+}  // namespace farfield::gpu

@@ -5,7 +5,7 @@
 // they are what the runtime knows before drawing: the cell's near geometry and impostor triangle counts, its draw
 // items, the frame size. Coefficients are measured rather than assumed because they differ by orders of magnitude
 // between a GPU and llvmpipe, where this project also runs.
-#include "farfield/runtime/cost_model.h"
+#include "farfield/gpu/cost_model.h"
 
 #include <algorithm>
 #include <array>
@@ -21,7 +21,7 @@
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
 
-namespace farfield::runtime {
+namespace farfield::gpu {
 namespace {
 
 constexpr int kTerms = 4;  // base, triangles, draw calls, pixels
@@ -324,4 +324,4 @@ CostModel calibrateCostModel(gpu::Renderer& renderer, const gpu::GpuScene& gpu_s
   return CostModel::fit(samples);
 }
 
-}  // namespace farfield::runtime
+}  // namespace farfield::gpu

@@ -1,0 +1,87 @@
+// farfield calibrate SCENE -o profile.json [--size WxH] [--fov DEG] [--views N] [--repeats N]
+//                    [--view-min X,Y,Z --view-max X,Y,Z] [--seed S] [--margin-quantile Q] [--csv FILE]
+// Fits the frame-time cost model on this machine and validates it on random views of the view space
+// (eval/calibration.h); writes the cost profile that placement bounds frame times with.
+#include <cstdio>
+#include <memory>
+
+#include "cli_util.h"
+#include "command.h"
+#include "farfield/core/allocator.h"
+#include "farfield/core/error.h"
+#include "farfield/eval/calibration.h"
+#include "farfield/gpu/context.h"
+#include "farfield/scene/import.h"
+
+namespace farfield::app {
+namespace {
+
+struct CalibrateArgs {
+  std::string scene;
+  std::string out;
+  std::string size = "512x512";
+  std::string view_min, view_max;
+  std::string csv;
+  eval::CalibrateOptions options;
+};
+
+void runCalibrateCommand(CalibrateArgs& args) {
+  const AllocatorSettings allocator = configureTimingAllocator();
+  eval::CalibrateOptions& o = args.options;
+  const IVec2 size = parseSize("--size", args.size);
+  o.width = size.x;
+  o.height = size.y;
+  if (args.view_min.empty() != args.view_max.empty())
+    throw Error("--view-min/--view-max", "give both corners of the view space, or neither");
+  if (!args.view_min.empty())
+    o.view_space = Box3::fromPoints(parseVec3("--view-min", args.view_min), parseVec3("--view-max", args.view_max));
+  const scene::Scene scene = scene::loadScene(args.scene);
+  const eval::CalibrateResult r = eval::calibrate(gpu::sharedHeadlessContext(), scene, o);
+  ensureParentDirectory(args.out);
+  gpu::saveCostProfile(r.profile, args.out);
+  if (!args.csv.empty()) {
+    ensureParentDirectory(args.csv);
+    eval::writeCalibrationCsv(r, args.csv);
+  }
+  const gpu::CostModel& m = r.profile.model;
+  std::printf("scene:              %s\n", args.scene.c_str());
+  std::printf("renderer:           %s\n", r.profile.renderer.c_str());
+  std::printf("malloc:             %s\n", allocator.description.c_str());
+  std::printf("model:              %.3f ms + %.3f ms/Mtri + %.4f ms/draw + %.3f ms/Mpixel (fit r2 %.3f, %zu samples)\n",
+              m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.r2, m.samples);
+  std::printf("validation:         %zu views at %dx%d, %.0f deg, min of %d renders each\n", r.checks.size(), o.width,
+              o.height, double(o.fov_deg), o.repeats);
+  std::printf("measured/predicted: p50 %.3f  p95 %.3f  p99 %.3f  max %.3f\n", r.ratio_p50, r.ratio_p95, r.ratio_p99,
+              r.ratio_max);
+  std::printf("|error| ms:         p50 %.3f  p95 %.3f  max %.3f\n", r.abs_error_p50_ms, r.abs_error_p95_ms,
+              r.abs_error_max_ms);
+  std::printf("safety factor:      %.3f (quantile %.3f of measured/predicted); views over prediction x factor: %zu of %zu\n",
+              r.profile.safety_factor, o.margin_quantile, r.over_bound, r.checks.size());
+  std::printf("views slower than predicted (before the factor): %zu\n", r.under_predicted);
+  std::printf("wall:               %.1f s\n", r.wall_s);
+  std::printf("profile:            %s\n", args.out.c_str());
+  if (!args.csv.empty()) std::printf("csv:                %s\n", args.csv.c_str());
+}
+
+const RegisterCommand reg("calibrate", [](CLI::App& app) {
+  auto args = std::make_shared<CalibrateArgs>();
+  auto* cmd = app.add_subcommand("calibrate", "Fit the frame-time cost model on this machine and validate it on "
+                                              "random views; writes a cost profile (JSON).");
+  cmd->add_option("scene", args->scene, "Scene file (glTF, OBJ, ...) or builtin:NAME")->required();
+  cmd->add_option("-o,--out", args->out, "Cost profile to write (JSON)")->required();
+  cmd->add_option("--size", args->size, "Frame size WxH")->capture_default_str();
+  cmd->add_option("--fov", args->options.fov_deg, "Vertical field of view, degrees")->capture_default_str();
+  cmd->add_option("--views", args->options.views, "Validation views")->capture_default_str();
+  cmd->add_option("--fit-views", args->options.fit_views, "Views the model is fitted on")->capture_default_str();
+  cmd->add_option("--repeats", args->options.repeats, "Renders per view (the minimum is kept)")->capture_default_str();
+  cmd->add_option("--view-min", args->view_min, "View space corner X,Y,Z (default: the scene's bounds at 1.7 m)");
+  cmd->add_option("--view-max", args->view_max, "View space corner X,Y,Z");
+  cmd->add_option("--seed", args->options.seed, "Seed of the random views")->capture_default_str();
+  cmd->add_option("--margin-quantile", args->options.margin_quantile,
+                  "Safety factor = this quantile of measured/predicted (1 = the maximum)")->capture_default_str();
+  cmd->add_option("--csv", args->csv, "Per-view predicted and measured times");
+  cmd->callback([args] { runCalibrateCommand(*args); });
+});
+
+}  // namespace
+}  // namespace farfield::app

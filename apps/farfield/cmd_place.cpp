@@ -1,0 +1,93 @@
+// farfield place SCENE --profile profile.json -o DIR [--tmax MS] [--error-px PX] [--size WxH] [--fov DEG]
+//                [--view-min X,Y,Z --view-max X,Y,Z] [--cpv-size M] [--vdi-deg DEG] [--levels N] ...
+// Automatic impostor placement (Jeschke et al. 2005; bake/place.h): which object clusters become layered impostors
+// for which view cells, so every view of the view space renders under t_max with an error under the bound.
+#include <cstdio>
+#include <memory>
+
+#include "cli_util.h"
+#include "command.h"
+#include "farfield/bake/place.h"
+#include "farfield/core/error.h"
+#include "farfield/gpu/context.h"
+#include "farfield/scene/import.h"
+
+namespace farfield::app {
+namespace {
+
+struct PlaceArgs {
+  std::string scene;
+  std::string profile;
+  std::string out;
+  std::string size = "512x512";
+  std::string view_min, view_max;
+  int distance_steps = 11;
+  bake::PlaceOptions options;
+};
+
+void runPlaceCommand(PlaceArgs& args) {
+  bake::PlaceOptions& o = args.options;
+  const IVec2 size = parseSize("--size", args.size);
+  o.width = size.x;
+  o.height = size.y;
+  if (args.view_min.empty() != args.view_max.empty())
+    throw Error("--view-min/--view-max", "give both corners of the view space, or neither");
+  if (!args.view_min.empty())
+    o.view_space = Box3::fromPoints(parseVec3("--view-min", args.view_min), parseVec3("--view-max", args.view_max));
+  if (args.distance_steps < 1) throw Error("--distance-steps", "must be at least 1");
+  o.candidates.distance_steps = args.distance_steps;
+  o.scene_label = args.scene;
+  const gpu::CostProfile profile = gpu::loadCostProfile(args.profile);
+  const scene::Scene scene = scene::loadScene(args.scene);
+  const bake::PlaceReport r = bake::placeImpostors(gpu::sharedHeadlessContext(), scene, profile, o, args.out);
+  std::printf("scene:            %s (%zu objects: %zu clustered, %zu always geometry)\n", args.scene.c_str(),
+              scene.objects.size(), r.clustered_objects, r.geometry_objects);
+  std::printf("promises:         t_max %.2f ms, error %.2f px at %dx%d, %.1f deg (profile %s, safety factor %.3f)\n",
+              o.t_max_ms, o.error_px, o.width, o.height, double(o.fov_deg), args.profile.c_str(),
+              profile.safety_factor);
+  std::printf("view space:       %zu regions visited, %zu with problem views, %zu CPVs (%zu estimates), %.1f s\n",
+              r.regions, r.problem_regions, r.cpvs, r.estimates, r.view_space_s);
+  std::printf("candidates:       %zu considered, %zu intersecting, %zu serving no CPV, %zu identical, %zu kept, "
+              "%zu without a plan under the bound, %.1f s\n",
+              r.candidate_counts.considered, r.candidate_counts.intersecting, r.candidate_counts.no_cpv,
+              r.candidate_counts.identical, r.candidate_counts.kept, r.candidates_unplannable, r.candidates_s);
+  std::printf("greedy:           %zu generated, %zu kept, %zu freed; %.1f s choosing, %.1f s capturing\n",
+              r.impostors_generated, r.impostors, r.impostors_freed, r.greedy_s, r.capture_s);
+  std::printf("CPVs:             slowest %.2f ms before, %.2f ms after; %zu unsolved (still over t_max)\n",
+              r.t_enc_max_ms, r.t_after_max_ms, r.unsolved_cpvs);
+  std::printf("memory:           %.2f MB of impostors (GPU), %.2f MB on disk\n", r.memory_bytes / 1048576.0,
+              double(r.written_bytes) / 1048576.0);
+  std::printf("wall:             %.1f s\n", r.wall_s);
+  std::printf("database:         %s\n", args.out.c_str());
+}
+
+const RegisterCommand reg("place", [](CLI::App& app) {
+  auto args = std::make_shared<PlaceArgs>();
+  bake::PlaceOptions& o = args->options;
+  auto* cmd = app.add_subcommand("place", "Automatic impostor placement (Jeschke 2005): layered impostors of object "
+                                          "clusters per view cell, keeping every view under t_max and the error bound");
+  cmd->add_option("scene", args->scene, "Scene file (glTF, OBJ, ...) or builtin:NAME")->required();
+  cmd->add_option("--profile", args->profile, "Cost profile of this machine (farfield calibrate -o FILE)")->required();
+  cmd->add_option("-o,--out", args->out, "Placement database directory to write")->required();
+  cmd->add_option("--tmax", o.t_max_ms, "Frame budget, ms")->capture_default_str();
+  cmd->add_option("--error-px", o.error_px, "Error bound, pixels of the frames")->capture_default_str();
+  cmd->add_option("--size", args->size, "Frame size WxH")->capture_default_str();
+  cmd->add_option("--fov", o.fov_deg, "Vertical field of view, degrees")->capture_default_str();
+  cmd->add_option("--view-min", args->view_min, "View space corner X,Y,Z (default: the scene's bounds at 1.2-1.7 m)");
+  cmd->add_option("--view-max", args->view_max, "View space corner X,Y,Z");
+  cmd->add_option("--cpv-size", o.min_region_size, "Side of the CPVs' regions, metres")->capture_default_str();
+  cmd->add_option("--vdi-deg", o.min_vdi_deg, "Width of the CPVs' view-direction intervals, degrees")
+      ->capture_default_str();
+  cmd->add_option("--max-pitch", o.max_pitch_deg, "Views pitched further from the horizon are not guarded, degrees "
+                                                  "(90: all)")->capture_default_str();
+  cmd->add_option("--levels", o.hierarchy.max_levels, "Levels of the object hierarchy")->capture_default_str();
+  cmd->add_option("--distance-steps", args->distance_steps, "Shaft minimum distances per axis (1, 2, 4, ... times "
+                                                             "the cluster size)")->capture_default_str();
+  cmd->add_option("--max-texture", o.layered.max_texture_size, "Largest layer texture side, texels")
+      ->capture_default_str();
+  cmd->add_flag("--bound-cracks", o.layered.bound_cracks, "Halve layer spacing so cracks also stay under the bound");
+  cmd->callback([args] { runPlaceCommand(*args); });
+});
+
+}  // namespace
+}  // namespace farfield::app

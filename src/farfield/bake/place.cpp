@@ -1,0 +1,411 @@
+// The placement driver (Jeschke et al. 2005, sections 3-5): see place.h.
+#include "farfield/bake/place.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "farfield/core/enclosing_frustum.h"
+#include "farfield/core/error.h"
+#include "farfield/core/log.h"
+#include "farfield/core/strict_json.h"
+#include "farfield/core/progress.h"
+#include "farfield/core/timer.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/placement/greedy.h"
+#include "farfield/placement/placement_problem.h"
+#include "farfield/placement/view_space.h"
+#include "farfield/scene/bvh.h"
+#include "farfield/store/placement_store.h"
+
+namespace fs = std::filesystem;
+
+namespace farfield::bake {
+
+namespace {
+
+void validate(const PlaceOptions& o) {
+  if (!(o.t_max_ms > 0.0) || !std::isfinite(o.t_max_ms)) throw Error("--tmax", "must be a positive number of ms");
+  if (!(o.error_px > 0.0) || !std::isfinite(o.error_px)) throw Error("--error-px", "must be a positive number");
+  if (o.width < 8 || o.height < 8 || o.width > 8192 || o.height > 8192)
+    throw Error("--size", "must be 8..8192 pixels per side");
+  if (!(o.fov_deg > 1.0f && o.fov_deg < 170.0f)) throw Error("--fov", "must be in (1, 170) degrees");
+  if (!(o.min_region_size > 0.0f)) throw Error("--cpv-size", "must be a positive number of metres");
+  if (!(o.min_vdi_deg > 0.0f && o.min_vdi_deg <= 90.0f)) throw Error("--vdi-deg", "must be in (0, 90] degrees");
+  if (!(o.max_pitch_deg > 0.0f && o.max_pitch_deg <= 90.0f)) throw Error("--max-pitch", "must be in (0, 90] degrees");
+  if (!(o.max_object_share > 0.0f)) throw Error("place options", "max_object_share must be positive");
+  if (!(o.near_plane > 0.0f && o.far_plane > o.near_plane)) throw Error("--near/--far", "need 0 < near < far");
+}
+
+// The smallest |pitch| (radians) of the directions of a VDI, from its boundary sampled densely (0 when it crosses
+// the horizon), less a degree for what the samples miss.
+double minAbsPitch(const Vdi& vdi) {
+  constexpr int kSteps = 16;
+  double lo = 1e9, hi = -1e9, least = 1e9;
+  for (int i = 0; i <= kSteps; ++i)
+    for (int j = 0; j <= kSteps; ++j) {
+      if (i != 0 && i != kSteps && j != 0 && j != kSteps) continue;
+      const float u = vdi.u0 + (vdi.u1 - vdi.u0) * float(i) / kSteps;
+      const float v = vdi.v0 + (vdi.v1 - vdi.v0) * float(j) / kSteps;
+      const double pitch = std::asin(std::clamp(double(vdi.direction(u, v).z), -1.0, 1.0));
+      lo = std::min(lo, pitch);
+      hi = std::max(hi, pitch);
+      least = std::min(least, std::abs(pitch));
+    }
+  if (lo <= 0.0 && hi >= 0.0) return 0.0;
+  return std::max(0.0, least - degToRad(1.0));
+}
+
+// What drawing an object costs beyond a frame's fixed cost: triangles and draw calls.
+struct ObjectCost {
+  uint64_t triangles = 0;
+  uint32_t draws = 0;
+};
+
+}  // namespace
+
+Box3 defaultPlaceViewSpace(const scene::Scene& scene) {
+  const Box3 b = scene.bounds();
+  if (b.empty()) throw Error("view space", "the scene is empty");
+  return Box3::fromPoints(Vec3(b.lo.x, b.lo.y, b.lo.z + 1.2f), Vec3(b.hi.x, b.hi.y, b.lo.z + 1.7f));
+}
+
+nlohmann::json PlaceReport::toJson() const {
+  return {{"regions", regions},
+          {"problem_regions", problem_regions},
+          {"cpvs", cpvs},
+          {"estimates", estimates},
+          {"hierarchy_nodes", hierarchy_nodes},
+          {"clustered_objects", clustered_objects},
+          {"geometry_objects", geometry_objects},
+          {"candidates_considered", candidate_counts.considered},
+          {"candidates_intersecting", candidate_counts.intersecting},
+          {"candidates_no_cpv", candidate_counts.no_cpv},
+          {"candidates_identical", candidate_counts.identical},
+          {"candidates_kept", candidate_counts.kept},
+          {"candidates_unplannable", candidates_unplannable},
+          {"impostors", impostors},
+          {"impostors_generated", impostors_generated},
+          {"impostors_freed", impostors_freed},
+          {"unsolved_cpvs", unsolved_cpvs},
+          {"memory_bytes", memory_bytes},
+          {"written_bytes", written_bytes},
+          {"t_enc_max_ms", t_enc_max_ms},
+          {"t_after_max_ms", t_after_max_ms},
+          {"view_space_s", view_space_s},
+          {"candidates_s", candidates_s},
+          {"estimates_s", estimates_s},
+          {"greedy_s", greedy_s},
+          {"capture_s", capture_s},
+          {"write_s", write_s},
+          {"wall_s", wall_s}};
+}
+
+PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, const gpu::CostProfile& profile,
+                           const PlaceOptions& options, const std::string& out_dir) {
+  validate(options);
+  if (scene.objects.empty()) throw Error("place", "the scene has no objects");
+  Stopwatch wall;
+  PlaceReport report;
+  report.dir = out_dir;
+  context.makeCurrent();
+  const Box3 space = options.view_space.empty() ? defaultPlaceViewSpace(scene) : options.view_space;
+  if (space.empty() || !isFinite(space.lo) || !isFinite(space.hi)) throw Error("--view-min/--view-max", "empty view space");
+  const gpu::GpuScene gpu_scene(scene);
+  const scene::Bvh bvh(scene);
+  gpu::Renderer renderer;
+  const ErrorBound bound{options.error_px, options.width, options.height, degToRad(double(options.fov_deg))};
+  bound.validate("--error-px");
+  Lens lens;
+  lens.fov_y = float(degToRad(double(options.fov_deg)));
+  lens.aspect = float(options.width) / float(options.height);
+  lens.near_plane = options.near_plane;
+  lens.far_plane = options.far_plane;
+  const double pixels = double(options.width) * double(options.height);
+
+  // Per object: its triangles and draw calls (the GPU scene's clusters: what a frame draws for it, uncut).
+  std::vector<ObjectCost> cost(scene.objects.size() + 1);
+  {
+    std::vector<gpu::DrawItem> items;
+    for (const scene::Object& o : scene.objects) {
+      items.clear();
+      const uint32_t id = o.id;
+      gpu_scene.appendDrawItems(std::span<const uint32_t>(&id, 1), items);
+      for (const gpu::DrawItem& item : items) cost[id].triangles += item.triangleCount();
+      cost[id].draws = uint32_t(items.size());
+    }
+  }
+  const auto geometryMs = [&](uint64_t triangles, uint64_t draws) {
+    return (profile.model.ms_per_mtriangle * double(triangles) * 1e-6 + profile.model.ms_per_draw * double(draws)) *
+           profile.safety_factor;
+  };
+
+  // 1. The object hierarchy, without the objects too big to be a cluster's part.
+  const float widest = std::max(space.extent().x, space.extent().y) * options.max_object_share;
+  std::vector<placement::HierarchyItem> items;
+  for (const scene::Object& o : scene.objects) {
+    const Vec3 e = o.world_bounds.extent();
+    if (o.world_bounds.empty() || std::max(e.x, e.y) > widest) {
+      ++report.geometry_objects;
+      continue;
+    }
+    items.push_back({o.id, o.world_bounds, cost[o.id].triangles});
+  }
+  report.clustered_objects = items.size();
+  const placement::ObjectHierarchy hierarchy = placement::ObjectHierarchy::build(items, options.hierarchy);
+  report.hierarchy_nodes = hierarchy.nodes().size();
+
+  // 2. The problem view space.
+  Stopwatch step;
+  placement::ViewSpaceOptions vs_options;
+  vs_options.box = space;
+  vs_options.min_region_size = options.min_region_size;
+  vs_options.min_vdi_angle = float(degToRad(double(options.min_vdi_deg)));
+  vs_options.t_max = options.t_max_ms;
+  placement::ViewSpaceCallbacks callbacks;
+  std::vector<uint32_t> ids;
+  const double max_pitch = degToRad(double(options.max_pitch_deg));
+  callbacks.estimate = [&](const Box3& region, const Vdi& vdi, const std::vector<uint32_t>*) {
+    if (options.max_pitch_deg < 90.0f && minAbsPitch(vdi) > max_pitch) return 0.0;  // no view of the walkthrough
+    ids.clear();
+    bvh.queryFrustum(enclosingFrustum(region, vdi, lens), ids);
+    uint64_t triangles = 0, draws = 0;
+    for (uint32_t id : ids) {
+      triangles += cost[id].triangles;
+      draws += cost[id].draws;
+    }
+    return profile.boundMs(double(triangles), double(draws), pixels);
+  };
+  const placement::ViewSpace view_space = placement::approximateProblemViewSpace(vs_options, callbacks);
+  report.regions = view_space.counts.regions;
+  report.problem_regions = view_space.counts.problem_regions;
+  report.cpvs = view_space.cpvs.size();
+  report.estimates = view_space.counts.estimates;
+  for (const placement::Cpv& c : view_space.cpvs) report.t_enc_max_ms = std::max(report.t_enc_max_ms, c.t_enc);
+  report.view_space_s = step.seconds();
+  FF_INFO("place: " << report.regions << " regions visited, " << report.cpvs << " CPVs over t_max "
+                    << options.t_max_ms << " ms (slowest " << report.t_enc_max_ms << " ms) in "
+                    << report.view_space_s << " s");
+
+  // 3. Candidates and their layered plans.
+  step = Stopwatch();
+  placement::CandidateSet all = placement::generateCandidates(hierarchy, view_space, lens, options.candidates);
+  report.candidate_counts = all.counts;
+  placement::CandidateSet kept;
+  kept.counts = all.counts;
+  std::vector<impostor::LayeredPlan> plans;
+  for (placement::Candidate& c : all.candidates) {
+    const Shaft* shaft = std::get_if<Shaft>(&c.cell);
+    if (!shaft) {
+      ++report.candidates_unplannable;  // box cells need a shaft around them: not planned yet
+      continue;
+    }
+    try {
+      impostor::LayeredPlan plan = impostor::planLayered(hierarchy.nodes()[size_t(c.node)].bounds, *shaft, bound,
+                                                         options.layered);
+      if (!plan.keepsBound()) {
+        ++report.candidates_unplannable;
+        continue;
+      }
+      plans.push_back(std::move(plan));
+      kept.candidates.push_back(std::move(c));
+    } catch (const Error&) {
+      ++report.candidates_unplannable;  // the shaft does not clear the cluster
+    }
+  }
+  report.candidates_s = step.seconds();
+  FF_INFO("place: " << all.counts.considered << " candidates considered, " << all.counts.kept << " serve a CPV, "
+                    << kept.candidates.size() << " with a layered plan under " << options.error_px << " px ("
+                    << report.candidates_s << " s)");
+
+  // 4. Estimates and the greedy.
+  step = Stopwatch();
+  const std::vector<Frustum> frusta = placement::cpvFrusta(view_space, lens);
+  const placement::Candidate* first = kept.candidates.empty() ? nullptr : &kept.candidates.front();
+  placement::PlacementEstimates estimates;
+  estimates.t_object = [&](int node, uint32_t cpv) {
+    uint64_t triangles = 0, draws = 0;
+    for (uint32_t id : hierarchy.objects(node))
+      if (frusta[cpv].intersects(scene.objects[id - 1].world_bounds)) {
+        triangles += cost[id].triangles;
+        draws += cost[id].draws;
+      }
+    return geometryMs(triangles, draws);
+  };
+  estimates.t_impostor = [&](const placement::Candidate& c, uint32_t) {
+    const impostor::LayeredPlan& plan = plans[size_t(&c - first)];
+    return geometryMs(2 * uint64_t(plan.quads()), plan.quads());
+  };
+  estimates.memory = [&](const placement::Candidate& c) { return double(plans[size_t(&c - first)].bytes()); };
+  const placement::GreedyProblem problem = placement::makeGreedyProblem(view_space, hierarchy, kept, estimates);
+  report.estimates_s = step.seconds();
+
+  step = Stopwatch();
+  fs::create_directories(out_dir);
+  const uint64_t generation = store::nextPlacementGeneration(out_dir);
+  std::map<size_t, store::StoredPlacedImpostor> written;  // candidate -> record
+  double capture_s = 0.0;
+  const placement::GreedyResult result = placement::placeGreedy(problem, [&](size_t k) {
+    Stopwatch capture;
+    const placement::Candidate& c = kept.candidates[k];
+    std::vector<uint32_t> objects(hierarchy.objects(c.node).begin(), hierarchy.objects(c.node).end());
+    std::sort(objects.begin(), objects.end());
+    const impostor::LayeredImpostor imp = impostor::captureLayered(renderer, gpu_scene, objects, plans[k]);
+    written[k] = store::writePlacedImpostor(out_dir, generation, uint32_t(k), uint32_t(c.node), objects, imp,
+                                            hierarchy.nodes()[size_t(c.node)].bounds, std::get<Shaft>(c.cell), bound,
+                                            options.layered);
+    capture_s += capture.seconds();
+    ++report.impostors_generated;
+    if (options.progress && report.impostors_generated % 25 == 0)
+      FF_INFO("place: " << report.impostors_generated << " impostors generated");
+    return placement::GeneratedImpostor{double(plans[k].bytes()), {}};
+  });
+  report.greedy_s = step.seconds() - capture_s;
+  report.capture_s = capture_s;
+
+  // 5. The database: the kept impostors with their candidate numbers as ids.
+  step = Stopwatch();
+  store::PlacementIndex index;
+  index.generation = generation;
+  index.scene = options.scene_label;
+  index.scene_objects = scene.objects.size();
+  index.options = placeOptionsToJson(options);
+  index.view_space = space;
+  for (const placement::ViewSpaceNode& n : view_space.nodes) {
+    store::StoredViewSpaceNode s;
+    s.box = n.box;
+    s.children[0] = n.children[0];
+    s.children[1] = n.children[1];
+    s.cpv_first = n.cpv_first;
+    s.cpv_count = n.cpv_count;
+    index.nodes.push_back(s);
+  }
+  std::vector<size_t> kept_candidates;
+  for (const placement::ChosenImpostor& chosen : result.impostors) kept_candidates.push_back(chosen.candidate);
+  std::sort(kept_candidates.begin(), kept_candidates.end());  // the index lists ids ascending
+  for (size_t k : kept_candidates) index.impostors.push_back(written.at(k));
+  for (size_t c = 0; c < view_space.cpvs.size(); ++c) {
+    store::StoredCpv s;
+    s.region = view_space.cpvs[c].region;
+    s.vdi = view_space.cpvs[c].vdi;
+    s.t_enc = view_space.cpvs[c].t_enc;
+    s.t_after = result.cpv_times[c];
+    for (uint32_t i : result.cpv_impostors[c]) s.impostors.push_back(uint32_t(result.impostors[i].candidate));
+    std::sort(s.impostors.begin(), s.impostors.end());
+    report.t_after_max_ms = std::max(report.t_after_max_ms, s.t_after);
+    index.cpvs.push_back(std::move(s));
+  }
+  report.impostors = result.impostors.size();
+  report.impostors_freed = report.impostors_generated - report.impostors;
+  report.unsolved_cpvs = result.unsolved.size();
+  report.memory_bytes = result.memory;
+  index.summary = report.toJson();
+  store::writePlacementIndex(out_dir, index);
+  // writePlacementIndex removed the files of the impostors the greedy freed (no longer named by the index).
+  report.written_bytes = store::placementBytes(out_dir, index);
+  report.write_s = step.seconds();
+  report.wall_s = wall.seconds();
+  return report;
+}
+
+}  // namespace farfield::bake
+
+namespace farfield::bake {
+
+nlohmann::json placeOptionsToJson(const PlaceOptions& o) {
+  nlohmann::json space = nullptr;
+  if (!o.view_space.empty())
+    space = {{"lo", {o.view_space.lo.x, o.view_space.lo.y, o.view_space.lo.z}},
+             {"hi", {o.view_space.hi.x, o.view_space.hi.y, o.view_space.hi.z}}};
+  const placement::CandidateOptions& c = o.candidates;
+  const impostor::LayeredOptions& l = o.layered;
+  return {{"view_space", space},
+          {"t_max_ms", o.t_max_ms},
+          {"error_px", o.error_px},
+          {"width", o.width},
+          {"height", o.height},
+          {"fov_deg", o.fov_deg},
+          {"near_plane", o.near_plane},
+          {"far_plane", o.far_plane},
+          {"min_region_size", o.min_region_size},
+          {"min_vdi_deg", o.min_vdi_deg},
+          {"max_pitch_deg", o.max_pitch_deg},
+          {"max_object_share", o.max_object_share},
+          {"seed", o.seed},
+          {"hierarchy", {{"max_levels", o.hierarchy.max_levels},
+                         {"min_objects_to_split", o.hierarchy.min_objects_to_split}}},
+          {"candidates", {{"shafts", c.shafts},
+                          {"apex_angles", c.apex_angles},
+                          {"direction_step", c.direction_step},
+                          {"elevations", c.elevations},
+                          {"first_distance_factor", c.first_distance_factor},
+                          {"distance_steps", c.distance_steps},
+                          {"drop_identical", c.drop_identical},
+                          {"rectangular_cells", c.rectangular_cells}}},
+          {"layered", {{"texel_pixels", l.texel_pixels},
+                       {"max_texture_size", l.max_texture_size},
+                       {"max_layers", l.max_layers},
+                       {"layer_count", l.layer_count},
+                       {"bound_cracks", l.bound_cracks},
+                       {"id_textures", l.id_textures},
+                       {"solid_slices", l.solid_slices},
+                       {"dilate_texels", l.dilate_texels}}}};
+}
+
+PlaceOptions placeOptionsFromJson(const nlohmann::json& j, const std::string& source) {
+  StrictJson r(j, source, "placement option");
+  PlaceOptions o;
+  const nlohmann::json& space = r.at("view_space");
+  if (!space.is_null()) {
+    StrictJson s(space, source + ".view_space", "placement option");
+    std::vector<float> lo, hi;
+    s.numbers("lo", lo);
+    s.numbers("hi", hi);
+    s.rejectUnknown();
+    if (lo.size() != 3 || hi.size() != 3) throw Error(source + ".view_space", "lo and hi need three numbers each");
+    o.view_space = Box3::fromPoints(Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2]));
+  }
+  r.number("t_max_ms", o.t_max_ms);
+  r.number("error_px", o.error_px);
+  r.number("width", o.width);
+  r.number("height", o.height);
+  r.number("fov_deg", o.fov_deg);
+  r.number("near_plane", o.near_plane);
+  r.number("far_plane", o.far_plane);
+  r.number("min_region_size", o.min_region_size);
+  r.number("min_vdi_deg", o.min_vdi_deg);
+  r.number("max_pitch_deg", o.max_pitch_deg);
+  r.number("max_object_share", o.max_object_share);
+  r.number("seed", o.seed);
+  StrictJson h = r.object("hierarchy");
+  h.number("max_levels", o.hierarchy.max_levels);
+  h.number("min_objects_to_split", o.hierarchy.min_objects_to_split);
+  h.rejectUnknown();
+  StrictJson c = r.object("candidates");
+  o.candidates.shafts = c.boolean("shafts");
+  c.numbers("apex_angles", o.candidates.apex_angles);
+  c.number("direction_step", o.candidates.direction_step);
+  c.numbers("elevations", o.candidates.elevations);
+  c.number("first_distance_factor", o.candidates.first_distance_factor);
+  c.number("distance_steps", o.candidates.distance_steps);
+  o.candidates.drop_identical = c.boolean("drop_identical");
+  o.candidates.rectangular_cells = c.boolean("rectangular_cells");
+  c.rejectUnknown();
+  StrictJson l = r.object("layered");
+  l.number("texel_pixels", o.layered.texel_pixels);
+  l.number("max_texture_size", o.layered.max_texture_size);
+  l.number("max_layers", o.layered.max_layers);
+  l.number("layer_count", o.layered.layer_count);
+  o.layered.bound_cracks = l.boolean("bound_cracks");
+  o.layered.id_textures = l.boolean("id_textures");
+  o.layered.solid_slices = l.boolean("solid_slices");
+  l.number("dilate_texels", o.layered.dilate_texels);
+  l.rejectUnknown();
+  r.rejectUnknown();
+  validate(o);
+  return o;
+}
+
+}  // namespace farfield::bake

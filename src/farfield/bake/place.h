@@ -1,0 +1,91 @@
+// `farfield place`: automatic impostor placement with a frame-time guarantee (Jeschke et al. 2005), the driver that
+// runs the placement module over a scene's view space and writes a placement database (store/placement_store.h):
+//
+//   1. object hierarchy: a 9-level median-split BVH over the scene's objects (placement/object_hierarchy.h); objects
+//      larger than the view space allows as a cluster (the ground) stay geometry;
+//   2. problem view space: the view-space box split to `min_region_size`, view directions to `min_vdi_deg`; a view's
+//      time is bounded by the cost profile (gpu/cost_profile.h) over the objects that meet the enclosing frustum of
+//      its region and direction interval (placement/view_space.h);
+//   3. candidates: hierarchy node x shaft view cells (placement/candidates.h), each with a layered impostor planned
+//      under the error bound (impostor/layered.h): its memory and draw cost before it is built; a candidate whose plan
+//      cannot keep the bound is dropped;
+//   4. greedy selection with lazy recalculation (placement/greedy.h); each chosen candidate is captured on the GPU and
+//      written at once; impostors the greedy frees are deleted at the end.
+//
+// Times are milliseconds of the cost profile's machine; memory is the impostors' GPU bytes (textures and quads).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "farfield/core/bounds.h"
+#include "farfield/core/error_bound.h"
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/cost_profile.h"
+#include "farfield/impostor/layered.h"
+#include "farfield/placement/candidates.h"
+#include "farfield/placement/object_hierarchy.h"
+#include "farfield/scene/scene.h"
+
+namespace farfield::bake {
+
+struct PlaceOptions {
+  Box3 view_space;                  // empty: the scene's bounds in x and y at eye heights 1.2 .. 1.7 m above its floor
+  double t_max_ms = 20.0;           // the frame budget, > 0
+  // The error bound in the walkthrough's frames (Jeschke et al. 2005: 1 px at 512 x 512, 45 degrees).
+  double error_px = 1.0;
+  int width = 512;
+  int height = 512;
+  float fov_deg = 45.0f;
+  float near_plane = 0.5f;
+  float far_plane = 20000.0f;
+  float min_region_size = 23.0f;    // metres (the paper's CPV size)
+  float min_vdi_deg = 11.25f;       // degrees
+  // Views pitched more than this above or below the horizon are left out of the problem view space (no CPV holds
+  // them; a walkthrough that looks that far up or down draws full geometry there, unguarded). 90: every direction,
+  // as the paper. Street-level walkthroughs look within a few degrees of the horizon.
+  float max_pitch_deg = 90.0f;
+  placement::HierarchyOptions hierarchy;
+  placement::CandidateOptions candidates;
+  impostor::LayeredOptions layered;
+  // An object whose bounds are wider (x or y) than this share of the view space's larger side is never clustered
+  // into an impostor (the ground of a city); it stays geometry in every view.
+  float max_object_share = 0.5f;
+  bool progress = true;
+  std::string scene_label;          // recorded in the database
+  uint32_t seed = 0;                // reserved for sampling; recorded
+};
+
+struct PlaceReport {
+  size_t regions = 0, problem_regions = 0, cpvs = 0, estimates = 0;
+  size_t hierarchy_nodes = 0, clustered_objects = 0, geometry_objects = 0;
+  placement::CandidateCounts candidate_counts;
+  size_t candidates_unplannable = 0;  // dropped: no layered plan keeps the bound from the cell
+  size_t impostors = 0, impostors_generated = 0, impostors_freed = 0;
+  size_t unsolved_cpvs = 0;
+  double memory_bytes = 0.0;        // kept impostors, GPU bytes
+  uint64_t written_bytes = 0;       // files of the database
+  double t_enc_max_ms = 0.0;        // the slowest CPV before placement
+  double t_after_max_ms = 0.0;      // ... and after
+  double view_space_s = 0.0, candidates_s = 0.0, estimates_s = 0.0, greedy_s = 0.0, capture_s = 0.0, write_s = 0.0;
+  double wall_s = 0.0;
+  std::string dir;
+  nlohmann::json toJson() const;
+};
+
+// Places impostors for `scene` and writes the database into `out_dir` (created; replaced atomically). Makes `context`
+// current. Throws farfield::Error for bad options, an empty scene or an unwritable directory.
+PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, const gpu::CostProfile& profile,
+                           const PlaceOptions& options, const std::string& out_dir);
+
+// Options as saved in the database (whole) and back (strict: a missing or unknown key is an error naming `source`).
+nlohmann::json placeOptionsToJson(const PlaceOptions& options);
+PlaceOptions placeOptionsFromJson(const nlohmann::json& json, const std::string& source);
+
+// The default view space of a scene: its bounds in x and y, 1.2 .. 1.7 m above the lowest point (car and pedestrian
+// eyes over flat ground).
+Box3 defaultPlaceViewSpace(const scene::Scene& scene);
+
+}  // namespace farfield::bake

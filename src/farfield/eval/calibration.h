@@ -1,0 +1,72 @@
+// `farfield calibrate`: the rendering-time estimation of Jeschke et al. 2005 (section 3.2, after Wimmer and Wonka
+// 2003) fitted on the running machine and validated. The cost model (gpu/cost_model.h) is fitted on `fit_views`
+// random views of the view space, then checked on `views` other ones: each view's frustum-culled geometry is drawn
+// and timed (minimum of `repeats` renders, to remove the machine's noise) and compared with the prediction from its
+// triangles, draw calls and pixels. The distribution of measured / predicted gives the profile's safety factor
+// (the quantile `margin_quantile` of the ratios, 1 = the largest seen), so that prediction * factor bounds the
+// measured time of (that share of) the validation views.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "farfield/core/bounds.h"
+#include "farfield/core/camera.h"
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/cost_profile.h"
+#include "farfield/scene/scene.h"
+
+namespace farfield::eval {
+
+struct CalibrateOptions {
+  int width = 512;             // the walkthrough's frames (Jeschke et al. 2005: 512 x 512, 45 degrees)
+  int height = 512;
+  float fov_deg = 45.0f;
+  Box3 view_space;             // eyes are drawn uniformly from it; empty: the scene's bounds at 1.7 m above its floor
+  size_t views = 500;          // validation views (the issue asks for at least 500)
+  size_t fit_views = 100;      // random views of the view space the model is fitted on (other than the validation's)
+  int repeats = 3;             // renders per validation view, the minimum kept
+  double margin_quantile = 1.0;  // safety factor = this quantile of measured / predicted (1 = the maximum)
+  uint32_t seed = 1;
+  float near_plane = 0.5f;
+  float far_plane = 20000.0f;
+  bool progress = true;
+};
+
+struct ViewCheck {
+  Camera camera;
+  uint64_t triangles = 0;
+  size_t draw_calls = 0;
+  double predicted_ms = 0.0;
+  double measured_ms = 0.0;  // minimum of the repeats
+};
+
+struct CalibrateResult {
+  gpu::CostProfile profile;
+  std::vector<ViewCheck> checks;
+  // Quantiles of measured / predicted over the validation views, and of |measured - predicted| in ms.
+  double ratio_p50 = 0.0, ratio_p95 = 0.0, ratio_p99 = 0.0, ratio_max = 0.0;
+  double abs_error_p50_ms = 0.0, abs_error_p95_ms = 0.0, abs_error_max_ms = 0.0;
+  size_t under_predicted = 0;  // views slower than predicted (before the safety factor)
+  size_t over_bound = 0;       // views slower than predicted * safety factor
+  double wall_s = 0.0;
+};
+
+// The validation cameras: eyes uniform in the view space, yaw uniform, pitch within +-10 degrees. Deterministic in
+// the seed.
+std::vector<Camera> randomViews(const Box3& view_space, size_t count, uint32_t seed, int width, int height,
+                                float fov_deg, float near_plane, float far_plane);
+
+// The scene's default view space: its bounds in x and y, at 1.7 m above the lowest point of its bounds (a
+// pedestrian over flat ground), 0.01 m thick.
+Box3 defaultViewSpace(const scene::Scene& scene);
+
+// Fits and validates. Makes `context` current. Throws farfield::Error for bad options (fewer than 8 views, repeats
+// < 1, quantile outside (0, 1], an empty scene, a view space that is not finite).
+CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, const CalibrateOptions& options);
+
+// view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,predicted_ms,measured_ms
+void writeCalibrationCsv(const CalibrateResult& result, const std::string& path);
+
+}  // namespace farfield::eval

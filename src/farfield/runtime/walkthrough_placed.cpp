@@ -1,0 +1,154 @@
+// Walkthrough over a placement database (Representation::Placed; Jeschke et al. 2005, section 5: "In the runtime
+// system, the current CPV (if applicable) is looked up, and all impostors associated with this CPV are rendered instead
+// of the original scene parts"). The impostors are read and uploaded when a CPV first needs them and stay resident
+// under WalkthroughOptions::gpu_budget_bytes, least recently used evicted first.
+#include <algorithm>
+#include <cmath>
+#include <list>
+#include <unordered_map>
+
+#include "farfield/core/error.h"
+#include "farfield/core/error_bound.h"
+#include "farfield/core/timer.h"
+#include "farfield/impostor/layered.h"
+#include "farfield/runtime/walkthrough_placed.h"
+#include "farfield/store/placement_store.h"
+
+namespace farfield::runtime {
+
+void Walkthrough::openPlacement() {
+  placed_ = std::make_unique<Placed>();
+  Placed& p = *placed_;
+  p.index = store::readPlacementIndex(options_.database);
+  const std::string source = options_.database + "/" + store::kPlacementIndexFile;
+  if (p.index.scene_objects != scene_.objects.size())
+    throw Error(source, "was placed for a scene of " + std::to_string(p.index.scene_objects) +
+                            " objects, this one has " + std::to_string(scene_.objects.size()));
+  if (options_.error_px <= 0.0) {
+    const nlohmann::json& o = p.index.options;
+    if (!o.contains("error_px") || !o["error_px"].is_number())
+      throw Error(source, "options.error_px is missing: give the walkthrough an error bound");
+    options_.error_px = o["error_px"].get<double>();
+  }
+  p.hidden.assign(scene_.objects.size() + 1, 0);
+  p.object_triangles.assign(scene_.objects.size() + 1, 0);
+  for (const scene::Object& o : scene_.objects)
+    for (const scene::Part& part : o.parts) p.object_triangles[o.id] += scene_.meshes[part.mesh].triangleCount();
+}
+
+const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
+  Placed& p = *placed_;
+  FramePlan& plan = plan_;
+  plan.items.clear();
+  plan.layers.clear();
+  plan.report = {};
+  FrameReport& report = plan.report;
+  ++p.stats.frames;
+  const ErrorBound bound = ErrorBound::forCamera(options_.error_px, camera);
+  report.bound_px = options_.error_px;
+  report.bound_rad = bound.angle();
+  ids_.clear();
+  bvh_.queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
+  std::sort(ids_.begin(), ids_.end());
+
+  const std::optional<uint32_t> cpv = store::lookupCpv(p.index, camera.eye, camera.forward());
+  std::vector<uint32_t> drawn;  // impostor ids drawn this frame
+  if (cpv) {
+    ++p.stats.cpv_frames;
+    const store::StoredCpv& c = p.index.cpvs[*cpv];
+    report.cpv = *cpv;
+    report.cpv_t_after_ms = c.t_after;
+    for (uint32_t id : c.impostors) {
+      const store::StoredPlacedImpostor& record = *p.index.find(id);
+      auto it = p.resident.find(id);
+      if (it == p.resident.end()) {
+        Stopwatch timer;
+        const impostor::LayeredImpostor imp = store::loadPlacedImpostor(options_.database, record);
+        Placed::Resident r;
+        r.gpu = std::make_unique<impostor::GpuLayeredImpostor>(imp);
+        r.error_rad = imp.plan.error_angle;
+        r.bytes = r.gpu->gpuBytes();
+        p.resident_bytes += r.bytes;
+        it = p.resident.emplace(id, std::move(r)).first;
+        p.lru.push_front(id);
+        report.loaded = true;
+        ++p.stats.loads;
+        const double ms = timer.milliseconds();
+        p.stats.load_ms_total += ms;
+        p.stats.load_ms_max = std::max(p.stats.load_ms_max, ms);
+      } else {
+        p.lru.remove(id);
+        p.lru.push_front(id);
+      }
+      // The impostor keeps this frame's bound where the eye is in its shaft and its plan's error fits the frame's
+      // pixel (a camera narrower or larger than the placement's frames has smaller pixels).
+      const double theta = bound.angleWithin(frameRadius(camera, record.box));
+      if (record.shaft.contains(camera.eye) && it->second.error_rad <= theta) {
+        plan.layers.push_back(ClusterAsImpostor{id, uint32_t(record.objects.size()), it->second.error_rad, theta});
+        for (uint32_t o : record.objects) p.hidden[o] = 1;
+        drawn.push_back(id);
+      } else {
+        ClusterAsGeometry g{id, 0};
+        for (uint32_t o : record.objects)
+          if (std::binary_search(ids_.begin(), ids_.end(), o)) g.triangles += p.object_triangles[o];
+        plan.layers.push_back(g);
+        ++report.layers_as_geometry;
+        ++p.stats.geometry_fallbacks;
+      }
+    }
+  }
+  // Geometry: every object in the frustum that no impostor of this frame stands for.
+  ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [&](uint32_t id) { return p.hidden[id] != 0; }), ids_.end());
+  if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera);
+  for (const gpu::DrawItem& item : plan.items) report.geometry_triangles += item.triangleCount();
+  for (uint32_t id : drawn) {
+    const Placed::Resident& r = p.resident.at(id);
+    r.gpu->appendDrawItems(plan.items);
+    report.impostor_triangles += 2u * r.gpu->quads();
+    p.stats.impostor_quads += double(r.gpu->quads());
+    ++p.stats.impostor_draws;
+    for (uint32_t o : p.index.find(id)->objects) p.hidden[o] = 0;
+  }
+  p.stats.geometry_triangles += double(report.geometry_triangles);
+
+  // Residency: least recently used impostors leave the GPU beyond the budget (never one drawn this frame).
+  while (p.resident_bytes > options_.gpu_budget_bytes && !p.lru.empty()) {
+    const uint32_t victim = p.lru.back();
+    if (std::find(drawn.begin(), drawn.end(), victim) != drawn.end()) break;
+    p.resident_bytes -= p.resident.at(victim).bytes;
+    p.resident.erase(victim);
+    p.lru.pop_back();
+    ++p.stats.evictions;
+  }
+  report.resident_bytes = p.resident_bytes;
+  report.over_gpu_budget = p.resident_bytes > options_.gpu_budget_bytes;
+  if (report.over_gpu_budget) ++p.stats.over_gpu_budget_frames;
+  p.stats.resident_bytes_max = std::max(p.stats.resident_bytes_max, p.resident_bytes);
+  return plan;
+}
+
+std::map<std::string, double> Walkthrough::placedStatistics() const {
+  const Placed& p = *placed_;
+  const auto& s = p.stats;
+  const double n = s.frames ? double(s.frames) : 1.0;
+  std::map<std::string, double> out;
+  out["frames"] = double(s.frames);
+  out["cpv_frames"] = double(s.cpv_frames);
+  out["cpvs"] = double(p.index.cpvs.size());
+  out["impostors_in_database"] = double(p.index.impostors.size());
+  out["impostor_draws"] = double(s.impostor_draws);
+  out["mean_impostor_quads"] = s.impostor_quads / n;
+  out["mean_geometry_triangles"] = s.geometry_triangles / n;
+  out["impostors_drawn_as_geometry"] = double(s.geometry_fallbacks);
+  out["impostor_loads"] = double(s.loads);
+  out["impostor_load_ms_mean"] = s.loads ? s.load_ms_total / double(s.loads) : 0.0;
+  out["impostor_load_ms_max"] = s.load_ms_max;
+  out["cache_evictions"] = double(s.evictions);
+  out["gpu_budget_bytes"] = double(options_.gpu_budget_bytes);
+  out["resident_bytes_max"] = double(s.resident_bytes_max);
+  out["frames_over_gpu_budget"] = double(s.over_gpu_budget_frames);
+  out["error_bound_px"] = options_.error_px;
+  return out;
+}
+
+}  // namespace farfield::runtime

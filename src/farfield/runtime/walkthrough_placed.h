@@ -1,0 +1,36 @@
+// The state of a walkthrough over a placement database (Representation::Placed), shared by walkthrough.cpp (which
+// owns it) and walkthrough_placed.cpp (which uses it). Internal to the runtime module.
+#pragma once
+
+#include <list>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "farfield/impostor/layered.h"
+#include "farfield/runtime/walkthrough.h"
+#include "farfield/store/placement_store.h"
+
+namespace farfield::runtime {
+
+struct Walkthrough::Placed {
+  struct Resident {
+    std::unique_ptr<impostor::GpuLayeredImpostor> gpu;
+    double error_rad = 0.0;  // the plan's parallax bound from its shaft
+    uint64_t bytes = 0;
+  };
+  store::PlacementIndex index;
+  std::unordered_map<uint32_t, Resident> resident;  // by impostor id
+  std::list<uint32_t> lru;                          // most recent first
+  uint64_t resident_bytes = 0;
+  std::vector<uint8_t> hidden;                      // per object id: drawn by an impostor this frame
+  std::vector<uint64_t> object_triangles;
+  struct {
+    size_t frames = 0, cpv_frames = 0, impostor_draws = 0, geometry_fallbacks = 0, loads = 0, evictions = 0;
+    double load_ms_total = 0.0, load_ms_max = 0.0, geometry_triangles = 0.0, impostor_quads = 0.0;
+    uint64_t resident_bytes_max = 0;
+    size_t over_gpu_budget_frames = 0;
+  } stats;
+};
+
+}  // namespace farfield::runtime
