@@ -22,6 +22,7 @@ struct PlaceArgs {
   std::string size = "512x512";
   std::string view_min, view_max;
   int distance_steps = 11;
+  double texel_px = 0.0;
   bake::PlaceOptions options;
 };
 
@@ -37,6 +38,8 @@ void runPlaceCommand(PlaceArgs& args) {
   if (args.distance_steps < 1) throw Error("--distance-steps", "must be at least 1");
   o.candidates.distance_steps = args.distance_steps;
   o.scene_label = args.scene;
+  if (args.texel_px < 0.0) throw Error("--texel-px", "must be 0 (the error bound) or a positive number of pixels");
+  o.layered.texel_pixels = args.texel_px > 0.0 ? args.texel_px : o.error_px;
   const gpu::CostProfile profile = gpu::loadCostProfile(args.profile);
   const scene::Scene scene = scene::loadScene(args.scene);
   const bake::PlaceReport r = bake::placeImpostors(gpu::sharedHeadlessContext(), scene, profile, o, args.out);
@@ -45,12 +48,16 @@ void runPlaceCommand(PlaceArgs& args) {
   std::printf("promises:         t_max %.2f ms, error %.2f px at %dx%d, %.1f deg (profile %s, safety factor %.3f)\n",
               o.t_max_ms, o.error_px, o.width, o.height, double(o.fov_deg), args.profile.c_str(),
               profile.safety_factor);
+  if (o.visibility)
+    std::printf("visibility:       %zu regions sampled from %zu points, %.1f objects seen per region, %.1f s\n",
+                r.visibility_regions, r.visibility_points, r.mean_visible_objects, r.visibility_s);
   std::printf("view space:       %zu regions visited, %zu with problem views, %zu CPVs (%zu estimates), %.1f s\n",
               r.regions, r.problem_regions, r.cpvs, r.estimates, r.view_space_s);
   std::printf("candidates:       %zu considered, %zu intersecting, %zu serving no CPV, %zu identical, %zu kept, "
-              "%zu without a plan under the bound, %.1f s\n",
+              "%zu without a plan under the bound, %zu CPV serves dropped, %.1f s\n",
               r.candidate_counts.considered, r.candidate_counts.intersecting, r.candidate_counts.no_cpv,
-              r.candidate_counts.identical, r.candidate_counts.kept, r.candidates_unplannable, r.candidates_s);
+              r.candidate_counts.identical, r.candidate_counts.kept, r.candidates_unplannable, r.serves_dropped,
+              r.candidates_s);
   std::printf("greedy:           %zu generated, %zu kept, %zu freed; %.1f s choosing, %.1f s capturing\n",
               r.impostors_generated, r.impostors, r.impostors_freed, r.greedy_s, r.capture_s);
   std::printf("CPVs:             slowest %.2f ms before, %.2f ms after; %zu unsolved (still over t_max)\n",
@@ -80,11 +87,17 @@ const RegisterCommand reg("place", [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-pitch", o.max_pitch_deg, "Views pitched further from the horizon are not guarded, degrees "
                                                   "(90: all)")->capture_default_str();
+  cmd->add_flag("!--no-visibility", o.visibility, "Count every object in a view's frustum (no from-region "
+                                                 "visibility)");
+  cmd->add_option("--visibility-face", o.visibility_face, "Item-buffer face size of the visibility samples, pixels")
+      ->capture_default_str();
   cmd->add_option("--levels", o.hierarchy.max_levels, "Levels of the object hierarchy")->capture_default_str();
   cmd->add_option("--distance-steps", args->distance_steps, "Shaft minimum distances per axis (1, 2, 4, ... times "
                                                              "the cluster size)")->capture_default_str();
   cmd->add_option("--max-texture", o.layered.max_texture_size, "Largest layer texture side, texels")
       ->capture_default_str();
+  cmd->add_option("--texel-px", args->texel_px, "Impostor texel size in pixels of the frames at the nearest "
+                                                 "viewpoint (0: the error bound)")->capture_default_str();
   cmd->add_flag("--bound-cracks", o.layered.bound_cracks, "Halve layer spacing so cracks also stay under the bound");
   cmd->callback([args] { runPlaceCommand(*args); });
 });

@@ -164,6 +164,15 @@ void buildBsp(std::mt19937& rng, PlacementIndex& index, int node, int depth, con
     buildBsp(rng, index, index.nodes[size_t(node)].children[0], depth - 1, ids);
     buildBsp(rng, index, index.nodes[size_t(node)].children[1], depth - 1, ids);
   } else {
+    // A leaf: sometimes its visible set.
+    if (rng() % 2 == 0) {
+      StoredViewSpaceNode& leaf = index.nodes[size_t(node)];
+      leaf.has_visible = true;
+      std::set<uint32_t> seen;
+      for (uint32_t id = 1; id <= index.scene_objects; ++id)
+        if (rng() % 2 == 0) seen.insert(id);
+      leaf.visible.assign(seen.begin(), seen.end());
+    }
     const int level = int(rng() % 3);
     const uint32_t cells = 6u << (2 * level);
     std::set<uint32_t> chosen;
@@ -189,7 +198,7 @@ void randomViewSpace(std::mt19937& rng, PlacementIndex& index, int depth, const 
   const auto u = [&](double lo, double hi) { return float(std::uniform_real_distribution<double>(lo, hi)(rng)); };
   const Vec3 lo(u(-300, -100), u(-300, -100), u(0.5, 2));
   index.view_space = Box3::fromPoints(lo, lo + Vec3(u(100, 400), u(100, 400), u(5, 40)));
-  index.nodes = {StoredViewSpaceNode{index.view_space, {-1, -1}, 0, 0}};
+  index.nodes = {StoredViewSpaceNode{index.view_space, {-1, -1}, 0, 0, false, {}}};
   index.cpvs.clear();
   buildBsp(rng, index, 0, depth, ids);
 }
@@ -287,6 +296,8 @@ void expectSameIndex(const PlacementIndex& got, const PlacementIndex& want) {
     EXPECT_EQ(a.children[1], b.children[1]) << "node " << k;
     EXPECT_EQ(a.cpv_first, b.cpv_first) << "node " << k;
     EXPECT_EQ(a.cpv_count, b.cpv_count) << "node " << k;
+    EXPECT_EQ(a.has_visible, b.has_visible) << "node " << k;
+    EXPECT_EQ(a.visible, b.visible) << "node " << k;
   }
   ASSERT_EQ(got.cpvs.size(), want.cpvs.size());
   for (size_t k = 0; k < got.cpvs.size(); ++k) {
@@ -533,6 +544,15 @@ TEST(PlacementStoreTest, LookupCpvAgreesWithABruteForceScan) {
       }
       const std::optional<uint32_t> got = lookupCpv(index, eye, dir);
       ++views;
+      // The leaf holding the eye: a leaf whose box holds it (brute force over the nodes), none outside the space.
+      const std::optional<uint32_t> leaf = lookupLeaf(index, eye);
+      bool in_some_leaf = false;
+      for (const StoredViewSpaceNode& n : index.nodes) in_some_leaf |= n.children[0] < 0 && n.box.contains(eye);
+      EXPECT_EQ(leaf.has_value(), in_some_leaf) << "seed " << seed << " view " << k;
+      if (leaf) {
+        EXPECT_LT(index.nodes[*leaf].children[0], 0);
+        EXPECT_TRUE(index.nodes[*leaf].box.contains(eye));
+      }
       if (holding.empty()) {
         EXPECT_FALSE(got.has_value()) << "seed " << seed << " view " << k << ": found " << *got;
         continue;
@@ -694,8 +714,9 @@ TEST(PlacementStoreIntegrityTest, DamagedIndexGivesErrorsNamingTheElement) {
   const Box3 right = Box3::fromPoints(Vec3(50.0f, 0.0f, 0.0f), Vec3(100.0f, 50.0f, 10.0f));
   const Box3 right_lo = Box3::fromPoints(Vec3(50.0f, 0.0f, 0.0f), Vec3(100.0f, 25.0f, 10.0f));
   const Box3 right_hi = Box3::fromPoints(Vec3(50.0f, 25.0f, 0.0f), Vec3(100.0f, 50.0f, 10.0f));
-  v.nodes = {{v.view_space, {1, 2}, 0, 5}, {left, {-1, -1}, 0, 2}, {right, {3, 4}, 2, 3},
-             {right_lo, {-1, -1}, 2, 1}, {right_hi, {-1, -1}, 3, 2}};
+  v.nodes = {{v.view_space, {1, 2}, 0, 5, false, {}}, {left, {-1, -1}, 0, 2, false, {}},
+             {right, {3, 4}, 2, 3, false, {}}, {right_lo, {-1, -1}, 2, 1, false, {}},
+             {right_hi, {-1, -1}, 3, 2, false, {}}};
   const auto cpv = [](const Box3& region, int face, std::vector<uint32_t> imps) {
     return StoredCpv{region, Vdi::fullFace(face), 20.5, 12.25, std::move(imps)};
   };

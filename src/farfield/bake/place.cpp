@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <array>
 #include <map>
+#include <unordered_map>
 #include <set>
 
 #include "farfield/core/enclosing_frustum.h"
@@ -19,6 +21,7 @@
 #include "farfield/placement/view_space.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/store/placement_store.h"
+#include "farfield/urban/pvs.h"
 
 namespace fs = std::filesystem;
 
@@ -78,6 +81,11 @@ nlohmann::json PlaceReport::toJson() const {
           {"cpvs", cpvs},
           {"estimates", estimates},
           {"hierarchy_nodes", hierarchy_nodes},
+          {"visibility_regions", visibility_regions},
+          {"visibility_points", visibility_points},
+          {"mean_visible_objects", mean_visible_objects},
+          {"visibility_s", visibility_s},
+          {"serves_dropped", serves_dropped},
           {"clustered_objects", clustered_objects},
           {"geometry_objects", geometry_objects},
           {"candidates_considered", candidate_counts.considered},
@@ -166,13 +174,60 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   vs_options.t_max = options.t_max_ms;
   placement::ViewSpaceCallbacks callbacks;
   std::vector<uint32_t> ids;
+  // From-region visibility of the minimum-size regions, by their lower corner; sample points shared by neighbouring
+  // regions are rendered once.
+  std::unique_ptr<urban::PvsSampler> sampler;
+  std::map<std::array<float, 3>, std::vector<uint32_t>> region_visible;
+  std::map<std::array<float, 3>, std::vector<uint32_t>> point_visible;
+  const auto isLeafSized = [&](const Box3& region) {
+    const Vec3 e = region.extent();
+    return std::max({e.x, e.y, e.z}) <= options.min_region_size;
+  };
+  if (options.visibility) {
+    urban::PvsOptions pvs;
+    pvs.face_size = options.visibility_face;
+    pvs.far_plane = options.far_plane;
+    sampler = std::make_unique<urban::PvsSampler>(gpu_scene, pvs);
+    callbacks.visible_set = [&](const Box3& region) -> std::vector<uint32_t> {
+      if (!isLeafSized(region)) return {};  // big regions: every object counts (conservative)
+      Stopwatch timer;
+      const float z = 0.5f * (region.lo.z + region.hi.z);
+      std::vector<uint8_t> seen;
+      for (const Vec3& p : {Vec3(region.lo.x, region.lo.y, z), Vec3(region.hi.x, region.lo.y, z),
+                            Vec3(region.lo.x, region.hi.y, z), Vec3(region.hi.x, region.hi.y, z),
+                            Vec3(region.center().x, region.center().y, z)}) {
+        auto [it, fresh] = point_visible.try_emplace({p.x, p.y, p.z});
+        if (fresh) {
+          std::vector<uint8_t> here;
+          sampler->sampleViewpoint(p, here);
+          for (size_t id = 1; id < here.size(); ++id)
+            if (here[id]) it->second.push_back(uint32_t(id));
+          ++report.visibility_points;
+        }
+        for (uint32_t id : it->second) {
+          if (seen.size() <= id) seen.resize(id + 1, 0);
+          seen[id] = 1;
+        }
+      }
+      std::vector<uint32_t> out;
+      for (size_t id = 1; id < seen.size(); ++id)
+        if (seen[id]) out.push_back(uint32_t(id));
+      ++report.visibility_regions;
+      report.mean_visible_objects += double(out.size());
+      report.visibility_s += timer.seconds();
+      region_visible[{region.lo.x, region.lo.y, region.lo.z}] = out;
+      return out;
+    };
+  }
   const double max_pitch = degToRad(double(options.max_pitch_deg));
-  callbacks.estimate = [&](const Box3& region, const Vdi& vdi, const std::vector<uint32_t>*) {
+  callbacks.estimate = [&](const Box3& region, const Vdi& vdi, const std::vector<uint32_t>* visible) {
     if (options.max_pitch_deg < 90.0f && minAbsPitch(vdi) > max_pitch) return 0.0;  // no view of the walkthrough
     ids.clear();
     bvh.queryFrustum(enclosingFrustum(region, vdi, lens), ids);
+    const bool culled = visible && !visible->empty();
     uint64_t triangles = 0, draws = 0;
     for (uint32_t id : ids) {
+      if (culled && !std::binary_search(visible->begin(), visible->end(), id)) continue;
       triangles += cost[id].triangles;
       draws += cost[id].draws;
     }
@@ -185,6 +240,11 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   report.estimates = view_space.counts.estimates;
   for (const placement::Cpv& c : view_space.cpvs) report.t_enc_max_ms = std::max(report.t_enc_max_ms, c.t_enc);
   report.view_space_s = step.seconds();
+  if (report.visibility_regions) report.mean_visible_objects /= double(report.visibility_regions);
+  const auto visibleFrom = [&](const Box3& region) -> const std::vector<uint32_t>* {
+    const auto it = region_visible.find({region.lo.x, region.lo.y, region.lo.z});
+    return it == region_visible.end() || it->second.empty() ? nullptr : &it->second;
+  };
   FF_INFO("place: " << report.regions << " regions visited, " << report.cpvs << " CPVs over t_max "
                     << options.t_max_ms << " ms (slowest " << report.t_enc_max_ms << " ms) in "
                     << report.view_space_s << " s");
@@ -223,21 +283,50 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   // 4. Estimates and the greedy.
   step = Stopwatch();
   const std::vector<Frustum> frusta = placement::cpvFrusta(view_space, lens);
-  const placement::Candidate* first = kept.candidates.empty() ? nullptr : &kept.candidates.front();
+  const placement::Candidate* first = nullptr;
   placement::PlacementEstimates estimates;
-  estimates.t_object = [&](int node, uint32_t cpv) {
+  std::unordered_map<uint64_t, double> t_object_memo;
+  const auto tObject = [&](int node, uint32_t cpv) {
+    const uint64_t key = (uint64_t(uint32_t(node)) << 32) | cpv;
+    const auto it = t_object_memo.find(key);
+    if (it != t_object_memo.end()) return it->second;
+    const std::vector<uint32_t>* visible = visibleFrom(view_space.cpvs[cpv].region);
     uint64_t triangles = 0, draws = 0;
     for (uint32_t id : hierarchy.objects(node))
-      if (frusta[cpv].intersects(scene.objects[id - 1].world_bounds)) {
+      if ((!visible || std::binary_search(visible->begin(), visible->end(), id)) &&
+          frusta[cpv].intersects(scene.objects[id - 1].world_bounds)) {
         triangles += cost[id].triangles;
         draws += cost[id].draws;
       }
-    return geometryMs(triangles, draws);
+    return t_object_memo[key] = geometryMs(triangles, draws);
   };
-  estimates.t_impostor = [&](const placement::Candidate& c, uint32_t) {
-    const impostor::LayeredPlan& plan = plans[size_t(&c - first)];
-    return geometryMs(2 * uint64_t(plan.quads()), plan.quads());
+  const auto tImpostor = [&](size_t k) {
+    return geometryMs(2 * uint64_t(plans[k].quads()), plans[k].draws());
   };
+  // A CPV where the node's visible geometry costs no more than its impostor gains nothing from it: dropped before the
+  // greedy (keeps its input small).
+  for (size_t k = 0; k < kept.candidates.size(); ++k) {
+    placement::Candidate& c = kept.candidates[k];
+    const size_t before = c.cpvs.size();
+    c.cpvs.erase(std::remove_if(c.cpvs.begin(), c.cpvs.end(),
+                                [&](uint32_t cpv) { return tObject(c.node, cpv) <= tImpostor(k); }),
+                 c.cpvs.end());
+    report.serves_dropped += before - c.cpvs.size();
+  }
+  {
+    std::vector<placement::Candidate> useful;
+    std::vector<impostor::LayeredPlan> useful_plans;
+    for (size_t k = 0; k < kept.candidates.size(); ++k)
+      if (!kept.candidates[k].cpvs.empty()) {
+        useful.push_back(std::move(kept.candidates[k]));
+        useful_plans.push_back(std::move(plans[k]));
+      }
+    kept.candidates = std::move(useful);
+    plans = std::move(useful_plans);
+  }
+  first = kept.candidates.empty() ? nullptr : &kept.candidates.front();
+  estimates.t_object = tObject;
+  estimates.t_impostor = [&](const placement::Candidate& c, uint32_t) { return tImpostor(size_t(&c - first)); };
   estimates.memory = [&](const placement::Candidate& c) { return double(plans[size_t(&c - first)].bytes()); };
   const placement::GreedyProblem problem = placement::makeGreedyProblem(view_space, hierarchy, kept, estimates);
   report.estimates_s = step.seconds();
@@ -280,6 +369,13 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     s.children[1] = n.children[1];
     s.cpv_first = n.cpv_first;
     s.cpv_count = n.cpv_count;
+    if (n.children[0] < 0) {
+      const auto it = region_visible.find({n.box.lo.x, n.box.lo.y, n.box.lo.z});
+      if (it != region_visible.end() && !it->second.empty()) {
+        s.has_visible = true;
+        s.visible = it->second;
+      }
+    }
     index.nodes.push_back(s);
   }
   std::vector<size_t> kept_candidates;
@@ -333,6 +429,8 @@ nlohmann::json placeOptionsToJson(const PlaceOptions& o) {
           {"min_vdi_deg", o.min_vdi_deg},
           {"max_pitch_deg", o.max_pitch_deg},
           {"max_object_share", o.max_object_share},
+          {"visibility", o.visibility},
+          {"visibility_face", o.visibility_face},
           {"seed", o.seed},
           {"hierarchy", {{"max_levels", o.hierarchy.max_levels},
                          {"min_objects_to_split", o.hierarchy.min_objects_to_split}}},
@@ -378,6 +476,8 @@ PlaceOptions placeOptionsFromJson(const nlohmann::json& j, const std::string& so
   r.number("min_vdi_deg", o.min_vdi_deg);
   r.number("max_pitch_deg", o.max_pitch_deg);
   r.number("max_object_share", o.max_object_share);
+  o.visibility = r.boolean("visibility");
+  r.number("visibility_face", o.visibility_face);
   r.number("seed", o.seed);
   StrictJson h = r.object("hierarchy");
   h.number("max_levels", o.hierarchy.max_levels);

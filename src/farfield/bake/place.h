@@ -47,6 +47,12 @@ struct PlaceOptions {
   // them; a walkthrough that looks that far up or down draws full geometry there, unguarded). 90: every direction,
   // as the paper. Street-level walkthroughs look within a few degrees of the horizon.
   float max_pitch_deg = 90.0f;
+  // From-region visibility (section 3.1, observation 2.3): the objects seen from a minimum-size region are sampled
+  // in 360-degree item buffers (face_size pixels per cube face) from its corners and centre, and only they count in
+  // its views' times; the database keeps them, and the runtime draws only them there. Sampled, not conservative: an
+  // object seen between the samples only is missed (the bench's frames over t_max and cracks show it).
+  bool visibility = true;
+  int visibility_face = 64;
   placement::HierarchyOptions hierarchy;
   placement::CandidateOptions candidates;
   impostor::LayeredOptions layered;
@@ -61,6 +67,10 @@ struct PlaceOptions {
 struct PlaceReport {
   size_t regions = 0, problem_regions = 0, cpvs = 0, estimates = 0;
   size_t hierarchy_nodes = 0, clustered_objects = 0, geometry_objects = 0;
+  size_t visibility_regions = 0, visibility_points = 0;  // regions and points sampled
+  double mean_visible_objects = 0.0;                     // per sampled region
+  double visibility_s = 0.0;
+  size_t serves_dropped = 0;  // (candidate, CPV) pairs where the node's visible geometry costs less than the impostor
   placement::CandidateCounts candidate_counts;
   size_t candidates_unplannable = 0;  // dropped: no layered plan keeps the bound from the cell
   size_t impostors = 0, impostors_generated = 0, impostors_freed = 0;

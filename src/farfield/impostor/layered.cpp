@@ -63,6 +63,34 @@ namespace {
 // GpuMesh stores interleaved position, normal and uv floats (32 bytes a vertex) and 32-bit indices.
 constexpr size_t kQuadMeshBytes = 4 * 8 * sizeof(float) + 6 * sizeof(uint32_t);
 
+// Shelf packing of the layer images, in layer order: a layer goes right of the previous one on the current shelf, or
+// starts a new shelf below it, or a new atlas when the shelf would pass kAtlasSide. Atlases are as small as their
+// contents (plus padding). Deterministic: planLayered and GpuLayeredImpostor agree on the layout.
+void packAtlases(LayeredPlan& plan) {
+  plan.atlas_spots.assign(plan.layers.size(), {});
+  plan.atlas_sizes.clear();
+  int x = 0, y = 0, shelf = 0;
+  IVec2 used(0);
+  const auto close = [&] {
+    if (used.x > 0) plan.atlas_sizes.push_back(used);
+    x = y = shelf = 0;
+    used = IVec2(0);
+  };
+  for (size_t i = 0; i < plan.layers.size(); ++i) {
+    const int w = plan.layers[i].width + 2 * kAtlasPadding, h = plan.layers[i].height + 2 * kAtlasPadding;
+    if (x > 0 && x + w > kAtlasSide) {  // next shelf
+      y += shelf;
+      x = shelf = 0;
+    }
+    if (y > 0 && y + h > kAtlasSide) close();  // next atlas
+    plan.atlas_spots[i] = {uint32_t(plan.atlas_sizes.size()), x + kAtlasPadding, y + kAtlasPadding};
+    x += w;
+    shelf = std::max(shelf, h);
+    used = glm::max(used, IVec2(x, y + shelf));
+  }
+  close();
+}
+
 // K of the file comment (radians per metre). theta: half apex angle; d: capture eye distance.
 double parallaxPerMetre(double theta, double d, double r, double gamma) {
   const auto first = [&](double D) {
@@ -231,11 +259,13 @@ LayeredPlan planLayered(const Box3& box, const Shaft& shaft_in, const ErrorBound
 
     const uint64_t texels = uint64_t(layer.width) * uint64_t(layer.height);
     plan.texels += texels;
-    plan.texture_bytes += size_t(texels) * 4 * (options.id_textures ? 2 : 1);
     plan.mesh_bytes += kQuadMeshBytes;
     const double pixels = 4.0 * layer.half_u * layer.half_v * focal * focal / (distance * distance);
     plan.fill_pixels += std::min(pixels, double(bound.width) * double(bound.height));
   }
+  packAtlases(plan);
+  for (const IVec2& a : plan.atlas_sizes)
+    plan.texture_bytes += size_t(a.x) * size_t(a.y) * 4 * (options.id_textures ? 2 : 1);
   return plan;
 }
 
@@ -367,33 +397,59 @@ LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& sce
 GpuLayeredImpostor::GpuLayeredImpostor(const LayeredImpostor& impostor) {
   const LayeredPlan& plan = impostor.plan;
   FF_CHECK(impostor.layers.size() == plan.layers.size());
+  FF_CHECK(plan.atlas_spots.size() == plan.layers.size());
+  const bool ids = plan.id_textures;
+  std::vector<image::ColorImage> colors;
+  std::vector<image::IdImage> id_images;
+  std::vector<scene::Mesh> meshes(plan.atlas_sizes.size());
+  for (const IVec2& a : plan.atlas_sizes) {
+    colors.emplace_back(a.x, a.y, image::Rgba8(0, 0, 0, 0));
+    if (ids) id_images.emplace_back(a.x, a.y, 0u);
+  }
   for (size_t i = 0; i < plan.layers.size(); ++i) {
     const LayerPlan& lp = plan.layers[i];
     const Layer& layer = impostor.layers[i];
+    const LayeredPlan::AtlasSpot& spot = plan.atlas_spots[i];
+    FF_CHECK(layer.color.width() == lp.width && layer.color.height() == lp.height);
+    // The image and its padding, the padding repeating the edge texels (what clamp-to-edge sampling would see).
+    image::ColorImage& atlas = colors[spot.atlas];
+    for (int y = -kAtlasPadding; y < lp.height + kAtlasPadding; ++y)
+      for (int x = -kAtlasPadding; x < lp.width + kAtlasPadding; ++x) {
+        const int sx = std::clamp(x, 0, lp.width - 1), sy = std::clamp(y, 0, lp.height - 1);
+        atlas.at(spot.x + x, spot.y + y) = layer.color.at(sx, sy);
+        if (ids && !layer.ids.empty()) id_images[spot.atlas].at(spot.x + x, spot.y + y) = layer.ids.at(sx, sy);
+      }
+    const IVec2 size = plan.atlas_sizes[spot.atlas];
+    const Vec2 uv0(float(spot.x) / float(size.x), float(spot.y) / float(size.y));
+    const Vec2 uv1(float(spot.x + lp.width) / float(size.x), float(spot.y + lp.height) / float(size.y));
     const Vec3 centre = plan.shaft.apex + lp.depth * plan.shaft.axis;
     const Vec3 du = lp.half_u * plan.right, dv = lp.half_v * plan.up;
-    scene::Mesh quad;
+    scene::Mesh& mesh = meshes[spot.atlas];
+    const uint32_t base = uint32_t(mesh.positions.size());
     // uv (0, 0) is the image's top-left (row 0): the capture's -right, +up corner.
-    quad.positions = {centre - du + dv, centre + du + dv, centre + du - dv, centre - du - dv};
-    quad.uvs = {Vec2(0.0f, 0.0f), Vec2(1.0f, 0.0f), Vec2(1.0f, 1.0f), Vec2(0.0f, 1.0f)};
-    quad.normals.assign(4, plan.shaft.axis);
-    quad.indices = {3, 2, 1, 3, 1, 0};  // counter-clockwise seen from the viewers (right x up = axis)
-    quad.computeBounds();
-    meshes_.emplace_back(quad);
-
-    auto texture = std::make_unique<gpu::Texture>(gpu::Texture::fromImage(layer.color, /*mipmaps=*/false));
+    mesh.positions.insert(mesh.positions.end(), {centre - du + dv, centre + du + dv, centre + du - dv, centre - du - dv});
+    mesh.uvs.insert(mesh.uvs.end(), {uv0, Vec2(uv1.x, uv0.y), uv1, Vec2(uv0.x, uv1.y)});
+    mesh.normals.insert(mesh.normals.end(), 4, plan.shaft.axis);
+    // Counter-clockwise seen from the viewers (right x up = axis).
+    for (uint32_t k : {3u, 2u, 1u, 3u, 1u, 0u}) mesh.indices.push_back(base + k);
+    ++quads_;
+  }
+  for (size_t a = 0; a < meshes.size(); ++a) {
+    meshes[a].computeBounds();
+    meshes_.emplace_back(meshes[a]);
+    auto texture = std::make_unique<gpu::Texture>(gpu::Texture::fromImage(colors[a], /*mipmaps=*/false));
     texture->setClampToEdge();
     auto material = std::make_unique<gpu::GpuMaterial>();
     material->unlit = true;
     material->double_sided = true;
     material->texture = texture.get();
-    std::unique_ptr<gpu::Texture> ids;
-    if (!layer.ids.empty()) {
-      ids = std::make_unique<gpu::Texture>(gpu::Texture::fromIds(layer.ids));
-      material->id_texture = ids.get();
+    std::unique_ptr<gpu::Texture> id_texture;
+    if (ids) {
+      id_texture = std::make_unique<gpu::Texture>(gpu::Texture::fromIds(id_images[a]));
+      material->id_texture = id_texture.get();
     }
     textures_.push_back(std::move(texture));
-    id_textures_.push_back(std::move(ids));
+    id_textures_.push_back(std::move(id_texture));
     materials_.push_back(std::move(material));
   }
 }

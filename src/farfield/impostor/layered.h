@@ -79,13 +79,22 @@ struct LayeredPlan {
   int dilate_texels = 2;
   bool solid_slices = true;
   std::vector<LayerPlan> layers;  // far to near (increasing depth)
+  // The layers packed into texture atlases (shelves, in layer order, kAtlasPadding texels apart, at most
+  // kAtlasSide texels a side unless a layer alone is larger): one texture and one draw call per atlas on the GPU.
+  struct AtlasSpot {
+    uint32_t atlas = 0;
+    int x = 0, y = 0;  // the layer image's top-left texel in its atlas
+  };
+  std::vector<AtlasSpot> atlas_spots;  // per layer
+  std::vector<IVec2> atlas_sizes;      // per atlas, texels
 
   // Estimates before generation (the placement optimiser's memory and render cost).
-  uint64_t texels = 0;             // sum of width * height
-  size_t texture_bytes = 0;        // colour (+ ids) textures
+  uint64_t texels = 0;             // sum of the layers' width * height
+  size_t texture_bytes = 0;        // colour (+ ids) atlas textures
   size_t mesh_bytes = 0;           // quads' vertex and index buffers
   size_t bytes() const { return texture_bytes + mesh_bytes; }
-  uint32_t quads() const { return uint32_t(layers.size()); }  // = draw calls
+  uint32_t quads() const { return uint32_t(layers.size()); }
+  uint32_t draws() const { return uint32_t(atlas_sizes.size()); }  // draw calls: one per atlas
   // Pixels of the bound's frame the quads cover (transparent texels included: the fill-rate cost of an alpha test)
   // from the nearest viewpoint on the axis, each quad capped at the frame.
   double fill_pixels = 0.0;
@@ -120,25 +129,31 @@ struct LayeredImpostor {
 LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& scene,
                                std::span<const uint32_t> object_ids, const LayeredPlan& plan);
 
-// The layers on the GPU: per layer a 4-vertex quad (normal = the axis, uvs over the texture) and an unlit,
-// double-sided, textured material; the renderer's alpha test cuts out texels with alpha below 0.5 and its depth test
-// composes the layers (and any geometry around them), so the draw order does not change the image. Needs a current
-// context. Movable; draw items point into it.
+inline constexpr int kAtlasSide = 4096;
+inline constexpr int kAtlasPadding = 2;  // texels around each layer image, its edge texels repeated (clamp to edge)
+
+// The layers on the GPU: per atlas (LayeredPlan::atlas_sizes) one texture (and id texture) and one mesh of its layers'
+// quads (normal = the axis, uvs into the atlas), with an unlit, double-sided material: one draw call per atlas. The
+// renderer's alpha test cuts out texels with alpha below 0.5 and its depth test composes the layers (and any geometry
+// around them), so the draw order does not change the image. Needs a current context. Movable; draw items point into
+// it.
 class GpuLayeredImpostor {
  public:
   explicit GpuLayeredImpostor(const LayeredImpostor& impostor);
   GpuLayeredImpostor(GpuLayeredImpostor&&) noexcept = default;
   GpuLayeredImpostor& operator=(GpuLayeredImpostor&&) noexcept = default;
 
-  // Appends one item per layer, far to near; object_id is written where a layer has no id texture.
+  // Appends one item per atlas; object_id is written where a layer has no id texture.
   void appendDrawItems(std::vector<gpu::DrawItem>& out, uint32_t object_id = 0) const;
-  uint32_t quads() const { return uint32_t(meshes_.size()); }
+  uint32_t quads() const { return quads_; }
+  uint32_t draws() const { return uint32_t(meshes_.size()); }
   size_t gpuBytes() const;  // measured: the textures' and buffers' sizes
 
  private:
   std::vector<gpu::GpuMesh> meshes_;
   std::vector<std::unique_ptr<gpu::Texture>> textures_, id_textures_;
   std::vector<std::unique_ptr<gpu::GpuMaterial>> materials_;
+  uint32_t quads_ = 0;
 };
 
 }  // namespace farfield::impostor

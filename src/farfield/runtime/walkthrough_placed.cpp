@@ -50,6 +50,18 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   ids_.clear();
   bvh_.queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
   std::sort(ids_.begin(), ids_.end());
+  // From-region visibility: where placement sampled what the region sees, only that is drawn (its times assumed it).
+  if (const std::optional<uint32_t> leaf = store::lookupLeaf(p.index, camera.eye)) {
+    const store::StoredViewSpaceNode& node = p.index.nodes[*leaf];
+    if (node.has_visible) {
+      ids_.erase(std::remove_if(ids_.begin(), ids_.end(),
+                                [&](uint32_t id) {
+                                  return !std::binary_search(node.visible.begin(), node.visible.end(), id);
+                                }),
+                 ids_.end());
+      ++p.stats.visibility_frames;
+    }
+  }
 
   const std::optional<uint32_t> cpv = store::lookupCpv(p.index, camera.eye, camera.forward());
   std::vector<uint32_t> drawn;  // impostor ids drawn this frame
@@ -133,6 +145,7 @@ std::map<std::string, double> Walkthrough::placedStatistics() const {
   const double n = s.frames ? double(s.frames) : 1.0;
   std::map<std::string, double> out;
   out["frames"] = double(s.frames);
+  out["frames_culled_by_region_visibility"] = double(s.visibility_frames);
   out["cpv_frames"] = double(s.cpv_frames);
   out["cpvs"] = double(p.index.cpvs.size());
   out["impostors_in_database"] = double(p.index.impostors.size());

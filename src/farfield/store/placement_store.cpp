@@ -463,7 +463,8 @@ nlohmann::json placementToJson(const PlacementIndex& index) {
     nodes.push_back({{"box", box3Json(n.box)},
                      {"children", {n.children[0], n.children[1]}},
                      {"cpv_first", n.cpv_first},
-                     {"cpv_count", n.cpv_count}});
+                     {"cpv_count", n.cpv_count},
+                     {"visible", n.has_visible ? nlohmann::json(n.visible) : nlohmann::json(nullptr)}});
   j["nodes"] = std::move(nodes);
   nlohmann::json cpvs = nlohmann::json::array();
   for (const StoredCpv& c : index.cpvs)
@@ -547,7 +548,7 @@ PlacementIndex placementFromJson(const nlohmann::json& j, const std::string& sou
   for (size_t k = 0; k < nodes.size(); ++k) {
     const std::string where = nodeName(k);
     const nlohmann::json& n = nodes[k];
-    r.onlyKeys(n, {"box", "children", "cpv_first", "cpv_count"}, where);
+    r.onlyKeys(n, {"box", "children", "cpv_first", "cpv_count", "visible"}, where);
     StoredViewSpaceNode node;
     node.box = r.box3(n, "box", where);
     const nlohmann::json& children = r.member(n, "children", where);
@@ -563,6 +564,10 @@ PlacementIndex placementFromJson(const nlohmann::json& j, const std::string& sou
     }
     node.cpv_first = id32(r, n, "cpv_first", where);
     node.cpv_count = id32(r, n, "cpv_count", where);
+    if (!r.member(n, "visible", where).is_null()) {
+      node.has_visible = true;
+      node.visible = readIds(r, n, "visible", where, index.scene_objects);
+    }
     index.nodes.push_back(node);
   }
   checkNodes(r, index);
@@ -678,6 +683,19 @@ impostor::LayeredImpostor loadPlacedImpostor(const std::string& dir, const Store
     out.layers.push_back(std::move(layer));
   }
   return out;
+}
+
+std::optional<uint32_t> lookupLeaf(const PlacementIndex& index, const Vec3& eye) {
+  const std::vector<StoredViewSpaceNode>& nodes = index.nodes;
+  if (nodes.empty() || !nodes[0].box.contains(eye)) return std::nullopt;
+  size_t at = 0;
+  while (nodes[at].children[0] >= 0) {
+    const int lower = nodes[at].children[0], upper = nodes[at].children[1];
+    if (lower <= int(at) || upper <= int(at) || size_t(lower) >= nodes.size() || size_t(upper) >= nodes.size())
+      return std::nullopt;
+    at = nodes[size_t(lower)].box.contains(eye) ? size_t(lower) : size_t(upper);
+  }
+  return uint32_t(at);
 }
 
 std::optional<uint32_t> lookupCpv(const PlacementIndex& index, const Vec3& eye, const Vec3& dir) {

@@ -14,7 +14,8 @@
 //    "scene": "city.glb", "scene_objects": 1234,        // object ids are 1..scene_objects
 //    "options": {...}, "summary": {...},                // the caller's (e.g. the place command's), opaque, saved whole
 //    "view_space": {"lo": [x,y,z], "hi": [x,y,z]},
-//    "nodes": [{"box": BOX, "children": [1, 2], "cpv_first": 0, "cpv_count": 12}, ...],   // node 0: the whole box
+//    "nodes": [{"box": BOX, "children": [1, 2], "cpv_first": 0, "cpv_count": 12,
+//               "visible": null or [object ids seen from the region, ascending]}, ...],   // node 0: the whole box
 //    "cpvs": [{"region": BOX, "vdi": {"face": 0, "u0": -1, "u1": 0, "v0": -1, "v1": 0}, "t_enc": 21.5,
 //              "t_after": 15.9, "impostors": [3, 7]}, ...],                                // impostor ids, ascending
 //    "impostors": [{"id": 3, "node": 17, "objects": [4, 5, 9], "box": BOX,
@@ -118,6 +119,11 @@ struct StoredViewSpaceNode {
   int children[2] = {-1, -1};  // node indices; -1 for a leaf
   uint32_t cpv_first = 0;      // the CPVs of the subtree: [cpv_first, cpv_first + cpv_count)
   uint32_t cpv_count = 0;
+  // The objects seen from the region (from-region visibility), when placement computed them: the runtime draws only
+  // these there (the placement's times assumed it). Ascending ids; has_visible false: not computed (draw what the
+  // frustum holds).
+  bool has_visible = false;
+  std::vector<uint32_t> visible;
 };
 
 struct PlacementIndex {
@@ -173,6 +179,9 @@ PlacementIndex readPlacementIndex(const std::string& dir);
 // before decoding it, and each image's size against the plan. Errors name the file and the record ("impostor 12
 // layer 3 texture: truncated: 100 of 812 bytes").
 impostor::LayeredImpostor loadPlacedImpostor(const std::string& dir, const StoredPlacedImpostor& impostor);
+
+// The leaf of the BSP holding the eye (the lower child when on both), or none outside the view space.
+std::optional<uint32_t> lookupLeaf(const PlacementIndex& index, const Vec3& eye);
 
 // The CPV holding the view (eye, direction): walks the BSP from node 0 to the leaf holding the eye (the lower child
 // when the eye is on both) and returns the first of the leaf's CPVs whose region contains the eye and whose VDI holds

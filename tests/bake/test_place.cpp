@@ -1,0 +1,198 @@
+// Automatic impostor placement end to end (bake/place.h): a small city with a hand-made cost profile (so the times
+// are the model's, not this machine's noise), placed under a frame budget and an error bound, then walked with the
+// runtime's Placed representation. Checked independently of the placement's own bookkeeping:
+//   - every sampled view of the view space, planned by the runtime, is predicted (by the same profile, from what the
+//     plan actually draws) under t_max wherever its CPV was solved or no CPV holds it;
+//   - the impostors drawn keep the error bound against full geometry (parallax of item buffers);
+//   - the database reads back with the options that made it, strictly.
+#include "farfield/bake/place.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <variant>
+
+#include "farfield/core/error.h"
+#include "farfield/eval/parallax_error.h"
+#include "farfield/gen/city.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/runtime/walkthrough.h"
+#include "farfield/scene/bvh.h"
+#include "farfield/store/placement_store.h"
+#include "support/test_support.h"
+
+namespace farfield::bake {
+namespace {
+
+struct Placed {
+  gen::City city;
+  gpu::CostProfile profile;
+  PlaceOptions options;
+  PlaceReport report;
+  std::string dir;
+};
+
+gpu::CostProfile handProfile() {
+  gpu::CostProfile p;
+  p.model.base_ms = 1.0;
+  p.model.ms_per_draw = 0.25;
+  p.model.ms_per_mtriangle = 10.0;
+  p.safety_factor = 1.0;
+  p.width = p.height = 128;
+  p.fov_y_deg = 45.0;
+  return p;
+}
+
+const Placed& placed() {
+  static const Placed* s = [] {
+    auto* c = new Placed;
+    gen::CityOptions o;
+    o.blocks = 12;
+    o.detail = 0;
+    o.seed = 3;
+    o.objects = gen::ObjectGrouping::Buildings;
+    c->city = gen::generateCity(o);
+    c->profile = handProfile();
+    PlaceOptions& p = c->options;
+    p.width = p.height = 128;
+    p.fov_deg = 45.0f;
+    p.error_px = 2.0;
+    p.layered.texel_pixels = 2.0;
+    p.layered.max_texture_size = 128;
+    p.max_pitch_deg = 20.0f;
+    p.visibility_face = 32;
+    const Box3 b = c->city.scene.bounds();
+    p.min_region_size = 0.26f * std::max(b.extent().x, b.extent().y);
+    p.candidates.direction_step = float(degToRad(45.0));
+    p.candidates.apex_angles = {float(degToRad(45.0)), float(degToRad(90.0))};
+    p.candidates.distance_steps = 5;
+    p.hierarchy.max_levels = 6;
+    p.progress = false;
+    p.t_max_ms = 9.0;
+    c->dir = test::scratchDir("place_city").string();
+    c->report = placeImpostors(gpu::sharedHeadlessContext(), c->city.scene, c->profile, p, c->dir);
+    return c;
+  }();
+  return *s;
+}
+
+TEST(PlaceTest, ProblemViewsExistAndMostAreSolved) {
+  const Placed& s = placed();
+  const PlaceReport& r = s.report;
+  EXPECT_GT(r.cpvs, 10u);
+  EXPECT_GT(r.impostors, 0u);
+  EXPECT_LT(r.unsolved_cpvs, r.cpvs);  // placement solved some problem views
+  EXPECT_GT(r.t_enc_max_ms, s.options.t_max_ms);
+  EXPECT_GT(r.visibility_regions, 0u);
+  const store::PlacementIndex index = store::readPlacementIndex(s.dir);
+  EXPECT_EQ(index.cpvs.size(), r.cpvs);
+  EXPECT_EQ(index.impostors.size(), r.impostors);
+  size_t solved = 0;
+  for (const store::StoredCpv& c : index.cpvs) {
+    EXPECT_LE(c.t_after, c.t_enc + 1e-9);
+    if (c.t_after <= s.options.t_max_ms) ++solved;
+  }
+  EXPECT_EQ(solved, r.cpvs - r.unsolved_cpvs);
+  // The options that made it, back strictly.
+  EXPECT_EQ(placeOptionsToJson(placeOptionsFromJson(index.options, "index")), index.options);
+  nlohmann::json extra = index.options;
+  extra["colour"] = 1;
+  EXPECT_THROW(placeOptionsFromJson(extra, "index"), Error);
+  nlohmann::json missing = index.options;
+  missing.erase("t_max_ms");
+  EXPECT_THROW(placeOptionsFromJson(missing, "index"), Error);
+}
+
+TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
+  const Placed& s = placed();
+  const scene::Scene& scene = s.city.scene;
+  gpu::sharedHeadlessContext().makeCurrent();
+  const gpu::GpuScene gpu_scene(scene);
+  const scene::Bvh bvh(scene);
+  gpu::Renderer renderer;
+  runtime::WalkthroughOptions options;
+  options.database = s.dir;
+  options.representation = runtime::Representation::Placed;
+  runtime::Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
+  const store::PlacementIndex index = store::readPlacementIndex(s.dir);
+  const Box3 space = index.view_space;
+  gpu::RenderTarget target(128, 128), reference_target(128, 128);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  size_t guarded = 0, with_impostors = 0, checked_images = 0;
+  double worst_parallax = 0.0;
+  for (int k = 0; k < 300; ++k) {
+    Camera camera;
+    camera.eye = space.lo + (space.hi - space.lo) * Vec3(u(rng), u(rng), u(rng));
+    const float yaw = float(2.0 * kPi) * u(rng);
+    camera.at = camera.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
+    camera.width = camera.height = 128;
+    camera.fov_y = float(degToRad(45.0));
+    const runtime::FramePlan& plan = walkthrough.plan(camera);
+    uint64_t triangles = 0;
+    for (const gpu::DrawItem& item : plan.items) triangles += item.triangleCount();
+    const double predicted =
+        s.profile.boundMs(double(triangles), double(plan.items.size()), 128.0 * 128.0);
+    const bool solved = plan.report.cpv == urban::kNone || plan.report.cpv_t_after_ms <= s.options.t_max_ms;
+    if (solved) {
+      ++guarded;
+      EXPECT_LE(predicted, s.options.t_max_ms + 1e-9) << "view " << k << " cpv " << plan.report.cpv;
+    }
+    if (plan.report.cpv != urban::kNone && plan.report.impostor_triangles > 0) {
+      ++with_impostors;
+      if (checked_images < 40) {
+        // Against full geometry: what the impostors show stays within the bound (item buffers; the ground, drawn
+        // as geometry in both, left out; one texel of quantisation allowed beyond the bound).
+        // The reference: full geometry of what the runtime draws there (the region's sampled visible set, which
+        // placement and runtime both use; what that sampling misses is measured by the bench as cracks), with the
+        // impostors' objects as geometry.
+        std::vector<uint32_t> ids;
+        const std::optional<uint32_t> leaf = store::lookupLeaf(index, camera.eye);
+        if (leaf && index.nodes[*leaf].has_visible) ids = index.nodes[*leaf].visible;
+        for (const runtime::LayerDecision& d : plan.layers)
+          if (const auto* i = std::get_if<runtime::ClusterAsImpostor>(&d))
+            for (uint32_t o : index.find(i->impostor)->objects) ids.push_back(o);
+        ids.push_back(1);  // the ground
+        std::sort(ids.begin(), ids.end());
+        ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+        std::vector<gpu::DrawItem> reference;
+        gpu_scene.appendDrawItems(ids, reference);
+        renderer.render(camera, plan.items, target);
+        renderer.render(camera, reference, reference_target);
+        eval::ParallaxOptions po;
+        po.ignore_ids = {1};
+        const eval::ParallaxError e = eval::parallaxError(reference_target.readIds(), target.readIds(), po);
+        worst_parallax = std::max(worst_parallax, e.object_percentile_px);
+        EXPECT_LE(e.object_percentile_px, s.options.error_px + s.options.layered.texel_pixels) << "view " << k;
+        ++checked_images;
+      }
+    }
+  }
+  EXPECT_GT(guarded, 30u);
+  EXPECT_GT(with_impostors, 5u);
+  std::printf("guarded views %zu, with impostors %zu, worst parallax p99 %.2f px\n", guarded, with_impostors,
+              worst_parallax);
+}
+
+TEST(PlaceTest, BadOptionsAreErrors) {
+  const Placed& s = placed();
+  PlaceOptions o = s.options;
+  o.t_max_ms = 0.0;
+  EXPECT_THROW(placeImpostors(gpu::sharedHeadlessContext(), s.city.scene, s.profile, o,
+                              test::scratchDir("place_bad").string()),
+               Error);
+  o = s.options;
+  o.max_pitch_deg = 0.0f;
+  EXPECT_THROW(placeImpostors(gpu::sharedHeadlessContext(), s.city.scene, s.profile, o,
+                              test::scratchDir("place_bad").string()),
+               Error);
+  scene::Scene empty;
+  EXPECT_THROW(placeImpostors(gpu::sharedHeadlessContext(), empty, s.profile, s.options,
+                              test::scratchDir("place_bad").string()),
+               Error);
+}
+
+}  // namespace
+}  // namespace farfield::bake
