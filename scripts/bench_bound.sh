@@ -24,7 +24,7 @@ mkdir -p "$OUT"
 for path in drive walk; do
   for bake_px in 10 2; do
     /usr/bin/time -f "%e s, %M kB" -o "$OUT/bake-$path-$bake_px.time" \
-      "$FARFIELD" bake "$OUT/city.glb" --pipeline pvs,near-far,mmi --pvs-spacing 5 --error-px "$bake_px" \
+      "$FARFIELD" bake "$OUT/city.glb" --pipeline pvs,near-far,single,mmi --pvs-spacing 5 --error-px "$bake_px" \
       --station-spacing "$STATIONS" --path "$OUT/$path.json" -o "$OUT/imp-$path-$bake_px" > "$OUT/bake-$path-$bake_px.txt"
   done
   for bound in 10 5 2 1; do

@@ -21,7 +21,7 @@ mkdir -p "$OUT"
   | tee "$OUT/drive.txt"
 "$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --seed 1 -o "$OUT/walk.json" | tee "$OUT/walk.txt"
 run() {  # name path local
-  "$FARFIELD" bake "$OUT/city.glb" --pipeline pvs,near-far,mmi --local "$3" --layer-mesh "$LAYER_MESH" \
+  "$FARFIELD" bake "$OUT/city.glb" --pipeline pvs,near-far,single,mmi --local "$3" --layer-mesh "$LAYER_MESH" \
     --pvs-spacing 5 --path "$OUT/$2.json" --list -o "$OUT/imp-$1" | tee "$OUT/bake-$1.txt"
   "$FARFIELD" bench "$OUT/city.glb" --path "$OUT/$2.json" --impostors "$OUT/imp-$1" \
     --modes full,local,visible,smi,mmi,mmi-dynamic --mode-option frame_budget_ms="$BUDGET" \

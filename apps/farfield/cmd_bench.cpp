@@ -49,6 +49,8 @@ struct BenchArgs {
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
   double error_px = 0.0;  // 0 = not given
+  double t_max = 0.0;     // 0 = not given
+  int repeats = 1;
 };
 
 std::vector<std::string> splitModes(const std::string& text) {
@@ -104,6 +106,11 @@ void runBenchCommand(const BenchArgs& args) {
     throw Error("--near/--far", "need 0 < near < far");
   options.near_plane = args.near_plane;
   options.far_plane = args.far_plane;
+  options.repeats = args.repeats;
+  if (args.t_max != 0.0) {
+    if (!(args.t_max > 0.0)) throw Error("--tmax", "must be a positive number of ms");
+    options.t_max_ms = args.t_max;
+  }
   if (args.error_px != 0.0) {
     if (!(args.error_px > 0.0)) throw Error("--error-px", "must be a positive number of pixels");
     options.error_px = args.error_px;
@@ -161,6 +168,12 @@ void runBenchCommand(const BenchArgs& args) {
                 m.wall.median, m.wall.p95, m.wall.p99, m.wall.max, m.mean_triangles, m.speedup_vs_full, psnr, cracks,
                 parallax, over, popping);
   }
+  if (result.t_max_ms) {
+    std::printf("\nframes over t_max %.2f ms (fastest of %d renders per frame):", *result.t_max_ms, result.repeats);
+    for (const eval::ModeResult& m : result.modes)
+      std::printf(" %s %zu/%zu;", m.name.c_str(), m.frames_over_tmax, m.frames.size());
+    std::printf("\n");
+  }
   std::printf("\nwrote %s/{bench.json,bench.md,frames.csv}", args.out_dir.c_str());
   for (const std::string& p : result.plots) std::printf(", %s", p.c_str());
   std::printf(", %zu sample frames, report %s\n", result.samples.size(), report.c_str());
@@ -193,6 +206,8 @@ const RegisterCommand reg("bench", [](CLI::App& app) {
   cmd->add_option("--impostors", args->impostors,
                   "Impostor store of farfield bake for the depth-mesh and grid-mesh modes (= --mode-option "
                   "impostor_dir=DIR)");
+  cmd->add_option("--repeats", args->repeats, "Renders per frame and mode; the fastest is kept")->capture_default_str();
+  cmd->add_option("--tmax", args->t_max, "Frame budget, ms: frames slower than it are counted per mode");
   cmd->add_option("--error-px", args->error_px,
                   "Error bound, pixels: frames whose parallax p99 exceeds it are counted (default: the bound each "
                   "mode reports, if any)");

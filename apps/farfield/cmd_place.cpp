@@ -49,8 +49,10 @@ void runPlaceCommand(PlaceArgs& args) {
               o.t_max_ms, o.error_px, o.width, o.height, double(o.fov_deg), args.profile.c_str(),
               profile.safety_factor);
   if (o.visibility)
-    std::printf("visibility:       %zu regions sampled from %zu points, %.1f objects seen per region, %.1f s\n",
-                r.visibility_regions, r.visibility_points, r.mean_visible_objects, r.visibility_s);
+    std::printf("visibility:       %zu regions (%zu from the cache) sampled from %zu points, %.1f objects seen per "
+                "region, %.1f s\n",
+                r.visibility_regions, r.visibility_cached, r.visibility_points, r.mean_visible_objects,
+                r.visibility_s);
   std::printf("view space:       %zu regions visited, %zu with problem views, %zu CPVs (%zu estimates), %.1f s\n",
               r.regions, r.problem_regions, r.cpvs, r.estimates, r.view_space_s);
   std::printf("candidates:       %zu considered, %zu intersecting, %zu serving no CPV, %zu identical, %zu kept, "
@@ -89,6 +91,8 @@ const RegisterCommand reg("place", [](CLI::App& app) {
                                                   "(90: all)")->capture_default_str();
   cmd->add_flag("!--no-visibility", o.visibility, "Count every object in a view's frustum (no from-region "
                                                  "visibility)");
+  cmd->add_option("--visibility-cache", o.visibility_cache, "Keep the sampled visible sets in this file between runs "
+                                                            "(a t_max sweep samples them once)");
   cmd->add_option("--visibility-face", o.visibility_face, "Item-buffer face size of the visibility samples, pixels")
       ->capture_default_str();
   cmd->add_option("--levels", o.hierarchy.max_levels, "Levels of the object hierarchy")->capture_default_str();

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <array>
 #include <map>
 #include <unordered_map>
@@ -83,6 +84,7 @@ nlohmann::json PlaceReport::toJson() const {
           {"hierarchy_nodes", hierarchy_nodes},
           {"visibility_regions", visibility_regions},
           {"visibility_points", visibility_points},
+          {"visibility_cached", visibility_cached},
           {"mean_visible_objects", mean_visible_objects},
           {"visibility_s", visibility_s},
           {"serves_dropped", serves_dropped},
@@ -183,6 +185,31 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     const Vec3 e = region.extent();
     return std::max({e.x, e.y, e.z}) <= options.min_region_size;
   };
+  // The cache's identity: what the visible sets depend on.
+  const nlohmann::json cache_key = {{"scene_objects", scene.objects.size()},
+                                    {"view_space", {{"lo", {space.lo.x, space.lo.y, space.lo.z}},
+                                                    {"hi", {space.hi.x, space.hi.y, space.hi.z}}}},
+                                    {"min_region_size", options.min_region_size},
+                                    {"visibility_face", options.visibility_face},
+                                    {"far_plane", options.far_plane}};
+  std::map<std::array<float, 3>, std::vector<uint32_t>> cached;
+  if (options.visibility && !options.visibility_cache.empty() && fs::exists(options.visibility_cache)) {
+    try {
+      std::ifstream in(options.visibility_cache);
+      nlohmann::json j;
+      in >> j;
+      if (j.at("key") == cache_key) {
+        for (const nlohmann::json& r : j.at("regions"))
+          cached[{r.at("lo")[0].get<float>(), r.at("lo")[1].get<float>(), r.at("lo")[2].get<float>()}] =
+              r.at("visible").get<std::vector<uint32_t>>();
+      } else {
+        FF_WARN(options.visibility_cache << ": made for another scene or view space; sampling again");
+      }
+    } catch (const std::exception& e) {
+      FF_WARN(options.visibility_cache << ": unreadable (" << e.what() << "); sampling again");
+      cached.clear();
+    }
+  }
   if (options.visibility) {
     urban::PvsOptions pvs;
     pvs.face_size = options.visibility_face;
@@ -190,6 +217,12 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     sampler = std::make_unique<urban::PvsSampler>(gpu_scene, pvs);
     callbacks.visible_set = [&](const Box3& region) -> std::vector<uint32_t> {
       if (!isLeafSized(region)) return {};  // big regions: every object counts (conservative)
+      if (const auto hit = cached.find({region.lo.x, region.lo.y, region.lo.z}); hit != cached.end()) {
+        ++report.visibility_cached;
+        ++report.visibility_regions;
+        report.mean_visible_objects += double(hit->second.size());
+        return region_visible[hit->first] = hit->second;
+      }
       Stopwatch timer;
       const float z = 0.5f * (region.lo.z + region.hi.z);
       std::vector<uint8_t> seen;
@@ -241,6 +274,12 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   for (const placement::Cpv& c : view_space.cpvs) report.t_enc_max_ms = std::max(report.t_enc_max_ms, c.t_enc);
   report.view_space_s = step.seconds();
   if (report.visibility_regions) report.mean_visible_objects /= double(report.visibility_regions);
+  if (options.visibility && !options.visibility_cache.empty() && report.visibility_cached < report.visibility_regions) {
+    nlohmann::json regions = nlohmann::json::array();
+    for (const auto& [lo, visible] : region_visible) regions.push_back({{"lo", {lo[0], lo[1], lo[2]}}, {"visible", visible}});
+    const std::string text = nlohmann::json{{"key", cache_key}, {"regions", regions}}.dump() + "\n";
+    store::writeFileAtomic(options.visibility_cache, text);
+  }
   const auto visibleFrom = [&](const Box3& region) -> const std::vector<uint32_t>* {
     const auto it = region_visible.find({region.lo.x, region.lo.y, region.lo.z});
     return it == region_visible.end() || it->second.empty() ? nullptr : &it->second;

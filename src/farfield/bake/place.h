@@ -53,6 +53,10 @@ struct PlaceOptions {
   // object seen between the samples only is missed (the bench's frames over t_max and cracks show it).
   bool visibility = true;
   int visibility_face = 64;
+  // A file that keeps the sampled visible sets between runs over the same scene and view space (a t_max sweep samples
+  // them once): read when it matches (scene object count, view space, region size, face size), written otherwise.
+  // Not part of the saved options. "" = none.
+  std::string visibility_cache;
   placement::HierarchyOptions hierarchy;
   placement::CandidateOptions candidates;
   impostor::LayeredOptions layered;
@@ -68,6 +72,7 @@ struct PlaceReport {
   size_t regions = 0, problem_regions = 0, cpvs = 0, estimates = 0;
   size_t hierarchy_nodes = 0, clustered_objects = 0, geometry_objects = 0;
   size_t visibility_regions = 0, visibility_points = 0;  // regions and points sampled
+  size_t visibility_cached = 0;                          // regions read from the visibility cache
   double mean_visible_objects = 0.0;                     // per sampled region
   double visibility_s = 0.0;
   size_t serves_dropped = 0;  // (candidate, CPV) pairs where the node's visible geometry costs less than the impostor

@@ -65,6 +65,12 @@ struct BenchOptions {
   // The error bound every mode's parallax error is checked against (pixels, > 0); unset = each mode's own
   // info()["error_bound_px"], if any.
   std::optional<double> error_px;
+  // Renders per mode and frame; the frame's times are those of the fastest render (the machine's noise removed; a
+  // mode's first render of a frame also carries its loads, which later renders then skip: see the mode's info for
+  // load times). >= 1.
+  int repeats = 1;
+  // The frame budget (ms, > 0): frames whose wall time exceeds it are counted per mode; unset = not checked.
+  std::optional<double> t_max_ms;
 };
 
 struct ModeResult {
@@ -104,6 +110,8 @@ struct ModeResult {
   std::vector<int> over_bound;
   size_t frames_over_bound = 0;
   size_t frames_checked = 0;
+  // Frames whose wall time exceeds BenchOptions::t_max_ms (0 without it).
+  size_t frames_over_tmax = 0;
   // Popping (eval/temporal_error.h): per frame, with a reference, NaN for the first measured frame. The summary is
   // over the frames that have a value.
   std::vector<double> popping;
@@ -146,6 +154,8 @@ struct BenchResult {
   bool reference = false;
   bool baseline_added = false;  // "full" was not asked for and was added as the baseline
   int bad_pixel_threshold = 8;
+  int repeats = 1;                  // BenchOptions::repeats
+  std::optional<double> t_max_ms;   // BenchOptions::t_max_ms
   std::vector<ModeResult> modes;  // "full" first, then the asked order
   std::vector<SampleFrame> samples;
   std::vector<std::string> plots;  // PNGs relative to out_dir (filled by runPlotScript)

@@ -34,7 +34,7 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
   if (o.database.empty())
     throw Error(std::string("mode '") + runtime::representationName(representation) + "'",
                 "needs a pipeline store: farfield bench --impostors DIR (or --mode-option impostor_dir=DIR), baked "
-                "with farfield bake --pipeline pvs,near-far,mmi");
+                "with farfield bake --pipeline pvs,near-far,single,mmi (placed: farfield place)");
   o.gpu_budget_bytes = uint64_t(numberOption(context, "gpu_budget_mb", double(o.gpu_budget_bytes >> 20), 1.0) * 1048576.0);
   o.read_ahead = switchOption(context, "read_ahead", true);
   o.object_ids = choiceOption(context, "impostor_ids", "object", {"object", "layer"}) == "object";

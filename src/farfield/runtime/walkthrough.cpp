@@ -64,7 +64,7 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
   const Representation kind = options_.representation;
   const std::string me = std::string("walkthrough '") + representationName(kind) + "'";
   if (options_.database.empty())
-    throw Error(me, "needs an impostor database: a directory written by farfield bake --pipeline pvs,near-far,mmi");
+    throw Error(me, "needs an impostor database: a directory written by farfield bake --pipeline pvs,near-far,single,mmi (or farfield place for the placed mode)");
   if (!(options_.error_px >= 0.0) || !std::isfinite(options_.error_px))
     throw Error(me, "error bound must be a finite number of pixels >= 0");
   if (kind == Representation::Placed) {
@@ -78,7 +78,7 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
   const std::string& index_file = opened.index_file;
   if (index_.pipeline.empty())
     throw Error(index_file, "holds no pipeline data (" + me + " needs a store baked with farfield bake --pipeline "
-                            "pvs,near-far,mmi)");
+                            "pvs,near-far,single,mmi)");
   {
     // The stage lists must make a valid pipeline (known stages, in order, online a tail).
     std::string stages, online;

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Automatic impostor placement measured (docs/BENCHMARKS.md, "Placement", after Jeschke et al. 2005, Table 1 and
+# Figure 8): a procedural city with one object per building, the cost profile of this machine (farfield calibrate,
+# 500 validation views), then placement over the whole street area at pedestrian and car eye heights for a sweep of
+# frame budgets at the reference error bound, and the walkthrough benchmark of full, culled and placed along three
+# paths for each budget (every frame rendered 3 times, the fastest kept; full-geometry reference frames). Further
+# rows: other error bounds, halved and doubled CPVs, fewer candidates. tools/place_table.py makes the tables.
+# Usage: scripts/bench_place.sh FARFIELD OUT [SEED] [BLOCKS] [FRAMES] [STRIDE]
+# Environment: TMAXES (default "18 20 22 25 28"), BOUND (px, default 2), REF_TMAX (default 20), BOUNDS (default
+# "1 4"), SIZE (default 512x512), ROWS=0 to skip the extra rows.
+set -euo pipefail
+FARFIELD=${1:-build/release/bin/farfield}
+OUT=${2:-out/bench/place}
+SEED=${3:-1}
+BLOCKS=${4:-100}
+FRAMES=${5:-300}
+STRIDE=${6:-3}
+TMAXES=${TMAXES:-"18 20 22 25 28"}
+BOUND=${BOUND:-2}
+REF_TMAX=${REF_TMAX:-20}
+BOUNDS=${BOUNDS:-"1 4"}
+SIZE=${SIZE:-512x512}
+here=$(cd "$(dirname "$0")" && pwd)
+mkdir -p "$OUT"
+PLACE_COMMON=(--profile "$OUT/profile.json" --max-pitch 20 --size "$SIZE" --fov 45 --visibility-cache "$OUT/visibility.json")
+
+[ -f "$OUT/city.glb" ] || "$FARFIELD" gen city --blocks "$BLOCKS" --seed "$SEED" --objects buildings -o "$OUT/city.glb" \
+  > "$OUT/gen.txt"
+[ -f "$OUT/profile.json" ] || "$FARFIELD" calibrate "$OUT/city.glb" -o "$OUT/profile.json" --views 500 --size "$SIZE" \
+  --fov 45 --csv "$OUT/calibration.csv" > "$OUT/calibrate.txt"
+"$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 2 --fov 45 --seed "$SEED" -o "$OUT/walk.json" \
+  > /dev/null
+"$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 10 --fov 45 --car --seed "$((SEED + 1))" \
+  -o "$OUT/drive.json" > /dev/null
+"$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 4 --fov 45 --seed "$((SEED + 2))" \
+  -o "$OUT/random.json" > /dev/null
+
+place() {  # NAME ARGS...
+  local name=$1
+  shift
+  [ -f "$OUT/$name/placement.json" ] && return 0
+  /usr/bin/time -f "%e s, %M kB" -o "$OUT/$name.time" "$FARFIELD" place "$OUT/city.glb" "${PLACE_COMMON[@]}" \
+    -o "$OUT/$name" "$@" > "$OUT/$name.txt" 2>&1
+}
+
+for t in $TMAXES; do
+  place "place-b$BOUND-t$t" --tmax "$t" --error-px "$BOUND" --cpv-size 46
+  for path in walk drive random; do
+    "$FARFIELD" bench "$OUT/city.glb" --path "$OUT/$path.json" --modes full,culled,placed \
+      --impostors "$OUT/place-b$BOUND-t$t" --reference --size "$SIZE" --repeats 3 --tmax "$t" --error-px "$BOUND" \
+      --stride "$STRIDE" --samples 2 -o "$OUT/bench-$path-t$t" > "$OUT/bench-$path-t$t.txt" 2>&1
+  done
+done
+if [ "${ROWS:-1}" != 0 ]; then
+  for b in $BOUNDS; do place "place-b$b-t$REF_TMAX" --tmax "$REF_TMAX" --error-px "$b" --cpv-size 46; done
+  place "place-cpv-half" --tmax "$REF_TMAX" --error-px "$BOUND" --cpv-size 23 --visibility-cache "$OUT/visibility-23.json"
+  place "place-cpv-double" --tmax "$REF_TMAX" --error-px "$BOUND" --cpv-size 92 --visibility-cache "$OUT/visibility-92.json"
+  place "place-fewer-candidates" --tmax "$REF_TMAX" --error-px "$BOUND" --cpv-size 46 --distance-steps 3
+fi
+python3 "$here/../tools/place_table.py" "$OUT"
