@@ -31,6 +31,13 @@ Vec3 parseVec3(const std::string& option, const std::string& text) {
   return v;
 }
 
+Box3 parseViewSpace(const std::string& view_min, const std::string& view_max) {
+  if (view_min.empty() != view_max.empty())
+    throw Error("--view-min/--view-max", "give both corners of the view space, or neither");
+  if (view_min.empty()) return Box3{};
+  return Box3::fromPoints(parseVec3("--view-min", view_min), parseVec3("--view-max", view_max));
+}
+
 IVec2 parseSize(const std::string& option, const std::string& text) {
   const auto x = text.find('x');
   int w = 0, h = 0;

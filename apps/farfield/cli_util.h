@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "farfield/core/bounds.h"
 #include "farfield/core/math.h"
 
 namespace farfield::app {
@@ -11,6 +12,9 @@ namespace farfield::app {
 Vec3 parseVec3(const std::string& option, const std::string& text);
 // "WxH" -> (W, H), each 1..16384.
 IVec2 parseSize(const std::string& option, const std::string& text);
+// --view-min / --view-max "x,y,z" corners -> the box; both empty -> an empty box (the command's default). Throws for
+// one without the other.
+Box3 parseViewSpace(const std::string& view_min, const std::string& view_max);
 // Creates the parent directory of a file path if needed.
 void ensureParentDirectory(const std::string& file);
 

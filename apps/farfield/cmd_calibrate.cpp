@@ -31,10 +31,7 @@ void runCalibrateCommand(CalibrateArgs& args) {
   const IVec2 size = parseSize("--size", args.size);
   o.width = size.x;
   o.height = size.y;
-  if (args.view_min.empty() != args.view_max.empty())
-    throw Error("--view-min/--view-max", "give both corners of the view space, or neither");
-  if (!args.view_min.empty())
-    o.view_space = Box3::fromPoints(parseVec3("--view-min", args.view_min), parseVec3("--view-max", args.view_max));
+  o.view_space = parseViewSpace(args.view_min, args.view_max);
   const scene::Scene scene = scene::loadScene(args.scene);
   const eval::CalibrateResult r = eval::calibrate(gpu::sharedHeadlessContext(), scene, o);
   ensureParentDirectory(args.out);

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "farfield/core/error.h"
+#include "farfield/core/strict_json.h"
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
 #include "farfield/impostor/depth_mesh.h"
@@ -150,72 +151,10 @@ nlohmann::json pipelineOptionsToJson(const PipelineOptions& o) {
           {"views", layerViewsName(o.views)}};
 }
 
-namespace {
-
-// Strict reading of one JSON object of options: every key the caller asks for must be there with the right type,
-// and keys() lists the ones that were never asked for (unknown keys are errors, not ignored).
-class StrictOptions {
- public:
-  StrictOptions(const nlohmann::json& j, std::string where) : j_(j), where_(std::move(where)) {
-    if (!j_.is_object()) throw Error(where_, "pipeline options must be an object");
-  }
-  bool has(const char* key) const { return j_.contains(key); }
-  const nlohmann::json& at(const char* key) {
-    const auto it = j_.find(key);
-    if (it == j_.end()) throw Error(where_, std::string("pipeline option \"") + key + "\" is missing");
-    seen_.push_back(key);
-    return *it;
-  }
-  template <typename T>
-  void number(const char* key, T& out) {
-    const nlohmann::json& v = at(key);
-    if (!v.is_number()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be a number");
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) throw Error(where_, std::string("pipeline option \"") + key + "\" is not finite");
-    if constexpr (std::is_integral_v<T>) {
-      if (d != std::floor(d) || d < double(std::numeric_limits<T>::min()) || d > double(std::numeric_limits<T>::max()))
-        throw Error(where_, std::string("pipeline option \"") + key + "\" must be an integer in range");
-    }
-    out = T(d);
-  }
-  std::string text(const char* key) {
-    const nlohmann::json& v = at(key);
-    if (!v.is_string()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be a string");
-    return v.get<std::string>();
-  }
-  bool boolean(const char* key) {
-    const nlohmann::json& v = at(key);
-    if (!v.is_boolean()) throw Error(where_, std::string("pipeline option \"") + key + "\" must be true or false");
-    return v.get<bool>();
-  }
-  // One of `names` (the first maps to 0, ...).
-  size_t choice(const char* key, std::initializer_list<const char*> names) {
-    const std::string v = text(key);
-    size_t i = 0;
-    std::string list;
-    for (const char* n : names) {
-      if (v == n) return i;
-      list += (i++ ? ", " : "") + std::string(n);
-    }
-    throw Error(where_, std::string("pipeline option \"") + key + "\": unknown value '" + v + "' (expected " + list + ")");
-  }
-  void rejectUnknown() const {
-    for (const auto& [key, value] : j_.items())
-      if (std::find(seen_.begin(), seen_.end(), key) == seen_.end())
-        throw Error(where_, "unknown pipeline option \"" + key + "\"");
-  }
-
- private:
-  const nlohmann::json& j_;
-  std::string where_;
-  std::vector<std::string> seen_;
-};
-
-}  // namespace
 
 PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::string& source, int store_version) {
   PipelineOptions o;
-  StrictOptions r(j, source);
+  StrictJson r(j, source, "pipeline option");
   r.number("resolution", o.base.resolution);
   r.number("fov_deg", o.base.fov_deg);
   r.number("eye_height", o.base.eye_height);
@@ -228,7 +167,7 @@ PipelineOptions pipelineOptionsFromJson(const nlohmann::json& j, const std::stri
     r.number("frame_height", o.frame_height);
     r.number("frame_fov_deg", o.frame_fov_deg);
     r.number("station_spacing", o.station_spacing);
-    StrictOptions v(r.at("validity"), source + ": validity");
+    StrictJson v(r.at("validity"), source + ": validity", "pipeline option");
     v.number("step", o.validity.step);
     v.number("back", o.validity.back);
     v.number("width_share", o.validity.width_share);

@@ -11,6 +11,8 @@
 // file must be checkable alone, before it is parsed.
 #include "farfield/store/impostor_store.h"
 
+#include "farfield/store/json_fields.h"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -153,115 +155,12 @@ bool isStoreFileName(const std::string& relative) {
   return g > 0 && name == streetsFileName(g);
 }
 
-nlohmann::json vec3Json(const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
-
 nlohmann::json cameraJson(const Camera& c) {
   return {{"eye", vec3Json(c.eye)}, {"at", vec3Json(c.at)},      {"up", vec3Json(c.up)},
           {"fov_y", c.fov_y},       {"width", c.width},          {"height", c.height},
           {"near", c.near_plane},   {"far", c.far_plane}};
 }
 
-// Typed access with errors naming the source and the element.
-class JsonReader {
- public:
-  JsonReader(const std::string& source) : source_(source) {}
-  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
-    throw Error(source_, where + ": " + what);
-  }
-  const nlohmann::json& member(const nlohmann::json& j, const char* key, const std::string& where) const {
-    if (!j.is_object()) fail(where, "expected an object");
-    const auto it = j.find(key);
-    if (it == j.end()) fail(where, std::string("missing \"") + key + "\"");
-    return *it;
-  }
-  double number(const nlohmann::json& j, const char* key, const std::string& where) const {
-    const nlohmann::json& v = member(j, key, where);
-    if (!v.is_number()) fail(where, std::string("\"") + key + "\" must be a number");
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(where, std::string("\"") + key + "\" is not finite");
-    return d;
-  }
-  uint64_t count(const nlohmann::json& j, const char* key, const std::string& where) const {
-    const nlohmann::json& v = member(j, key, where);
-    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<int64_t>() >= 0))
-      fail(where, std::string("\"") + key + "\" must be a non-negative integer");
-    return v.get<uint64_t>();
-  }
-  std::string text(const nlohmann::json& j, const char* key, const std::string& where) const {
-    const nlohmann::json& v = member(j, key, where);
-    if (!v.is_string()) fail(where, std::string("\"") + key + "\" must be a string");
-    return v.get<std::string>();
-  }
-  // A file name relative to the store directory: no absolute path, no "..".
-  std::string relativeFile(const nlohmann::json& j, const char* key, const std::string& where,
-                           bool allow_empty) const {
-    const std::string name = text(j, key, where);
-    if (name.empty()) {
-      if (!allow_empty) fail(where, std::string("\"") + key + "\" is empty");
-      return name;
-    }
-    const fs::path p(name);
-    if (p.is_absolute()) fail(where, std::string("\"") + key + "\" must be relative to the store directory");
-    for (const fs::path& part : p)
-      if (part == "..") fail(where, std::string("\"") + key + "\" must not contain \"..\"");
-    return name;
-  }
-  Vec3 vec3(const nlohmann::json& j, const char* key, const std::string& where) const {
-    const nlohmann::json& v = member(j, key, where);
-    if (!v.is_array() || v.size() != 3) fail(where, std::string("\"") + key + "\" must be [x, y, z]");
-    Vec3 out;
-    for (int i = 0; i < 3; ++i) {
-      if (!v[size_t(i)].is_number()) fail(where, std::string("\"") + key + "\" must hold numbers");
-      out[i] = v[size_t(i)].get<float>();
-    }
-    if (!isFinite(out)) fail(where, std::string("\"") + key + "\" is not finite");
-    return out;
-  }
-  Camera camera(const nlohmann::json& j, const std::string& where) const {
-    const nlohmann::json& c = member(j, "camera", where);
-    const std::string at = where + ": camera";
-    Camera cam;
-    cam.eye = vec3(c, "eye", at);
-    cam.at = vec3(c, "at", at);
-    cam.up = vec3(c, "up", at);
-    cam.fov_y = float(number(c, "fov_y", at));
-    cam.width = int(count(c, "width", at));
-    cam.height = int(count(c, "height", at));
-    cam.near_plane = float(number(c, "near", at));
-    cam.far_plane = float(number(c, "far", at));
-    try {
-      cam.validate("camera");
-    } catch (const Error& e) {
-      fail(at, e.what());
-    }
-    return cam;
-  }
-
- private:
-  std::string source_;
-};
-
-// "KEY_crc32" and "KEY_bytes" next to a file name (version 3, non-empty names with a known check).
-void putCheck(nlohmann::json& j, const std::string& key, const std::string& file, const FileCheck& check,
-              bool with_checks) {
-  if (!with_checks || file.empty() || !check.known) return;
-  j[key + "_crc32"] = check.crc32;
-  j[key + "_bytes"] = check.bytes;
-}
-
-// The check of the file named by j[key]: required for non-empty names in version 3 indexes, read whenever present.
-FileCheck readCheck(const JsonReader& r, const nlohmann::json& j, const std::string& key, const std::string& where,
-                    const std::string& file, bool required) {
-  FileCheck check;
-  const std::string crc_key = key + "_crc32", bytes_key = key + "_bytes";
-  if (file.empty() || (!required && !j.contains(crc_key) && !j.contains(bytes_key))) return check;
-  const uint64_t crc = r.count(j, crc_key.c_str(), where);
-  if (crc > 0xffffffffu) r.fail(where, "\"" + crc_key + "\" must be a CRC-32 (0..4294967295)");
-  check.crc32 = uint32_t(crc);
-  check.bytes = r.count(j, bytes_key.c_str(), where);
-  check.known = true;
-  return check;
-}
 
 nlohmann::json viewJson(const StoredView& v, bool with_checks) {
   nlohmann::json j = {{"camera", cameraJson(v.camera)}, {"texture", v.texture},   {"mesh", v.mesh},
@@ -306,22 +205,6 @@ nlohmann::json pipelineJson(const CellPipeline& p, int version) {
     if (version <= 3) j["mmi"]["single"] = layerJson(p.single, with_checks);
   }
   return j;
-}
-
-std::vector<uint32_t> readIds(const JsonReader& r, const nlohmann::json& j, const char* key, const std::string& where,
-                              size_t scene_objects) {
-  const nlohmann::json& list = r.member(j, key, where);
-  if (!list.is_array()) r.fail(where, std::string("\"") + key + "\" must be an array of object ids");
-  std::vector<uint32_t> ids;
-  ids.reserve(list.size());
-  for (const nlohmann::json& id : list) {
-    if (!id.is_number_unsigned() || id.get<uint64_t>() == 0 || id.get<uint64_t>() > scene_objects)
-      r.fail(where, std::string("\"") + key + "\" holds an id outside 1.." + std::to_string(scene_objects));
-    ids.push_back(id.get<uint32_t>());
-  }
-  if (std::adjacent_find(ids.begin(), ids.end(), std::greater_equal<uint32_t>()) != ids.end())
-    r.fail(where, std::string("\"") + key + "\" must be ascending without repeats");
-  return ids;
 }
 
 impostor::ValidityRegion readValidity(const JsonReader& r, const nlohmann::json& m, const std::string& at) {

@@ -691,6 +691,7 @@ std::optional<uint32_t> lookupLeaf(const PlacementIndex& index, const Vec3& eye)
   size_t at = 0;
   while (nodes[at].children[0] >= 0) {
     const int lower = nodes[at].children[0], upper = nodes[at].children[1];
+    // Guards for an index built in memory and never checked (a read index always passes them).
     if (lower <= int(at) || upper <= int(at) || size_t(lower) >= nodes.size() || size_t(upper) >= nodes.size())
       return std::nullopt;
     at = nodes[size_t(lower)].box.contains(eye) ? size_t(lower) : size_t(upper);
@@ -699,17 +700,9 @@ std::optional<uint32_t> lookupLeaf(const PlacementIndex& index, const Vec3& eye)
 }
 
 std::optional<uint32_t> lookupCpv(const PlacementIndex& index, const Vec3& eye, const Vec3& dir) {
-  const std::vector<StoredViewSpaceNode>& nodes = index.nodes;
-  if (nodes.empty() || !nodes[0].box.contains(eye)) return std::nullopt;
-  size_t at = 0;
-  while (nodes[at].children[0] >= 0) {
-    const int lower = nodes[at].children[0], upper = nodes[at].children[1];
-    // Guards for an index built in memory and never checked (a read index always passes them).
-    if (lower <= int(at) || upper <= int(at) || size_t(lower) >= nodes.size() || size_t(upper) >= nodes.size())
-      return std::nullopt;
-    at = nodes[size_t(lower)].box.contains(eye) ? size_t(lower) : size_t(upper);
-  }
-  const StoredViewSpaceNode& leaf = nodes[at];
+  const std::optional<uint32_t> leaf_index = lookupLeaf(index, eye);
+  if (!leaf_index) return std::nullopt;
+  const StoredViewSpaceNode& leaf = index.nodes[*leaf_index];
   const uint64_t end = std::min<uint64_t>(uint64_t(leaf.cpv_first) + leaf.cpv_count, index.cpvs.size());
   for (uint64_t k = leaf.cpv_first; k < end; ++k)
     if (index.cpvs[k].region.contains(eye) && index.cpvs[k].vdi.contains(dir)) return uint32_t(k);
