@@ -1,0 +1,88 @@
+// `farfield calibrate` (eval/calibration.h): random views lie in the view space and repeat with the seed; the safety
+// factor taken at the quantile 1 bounds every validation view it was derived from, and a lower quantile leaves the
+// share of views above it that the quantile says; bad options are errors.
+#include "farfield/eval/calibration.h"
+
+#include <gtest/gtest.h>
+
+#include "farfield/core/error.h"
+#include "farfield/gen/city.h"
+#include "farfield/gpu/context.h"
+
+namespace farfield::eval {
+namespace {
+
+const scene::Scene& smallCity() {
+  static const scene::Scene* s = [] {
+    gen::CityOptions o;
+    o.blocks = 12;
+    o.detail = 0;
+    o.seed = 8;
+    o.objects = gen::ObjectGrouping::Buildings;
+    return new scene::Scene(gen::generateCity(o).scene);
+  }();
+  return *s;
+}
+
+TEST(CalibrationTest, RandomViewsLieInTheViewSpaceAndRepeat) {
+  const Box3 space = Box3::fromPoints(Vec3(-10, -20, 1), Vec3(30, 5, 2));
+  const std::vector<Camera> a = randomViews(space, 200, 4, 64, 48, 45.0f, 0.5f, 1000.0f);
+  const std::vector<Camera> b = randomViews(space, 200, 4, 64, 48, 45.0f, 0.5f, 1000.0f);
+  ASSERT_EQ(a.size(), 200u);
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_TRUE(space.contains(a[i].eye));
+    EXPECT_EQ(a[i].eye, b[i].eye);
+    EXPECT_EQ(a[i].at, b[i].at);
+    const Vec3 d = glm::normalize(a[i].at - a[i].eye);
+    EXPECT_LE(std::abs(std::asin(d.z)), degToRad(10.0) + 1e-5);  // pitch within 10 degrees
+    EXPECT_EQ(a[i].width, 64);
+  }
+}
+
+TEST(CalibrationTest, TheSafetyFactorBoundsTheViewsItCameFrom) {
+  CalibrateOptions o;
+  o.width = o.height = 64;
+  o.views = 24;
+  o.fit_views = 12;
+  o.repeats = 1;
+  o.progress = false;
+  const CalibrateResult r = calibrate(gpu::sharedHeadlessContext(), smallCity(), o);
+  ASSERT_EQ(r.checks.size(), 24u);
+  EXPECT_GE(r.profile.safety_factor, 1.0);
+  EXPECT_EQ(r.over_bound, 0u);  // quantile 1: the largest ratio
+  size_t over = 0;
+  for (const ViewCheck& c : r.checks) {
+    EXPECT_GT(c.predicted_ms, 0.0);
+    EXPECT_GT(c.measured_ms, 0.0);
+    over += c.measured_ms > c.predicted_ms * r.profile.safety_factor * (1 + 1e-12) ? 1 : 0;
+  }
+  EXPECT_EQ(over, 0u);
+  EXPECT_LE(r.ratio_p50, r.ratio_max);
+  EXPECT_EQ(r.profile.width, 64);
+  EXPECT_EQ(r.profile.validation["views"], 24);
+  // A lower quantile leaves views above the bound, about as many as it says (24 views: quantile 0.5 -> ~12).
+  o.margin_quantile = 0.5;
+  const CalibrateResult half = calibrate(gpu::sharedHeadlessContext(), smallCity(), o);
+  EXPECT_GE(half.over_bound, 6u);
+  EXPECT_LE(half.over_bound, 18u);
+}
+
+TEST(CalibrationTest, BadOptionsAreErrors) {
+  CalibrateOptions o;
+  o.progress = false;
+  o.views = 3;
+  EXPECT_THROW(calibrate(gpu::sharedHeadlessContext(), smallCity(), o), Error);
+  o = CalibrateOptions{};
+  o.margin_quantile = 0.0;
+  EXPECT_THROW(calibrate(gpu::sharedHeadlessContext(), smallCity(), o), Error);
+  o = CalibrateOptions{};
+  o.repeats = 0;
+  EXPECT_THROW(calibrate(gpu::sharedHeadlessContext(), smallCity(), o), Error);
+  o = CalibrateOptions{};
+  o.fit_views = 2;
+  EXPECT_THROW(calibrate(gpu::sharedHeadlessContext(), smallCity(), o), Error);
+  EXPECT_THROW(calibrate(gpu::sharedHeadlessContext(), scene::Scene{}, CalibrateOptions{}), Error);
+}
+
+}  // namespace
+}  // namespace farfield::eval

@@ -1,0 +1,85 @@
+// The cost profile (gpu/cost_profile.h): saved whole and read back strictly; the bound is the prediction times the
+// safety factor.
+#include "farfield/gpu/cost_profile.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "farfield/core/error.h"
+#include "support/test_support.h"
+
+namespace farfield::gpu {
+namespace {
+
+CostProfile oddProfile() {
+  CostProfile p;
+  p.model.base_ms = 1.25;
+  p.model.ms_per_mtriangle = 3.5;
+  p.model.ms_per_draw = 0.0625;
+  p.model.ms_per_mpixel = 0.75;
+  p.model.samples = 17;
+  p.model.rms_error_ms = 0.5;
+  p.model.r2 = 0.875;
+  p.safety_factor = 1.5;
+  p.width = 640;
+  p.height = 360;
+  p.fov_y_deg = 52.5;
+  p.renderer = "test renderer";
+  p.validation = {{"views", 500}};
+  return p;
+}
+
+TEST(CostProfileTest, RoundTripAndBound) {
+  const std::string file = (test::scratchDir("cost_profile") / "profile.json").string();
+  const CostProfile p = oddProfile();
+  saveCostProfile(p, file);
+  const CostProfile q = loadCostProfile(file);
+  EXPECT_EQ(q.toJson(), p.toJson());
+  // By hand: (1.25 + 3.5 * 2 + 0.0625 * 100 + 0.75 * 1) * 1.5.
+  EXPECT_DOUBLE_EQ(q.boundMs(2e6, 100, 1e6), (1.25 + 7.0 + 6.25 + 0.75) * 1.5);
+}
+
+TEST(CostProfileTest, StrictReadNamesTheKey) {
+  const nlohmann::json good = oddProfile().toJson();
+  const auto expectError = [](const nlohmann::json& j, const std::string& part) {
+    try {
+      CostProfile::fromJson(j, "profile.json");
+      ADD_FAILURE() << "expected an error naming " << part;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("profile.json"), std::string::npos) << e.what();
+    }
+  };
+  nlohmann::json j = good;
+  j["extra"] = 1;
+  expectError(j, "extra");
+  j = good;
+  j.erase("safety_factor");
+  expectError(j, "safety_factor");
+  j = good;
+  j["safety_factor"] = 0.5;  // a bound below the prediction
+  expectError(j, "safety_factor");
+  j = good;
+  j["model"]["ms_per_draw"] = -1.0;
+  expectError(j, "ms_per_draw");
+  j = good;
+  j["model"]["colour"] = 1;
+  expectError(j, "colour");
+  j = good;
+  j["version"] = 2;
+  expectError(j, "version");
+  j = good;
+  j["format"] = "something";
+  expectError(j, "format");
+  j = good;
+  j["width"] = "wide";
+  expectError(j, "width");
+  EXPECT_THROW(loadCostProfile((test::scratchDir("cost_profile_missing") / "none.json").string()), Error);
+  const std::string garbage = (test::scratchDir("cost_profile_garbage") / "bad.json").string();
+  std::ofstream(garbage) << "{not json";
+  EXPECT_THROW(loadCostProfile(garbage), Error);
+}
+
+}  // namespace
+}  // namespace farfield::gpu
