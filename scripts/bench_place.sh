@@ -3,7 +3,8 @@
 # Figure 8): a procedural city with one object per building, the cost profile of this machine (farfield calibrate,
 # 500 validation views), then placement over the whole street area at pedestrian and car eye heights for a sweep of
 # frame budgets at the reference error bound, and the walkthrough benchmark of full, culled and placed along three
-# paths for each budget (every frame rendered 3 times, the fastest kept; full-geometry reference frames). Further
+# paths for each budget (a walk, a drive, and independent random views of the view space; every frame rendered 3
+# times, the fastest kept; full-geometry reference frames). Further
 # rows: other error bounds, halved and doubled CPVs, fewer candidates. tools/place_table.py makes the tables.
 # Usage: scripts/bench_place.sh FARFIELD OUT [SEED] [BLOCKS] [FRAMES] [STRIDE]
 # Environment: TMAXES (default "18 20 22 25 28"), BOUND (px, default 2), REF_TMAX (default 20), BOUNDS (default
@@ -32,8 +33,8 @@ PLACE_COMMON=(--profile "$OUT/profile.json" --max-pitch 20 --size "$SIZE" --fov 
   > /dev/null
 "$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 10 --fov 45 --car --seed "$((SEED + 1))" \
   -o "$OUT/drive.json" > /dev/null
-"$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 4 --fov 45 --seed "$((SEED + 2))" \
-  -o "$OUT/random.json" > /dev/null
+"$FARFIELD" path views "$OUT/city.glb" --frames "$FRAMES" --fov 45 --seed "$((SEED + 2))" -o "$OUT/random.json" \
+  > /dev/null
 
 place() {  # NAME ARGS...
   local name=$1
@@ -46,6 +47,7 @@ place() {  # NAME ARGS...
 for t in $TMAXES; do
   place "place-b$BOUND-t$t" --tmax "$t" --error-px "$BOUND" --cpv-size 46
   for path in walk drive random; do
+    [ -f "$OUT/bench-$path-t$t/bench.json" ] && continue
     "$FARFIELD" bench "$OUT/city.glb" --path "$OUT/$path.json" --modes full,culled,placed \
       --impostors "$OUT/place-b$BOUND-t$t" --reference --size "$SIZE" --repeats 3 --tmax "$t" --error-px "$BOUND" \
       --stride "$STRIDE" --samples 2 -o "$OUT/bench-$path-t$t" > "$OUT/bench-$path-t$t.txt" 2>&1

@@ -1,5 +1,6 @@
 // farfield path street STREETS.json [--frames N] [--seed S] [--car] [--fps F] [--fov DEG] [--turn-radius M] -o FILE
 // farfield path flyover SCENE [--frames N] [--fps F] [--altitude M] [--fov DEG] -o FILE
+// farfield path views SCENE [--frames N] [--seed S] [--view-min X,Y,Z --view-max X,Y,Z] [--fov DEG] -o FILE
 // farfield path orbit SCENE [--frames N] [--fps F] [--radius-scale K] [--elevation DEG] [--fov DEG] -o FILE
 // Writes a camera path (JSON, see farfield/gen/camera_path.h) for the walkthrough benchmark.
 #include <cstdio>
@@ -8,7 +9,9 @@
 
 #include "cli_util.h"
 #include "command.h"
+#include "farfield/bake/place.h"
 #include "farfield/core/error.h"
+#include "farfield/eval/calibration.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gen/city.h"
 #include "farfield/scene/import.h"
@@ -30,6 +33,7 @@ struct PathArgs {
   float altitude = 150.0f;
   float radius_scale = 1.2f;
   float elevation_deg = 25.0f;
+  std::string view_min, view_max;
 };
 
 void writeAndReport(const gen::CameraPath& path, const std::string& output, const std::string& what) {
@@ -98,8 +102,23 @@ void addCommon(CLI::App* cmd, PathArgs& args) {
   cmd->add_option("-o,--output", args.output, "Output camera path (.json)")->required();
 }
 
+// Independent random views of a view space (eye uniform in the box, any heading, pitch within 10 degrees): the
+// "random path" of placement's experiments, which visits problem views a street walk may never reach.
+void runViews(const PathArgs& args) {
+  const scene::Scene scene = scene::loadScene(args.input);
+  Box3 space = parseViewSpace(args.view_min, args.view_max);
+  if (space.empty()) space = bake::defaultPlaceViewSpace(scene);
+  const float fov = args.fov_deg > 0.0f ? args.fov_deg : 45.0f;
+  gen::CameraPath path;
+  path.kind = "random views";
+  path.fps = args.fps;
+  for (const Camera& c : eval::randomViews(space, size_t(args.frames), uint32_t(args.seed), 64, 64, fov, 0.5f, 1.0f))
+    path.frames.push_back({c.eye, c.at, Vec3(0.0f, 0.0f, 1.0f), c.fov_y});
+  writeAndReport(path, args.output, "random views");
+}
+
 const RegisterCommand reg("path", [](CLI::App& app) {
-  auto* cmd = app.add_subcommand("path", "Write a camera path: a street walk, a flyover or an orbit.");
+  auto* cmd = app.add_subcommand("path", "Write a camera path: a street walk, random views, a flyover or an orbit.");
   cmd->require_subcommand(1);
 
   auto street = std::make_shared<PathArgs>();
@@ -119,6 +138,16 @@ const RegisterCommand reg("path", [](CLI::App& app) {
   addCommon(f, *fly);
   f->add_option("--altitude", fly->altitude, "Height above the lowest point of the scene, metres");
   f->callback([fly] { runFlyover(*fly); });
+
+  auto views = std::make_shared<PathArgs>();
+  auto* v = cmd->add_subcommand("views", "Independent random views of a view space (eye in a box, any heading, "
+                                         "pitch within 10 degrees).");
+  v->add_option("scene", views->input, "Scene file or builtin:NAME")->required();
+  addCommon(v, *views);
+  v->add_option("--seed", views->seed, "Random seed");
+  v->add_option("--view-min", views->view_min, "View space corner X,Y,Z (default: the scene's bounds at 1.2-1.7 m)");
+  v->add_option("--view-max", views->view_max, "View space corner X,Y,Z");
+  v->callback([views] { runViews(*views); });
 
   auto orb = std::make_shared<PathArgs>();
   auto* o = cmd->add_subcommand("orbit", "A circle around the scene's bounds, looking at their centre.");
