@@ -39,6 +39,10 @@ expect_error("badpath.json" path street ${WORK}/badpath.json -o ${WORK}/p.json)
 expect_error("--blocks" gen city --blocks 5 -o ${WORK}/c.glb)
 expect_error("badpath.json" walk builtin:cubes --path ${WORK}/badpath.json --mode full)
 expect_error("nopath.json" bench builtin:cubes --path ${WORK}/nopath.json --modes full -o ${WORK}/b)
+expect_error("--view-min" path views builtin:cubes --view-min 1,2 --view-max 3,4,5 -o ${WORK}/v.json)
+expect_error("--view-min/--view-max" path views builtin:cubes --view-min 1,2,3 -o ${WORK}/v.json)
+expect_error("profile.json" place builtin:cubes --profile ${WORK}/profile.json -o ${WORK}/placed)
+expect_error("--tmax" bench builtin:cubes --path ${WORK}/nopath.json --tmax -3 -o ${WORK}/b)
 # A mode option no mode of the run reads (a typo) is refused, after the modes are made.
 execute_process(COMMAND ${FARFIELD} path orbit builtin:cubes --frames 2 -o ${WORK}/orbit.json RESULT_VARIABLE rc
                 OUTPUT_QUIET)
