@@ -7,6 +7,10 @@ import re
 import sys
 
 
+def disk_bytes(directory):
+    return sum(os.path.getsize(os.path.join(root, f)) for root, _, files in os.walk(directory) for f in files)
+
+
 def placement_rows(out):
     rows = []
     for name in sorted(os.listdir(out)):
@@ -19,11 +23,11 @@ def placement_rows(out):
             os.path.join(out, name + ".time")) else "?"
         rows.append("| %s | %.0f | %.0f | %d | %d | %d | %d | %.1f | %.1f | %d | %.1f | %.1f | %.1f | %.1f | %s |" % (
             name, o["t_max_ms"], o["error_px"], s["cpvs"], s["candidates_kept"] - s["candidates_unplannable"],
-            s["impostors"], s["unsolved_cpvs"], s["memory_bytes"] / 2**20, s["written_bytes"] / 2**20,
-            s["impostors_freed"], s["visibility_s"], s["view_space_s"] - s["visibility_s"], s["candidates_s"],
+            s["impostors"], s["unsolved_cpvs"], s["memory_bytes"] / 2**20, disk_bytes(os.path.join(out, name)) / 2**20,
+            s["impostors_freed"], s["visibility_s"] if s.get("visibility_cached", 0) == 0 else float("nan"), s["view_space_s"] - s["visibility_s"], s["candidates_s"],
             s["greedy_s"] + s["capture_s"], wall))
     head = ("| run | t_max ms | bound px | CPVs | candidates | impostors | unsolved CPVs | GPU MB | disk MB | freed | "
-            "visibility s | view space s | candidates s | greedy + capture s | wall |\n|" + "---|" * 15)
+            "visibility s (nan: cached) | view space s | candidates s | greedy + capture s | wall |\n|" + "---|" * 15)
     return head + "\n" + "\n".join(rows)
 
 

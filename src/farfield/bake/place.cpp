@@ -436,6 +436,8 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   report.impostors_freed = report.impostors_generated - report.impostors;
   report.unsolved_cpvs = result.unsolved.size();
   report.memory_bytes = result.memory;
+  for (const store::StoredPlacedImpostor& imp : index.impostors)  // the data files (the index comes on top)
+    for (const store::StoredImpostorLayer& l : imp.layers) report.written_bytes += l.texture_check.bytes + l.ids_check.bytes;
   index.summary = report.toJson();
   store::writePlacementIndex(out_dir, index);
   // writePlacementIndex removed the files of the impostors the greedy freed (no longer named by the index).

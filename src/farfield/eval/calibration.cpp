@@ -146,7 +146,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   result.abs_error_max_ms = quantile(errors, 1.0);
   profile.safety_factor = std::max(1.0, quantile(ratios, options.margin_quantile));
   for (const ViewCheck& c : result.checks)
-    if (c.measured_ms > c.predicted_ms * profile.safety_factor) ++result.over_bound;
+    if (c.measured_ms / std::max(c.predicted_ms, 1e-6) > profile.safety_factor) ++result.over_bound;  // as ratios
   result.wall_s = wall.seconds();
   profile.validation = {{"views", result.checks.size()},
                         {"repeats", options.repeats},
