@@ -11,6 +11,8 @@
 // file must be checkable alone, before it is parsed.
 #include "farfield/store/impostor_store.h"
 
+#include "farfield/store/generation_names.h"
+
 #include "farfield/store/json_fields.h"
 
 #include <fcntl.h>
@@ -120,22 +122,6 @@ std::string hex32(uint32_t v) {
   char buf[16];
   std::snprintf(buf, sizeof(buf), "%08x", v);
   return buf;
-}
-
-std::string generationPrefix(uint64_t generation) {
-  if (generation == 0) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "g%06llu.", static_cast<unsigned long long>(generation));
-  return buf;
-}
-
-// The generation in a store file name "gG.<rest>" (0 when the name has none).
-uint64_t generationOf(const std::string& name) {
-  if (name.size() < 3 || name[0] != 'g') return 0;
-  size_t k = 1;
-  uint64_t g = 0;
-  while (k < name.size() && name[k] >= '0' && name[k] <= '9' && k < 19) g = g * 10 + uint64_t(name[k++] - '0');
-  return k >= 7 && k < name.size() && name[k] == '.' ? g : 0;
 }
 
 // Names the store writes: cells/eNNNNNN.* (versions 1, 2), cells/gG.*, streets.json, gG.streets.json, index.json.tmp

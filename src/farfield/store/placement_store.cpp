@@ -13,6 +13,8 @@
 // ids are packed in RGBA like the impostor store's layer views (PNG keeps them exactly).
 #include "farfield/store/placement_store.h"
 
+#include "farfield/store/generation_names.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -39,21 +41,6 @@ constexpr char kImpostorDir[] = "impostors";
 
 std::string joinPath(const std::string& dir, const std::string& relative) {
   return (fs::path(dir) / relative).string();
-}
-
-std::string generationPrefix(uint64_t generation) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "g%06llu.", static_cast<unsigned long long>(generation));
-  return buf;
-}
-
-// The generation in a file name "gG.<rest>" (six or more digits; 0 when the name has none).
-uint64_t generationOf(const std::string& name) {
-  if (name.size() < 3 || name[0] != 'g') return 0;
-  size_t k = 1;
-  uint64_t g = 0;
-  while (k < name.size() && name[k] >= '0' && name[k] <= '9' && k < 19) g = g * 10 + uint64_t(name[k++] - '0');
-  return k >= 7 && k < name.size() && name[k] == '.' ? g : 0;
 }
 
 // fsync of a directory, so that the renames into it are durable before the index that names the files is.
