@@ -658,7 +658,7 @@ impostor::DepthMeshImpostor meshFromBytes(const std::string& bytes, const std::s
   out.triangle_ids.resize(t);
   const char* p = bytes.data() + kMeshHeaderBytes;
   const auto take = [&](void* dst, size_t n) {
-    std::memcpy(dst, p, n);
+    if (n > 0) std::memcpy(dst, p, n);  // an empty vector's data() may be null: memcpy must not see it
     p += n;
   };
   take(m.positions.data(), 12 * v);
