@@ -51,7 +51,8 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   bvh_.queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
   std::sort(ids_.begin(), ids_.end());
   // From-region visibility: where placement sampled what the region sees, only that is drawn (its times assumed it).
-  if (const std::optional<uint32_t> leaf = store::lookupLeaf(p.index, camera.eye)) {
+  const std::optional<uint32_t> leaf = store::lookupLeaf(p.index, camera.eye);
+  if (leaf) {
     const store::StoredViewSpaceNode& node = p.index.nodes[*leaf];
     if (node.has_visible) {
       ids_.erase(std::remove_if(ids_.begin(), ids_.end(),
@@ -63,7 +64,8 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
     }
   }
 
-  const std::optional<uint32_t> cpv = store::lookupCpv(p.index, camera.eye, camera.forward());
+  const std::optional<uint32_t> cpv =
+      leaf ? store::cpvInLeaf(p.index, *leaf, camera.eye, camera.forward()) : std::nullopt;
   std::vector<uint32_t> drawn;  // impostor ids drawn this frame
   if (cpv) {
     ++p.stats.cpv_frames;
@@ -81,16 +83,16 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
         r.error_rad = imp.plan.error_angle;
         r.bytes = r.gpu->gpuBytes();
         p.resident_bytes += r.bytes;
-        it = p.resident.emplace(id, std::move(r)).first;
         p.lru.push_front(id);
+        r.lru = p.lru.begin();
+        it = p.resident.emplace(id, std::move(r)).first;
         report.loaded = true;
         ++p.stats.loads;
         const double ms = timer.milliseconds();
         p.stats.load_ms_total += ms;
         p.stats.load_ms_max = std::max(p.stats.load_ms_max, ms);
       } else {
-        p.lru.remove(id);
-        p.lru.push_front(id);
+        p.lru.splice(p.lru.begin(), p.lru, it->second.lru);  // most recent first, in constant time
       }
       // The impostor keeps this frame's bound where the eye is in its shaft and its plan's error fits the frame's
       // pixel (a camera narrower or larger than the placement's frames has smaller pixels).

@@ -18,6 +18,7 @@ struct Walkthrough::Placed {
     std::unique_ptr<impostor::GpuLayeredImpostor> gpu;
     double error_rad = 0.0;  // the plan's parallax bound from its shaft
     uint64_t bytes = 0;
+    std::list<uint32_t>::iterator lru;  // its place in Placed::lru
   };
   store::PlacementIndex index;
   std::unordered_map<uint32_t, Resident> resident;  // by impostor id

@@ -687,9 +687,13 @@ std::optional<uint32_t> lookupLeaf(const PlacementIndex& index, const Vec3& eye)
 }
 
 std::optional<uint32_t> lookupCpv(const PlacementIndex& index, const Vec3& eye, const Vec3& dir) {
-  const std::optional<uint32_t> leaf_index = lookupLeaf(index, eye);
-  if (!leaf_index) return std::nullopt;
-  const StoredViewSpaceNode& leaf = index.nodes[*leaf_index];
+  const std::optional<uint32_t> leaf = lookupLeaf(index, eye);
+  return leaf ? cpvInLeaf(index, *leaf, eye, dir) : std::nullopt;
+}
+
+std::optional<uint32_t> cpvInLeaf(const PlacementIndex& index, uint32_t leaf_index, const Vec3& eye, const Vec3& dir) {
+  if (leaf_index >= index.nodes.size()) return std::nullopt;
+  const StoredViewSpaceNode& leaf = index.nodes[leaf_index];
   const uint64_t end = std::min<uint64_t>(uint64_t(leaf.cpv_first) + leaf.cpv_count, index.cpvs.size());
   for (uint64_t k = leaf.cpv_first; k < end; ++k)
     if (index.cpvs[k].region.contains(eye) && index.cpvs[k].vdi.contains(dir)) return uint32_t(k);

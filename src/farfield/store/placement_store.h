@@ -187,6 +187,8 @@ std::optional<uint32_t> lookupLeaf(const PlacementIndex& index, const Vec3& eye)
 // when the eye is on both) and returns the first of the leaf's CPVs whose region contains the eye and whose VDI holds
 // `dir` (non-zero; need not be unit); none outside the view space or when no CPV there holds the view.
 std::optional<uint32_t> lookupCpv(const PlacementIndex& index, const Vec3& eye, const Vec3& dir);
+// The same within a leaf already found by lookupLeaf (a caller that needs both walks the BSP once).
+std::optional<uint32_t> cpvInLeaf(const PlacementIndex& index, uint32_t leaf, const Vec3& eye, const Vec3& dir);
 
 // Bytes on disk of DIR/placement.json and of every file the index names (for reports). Throws farfield::Error naming
 // a file that is missing.
