@@ -1,0 +1,83 @@
+// The viewer's frames: one mode at a time, switchable while running, drawn into one render target with the shared
+// renderer. full and culled are eval's built-in modes run through eval::FrameRunner; the database's representations
+// (local, visible, smi, mmi, mmi-dynamic, placed) go through the runtime's product API, runtime::Walkthrough, whose
+// plan (items, per-layer decisions, report) the panels show. No second renderer.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/eval/frame_runner.h"
+#include "farfield/eval/mode.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/runtime/walkthrough.h"
+#include "farfield/scene/bvh.h"
+#include "farfield/scene/scene.h"
+#include "farfield/view/impostor_kinds.h"
+
+namespace farfield::view {
+
+struct ModeSettings {
+  std::string database;        // impostor database directory ("" = none)
+  double error_px = 0.0;       // the walkthrough's bound; 0 = the database's
+  uint64_t gpu_budget_bytes = uint64_t(512) << 20;
+};
+
+// One displayed frame.
+struct ViewFrame {
+  double cpu_ms = 0.0;   // from the mode's selection (plan) through the draw to glFinish
+  double gpu_ms = 0.0;   // gpu::GpuTimer (the renderer's)
+  uint64_t triangles = 0;
+  uint32_t draw_calls = 0;
+  const runtime::FramePlan* plan = nullptr;  // walkthrough modes; valid until the next frame
+  std::array<size_t, kDecisionKinds> decisions{};
+};
+
+class ModeRenderer {
+ public:
+  // Everything given must outlive the renderer; needs the OpenGL context current.
+  ModeRenderer(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const scene::Bvh& bvh,
+               gpu::Renderer& renderer, gpu::RenderTarget& target, ModeSettings settings);
+  ~ModeRenderer();
+
+  // Switches to a mode ("full", "culled" or a runtime representation name). Throws farfield::Error (an unknown name,
+  // a database that cannot draw it, a damaged database); the previous mode stays in use then.
+  void select(const std::string& mode);
+  const std::string& mode() const { return mode_; }
+  // The walkthrough of the current mode, null for full and culled.
+  const runtime::Walkthrough* walkthrough() const { return walkthrough_.get(); }
+
+  // Renders the camera's frame into the target and waits for it. tint: impostor items tinted by kind.
+  ViewFrame render(const Camera& camera, size_t frame_index, bool tint);
+  // Draws the last frame's items again (walkthrough modes: without planning again; full and culled: the same
+  // camera run again), tinted or not: the reference check measures the untinted frame.
+  void redraw(const Camera& camera, size_t frame_index, bool tint);
+
+ private:
+  const scene::Scene& scene_;
+  const gpu::GpuScene& gpu_scene_;
+  const scene::Bvh& bvh_;
+  gpu::Renderer& renderer_;
+  gpu::RenderTarget& target_;
+  ModeSettings settings_;
+  eval::ModeContext context_;
+  eval::FrameRunner runner_;
+  std::string mode_;
+  std::unique_ptr<eval::Mode> eval_mode_;
+  std::unique_ptr<runtime::Walkthrough> walkthrough_;
+  gpu::FrameStats draw(const Camera& camera, bool tint);
+
+  std::vector<gpu::DrawItem> last_items_;  // the walkthrough's last plan, untinted
+  std::vector<size_t> last_kinds_;         // and the kinds of its items
+  std::vector<gpu::GpuMaterial> tint_materials_;
+};
+
+// The runtime representation of a mode name, or none for full, culled and unknown names.
+std::optional<runtime::Representation> representationOf(const std::string& mode);
+
+}  // namespace farfield::view

@@ -1,0 +1,68 @@
+# farfield view as a script: bad arguments and bad databases give "error: ..." naming the input and exit code 2 (never
+# a crash), and a scripted replay writes its screenshots and recorded path and exits 0. The window needs a display
+# (ctest runs under xvfb-run, see the Makefile); without one only the checks made before the window opens run.
+# Run by ctest with -DFARFIELD=<binary> -DWORK=<scratch dir>.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+
+function(expect_error expected_substring)
+  execute_process(COMMAND ${FARFIELD} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 2)
+    message(FATAL_ERROR "farfield ${ARGN}: expected exit code 2, got '${rc}'\nstdout: ${out}\nstderr: ${err}")
+  endif()
+  if(NOT err MATCHES "error: ")
+    message(FATAL_ERROR "farfield ${ARGN}: stderr lacks 'error: '\n${err}")
+  endif()
+  string(FIND "${err}" "${expected_substring}" pos)
+  if(pos EQUAL -1)
+    message(FATAL_ERROR "farfield ${ARGN}: stderr lacks '${expected_substring}'\n${err}")
+  endif()
+  message(STATUS "ok: farfield ${ARGN} -> ${err}")
+endfunction()
+
+execute_process(COMMAND ${FARFIELD} path orbit builtin:cubes --frames 3 -o ${WORK}/orbit.json RESULT_VARIABLE rc
+                OUTPUT_QUIET)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "farfield path orbit failed: ${rc}")
+endif()
+set(script --replay ${WORK}/orbit.json --screenshot-at 0,2 -o ${WORK}/shots --exit --size 160x120)
+
+# Before the window: arguments, the scene, the camera path.
+expect_error("--size" view builtin:cubes --size 12by4 --replay ${WORK}/orbit.json --exit)
+expect_error("--screenshot-at" view builtin:cubes --replay ${WORK}/orbit.json --screenshot-at 1,x -o ${WORK}/s --exit)
+expect_error("--exit" view builtin:cubes --exit)
+expect_error("--path/--replay" view builtin:cubes --path ${WORK}/orbit.json --replay ${WORK}/orbit.json)
+expect_error("no-such-scene.glb" view ${WORK}/no-such-scene.glb ${script})
+expect_error("nopath.json" view builtin:cubes --replay ${WORK}/nopath.json --exit)
+
+if(NOT DEFINED ENV{DISPLAY})
+  message(STATUS "skipped: no DISPLAY for the window checks (run under xvfb-run)")
+  return()
+endif()
+
+# Bad databases: a missing directory, one without an index, a cut index, a garbled placement index.
+expect_error("missing.imp" view builtin:cubes --impostors ${WORK}/missing.imp ${script})
+file(MAKE_DIRECTORY ${WORK}/empty.imp)
+expect_error("empty.imp" view builtin:cubes --impostors ${WORK}/empty.imp ${script})
+file(MAKE_DIRECTORY ${WORK}/cut.imp)
+file(WRITE ${WORK}/cut.imp/index.json "{\"format\": \"farfield-impostors\", \"version\": 3, \"gen")
+expect_error("cut.imp/index.json" view builtin:cubes --impostors ${WORK}/cut.imp ${script})
+file(MAKE_DIRECTORY ${WORK}/bad.place)
+file(WRITE ${WORK}/bad.place/placement.json "{\"format\": \"farfield-placement\"}")
+expect_error("bad.place/placement.json" view builtin:cubes --impostors ${WORK}/bad.place ${script})
+expect_error("--mode mmi" view builtin:cubes --mode mmi ${script})
+
+# A scripted replay: screenshots of the frame and of the window, the cameras recorded, exit code 0.
+execute_process(COMMAND ${FARFIELD} view builtin:cubes --mode culled ${script} --record ${WORK}/recorded.json
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "farfield view (scripted) failed: ${rc}\nstdout: ${out}\nstderr: ${err}")
+endif()
+foreach(f shots/frame_0.png shots/window_0.png shots/frame_2.png shots/window_2.png recorded.json)
+  if(NOT EXISTS ${WORK}/${f})
+    message(FATAL_ERROR "farfield view (scripted) did not write ${f}")
+  endif()
+endforeach()
+if(EXISTS ${WORK}/shots/frame_1.png)
+  message(FATAL_ERROR "farfield view wrote frame_1.png, which --screenshot-at did not ask for")
+endif()
