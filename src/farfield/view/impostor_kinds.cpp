@@ -14,10 +14,10 @@ const char* decisionName(size_t kind) {
 
 Vec4 decisionTint(size_t kind) {
   switch (kind) {
-    case 0: return {1.0f, 0.55f, 0.2f, 1.0f};   // impostor valid under the bound: orange
-    case 2: return {1.0f, 0.2f, 0.2f, 1.0f};    // unchecked: red
-    case 3: return {0.25f, 0.9f, 1.0f, 1.0f};   // dynamic: cyan
-    case 4: return {0.95f, 0.35f, 1.0f, 1.0f};  // placed cluster: magenta
+    case 0: return {1.0f, 0.45f, 0.1f, 1.0f};   // impostor valid under the bound: orange
+    case 2: return {1.0f, 0.12f, 0.12f, 1.0f};  // unchecked: red
+    case 3: return {0.1f, 0.8f, 1.0f, 1.0f};    // dynamic: cyan
+    case 4: return {0.9f, 0.2f, 1.0f, 1.0f};    // placed cluster: magenta
     default: return {1.0f, 1.0f, 1.0f, 1.0f};
   }
 }

@@ -41,8 +41,9 @@ void drawWalkthrough(const PanelState& s) {
     ImGui::Text("cell: none%s", r.cpv != urban::kNone ? "" : " (outside the streets)");
   if (r.cpv != urban::kNone) ImGui::Text("CPV %u, placed time bound %.1f ms", r.cpv, r.cpv_t_after_ms);
   ImGui::Text("triangles: %" PRIu64 " geometry, %" PRIu64 " impostor", r.geometry_triangles, r.impostor_triangles);
-  for (size_t k = 0; k < kDecisionKinds; ++k) {
-    if (s.frame.decisions[k] == 0) continue;
+  // Every kind the mode can draw, zeros included, so that the panel keeps its size from frame to frame.
+  const bool placed = s.modes[size_t(s.mode_index)] == "placed";
+  for (size_t k = placed ? 4 : 0; k < (placed ? kDecisionKinds : 4); ++k) {
     ImGui::ColorButton(decisionName(k), imColor(decisionTint(k)), ImGuiColorEditFlags_NoTooltip, ImVec2(10, 10));
     ImGui::SameLine();
     ImGui::Text("%-20s %zu", decisionName(k), s.frame.decisions[k]);
@@ -94,10 +95,10 @@ PanelActions drawMainPanel(PanelState& s) {
   char overlay[64];
   std::snprintf(overlay, sizeof(overlay), "CPU %.2f ms", s.frame.cpu_ms);
   ImGui::PlotLines("##cpu", h.cpuMs().data(), int(h.cpuMs().size()), int(h.offset()), overlay, 0.0f, top,
-                   ImVec2(320, 60));
+                   ImVec2(320, 48));
   std::snprintf(overlay, sizeof(overlay), "GPU %.2f ms", s.frame.gpu_ms);
   ImGui::PlotLines("##gpu", h.gpuMs().data(), int(h.gpuMs().size()), int(h.offset()), overlay, 0.0f, top,
-                   ImVec2(320, 60));
+                   ImVec2(320, 48));
   ImGui::Text("triangles %" PRIu64 ", draw calls %u", s.frame.triangles, s.frame.draw_calls);
   drawWalkthrough(s);
   drawPromises(s);

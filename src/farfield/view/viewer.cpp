@@ -310,7 +310,7 @@ class Viewer {
     panel_.path_status.clear();
     if (player_.frameCount() > 0) {
       char text[128];
-      std::snprintf(text, sizeof(text), "path frame %zu of %zu%s%s", player_.frame() + 1, player_.frameCount(),
+      std::snprintf(text, sizeof(text), "path frame %zu (0..%zu)%s%s", player_.frame(), player_.frameCount() - 1,
                     player_.finished() ? " (ended)" : "", player_.paused() ? " (paused: P)" : "");
       panel_.path_status = text;
     }
@@ -331,7 +331,7 @@ class Viewer {
           overlay.cpv = plan->report.cpv;
         }
         overlay.placement = database_.placement.get();
-        drawStreetMap(overlay, camera_, 280.0f);
+        drawStreetMap(overlay, camera_, std::clamp(0.38f * std::min(viewport->Size.x, viewport->Size.y), 120.0f, 320.0f));
         ImGui::Text("%s, eye %.0f %.0f %.1f m", navigationName(panel_.navigation), camera_.eye.x, camera_.eye.y,
                     camera_.eye.z);
       }
