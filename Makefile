@@ -7,7 +7,7 @@ CMAKE_FLAGS ?=
 # Real windows for the viewer's tests come from Xvfb when it is installed and no display is set.
 XVFB        := $(shell if [ -z "$$DISPLAY" ] && command -v xvfb-run >/dev/null 2>&1; then echo "xvfb-run -a -s '-screen 0 1280x1024x24'"; fi)
 
-.PHONY: all deps configure build demo test test-asan bench clean
+.PHONY: all deps configure build build-cli demo test test-asan bench clean
 
 all: build
 
@@ -20,7 +20,11 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
-demo: build
+# The demo needs only the command-line tool (the tests build the rest).
+build-cli: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target farfield_cli
+
+demo: build-cli
 	@bash scripts/demo.sh $(BUILD)/bin/farfield out/demo
 
 test: build

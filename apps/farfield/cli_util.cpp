@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "farfield/core/error.h"
+#include "farfield/gen/camera_path.h"
 
 namespace farfield::app {
 namespace {
@@ -31,9 +32,14 @@ Vec3 parseVec3(const std::string& option, const std::string& text) {
   return v;
 }
 
-Box3 parseViewSpace(const std::string& view_min, const std::string& view_max) {
+Box3 parseViewSpace(const std::string& view_min, const std::string& view_max, const std::string& around,
+                    float margin_m) {
   if (view_min.empty() != view_max.empty())
     throw Error("--view-min/--view-max", "give both corners of the view space, or neither");
+  if (!around.empty()) {
+    if (!view_min.empty()) throw Error("--around", "give either --around or --view-min/--view-max, not both");
+    return gen::eyeBounds(gen::loadCameraPath(around), margin_m, around);
+  }
   if (view_min.empty()) return Box3{};
   return Box3::fromPoints(parseVec3("--view-min", view_min), parseVec3("--view-max", view_max));
 }

@@ -14,7 +14,9 @@ Vec3 parseVec3(const std::string& option, const std::string& text);
 IVec2 parseSize(const std::string& option, const std::string& text);
 // --view-min / --view-max "x,y,z" corners -> the box; both empty -> an empty box (the command's default). Throws for
 // one without the other.
-Box3 parseViewSpace(const std::string& view_min, const std::string& view_max);
+// The view space of --view-min/--view-max, or of --around PATH (gen::eyeBounds with --margin); an empty box for none.
+Box3 parseViewSpace(const std::string& view_min, const std::string& view_max, const std::string& around = {},
+                    float margin_m = 0.0f);
 // Creates the parent directory of a file path if needed.
 void ensureParentDirectory(const std::string& file);
 

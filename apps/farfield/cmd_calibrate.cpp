@@ -20,7 +20,8 @@ struct CalibrateArgs {
   std::string scene;
   std::string out;
   std::string size = "512x512";
-  std::string view_min, view_max;
+  std::string view_min, view_max, around;
+  float margin = 50.0f;
   std::string csv;
   eval::CalibrateOptions options;
 };
@@ -31,7 +32,7 @@ void runCalibrateCommand(CalibrateArgs& args) {
   const IVec2 size = parseSize("--size", args.size);
   o.width = size.x;
   o.height = size.y;
-  o.view_space = parseViewSpace(args.view_min, args.view_max);
+  o.view_space = parseViewSpace(args.view_min, args.view_max, args.around, args.margin);
   const scene::Scene scene = scene::loadScene(args.scene);
   const eval::CalibrateResult r = eval::calibrate(gpu::sharedHeadlessContext(), scene, o);
   ensureParentDirectory(args.out);
@@ -73,6 +74,9 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
   cmd->add_option("--repeats", args->options.repeats, "Renders per view (the minimum is kept)")->capture_default_str();
   cmd->add_option("--view-min", args->view_min, "View space corner X,Y,Z (default: the scene's bounds at 1.7 m)");
   cmd->add_option("--view-max", args->view_max, "View space corner X,Y,Z");
+  cmd->add_option("--around", args->around, "View space: the district along a camera path (its eyes' bounds "
+                                           "grown by --margin)");
+  cmd->add_option("--margin", args->margin, "Margin of --around on the ground, metres")->capture_default_str();
   cmd->add_option("--seed", args->options.seed, "Seed of the random views")->capture_default_str();
   cmd->add_option("--margin-quantile", args->options.margin_quantile,
                   "Safety factor = this quantile of measured/predicted (1 = the maximum)")->capture_default_str();

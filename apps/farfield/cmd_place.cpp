@@ -20,7 +20,8 @@ struct PlaceArgs {
   std::string profile;
   std::string out;
   std::string size = "512x512";
-  std::string view_min, view_max;
+  std::string view_min, view_max, around;
+  float margin = 50.0f;
   int distance_steps = 11;
   double texel_px = 0.0;
   bake::PlaceOptions options;
@@ -31,7 +32,7 @@ void runPlaceCommand(PlaceArgs& args) {
   const IVec2 size = parseSize("--size", args.size);
   o.width = size.x;
   o.height = size.y;
-  o.view_space = parseViewSpace(args.view_min, args.view_max);
+  o.view_space = parseViewSpace(args.view_min, args.view_max, args.around, args.margin);
   if (args.distance_steps < 1) throw Error("--distance-steps", "must be at least 1");
   o.candidates.distance_steps = args.distance_steps;
   o.scene_label = args.scene;
@@ -81,6 +82,9 @@ const RegisterCommand reg("place", [](CLI::App& app) {
   cmd->add_option("--fov", o.fov_deg, "Vertical field of view, degrees")->capture_default_str();
   cmd->add_option("--view-min", args->view_min, "View space corner X,Y,Z (default: the scene's bounds at 1.2-1.7 m)");
   cmd->add_option("--view-max", args->view_max, "View space corner X,Y,Z");
+  cmd->add_option("--around", args->around, "View space: the district along a camera path (its eyes' bounds "
+                                           "grown by --margin)");
+  cmd->add_option("--margin", args->margin, "Margin of --around on the ground, metres")->capture_default_str();
   cmd->add_option("--cpv-size", o.min_region_size, "Side of the CPVs' regions, metres")->capture_default_str();
   cmd->add_option("--vdi-deg", o.min_vdi_deg, "Width of the CPVs' view-direction intervals, degrees")
       ->capture_default_str();

@@ -134,6 +134,26 @@ TEST(CameraPath, DeadEndTurnsBack) {
   EXPECT_GT(max_x, 35.0f);
 }
 
+TEST(CameraPath, EyeBoundsAreTheDistrictAroundThePath) {
+  CameraPath path;
+  for (const Vec3& eye : {Vec3(10.0f, 20.0f, 1.2f), Vec3(30.0f, -5.0f, 1.2f), Vec3(15.0f, 0.0f, 1.3f)}) {
+    farfield::gen::PathFrame f;
+    f.eye = eye;
+    f.at = eye + Vec3(1.0f, 0.0f, 0.0f);
+    path.frames.push_back(f);
+  }
+  const farfield::Box3 box = farfield::gen::eyeBounds(path, 50.0f, "p.json");
+  EXPECT_FLOAT_EQ(box.lo.x, -40.0f);
+  EXPECT_FLOAT_EQ(box.hi.x, 80.0f);
+  EXPECT_FLOAT_EQ(box.lo.y, -55.0f);
+  EXPECT_FLOAT_EQ(box.hi.y, 70.0f);
+  EXPECT_FLOAT_EQ(box.lo.z, 1.2f);
+  EXPECT_FLOAT_EQ(box.hi.z, 1.7f);  // at least 0.5 m tall
+  for (const farfield::gen::PathFrame& f : path.frames) EXPECT_TRUE(box.contains(f.eye));
+  EXPECT_THROW(farfield::gen::eyeBounds(path, -1.0f, "p.json"), farfield::Error);
+  EXPECT_THROW(farfield::gen::eyeBounds(CameraPath{}, 1.0f, "p.json"), farfield::Error);
+}
+
 TEST(CameraPath, JsonRoundTrip) {
   const StreetGraph g = city(30, 4);
   StreetWalkOptions o;

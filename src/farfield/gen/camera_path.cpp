@@ -432,3 +432,20 @@ CameraPath orbit(const Box3& bounds, const OrbitOptions& options) {
 }
 
 }  // namespace farfield::gen
+
+namespace farfield::gen {
+
+Box3 eyeBounds(const CameraPath& path, float margin_m, const std::string& where) {
+  if (path.frames.empty()) throw Error(where, "the path has no frames");
+  if (!(margin_m >= 0.0f)) throw Error(where, "the margin must be 0 or more metres");
+  Box3 box;
+  for (const PathFrame& f : path.frames) box.expand(f.eye);
+  box.lo.x -= margin_m;
+  box.lo.y -= margin_m;
+  box.hi.x += margin_m;
+  box.hi.y += margin_m;
+  box.hi.z = std::max(box.hi.z, box.lo.z + 0.5f);
+  return box;
+}
+
+}  // namespace farfield::gen

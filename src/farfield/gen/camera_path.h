@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "farfield/core/bounds.h"
 #include "farfield/core/camera.h"
 #include "farfield/core/math.h"
 
@@ -37,6 +38,10 @@ struct CameraPath {
 // Throws farfield::Error naming the file (missing, not JSON, missing keys, non-finite numbers, no frames).
 CameraPath loadCameraPath(const std::string& path);
 void saveCameraPath(const CameraPath& path, const std::string& file);
+// The view space around a path (a district along a route): the bounds of its eyes grown by margin_m (>= 0) on the
+// ground plane; in height from the lowest to the highest eye, at least 0.5 m tall. Throws farfield::Error naming
+// `where` for a path without frames or a negative margin.
+Box3 eyeBounds(const CameraPath& path, float margin_m, const std::string& where);
 
 enum class Walker { Pedestrian, Car };  // eye 1.7 m at 1.4 m/s, or 1.2 m at 10 m/s
 
