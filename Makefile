@@ -4,8 +4,9 @@ JOBS        ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD       ?= build/release
 BUILD_ASAN  ?= build/asan
 CMAKE_FLAGS ?=
-# Real windows for the viewer's tests come from Xvfb when it is installed and no display is set.
-XVFB        := $(shell if [ -z "$$DISPLAY" ] && command -v xvfb-run >/dev/null 2>&1; then echo "xvfb-run -a -s '-screen 0 1280x1024x24'"; fi)
+# Real windows for the viewer's tests come from Xvfb when it is installed and no display is set. -noreset: by default
+# Xvfb resets when its last client disconnects, and a test connecting during the reset fails to open the display.
+XVFB        := $(shell if [ -z "$$DISPLAY" ] && command -v xvfb-run >/dev/null 2>&1; then echo "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset'"; fi)
 
 .PHONY: all deps configure build build-cli demo test test-asan bench clean
 
