@@ -5,12 +5,13 @@
 # error bound of 2 px and a frame budget t_max), and the walkthrough benchmark of full geometry, view-frustum culling
 # and the placed impostors against full-geometry reference frames.
 # Writes OUT/report.html (self-contained: the verdict of the two promises first) and OUT/report.md.
-# Environment: FF_DEMO_BLOCKS, FF_DEMO_DETAIL, FF_DEMO_FRAMES, FF_DEMO_STRIDE, FF_DEMO_TMAX (ms), FF_DEMO_BOUND (px).
+# Environment: FF_DEMO_BLOCKS, FF_DEMO_DETAIL, FF_DEMO_SEED, FF_DEMO_FRAMES, FF_DEMO_STRIDE, FF_DEMO_TMAX (ms), FF_DEMO_BOUND (px).
 set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
 OUT=${2:-out/demo}
 BLOCKS=${FF_DEMO_BLOCKS:-400}
 DETAIL=${FF_DEMO_DETAIL:-2}
+SEED=${FF_DEMO_SEED:-1}
 FRAMES=${FF_DEMO_FRAMES:-300}
 STRIDE=${FF_DEMO_STRIDE:-2}
 TMAX=${FF_DEMO_TMAX:-30}
@@ -30,10 +31,10 @@ step() {  # TITLE LOG COMMAND...: runs a step, keeps its output in LOG and the c
   "$@" 2>&1 | tee "$log"
 }
 
-step "generate the default city (blocks $BLOCKS, detail $DETAIL, one object per building)" "$OUT/gen.txt" \
-  "$FARFIELD" gen city --blocks "$BLOCKS" --detail "$DETAIL" --seed 1 --objects buildings -o "$OUT/city.glb"
+step "generate the default city (blocks $BLOCKS, detail $DETAIL, seed $SEED, one object per building)" "$OUT/gen.txt" \
+  "$FARFIELD" gen city --blocks "$BLOCKS" --detail "$DETAIL" --seed "$SEED" --objects buildings -o "$OUT/city.glb"
 step "a $FRAMES-frame street drive" "$OUT/path.txt" \
-  "$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --seed 1 --car --fov "$FOV" -o "$OUT/path.json"
+  "$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --seed "$SEED" --car --fov "$FOV" -o "$OUT/path.json"
 step "measure this machine's frame cost over the drive's district (about a minute)" "$OUT/calibrate.txt" \
   "$FARFIELD" calibrate "$OUT/city.glb" -o "$OUT/profile.json" --size "$SIZE" --fov "$FOV" --views 60 --fit-views 40 \
   --around "$OUT/path.json" --margin "$MARGIN"

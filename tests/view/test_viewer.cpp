@@ -109,6 +109,41 @@ TEST(Viewer, ReplayedImpostorFramesEqualTheBenchModeAtTheSameCamera) {
   }
 }
 
+TEST(Viewer, ReplayedPlacedFramesEqualTheBenchModeAtTheSameCamera) {
+  FF_REQUIRE_DISPLAY();
+  const test::ViewPlacement& c = test::viewPlacement();
+  ASSERT_GT(c.report.impostors, 0u) << "the placement placed nothing: the test would not see an impostor";
+  const int size = 128;  // the frames the placement was made for
+  const std::string out = farfield::test::scratchDir("view_placed").string();
+  ViewerOptions options;
+  options.replay = c.path_file;
+  options.screenshot_at = {0, 3, 7};
+  options.out_dir = out;
+  options.exit_at_end = true;
+  options.width = options.height = size;
+  options.mode = "placed";
+  options.impostors = c.database;
+  runViewer(c.city.scene, options);
+
+  gpu::sharedHeadlessContext();
+  eval::registerImpostorModes();
+  eval::ModeRunResources run(c.city.scene, size, size, {{"impostor_dir", c.database}});
+  std::unique_ptr<eval::Mode> bench_mode = eval::createMode("placed", run.context);
+  bench_mode->prepare(run.context);
+  eval::FrameRunner runner(run.renderer, run.target);
+  for (size_t i = 0; i < c.path.frames.size(); ++i) {
+    runner.run(*bench_mode, eval::pathCamera(c.path, i, size, size), i);
+    if (i != 0 && i != 3 && i != 7) continue;
+    const image::ColorImage frame = image::readPng(out + "/frame_" + std::to_string(i) + ".png");
+    EXPECT_GT(image::psnr(frame, run.target.readColor()), 40.0) << "placed frame " << i;
+  }
+  // The path meets the placement's impostors (the frames compared are not geometry only).
+  EXPECT_GT(bench_mode->info().at("impostor_draws"), 0.0);
+  // Another frame of the path is not close: the comparison can fail.
+  runner.run(*bench_mode, eval::pathCamera(c.path, 7, size, size), 7);
+  EXPECT_LT(image::psnr(image::readPng(out + "/frame_0.png"), run.target.readColor()), 40.0);
+}
+
 TEST(Viewer, TintShowsImpostorsInTheirKindsColour) {
   FF_REQUIRE_DISPLAY();
   const test::ViewCity& c = test::viewCity();

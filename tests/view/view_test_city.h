@@ -4,15 +4,19 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <memory>
+#include <random>
 #include <string>
 
 #include "farfield/bake/bake.h"
 #include "farfield/bake/pipeline.h"
+#include "farfield/bake/place.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gen/city.h"
 #include "farfield/gpu/context.h"
+#include "farfield/store/placement_store.h"
 #include "farfield/urban/cells.h"
 #include "support/test_support.h"
 
@@ -51,6 +55,72 @@ inline const ViewCity& viewCity() {
     c->store = (dir / "city.imp").string();
     bake::bakePipeline(gpu::sharedHeadlessContext(), c->city.scene, cells, bake::cellsOnPath(cells, c->path),
                        extract::parsePipeline("pvs,near-far,single,mmi"), options, c->store);
+    return c;
+  }();
+  return *s;
+}
+
+// A placement database (farfield place) over a 12-block city with one object per building, under a hand-made cost
+// profile whose t_max (9 ms) only impostors can keep from some views, with its report (built once per process).
+struct ViewPlacement {
+  gen::City city;
+  gen::CameraPath path;
+  std::string path_file;
+  std::string database;
+  bake::PlaceReport report;
+};
+
+inline const ViewPlacement& viewPlacement() {
+  static const ViewPlacement* s = [] {
+    auto* c = new ViewPlacement;
+    gen::CityOptions o;
+    o.blocks = 12;
+    o.detail = 0;
+    o.seed = 3;
+    o.objects = gen::ObjectGrouping::Buildings;
+    c->city = gen::generateCity(o);
+    gpu::CostProfile profile;
+    profile.model.base_ms = 1.0;
+    profile.model.ms_per_draw = 0.25;
+    profile.model.ms_per_mtriangle = 10.0;
+    profile.safety_factor = 1.0;
+    profile.width = profile.height = 128;
+    profile.fov_y_deg = 45.0;
+    bake::PlaceOptions p;
+    p.width = p.height = 128;
+    p.fov_deg = 45.0f;
+    p.error_px = 2.0;
+    p.layered.texel_pixels = 2.0;
+    p.layered.max_texture_size = 128;
+    p.max_pitch_deg = 20.0f;
+    p.visibility_face = 32;
+    const Box3 b = c->city.scene.bounds();
+    p.min_region_size = 0.26f * std::max(b.extent().x, b.extent().y);
+    p.candidates.direction_step = float(degToRad(45.0));
+    p.candidates.apex_angles = {float(degToRad(45.0)), float(degToRad(90.0))};
+    p.candidates.distance_steps = 5;
+    p.hierarchy.max_levels = 6;
+    p.progress = false;
+    p.t_max_ms = 9.0;
+    const std::filesystem::path dir = farfield::test::scratchDir("view_placement");
+    c->database = (dir / "city.place").string();
+    c->report = bake::placeImpostors(gpu::sharedHeadlessContext(), c->city.scene, profile, p, c->database);
+    // Random level views of the view space (seeded), like the placement's own tests: a street walk this short
+    // may meet no problem view.
+    const Box3 space = store::readPlacementIndex(c->database).view_space;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int k = 0; k < 24; ++k) {
+      gen::PathFrame f;
+      f.eye = space.lo + (space.hi - space.lo) * Vec3(u(rng), u(rng), u(rng));
+      const float yaw = float(2.0 * kPi) * u(rng);
+      f.at = f.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
+      f.up = Vec3(0.0f, 0.0f, 1.0f);
+      f.fov_y = float(degToRad(45.0));
+      c->path.frames.push_back(f);
+    }
+    c->path_file = (dir / "walk.json").string();
+    gen::saveCameraPath(c->path, c->path_file);
     return c;
   }();
   return *s;
