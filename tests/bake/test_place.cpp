@@ -21,6 +21,7 @@
 #include "farfield/runtime/walkthrough.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/store/placement_store.h"
+#include "support/small_placement.h"
 #include "support/test_support.h"
 
 namespace farfield::bake {
@@ -34,43 +35,13 @@ struct Placed {
   std::string dir;
 };
 
-gpu::CostProfile handProfile() {
-  gpu::CostProfile p;
-  p.model.base_ms = 1.0;
-  p.model.ms_per_draw = 0.25;
-  p.model.ms_per_mtriangle = 10.0;
-  p.safety_factor = 1.0;
-  p.width = p.height = 128;
-  p.fov_y_deg = 45.0;
-  return p;
-}
-
 const Placed& placed() {
   static const Placed* s = [] {
     auto* c = new Placed;
-    gen::CityOptions o;
-    o.blocks = 12;
-    o.detail = 0;
-    o.seed = 3;
-    o.objects = gen::ObjectGrouping::Buildings;
-    c->city = gen::generateCity(o);
-    c->profile = handProfile();
+    c->city = test::smallPlacementCity();
+    c->profile = test::handProfile();
+    c->options = test::smallPlaceOptions(c->city.scene);
     PlaceOptions& p = c->options;
-    p.width = p.height = 128;
-    p.fov_deg = 45.0f;
-    p.error_px = 2.0;
-    p.layered.texel_pixels = 2.0;
-    p.layered.max_texture_size = 128;
-    p.max_pitch_deg = 20.0f;
-    p.visibility_face = 32;
-    const Box3 b = c->city.scene.bounds();
-    p.min_region_size = 0.26f * std::max(b.extent().x, b.extent().y);
-    p.candidates.direction_step = float(degToRad(45.0));
-    p.candidates.apex_angles = {float(degToRad(45.0)), float(degToRad(90.0))};
-    p.candidates.distance_steps = 5;
-    p.hierarchy.max_levels = 6;
-    p.progress = false;
-    p.t_max_ms = 9.0;
     c->dir = test::scratchDir("place_city").string();
     c->report = placeImpostors(gpu::sharedHeadlessContext(), c->city.scene, c->profile, p, c->dir);
     return c;

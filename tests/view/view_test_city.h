@@ -18,6 +18,7 @@
 #include "farfield/gpu/context.h"
 #include "farfield/store/placement_store.h"
 #include "farfield/urban/cells.h"
+#include "support/small_placement.h"
 #include "support/test_support.h"
 
 namespace farfield::view::test {
@@ -73,38 +74,12 @@ struct ViewPlacement {
 inline const ViewPlacement& viewPlacement() {
   static const ViewPlacement* s = [] {
     auto* c = new ViewPlacement;
-    gen::CityOptions o;
-    o.blocks = 12;
-    o.detail = 0;
-    o.seed = 3;
-    o.objects = gen::ObjectGrouping::Buildings;
-    c->city = gen::generateCity(o);
-    gpu::CostProfile profile;
-    profile.model.base_ms = 1.0;
-    profile.model.ms_per_draw = 0.25;
-    profile.model.ms_per_mtriangle = 10.0;
-    profile.safety_factor = 1.0;
-    profile.width = profile.height = 128;
-    profile.fov_y_deg = 45.0;
-    bake::PlaceOptions p;
-    p.width = p.height = 128;
-    p.fov_deg = 45.0f;
-    p.error_px = 2.0;
-    p.layered.texel_pixels = 2.0;
-    p.layered.max_texture_size = 128;
-    p.max_pitch_deg = 20.0f;
-    p.visibility_face = 32;
-    const Box3 b = c->city.scene.bounds();
-    p.min_region_size = 0.26f * std::max(b.extent().x, b.extent().y);
-    p.candidates.direction_step = float(degToRad(45.0));
-    p.candidates.apex_angles = {float(degToRad(45.0)), float(degToRad(90.0))};
-    p.candidates.distance_steps = 5;
-    p.hierarchy.max_levels = 6;
-    p.progress = false;
-    p.t_max_ms = 9.0;
+    c->city = farfield::test::smallPlacementCity();
+    const bake::PlaceOptions p = farfield::test::smallPlaceOptions(c->city.scene);
     const std::filesystem::path dir = farfield::test::scratchDir("view_placement");
     c->database = (dir / "city.place").string();
-    c->report = bake::placeImpostors(gpu::sharedHeadlessContext(), c->city.scene, profile, p, c->database);
+    c->report = bake::placeImpostors(gpu::sharedHeadlessContext(), c->city.scene, farfield::test::handProfile(), p,
+                                     c->database);
     // Random level views of the view space (seeded), like the placement's own tests: a street walk this short
     // may meet no problem view.
     const Box3 space = store::readPlacementIndex(c->database).view_space;

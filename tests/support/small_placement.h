@@ -1,0 +1,54 @@
+// A small placement problem shared by the placement's and the viewer's tests: a 12-block city with one object per
+// building, a hand-made cost profile (so the times are the model's, not this machine's noise) and placement options
+// for 128x128 frames at 45 degrees under 2 px, with a t_max of 9 ms that only impostors can keep from some views.
+#pragma once
+
+#include <algorithm>
+
+#include "farfield/bake/place.h"
+#include "farfield/gen/city.h"
+#include "farfield/gpu/cost_profile.h"
+
+namespace farfield::test {
+
+inline gen::City smallPlacementCity() {
+  gen::CityOptions o;
+  o.blocks = 12;
+  o.detail = 0;
+  o.seed = 3;
+  o.objects = gen::ObjectGrouping::Buildings;
+  return gen::generateCity(o);
+}
+
+inline gpu::CostProfile handProfile() {
+  gpu::CostProfile p;
+  p.model.base_ms = 1.0;
+  p.model.ms_per_draw = 0.25;
+  p.model.ms_per_mtriangle = 10.0;
+  p.safety_factor = 1.0;
+  p.width = p.height = 128;
+  p.fov_y_deg = 45.0;
+  return p;
+}
+
+inline bake::PlaceOptions smallPlaceOptions(const scene::Scene& scene) {
+  bake::PlaceOptions p;
+  p.width = p.height = 128;
+  p.fov_deg = 45.0f;
+  p.error_px = 2.0;
+  p.layered.texel_pixels = 2.0;
+  p.layered.max_texture_size = 128;
+  p.max_pitch_deg = 20.0f;
+  p.visibility_face = 32;
+  const Box3 b = scene.bounds();
+  p.min_region_size = 0.26f * std::max(b.extent().x, b.extent().y);
+  p.candidates.direction_step = float(degToRad(45.0));
+  p.candidates.apex_angles = {float(degToRad(45.0)), float(degToRad(90.0))};
+  p.candidates.distance_steps = 5;
+  p.hierarchy.max_levels = 6;
+  p.progress = false;
+  p.t_max_ms = 9.0;
+  return p;
+}
+
+}  // namespace farfield::test
