@@ -66,6 +66,23 @@ TEST(PlaceTest, ProblemViewsExistAndMostAreSolved) {
     if (c.t_after <= s.options.t_max_ms) ++solved;
   }
   EXPECT_EQ(solved, r.cpvs - r.unsolved_cpvs);
+  // What the memory holds, counted again from the database's images: texels, covered texels, id textures.
+  uint64_t texels = 0, covered = 0, id_texels = 0;
+  for (const store::StoredPlacedImpostor& stored : index.impostors) {
+    const impostor::LayeredImpostor imp = store::loadPlacedImpostor(s.dir, stored);
+    for (const impostor::Layer& layer : imp.layers) {
+      texels += layer.color.pixelCount();
+      for (const image::Rgba8& p : layer.color.pixels()) covered += p.a > 0 ? 1 : 0;
+      id_texels += layer.ids.pixelCount();
+    }
+  }
+  EXPECT_EQ(r.layer_texels, texels);
+  EXPECT_EQ(r.covered_texels, covered);
+  EXPECT_GT(covered, 0u);
+  EXPECT_LT(covered, texels);
+  EXPECT_EQ(id_texels, texels);  // id textures on (the default): as many id texels as colour texels
+  EXPECT_GT(r.id_texture_bytes, 4.0 * double(texels) - 1.0);  // 4 bytes an id texel, atlas padding on top
+  EXPECT_LE(r.id_texture_bytes, 0.5 * r.memory_bytes);
   // The options that made it, back strictly.
   EXPECT_EQ(placeOptionsToJson(placeOptionsFromJson(index.options, "index")), index.options);
   nlohmann::json extra = index.options;

@@ -101,6 +101,9 @@ nlohmann::json PlaceReport::toJson() const {
           {"impostors_freed", impostors_freed},
           {"unsolved_cpvs", unsolved_cpvs},
           {"memory_bytes", memory_bytes},
+          {"id_texture_bytes", id_texture_bytes},
+          {"layer_texels", layer_texels},
+          {"covered_texels", covered_texels},
           {"written_bytes", written_bytes},
           {"t_enc_max_ms", t_enc_max_ms},
           {"t_after_max_ms", t_after_max_ms},
@@ -374,6 +377,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   fs::create_directories(out_dir);
   const uint64_t generation = store::nextPlacementGeneration(out_dir);
   std::map<size_t, store::StoredPlacedImpostor> written;  // candidate -> record
+  std::map<size_t, uint64_t> covered;                     // candidate -> texels its objects cover
   double capture_s = 0.0;
   const placement::GreedyResult result = placement::placeGreedy(problem, [&](size_t k) {
     Stopwatch capture;
@@ -384,6 +388,8 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     written[k] = store::writePlacedImpostor(out_dir, generation, uint32_t(k), uint32_t(c.node), objects, imp,
                                             hierarchy.nodes()[size_t(c.node)].bounds, std::get<Shaft>(c.cell), bound,
                                             options.layered);
+    covered[k] = 0;
+    for (const impostor::Layer& layer : imp.layers) covered[k] += layer.data_texels;
     capture_s += capture.seconds();
     ++report.impostors_generated;
     if (options.progress && report.impostors_generated % 25 == 0)
@@ -420,7 +426,12 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   std::vector<size_t> kept_candidates;
   for (const placement::ChosenImpostor& chosen : result.impostors) kept_candidates.push_back(chosen.candidate);
   std::sort(kept_candidates.begin(), kept_candidates.end());  // the index lists ids ascending
-  for (size_t k : kept_candidates) index.impostors.push_back(written.at(k));
+  for (size_t k : kept_candidates) {
+    index.impostors.push_back(written.at(k));
+    report.layer_texels += plans[k].texels;
+    report.covered_texels += covered.at(k);
+    if (plans[k].id_textures) report.id_texture_bytes += 0.5 * double(plans[k].texture_bytes);
+  }
   for (size_t c = 0; c < view_space.cpvs.size(); ++c) {
     store::StoredCpv s;
     s.region = view_space.cpvs[c].region;
