@@ -64,9 +64,12 @@ void runPlaceCommand(PlaceArgs& args) {
               r.t_enc_max_ms, r.t_after_max_ms, r.unsolved_cpvs);
   std::printf("memory:           %.2f MB of impostors (GPU), %.2f MB on disk\n", r.memory_bytes / 1048576.0,
               double(r.written_bytes) / 1048576.0);
-  std::printf("                  of which %.2f MB object-id textures (for measurement); %.1f%% of the layers' texels "
-              "covered\n", r.id_texture_bytes / 1048576.0,
-              r.layer_texels ? 100.0 * double(r.covered_texels) / double(r.layer_texels) : 0.0);
+  std::printf("                  of which %.2f MB object-id textures (for measurement); layers cropped to their "
+              "data: %.1f%% of the captured texels kept (%.2f MB estimated before), %.1f%% of those covered\n",
+              r.id_texture_bytes / 1048576.0,
+              r.layer_texels ? 100.0 * double(r.stored_texels) / double(r.layer_texels) : 0.0,
+              r.estimated_bytes / 1048576.0,
+              r.stored_texels ? 100.0 * double(r.covered_texels) / double(r.stored_texels) : 0.0);
   std::printf("wall:             %.1f s\n", r.wall_s);
   std::printf("database:         %s\n", args.out.c_str());
 }

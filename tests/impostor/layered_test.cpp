@@ -391,6 +391,60 @@ TEST_F(ImpostorGpuTest, LayeredPlanEstimatesAreTheMeasuredMemory) {
   }
 }
 
+TEST_F(ImpostorGpuTest, CroppedLayersDrawTheSameImageWithFewerTexels) {
+  const Cluster c;
+  const gpu::GpuScene scene(c.s.scene);
+  const ErrorBound bound = testBound();
+  const LayeredImpostor full = captureLayered(*renderer_, scene, c.ids, planLayered(c.box, c.shaft, bound));
+  const LayeredImpostor cropped = cropLayered(full);
+  ASSERT_TRUE(cropped.plan.cropped);
+  EXPECT_LT(cropped.plan.texels, full.plan.texels);
+  EXPECT_LT(cropped.plan.bytes(), full.plan.bytes());
+  for (size_t i = 0; i < full.layers.size(); ++i) {
+    // Nothing but transparent black outside the crop, and the crop's texels are the captured ones.
+    const LayerPlan& lp = cropped.plan.layers[i];
+    const Layer& a = full.layers[i];
+    const Layer& b = cropped.layers[i];
+    ASSERT_EQ(b.color.width(), lp.width);
+    size_t data_outside = 0;
+    for (int y = 0; y < a.color.height(); ++y)
+      for (int x = 0; x < a.color.width(); ++x) {
+        const bool inside = x >= lp.crop_x && y >= lp.crop_y && x < lp.crop_x + lp.width && y < lp.crop_y + lp.height;
+        if (inside)
+          ASSERT_EQ(b.color.at(x - lp.crop_x, y - lp.crop_y), a.color.at(x, y));
+        else
+          data_outside += a.color.at(x, y) != image::Rgba8(0, 0, 0, 0) || a.ids.at(x, y) != 0 ? 1 : 0;
+      }
+    EXPECT_EQ(data_outside, 0u) << "layer " << i;
+    EXPECT_EQ(b.data_texels, a.data_texels);
+  }
+  // From the shaft's viewpoints the two draw the same pixels (ids exactly, colours up to rounding of the moved
+  // quads' texture coordinates).
+  const GpuLayeredImpostor gpu_full(full), gpu_cropped(cropped);
+  EXPECT_EQ(gpu_cropped.gpuBytes(), cropped.plan.bytes());
+  std::vector<gpu::DrawItem> items_full, items_cropped;
+  gpu_full.appendDrawItems(items_full);
+  gpu_cropped.appendDrawItems(items_cropped);
+  for (const float t : {0.0f, 0.3f, 0.7f, 1.0f}) {
+    const Camera camera = viewFrom(c.shaft.sample(t, 1.0f, 0.5f, 2.0f * c.shaft.min_distance), c.shaft, bound);
+    const test::Frame a = test::renderItems(*renderer_, camera, items_full);
+    const test::Frame b = test::renderItems(*renderer_, camera, items_cropped);
+    size_t ids_differ = 0;
+    for (size_t p = 0; p < a.ids.pixelCount(); ++p) ids_differ += a.ids.pixels()[p] != b.ids.pixels()[p] ? 1 : 0;
+    EXPECT_LE(ids_differ, a.ids.pixelCount() / 1000) << "viewpoint " << t;
+    EXPECT_LT(image::shareOverThreshold(a.color, b.color, 8), 0.001) << "viewpoint " << t;
+  }
+  // A crop outside its image, a wrong count, or cropping twice are errors.
+  LayeredPlan plan = full.plan;
+  std::vector<LayerCrop> crops(plan.layers.size(), LayerCrop{0, 0, 1, 1});
+  crops[0] = {plan.layers[0].width, 0, 1, 1};
+  EXPECT_THROW(cropLayers(plan, crops), Error);
+  EXPECT_THROW(cropLayers(plan, std::vector<LayerCrop>(1, LayerCrop{0, 0, 1, 1})), Error);
+  LayeredPlan twice = cropped.plan;
+  EXPECT_THROW(cropLayers(twice, std::vector<LayerCrop>(twice.layers.size(), LayerCrop{0, 0, 1, 1})), Error);
+  EXPECT_THROW(captureLayered(*renderer_, scene, c.ids, cropped.plan), Error);
+}
+
 TEST_F(ImpostorGpuTest, LayeredCaptureRejectsObjectsNotInTheSceneOrOutsideTheBox) {
   const Cluster c;
   const gpu::GpuScene scene(c.s.scene);

@@ -349,6 +349,10 @@ void expectSameIndex(const PlacementIndex& got, const PlacementIndex& want) {
       EXPECT_EQ(x.ids_check.bytes, y.ids_check.bytes);
       EXPECT_EQ(x.ids_check.known, !y.ids.empty());
       EXPECT_EQ(x.data_texels, y.data_texels);
+      EXPECT_EQ(x.crop.x, y.crop.x);
+      EXPECT_EQ(x.crop.y, y.crop.y);
+      EXPECT_EQ(x.crop.width, y.crop.width);
+      EXPECT_EQ(x.crop.height, y.crop.height);
       EXPECT_TRUE(same(x.render_ms, y.render_ms)) << a.record << " layer " << l;
     }
   }
@@ -399,7 +403,13 @@ TEST(PlacementStoreTest, IndexRoundTripKeepsEveryFieldBitForBit) {
           s.ids = placedLayerFileName(index.generation, id, l, true);
           s.ids_check = FileCheck{uint64_t(rng()), uint32_t(rng()), true};
         }
-        s.data_texels = rng() % (uint64_t(plan.layers[l].width) * uint64_t(plan.layers[l].height) + 1);
+        // A random rectangle of the captured image (cropLayered), holding the data texels.
+        const int w = plan.layers[l].width, h = plan.layers[l].height;
+        s.crop.x = int(rng() % uint32_t(w));
+        s.crop.y = int(rng() % uint32_t(h));
+        s.crop.width = 1 + int(rng() % uint32_t(w - s.crop.x));
+        s.crop.height = 1 + int(rng() % uint32_t(h - s.crop.y));
+        s.data_texels = rng() % (uint64_t(s.crop.width) * uint64_t(s.crop.height) + 1);
         s.render_ms = std::uniform_real_distribution<double>(0, 10)(rng);
         imp.layers.push_back(s);
       }
@@ -735,7 +745,8 @@ TEST(PlacementStoreIntegrityTest, DamagedIndexGivesErrorsNamingTheElement) {
       {"unknown top-level member", [](nlohmann::json& j) { j["extra"] = 1; }, {"top level", "unknown member \"extra\""}},
       {"missing cpvs", [](nlohmann::json& j) { j.erase("cpvs"); }, {"top level", "missing \"cpvs\""}},
       {"wrong format", [](nlohmann::json& j) { j["format"] = "farfield-impostor-store"; }, {"\"format\""}},
-      {"newer version", [](nlohmann::json& j) { j["version"] = 2; }, {"unsupported version 2"}},
+      {"newer version", [](nlohmann::json& j) { j["version"] = 3; }, {"unsupported version 3"}},
+      {"older version (layers not cropped)", [](nlohmann::json& j) { j["version"] = 1; }, {"unsupported version 1"}},
       {"generation 0", [](nlohmann::json& j) { j["generation"] = 0; }, {"\"generation\"", ">= 1"}},
       {"scene_objects a string", [](nlohmann::json& j) { j["scene_objects"] = "many"; },
        {"\"scene_objects\" must be a non-negative integer"}},
@@ -830,6 +841,12 @@ TEST(PlacementStoreIntegrityTest, DamagedIndexGivesErrorsNamingTheElement) {
        {"impostors[0].layers[0]", "\"texture\" is empty"}},
       {"more data texels than texels", [](nlohmann::json& j) { j["impostors"][0]["layers"][0]["data_texels"] = 100000; },
        {"impostors[0].layers[0]", "exceeds"}},
+      {"a crop outside its image", [](nlohmann::json& j) { j["impostors"][0]["layers"][0]["crop"] = {0, 0, 100000, 1}; },
+       {"impostors[0].layers", "layer 0", "crop 100000x1"}},
+      {"a crop of three numbers", [](nlohmann::json& j) { j["impostors"][0]["layers"][0]["crop"] = {0, 0, 1}; },
+       {"impostors[0].layers[0]", "\"crop\" must be"}},
+      {"a missing crop", [](nlohmann::json& j) { j["impostors"][0]["layers"][0].erase("crop"); },
+       {"impostors[0].layers[0]", "crop"}},
       {"unknown layer member", [](nlohmann::json& j) { j["impostors"][0]["layers"][0]["mesh"] = "x"; },
        {"impostors[0].layers[0]", "unknown member \"mesh\""}},
       {"a shaft into the cluster", [](nlohmann::json& j) { j["impostors"][2]["shaft"]["min_distance"] = 0.5; },

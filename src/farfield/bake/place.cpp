@@ -104,6 +104,8 @@ nlohmann::json PlaceReport::toJson() const {
           {"id_texture_bytes", id_texture_bytes},
           {"layer_texels", layer_texels},
           {"covered_texels", covered_texels},
+          {"stored_texels", stored_texels},
+          {"estimated_bytes", estimated_bytes},
           {"written_bytes", written_bytes},
           {"t_enc_max_ms", t_enc_max_ms},
           {"t_after_max_ms", t_after_max_ms},
@@ -378,23 +380,29 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   const uint64_t generation = store::nextPlacementGeneration(out_dir);
   std::map<size_t, store::StoredPlacedImpostor> written;  // candidate -> record
   std::map<size_t, uint64_t> covered;                     // candidate -> texels its objects cover
+  std::map<size_t, uint64_t> stored_texels;               // candidate -> texels kept after cropping
+  std::map<size_t, double> id_bytes;                      // candidate -> bytes of its id textures
   double capture_s = 0.0;
   const placement::GreedyResult result = placement::placeGreedy(problem, [&](size_t k) {
     Stopwatch capture;
     const placement::Candidate& c = kept.candidates[k];
     std::vector<uint32_t> objects(hierarchy.objects(c.node).begin(), hierarchy.objects(c.node).end());
     std::sort(objects.begin(), objects.end());
-    const impostor::LayeredImpostor imp = impostor::captureLayered(renderer, gpu_scene, objects, plans[k]);
+    // Each layer keeps only the rectangle its slab's objects cover (cropLayered: the same image, fewer texels).
+    const impostor::LayeredImpostor imp =
+        impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene, objects, plans[k]));
     written[k] = store::writePlacedImpostor(out_dir, generation, uint32_t(k), uint32_t(c.node), objects, imp,
                                             hierarchy.nodes()[size_t(c.node)].bounds, std::get<Shaft>(c.cell), bound,
                                             options.layered);
     covered[k] = 0;
     for (const impostor::Layer& layer : imp.layers) covered[k] += layer.data_texels;
+    stored_texels[k] = imp.plan.texels;
+    id_bytes[k] = imp.plan.id_textures ? 0.5 * double(imp.plan.texture_bytes) : 0.0;
     capture_s += capture.seconds();
     ++report.impostors_generated;
     if (options.progress && report.impostors_generated % 25 == 0)
       FF_INFO("place: " << report.impostors_generated << " impostors generated");
-    return placement::GeneratedImpostor{double(plans[k].bytes()), {}};
+    return placement::GeneratedImpostor{double(imp.plan.bytes()), {}};
   });
   report.greedy_s = step.seconds() - capture_s;
   report.capture_s = capture_s;
@@ -429,8 +437,10 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   for (size_t k : kept_candidates) {
     index.impostors.push_back(written.at(k));
     report.layer_texels += plans[k].texels;
+    report.stored_texels += stored_texels.at(k);
     report.covered_texels += covered.at(k);
-    if (plans[k].id_textures) report.id_texture_bytes += 0.5 * double(plans[k].texture_bytes);
+    report.id_texture_bytes += id_bytes.at(k);
+    report.estimated_bytes += double(plans[k].bytes());
   }
   for (size_t c = 0; c < view_space.cpvs.size(); ++c) {
     store::StoredCpv s;

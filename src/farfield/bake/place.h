@@ -80,12 +80,13 @@ struct PlaceReport {
   size_t candidates_unplannable = 0;  // dropped: no layered plan keeps the bound from the cell
   size_t impostors = 0, impostors_generated = 0, impostors_freed = 0;
   size_t unsolved_cpvs = 0;
-  double memory_bytes = 0.0;        // kept impostors, GPU bytes
+  double memory_bytes = 0.0;        // kept impostors, GPU bytes (each layer cropped to its data: cropLayered)
+  double estimated_bytes = 0.0;     // the same impostors as the optimiser estimated them (uncropped plans)
   // What that memory holds (kept impostors): per-texel object ids (for measurement; half of the texture bytes when
-  // LayeredOptions::id_textures), and the layers' texels against those their objects cover (the rest is transparent:
-  // what cropping each layer to its data would save).
+  // LayeredOptions::id_textures), the layers' texels as captured, as stored after cropping, and those their objects
+  // cover.
   double id_texture_bytes = 0.0;
-  uint64_t layer_texels = 0, covered_texels = 0;
+  uint64_t layer_texels = 0, stored_texels = 0, covered_texels = 0;
   uint64_t written_bytes = 0;       // files of the database
   double t_enc_max_ms = 0.0;        // the slowest CPV before placement
   double t_after_max_ms = 0.0;      // ... and after

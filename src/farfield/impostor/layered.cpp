@@ -76,7 +76,12 @@ void packAtlases(LayeredPlan& plan) {
     x = y = shelf = 0;
     used = IVec2(0);
   };
-  for (size_t i = 0; i < plan.layers.size(); ++i) {
+  // Tallest first, so that each shelf holds layers of similar heights (cropped layers vary a lot).
+  std::vector<size_t> order(plan.layers.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return plan.layers[a].height > plan.layers[b].height; });
+  for (const size_t i : order) {
     const int w = plan.layers[i].width + 2 * kAtlasPadding, h = plan.layers[i].height + 2 * kAtlasPadding;
     if (x > 0 && x + w > kAtlasSide) {  // next shelf
       y += shelf;
@@ -317,6 +322,7 @@ LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& sce
                                std::span<const uint32_t> object_ids, const LayeredPlan& plan) {
   if (object_ids.empty()) throw Error("layered impostor objects", "the cluster lists no object");
   if (plan.layers.empty()) throw Error("layered impostor plan", "has no layers (make it with planLayered)");
+  if (plan.cropped) throw Error("layered impostor plan", "is cropped: capture with the plan planLayered made");
   std::vector<gpu::DrawItem> items;
   try {
     scene.appendDrawItems(object_ids, items);
@@ -394,6 +400,98 @@ LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& sce
   return out;
 }
 
+void cropLayers(LayeredPlan& plan, std::span<const LayerCrop> crops) {
+  if (plan.cropped) throw Error("layered impostor plan", "is cropped already");
+  if (crops.size() != plan.layers.size())
+    throw Error("layered impostor crops", std::to_string(crops.size()) + " crops for " +
+                                              std::to_string(plan.layers.size()) + " layers");
+  plan.texels = 0;
+  for (size_t i = 0; i < crops.size(); ++i) {
+    LayerPlan& layer = plan.layers[i];
+    const LayerCrop& c = crops[i];
+    if (c.width < 1 || c.height < 1 || c.x < 0 || c.y < 0 || c.x + c.width > layer.width ||
+        c.y + c.height > layer.height)
+      throw Error("layered impostor layer " + std::to_string(i),
+                  "crop " + std::to_string(c.width) + "x" + std::to_string(c.height) + " at (" + std::to_string(c.x) +
+                      ", " + std::to_string(c.y) + ") leaves its " + std::to_string(layer.width) + "x" +
+                      std::to_string(layer.height) + " image");
+    // A texel is s metres a side in the quad's plane (half_u = width * s / 2); column x spans [-half_u + x s, ...],
+    // row y spans [half_v - (y + 1) s, half_v - y s] (row 0 at the top, towards +up).
+    const double s = 2.0 * double(layer.half_u) / double(layer.width);
+    layer.offset_u = float(double(layer.offset_u) - layer.half_u + (c.x + 0.5 * c.width) * s);
+    layer.offset_v = float(double(layer.offset_v) + layer.half_v - (c.y + 0.5 * c.height) * s);
+    layer.half_u = float(0.5 * c.width * s);
+    layer.half_v = float(0.5 * c.height * s);
+    layer.crop_x = c.x;
+    layer.crop_y = c.y;
+    layer.width = c.width;
+    layer.height = c.height;
+    plan.texels += uint64_t(c.width) * uint64_t(c.height);
+  }
+  packAtlases(plan);
+  plan.texture_bytes = 0;
+  for (const IVec2& a : plan.atlas_sizes)
+    plan.texture_bytes += size_t(a.x) * size_t(a.y) * 4 * (plan.id_textures ? 2 : 1);
+  plan.cropped = true;
+}
+
+LayerCrop dataCrop(const Layer& layer) {
+  const int w = layer.color.width(), h = layer.color.height();
+  const bool ids = !layer.ids.empty();
+  int x0 = w, y0 = h, x1 = -1, y1 = -1;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const image::Rgba8 c = layer.color.at(x, y);
+      const bool data = c != image::Rgba8(0, 0, 0, 0) || (ids && layer.ids.at(x, y) != 0);
+      if (!data) continue;
+      x0 = std::min(x0, x);
+      y0 = std::min(y0, y);
+      x1 = std::max(x1, x);
+      y1 = std::max(y1, y);
+    }
+  if (x1 < 0) return {0, 0, 1, 1};
+  x0 = std::max(0, x0 - 1);
+  y0 = std::max(0, y0 - 1);
+  x1 = std::min(w - 1, x1 + 1);
+  y1 = std::min(h - 1, y1 + 1);
+  return {x0, y0, x1 - x0 + 1, y1 - y0 + 1};
+}
+
+LayeredImpostor cropLayered(const LayeredImpostor& impostor) {
+  if (impostor.layers.size() != impostor.plan.layers.size())
+    throw Error("layered impostor", std::to_string(impostor.layers.size()) + " layer images for " +
+                                        std::to_string(impostor.plan.layers.size()) + " planned layers");
+  std::vector<LayerCrop> crops;
+  for (size_t i = 0; i < impostor.layers.size(); ++i) {
+    const Layer& layer = impostor.layers[i];
+    const LayerPlan& lp = impostor.plan.layers[i];
+    if (layer.color.width() != lp.width || layer.color.height() != lp.height ||
+        (!layer.ids.empty() && (layer.ids.width() != lp.width || layer.ids.height() != lp.height)))
+      throw Error("layered impostor layer " + std::to_string(i), "images do not match the plan's size");
+    crops.push_back(dataCrop(layer));
+  }
+  LayeredImpostor out;
+  out.plan = impostor.plan;
+  cropLayers(out.plan, crops);
+  out.capture_ms = impostor.capture_ms;
+  for (size_t i = 0; i < impostor.layers.size(); ++i) {
+    const Layer& layer = impostor.layers[i];
+    const LayerCrop& c = crops[i];
+    Layer cut;
+    cut.color = image::ColorImage(c.width, c.height);
+    if (!layer.ids.empty()) cut.ids = image::IdImage(c.width, c.height);
+    for (int y = 0; y < c.height; ++y)
+      for (int x = 0; x < c.width; ++x) {
+        cut.color.at(x, y) = layer.color.at(c.x + x, c.y + y);
+        if (!layer.ids.empty()) cut.ids.at(x, y) = layer.ids.at(c.x + x, c.y + y);
+      }
+    cut.data_texels = layer.data_texels;
+    cut.render_ms = layer.render_ms;
+    out.layers.push_back(std::move(cut));
+  }
+  return out;
+}
+
 GpuLayeredImpostor::GpuLayeredImpostor(const LayeredImpostor& impostor) {
   const LayeredPlan& plan = impostor.plan;
   FF_CHECK(impostor.layers.size() == plan.layers.size());
@@ -422,7 +520,7 @@ GpuLayeredImpostor::GpuLayeredImpostor(const LayeredImpostor& impostor) {
     const IVec2 size = plan.atlas_sizes[spot.atlas];
     const Vec2 uv0(float(spot.x) / float(size.x), float(spot.y) / float(size.y));
     const Vec2 uv1(float(spot.x + lp.width) / float(size.x), float(spot.y + lp.height) / float(size.y));
-    const Vec3 centre = plan.shaft.apex + lp.depth * plan.shaft.axis;
+    const Vec3 centre = plan.shaft.apex + lp.depth * plan.shaft.axis + lp.offset_u * plan.right + lp.offset_v * plan.up;
     const Vec3 du = lp.half_u * plan.right, dv = lp.half_v * plan.up;
     scene::Mesh& mesh = meshes[spot.atlas];
     const uint32_t base = uint32_t(mesh.positions.size());

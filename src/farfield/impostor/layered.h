@@ -57,6 +57,16 @@ struct LayerPlan {
   float half_v = 0.0f;
   int width = 0, height = 0;       // texels
   float fov_y = 0.0f;              // the capture camera's vertical field of view (radians) that images the quad
+  // After cropLayered: the image is the rectangle of the captured one starting at texel (crop_x, crop_y) (row 0 at
+  // the top), width x height texels; the quad, half_u x half_v, is centred offset_u along LayeredPlan::right and
+  // offset_v along ::up from the axis (0 for an uncropped layer).
+  int crop_x = 0, crop_y = 0;
+  float offset_u = 0.0f, offset_v = 0.0f;
+};
+
+// A rectangle of a layer's captured image, texels, row 0 at the top.
+struct LayerCrop {
+  int x = 0, y = 0, width = 0, height = 0;
 };
 
 struct LayeredPlan {
@@ -79,7 +89,7 @@ struct LayeredPlan {
   int dilate_texels = 2;
   bool solid_slices = true;
   std::vector<LayerPlan> layers;  // far to near (increasing depth)
-  // The layers packed into texture atlases (shelves, in layer order, kAtlasPadding texels apart, at most
+  // The layers packed into texture atlases (shelves, tallest layers first, kAtlasPadding texels apart, at most
   // kAtlasSide texels a side unless a layer alone is larger): one texture and one draw call per atlas on the GPU.
   struct AtlasSpot {
     uint32_t atlas = 0;
@@ -100,6 +110,7 @@ struct LayeredPlan {
   double fill_pixels = 0.0;
 
   bool keepsBound() const { return !layers_capped && error_angle <= bound_angle; }
+  bool cropped = false;  // cropLayers was applied: the layers are parts of the captured images
 };
 
 // Plans the layers of the cluster `box` for the viewpoints of `shaft` under `bound`. Pure arithmetic, no GL. Throws
@@ -128,6 +139,24 @@ struct LayeredImpostor {
 // list, an id the scene does not have, an object whose bounds leave plan.box, or a plan without layers.
 LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& scene,
                                std::span<const uint32_t> object_ids, const LayeredPlan& plan);
+
+// The plan with layer i cut to crops[i], a rectangle of its captured image (plan.layers[i].width x height, the plan
+// not cropped yet): each quad shrinks to its rectangle and moves with it, the atlases are packed again and texels and
+// texture_bytes counted again (fill_pixels stays the estimate of the whole quads: an upper bound). Throws
+// farfield::Error naming the layer for a crop count other than the layer count, an empty crop, a crop outside its
+// image, or a plan already cropped.
+void cropLayers(LayeredPlan& plan, std::span<const LayerCrop> crops);
+
+// The rectangle of the layer's texels that are not transparent black or carry an object id, grown by one texel on
+// every side and clamped to the image: outside it every texel is transparent black with id 0, as is its border ring,
+// which the atlas's edge clamp repeats. A 1x1 rectangle at (0, 0) for a layer without data.
+LayerCrop dataCrop(const Layer& layer);
+
+// The impostor with every layer cut to its dataCrop: the same image from every viewpoint (what is dropped is
+// transparent black, and the texels that bilinear filtering and the edge clamp now read at a cut are too), fewer
+// texels. The layers' data_texels and render_ms are kept. Throws farfield::Error for an impostor whose images do not
+// match its plan or whose plan is already cropped.
+LayeredImpostor cropLayered(const LayeredImpostor& impostor);
 
 inline constexpr int kAtlasSide = 4096;
 inline constexpr int kAtlasPadding = 2;  // texels around each layer image, its edge texels repeated (clamp to edge)

@@ -125,8 +125,11 @@ nlohmann::json layeredOptionsJson(const impostor::LayeredOptions& o) {
 nlohmann::json impostorJson(const StoredPlacedImpostor& imp) {
   nlohmann::json layers = nlohmann::json::array();
   for (const StoredImpostorLayer& l : imp.layers) {
-    nlohmann::json j = {{"texture", l.texture}, {"ids", l.ids}, {"data_texels", l.data_texels},
-                        {"render_ms", l.render_ms}};
+    nlohmann::json j = {{"texture", l.texture},
+                        {"ids", l.ids},
+                        {"data_texels", l.data_texels},
+                        {"render_ms", l.render_ms},
+                        {"crop", {l.crop.x, l.crop.y, l.crop.width, l.crop.height}}};
     putCheck(j, "texture", l.texture, l.texture_check, true);
     putCheck(j, "ids", l.ids, l.ids_check, true);
     layers.push_back(std::move(j));
@@ -235,7 +238,7 @@ StoredPlacedImpostor readImpostor(const JsonReader& r, const nlohmann::json& j, 
     const std::string at = where + ".layers[" + std::to_string(l) + "]";
     const nlohmann::json& lj = layers[l];
     r.onlyKeys(lj, {"texture", "texture_crc32", "texture_bytes", "ids", "ids_crc32", "ids_bytes", "data_texels",
-                    "render_ms"},
+                    "render_ms", "crop"},
                at);
     StoredImpostorLayer layer;
     layer.texture = r.relativeFile(lj, "texture", at, false);
@@ -248,12 +251,28 @@ StoredPlacedImpostor readImpostor(const JsonReader& r, const nlohmann::json& j, 
       r.fail(at, imp.options.id_textures ? "\"ids\" is empty but the options have id_textures"
                                          : "\"ids\" names a file but the options have no id_textures");
     layer.data_texels = size_t(r.count(lj, "data_texels", at));
-    const uint64_t texels = uint64_t(plan.layers[l].width) * uint64_t(plan.layers[l].height);
-    if (layer.data_texels > texels)
-      r.fail(at, "\"data_texels\" " + std::to_string(layer.data_texels) + " exceeds the layer's " +
-                     std::to_string(texels) + " texels");
+    const nlohmann::json& crop = r.member(lj, "crop", at);
+    if (!crop.is_array() || crop.size() != 4 || !std::all_of(crop.begin(), crop.end(), [](const nlohmann::json& v) {
+          return v.is_number_integer() && v.get<int64_t>() >= 0 && v.get<int64_t>() <= (int64_t(1) << 20);
+        }))
+      r.fail(at, "\"crop\" must be [x, y, width, height], integers of 0 .. 2^20");
+    layer.crop = {crop[0].get<int>(), crop[1].get<int>(), crop[2].get<int>(), crop[3].get<int>()};
     layer.render_ms = nonNegative(r, lj, "render_ms", at);
     imp.layers.push_back(std::move(layer));
+  }
+  std::vector<impostor::LayerCrop> crops;
+  for (const StoredImpostorLayer& layer : imp.layers) crops.push_back(layer.crop);
+  try {
+    impostor::cropLayers(plan, crops);
+  } catch (const Error& e) {
+    r.fail(where + ".layers", e.what());
+  }
+  for (size_t l = 0; l < imp.layers.size(); ++l) {
+    const uint64_t texels = uint64_t(plan.layers[l].width) * uint64_t(plan.layers[l].height);
+    if (imp.layers[l].data_texels > texels)
+      r.fail(where + ".layers[" + std::to_string(l) + "]", "\"data_texels\" " +
+                 std::to_string(imp.layers[l].data_texels) + " exceeds the layer's " + std::to_string(texels) +
+                 " texels");
   }
   return imp;
 }
@@ -403,6 +422,18 @@ StoredPlacedImpostor writePlacedImpostor(const std::string& dir, uint64_t genera
     fail("the impostor has " + std::to_string(impostor.layers.size()) + " layers (its plan " +
          std::to_string(impostor.plan.layers.size()) + "), the plan of its box, shaft, bound and options " +
          std::to_string(count) + " (was it captured with other inputs?)");
+  // The part of each captured image the impostor holds (all of it when not cropped).
+  std::vector<impostor::LayerCrop> crops;
+  for (size_t l = 0; l < count; ++l) {
+    const impostor::LayerPlan& lp = impostor.plan.layers[l];
+    crops.push_back(impostor.plan.cropped ? impostor::LayerCrop{lp.crop_x, lp.crop_y, lp.width, lp.height}
+                                          : impostor::LayerCrop{0, 0, plan.layers[l].width, plan.layers[l].height});
+  }
+  try {
+    impostor::cropLayers(plan, crops);
+  } catch (const Error& e) {
+    fail(e.what());
+  }
   for (size_t l = 0; l < count; ++l) {
     const impostor::LayerPlan& p = plan.layers[l];
     const impostor::Layer& layer = impostor.layers[l];
@@ -430,6 +461,7 @@ StoredPlacedImpostor writePlacedImpostor(const std::string& dir, uint64_t genera
     }
     s.data_texels = layer.data_texels;
     s.render_ms = layer.render_ms;
+    s.crop = crops[l];
     out.layers.push_back(std::move(s));
   }
   return out;
@@ -481,7 +513,7 @@ PlacementIndex placementFromJson(const nlohmann::json& j, const std::string& sou
   const uint64_t version = r.count(j, "version", top);
   if (version != uint64_t(kPlacementVersion))
     r.fail("\"version\"", "unsupported version " + std::to_string(version) + " (this build reads version " +
-                              std::to_string(kPlacementVersion) + ")");
+                              std::to_string(kPlacementVersion) + "; run farfield place again)");
   index.version = int(version);
   index.generation = r.count(j, "generation", top);
   if (index.generation == 0) r.fail("\"generation\"", "must be >= 1");
@@ -643,6 +675,13 @@ impostor::LayeredImpostor loadPlacedImpostor(const std::string& dir, const Store
   if (out.plan.layers.size() != imp.layers.size())
     throw Error(index_file, record + ": lists " + std::to_string(imp.layers.size()) + " layers, its plan has " +
                                 std::to_string(out.plan.layers.size()));
+  std::vector<impostor::LayerCrop> crops;
+  for (const StoredImpostorLayer& s : imp.layers) crops.push_back(s.crop);
+  try {
+    impostor::cropLayers(out.plan, crops);
+  } catch (const Error& e) {
+    throw Error(index_file, record + ": " + e.what());
+  }
   out.capture_ms = imp.capture_ms;
   for (size_t l = 0; l < imp.layers.size(); ++l) {
     const StoredImpostorLayer& s = imp.layers[l];

@@ -75,7 +75,8 @@
 
 namespace farfield::store {
 
-inline constexpr int kPlacementVersion = 1;
+// Version 2: each layer holds only the rectangle of its captured image that has data ("crop").
+inline constexpr int kPlacementVersion = 2;
 inline constexpr char kPlacementFormat[] = "farfield-placement";
 inline constexpr char kPlacementIndexFile[] = "placement.json";
 
@@ -86,6 +87,8 @@ struct StoredImpostorLayer {
   FileCheck ids_check;
   size_t data_texels = 0;
   double render_ms = 0.0;
+  // The part of the captured layer image that is stored (impostor::cropLayered); the whole image when not cropped.
+  impostor::LayerCrop crop;
 };
 
 // A layered impostor of an object cluster (impostor/layered.h), valid in a shaft view cell.
