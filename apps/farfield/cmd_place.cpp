@@ -110,6 +110,8 @@ const RegisterCommand reg("place", [](CLI::App& app) {
   cmd->add_option("--texel-px", args->texel_px, "Impostor texel size in pixels of the frames at the nearest "
                                                  "viewpoint (0: the error bound)")->capture_default_str();
   cmd->add_flag("--bound-cracks", o.layered.bound_cracks, "Halve layer spacing so cracks also stay under the bound");
+  cmd->add_flag("!--no-id-textures", o.layered.id_textures, "Leave out the per-texel object ids (half the impostors' "
+                                                             "memory; bench then cannot measure their parallax)");
   cmd->callback([args] { runPlaceCommand(*args); });
 });
 
