@@ -2,16 +2,9 @@
 # and print scene info. Run by ctest with -DFARFIELD=<binary> -DWORK=<scratch dir>.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
+include(${CMAKE_CURRENT_LIST_DIR}/cli_helpers.cmake)
 
-function(run_ok)
-  execute_process(COMMAND ${FARFIELD} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "farfield ${ARGN}: exit code ${rc}\nstdout: ${out}\nstderr: ${err}")
-  endif()
-  set(LAST_OUT "${out}" PARENT_SCOPE)
-endfunction()
-
-run_ok(render builtin:cubes --eye 18,-22,14 --at 0,0,1 --fov 55 --size 160x120 -o ${WORK}/a.png
+run_ok(${FARFIELD} render builtin:cubes --eye 18,-22,14 --at 0,0,1 --fov 55 --size 160x120 -o ${WORK}/a.png
        --depth ${WORK}/a.pfm --ids ${WORK}/a_ids.png)
 foreach(f a.png a.pfm a_ids.png)
   if(NOT EXISTS ${WORK}/${f})
@@ -25,13 +18,13 @@ if(NOT LAST_OUT MATCHES "gpu ms:")
   message(FATAL_ERROR "render did not report GPU time:\n${LAST_OUT}")
 endif()
 
-run_ok(diff ${WORK}/a.png ${WORK}/a.png --json)
+run_ok(${FARFIELD} diff ${WORK}/a.png ${WORK}/a.png --json)
 if(NOT LAST_OUT MATCHES "\"identical\": true")
   message(FATAL_ERROR "a frame differs from itself:\n${LAST_OUT}")
 endif()
 
-run_ok(render builtin:cubes --eye 20,-20,14 --at 0,0,1 --fov 55 --size 160x120 -o ${WORK}/b.png)
-run_ok(diff ${WORK}/a.png ${WORK}/b.png --json --heatmap ${WORK}/d.png)
+run_ok(${FARFIELD} render builtin:cubes --eye 20,-20,14 --at 0,0,1 --fov 55 --size 160x120 -o ${WORK}/b.png)
+run_ok(${FARFIELD} diff ${WORK}/a.png ${WORK}/b.png --json --heatmap ${WORK}/d.png)
 if(NOT LAST_OUT MATCHES "\"identical\": false")
   message(FATAL_ERROR "two different views compare identical:\n${LAST_OUT}")
 endif()
@@ -39,7 +32,7 @@ if(NOT EXISTS ${WORK}/d.png)
   message(FATAL_ERROR "diff did not write the heat map")
 endif()
 
-run_ok(info builtin:cubes)
+run_ok(${FARFIELD} info builtin:cubes)
 if(NOT LAST_OUT MATCHES "objects: +2[0-9]")
   message(FATAL_ERROR "info builtin:cubes should list 26 objects (ground + 25 boxes):\n${LAST_OUT}")
 endif()

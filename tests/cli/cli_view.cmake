@@ -4,21 +4,7 @@
 # Run by ctest with -DFARFIELD=<binary> -DWORK=<scratch dir>.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
-
-function(expect_error expected_substring)
-  execute_process(COMMAND ${FARFIELD} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 2)
-    message(FATAL_ERROR "farfield ${ARGN}: expected exit code 2, got '${rc}'\nstdout: ${out}\nstderr: ${err}")
-  endif()
-  if(NOT err MATCHES "error: ")
-    message(FATAL_ERROR "farfield ${ARGN}: stderr lacks 'error: '\n${err}")
-  endif()
-  string(FIND "${err}" "${expected_substring}" pos)
-  if(pos EQUAL -1)
-    message(FATAL_ERROR "farfield ${ARGN}: stderr lacks '${expected_substring}'\n${err}")
-  endif()
-  message(STATUS "ok: farfield ${ARGN} -> ${err}")
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/cli_helpers.cmake)
 
 execute_process(COMMAND ${FARFIELD} path orbit builtin:cubes --frames 3 -o ${WORK}/orbit.json RESULT_VARIABLE rc
                 OUTPUT_QUIET)

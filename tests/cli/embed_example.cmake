@@ -3,14 +3,7 @@
 # -DFARFIELD=<binary> -DEXAMPLE=<embed_walkthrough binary> -DWORK=<scratch dir>.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
-
-function(run_ok)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "${ARGN}: exit code ${rc}\nstdout: ${out}\nstderr: ${err}")
-  endif()
-  set(LAST_OUT "${out}" PARENT_SCOPE)
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/cli_helpers.cmake)
 
 run_ok(${FARFIELD} gen city --blocks 12 --detail 0 --seed 4 -o ${WORK}/city.glb)
 run_ok(${FARFIELD} path street ${WORK}/city.streets.json --frames 20 --fps 5 --seed 4 --car -o ${WORK}/drive.json)
