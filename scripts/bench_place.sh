@@ -41,7 +41,7 @@ place() {  # NAME ARGS...
   shift
   # A database of this build's format is reused; an older one (the store refuses it) is placed again.
   PLACED=0
-  grep -q '"version": 2,' "$OUT/$name/placement.json" 2>/dev/null && return 0
+  grep -q '"version": 3,' "$OUT/$name/placement.json" 2>/dev/null && return 0
   rm -rf "${OUT:?}/$name"
   PLACED=1
   /usr/bin/time -f "%e s, %M kB" -o "$OUT/$name.time" "$FARFIELD" place "$OUT/city.glb" "${PLACE_COMMON[@]}" \

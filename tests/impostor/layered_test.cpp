@@ -162,15 +162,34 @@ TEST(LayeredPlanTest, LayersAndTexelsFollowTheShaftAndTheBound) {
   EXPECT_LT(count(45.0f, 100.0f, 4.0), count(45.0f, 100.0f, 1.0));
   EXPECT_EQ(count(11.25f, 20000.0f, 2.0), 1u);
 
-  // Texels: one (corner) pixel of the bound's frame from the nearest viewpoint, or coarser when capped.
-  const LayeredPlan plan = planLayered(box, Shaft::make(Vec3(0.0f), Vec3(0, -1, 0), 0.5f, 200.0f), bound);
+  // Texels: at most one (corner) pixel of the bound's frame from every viewpoint of the shaft (sampled, against the
+  // corners and centre of each layer's quad), exactly one from the nearest; or coarser when capped.
+  const Shaft wide = Shaft::make(Vec3(0.0f), Vec3(0, -1, 0), 0.5f, 60.0f);
+  const LayeredPlan plan = planLayered(box, wide, bound);
   EXPECT_NEAR(plan.texel_angle, bound.cornerPixelAngle(), 1e-9);
   EXPECT_FALSE(plan.resolution_capped);
+  ASSERT_GE(plan.layers.size(), 3u);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  double tightest = 0.0;
   for (const LayerPlan& layer : plan.layers) {
     const double texel = 2.0 * layer.half_u / layer.width;
-    EXPECT_NEAR(texel / (200.0 - plan.radius), bound.cornerPixelAngle(), 1e-6);
     EXPECT_NEAR(2.0 * layer.half_v / layer.height, texel, 1e-6);
+    const Vec3 centre = wide.apex + layer.depth * wide.axis;
+    for (int k = 0; k < 2000; ++k) {
+      const Vec3 eye = wide.sample(u(rng), u(rng), u(rng), 3.0f * wide.min_distance);
+      for (const Vec2 corner : {Vec2(0.0f), Vec2(-1, -1), Vec2(-1, 1), Vec2(1, -1), Vec2(1, 1)}) {
+        const Vec3 p = centre + corner.x * layer.half_u * plan.right + corner.y * layer.half_v * plan.up;
+        const double angle = texel / double(glm::length(eye - p));
+        EXPECT_LE(angle, bound.cornerPixelAngle() * (1.0 + 1e-4));
+        tightest = std::max(tightest, angle);
+      }
+    }
   }
+  EXPECT_GT(tightest, 0.5 * bound.cornerPixelAngle());  // not needlessly fine
+  // The far side of the cluster, seen from further away, has coarser texels than the near side.
+  const auto texel = [](const LayerPlan& l) { return 2.0 * l.half_u / l.width; };
+  EXPECT_GT(texel(plan.layers.front()), 1.1 * texel(plan.layers.back()));
   LayeredOptions capped;
   capped.max_texture_size = 16;
   const LayeredPlan small = planLayered(box, Shaft::make(Vec3(0.0f), Vec3(0, -1, 0), 0.5f, 200.0f), bound, capped);

@@ -235,7 +235,10 @@ LayeredPlan planLayered(const Box3& box, const Shaft& shaft_in, const ErrorBound
   plan.spacing = depth_range / count;
   plan.error_angle = 0.5 * plan.parallax_per_metre * plan.spacing;
 
-  // Texels: no larger than the wanted angle from the nearest viewpoint (distance >= d - r).
+  // Texels: no larger than the wanted angle from the nearest viewpoint of each layer's quad. Every point drawn lies
+  // within r of the apex, so every viewpoint (|V - apex| >= d) is at least d - r from it; and a viewpoint's axial
+  // coordinate is at least d cos(theta) (within theta of the axis), so it is at least d cos(theta) - depth from the
+  // plane z = depth. The layers on the far side of a deep cluster get coarser texels.
   const double wanted = bound.cornerPixelAngle() * std::min(options.texel_pixels, bound.pixels);
   const double near_gap = d - r;
   const double margin = slabMargin(plan);
@@ -248,7 +251,8 @@ LayeredPlan planLayered(const Box3& box, const Shaft& shaft_in, const ErrorBound
     layer.z_hi = float(zb);
     layer.depth = float(0.5 * (za + zb));
     const Vec2 half = slabFootprint(corners, za - margin, zb + margin, layer.depth, d);
-    double s = wanted * near_gap;
+    const double gap = std::max(near_gap, d * std::cos(theta) - double(layer.depth));
+    double s = wanted * gap;
     const double extent = 2.0 * std::max(half.x, half.y);
     if (extent / s > double(options.max_texture_size)) {
       s = extent / double(options.max_texture_size);
@@ -260,7 +264,7 @@ LayeredPlan planLayered(const Box3& box, const Shaft& shaft_in, const ErrorBound
     layer.half_v = float(0.5 * layer.height * s);
     const double distance = d - layer.depth;
     layer.fov_y = float(2.0 * std::atan(layer.half_v / distance));
-    plan.texel_angle = std::max(plan.texel_angle, s / near_gap);
+    plan.texel_angle = std::max(plan.texel_angle, s / gap);
 
     const uint64_t texels = uint64_t(layer.width) * uint64_t(layer.height);
     plan.texels += texels;

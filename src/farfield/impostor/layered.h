@@ -34,8 +34,9 @@
 namespace farfield::impostor {
 
 struct LayeredOptions {
-  // Texel size, in pixels of the bound's frame (its smallest, corner pixel), seen from the nearest viewpoint of the
-  // shaft; never coarser than the bound's angle (a texel is at most min(texel_pixels, bound.pixels) pixels).
+  // Texel size, in pixels of the bound's frame (its smallest, corner pixel), seen from the shaft's nearest viewpoint
+  // to the texel's layer (layers on the far side of the cluster get larger texels); never coarser than the bound's
+  // angle (a texel is at most min(texel_pixels, bound.pixels) pixels).
   double texel_pixels = 1.0;
   int max_texture_size = 1024;  // per side, 1..16384; a layer that would need more gets coarser texels
   int max_layers = 64;          // a plan that needs more keeps this many and says so (layers_capped)
@@ -83,7 +84,7 @@ struct LayeredPlan {
   double error_angle = 0.0;   // radians: K * spacing / 2, the parallax bound from any viewpoint of the shaft
   double bound_angle = 0.0;   // radians: bound.angle()
   bool layers_capped = false; // the bound needed more than max_layers: error_angle > bound_angle
-  double texel_angle = 0.0;   // radians: the largest texel seen from the nearest viewpoint (min_distance - radius)
+  double texel_angle = 0.0;   // radians: the largest texel seen from the nearest viewpoint of its layer
   bool resolution_capped = false;  // a layer hit max_texture_size: texel_angle exceeds the wanted one
   bool id_textures = true;
   int dilate_texels = 2;

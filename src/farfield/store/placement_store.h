@@ -75,8 +75,9 @@
 
 namespace farfield::store {
 
-// Version 2: each layer holds only the rectangle of its captured image that has data ("crop").
-inline constexpr int kPlacementVersion = 2;
+// Version 2: each layer holds only the rectangle of its captured image that has data ("crop"). Version 3: texels
+// sized per layer (impostor::planLayered), so the plans of version 2 inputs differ.
+inline constexpr int kPlacementVersion = 3;
 inline constexpr char kPlacementFormat[] = "farfield-placement";
 inline constexpr char kPlacementIndexFile[] = "placement.json";
 
