@@ -47,7 +47,7 @@ TEST(DatabaseModes, APipelineStoreOffersWhatTheWalkthroughCanOpen) {
   const scene::Bvh bvh(c.city.scene);
   gpu::Renderer renderer;
   for (const std::string& mode : m.modes) {
-    const auto representation = representationOf(mode);
+    const auto representation = runtime::representationFromName(mode);
     if (!representation || *representation == runtime::Representation::MmiDynamic) continue;  // calibration: slow
     runtime::WalkthroughOptions options;
     options.database = c.store;

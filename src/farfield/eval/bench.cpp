@@ -82,28 +82,6 @@ double crackShare(const image::IdImage& reference, const image::IdImage& frame) 
 
 // The parallax error of a frame (99th percentile, pixels), or NaN when its item buffer shows ids that are not scene
 // objects (an impostor drawn with an id of its own: the metric needs the ids of the objects it stands for).
-double frameParallax(const image::IdImage& reference, const image::IdImage& frame, size_t object_count) {
-  for (uint32_t id : frame.pixels())
-    if (id > object_count) return std::numeric_limits<double>::quiet_NaN();
-  ParallaxOptions options;
-  options.skip_absent = true;  // impostor triangles carry their majority object's id: small objects may be absent
-  return parallaxError(reference, frame, options).object_percentile_px;
-}
-
-// Parallax error per pixel as a picture: black where the object is right, dark red to yellow for 1 to 32+ pixels.
-image::ColorImage parallaxHeatmap(const image::IdImage& reference, const image::IdImage& frame) {
-  ParallaxOptions options;
-  options.skip_absent = true;
-  const image::Image<float> map = parallaxErrorMap(reference, frame, options);
-  image::ColorImage out(map.width(), map.height(), image::Rgba8(0, 0, 0, 255));
-  for (size_t i = 0; i < map.pixelCount(); ++i) {
-    const float t = std::min(1.0f, map.pixels()[i] / 32.0f);
-    if (map.pixels()[i] <= 0.0f) continue;
-    out.pixels()[i] = image::Rgba8(uint8_t(96 + 159 * t), uint8_t(255 * t * t), 0, 255);
-  }
-  return out;
-}
-
 std::string shellQuote(const std::string& s) {
   std::string out = "'";
   for (char c : s) {
@@ -344,7 +322,7 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
           mode_result.errors.push_back(e);
           ids = target.readIds();
           mode_result.crack_shares.push_back(crackShare(reference_ids, ids));
-          mode_result.parallax_px.push_back(frameParallax(reference_ids, ids, scene.objects.size()));
+          mode_result.parallax_px.push_back(frameParallaxPx(reference_ids, ids, scene.objects.size()));
           mode_result.popping.push_back(
               k == 0 ? std::numeric_limits<double>::quiet_NaN()
                      : poppingError(previous_frame[m], frame, previous_reference, reference));

@@ -250,4 +250,26 @@ image::Image<float> parallaxErrorMap(const image::IdImage& reference, const imag
   return map;
 }
 
+double frameParallaxPx(const image::IdImage& reference, const image::IdImage& frame, size_t object_count) {
+  for (uint32_t id : frame.pixels())
+    if (id > object_count) return std::numeric_limits<double>::quiet_NaN();
+  ParallaxOptions options;
+  options.skip_absent = true;
+  return parallaxError(reference, frame, options).object_percentile_px;
+}
+
+image::ColorImage parallaxHeatmap(const image::IdImage& reference, const image::IdImage& frame) {
+  ParallaxOptions options;
+  options.skip_absent = true;
+  const image::Image<float> map = parallaxErrorMap(reference, frame, options);
+  image::ColorImage out(map.width(), map.height(), image::Rgba8(0, 0, 0, 255));
+  for (size_t i = 0; i < map.pixelCount(); ++i) {
+    const float px = map.pixels()[i];
+    if (!(px > 0.0f)) continue;
+    const float t = std::min(1.0f, px / 32.0f);
+    out.pixels()[i] = image::Rgba8(uint8_t(96 + 159 * t), uint8_t(255 * t * t), 0, 255);
+  }
+  return out;
+}
+
 }  // namespace farfield::eval

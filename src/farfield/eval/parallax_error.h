@@ -59,4 +59,12 @@ ParallaxError parallaxError(const image::IdImage& reference, const image::IdImag
 image::Image<float> parallaxErrorMap(const image::IdImage& reference, const image::IdImage& test,
                                      const ParallaxOptions& options = {});
 
+// A frame's parallax as bench and the viewer report it: object_percentile_px with skip_absent (impostor triangles
+// carry their majority object's id, so small objects may be absent); NaN when the frame shows ids above
+// object_count (ids that are not scene objects: the parallax cannot be measured).
+double frameParallaxPx(const image::IdImage& reference, const image::IdImage& frame, size_t object_count);
+
+// The same per pixel as a picture: black where the object is right, dark red to yellow for 1 to 32+ pixels.
+image::ColorImage parallaxHeatmap(const image::IdImage& reference, const image::IdImage& frame);
+
 }  // namespace farfield::eval

@@ -41,6 +41,28 @@ const char* representationName(Representation representation) {
   return "?";
 }
 
+std::optional<Representation> representationFromName(const std::string& name) {
+  using R = Representation;
+  for (R r : {R::Local, R::Visible, R::Smi, R::Mmi, R::MmiDynamic, R::Placed})
+    if (name == representationName(r)) return r;
+  return std::nullopt;
+}
+
+std::string missingStage(const store::StoreIndex& index, Representation kind) {
+  const std::string me = std::string("walkthrough '") + representationName(kind) + "'";
+  if (kind == Representation::Placed) return me + " needs a placement database (farfield place), not a pipeline store";
+  // Smi draws the single stage's mesh (version 2 and 3 stores read with the stage where their mmi stage built it).
+  const char* needed = kind == Representation::Visible ? extract::kStagePvs
+                       : kind == Representation::Local ? extract::kStageNearFar
+                       : kind == Representation::Smi   ? extract::kStageSingle
+                                                       : extract::kStageMmi;
+  if (!contains(index.pipeline, needed))
+    return "its pipeline has no " + std::string(needed) + " stage, which " + me + " needs";
+  if (kind == Representation::Visible && contains(index.online, extract::kStagePvs))
+    return me + " needs the pvs stage baked";
+  return "";
+}
+
 struct Walkthrough::Layer {
   std::vector<uint32_t> objects;
   Box3 bounds;                                        // world bounds of its objects
@@ -90,18 +112,7 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
       throw Error(index_file, std::string("bad \"pipeline\"/\"online\": ") + e.what());
     }
   }
-  std::vector<std::string> baked;
-  for (const std::string& s : index_.pipeline)
-    if (!contains(index_.online, s)) baked.push_back(s);
-  // Smi draws the single stage's mesh (version 2 and 3 stores read with the stage where their mmi stage built it).
-  const char* needed = kind == Representation::Visible ? extract::kStagePvs
-                       : kind == Representation::Local ? extract::kStageNearFar
-                       : kind == Representation::Smi   ? extract::kStageSingle
-                                                       : extract::kStageMmi;
-  if (!contains(index_.pipeline, needed))
-    throw Error(index_file, "its pipeline has no " + std::string(needed) + " stage, which " + me + " needs");
-  if (kind == Representation::Visible && !contains(baked, extract::kStagePvs))
-    throw Error(index_file, me + " needs the pvs stage baked");
+  if (const std::string missing = missingStage(index_, kind); !missing.empty()) throw Error(index_file, missing);
   for (const std::string& s : index_.online) {
     // Stages this representation needs that the bake left to the runtime.
     const bool needs = kind == Representation::Local     ? s == extract::kStageNearFar

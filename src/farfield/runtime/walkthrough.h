@@ -60,6 +60,11 @@ enum class Representation {
                // layered impostors of object clusters chosen to keep the frame under t_max; geometry elsewhere
 };
 const char* representationName(Representation representation);
+// The representation of that name (representationName's inverse), none for another name.
+std::optional<Representation> representationFromName(const std::string& name);
+// Why a walkthrough of `kind` cannot open the pipeline store `index` (the stage its pipeline lacks, or a stage left
+// to the runtime that must be baked), "" when it can. Placed always has a reason: it needs a placement database.
+std::string missingStage(const store::StoreIndex& index, Representation kind);
 
 struct WalkthroughOptions {
   std::string database;                        // directory written by `farfield bake --pipeline` (or, for Placed,

@@ -1,21 +1,14 @@
 #include "farfield/view/database_modes.h"
 
-#include <algorithm>
 #include <filesystem>
 
 #include "farfield/core/error.h"
-#include "farfield/extract/pipeline_options.h"
+#include "farfield/runtime/walkthrough.h"
 #include "farfield/store/impostor_store.h"
 
 namespace fs = std::filesystem;
 
 namespace farfield::view {
-namespace {
-bool contains(const std::vector<std::string>& list, const std::string& item) {
-  return std::find(list.begin(), list.end(), item) != list.end();
-}
-}  // namespace
-
 DatabaseModes databaseModes(const std::string& dir) {
   DatabaseModes out;
   out.modes = {"full", "culled"};
@@ -39,15 +32,10 @@ DatabaseModes databaseModes(const std::string& dir) {
                             "pvs,near-far,single,mmi, or a placement from farfield place)");
   out.kind = DatabaseKind::Pipeline;
   out.streets_file = (fs::path(dir) / index.streets).string();
-  // The rules of runtime::Walkthrough's constructor: which stage each representation needs.
-  const bool pvs_baked = contains(index.pipeline, extract::kStagePvs) && !contains(index.online, extract::kStagePvs);
-  if (contains(index.pipeline, extract::kStageNearFar)) out.modes.push_back("local");
-  if (pvs_baked) out.modes.push_back("visible");
-  if (contains(index.pipeline, extract::kStageSingle)) out.modes.push_back("smi");
-  if (contains(index.pipeline, extract::kStageMmi)) {
-    out.modes.push_back("mmi-dynamic");
-    out.modes.push_back("mmi");
-  }
+  // The representations runtime::Walkthrough can open on this store, in the viewer's order.
+  using R = runtime::Representation;
+  for (R r : {R::Local, R::Visible, R::Smi, R::MmiDynamic, R::Mmi})
+    if (runtime::missingStage(index, r).empty()) out.modes.push_back(runtime::representationName(r));
   return out;
 }
 

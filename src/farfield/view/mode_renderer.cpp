@@ -6,13 +6,6 @@
 
 namespace farfield::view {
 
-std::optional<runtime::Representation> representationOf(const std::string& mode) {
-  using R = runtime::Representation;
-  for (R r : {R::Local, R::Visible, R::Smi, R::Mmi, R::MmiDynamic, R::Placed})
-    if (mode == runtime::representationName(r)) return r;
-  return std::nullopt;
-}
-
 ModeRenderer::ModeRenderer(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const scene::Bvh& bvh,
                            gpu::Renderer& renderer, gpu::RenderTarget& target, ModeSettings settings)
     : scene_(scene),
@@ -33,7 +26,7 @@ ModeRenderer::ModeRenderer(const scene::Scene& scene, const gpu::GpuScene& gpu_s
 ModeRenderer::~ModeRenderer() = default;
 
 void ModeRenderer::select(const std::string& mode) {
-  if (const auto representation = representationOf(mode)) {
+  if (const auto representation = runtime::representationFromName(mode)) {
     runtime::WalkthroughOptions options;
     options.database = settings_.database;
     options.representation = *representation;

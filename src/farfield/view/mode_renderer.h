@@ -77,7 +77,4 @@ class ModeRenderer {
   std::vector<gpu::GpuMaterial> tint_materials_;
 };
 
-// The runtime representation of a mode name, or none for full, culled and unknown names.
-std::optional<runtime::Representation> representationOf(const std::string& mode);
-
 }  // namespace farfield::view
