@@ -379,8 +379,6 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   fs::create_directories(out_dir);
   const uint64_t generation = store::nextPlacementGeneration(out_dir);
   std::map<size_t, store::StoredPlacedImpostor> written;  // candidate -> record
-  std::map<size_t, uint64_t> covered;                     // candidate -> texels its objects cover
-  std::map<size_t, uint64_t> stored_texels;               // candidate -> texels kept after cropping
   std::map<size_t, double> id_bytes;                      // candidate -> bytes of its id textures
   double capture_s = 0.0;
   const placement::GreedyResult result = placement::placeGreedy(problem, [&](size_t k) {
@@ -394,9 +392,6 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     written[k] = store::writePlacedImpostor(out_dir, generation, uint32_t(k), uint32_t(c.node), objects, imp,
                                             hierarchy.nodes()[size_t(c.node)].bounds, std::get<Shaft>(c.cell), bound,
                                             options.layered);
-    covered[k] = 0;
-    for (const impostor::Layer& layer : imp.layers) covered[k] += layer.data_texels;
-    stored_texels[k] = imp.plan.texels;
     id_bytes[k] = imp.plan.id_textures ? 0.5 * double(imp.plan.texture_bytes) : 0.0;
     capture_s += capture.seconds();
     ++report.impostors_generated;
@@ -437,8 +432,10 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   for (size_t k : kept_candidates) {
     index.impostors.push_back(written.at(k));
     report.layer_texels += plans[k].texels;
-    report.stored_texels += stored_texels.at(k);
-    report.covered_texels += covered.at(k);
+    for (const store::StoredImpostorLayer& layer : written.at(k).layers) {
+      report.stored_texels += uint64_t(layer.crop.width) * uint64_t(layer.crop.height);
+      report.covered_texels += layer.data_texels;
+    }
     report.id_texture_bytes += id_bytes.at(k);
     report.estimated_bytes += double(plans[k].bytes());
   }
