@@ -17,6 +17,10 @@ packages=(
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev python3 python3-matplotlib python3-numpy
 )
 
+# node and npm run the Khronos glTF validator in the tests (npm only for tools that exist nowhere else); a node
+# already installed (with its npm) is kept.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
+
 missing=()
 for p in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
@@ -24,8 +28,23 @@ for p in "${packages[@]}"; do
   fi
 done
 
+# The glTF validator, at the version pinned by tools/gltf-validator/package-lock.json, into that folder's
+# node_modules (git-ignored; the only network use outside apt-get; never at build time).
+install_gltf_validator() {
+  local dir
+  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tools/gltf-validator"
+  if [ -f "$dir/node_modules/gltf-validator/package.json" ] &&
+     [ "$(node -p "require('$dir/node_modules/gltf-validator/package.json').version")" = \
+       "$(node -p "require('$dir/package-lock.json').packages['node_modules/gltf-validator'].version")" ]; then
+    return
+  fi
+  echo "install-deps: installing the glTF validator (npm ci in $dir)"
+  (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+}
+
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
+  install_gltf_validator
   exit 0
 fi
 
@@ -40,4 +59,5 @@ echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $sudo apt-get update -qq
 $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+install_gltf_validator
 echo "install-deps: done"
