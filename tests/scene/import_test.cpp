@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "farfield/core/error.h"
@@ -27,6 +29,30 @@ void expectError(F&& f, const std::vector<std::string>& needles) {
 const Object* findObject(const Scene& s, const std::string& name) {
   for (const Object& o : s.objects)
     if (o.name == name) return &o;
+  return nullptr;
+}
+
+// The placeholder, checked texel by texel against its definition: 64 x 64, 8-texel squares alternating between
+// two opaque colours (magenta at the top left), so it shows on any surface.
+void expectCheckerboard(const std::shared_ptr<const image::ColorImage>& t) {
+  ASSERT_TRUE(t);
+  ASSERT_EQ(t->width(), 64);
+  ASSERT_EQ(t->height(), 64);
+  const image::Rgba8 a = t->at(0, 0), b = t->at(8, 0);
+  EXPECT_EQ(a, image::Rgba8(255, 0, 255, 255));
+  EXPECT_NE(a, b);
+  EXPECT_EQ(b.a, 255);
+  // Far apart in every channel sum, so the squares are visible under any lighting.
+  EXPECT_GT(std::abs(int(a.r) + a.g + a.b - (int(b.r) + b.g + b.b)), 300);
+  int mismatches = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) mismatches += t->at(x, y) != (((x / 8) % 2) == ((y / 8) % 2) ? a : b);
+  EXPECT_EQ(mismatches, 0);
+}
+
+const ImportStats::MissingTexture* findMissing(const ImportStats& st, const std::string& name) {
+  for (const auto& m : st.missing_textures)
+    if (m.name == name) return &m;
   return nullptr;
 }
 
@@ -119,9 +145,27 @@ TEST(Import, GltfWithExternalBufferAndTexture) {
   EXPECT_EQ(m.texture->at(3, 0), image::Rgba8(255, 255, 255, 255));
   EXPECT_EQ(m.base_color, Vec4(0.5f, 0.5f, 0.5f, 1.0f));
 
-  // The same file naming a texture that is not there, and one whose node is its own child.
+  // The same file naming a texture that is not there: a counted warning and the placeholder, the rest imported.
   const auto dir2 = test::scratchDir("import_gltf_missing");
-  expectError([&] { importScene(writeGltf(dir2, "gone.png")); }, {"tri.gltf", "gone.png"});
+  ImportStats st;
+  const Scene missing = importScene(writeGltf(dir2, "gone.png"), {}, &st);
+  EXPECT_EQ(missing.triangleCount(), 1u);
+  ASSERT_EQ(st.missing_textures.size(), 1u);
+  EXPECT_EQ(st.missing_textures[0].name, "gone.png");
+  EXPECT_NE(st.missing_textures[0].reason.find("gone.png"), std::string::npos) << st.missing_textures[0].reason;
+  EXPECT_EQ(st.placeholder_materials, 1u);
+  expectCheckerboard(missing.materials[missing.objects[0].parts[0].material].texture);
+  ASSERT_EQ(st.warnings().size(), 2u);
+  EXPECT_EQ(st.warnings()[0].rfind("1 texture missing", 0), 0u) << st.warnings()[0];
+  EXPECT_NE(st.warnings()[0].find("gone.png"), std::string::npos);
+  // An embedded image whose bytes are no image: the same.
+  ImportStats st_bad;
+  const Scene undecodable = importScene(writeGltf(dir2, "data:image/png;base64,bm90IGFuIGltYWdl"), {}, &st_bad);
+  ASSERT_EQ(st_bad.missing_textures.size(), 1u);
+  EXPECT_EQ(st_bad.missing_textures[0].name, "image 0");
+  EXPECT_NE(st_bad.missing_textures[0].reason.find("cannot decode"), std::string::npos);
+  expectCheckerboard(undecodable.materials[undecodable.objects[0].parts[0].material].texture);
+  // And one whose node is its own child is still an error.
   const auto dir3 = test::scratchDir("import_gltf_cycle");
   std::filesystem::copy_file(dir / "tex.png", dir3 / "tex.png");
   expectError([&] { importScene(writeGltf(dir3, "tex.png", R"(, "children": [0])")); }, {"tri.gltf", "reached twice"});
@@ -145,8 +189,6 @@ TEST(Import, MalformedInputsNameTheFile) {
   const auto data = test::testDataDir() / "scene";
   expectError([&] { importScene((data / "nan_vertex.obj").string()); },
               {"nan_vertex.obj", "vertex 2", "non-finite coordinate"});
-  expectError([&] { importScene((data / "missing_texture.obj").string()); },
-              {"missing_texture.obj", "does_not_exist.png"});
   expectError([&] { importScene((data / "no_such_model.obj").string()); }, {"no_such_model.obj", "not found"});
 
   const auto dir = test::scratchDir("import_malformed");
@@ -169,12 +211,100 @@ TEST(Import, MalformedInputsNameTheFile) {
   std::ofstream(mixed) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\nf 1 2\n";
   EXPECT_EQ(importScene(mixed).triangleCount(), 2u);
 
-  // A texture that exists but is not an image.
+  // A truncated AC3D file (the last surface's references cut off) is corrupt model data: an error naming it.
+  std::ifstream full(data / "textured_box.ac");
+  std::string text((std::istreambuf_iterator<char>(full)), std::istreambuf_iterator<char>());
+  const std::string cut = (dir / "cut.ac").string();
+  std::ofstream(cut) << text.substr(0, text.rfind("refs 4") + 8);
+  expectError([&] { importScene(cut); }, {"cut.ac"});
+}
+
+// Missing or unreadable textures are counted warnings with a checkerboard in their place, never a failed import.
+TEST(Import, MissingTexturesBecomeCountedPlaceholders) {
+  const auto data = test::testDataDir() / "scene";
+  // OBJ whose material names a file that is not there.
+  ImportStats st;
+  const Scene obj = importScene((data / "missing_texture.obj").string(), {}, &st);
+  EXPECT_EQ(obj.triangleCount(), 1u);
+  ASSERT_EQ(st.missing_textures.size(), 1u);
+  EXPECT_EQ(st.missing_textures[0].name, "does_not_exist.png");
+  EXPECT_NE(st.missing_textures[0].reason.find("no file"), std::string::npos) << st.missing_textures[0].reason;
+  EXPECT_EQ(st.placeholder_materials, 1u);
+  const Material& m = obj.materials[obj.objects[0].parts[0].material];
+  expectCheckerboard(m.texture);
+  EXPECT_TRUE(TextureFiles::isPlaceholder(m.texture));
+  EXPECT_TRUE(m.texture_path.empty());  // not from a file
+
+  // A texture that exists but is not an image, named by two materials: one file missing, two placeholders.
+  const auto dir = test::scratchDir("import_bad_texture");
   std::ofstream(dir / "bad.png") << "not a png";
-  std::ofstream(dir / "bad_tex.mtl") << "newmtl m\nmap_Kd bad.png\n";
+  std::ofstream(dir / "bad_tex.mtl") << "newmtl m\nmap_Kd bad.png\nnewmtl n\nKd 1 0 0\nmap_Kd bad.png\n";
   const std::string bad_tex = (dir / "bad_tex.obj").string();
-  std::ofstream(bad_tex) << "mtllib bad_tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl m\nf 1/1 2/1 3/1\n";
-  expectError([&] { importScene(bad_tex); }, {"bad_tex.obj", "bad.png"});
+  std::ofstream(bad_tex) << "mtllib bad_tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\no a\nusemtl m\n"
+                            "f 1/1 2/1 3/1\no b\nusemtl n\nf 2/1 4/1 3/1\n";
+  ImportStats st2;
+  const Scene bad = importScene(bad_tex, {}, &st2);
+  EXPECT_EQ(bad.triangleCount(), 2u);
+  ASSERT_EQ(st2.missing_textures.size(), 1u);
+  EXPECT_EQ(st2.missing_textures[0].name, "bad.png");
+  EXPECT_NE(st2.missing_textures[0].reason.find("cannot decode"), std::string::npos) << st2.missing_textures[0].reason;
+  EXPECT_EQ(st2.placeholder_materials, 2u);
+  for (const Object& o : bad.objects) expectCheckerboard(bad.materials[o.parts[0].material].texture);
+  // Without stats the import still succeeds (the warnings go to the log).
+  EXPECT_EQ(importScene(bad_tex).triangleCount(), 2u);
+}
+
+// AC3D (the TORCS track format): one texture found, one missing, one object with TORCS's four texture lines.
+TEST(Import, Ac3dTexturesMissingAndMultiTextured) {
+  const std::string path = (test::testDataDir() / "scene" / "textured_box.ac").string();
+  ImportStats st;
+  const Scene s = importScene(path, {}, &st);
+  EXPECT_NO_THROW(s.validate(path));
+  EXPECT_EQ(s.triangleCount(), 2u + 1u + 2u);
+  const Object* wall = findObject(s, "wall");
+  const Object* lost = findObject(s, "lost");
+  const Object* track = findObject(s, "track");
+  ASSERT_TRUE(wall && lost && track);
+  // The found texture is the 4 x 2 PNG; the track keeps its first (base) texture line, the same file.
+  for (const Object* o : {wall, track}) {
+    const Material& m = s.materials[o->parts[0].material];
+    ASSERT_TRUE(m.texture);
+    ASSERT_EQ(m.texture->width(), 4);
+    EXPECT_EQ(m.texture->at(0, 0), image::Rgba8(255, 0, 0, 255));
+    EXPECT_NE(m.texture_path.find("textured_quad.png"), std::string::npos);
+  }
+  expectCheckerboard(s.materials[lost->parts[0].material].texture);
+  // One file missing (the other texture lines of the track are not used, so not reported), one AC3D object with
+  // extra texture lines.
+  ASSERT_EQ(st.missing_textures.size(), 1u);
+  EXPECT_TRUE(findMissing(st, "no_such_texture.png"));
+  EXPECT_FALSE(findMissing(st, "ERROR"));
+  EXPECT_EQ(st.placeholder_materials, 1u);
+  EXPECT_EQ(st.extra_ac3d_textures, 1u);
+  const std::vector<std::string> w = st.warnings();
+  ASSERT_EQ(w.size(), 3u);
+  EXPECT_NE(w[0].find("1 texture missing"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("no_such_texture.png"), std::string::npos) << w[0];
+  EXPECT_NE(w[2].find("1 AC3D objects"), std::string::npos) << w[2];
+  // AC3D is Y up: the wall spans file x 0..2, y 0..1 at z 0 -> world x 0..2, z 0..1.
+  EXPECT_NEAR(glm::distance(wall->world_bounds.hi, Vec3(2, 0, 1)), 0.0f, 1e-6f);
+}
+
+TEST(Import, WarningsNameTheFirstFilesAndCountTheRest) {
+  ImportStats st;
+  for (char i = '0'; i < '8'; ++i) st.missing_textures.push_back({std::string("t") + i + ".png", "no file"});
+  st.placeholder_materials = 11;
+  const std::vector<std::string> w = st.warnings(3);
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_EQ(w[0], "8 textures missing or unreadable (checkerboard placeholders on 11 materials): t0.png, t1.png, "
+                  "t2.png, ... and 5 more");
+  EXPECT_TRUE(ImportStats().warnings().empty());
+  ImportStats other;
+  other.missing_textures = {{"t1.png", "no file"}, {"u.png", "no file"}};
+  other.placeholder_materials = 2;
+  st.merge(other);
+  EXPECT_EQ(st.missing_textures.size(), 9u);
+  EXPECT_EQ(st.placeholder_materials, 13u);
 }
 
 TEST(Import, LoadSceneSpecs) {

@@ -1,7 +1,8 @@
 // Scene import. glTF (.glb, .gltf) is read with tinygltf so that the per-node "farfield" extras written by
 // exportGlb (object name, footprint, parent) come back; every other format goes through assimp. Both paths
 // flatten the node hierarchy into one Object per node with its world transform, decode textures with stb_image
-// into RGBA8, and rotate Y-up files to Farfield's Z up.
+// into RGBA8, and rotate Y-up files to Farfield's Z up. A texture that cannot be read is a counted warning with a
+// checkerboard in its place (TextureFiles), never a failed import: real models often lose a texture or two.
 #include "farfield/scene/import.h"
 
 #include <assimp/Importer.hpp>
@@ -17,11 +18,13 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
@@ -86,6 +89,26 @@ TexturePtr decodeImage(const unsigned char* bytes, size_t size, std::string* why
   return img;
 }
 
+// Reads an image file into RGBA8; null with `why` set on failure.
+TexturePtr readImageFile(const fs::path& file, std::string* why) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) {
+    *why = "no file " + file.string();
+    return nullptr;
+  }
+  int w = 0, h = 0, n = 0;
+  unsigned char* pixels = stbi_load(file.string().c_str(), &w, &h, &n, 4);
+  if (!pixels) {
+    const char* reason = stbi_failure_reason();
+    *why = file.string() + ": cannot decode image (" + (reason ? reason : "unknown reason") + ")";
+    return nullptr;
+  }
+  auto img = std::make_shared<image::ColorImage>(w, h);
+  std::memcpy(img->data(), pixels, size_t(w) * size_t(h) * 4);
+  stbi_image_free(pixels);
+  return img;
+}
+
 void checkEmpty(const Scene& scene, const std::string& path) {
   if (scene.triangleCount() == 0) throw Error(path, "empty scene: no triangles");
 }
@@ -94,19 +117,18 @@ void checkEmpty(const Scene& scene, const std::string& path) {
 // glTF through tinygltf
 
 // tinygltf hands every image's bytes (embedded or read from a file next to the model) to this callback; decoding
-// here keeps one decoder (and one error message) for all formats.
-bool loadGltfImage(tinygltf::Image* image, const int image_idx, std::string* err, std::string*, int, int,
-                   const unsigned char* bytes, int size, void*) {
+// here keeps one decoder for all formats. An image that does not decode is left empty and its reason kept in the
+// map behind `user` (image index -> why): GltfReader gives its materials the placeholder. (Returning false would
+// make tinygltf refuse the whole model.)
+bool loadGltfImage(tinygltf::Image* image, const int image_idx, std::string*, std::string*, int, int,
+                   const unsigned char* bytes, int size, void* user) {
   std::string why;
   TexturePtr img = decodeImage(bytes, size_t(std::max(size, 0)), &why);
   if (!img) {
-    if (err) {
-      const std::string label = !image->uri.empty() ? image->uri
-                                : !image->name.empty() ? image->name
-                                                       : "image " + std::to_string(image_idx);
-      *err += "texture '" + label + "': " + why + "\n";
-    }
-    return false;
+    (*static_cast<std::map<int, std::string>*>(user))[image_idx] = why;
+    image->image.clear();
+    image->width = image->height = -1;
+    return true;
   }
   image->width = img->width();
   image->height = img->height();
@@ -120,8 +142,9 @@ bool loadGltfImage(tinygltf::Image* image, const int image_idx, std::string* err
 
 class GltfReader {
  public:
-  GltfReader(const std::string& path, const tinygltf::Model& model, const ImportOptions& options)
-      : path_(path), model_(model), options_(options) {}
+  GltfReader(const std::string& path, const tinygltf::Model& model, const ImportOptions& options,
+             const std::map<int, std::string>& undecodable, ImportStats& stats)
+      : path_(path), model_(model), options_(options), undecodable_(undecodable), stats_(stats) {}
 
   Scene read() {
     readMaterials();
@@ -148,8 +171,7 @@ class GltfReader {
       if (parent > 0 && size_t(parent) <= scene_.objects.size() && uint32_t(parent) != object_index + 1)
         scene_.objects[object_index].parent = uint32_t(parent);
 
-    if (skipped_primitives_ > 0)
-      FF_WARN(path_ << ": skipped " << skipped_primitives_ << " primitive(s) that are not triangles");
+    stats_.skipped_faces += skipped_primitives_;
     return std::move(scene_);
   }
 
@@ -165,13 +187,26 @@ class GltfReader {
            " out of range");
     const tinygltf::Image& img = model_.images[size_t(source)];
     *texture_path = img.uri.rfind("data:", 0) == 0 ? std::string() : img.uri;
-    if (img.image.empty() || img.width <= 0 || img.height <= 0) {
-      // tinygltf leaves an external image it could not read empty, with only a warning.
-      const std::string label = !img.uri.empty() ? img.uri : "image " + std::to_string(source);
-      fail("texture '" + label + "' cannot be read (missing or unreadable file, relative to the model)");
-    }
     auto it = images_.find(source);
-    if (it != images_.end()) return it->second;
+    if (it != images_.end()) {
+      if (TextureFiles::isPlaceholder(it->second)) ++stats_.placeholder_materials;
+      return it->second;
+    }
+    if (img.image.empty() || img.width <= 0 || img.height <= 0) {
+      // tinygltf leaves an external image it could not find empty, with only a warning; loadGltfImage leaves an
+      // undecodable one empty.
+      texture_path->clear();
+      const bool external = !img.uri.empty() && img.uri.rfind("data:", 0) != 0;
+      const std::string label = external ? img.uri : !img.name.empty() ? img.name : "image " + std::to_string(source);
+      auto why = undecodable_.find(source);
+      const std::string reason =
+          why != undecodable_.end() ? why->second
+          : external ? "no file " + (fs::path(path_).parent_path() / img.uri).string() + " (or not readable)"
+                     : "no image data";
+      stats_.missing_textures.push_back({label, reason});
+      ++stats_.placeholder_materials;
+      return images_[source] = checkerboardTexture();
+    }
     if (img.component != 4 || img.bits != 8 ||
         img.image.size() != size_t(img.width) * size_t(img.height) * 4)
       fail("image " + std::to_string(source) + ": unexpected pixel layout");
@@ -474,6 +509,8 @@ class GltfReader {
   const std::string& path_;
   const tinygltf::Model& model_;
   const ImportOptions& options_;
+  const std::map<int, std::string>& undecodable_;
+  ImportStats& stats_;
   Scene scene_;
   std::map<std::pair<int, int>, int64_t> meshes_;
   std::map<int, TexturePtr> images_;
@@ -483,10 +520,11 @@ class GltfReader {
   size_t skipped_primitives_ = 0;
 };
 
-Scene importGltf(const std::string& path, bool binary, const ImportOptions& options) {
+Scene importGltf(const std::string& path, bool binary, const ImportOptions& options, ImportStats& stats) {
   detail::checkTinygltfBinding();
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(&loadGltfImage, nullptr);
+  std::map<int, std::string> undecodable;
+  loader.SetImageLoader(&loadGltfImage, &undecodable);
   tinygltf::Model model;
   std::string err, warn;
   const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
@@ -495,7 +533,7 @@ Scene importGltf(const std::string& path, bool binary, const ImportOptions& opti
   if (!ok)
     throw Error(path, "cannot read glTF (truncated or corrupt file?): " + (err.empty() ? std::string("no details") : err));
   if (!warn.empty()) FF_DEBUG(path << ": tinygltf: " << warn);
-  Scene scene = GltfReader(path, model, options).read();
+  Scene scene = GltfReader(path, model, options, undecodable, stats).read();
   checkEmpty(scene, path);
   return scene;
 }
@@ -505,8 +543,8 @@ Scene importGltf(const std::string& path, bool binary, const ImportOptions& opti
 
 class AssimpReader {
  public:
-  AssimpReader(const std::string& path, const aiScene& ai, const ImportOptions& options)
-      : path_(path), ai_(ai), options_(options), dir_(fs::path(path).parent_path()) {}
+  AssimpReader(const std::string& path, const aiScene& ai, const ImportOptions& options, ImportStats& stats)
+      : path_(path), ai_(ai), options_(options), dir_(fs::path(path).parent_path()), stats_(stats), files_(stats) {}
 
   Scene read() {
     for (unsigned i = 0; i < ai_.mNumMaterials; ++i) scene_.addMaterial(material(*ai_.mMaterials[i], i));
@@ -516,7 +554,7 @@ class AssimpReader {
       if (convertMesh(*ai_.mMeshes[i], i, &mesh)) mesh_map_[i] = int64_t(scene_.addMesh(std::move(mesh)));
     }
     if (ai_.mRootNode) visit(*ai_.mRootNode, rootTransform(options_));
-    if (skipped_faces_ > 0) FF_WARN(path_ << ": skipped " << skipped_faces_ << " face(s) that are not triangles");
+    stats_.skipped_faces += skipped_faces_;
     return std::move(scene_);
   }
 
@@ -533,21 +571,15 @@ class AssimpReader {
   }
 
   TexturePtr embeddedTexture(const aiTexture& tex, const std::string& label) {
-    std::string why;
-    TexturePtr img;
-    if (tex.mHeight == 0) {
-      // Compressed (PNG, JPEG, ...): mWidth is the byte count.
-      img = decodeImage(reinterpret_cast<const unsigned char*>(tex.pcData), tex.mWidth, &why);
-    } else {
-      auto raw = std::make_shared<image::ColorImage>(int(tex.mWidth), int(tex.mHeight));
-      for (size_t i = 0; i < raw->pixelCount(); ++i) {
-        const aiTexel& t = tex.pcData[i];
-        raw->pixels()[i] = image::Rgba8(t.r, t.g, t.b, t.a);
-      }
-      img = raw;
+    if (tex.mHeight == 0)  // compressed (PNG, JPEG, ...): mWidth is the byte count
+      return files_.decode("embedded texture " + label, reinterpret_cast<const unsigned char*>(tex.pcData),
+                           tex.mWidth);
+    auto raw = std::make_shared<image::ColorImage>(int(tex.mWidth), int(tex.mHeight));
+    for (size_t i = 0; i < raw->pixelCount(); ++i) {
+      const aiTexel& t = tex.pcData[i];
+      raw->pixels()[i] = image::Rgba8(t.r, t.g, t.b, t.a);
     }
-    if (!img) fail("embedded texture '" + label + "': " + why);
-    return img;
+    return raw;
   }
 
   TexturePtr fileTexture(const std::string& name, std::string* resolved_out) {
@@ -556,22 +588,10 @@ class AssimpReader {
     fs::path p = fs::path(rel).is_absolute() ? fs::path(rel) : dir_ / rel;
     // Models moved from another machine often keep absolute or foreign paths; the file next to the model is
     // the next best guess.
-    if (!fs::exists(p) && fs::exists(dir_ / fs::path(rel).filename())) p = dir_ / fs::path(rel).filename();
-    *resolved_out = p.string();
-    if (auto it = files_.find(p.string()); it != files_.end()) return it->second;
     std::error_code ec;
-    if (!fs::is_regular_file(p, ec))
-      fail("texture '" + name + "' cannot be read: no file " + p.string());
-    int w = 0, h = 0, n = 0;
-    unsigned char* pixels = stbi_load(p.string().c_str(), &w, &h, &n, 4);
-    if (!pixels) {
-      const char* reason = stbi_failure_reason();
-      fail("texture '" + name + "' cannot be read: " + p.string() + ": " + (reason ? reason : "decode error"));
-    }
-    auto img = std::make_shared<image::ColorImage>(w, h);
-    std::memcpy(img->data(), pixels, size_t(w) * size_t(h) * 4);
-    stbi_image_free(pixels);
-    files_[p.string()] = img;
+    if (!fs::exists(p, ec) && fs::exists(dir_ / fs::path(rel).filename(), ec)) p = dir_ / fs::path(rel).filename();
+    TexturePtr img = files_.load(name, p);
+    *resolved_out = TextureFiles::isPlaceholder(img) ? std::string() : p.string();
     return img;
   }
 
@@ -601,8 +621,10 @@ class AssimpReader {
       if (const aiTexture* emb = ai_.GetEmbeddedTexture(t.c_str())) {
         auto it = embedded_.find(t);
         m.texture = it != embedded_.end() ? it->second : (embedded_[t] = embeddedTexture(*emb, t));
+        if (it != embedded_.end() && TextureFiles::isPlaceholder(m.texture)) ++stats_.placeholder_materials;
       } else if (!t.empty() && t[0] == '*') {
-        fail("material '" + m.name + "': embedded texture '" + t + "' does not exist");
+        // A reference to an embedded texture the file does not hold: a missing texture like any other.
+        m.texture = files_.placeholder(t, "the file holds no such embedded texture");
       } else {
         m.texture = fileTexture(t, &m.texture_path);
       }
@@ -679,9 +701,10 @@ class AssimpReader {
   const aiScene& ai_;
   const ImportOptions& options_;
   fs::path dir_;
+  ImportStats& stats_;
+  TextureFiles files_;
   Scene scene_;
   std::vector<int64_t> mesh_map_;
-  std::map<std::string, TexturePtr> files_;
   std::map<std::string, TexturePtr> embedded_;
   size_t skipped_faces_ = 0;
 };
@@ -700,14 +723,51 @@ std::string acceptedFormats(const Assimp::Importer& importer) {
   return out;
 }
 
-Scene importAssimp(const std::string& path, const ImportOptions& options) {
+bool isAc3d(const std::string& ext) { return ext == ".ac" || ext == ".acc" || ext == ".ac3d"; }
+
+// AC3D allows one `texture` line per object. TORCS tracks list up to four (base, tiled, skids, shad; the last ones
+// unquoted), and assimp 5.2 keeps the last line and reads an unquoted name as "ERROR", so every multi-textured
+// object would lose its base texture. Keeping each object's first texture line gives the file's AC3D meaning.
+// Returns the text to read and counts the objects that listed more than one.
+std::string firstTexturePerObject(const std::string& path, size_t* objects_with_extra) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot open file");
+  std::string out, line;
+  bool seen = false, counted = false;
+  while (std::getline(in, line)) {
+    const size_t start = line.find_first_not_of(" \t");
+    const std::string_view word = start == std::string::npos ? std::string_view() : std::string_view(line).substr(start);
+    if (word.rfind("OBJECT", 0) == 0) {
+      seen = counted = false;
+    } else if (word.rfind("texture", 0) == 0 && (word.size() == 7 || word[7] == ' ' || word[7] == '\t')) {
+      if (seen) {
+        if (!counted) ++*objects_with_extra;
+        counted = true;
+        continue;
+      }
+      seen = true;
+    }
+    out += line;
+    out += '\n';
+  }
+  if (in.bad()) throw Error(path, "read error");
+  return out;
+}
+
+Scene importAssimp(const std::string& path, const ImportOptions& options, ImportStats& stats) {
   Assimp::Importer importer;
   // Points and lines carry no surface: the SortByPType step drops them. Faces that still are not triangles are
   // counted and reported by AssimpReader.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   // Read without post-processing first: non-finite coordinates must be reported before normal generation or
   // vertex joining turn them into something harder to trace.
-  const aiScene* raw = importer.ReadFile(path, 0);
+  const aiScene* raw = nullptr;
+  if (const std::string ext = lowerExtension(path); isAc3d(ext)) {
+    const std::string text = firstTexturePerObject(path, &stats.extra_ac3d_textures);
+    raw = importer.ReadFileFromMemory(text.data(), text.size(), 0, "ac");
+  } else {
+    raw = importer.ReadFile(path, 0);
+  }
   if (!raw) throw Error(path, std::string("cannot read: ") + importer.GetErrorString());
   for (unsigned m = 0; m < raw->mNumMeshes; ++m) {
     const aiMesh& am = *raw->mMeshes[m];
@@ -737,32 +797,118 @@ Scene importAssimp(const std::string& path, const ImportOptions& options) {
       aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals | aiProcess_SortByPType |
       aiProcess_FlipUVs | aiProcess_ValidateDataStructure);
   if (!ai) throw Error(path, std::string("invalid or truncated data: ") + importer.GetErrorString());
-  Scene scene = AssimpReader(path, *ai, options).read();
+  Scene scene = AssimpReader(path, *ai, options, stats).read();
   checkEmpty(scene, path);
   return scene;
 }
 
 }  // namespace
 
-Scene importScene(const std::string& path, const ImportOptions& options) {
+Scene importScene(const std::string& path, const ImportOptions& options, ImportStats* stats) {
   if (options.up_axis != 'y' && options.up_axis != 'z')
     throw Error(path, std::string("up axis must be 'y' or 'z', not '") + options.up_axis + "'");
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error(path, "file not found");
   if (!fs::is_regular_file(path, ec)) throw Error(path, "not a regular file");
   const std::string ext = lowerExtension(path);
-  if (ext == ".glb") return importGltf(path, true, options);
-  if (ext == ".gltf") return importGltf(path, false, options);
-  Assimp::Importer probe;
-  if (ext.empty() || !probe.IsExtensionSupported(ext))
-    throw Error(path, "unknown scene format '" + ext + "' (accepted: " + acceptedFormats(probe) + ")");
-  return importAssimp(path, options);
+  ImportStats local;
+  ImportStats& st = stats ? *stats : local;
+  Scene scene;
+  if (ext == ".glb" || ext == ".gltf") {
+    scene = importGltf(path, ext == ".glb", options, st);
+  } else {
+    Assimp::Importer probe;
+    if (ext.empty() || !probe.IsExtensionSupported(ext))
+      throw Error(path, "unknown scene format '" + ext + "' (accepted: " + acceptedFormats(probe) + ")");
+    scene = importAssimp(path, options, st);
+  }
+  if (!stats)
+    for (const std::string& w : local.warnings()) FF_WARN(path << ": " << w);
+  return scene;
 }
 
-Scene loadScene(const std::string& spec, const ImportOptions& options) {
+Scene loadScene(const std::string& spec, const ImportOptions& options, ImportStats* stats) {
   constexpr const char* kBuiltin = "builtin:";
   if (spec.rfind(kBuiltin, 0) == 0) return builtinScene(spec.substr(std::strlen(kBuiltin)));
-  return importScene(spec, options);
+  return importScene(spec, options, stats);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Counted warnings and the placeholder
+
+std::vector<std::string> ImportStats::warnings(size_t max_names) const {
+  std::vector<std::string> out;
+  if (!missing_textures.empty()) {
+    const size_t n = missing_textures.size();
+    std::string line = std::to_string(n) + (n == 1 ? " texture" : " textures") +
+                       " missing or unreadable (checkerboard placeholders on " + std::to_string(placeholder_materials) +
+                       (placeholder_materials == 1 ? " material" : " materials") + "): ";
+    for (size_t i = 0; i < n && i < max_names; ++i) line += (i ? ", " : "") + missing_textures[i].name;
+    if (n > max_names) line += ", ... and " + std::to_string(n - max_names) + " more";
+    out.push_back(line);
+    // The first reason says why in the words of the file system or the decoder.
+    out.push_back("  (" + missing_textures[0].name + ": " + missing_textures[0].reason + ")");
+  }
+  if (skipped_faces > 0)
+    out.push_back(std::to_string(skipped_faces) + " face(s) that are not triangles skipped (points, lines)");
+  if (extra_ac3d_textures > 0)
+    out.push_back(std::to_string(extra_ac3d_textures) +
+                  " AC3D objects list several textures (multi-texturing extension): the first of each is used");
+  return out;
+}
+
+void ImportStats::merge(const ImportStats& other) {
+  for (const MissingTexture& m : other.missing_textures)
+    if (std::none_of(missing_textures.begin(), missing_textures.end(),
+                     [&](const MissingTexture& k) { return k.name == m.name; }))
+      missing_textures.push_back(m);
+  placeholder_materials += other.placeholder_materials;
+  skipped_faces += other.skipped_faces;
+  extra_ac3d_textures += other.extra_ac3d_textures;
+}
+
+std::shared_ptr<const image::ColorImage> checkerboardTexture() {
+  static const std::shared_ptr<const image::ColorImage> board = [] {
+    constexpr int kSize = 64, kSquare = 8;
+    auto img = std::make_shared<image::ColorImage>(kSize, kSize);
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x)
+        img->at(x, y) = ((x / kSquare + y / kSquare) % 2 == 0) ? image::Rgba8(255, 0, 255, 255)
+                                                                : image::Rgba8(24, 24, 24, 255);
+    return img;
+  }();
+  return board;
+}
+
+bool TextureFiles::isPlaceholder(const std::shared_ptr<const image::ColorImage>& texture) {
+  return texture && texture == checkerboardTexture();
+}
+
+std::shared_ptr<const image::ColorImage> TextureFiles::placeholder(const std::string& name, const std::string& reason) {
+  if (std::none_of(stats_.missing_textures.begin(), stats_.missing_textures.end(),
+                   [&](const ImportStats::MissingTexture& m) { return m.name == name; }))
+    stats_.missing_textures.push_back({name, reason});
+  ++stats_.placeholder_materials;
+  return checkerboardTexture();
+}
+
+std::shared_ptr<const image::ColorImage> TextureFiles::load(const std::string& name, const fs::path& file) {
+  const std::string key = file.lexically_normal().string();
+  if (auto it = files_.find(key); it != files_.end()) {
+    if (isPlaceholder(it->second)) ++stats_.placeholder_materials;
+    return it->second;
+  }
+  std::string why;
+  TexturePtr img = readImageFile(file, &why);
+  if (!img) img = placeholder(name, why);
+  return files_[key] = img;
+}
+
+std::shared_ptr<const image::ColorImage> TextureFiles::decode(const std::string& name, const unsigned char* bytes,
+                                                              size_t size) {
+  std::string why;
+  TexturePtr img = decodeImage(bytes, size, &why);
+  return img ? img : placeholder(name, why);
 }
 
 }  // namespace farfield::scene
