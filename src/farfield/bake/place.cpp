@@ -62,12 +62,6 @@ double minAbsPitch(const Vdi& vdi) {
   return std::max(0.0, least - degToRad(1.0));
 }
 
-// What drawing an object costs beyond a frame's fixed cost: triangles and draw calls.
-struct ObjectCost {
-  uint64_t triangles = 0;
-  uint32_t draws = 0;
-};
-
 }  // namespace
 
 Box3 defaultPlaceViewSpace(const scene::Scene& scene) {
@@ -141,17 +135,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   const double pixels = double(options.width) * double(options.height);
 
   // Per object: its triangles and draw calls (the GPU scene's clusters: what a frame draws for it, uncut).
-  std::vector<ObjectCost> cost(scene.objects.size() + 1);
-  {
-    std::vector<gpu::DrawItem> items;
-    for (const scene::Object& o : scene.objects) {
-      items.clear();
-      const uint32_t id = o.id;
-      gpu_scene.appendDrawItems(std::span<const uint32_t>(&id, 1), items);
-      for (const gpu::DrawItem& item : items) cost[id].triangles += item.triangleCount();
-      cost[id].draws = uint32_t(items.size());
-    }
-  }
+  const std::vector<gpu::ObjectDrawCost> cost = gpu_scene.objectDrawCosts();
   const auto geometryMs = [&](uint64_t triangles, uint64_t draws) {
     return (profile.model.ms_per_mtriangle * double(triangles) * 1e-6 + profile.model.ms_per_draw * double(draws)) *
            profile.safety_factor;

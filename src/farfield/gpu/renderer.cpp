@@ -352,6 +352,19 @@ std::vector<DrawItem> GpuScene::drawItems() const {
   return items;
 }
 
+std::vector<ObjectDrawCost> GpuScene::objectDrawCosts() const {
+  std::vector<ObjectDrawCost> cost(scene_->objects.size() + 1);
+  std::vector<DrawItem> items;
+  for (const scene::Object& o : scene_->objects) {
+    items.clear();
+    const uint32_t id = o.id;
+    appendDrawItems(std::span<const uint32_t>(&id, 1), items);
+    for (const DrawItem& item : items) cost[id].triangles += item.triangleCount();
+    cost[id].draws = uint32_t(items.size());
+  }
+  return cost;
+}
+
 size_t GpuScene::gpuBytes() const {
   size_t bytes = 0;
   for (const auto& m : meshes_) bytes += m.byteSize();

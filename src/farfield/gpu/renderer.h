@@ -107,6 +107,12 @@ struct GpuSceneOptions {
   uint32_t bridge_triangles = 48;
 };
 
+// What drawing one object whole costs beyond a frame's fixed cost (the cost model's terms).
+struct ObjectDrawCost {
+  uint64_t triangles = 0;
+  uint32_t draws = 0;  // draw items: one per part
+};
+
 // A scene's meshes, textures and materials uploaded once; draw items for all or some of its objects.
 class GpuScene {
  public:
@@ -130,6 +136,8 @@ class GpuScene {
   // items of the listed objects drawn with this camera.
   void appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out, const Camera& camera) const;
   std::vector<DrawItem> drawItems() const;
+  // Per object id (index 0 unused, size objects + 1): the triangles and draw items of appendDrawItems for it alone.
+  std::vector<ObjectDrawCost> objectDrawCosts() const;
   size_t gpuBytes() const;
   // Clusters of scene mesh `mesh` (index ranges of meshes()[mesh], bounds in mesh space) and their facing groups.
   std::span<const MeshCluster> clusters(uint32_t mesh) const { return clusters_.at(mesh); }

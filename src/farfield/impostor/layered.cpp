@@ -58,12 +58,7 @@
 #include "farfield/scene/mesh.h"
 
 namespace farfield::impostor {
-namespace {
-
-// GpuMesh stores interleaved position, normal and uv floats (32 bytes a vertex) and 32-bit indices.
-constexpr size_t kQuadMeshBytes = 4 * 8 * sizeof(float) + 6 * sizeof(uint32_t);
-
-// Shelf packing of the layer images, in layer order: a layer goes right of the previous one on the current shelf, or
+// Shelf packing of the layer images, tallest first: a layer goes right of the previous one on the current shelf, or
 // starts a new shelf below it, or a new atlas when the shelf would pass kAtlasSide. Atlases are as small as their
 // contents (plus padding). Deterministic: planLayered and GpuLayeredImpostor agree on the layout.
 void packAtlases(LayeredPlan& plan) {
@@ -95,6 +90,8 @@ void packAtlases(LayeredPlan& plan) {
   }
   close();
 }
+
+namespace {
 
 // K of the file comment (radians per metre). theta: half apex angle; d: capture eye distance.
 double parallaxPerMetre(double theta, double d, double r, double gamma) {
@@ -268,7 +265,7 @@ LayeredPlan planLayered(const Box3& box, const Shaft& shaft_in, const ErrorBound
 
     const uint64_t texels = uint64_t(layer.width) * uint64_t(layer.height);
     plan.texels += texels;
-    plan.mesh_bytes += kQuadMeshBytes;
+    plan.mesh_bytes += kLayerQuadBytes;
     const double pixels = 4.0 * layer.half_u * layer.half_v * focal * focal / (distance * distance);
     plan.fill_pixels += std::min(pixels, double(bound.width) * double(bound.height));
   }

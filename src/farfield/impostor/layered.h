@@ -161,6 +161,14 @@ LayeredImpostor cropLayered(const LayeredImpostor& impostor);
 
 inline constexpr int kAtlasSide = 4096;
 inline constexpr int kAtlasPadding = 2;  // texels around each layer image, its edge texels repeated (clamp to edge)
+// A layer quad's vertex and index buffers: GpuMesh's interleaved position, normal and uv floats (32 bytes a vertex)
+// and 32-bit indices.
+inline constexpr size_t kLayerQuadBytes = 4 * 8 * sizeof(float) + 6 * sizeof(uint32_t);
+
+// Packs plan.layers into atlases (sets atlas_spots and atlas_sizes; texture_bytes is the caller's): shelves, tallest
+// layers first, at most kAtlasSide a side unless a layer alone is larger. planLayered and cropLayers call it; a plan
+// made elsewhere (impostor/environment_map.h) calls it once its layers are set.
+void packAtlases(LayeredPlan& plan);
 
 // The layers on the GPU: per atlas (LayeredPlan::atlas_sizes) one texture (and id texture) and one mesh of its layers'
 // quads (normal = the axis, uvs into the atlas), with an unlit, double-sided material: one draw call per atlas. The
