@@ -261,3 +261,108 @@ TEST(CityJsonImport, Delft) {
   }
   c.scene.validate("delft");
 }
+
+// Appearances: b2 (a gabled house, its south wall textured with facade.png in theme "summer", its roof a
+// diffuseColor material) and b4 (a box whose roof names a texture file that does not exist), written by
+// tests/data/geodata/make_appearance_files.py, as CityJSON 2.0 (with a transform) and 1.0 (without).
+TEST(CityJsonImport, TexturesMaterialsAndThemes) {
+  for (const char* name : {"textured.city.json", "textured_v10.city.json"}) {
+    SCOPED_TRACE(name);
+    const CityJsonScene c = importCityJson(dataFile(name));
+    const auto& st = c.stats;
+    EXPECT_EQ(st.texture_themes, (std::vector<std::string>{"summer", "winter"}));
+    EXPECT_EQ(st.material_themes, (std::vector<std::string>{"summer"}));
+    EXPECT_EQ(st.texture_theme, "summer");
+    EXPECT_EQ(st.material_theme, "summer");
+    ASSERT_EQ(c.scene.objects.size(), 2u);
+    // Hand-computed: b2 = ground 48 + long walls 2 x 48 + gables 2 x (36 + 9) + roofs 2 x 8 x sqrt(18), 16
+    // triangles; b4 = 2 x 25 + 4 x 15 = 110, 12 triangles.
+    EXPECT_EQ(st.triangles, 16u + 12u);
+    EXPECT_EQ(st.textured_surfaces, 2u);  // b2's south wall, b4's roof (placeholder)
+    EXPECT_EQ(st.material_surfaces, 2u);  // b2's two roof faces
+    EXPECT_EQ(st.bad_texture_references, 0u);
+    const auto b2 = measureObject(c, *objectNamed(c, "b2"));
+    const double roof = 2.0 * 8.0 * std::sqrt(18.0);
+    ASSERT_EQ(b2.count("facade.png"), 1u);
+    ASSERT_EQ(b2.count("roof tiles"), 1u);
+    EXPECT_NEAR(b2.at("facade.png").area, 48.0, 1e-3);
+    EXPECT_NEAR(b2.at("roof tiles").area, roof, 1e-3);
+    EXPECT_NEAR(b2.at("wall").area, 48.0 + 90.0, 1e-3);
+    EXPECT_NEAR(b2.at("ground surface").area, 48.0, 1e-3);
+    double volume = 0.0;
+    for (const auto& [n, m] : b2) volume += m.volume;
+    EXPECT_NEAR(volume, 8.0 * 6.0 * 6.0 + 0.5 * 6.0 * 3.0 * 8.0, 1e-2);  // closed and outward
+    const auto b4 = measureObject(c, *objectNamed(c, "b4"));
+    ASSERT_EQ(b4.count("textures/missing_roof.jpg"), 1u);
+    EXPECT_NEAR(b4.at("textures/missing_roof.jpg").area, 25.0, 1e-3);
+
+    for (const auto& p : objectNamed(c, "b2")->parts) {
+      const auto& m = c.scene.materials[p.material];
+      const auto& mesh = c.scene.meshes[p.mesh];
+      if (m.name == "roof tiles") {
+        EXPECT_EQ(m.base_color, farfield::Vec4(0.8f, 0.2f, 0.1f, 1.0f));
+        EXPECT_FALSE(m.texture);
+      }
+      if (m.name != "facade.png") continue;
+      // The texture itself: 4 x 2, row 0 red, green, blue, white.
+      ASSERT_TRUE(m.texture);
+      ASSERT_EQ(m.texture->width(), 4);
+      EXPECT_EQ(m.texture->at(0, 0), farfield::image::Rgba8(255, 0, 0, 255));
+      EXPECT_EQ(m.texture->at(3, 1), farfield::image::Rgba8(255, 0, 255, 255));
+      EXPECT_NE(m.texture_path.find("facade.png"), std::string::npos);
+      // The file maps u = (x - west) / 8 and v = height / 6 from the bottom; Farfield's v runs from the top.
+      ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());
+      float west = 1e9f, base = 1e9f;
+      for (const auto& q : mesh.positions) west = std::min(west, q.x), base = std::min(base, q.z);
+      for (size_t i = 0; i < mesh.positions.size(); ++i) {
+        EXPECT_NEAR(mesh.uvs[i].x, (mesh.positions[i].x - west) / 8.0f, 1e-5f);
+        EXPECT_NEAR(mesh.uvs[i].y, 1.0f - (mesh.positions[i].z - base) / 6.0f, 1e-5f);
+      }
+    }
+    // The missing file: one counted warning and the checkerboard.
+    ASSERT_EQ(st.import.missing_textures.size(), 1u);
+    EXPECT_EQ(st.import.missing_textures[0].name, "textures/missing_roof.jpg");
+    EXPECT_EQ(st.import.placeholder_materials, 1u);
+    for (const auto& p : objectNamed(c, "b4")->parts) {
+      const auto& m = c.scene.materials[p.material];
+      if (m.name == "textures/missing_roof.jpg") {
+        EXPECT_TRUE(farfield::scene::TextureFiles::isPlaceholder(m.texture));
+        EXPECT_TRUE(m.texture_path.empty());
+        EXPECT_EQ(c.scene.meshes[p.mesh].uvs.size(), c.scene.meshes[p.mesh].positions.size());
+      }
+    }
+  }
+
+  // Theme "winter": b2's south wall takes texture 1 (the missing file), b4 has no texture in it.
+  CityJsonImportOptions winter;
+  winter.theme = "winter";
+  const CityJsonScene w = importCityJson(dataFile("textured.city.json"), winter);
+  EXPECT_EQ(w.stats.texture_theme, "winter");
+  EXPECT_EQ(w.stats.material_theme, "summer");  // the only material theme
+  EXPECT_EQ(w.stats.textured_surfaces, 1u);
+  EXPECT_EQ(measureObject(w, *objectNamed(w, "b2")).count("textures/missing_roof.jpg"), 1u);
+  EXPECT_EQ(measureObject(w, *objectNamed(w, "b4")).count("textures/missing_roof.jpg"), 0u);
+  CityJsonImportOptions autumn;
+  autumn.theme = "autumn";
+  try {
+    importCityJson(dataFile("textured.city.json"), autumn);
+    ADD_FAILURE() << "no error for a theme the file does not have";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("summer, winter"), std::string::npos) << e.what();
+  }
+
+  // Texture references that do not fit: a uv index out of range, a ring with one uv too few. The faces are kept
+  // with their class colour and counted.
+  nlohmann::json doc;
+  std::ifstream(dataFile("textured.city.json")) >> doc;
+  doc["CityObjects"]["b2"]["geometry"][0]["texture"]["summer"]["values"][0][1][0][2] = 99;
+  doc["CityObjects"]["b4"]["geometry"][0]["texture"]["summer"]["values"][0][1][0].erase(4);
+  const auto dir = farfield::test::scratchDir("geodata_cityjson_textures");
+  const std::string bad = (dir / "bad_refs.city.json").string();
+  std::ofstream(bad) << doc.dump();
+  const CityJsonScene b = importCityJson(bad);
+  EXPECT_EQ(b.stats.bad_texture_references, 2u);
+  EXPECT_EQ(b.stats.textured_surfaces, 0u);
+  EXPECT_EQ(b.stats.triangles, 28u);
+  EXPECT_EQ(measureObject(b, *objectNamed(b, "b2")).count("facade.png"), 0u);
+}

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -19,7 +20,9 @@
 #include "farfield/core/polygon2d.h"
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
+#include "farfield/geodata/city_surfaces.h"
 #include "farfield/geodata/triangulate.h"
+#include "farfield/scene/import.h"
 
 namespace farfield::geodata {
 
@@ -40,56 +43,6 @@ constexpr const char* kNoGeometry = "objects without usable geometry";
 constexpr const char* kLodFiltered = "objects without geometry at the requested LoD";
 constexpr const char* kMalformedObject = "malformed city objects";
 
-enum class Category { Building, BuildingPart, Ground, Other };
-
-// Colour classes: one material each.
-enum SurfaceClass : int {
-  kWall = 0, kRoof, kGroundSurface, kRoad, kLand, kVegetation, kWater, kTerrain, kStructure, kClassCount
-};
-
-struct ClassStyle {
-  const char* name;
-  Vec4 colour;
-};
-constexpr ClassStyle kStyles[kClassCount] = {
-    {"wall", {0.86f, 0.82f, 0.74f, 1.0f}},       {"roof", {0.72f, 0.32f, 0.24f, 1.0f}},
-    {"ground surface", {0.38f, 0.36f, 0.34f, 1.0f}}, {"road", {0.33f, 0.33f, 0.35f, 1.0f}},
-    {"land use", {0.66f, 0.68f, 0.50f, 1.0f}},   {"vegetation", {0.32f, 0.55f, 0.27f, 1.0f}},
-    {"water", {0.26f, 0.46f, 0.70f, 1.0f}},      {"terrain", {0.58f, 0.52f, 0.42f, 1.0f}},
-    {"structure", {0.62f, 0.62f, 0.64f, 1.0f}},
-};
-
-Category categoryOf(const std::string& type) {
-  if (type == "Building") return Category::Building;
-  if (type.rfind("Building", 0) == 0) return Category::BuildingPart;  // BuildingPart, BuildingInstallation, ...
-  static const std::set<std::string> ground = {"Road",     "Railway",    "TransportSquare", "Waterway",
-                                               "LandUse",  "PlantCover", "WaterBody",       "TINRelief"};
-  if (ground.count(type)) return Category::Ground;
-  return Category::Other;
-}
-
-// The colour class of an object type's surfaces when no semantics say otherwise (buildings: by normal).
-SurfaceClass defaultClass(const std::string& type) {
-  if (type == "Road" || type == "Railway" || type == "TransportSquare") return kRoad;
-  if (type == "LandUse") return kLand;
-  if (type == "PlantCover" || type == "SolitaryVegetationObject") return kVegetation;
-  if (type == "WaterBody" || type == "Waterway") return kWater;
-  if (type == "TINRelief") return kTerrain;
-  return kStructure;
-}
-
-std::optional<SurfaceClass> semanticClass(const std::string& s) {
-  if (s == "RoofSurface") return kRoof;
-  if (s == "WallSurface" || s == "ClosureSurface" || s == "OuterCeilingSurface" || s == "Window" || s == "Door" ||
-      s == "InteriorWallSurface" || s == "CeilingSurface")
-    return kWall;
-  if (s == "GroundSurface" || s == "OuterFloorSurface" || s == "FloorSurface") return kGroundSurface;
-  if (s == "TrafficArea" || s == "TransportationMarking" || s == "TransportationHole") return kRoad;
-  if (s == "AuxiliaryTrafficArea") return kLand;
-  if (s == "WaterSurface" || s == "WaterGroundSurface" || s == "WaterClosureSurface") return kWater;
-  return std::nullopt;
-}
-
 std::optional<double> lodOf(const Json& g) {
   auto it = g.find("lod");
   if (it == g.end()) return std::nullopt;
@@ -103,13 +56,38 @@ std::optional<double> lodOf(const Json& g) {
   return std::nullopt;
 }
 
-// Output meshes of one scene object, one per surface class.
+// Output meshes of one scene object, one per material (class colour, texture or appearance material).
 struct ObjectMeshes {
-  scene::Mesh meshes[kClassCount];
+  std::map<uint32_t, scene::Mesh> meshes;
   std::vector<Vec2> hull_points;
 };
 
+// A geometry's per-surface arrays, stepped down in parallel through solids and shells: semantics "values",
+// texture "values" of the chosen theme (one level deeper: rings) and material "values" (or one "value" for all).
+struct SurfaceRefs {
+  const Json* semantics = nullptr;
+  const Json* texture = nullptr;
+  const Json* material = nullptr;
+  std::optional<int64_t> material_all;
+
+  static const Json* child(const Json* values, size_t i) {
+    if (!values || !values->is_array() || i >= values->size()) return nullptr;
+    return &(*values)[i];
+  }
+  SurfaceRefs at(size_t i) const { return {child(semantics, i), child(texture, i), child(material, i), material_all}; }
+};
+
+// appearance: the file's textures, texture coordinates and materials, and the themes chosen.
+struct Appearance {
+  const Json* textures = nullptr;          // [{"type", "image", ...}]
+  std::vector<std::optional<Vec2>> uvs;    // "vertices-texture", v flipped to Farfield's top-left origin
+  const Json* materials = nullptr;         // [{"name", "diffuseColor", "transparency", ...}]
+  std::string texture_theme, material_theme;
+  std::vector<std::optional<uint32_t>> texture_materials;  // per texture index, once loaded
+};
+
 struct Importer {
+  Importer(const std::string& p, const CityJsonImportOptions& o, CityJsonStats& s) : path(p), options(o), st(s) {}
   const std::string& path;
   const CityJsonImportOptions& options;
   CityJsonStats& st;
@@ -117,15 +95,98 @@ struct Importer {
   std::vector<char> vertex_ok;
   DVec3 origin{0.0};
   DVec3 used_min{std::numeric_limits<double>::max()}, used_max{std::numeric_limits<double>::lowest()};
+  Appearance app;
+  CityMaterials* materials = nullptr;
+  scene::TextureFiles* texture_files = nullptr;
 
   void skip(const char* reason, size_t n = 1) { st.skipped[reason] += n; }
 
+  // The scene material of texture `t` (loaded on first use; a missing file gives the placeholder).
+  std::optional<uint32_t> textureMaterial(int64_t t) {
+    if (!app.textures || t < 0 || uint64_t(t) >= app.textures->size()) return std::nullopt;
+    if (app.texture_materials.empty()) app.texture_materials.resize(app.textures->size());
+    std::optional<uint32_t>& slot = app.texture_materials[size_t(t)];
+    if (slot) return slot;
+    const Json& tex = (*app.textures)[size_t(t)];
+    std::string image = tex.is_object() && tex.contains("image") && tex["image"].is_string() ? tex["image"].get<std::string>()
+                                                                                           : std::string();
+    std::shared_ptr<const image::ColorImage> img;
+    std::string file;
+    if (image.empty()) {
+      img = texture_files->placeholder("texture " + std::to_string(t), "no \"image\" string");
+      image = "texture " + std::to_string(t);
+    } else if (image.find("://") != std::string::npos) {
+      img = texture_files->placeholder(image, "not a local file (URLs are not fetched)");
+    } else {
+      std::replace(image.begin(), image.end(), '\\', '/');
+      const std::filesystem::path p = std::filesystem::path(image).is_absolute()
+                                          ? std::filesystem::path(image)
+                                          : std::filesystem::path(path).parent_path() / image;
+      img = texture_files->load(image, p);
+      if (!scene::TextureFiles::isPlaceholder(img)) file = p.string();
+    }
+    slot = materials->forTexture(image, img, file);
+    return slot;
+  }
+
+  std::optional<uint32_t> appearanceMaterial(int64_t m) {
+    if (!app.materials || m < 0 || uint64_t(m) >= app.materials->size()) return std::nullopt;
+    const Json& mat = (*app.materials)[size_t(m)];
+    if (!mat.is_object()) return std::nullopt;
+    Vec4 rgba(0.8f, 0.8f, 0.8f, 1.0f);  // X3D's default diffuse colour
+    if (auto d = mat.find("diffuseColor"); d != mat.end() && d->is_array() && d->size() == 3 &&
+                                           (*d)[0].is_number() && (*d)[1].is_number() && (*d)[2].is_number())
+      rgba = Vec4((*d)[0].get<float>(), (*d)[1].get<float>(), (*d)[2].get<float>(), 1.0f);
+    if (auto tr = mat.find("transparency"); tr != mat.end() && tr->is_number())
+      rgba.a = 1.0f - tr->get<float>();
+    rgba = glm::clamp(rgba, Vec4(0.0f), Vec4(1.0f));
+    if (!isFinite(Vec3(rgba)) || !std::isfinite(rgba.a)) return std::nullopt;
+    const std::string name = mat.contains("name") && mat["name"].is_string() ? mat["name"].get<std::string>()
+                                                                              : "material " + std::to_string(m);
+    return materials->forColour("material " + std::to_string(m), name, rgba);
+  }
+
+  // Texture of a surface from its texture values (one [t, uv, uv, ...] per ring, or [null]): the material and the
+  // uvs of each ring, or nothing when untextured or when the references do not fit the rings (counted).
+  std::optional<uint32_t> surfaceTexture(const Json* tex, const std::vector<size_t>& ring_sizes,
+                                         const std::vector<bool>& closing_dropped, CityFace& face) {
+    if (!tex || !tex->is_array() || tex->empty()) return std::nullopt;
+    const Json& first = (*tex)[0];
+    if (!first.is_array() || first.empty() || first[0].is_null()) return std::nullopt;
+    auto bad = [&]() -> std::optional<uint32_t> {
+      ++st.bad_texture_references;
+      face.uvs.clear();
+      return std::nullopt;
+    };
+    if (!first[0].is_number_integer() || tex->size() != ring_sizes.size()) return bad();
+    const int64_t t = first[0].get<int64_t>();
+    face.uvs.assign(ring_sizes.size(), {});
+    for (size_t r = 0; r < ring_sizes.size(); ++r) {
+      const Json& ring = (*tex)[r];
+      if (!ring.is_array() || ring.empty() || !ring[0].is_number_integer() || ring[0].get<int64_t>() != t) return bad();
+      const size_t n = ring.size() - 1 - (closing_dropped[r] ? 1 : 0);
+      if (n != ring_sizes[r]) return bad();
+      for (size_t i = 0; i < n; ++i) {
+        const Json& k = ring[i + 1];
+        if (!k.is_number_integer()) return bad();
+        const int64_t uv = k.get<int64_t>();
+        if (uv < 0 || uint64_t(uv) >= app.uvs.size() || !app.uvs[size_t(uv)]) return bad();
+        face.uvs[r].push_back(*app.uvs[size_t(uv)]);
+      }
+    }
+    const std::optional<uint32_t> m = textureMaterial(t);
+    if (!m) return bad();
+    return m;
+  }
+
   // One surface: [outer ring, hole, ...], each ring an array of vertex indices.
-  void surface(const Json& s, std::optional<SurfaceClass> semantic, SurfaceClass fallback, bool by_normal,
-               ObjectMeshes& out) {
+  void surface(const Json& s, const SurfaceRefs& refs, std::optional<SurfaceClass> semantic, SurfaceClass fallback,
+               bool by_normal, ObjectMeshes& out) {
     if (!s.is_array() || s.empty()) return skip(kMalformedSurface);
-    std::vector<std::vector<DVec3>> rings;
-    rings.reserve(s.size());
+    CityFace face;
+    face.rings.reserve(s.size());
+    std::vector<size_t> ring_sizes;
+    std::vector<bool> closing_dropped;
     for (size_t r = 0; r < s.size(); ++r) {
       const Json& ring = s[r];
       if (!ring.is_array()) return skip(kMalformedSurface);
@@ -139,70 +200,88 @@ struct Importer {
         pts.push_back(vertices[size_t(i)] - origin);
       }
       // A repeated closing vertex is tolerated.
-      if (pts.size() > 3 && pts.front() == pts.back()) pts.pop_back();
+      const bool closed = pts.size() > 3 && pts.front() == pts.back();
+      if (closed) pts.pop_back();
       if (pts.size() < 3) {
         if (r == 0) return skip(kTooFew);
-        continue;  // a degenerate hole is dropped, the face kept
+        // A degenerate hole is dropped, the face kept; its texture references then cannot be matched.
+        ring_sizes.push_back(size_t(-1));
+        closing_dropped.push_back(closed);
+        continue;
       }
-      rings.push_back(std::move(pts));
+      ring_sizes.push_back(pts.size());
+      closing_dropped.push_back(closed);
+      face.rings.push_back(std::move(pts));
     }
     PolygonTriangulation t;
     DVec3 n(0.0, 0.0, 1.0);
-    if (!triangulateFace3(rings, t, &n)) return skip(kNoArea);
+    if (!triangulateCityFace(face, t, &n)) return skip(kNoArea);
 
     SurfaceClass cls = fallback;
     if (semantic) {
       cls = *semantic;
       ++st.semantic_surfaces;
     } else if (by_normal) {
-      cls = n.z > 0.3 ? kRoof : (n.z < -0.7 ? kGroundSurface : kWall);
+      cls = classByNormal(n);
       ++st.inferred_surfaces;
     }
-    scene::Mesh& m = out.meshes[cls];
-    const uint32_t first = uint32_t(m.positions.size());
-    const Vec3 normal = Vec3(n);
-    for (const auto& ring : rings)
+    std::optional<uint32_t> material;
+    if (std::find(ring_sizes.begin(), ring_sizes.end(), size_t(-1)) == ring_sizes.end())
+      material = surfaceTexture(refs.texture, ring_sizes, closing_dropped, face);
+    else if (refs.texture)
+      ++st.bad_texture_references;
+    if (material) {
+      ++st.textured_surfaces;
+    } else {
+      face.uvs.clear();
+      std::optional<int64_t> m = refs.material_all;
+      if (refs.material && refs.material->is_number_integer()) m = refs.material->get<int64_t>();
+      if (m) material = appearanceMaterial(*m);
+      if (material) ++st.material_surfaces;
+    }
+    scene::Mesh& mesh = out.meshes[material ? *material : materials->forClass(cls)];
+    for (const auto& ring : face.rings)
       for (const DVec3& p : ring) {
-        m.positions.emplace_back(Vec3(p));
-        m.normals.push_back(normal);
         out.hull_points.emplace_back(float(p.x), float(p.y));
         used_min = glm::min(used_min, p + origin);
         used_max = glm::max(used_max, p + origin);
       }
-    for (const DVec3& p : t.extra) {
-      m.positions.emplace_back(Vec3(p));
-      m.normals.push_back(normal);
-    }
-    for (uint32_t i : t.indices) m.indices.push_back(first + i);
+    st.triangles += appendCityFace(face, t, n, false, mesh);
     ++st.surfaces;
-    st.holes += rings.size() - 1;
-    st.triangles += t.indices.size() / 3;
+    st.holes += face.rings.size() - 1;
   }
 
-  // Semantic class of surface k from a (possibly nested) "values" entry and the "surfaces" list.
-  std::optional<SurfaceClass> semanticOf(const Json* values, size_t k, const Json* surfaces) const {
-    if (!values || !values->is_array() || k >= values->size() || !surfaces || !surfaces->is_array())
-      return std::nullopt;
-    const Json& v = (*values)[k];
-    if (!v.is_number_integer()) return std::nullopt;
-    const int64_t i = v.get<int64_t>();
+  // Semantic class of a surface from its (possibly nested) "values" entry and the "surfaces" list.
+  std::optional<SurfaceClass> semanticOf(const Json* value, const Json* surfaces) const {
+    if (!value || !value->is_number_integer() || !surfaces || !surfaces->is_array()) return std::nullopt;
+    const int64_t i = value->get<int64_t>();
     if (i < 0 || uint64_t(i) >= surfaces->size()) return std::nullopt;
     const Json& s = (*surfaces)[size_t(i)];
     if (!s.is_object() || !s.contains("type") || !s["type"].is_string()) return std::nullopt;
-    return semanticClass(s["type"].get<std::string>());
+    return semanticSurfaceClass(s["type"].get<std::string>());
   }
 
   // A list of surfaces (a MultiSurface, a CompositeSurface or one shell of a solid).
-  void surfaceList(const Json& list, const Json* values, const Json* surfaces, SurfaceClass fallback, bool by_normal,
-                   ObjectMeshes& out) {
+  void surfaceList(const Json& list, const SurfaceRefs& refs, const Json* surfaces, SurfaceClass fallback,
+                   bool by_normal, ObjectMeshes& out) {
     if (!list.is_array()) return skip(kMalformedGeometry);
-    for (size_t k = 0; k < list.size(); ++k)
-      surface(list[k], semanticOf(values, k, surfaces), fallback, by_normal, out);
+    for (size_t k = 0; k < list.size(); ++k) {
+      const SurfaceRefs r = refs.at(k);
+      surface(list[k], r, semanticOf(r.semantics, surfaces), fallback, by_normal, out);
+    }
   }
 
-  static const Json* child(const Json* values, size_t i) {
-    if (!values || !values->is_array() || i >= values->size()) return nullptr;
-    return &(*values)[i];
+  // The "values" of theme `theme` in a geometry's "texture" or "material" object.
+  static const Json* themeValues(const Json& g, const char* key, const std::string& theme, const Json** value) {
+    auto it = g.find(key);
+    if (it == g.end() || !it->is_object() || theme.empty()) return nullptr;
+    auto th = it->find(theme);
+    if (th == it->end() || !th->is_object()) return nullptr;
+    if (value) {
+      if (auto v = th->find("value"); v != th->end()) *value = &*v;
+    }
+    auto v = th->find("values");
+    return v != th->end() ? &*v : nullptr;
   }
 
   void geometry(const Json& g, const std::string& object_type, ObjectMeshes& out) {
@@ -212,20 +291,23 @@ struct Importer {
     if (!g.contains("boundaries")) return skip(kMalformedGeometry);
     const Json& b = g["boundaries"];
     const Json* surfaces = nullptr;
-    const Json* values = nullptr;
+    SurfaceRefs refs;
     if (auto it = g.find("semantics"); it != g.end() && it->is_object()) {
       if (auto s = it->find("surfaces"); s != it->end()) surfaces = &*s;
-      if (auto v = it->find("values"); v != it->end()) values = &*v;
+      if (auto v = it->find("values"); v != it->end()) refs.semantics = &*v;
     }
-    const Category cat = categoryOf(object_type);
-    const bool building = cat == Category::Building || cat == Category::BuildingPart;
-    const SurfaceClass fallback = building ? kWall : defaultClass(object_type);
+    refs.texture = themeValues(g, "texture", app.texture_theme, nullptr);
+    const Json* material_value = nullptr;
+    refs.material = themeValues(g, "material", app.material_theme, &material_value);
+    if (material_value && material_value->is_number_integer()) refs.material_all = material_value->get<int64_t>();
+    const CityCategory cat = cityCategoryOf(object_type);
+    const bool building = cat == CityCategory::Building || cat == CityCategory::BuildingPart;
+    const SurfaceClass fallback = building ? kWall : defaultSurfaceClass(object_type);
     if (type == "MultiSurface" || type == "CompositeSurface") {
-      surfaceList(b, values, surfaces, fallback, building, out);
+      surfaceList(b, refs, surfaces, fallback, building, out);
     } else if (type == "Solid") {
       if (!b.is_array()) return skip(kMalformedGeometry);
-      for (size_t shell = 0; shell < b.size(); ++shell)
-        surfaceList(b[shell], child(values, shell), surfaces, fallback, building, out);
+      for (size_t shell = 0; shell < b.size(); ++shell) surfaceList(b[shell], refs.at(shell), surfaces, fallback, building, out);
     } else if (type == "MultiSolid" || type == "CompositeSolid") {
       if (!b.is_array()) return skip(kMalformedGeometry);
       for (size_t solid = 0; solid < b.size(); ++solid) {
@@ -233,9 +315,9 @@ struct Importer {
           skip(kMalformedGeometry);
           continue;
         }
-        const Json* sv = child(values, solid);
+        const SurfaceRefs sr = refs.at(solid);
         for (size_t shell = 0; shell < b[solid].size(); ++shell)
-          surfaceList(b[solid][shell], child(sv, shell), surfaces, fallback, building, out);
+          surfaceList(b[solid][shell], sr.at(shell), surfaces, fallback, building, out);
       }
     } else if (type == "MultiPoint" || type == "MultiLineString") {
       skip(kUnsupportedGeometry);
@@ -288,6 +370,74 @@ DVec3 readTriple(const Json& j, const std::string& path, const char* what) {
   if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
     throw Error(path, std::string("transform: \"") + what + "\" must hold finite numbers");
   return v;
+}
+
+// Themes named by the geometries' "texture" or "material" objects (`key`), sorted by name.
+std::vector<std::string> themesOf(const Json& objects, const char* key) {
+  std::set<std::string> names;
+  for (auto it = objects.begin(); it != objects.end(); ++it) {
+    const Json& o = it.value();
+    if (!o.is_object()) continue;
+    auto g = o.find("geometry");
+    if (g == o.end() || !g->is_array()) continue;
+    for (const Json& geom : *g) {
+      if (!geom.is_object()) continue;
+      auto a = geom.find(key);
+      if (a == geom.end() || !a->is_object()) continue;
+      for (auto t = a->begin(); t != a->end(); ++t) names.insert(t.key());
+    }
+  }
+  return {names.begin(), names.end()};
+}
+
+// The theme to use: the one asked for, else CityJSON 1.0's "default-theme-*", else the first by name (JSON objects
+// have no order a reader must keep, so "the first in the file" is not defined).
+std::string chooseTheme(const std::vector<std::string>& themes, const std::string& asked, const Json& appearance,
+                        const char* default_key) {
+  if (themes.empty()) return {};
+  if (!asked.empty() && std::find(themes.begin(), themes.end(), asked) != themes.end()) return asked;
+  if (auto d = appearance.find(default_key); d != appearance.end() && d->is_string() &&
+                                             std::find(themes.begin(), themes.end(), d->get<std::string>()) != themes.end())
+    return d->get<std::string>();
+  return themes.front();
+}
+
+void readAppearance(const Json& doc, const Json& objects, const std::string& path,
+                    const CityJsonImportOptions& options, Appearance& app, CityJsonStats& st) {
+  st.texture_themes = themesOf(objects, "texture");
+  st.material_themes = themesOf(objects, "material");
+  if (!options.theme.empty() &&
+      std::find(st.texture_themes.begin(), st.texture_themes.end(), options.theme) == st.texture_themes.end() &&
+      std::find(st.material_themes.begin(), st.material_themes.end(), options.theme) == st.material_themes.end()) {
+    std::string known;
+    for (const auto* list : {&st.texture_themes, &st.material_themes})
+      for (const std::string& t : *list) known += (known.empty() ? "" : ", ") + t;
+    throw Error(path, "no appearance theme '" + options.theme + "' (themes: " + (known.empty() ? "none" : known) + ")");
+  }
+  static const Json kEmpty = Json::object();
+  auto ait = doc.find("appearance");
+  const Json& a = ait != doc.end() && ait->is_object() ? *ait : kEmpty;
+  st.texture_theme = chooseTheme(st.texture_themes, options.theme, a, "default-theme-texture");
+  st.material_theme = chooseTheme(st.material_themes, options.theme, a, "default-theme-material");
+  app.texture_theme = st.texture_theme;
+  app.material_theme = st.material_theme;
+  if (auto t = a.find("textures"); t != a.end() && t->is_array()) app.textures = &*t;
+  if (auto m = a.find("materials"); m != a.end() && m->is_array()) app.materials = &*m;
+  if (auto v = a.find("vertices-texture"); v != a.end() && v->is_array()) {
+    app.uvs.reserve(v->size());
+    for (const Json& uv : *v) {
+      if (uv.is_array() && uv.size() == 2 && uv[0].is_number() && uv[1].is_number()) {
+        // CityJSON puts (0, 0) at the bottom left of the image, Farfield at the top left.
+        const Vec2 p(uv[0].get<float>(), 1.0f - uv[1].get<float>());
+        if (isFinite(p)) {
+          app.uvs.emplace_back(p);
+          continue;
+        }
+      }
+      app.uvs.emplace_back(std::nullopt);
+      ++st.bad_texture_vertices;
+    }
+  }
 }
 
 }  // namespace
@@ -350,7 +500,7 @@ CityJsonScene importCityJson(const std::string& path, const CityJsonImportOption
   }
   if (result.reference.crs.empty()) result.reference.crs = "unknown (CityJSON without referenceSystem)";
 
-  Importer im{path, options, st, {}, {}, DVec3(0.0)};
+  Importer im{path, options, st};
   const Json& verts = *vit;
   st.vertices = verts.size();
   im.vertices.resize(verts.size());
@@ -408,13 +558,11 @@ CityJsonScene importCityJson(const std::string& path, const CityJsonImportOption
   }
 
   scene::Scene& scene = result.scene;
-  uint32_t materials[kClassCount];
-  for (int c = 0; c < kClassCount; ++c) {
-    scene::Material m;
-    m.name = kStyles[c].name;
-    m.base_color = kStyles[c].colour;
-    materials[c] = scene.addMaterial(std::move(m));
-  }
+  CityMaterials materials(scene);
+  scene::TextureFiles texture_files(st.import);
+  im.materials = &materials;
+  im.texture_files = &texture_files;
+  readAppearance(doc, objects, path, options, im.app, st);
 
   Progress progress("import " + path, objects.size());
   for (auto it = objects.begin(); it != objects.end(); ++it) {
@@ -430,9 +578,9 @@ CityJsonScene importCityJson(const std::string& path, const CityJsonImportOption
       im.skip(kMalformedObject);
       continue;
     }
-    const Category root_cat = categoryOf(root_type);
-    if (root_cat == Category::Ground && !options.ground_objects) continue;
-    if (root_cat == Category::Other && !options.other_objects) continue;
+    const CityCategory root_cat = cityCategoryOf(root_type);
+    if (root_cat == CityCategory::Ground && !options.ground_objects) continue;
+    if (root_cat == CityCategory::Other && !options.other_objects) continue;
 
     ObjectMeshes meshes;
     size_t parts = 0;
@@ -451,7 +599,7 @@ CityJsonScene importCityJson(const std::string& path, const CityJsonImportOption
         const uint64_t before = st.triangles;
         for (const Json* g : geometries) im.geometry(*g, type, meshes);
         if (st.triangles > before || depth == 0) ++types[type];
-        if (depth > 0 && st.triangles > before && categoryOf(type) == Category::BuildingPart && type == "BuildingPart")
+        if (depth > 0 && st.triangles > before && type == "BuildingPart")
           ++parts;
       } catch (const Json::exception&) {
         im.skip(kMalformedObject);
@@ -463,10 +611,9 @@ CityJsonScene importCityJson(const std::string& path, const CityJsonImportOption
 
     scene::Object object;
     object.name = it.key();
-    for (int c = 0; c < kClassCount; ++c) {
-      scene::Mesh& m = meshes.meshes[c];
+    for (auto& [material, m] : meshes.meshes) {
       if (m.indices.empty()) continue;
-      object.parts.push_back({scene.addMesh(std::move(m)), materials[c]});
+      object.parts.push_back({scene.addMesh(std::move(m)), material});
     }
     if (object.parts.empty()) {
       im.skip(lod_filtered_any ? kLodFiltered : kNoGeometry);
@@ -477,10 +624,10 @@ CityJsonScene importCityJson(const std::string& path, const CityJsonImportOption
     for (const auto& [type, n] : types) st.objects_by_type[type] += n;
     st.building_parts += parts;
     switch (root_cat) {
-      case Category::Building: ++st.buildings; break;
-      case Category::BuildingPart: ++st.buildings; break;  // a part without its building stands for one
-      case Category::Ground: ++st.ground_objects; break;
-      case Category::Other: ++st.other_objects; break;
+      case CityCategory::Building: ++st.buildings; break;
+      case CityCategory::BuildingPart: ++st.buildings; break;  // a part without its building stands for one
+      case CityCategory::Ground: ++st.ground_objects; break;
+      case CityCategory::Other: ++st.other_objects; break;
     }
   }
   progress.finish();

@@ -4,6 +4,14 @@
 // coloured by their semantic class (RoofSurface, WallSurface, GroundSurface, ...) when the file gives one; building
 // surfaces without semantics are classified by their normal (facing up: roof, down: ground, else wall).
 //
+// Appearances: a surface with a texture in the chosen theme (appearance.textures, "vertices-texture" and the
+// geometry's per-ring "texture" values) gets one material per texture image, its file read relative to the CityJSON
+// file; a surface without one but with a material (appearance.materials, diffuseColor and transparency) gets that
+// colour; the rest their class colour. A texture file that is missing or cannot be decoded is a counted warning
+// (stats.import) with a checkerboard in its place. Themes: CityJsonImportOptions::theme, else CityJSON 1.0's
+// "default-theme-texture"/"default-theme-material", else the first theme by name. The three versions store
+// appearances alike; 1.0 alone has the default themes and numeric LoDs, 1.1 and 2.0 require `transform`.
+//
 // Coordinates: the file's `transform` (scale, translate) is applied in double precision, then the centre of the
 // vertices' bounding box, rounded to whole metres (z kept at 0), is subtracted so that the scene's floats keep
 // millimetre precision (EPSG:7415 coordinates are about 85,000 / 445,000 m). GeoReference gives the offset back.
@@ -13,9 +21,11 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "farfield/core/bounds.h"
 #include "farfield/geodata/projection.h"
+#include "farfield/scene/import.h"
 #include "farfield/scene/scene.h"
 
 namespace farfield::geodata {
@@ -26,6 +36,9 @@ struct CityJsonImportOptions {
   std::optional<double> max_lod;
   bool ground_objects = true;  // roads, railways, land use, vegetation, water, terrain
   bool other_objects = true;   // bridges, tunnels, city furniture, generic objects, unknown (extension) types
+  // Appearance theme for textures and materials (empty: see the file comment). A theme the file does not have is
+  // an error listing those it has.
+  std::string theme;
 };
 
 struct CityJsonStats {
@@ -42,6 +55,13 @@ struct CityJsonStats {
   size_t semantic_surfaces = 0;           // of which with a semantic class from the file
   size_t inferred_surfaces = 0;           // building surfaces classified by their normal
   size_t holes = 0;                       // inner rings
+  size_t textured_surfaces = 0;           // surfaces drawn with a texture (placeholders included)
+  size_t material_surfaces = 0;           // surfaces drawn in an appearance material's colour
+  size_t bad_texture_references = 0;      // texture references that do not fit their surface (drawn untextured)
+  size_t bad_texture_vertices = 0;        // "vertices-texture" entries that are not two finite numbers
+  std::vector<std::string> texture_themes, material_themes;  // in the file, by name
+  std::string texture_theme, material_theme;                  // used (empty: none)
+  scene::ImportStats import;              // missing or unreadable texture files (checkerboard placeholders)
   uint64_t triangles = 0;
   std::map<std::string, size_t> skipped;  // per reason: faces and objects that could not be used
   double read_s = 0.0, build_s = 0.0;
