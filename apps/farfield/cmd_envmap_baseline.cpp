@@ -1,8 +1,9 @@
 // farfield envmap-baseline SCENE --placement DIR --profile profile.json -o report.json [--sample N] [--seed S]
-//                          [--far 50,100,...]
+//                          [--far 50,100,...] [--all-cells VISIBILITY_CACHE]
 // The per-cell environment-map baseline (Jeschke et al. 2005, test 15) for the view cells of a placement, at its
 // t_max, error bound and frame: eval/envmap_baseline.h.
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <sstream>
 
@@ -20,13 +21,47 @@ namespace farfield::app {
 namespace {
 
 struct EnvMapArgs {
-  std::string scene, placement, profile, output;
+  std::string scene, placement, profile, output, all_cells;
   std::vector<double> far;
   eval::EnvMapBaselineOptions options;
 };
 
+// Every cell of the view space from the visibility cache `farfield place --visibility-cache` wrote (each region's lower
+// corner and visible set); the cells have the size of the placement's problem cells (all minimum-size regions of its
+// partition have one size).
+std::vector<eval::EnvMapCellInput> cellsFromCache(const std::string& path, const store::PlacementIndex& index) {
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot be read");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const std::exception& e) {
+    throw Error(path, std::string("not JSON: ") + e.what());
+  }
+  Vec3 extent(0.0f);
+  for (const store::StoredViewSpaceNode& n : index.nodes)
+    if (n.children[0] == -1 && n.cpv_count > 0) extent = n.box.extent();
+  if (extent == Vec3(0.0f)) throw Error("placement database", "has no problem cell");
+  std::vector<eval::EnvMapCellInput> cells;
+  try {
+    for (const nlohmann::json& r : j.at("regions")) {
+      eval::EnvMapCellInput c;
+      c.region.lo = Vec3(r.at("lo")[0].get<float>(), r.at("lo")[1].get<float>(), r.at("lo")[2].get<float>());
+      c.region.hi = c.region.lo + extent;
+      c.visible = r.at("visible").get<std::vector<uint32_t>>();
+      if (!index.view_space.contains(c.region.lo)) throw Error(path, "a region lies outside the placement's view space");
+      cells.push_back(std::move(c));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, std::string("not a visibility cache: ") + e.what());
+  }
+  if (cells.empty()) throw Error(path, "holds no region");
+  return cells;
+}
+
 void runEnvMapBaseline(EnvMapArgs& args) {
   const store::PlacementIndex index = store::readPlacementIndex(args.placement);
+  if (!args.all_cells.empty()) args.options.cells = cellsFromCache(args.all_cells, index);
   const bake::PlaceOptions place = bake::placeOptionsFromJson(index.options, args.placement + "/placement.json options");
   const ErrorBound bound{place.error_px, place.width, place.height, degToRad(double(place.fov_deg))};
   Lens lens;
@@ -69,6 +104,9 @@ const RegisterCommand reg("envmap-baseline", [](CLI::App& app) {
   cmd->add_option("--seed", args->options.seed, "Seed of the sample")->capture_default_str();
   cmd->add_option("--far", args->far, "Far-field distances to try, metres (default 50,75,100,150,200,300,400,600)")
       ->delimiter(',');
+  cmd->add_option("--all-cells", args->all_cells, "Every cell of the view space, from the visibility cache of the "
+                                                  "placement (farfield place --visibility-cache), not only its "
+                                                  "problem cells (the paper's rule; use one --far distance)");
   cmd->callback([args] { runEnvMapBaseline(*args); });
 });
 

@@ -2,6 +2,8 @@
 #include "farfield/eval/envmap_baseline.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <cmath>
 #include <memory>
 #include <numeric>
@@ -66,6 +68,7 @@ nlohmann::json EnvMapBaselineReport::toJson() const {
   return {{"t_max_ms", t_max_ms},
           {"bound", {{"pixels", bound.pixels}, {"width", bound.width}, {"height", bound.height}, {"fov_y", bound.fov_y}}},
           {"problem_cells", problem_cells},
+          {"all_cells", all_cells},
           {"captured_cells", cells.size()},
           {"unsolved", unsolved},
           {"bytes_captured", bytes_captured},
@@ -101,8 +104,14 @@ EnvMapBaselineReport runEnvMapBaseline(gpu::Context& context, const scene::Scene
     report.placement_bytes += mesh + (imp.options.id_textures ? 0.5 : 1.0) * textures;
   }
 
-  // The cells: leaves of the placement's view-space partition that hold CPVs.
-  std::vector<size_t> cells;
+  // The cells: leaves of the placement's view-space partition that hold CPVs (or the caller's), each with its CPVs.
+  struct CellRef {
+    Box3 box;
+    const std::vector<uint32_t>* visible;
+    uint32_t cpv_first = 0, cpv_count = 0;
+  };
+  std::vector<CellRef> cells;
+  std::map<std::array<float, 3>, size_t> problem_by_corner;
   for (size_t n = 0; n < index.nodes.size(); ++n) {
     const store::StoredViewSpaceNode& node = index.nodes[n];
     if (node.children[0] != -1 || node.cpv_count == 0) continue;
@@ -110,14 +119,30 @@ EnvMapBaselineReport runEnvMapBaseline(gpu::Context& context, const scene::Scene
       throw Error("placement database", "region " + std::to_string(n) +
                                             " has no visible set (placed without visibility): the baseline culls "
                                             "each cell by it, as the paper's does");
-    cells.push_back(n);
+    problem_by_corner[{node.box.lo.x, node.box.lo.y, node.box.lo.z}] = n;
+    cells.push_back({node.box, &node.visible, node.cpv_first, node.cpv_count});
   }
   report.problem_cells = cells.size();
+  if (!options.cells.empty()) {
+    cells.clear();
+    for (const EnvMapCellInput& c : options.cells) {
+      CellRef ref{c.region, &c.visible, 0, 0};
+      if (const auto it = problem_by_corner.find({c.region.lo.x, c.region.lo.y, c.region.lo.z});
+          it != problem_by_corner.end()) {
+        ref.cpv_first = index.nodes[it->second].cpv_first;
+        ref.cpv_count = index.nodes[it->second].cpv_count;
+      }
+      for (uint32_t id : c.visible)
+        if (id == 0 || id > scene.objects.size())
+          throw Error("environment-map cells", "object id " + std::to_string(id) + " is not in the scene");
+      cells.push_back(ref);
+    }
+  }
+  report.all_cells = cells.size();
   if (options.sample > 0 && options.sample < cells.size()) {
     std::mt19937 rng(options.seed);
     std::shuffle(cells.begin(), cells.end(), rng);
     cells.resize(options.sample);
-    std::sort(cells.begin(), cells.end());
   }
 
   context.makeCurrent();
@@ -132,14 +157,13 @@ EnvMapBaselineReport runEnvMapBaseline(gpu::Context& context, const scene::Scene
   std::unique_ptr<Progress> progress;
   if (options.progress) progress = std::make_unique<Progress>("envmap baseline", cells.size());
   std::vector<uint32_t> in_frustum;
-  for (size_t n : cells) {
-    const store::StoredViewSpaceNode& node = index.nodes[n];
+  for (const CellRef& node : cells) {
     EnvMapCell cell;
     cell.region = node.box;
     cell.cpvs = node.cpv_count;
-    cell.visible_objects = node.visible.size();
+    cell.visible_objects = node.visible->size();
     std::vector<impostor::EnvMapObject> objects;
-    for (uint32_t id : node.visible) objects.push_back({id, scene.objects[id - 1].world_bounds});
+    for (uint32_t id : *node.visible) objects.push_back({id, scene.objects[id - 1].world_bounds});
 
     // The largest distance that keeps every CPV of the cell under t_max.
     impostor::EnvMapPlan plan;
@@ -197,14 +221,14 @@ EnvMapBaselineReport runEnvMapBaseline(gpu::Context& context, const scene::Scene
   const size_t m = report.cells.size();
   if (m > 0) {
     const double mean = report.bytes_captured / double(m);
-    report.bytes_estimate = mean * double(report.problem_cells);
-    if (m < report.problem_cells && m > 1) {
+    report.bytes_estimate = mean * double(report.all_cells);
+    if (m < report.all_cells && m > 1) {
       double var = 0.0;
       for (const EnvMapCell& c : report.cells) var += (double(c.bytes) - mean) * (double(c.bytes) - mean);
       var /= double(m - 1);
       // Sampling without replacement: the finite-population correction.
-      const double fpc = double(report.problem_cells - m) / double(report.problem_cells - 1);
-      report.bytes_stderr = double(report.problem_cells) * std::sqrt(var / double(m) * fpc);
+      const double fpc = double(report.all_cells - m) / double(report.all_cells - 1);
+      report.bytes_stderr = double(report.all_cells) * std::sqrt(var / double(m) * fpc);
     }
   }
   report.wall_s = wall.seconds();

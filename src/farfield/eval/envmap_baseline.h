@@ -34,9 +34,19 @@
 
 namespace farfield::eval {
 
+// A view cell given by the caller (every cell of the view space, the paper's rule) with its visible set.
+struct EnvMapCellInput {
+  Box3 region;
+  std::vector<uint32_t> visible;  // ascending object ids
+};
+
 struct EnvMapBaselineOptions {
   std::vector<double> far_distances = {50.0, 75.0, 100.0, 150.0, 200.0, 300.0, 400.0, 600.0};  // metres
   size_t sample = 0;        // cells captured; 0 = all
+  // Not empty: these cells instead of the placement's problem cells (the paper covers every cell of the view space);
+  // a cell whose region is a problem cell of the placement gets its CPVs, any other none (its distance is the
+  // largest tried). Use one far-field distance with it for the paper's rule.
+  std::vector<EnvMapCellInput> cells;
   uint32_t seed = 1;
   impostor::EnvMapOptions envmap;
   bool progress = true;
@@ -60,10 +70,11 @@ struct EnvMapBaselineReport {
   double t_max_ms = 0.0;
   ErrorBound bound;
   size_t problem_cells = 0;       // the placement's minimum-size regions with CPVs
-  std::vector<EnvMapCell> cells;  // the captured ones, in region order
+  size_t all_cells = 0;           // the cells the estimate is for (problem_cells, or EnvMapBaselineOptions::cells)
+  std::vector<EnvMapCell> cells;  // the captured ones
   size_t unsolved = 0;
   double bytes_captured = 0.0;    // sum over `cells`
-  double bytes_estimate = 0.0;    // for all problem cells: mean * problem_cells (= bytes_captured without sampling)
+  double bytes_estimate = 0.0;    // for all cells: mean * all_cells (= bytes_captured without sampling)
   double bytes_stderr = 0.0;      // standard error of that estimate (0 without sampling)
   double placement_bytes = 0.0;   // the placement's impostors, colour textures and quads (ids left out)
   double placement_total_bytes = 0.0;  // ... as placed (ids included when it has them)
