@@ -1,19 +1,22 @@
 // Scene export to binary glTF through tinygltf. One buffer holds every mesh's vertex and index data and the
 // PNG-encoded textures; each object becomes one root node whose matrix is its transform turned to glTF's Y up,
 // with the Farfield-only data (name, footprint, parent) in the node's extras under "farfield", which
-// importScene reads back.
+// importScene reads back. Meshes, materials and images are written on first use, so a subset of a scene's objects
+// (a 3D Tiles leaf) carries only what it draws.
 #include "farfield/scene/export_gltf.h"
 
 #include <stb_image_write.h>
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "farfield/core/error.h"
@@ -24,39 +27,74 @@ namespace detail {
 void checkTinygltfBinding();  // import.cpp
 }  // namespace detail
 
+Mat4 worldToGltf() { return Mat4(Vec4(1, 0, 0, 0), Vec4(0, 0, -1, 0), Vec4(0, 1, 0, 0), Vec4(0, 0, 0, 1)); }
+
 namespace {
 
-// Inverse of the importer's Y-up to Z-up turn: world (x, y, z) is written as glTF (x, z, -y).
-const Mat4 kZUpToYUp(Vec4(1, 0, 0, 0), Vec4(0, 0, -1, 0), Vec4(0, 1, 0, 0), Vec4(0, 0, 0, 1));
-
-class GlbWriter {
- public:
-  GlbWriter(const Scene& scene, const std::string& path) : scene_(scene), path_(path) {
-    model_.asset.version = "2.0";
-    model_.asset.generator = "Farfield";
-    model_.buffers.emplace_back();
+tinygltf::Value toValue(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::boolean:
+      return tinygltf::Value(j.get<bool>());
+    case nlohmann::json::value_t::number_integer:
+    case nlohmann::json::value_t::number_unsigned: {
+      const int64_t v = j.get<int64_t>();
+      if (v >= std::numeric_limits<int>::min() && v <= std::numeric_limits<int>::max()) return tinygltf::Value(int(v));
+      return tinygltf::Value(double(v));
+    }
+    case nlohmann::json::value_t::number_float:
+      return tinygltf::Value(j.get<double>());
+    case nlohmann::json::value_t::string:
+      return tinygltf::Value(j.get<std::string>());
+    case nlohmann::json::value_t::array: {
+      tinygltf::Value::Array a;
+      for (const auto& e : j) a.push_back(toValue(e));
+      return tinygltf::Value(std::move(a));
+    }
+    case nlohmann::json::value_t::object: {
+      tinygltf::Value::Object o;
+      for (const auto& [k, v] : j.items()) o[k] = toValue(v);
+      return tinygltf::Value(std::move(o));
+    }
+    default:
+      return tinygltf::Value();
   }
+}
 
-  tinygltf::Model build() {
-    for (size_t i = 0; i < scene_.meshes.size(); ++i) writeMesh(i);
-    for (const Material& m : scene_.materials) writeMaterial(m);
-    tinygltf::Scene root;
-    for (const Object& o : scene_.objects) root.nodes.push_back(writeNode(o));
-    model_.scenes.push_back(root);
-    model_.defaultScene = 0;
-    if (model_.buffers[0].data.size() > size_t(std::numeric_limits<uint32_t>::max()) - 1024)
-      throw Error(path_, "scene data exceeds the 4 GiB limit of a .glb file");
-    return std::move(model_);
-  }
+void appendBytes(void* context, void* data, int size) {
+  auto* out = static_cast<std::vector<unsigned char>*>(context);
+  const auto* p = static_cast<const unsigned char*>(data);
+  out->insert(out->end(), p, p + size);
+}
 
- private:
-  struct MeshAccessors {
+}  // namespace
+
+struct GltfBuilder::Impl {
+  struct Primitive {
     int position = -1, normal = -1, uv = -1, indices = -1;
   };
 
+  std::string path;
+  tinygltf::Model model;
+  std::map<std::pair<const Scene*, uint32_t>, Primitive> scene_meshes;
+  // (scene, material, has uvs) -> glTF material: a texture needs TEXCOORD_0, so a mesh without uvs gets the
+  // material without its texture.
+  std::map<std::tuple<const Scene*, uint32_t, bool>, int> scene_materials;
+  std::map<std::pair<const image::ColorImage*, bool>, int> textures;  // (image, clamp) -> texture
+  std::map<const image::ColorImage*, int> images;
+  int sampler_repeat = -1, sampler_clamp = -1;
+  std::map<std::pair<const Scene*, std::vector<std::pair<uint32_t, uint32_t>>>, int> object_meshes;
+
+  explicit Impl(std::string p) : path(std::move(p)) {
+    model.asset.version = "2.0";
+    model.asset.generator = "Farfield";
+    model.buffers.emplace_back();
+    model.scenes.emplace_back();
+    model.defaultScene = 0;
+  }
+
   // Appends bytes to the single buffer at a 4-byte boundary and returns a buffer view over them.
   int addView(const void* data, size_t bytes, int target) {
-    std::vector<unsigned char>& buf = model_.buffers[0].data;
+    std::vector<unsigned char>& buf = model.buffers[0].data;
     while (buf.size() % 4 != 0) buf.push_back(0);
     tinygltf::BufferView bv;
     bv.buffer = 0;
@@ -65,8 +103,8 @@ class GlbWriter {
     bv.target = target;
     const auto* p = static_cast<const unsigned char*>(data);
     buf.insert(buf.end(), p, p + bytes);
-    model_.bufferViews.push_back(bv);
-    return int(model_.bufferViews.size() - 1);
+    model.bufferViews.push_back(bv);
+    return int(model.bufferViews.size() - 1);
   }
 
   int addAccessor(int view, int component_type, int type, size_t count) {
@@ -75,82 +113,88 @@ class GlbWriter {
     a.componentType = component_type;
     a.type = type;
     a.count = count;
-    model_.accessors.push_back(a);
-    return int(model_.accessors.size() - 1);
+    model.accessors.push_back(a);
+    return int(model.accessors.size() - 1);
   }
 
-  void writeMesh(size_t index) {
-    const Mesh& src = scene_.meshes[index];
-    MeshAccessors acc;
-    if (src.positions.empty() || src.indices.empty()) {
-      accessors_.push_back(acc);
-      return;
-    }
-    src.validate(path_ + ": mesh " + std::to_string(index));
+  // Vertex and index accessors of a mesh; normals only when `normals` (unlit materials need none).
+  Primitive writeMesh(const Mesh& src, bool normals, const std::string& what) {
+    Primitive acc;
+    if (src.positions.empty() || src.indices.empty()) return acc;
+    src.validate(path + ": " + what);
     acc.position = addAccessor(addView(src.positions.data(), src.positions.size() * sizeof(Vec3),
                                        TINYGLTF_TARGET_ARRAY_BUFFER),
                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.positions.size());
     // glTF requires min and max on POSITION accessors.
     Box3 b;
     for (const Vec3& p : src.positions) b.expand(p);
-    model_.accessors[size_t(acc.position)].minValues = {b.lo.x, b.lo.y, b.lo.z};
-    model_.accessors[size_t(acc.position)].maxValues = {b.hi.x, b.hi.y, b.hi.z};
-    std::vector<Vec3> computed;
-    const std::vector<Vec3>* normals = &src.normals;
-    if (src.normals.size() != src.positions.size()) {
-      Mesh copy = src;
-      copy.computeNormals();
-      computed = std::move(copy.normals);
-      normals = &computed;
+    model.accessors[size_t(acc.position)].minValues = {b.lo.x, b.lo.y, b.lo.z};
+    model.accessors[size_t(acc.position)].maxValues = {b.hi.x, b.hi.y, b.hi.z};
+    if (normals) {
+      std::vector<Vec3> n = src.normals;
+      if (n.size() != src.positions.size()) {
+        Mesh copy = src;
+        copy.computeNormals();
+        n = std::move(copy.normals);
+      }
+      // glTF requires unit normals: a vertex of degenerate triangles only (no direction) gets +z.
+      for (Vec3& v : n) {
+        const float len = glm::length(v);
+        v = (std::isfinite(len) && len > 1e-12f) ? v / len : Vec3(0, 0, 1);
+      }
+      acc.normal = addAccessor(addView(n.data(), n.size() * sizeof(Vec3), TINYGLTF_TARGET_ARRAY_BUFFER),
+                               TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n.size());
     }
-    acc.normal = addAccessor(addView(normals->data(), normals->size() * sizeof(Vec3), TINYGLTF_TARGET_ARRAY_BUFFER),
-                             TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, normals->size());
     if (src.uvs.size() == src.positions.size())
       acc.uv = addAccessor(addView(src.uvs.data(), src.uvs.size() * sizeof(Vec2), TINYGLTF_TARGET_ARRAY_BUFFER),
                            TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, src.uvs.size());
     acc.indices = addAccessor(addView(src.indices.data(), src.indices.size() * sizeof(uint32_t),
                                       TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, src.indices.size());
-    accessors_.push_back(acc);
+    return acc;
   }
 
-  static void appendBytes(void* context, void* data, int size) {
-    auto* out = static_cast<std::vector<unsigned char>*>(context);
-    const auto* p = static_cast<const unsigned char*>(data);
-    out->insert(out->end(), p, p + size);
-  }
-
-  // glTF texture index for an image, PNG-encoded into the buffer once however many materials share it.
-  int textureFor(const image::ColorImage& img, const std::string& name) {
-    if (auto it = textures_.find(&img); it != textures_.end()) return it->second;
-    if (img.empty()) throw Error(path_, "texture '" + name + "' is empty");
-    std::vector<unsigned char> png;
-    if (!stbi_write_png_to_func(&GlbWriter::appendBytes, &png, img.width(), img.height(), 4, img.data(),
-                                img.width() * 4))
-      throw Error(path_, "cannot encode texture '" + name + "' as PNG");
-    tinygltf::Image gi;
-    gi.name = name;
-    gi.mimeType = "image/png";
-    gi.bufferView = addView(png.data(), png.size(), 0);
-    model_.images.push_back(gi);
-    if (model_.samplers.empty()) {
-      tinygltf::Sampler s;
-      s.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-      s.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-      s.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;
-      s.wrapT = TINYGLTF_TEXTURE_WRAP_REPEAT;
-      model_.samplers.push_back(s);
-    }
-    tinygltf::Texture t;
-    t.source = int(model_.images.size() - 1);
-    t.sampler = 0;
-    model_.textures.push_back(t);
-    const int index = int(model_.textures.size() - 1);
-    textures_[&img] = index;
+  int sampler(bool clamp) {
+    int& index = clamp ? sampler_clamp : sampler_repeat;
+    if (index >= 0) return index;
+    tinygltf::Sampler s;
+    s.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    s.minFilter = clamp ? TINYGLTF_TEXTURE_FILTER_LINEAR : TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+    s.wrapS = s.wrapT = clamp ? TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE : TINYGLTF_TEXTURE_WRAP_REPEAT;
+    model.samplers.push_back(s);
+    index = int(model.samplers.size() - 1);
     return index;
   }
 
-  void writeMaterial(const Material& m) {
+  // glTF texture index for an image, PNG-encoded into the buffer once however many materials share it.
+  int textureFor(const image::ColorImage& img, const std::string& name, bool clamp) {
+    if (auto it = textures.find({&img, clamp}); it != textures.end()) return it->second;
+    int source = -1;
+    if (auto it = images.find(&img); it != images.end()) {
+      source = it->second;
+    } else {
+      if (img.empty()) throw Error(path, "texture '" + name + "' is empty");
+      std::vector<unsigned char> png;
+      if (!stbi_write_png_to_func(&appendBytes, &png, img.width(), img.height(), 4, img.data(), img.width() * 4))
+        throw Error(path, "cannot encode texture '" + name + "' as PNG");
+      tinygltf::Image gi;
+      gi.name = name;
+      gi.mimeType = "image/png";
+      gi.bufferView = addView(png.data(), png.size(), 0);
+      model.images.push_back(gi);
+      source = int(model.images.size() - 1);
+      images[&img] = source;
+    }
+    tinygltf::Texture t;
+    t.source = source;
+    t.sampler = sampler(clamp);
+    model.textures.push_back(t);
+    const int index = int(model.textures.size() - 1);
+    textures[{&img, clamp}] = index;
+    return index;
+  }
+
+  int writeMaterial(const Material& m, bool textured, const GltfMaterialOptions& options) {
     tinygltf::Material gm;
     gm.name = m.name;
     gm.pbrMetallicRoughness.baseColorFactor = {m.base_color.r, m.base_color.g, m.base_color.b, m.base_color.a};
@@ -158,61 +202,94 @@ class GlbWriter {
     gm.pbrMetallicRoughness.metallicFactor = 0.0;
     gm.pbrMetallicRoughness.roughnessFactor = 1.0;
     gm.doubleSided = m.double_sided;
-    if (m.base_color.a < 1.0f) gm.alphaMode = "BLEND";
-    if (m.texture)
+    if (options.alpha_mask) {
+      gm.alphaMode = "MASK";
+      gm.alphaCutoff = options.alpha_cutoff;
+    } else if (m.base_color.a < 1.0f) {
+      gm.alphaMode = "BLEND";
+    }
+    if (m.texture && textured)
       gm.pbrMetallicRoughness.baseColorTexture.index =
-          textureFor(*m.texture, m.texture_path.empty() ? m.name : m.texture_path);
+          textureFor(*m.texture, m.texture_path.empty() ? m.name : m.texture_path, options.clamp);
     if (m.unlit) {
       gm.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
-      if (std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), "KHR_materials_unlit") ==
-          model_.extensionsUsed.end())
-        model_.extensionsUsed.push_back("KHR_materials_unlit");
+      if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), "KHR_materials_unlit") ==
+          model.extensionsUsed.end())
+        model.extensionsUsed.push_back("KHR_materials_unlit");
     }
-    model_.materials.push_back(gm);
+    model.materials.push_back(gm);
+    return int(model.materials.size() - 1);
+  }
+
+  tinygltf::Primitive primitive(const Primitive& acc, int material) {
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.attributes["POSITION"] = acc.position;
+    if (acc.normal >= 0) prim.attributes["NORMAL"] = acc.normal;
+    if (acc.uv >= 0) prim.attributes["TEXCOORD_0"] = acc.uv;
+    prim.indices = acc.indices;
+    prim.material = material;
+    return prim;
   }
 
   // One glTF mesh per distinct list of (mesh, material) parts; objects with the same parts share it.
-  int gltfMesh(const Object& o) {
+  int objectMesh(const Scene& scene, const Object& o) {
     std::vector<std::pair<uint32_t, uint32_t>> key;
     for (const Part& p : o.parts) key.emplace_back(p.mesh, p.material);
-    if (auto it = meshes_.find(key); it != meshes_.end()) return it->second;
+    if (auto it = object_meshes.find({&scene, key}); it != object_meshes.end()) return it->second;
     tinygltf::Mesh gm;
     gm.name = o.name;
     for (const Part& p : o.parts) {
-      if (p.mesh >= accessors_.size() || p.material >= scene_.materials.size())
-        throw Error(path_, "object " + std::to_string(o.id) + ": part names a missing mesh or material");
-      const MeshAccessors& acc = accessors_[p.mesh];
+      if (p.mesh >= scene.meshes.size() || p.material >= scene.materials.size())
+        throw Error(path, "object " + std::to_string(o.id) + ": part names a missing mesh or material");
+      auto mesh_it = scene_meshes.find({&scene, p.mesh});
+      if (mesh_it == scene_meshes.end())
+        mesh_it = scene_meshes
+                      .emplace(std::pair(&scene, p.mesh),
+                               writeMesh(scene.meshes[p.mesh], true, "mesh " + std::to_string(p.mesh)))
+                      .first;
+      const Primitive& acc = mesh_it->second;
       if (acc.position < 0) continue;  // no triangles
-      tinygltf::Primitive prim;
-      prim.mode = TINYGLTF_MODE_TRIANGLES;
-      prim.attributes["POSITION"] = acc.position;
-      prim.attributes["NORMAL"] = acc.normal;
-      if (acc.uv >= 0) prim.attributes["TEXCOORD_0"] = acc.uv;
-      prim.indices = acc.indices;
-      prim.material = int(p.material);
-      gm.primitives.push_back(prim);
+      const bool textured = acc.uv >= 0;
+      auto mat_it = scene_materials.find({&scene, p.material, textured});
+      if (mat_it == scene_materials.end())
+        mat_it = scene_materials
+                     .emplace(std::tuple(&scene, p.material, textured),
+                              writeMaterial(scene.materials[p.material], textured, {}))
+                     .first;
+      gm.primitives.push_back(primitive(acc, mat_it->second));
     }
     int index = -1;
     if (!gm.primitives.empty()) {
-      model_.meshes.push_back(gm);
-      index = int(model_.meshes.size() - 1);
+      model.meshes.push_back(gm);
+      index = int(model.meshes.size() - 1);
     }
-    meshes_[key] = index;
+    object_meshes[{&scene, key}] = index;
     return index;
   }
 
-  int writeNode(const Object& o) {
-    tinygltf::Node node;
-    node.name = o.name;
-    node.mesh = gltfMesh(o);
-    // The importer applies kYUpToZUp above the node, so writing kZUpToYUp * transform gives back the transform.
-    const Mat4 m = kZUpToYUp * o.transform;
-    const bool identity = m == Mat4(1.0f);
-    if (!identity) {
-      node.matrix.resize(16);
+  int node(const std::string& name, int mesh, int parent, const Mat4& m, tinygltf::Value extras) {
+    tinygltf::Node n;
+    n.name = name;
+    n.mesh = mesh;
+    if (m != Mat4(1.0f)) {
+      n.matrix.resize(16);
       for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) node.matrix[size_t(c * 4 + r)] = m[c][r];
+        for (int r = 0; r < 4; ++r) n.matrix[size_t(c * 4 + r)] = m[c][r];
     }
+    n.extras = std::move(extras);
+    model.nodes.push_back(std::move(n));
+    const int index = int(model.nodes.size() - 1);
+    if (parent < 0) {
+      model.scenes[0].nodes.push_back(index);
+    } else {
+      if (size_t(parent) >= model.nodes.size() - 1) throw Error(path, "node parent " + std::to_string(parent) + " does not exist");
+      model.nodes[size_t(parent)].children.push_back(index);
+    }
+    return index;
+  }
+
+  void writeObject(const Scene& scene, const Object& o) {
     tinygltf::Value::Object ff;
     ff["name"] = tinygltf::Value(o.name);
     if (o.parent != 0) ff["parent"] = tinygltf::Value(int(o.parent));
@@ -224,35 +301,75 @@ class GlbWriter {
     }
     tinygltf::Value::Object extras;
     extras["farfield"] = tinygltf::Value(std::move(ff));
-    node.extras = tinygltf::Value(std::move(extras));
-    model_.nodes.push_back(node);
-    return int(model_.nodes.size() - 1);
+    // The importer applies the y-up to z-up turn above the node, so worldToGltf() * transform gives back the
+    // transform.
+    node(o.name, objectMesh(scene, o), -1, worldToGltf() * o.transform, tinygltf::Value(std::move(extras)));
   }
-
-  const Scene& scene_;
-  const std::string& path_;
-  tinygltf::Model model_;
-  std::vector<MeshAccessors> accessors_;
-  std::map<const image::ColorImage*, int> textures_;
-  std::map<std::vector<std::pair<uint32_t, uint32_t>>, int> meshes_;
 };
 
-}  // namespace
+GltfBuilder::GltfBuilder(std::string path) : impl_(std::make_unique<Impl>(std::move(path))) {}
+GltfBuilder::~GltfBuilder() = default;
 
-void exportGlb(const Scene& scene, const std::string& path) {
+void GltfBuilder::addObjects(const Scene& scene) {
+  for (const Object& o : scene.objects) impl_->writeObject(scene, o);
+}
+
+void GltfBuilder::addObjects(const Scene& scene, std::span<const uint32_t> ids) {
+  for (uint32_t id : ids) {
+    if (id == 0 || id > scene.objects.size())
+      throw Error(impl_->path, "object id " + std::to_string(id) + " is not in the scene (1.." +
+                                   std::to_string(scene.objects.size()) + ")");
+    impl_->writeObject(scene, scene.objects[id - 1]);
+  }
+}
+
+int GltfBuilder::addMesh(const Mesh& mesh, const Material& material, const GltfMaterialOptions& options,
+                         const std::string& name) {
+  const Impl::Primitive acc = impl_->writeMesh(mesh, !material.unlit, name);
+  if (acc.position < 0) return -1;
+  tinygltf::Mesh gm;
+  gm.name = name;
+  gm.primitives.push_back(impl_->primitive(acc, impl_->writeMaterial(material, acc.uv >= 0, options)));
+  impl_->model.meshes.push_back(gm);
+  return int(impl_->model.meshes.size() - 1);
+}
+
+int GltfBuilder::addNode(const std::string& name, int mesh, int parent, const Mat4& matrix,
+                         const nlohmann::json& extras) {
+  if (mesh >= int(impl_->model.meshes.size()))
+    throw Error(impl_->path, "node '" + name + "': mesh " + std::to_string(mesh) + " does not exist");
+  return impl_->node(name, mesh, parent, matrix, extras.is_null() ? tinygltf::Value() : toValue(extras));
+}
+
+size_t GltfBuilder::write() {
   detail::checkTinygltfBinding();
-  const tinygltf::Model model = GlbWriter(scene, path).build();
+  const std::string& path = impl_->path;
+  tinygltf::Model& model = impl_->model;
+  if (model.buffers[0].data.size() > size_t(std::numeric_limits<uint32_t>::max()) - 1024)
+    throw Error(path, "scene data exceeds the 4 GiB limit of a .glb file");
+  // glTF forbids an empty buffer: a model without data has none.
+  const bool no_data = model.buffers[0].data.empty();
+  if (no_data) model.buffers.clear();
   // Serialised to memory first so that a file that cannot be written is reported with the stream's state
   // (tinygltf's file writer does not check it).
   std::ostringstream data;
   tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToStream(&model, data, false, true)) throw Error(path, "cannot serialise glTF");
+  const bool ok = writer.WriteGltfSceneToStream(&model, data, false, true);
+  if (no_data) model.buffers.emplace_back();
+  if (!ok) throw Error(path, "cannot serialise glTF");
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(path, "cannot open for writing");
   const std::string bytes = data.str();
   out.write(bytes.data(), std::streamsize(bytes.size()));
   out.close();
   if (!out) throw Error(path, "write failed");
+  return bytes.size();
+}
+
+void exportGlb(const Scene& scene, const std::string& path) {
+  GltfBuilder builder(path);
+  builder.addObjects(scene);
+  builder.write();
 }
 
 }  // namespace farfield::scene
