@@ -68,6 +68,21 @@ if(n_tiles LESS 3)
 endif()
 validate(${tiles})
 
+# expect_in_glb(FILE TEXT...): the glb's JSON chunk holds each text.
+function(expect_in_glb file)
+  file(STRINGS ${file} text)
+  foreach(t ${ARGN})
+    string(FIND "${text}" "${t}" pos)
+    if(pos EQUAL -1)
+      message(FATAL_ERROR "${file} lacks ${t}")
+    endif()
+  endforeach()
+endfunction()
+expect_in_glb(${WORK}/pipeline.glb "\"name\":\"impostors\"" "\"kind\":\"street cell\"" "\"kind\":\"textured depth mesh\""
+              "\"alphaMode\":\"MASK\"" "KHR_materials_unlit" "\"creation_camera\"")
+expect_in_glb(${WORK}/placed.glb "\"kind\":\"conservative problem view\"" "\"kind\":\"layered impostor\""
+              "\"alphaMode\":\"MASK\"" "\"error_angle_rad\"")
+
 # Bad input.
 file(MAKE_DIRECTORY ${WORK}/not_a_database)
 expect_error("is not an impostor database" export ${WORK}/city.glb --impostors ${WORK}/not_a_database

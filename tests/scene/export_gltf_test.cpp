@@ -5,6 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
+
+#include <tiny_gltf.h>
 
 #include "farfield/core/error.h"
 #include "farfield/scene/builtin.h"
@@ -89,6 +92,72 @@ TEST(ExportGlb, RoundTripKeepsGeometryTexturesAndExtras) {
   EXPECT_EQ(ground.texture->height(), ta.height());
   EXPECT_EQ(ground.texture->pixels(), ta.pixels());
   EXPECT_EQ(back.stats().textures, 1u);
+}
+
+// The builder under exportGlb, as the store's exporters use it: a subset of objects carries only what it draws; a free
+// mesh gets its own material (alpha mask, clamped sampler, unlit without normals); nodes nest with extras.
+TEST(GltfBuilder, SubsetsFreeMeshesAndNodes) {
+  const Scene src = testScene();
+  const auto dir = test::scratchDir("gltf_builder");
+  const std::string path = (dir / "subset.glb").string();
+  GltfBuilder builder(path);
+  const uint32_t ids[] = {3, 2};
+  builder.addObjects(src, ids);
+  Mesh quad;
+  quad.positions = {{0, 0, 5}, {4, 0, 5}, {4, 2, 5}, {0, 2, 5}};
+  quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  Material m;
+  m.name = "cutout";
+  m.unlit = true;
+  m.double_sided = true;
+  m.texture = std::make_shared<image::ColorImage>(4, 2, image::Rgba8(255, 0, 0, 0));
+  const int mesh = builder.addMesh(quad, m, {true, 0.5f, true}, "quad");
+  const int group = builder.addNode("group", -1, -1, worldToGltf(), nlohmann::json{{"what", "a group"}});
+  builder.addNode("quad node", mesh, group, Mat4(1.0f), nlohmann::json{{"n", 3}});
+  EXPECT_EQ(builder.addMesh(Mesh{}, m, {}, "empty"), -1);
+  EXPECT_THROW(builder.addObjects(src, std::vector<uint32_t>{99}), Error);
+  EXPECT_THROW(builder.addNode("bad", 1000, -1, Mat4(1.0f), nullptr), Error);
+  EXPECT_GT(builder.write(), 0u);
+
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, path)) << err;
+  // Objects 3 and 2 (in that order), the group and its child: roots are the two objects and the group.
+  ASSERT_EQ(model.scenes[0].nodes.size(), 3u);
+  EXPECT_EQ(model.nodes[size_t(model.scenes[0].nodes[0])].name, src.object(3).name);
+  EXPECT_EQ(model.nodes[size_t(model.scenes[0].nodes[1])].name, src.object(2).name);
+  const tinygltf::Node& g = model.nodes[size_t(model.scenes[0].nodes[2])];
+  EXPECT_EQ(g.name, "group");
+  EXPECT_EQ(g.extras.Get("what").Get<std::string>(), "a group");
+  ASSERT_EQ(g.children.size(), 1u);
+  const tinygltf::Node& q = model.nodes[size_t(g.children[0])];
+  EXPECT_EQ(q.extras.Get("n").GetNumberAsInt(), 3);
+  // Only the meshes and materials the two objects use, plus the quad's.
+  std::set<std::pair<uint32_t, uint32_t>> used;
+  for (uint32_t id : ids)
+    for (const Part& p : src.object(id).parts) used.insert({p.mesh, p.material});
+  std::set<uint32_t> used_materials;
+  for (const auto& [mesh_index, material] : used) used_materials.insert(material);
+  EXPECT_EQ(model.materials.size(), used_materials.size() + 1);
+  const tinygltf::Material& cut = model.materials.back();
+  EXPECT_EQ(cut.alphaMode, "MASK");
+  EXPECT_DOUBLE_EQ(cut.alphaCutoff, 0.5);
+  EXPECT_TRUE(cut.doubleSided);
+  EXPECT_TRUE(cut.extensions.count("KHR_materials_unlit"));
+  const tinygltf::Texture& tex = model.textures[size_t(cut.pbrMetallicRoughness.baseColorTexture.index)];
+  EXPECT_EQ(model.samplers[size_t(tex.sampler)].wrapS, TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+  const tinygltf::Primitive& prim = model.meshes[size_t(q.mesh)].primitives[0];
+  EXPECT_FALSE(prim.attributes.count("NORMAL"));  // unlit: none
+  EXPECT_TRUE(prim.attributes.count("TEXCOORD_0"));
+  // The quad's world points come back through the group's matrix and the importer's Y-up to Z-up turn.
+  const Scene back = importScene(path);
+  ASSERT_EQ(back.objects.size(), 3u);
+  const Object& o = back.objects[2];
+  const Mesh& bm = back.meshes[o.parts[0].mesh];
+  for (size_t v = 0; v < quad.positions.size(); ++v)
+    EXPECT_NEAR(glm::distance(Vec3(o.transform * Vec4(bm.positions[v], 1.0f)), quad.positions[v]), 0.0f, 1e-5f);
 }
 
 TEST(ExportGlb, TruncatedFileGivesError) {
