@@ -13,6 +13,7 @@ packages=(
   libassimp-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libpng-dev libzstd-dev
   # geometry, GIS
   libcgal-dev libgmp-dev libmpfr-dev libmeshoptimizer-dev libgdal-dev libosmium2-dev libproj-dev libexpat1-dev libbz2-dev zlib1g-dev
+  libcitygml-dev
   # CLI, threads, tests, benchmarks, plots
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev python3 python3-matplotlib python3-numpy
 )
