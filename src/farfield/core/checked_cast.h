@@ -1,7 +1,8 @@
 // Checked numeric conversions of input values (files, options, headers). A C++ conversion of a floating-point value
-// that does not fit the target type (1e300 to int, NaN to size_t, 1e300 to float) is undefined behaviour, and an
-// integer narrowed to a smaller type silently wraps (2^32 + 512 pixels read as 512): every conversion of a value that
-// came from outside goes through checkedCast, which refuses what does not fit with a farfield::Error naming the input.
+// that does not fit the target integer type (1e300 to int, NaN to size_t) is undefined behaviour, an integer narrowed
+// to a smaller type silently wraps (2^32 + 512 pixels read as 512), and a double beyond float's range becomes an
+// infinity: every conversion of a value that came from outside goes through checkedCast, which refuses what does not
+// fit with a farfield::Error naming the input.
 //
 //   fitsIn<To>(v)                    true when To(v) is defined and keeps v (its integer part, for a floating v
 //                                    converted to an integer: To(v) truncates toward zero as the cast does; a finite
@@ -70,7 +71,8 @@ constexpr bool fitsIn(From v) {
     else
       return x > -1.0L && x < upper;
   } else if constexpr (std::is_floating_point_v<From> && sizeof(To) < sizeof(From)) {
-    // Narrowing floating point (double to float): out of range is undefined; NaN and infinities carry over.
+    // Narrowing floating point (double to float): IEEE arithmetic rounds a value beyond the range to an infinity, which
+    // a reader then refuses as "not finite" far from the input; here it is out of range. NaN and infinities carry over.
     return !std::isfinite(v) || std::fabs(v) <= From(std::numeric_limits<To>::max());
   } else {
     return true;  // integer to floating (rounded, always in range for these types), or widening floating point

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 
 namespace farfield {
@@ -38,10 +39,11 @@ class StrictJson {
     const double d = v.get<double>();
     if (!std::isfinite(d)) throw Error(where_, what_ + " \"" + key + "\" is not finite");
     if constexpr (std::is_integral_v<T>) {
-      if (d != std::floor(d) || d < double(std::numeric_limits<T>::min()) || d > double(std::numeric_limits<T>::max()))
+      // fitsIn, not "d <= double(max)": double(INT64_MAX) is 2^63, one past the range.
+      if (d != std::floor(d) || !fitsIn<T>(d))
         throw Error(where_, what_ + " \"" + key + "\" must be an integer in range");
     }
-    out = T(d);
+    out = checkedCast<T>(d, where_, what_ + " \"" + key + "\"");
   }
   template <typename T>
   void numbers(const char* key, std::vector<T>& out) {
@@ -51,7 +53,7 @@ class StrictJson {
     for (const nlohmann::json& e : v) {
       if (!e.is_number() || !std::isfinite(e.get<double>()))
         throw Error(where_, what_ + " \"" + key + "\" must hold finite numbers only");
-      out.push_back(T(e.get<double>()));
+      out.push_back(checkedCast<T>(e.get<double>(), where_, what_ + " \"" + key + "\""));
     }
   }
   std::string text(const char* key) {
