@@ -65,6 +65,7 @@ TEST(Flythrough, StartsAwayZoomsInAndCrossesPlainThenMountains) {
   // Looking ahead and down (never up).
   for (const Viewpoint& v : path) EXPECT_LT(v.at.z, v.eye.z);
   EXPECT_THROW(flythroughPath(hf, FlythroughOptions{1}), Error);
+  EXPECT_THROW(flythroughPath(hf, FlythroughOptions{kMaxFlythroughFrames + 1}), Error);
 }
 
 TEST(Flythrough, BackAndForthRepeatsTheSpanBothWays) {

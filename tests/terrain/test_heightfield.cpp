@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "farfield/terrain/dem_io.h"
 #include "farfield/terrain/fractal.h"
 #include "farfield/terrain/heightfield.h"
+#include "farfield/terrain/terrain_data.h"
 #include "support/test_support.h"
 
 namespace farfield::terrain {
@@ -195,6 +197,78 @@ TEST(Dem, NetCdfLoads) {
   // Same orientation rule as GeoTIFF: north row last.
   EXPECT_FLOAT_EQ(hf.at(0, h - 1), 0.0f);
   EXPECT_FLOAT_EQ(hf.at(3, 0), 550.0f);
+}
+
+// A header may claim any size: an ASCII grid of 100000 x 100000 points holding eight values was read into a raster
+// of 10^10 doubles (std::bad_alloc, "internal error"). The size is refused from the header.
+TEST(Dem, AbsurdHeaderSizeIsAClearError) {
+  const std::string path = (farfield::test::testDataDir() / "terrain" / "fuzz" / "huge_header.asc").string();
+  try {
+    loadDem(path);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find("100000x100000"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("exceeds the limit of 268435456"), std::string::npos) << msg;
+  }
+  // The limit is an option: a real file over a lower limit is refused the same way.
+  const auto dir = farfield::test::scratchDir("terrain_cap");
+  const std::string small = (dir / "small.tif").string();
+  writeRaster(small, "GTiff", GDT_Float32, 8, 6, std::vector<double>(48, 5.0), nullptr, nullptr);
+  DemLoadOptions o;
+  o.max_grid_points = 47;
+  EXPECT_THROW(loadDem(small, o), Error);
+  o.max_grid_points = 48;
+  EXPECT_EQ(loadDem(small, o).size(), 48u);
+}
+
+// A geographic raster whose centre lies past a pole gave a negative cell size (cos of the latitude), and a cell size
+// option of infinity was taken as given: both are refused.
+TEST(Dem, UnusableCellSizesAreClearErrors) {
+  GDALAllRegister();
+  const auto dir = farfield::test::scratchDir("terrain_bad_cells");
+  const std::string path = (dir / "past_the_pole.tif").string();
+  GDALDatasetH ds = GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), 8, 6, 1, GDT_Float32, nullptr);
+  ASSERT_NE(ds, nullptr);
+  double gt[6] = {7.0, 0.001, 0.0, 100.0, 0.0, -0.001};
+  GDALSetGeoTransform(ds, gt);
+  GDALSetProjection(ds, "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],"
+                        "PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]");
+  std::vector<float> v(48, 3.0f);
+  ASSERT_EQ(GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Write, 0, 0, 8, 6, v.data(), 8, 6, GDT_Float32, 0, 0),
+            CE_None);
+  GDALClose(ds);
+  try {
+    loadDem(path);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("expected positive finite sizes"), std::string::npos) << e.what();
+  }
+  DemLoadOptions o;
+  o.cell_size = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(loadDem(path, o), Error);
+  o.cell_size = 2.0;
+  EXPECT_EQ(loadDem(path, o).cell_x, 2.0);
+}
+
+TEST(TerrainSpec, FractalSpecsAreWholeNumbersOnly) {
+  const FractalOptions f = parseFractalSpec("fractal:33:18446744073709551615");
+  EXPECT_EQ(f.size, 33);
+  EXPECT_EQ(f.seed, 18446744073709551615ull);
+  EXPECT_EQ(parseFractalSpec("fractal:65").seed, FractalOptions{}.seed);
+  // sscanf("%d") read 99999999999 as some int (undefined), "33x" as 33 and "-1" as seed 2^64 - 1.
+  for (const char* bad : {"fractal:99999999999", "fractal:33x", "fractal:33:-1", "fractal:-33", "fractal: 33",
+                          "fractal:33:1:2", "fractal:", "fractal:33:18446744073709551616", "fractal:1e3"}) {
+    try {
+      parseFractalSpec(bad);
+      ADD_FAILURE() << bad << ": no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(std::string(bad) + ": ", 0), 0u) << e.what();
+    }
+  }
+  EXPECT_THROW(TerrainData::load("fractal:99999999999"), Error);
+  EXPECT_EQ(TerrainData::load("fractal:33:7")->source.width, 33);
 }
 
 TEST(Heightfield, FillNodataFillsHolesAndCounts) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 
 namespace farfield::terrain {
@@ -58,6 +59,8 @@ Heightfield loadDem(const std::string& path, const DemLoadOptions& options) {
   if (options.band < 1) throw Error(path, "band must be 1 or more");
   if (!(options.height_scale > 0.0) || !std::isfinite(options.height_scale))
     throw Error(path, "height scale must be a positive number");
+  if (!(options.cell_size >= 0.0) || !std::isfinite(options.cell_size))
+    throw Error(path, "cell size must be a finite number of metres (0: from the georeferencing)");
 
   QuietGdalErrors quiet;
   DatasetCloser ds;
@@ -83,6 +86,8 @@ Heightfield loadDem(const std::string& path, const DemLoadOptions& options) {
   const int w = GDALGetRasterXSize(ds.handle), h = GDALGetRasterYSize(ds.handle);
   if (w < 2 || h < 2)
     throw Error(path, "raster is " + std::to_string(w) + "x" + std::to_string(h) + ", need at least 2x2 cells");
+  capSize(uint64_t(w) * uint64_t(h), options.max_grid_points, path,
+          "raster of " + std::to_string(w) + "x" + std::to_string(h) + " grid points:");
 
   Heightfield hf(w, h);
   hf.source = path;
@@ -132,15 +137,16 @@ Heightfield loadDem(const std::string& path, const DemLoadOptions& options) {
       hf.notes.push_back("no coordinate system: geotransform units taken as metres");
     }
     if (srs) OSRDestroySpatialReference(srs);
+    // A geotransform of extreme numbers (or a latitude past a pole) gives no usable cell size.
+    if (!(std::isfinite(hf.cell_x) && std::isfinite(hf.cell_y) && hf.cell_x > 0.0 && hf.cell_y > 0.0))
+      throw Error(path, "geotransform gives cells of " + std::to_string(hf.cell_x) + " x " +
+                            std::to_string(hf.cell_y) + " m, expected positive finite sizes");
     // Georeferenced position of the south-west grid point's centre.
     const int south_row = north_up ? h - 1 : 0;
     hf.geo_origin = DVec2(gt[0] + gt[1] * 0.5, gt[3] + gt[5] * (south_row + 0.5));
   }
 
   // Vertical: raw values, nodata, scale/offset, unit.
-  std::vector<double> raw(size_t(w) * size_t(h));
-  if (GDALRasterIO(band, GF_Read, 0, 0, w, h, raw.data(), w, h, GDT_Float64, 0, 0) != CE_None)
-    throw Error(path, "cannot read band " + std::to_string(options.band) + QuietGdalErrors::last());
   int has_nodata = 0;
   const double nodata_value = GDALGetRasterNoDataValue(band, &has_nodata);
   int has_scale = 0, has_offset = 0;
@@ -155,10 +161,15 @@ Heightfield loadDem(const std::string& path, const DemLoadOptions& options) {
     hf.notes.push_back(std::string("heights converted from ") + unit + " to metres");
   }
   std::vector<uint8_t> mask(hf.size(), 0);
+  // Row by row: a whole raster of doubles would take twice the heights' memory again.
+  std::vector<double> raw(static_cast<size_t>(w));
   for (int r = 0; r < h; ++r) {
+    if (GDALRasterIO(band, GF_Read, 0, r, w, 1, raw.data(), w, 1, GDT_Float64, 0, 0) != CE_None)
+      throw Error(path, "cannot read band " + std::to_string(options.band) + " (row " + std::to_string(r) + ")" +
+                            QuietGdalErrors::last());
     const int j = north_up ? h - 1 - r : r;
     for (int i = 0; i < w; ++i) {
-      const double v = raw[size_t(r) * size_t(w) + size_t(i)];
+      const double v = raw[size_t(i)];
       const size_t k = hf.index(i, j);
       const bool missing = !std::isfinite(v) ||
                            (has_nodata && (v == nodata_value || float(v) == float(nodata_value)));

@@ -31,7 +31,9 @@ float smoothstep(float t) {
 
 std::vector<Viewpoint> flythroughPath(const Heightfield& hf, const FlythroughOptions& o,
                                       FlythroughLandmarks* landmarks) {
-  if (o.frames < 2) throw Error("flythrough", "needs at least 2 frames");
+  if (o.frames < 2 || o.frames > kMaxFlythroughFrames)
+    throw Error("flythrough", "needs 2.." + std::to_string(kMaxFlythroughFrames) + " frames, got " +
+                                  std::to_string(o.frames));
   if (hf.width < 8 || hf.height < 8) throw Error(hf.source, "heightfield too small for a flythrough (need 8x8)");
   const float ex = float(hf.extentX()), ey = float(hf.extentY());
   const float diag = std::sqrt(ex * ex + ey * ey);

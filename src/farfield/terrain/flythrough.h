@@ -20,6 +20,9 @@ struct Viewpoint {
   float fov_y = float(degToRad(60.0));
 };
 
+// Nine hours at 30 frames a second; more would only be an allocation failure (the path is built in memory).
+inline constexpr int kMaxFlythroughFrames = 1000000;
+
 struct FlythroughOptions {
   int frames = 600;
   float fov_deg = 60.0f;
@@ -34,7 +37,7 @@ struct FlythroughLandmarks {
   Vec2 plain{0.0f}, mountains{0.0f}, beyond{0.0f};  // world xy
 };
 
-// Throws farfield::Error for frames < 2 or a heightfield smaller than 8x8 points.
+// Throws farfield::Error for frames outside 2..kMaxFlythroughFrames or a heightfield smaller than 8x8 points.
 std::vector<Viewpoint> flythroughPath(const Heightfield& hf, const FlythroughOptions& options = {},
                                       FlythroughLandmarks* landmarks = nullptr);
 

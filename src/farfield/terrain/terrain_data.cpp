@@ -1,27 +1,52 @@
 #include "farfield/terrain/terrain_data.h"
 
-#include <cstdio>
+#include <charconv>
+#include <optional>
 #include <sstream>
+#include <string_view>
 
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 #include "farfield/terrain/dem_io.h"
 #include "farfield/terrain/fractal.h"
 
 namespace farfield::terrain {
 
+namespace {
+
+// A whole number of decimal digits only (no sign, space or exponent), or none when `text` is not one or does not fit.
+std::optional<uint64_t> decimal(std::string_view text) {
+  uint64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size()) return {};
+  return v;
+}
+
+}  // namespace
+
+FractalOptions parseFractalSpec(const std::string& spec) {
+  const std::string usage = "expected fractal:SIZE or fractal:SIZE:SEED (SIZE = 2^n + 1, e.g. fractal:513:7)";
+  if (spec.rfind("fractal:", 0) != 0) throw Error(spec, usage);
+  const std::string_view rest = std::string_view(spec).substr(8);
+  const size_t colon = rest.find(':');
+  const std::optional<uint64_t> size = decimal(rest.substr(0, colon));
+  if (!size) throw Error(spec, usage);
+  FractalOptions f;
+  f.size = checkedCast<int>(*size, spec, "SIZE");
+  if (colon != std::string_view::npos) {
+    const std::optional<uint64_t> seed = decimal(rest.substr(colon + 1));
+    if (!seed) throw Error(spec, usage + "; SEED must be a whole number in 0..18446744073709551615");
+    f.seed = *seed;
+  }
+  return f;
+}
+
 std::unique_ptr<TerrainData> TerrainData::load(const std::string& spec, const TerrainLoadOptions& options) {
   auto data = std::make_unique<TerrainData>();
   if (spec.rfind("fractal:", 0) == 0) {
-    FractalOptions f;
-    int size = 0;
-    unsigned long long seed = 1;
-    const int n = std::sscanf(spec.c_str() + 8, "%d:%llu", &size, &seed);
-    if (n < 1) throw Error(spec, "expected fractal:SIZE or fractal:SIZE:SEED (SIZE = 2^n + 1, e.g. fractal:513:7)");
-    f.size = size;
-    f.seed = seed;
-    data->source = fractalTerrain(f);
+    data->source = fractalTerrain(parseFractalSpec(spec));
   } else {
-    data->source = loadDem(spec);
+    data->source = loadDem(spec, options.dem);
   }
   if (options.block < 2 || (options.block & (options.block - 1)) != 0)
     throw Error("LOD block size", "must be a power of two >= 2");

@@ -7,6 +7,8 @@
 
 #include "farfield/image/image.h"
 #include "farfield/scene/scene.h"
+#include "farfield/terrain/dem_io.h"
+#include "farfield/terrain/fractal.h"
 #include "farfield/terrain/heightfield.h"
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_texture.h"
@@ -17,7 +19,13 @@ struct TerrainLoadOptions {
   int block = 128;        // LOD block size (cells); the heightfield is cropped (centred) to whole blocks
   int texture_scale = 1;  // texels per cell
   std::string texture;    // a PNG to use as the original texture instead of the generated one ("" = generate)
+  DemLoadOptions dem;     // how a DEM file is read (band, cell size, height scale, size limit)
 };
+
+// "fractal:SIZE[:SEED]" -> the fractal's size and seed (the other options at their defaults). Throws farfield::Error
+// naming the spec for anything else: a sign, a space, trailing text, a SIZE beyond int or a SEED beyond 64 bits
+// (fractalTerrain then checks that SIZE is 2^n + 1).
+FractalOptions parseFractalSpec(const std::string& spec);
 
 struct TerrainData {
   Heightfield source;  // as loaded (before cropping)
@@ -26,8 +34,8 @@ struct TerrainData {
   std::unique_ptr<QuadtreeLod> lod;
   image::ColorImage texture;
 
-  // spec: a DEM file (see dem_io.h) or "fractal:SIZE[:SEED]" (see fractal.h; SIZE = 2^n + 1). Throws
-  // farfield::Error for bad files or specs.
+  // spec: a DEM file (see dem_io.h) or "fractal:SIZE[:SEED]" (see fractal.h; SIZE = 2^n + 1, SEED a whole number
+  // 0..2^64-1, both in decimal digits only). Throws farfield::Error for bad files or specs.
   static std::unique_ptr<TerrainData> load(const std::string& spec, const TerrainLoadOptions& options = {});
   // One-line description: size, cell size, height range, nodata count, crop.
   std::string describe() const;
