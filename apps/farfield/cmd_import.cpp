@@ -1,8 +1,14 @@
 // farfield import osm FILE.osm.pbf [--bbox minlon,minlat,maxlon,maxlat] [--objects blocks|buildings]
 //                     [--highways a,b,c] [--tunnels] [--default-height M] [--merge-tolerance M] -o city.glb
-// farfield import cityjson FILE.city.json [--max-lod L] [--no-ground] [--no-other] -o city.glb
-// Imports a real city: writes the scene (.glb), the street graph (city.streets.json, OSM only) and the geographic
-// reference of the local coordinates (city.georef.json); prints what was imported and skipped, per reason.
+// farfield import cityjson FILE.city.json [--max-lod L] [--no-ground] [--no-other] [--theme T] -o city.glb
+// farfield import citygml FILE.gml [--max-lod L] [--no-ground] [--no-other] [--theme T] [--objects blocks|buildings]
+//                         -o city.glb
+// farfield import FILE -o city.glb   (the format from the extension: .osm.pbf/.osm, .city.json/.json, .gml/.citygml)
+// Imports a real city: writes the scene (.glb), the street graph (city.streets.json, when the file has streets) and
+// the geographic reference of the local coordinates (city.georef.json); prints what was imported and skipped, per
+// reason, and the texture files that were missing (drawn as checkerboards).
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -15,6 +21,7 @@
 #include "farfield/core/timer.h"
 #include "farfield/gen/city.h"
 #include "farfield/geodata/cityjson_import.h"
+#include "farfield/geodata/citygml_import.h"
 #include "farfield/geodata/osm_import.h"
 #include "farfield/geodata/projection.h"
 #include "farfield/scene/export_gltf.h"
@@ -30,7 +37,7 @@ struct OsmArgs {
 };
 
 struct CityJsonArgs {
-  std::string input, output;
+  std::string input, output, theme, objects = "blocks";
   double max_lod = -1.0;
   bool no_ground = false, no_other = false;
 };
@@ -45,6 +52,16 @@ void printReference(const geodata::GeoReference& r) {
               r.origin.z, r.crs.c_str(), r.description.empty() ? "" : ", ", r.description.c_str(), r.crs.c_str());
 }
 
+void printWarnings(const scene::ImportStats& st) {
+  for (const std::string& w : st.warnings()) std::printf("warning:      %s\n", w.c_str());
+}
+
+gen::ObjectGrouping parseGrouping(const std::string& objects) {
+  if (objects == "blocks") return gen::ObjectGrouping::Blocks;
+  if (objects == "buildings") return gen::ObjectGrouping::Buildings;
+  throw Error("--objects", "expected 'blocks' or 'buildings', got '" + objects + "'");
+}
+
 void writeScene(const scene::Scene& scene, const geodata::GeoReference& reference, const std::string& output,
                 double& write_s) {
   ensureParentDirectory(output);
@@ -57,9 +74,7 @@ void writeScene(const scene::Scene& scene, const geodata::GeoReference& referenc
 void runOsm(const OsmArgs& args) {
   geodata::OsmImportOptions options;
   if (!args.bbox.empty()) options.read.bbox = geodata::parseLonLatBox("--bbox", args.bbox);
-  if (args.objects == "blocks") options.objects = gen::ObjectGrouping::Blocks;
-  else if (args.objects == "buildings") options.objects = gen::ObjectGrouping::Buildings;
-  else throw Error("--objects", "expected 'blocks' or 'buildings', got '" + args.objects + "'");
+  options.objects = parseGrouping(args.objects);
   if (!args.highways.empty()) options.read.highways = geodata::parseHighwayList("--highways", args.highways);
   options.read.include_tunnels = args.tunnels;
   options.read.heights.default_height = args.default_height;
@@ -103,6 +118,7 @@ void runCityJson(const CityJsonArgs& args) {
   if (args.max_lod >= 0.0) options.max_lod = args.max_lod;
   options.ground_objects = !args.no_ground;
   options.other_objects = !args.no_other;
+  options.theme = args.theme;
   Stopwatch total;
   const geodata::CityJsonScene c = geodata::importCityJson(args.input, options);
   const geodata::CityJsonStats& st = c.stats;
@@ -117,6 +133,10 @@ void runCityJson(const CityJsonArgs& args) {
   for (const auto& [type, n] : st.objects_by_type) std::printf("  %-46s %zu\n", type.c_str(), n);
   std::printf("surfaces:     %zu (%zu with semantics, %zu building surfaces classified by normal, %zu holes)\n",
               st.surfaces, st.semantic_surfaces, st.inferred_surfaces, st.holes);
+  std::printf("appearance:   %zu textured surfaces (theme '%s'), %zu in material colours (theme '%s'), %zu bad "
+              "texture references\n", st.textured_surfaces, st.texture_theme.c_str(), st.material_surfaces,
+              st.material_theme.c_str(), st.bad_texture_references);
+  printWarnings(st.import);
   printSkips(st.skipped, st.skippedTotal(), "faces/objects");
   std::printf("scene:        %zu objects, %llu triangles\n", c.scene.objects.size(),
               (unsigned long long)c.scene.triangleCount());
@@ -126,9 +146,88 @@ void runCityJson(const CityJsonArgs& args) {
   std::printf("wrote %s, %s\n", args.output.c_str(), geodata::geoReferencePathFor(args.output).c_str());
 }
 
+void runCityGml(const CityJsonArgs& args) {
+  geodata::CityGmlImportOptions options;
+  if (args.max_lod >= 0.0) options.max_lod = unsigned(args.max_lod);
+  options.ground_objects = !args.no_ground;
+  options.other_objects = !args.no_other;
+  options.theme = args.theme;
+  options.objects = parseGrouping(args.objects);
+  Stopwatch total;
+  const geodata::CityGmlScene c = geodata::importCityGml(args.input, options);
+  const geodata::CityGmlStats& st = c.stats;
+  double write_s = 0.0;
+  writeScene(c.city.scene, c.reference, args.output, write_s);
+  const bool streets = c.city.streets.streetCount() > 0;
+  const std::string streets_path = gen::streetsPathFor(args.output);
+  if (streets) c.city.streets.save(streets_path);
+
+  std::printf("input:        %s (CityGML %s, %zu city objects, CRS %s)\n", args.input.c_str(),
+              st.version.empty() ? "?" : st.version.c_str(), st.city_objects, st.crs.empty() ? "unknown" : st.crs.c_str());
+  std::printf("imported:     %zu buildings (%zu parts), %zu ground objects, %zu other objects\n", st.buildings,
+              st.building_parts, st.ground_objects, st.other_objects);
+  for (const auto& [type, n] : st.objects_by_type) std::printf("  %-46s %zu\n", type.c_str(), n);
+  for (const auto& [lod, n] : st.lods)
+    std::printf("  %-46s %zu\n", ("objects drawn at LoD " + std::to_string(lod)).c_str(), n);
+  std::printf("surfaces:     %zu (%zu with semantics, %zu building surfaces classified by normal, %zu holes, %zu "
+              "shared)\n", st.surfaces, st.semantic_surfaces, st.inferred_surfaces, st.holes, st.shared_polygons);
+  std::printf("appearance:   %zu textured surfaces, %zu in material colours (theme '%s'), %zu bad texture "
+              "coordinates\n", st.textured_surfaces, st.material_surfaces, st.theme.c_str(), st.bad_texture_coordinates);
+  printWarnings(st.import);
+  printSkips(st.skipped, st.skippedTotal(), "polygons/objects");
+  if (streets)
+    std::printf("streets:      %zu road objects (%zu surfaces) -> %zu centre-line segments -> %zu junctions, %zu "
+                "streets, %zu blocks; %zu buildings in no block\n", st.road_objects, st.road_polygons,
+                st.centre_line_segments, c.city.streets.junctionCount(), c.city.streets.streetCount(),
+                c.city.streets.blockCount(), st.outside_blocks);
+  else
+    std::printf("streets:      none (no transportation surfaces): one object per city object\n");
+  std::printf("scene:        %zu objects, %llu triangles\n", c.city.scene.objects.size(),
+              (unsigned long long)c.city.scene.triangleCount());
+  printReference(c.reference);
+  std::printf("time:         %.2f s (read %.2f, triangulate %.2f, streets %.2f, write %.2f)\n", total.seconds(),
+              st.read_s, st.build_s, st.streets_s, write_s);
+  std::printf("wrote %s%s%s, %s\n", args.output.c_str(), streets ? ", " : "", streets ? streets_path.c_str() : "",
+              geodata::geoReferencePathFor(args.output).c_str());
+}
+
+// `farfield import FILE -o OUT`: the importer from the file name, with its default options.
+void runByExtension(const std::string& input, const std::string& output) {
+  if (input.empty()) throw Error("import", "expected a subcommand (osm, cityjson, citygml) or a FILE and -o OUT");
+  if (output.empty()) throw Error("import", "-o,--output is required");
+  std::string name = input;
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+  auto ends = [&](const std::string& ext) {
+    return name.size() >= ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0;
+  };
+  if (ends(".gml") || ends(".citygml") || ends(".xml")) {
+    CityJsonArgs a;
+    a.input = input, a.output = output;
+    return runCityGml(a);
+  }
+  if (ends(".json") || ends(".cityjson")) {
+    CityJsonArgs a;
+    a.input = input, a.output = output;
+    return runCityJson(a);
+  }
+  if (ends(".pbf") || ends(".osm")) {
+    OsmArgs a;
+    a.input = input, a.output = output;
+    return runOsm(a);
+  }
+  throw Error(input, "unknown city format (expected .osm.pbf, .osm, .city.json, .gml or .citygml; or name the "
+                     "format: farfield import osm|cityjson|citygml)");
+}
+
 const RegisterCommand reg("import", [](CLI::App& app) {
-  auto* cmd = app.add_subcommand("import", "Import a real city: OpenStreetMap (PBF/XML) or CityJSON.");
-  cmd->require_subcommand(1);
+  auto* cmd = app.add_subcommand("import", "Import a real city: OpenStreetMap (PBF/XML), CityJSON or CityGML.");
+  cmd->require_subcommand(0, 1);
+  auto any = std::make_shared<std::pair<std::string, std::string>>();
+  cmd->add_option("file", any->first, "City file, its format from the extension (.osm.pbf, .city.json, .gml)");
+  cmd->add_option("-o,--output", any->second, "Output scene (.glb)");
+  cmd->callback([cmd, any] {
+    if (cmd->get_subcommands().empty()) runByExtension(any->first, any->second);
+  });
 
   auto osm = std::make_shared<OsmArgs>();
   auto* o = cmd->add_subcommand("osm", "Buildings and streets from an OpenStreetMap file (.osm.pbf, .osm).");
@@ -154,7 +253,20 @@ const RegisterCommand reg("import", [](CLI::App& app) {
       ->check(CLI::Range(0.0, 4.0));
   c->add_flag("--no-ground", cj->no_ground, "Leave out roads, land use, vegetation, water and terrain");
   c->add_flag("--no-other", cj->no_other, "Leave out bridges, tunnels, furniture and generic objects");
+  c->add_option("--theme", cj->theme, "Appearance theme of textures and materials (default: the first)");
   c->callback([cj] { runCityJson(*cj); });
+
+  auto gml = std::make_shared<CityJsonArgs>();
+  auto* g = cmd->add_subcommand("citygml", "Buildings, roads and land use from a CityGML 1.0 or 2.0 file (.gml).");
+  g->add_option("file", gml->input, "CityGML file")->required();
+  g->add_option("-o,--output", gml->output, "Output scene (.glb); the street graph goes to .streets.json")->required();
+  g->add_option("--max-lod", gml->max_lod, "Use the highest LoD not above this (default: the highest)")
+      ->check(CLI::Range(0.0, 4.0));
+  g->add_flag("--no-ground", gml->no_ground, "Leave out roads, land use, vegetation, water and relief");
+  g->add_flag("--no-other", gml->no_other, "Leave out bridges, tunnels, furniture and generic objects");
+  g->add_option("--theme", gml->theme, "Appearance theme of textures and materials (default: the first)");
+  g->add_option("--objects", gml->objects, "With roads: one object per 'blocks' (default) or per 'buildings'");
+  g->callback([gml] { runCityGml(*gml); });
 });
 
 }  // namespace

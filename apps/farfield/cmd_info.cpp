@@ -10,7 +10,8 @@ namespace farfield::app {
 namespace {
 
 void runInfo(const std::string& spec, bool list_objects) {
-  const scene::Scene scene = scene::loadScene(spec);
+  scene::ImportStats import_stats;
+  const scene::Scene scene = scene::loadScene(spec, {}, &import_stats);
   const scene::SceneStats s = scene.stats();
   std::printf("scene:      %s\n", spec.c_str());
   std::printf("objects:    %zu\n", s.objects);
@@ -29,6 +30,7 @@ void runInfo(const std::string& spec, bool list_objects) {
     std::printf("  %-24s %dx%d %s\n", m.name.c_str(), m.texture->width(), m.texture->height(),
                 m.texture_path.c_str());
   }
+  for (const std::string& w : import_stats.warnings()) std::printf("warning:    %s\n", w.c_str());
   if (list_objects) {
     for (const auto& o : scene.objects) {
       uint64_t tris = 0;

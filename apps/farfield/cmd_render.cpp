@@ -33,7 +33,8 @@ struct RenderArgs {
 
 void runRender(const RenderArgs& args) {
   const AllocatorSettings allocator = configureTimingAllocator();
-  scene::Scene scene = scene::loadScene(args.scene);
+  scene::ImportStats import_stats;
+  scene::Scene scene = scene::loadScene(args.scene, {}, &import_stats);
   Camera camera;
   camera.eye = parseVec3("--eye", args.eye);
   camera.at = parseVec3("--at", args.at);
@@ -73,6 +74,7 @@ void runRender(const RenderArgs& args) {
   std::printf("wall ms:    %.3f\n", stats.wall_ms);
   std::printf("gpu ms:     %.3f\n", stats.gpu_ms);
   std::printf("malloc:     %s\n", allocator.description.c_str());
+  for (const std::string& w : import_stats.warnings()) std::printf("warning:    %s\n", w.c_str());
 }
 
 const RegisterCommand reg("render", [](CLI::App& app) {
