@@ -252,6 +252,17 @@ TEST(ImpostorStoreTest, DamagedIndexGivesErrorsNamingTheFile) {
   j = good;
   j["cells"][0]["camera"]["at"] = j["cells"][0]["camera"]["eye"];
   expect_index_error(j, "coincide");
+  // Values beyond the types they are stored in: an int conversion made 2^32 + width the same width, and an object
+  // count beyond 32 bits let ids wrap.
+  j = good;
+  j["cells"][0]["camera"]["width"] = (uint64_t(1) << 32) + j["cells"][0]["camera"]["width"].get<uint64_t>();
+  expect_index_error(j, "cells[0]: camera: \"width\": 4294967");
+  j = good;
+  j["cells"][0]["camera"]["height"] = uint64_t(1) << 63;
+  expect_index_error(j, "is out of range");
+  j = good;
+  j["scene_objects"] = (uint64_t(1) << 32) + 12;
+  expect_index_error(j, "\"scene_objects\": must be at most 4294967295");
   writeBytes(file, good.dump().substr(0, 100));
   expectError([&] { readIndex(s.dir); }, file, "not valid JSON");
   // The same content with another layout, and a changed value without a new checksum.

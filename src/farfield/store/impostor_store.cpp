@@ -421,6 +421,8 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
   index.streets_check = readCheck(r, j, "streets", "top level", index.streets, require_checks);
   if (j.contains("scene") && j["scene"].is_string()) index.scene = j["scene"].get<std::string>();
   index.scene_objects = size_t(r.count(j, "scene_objects", "top level"));
+  // Object ids are 32-bit: a larger count would let an id wrap when it is stored.
+  if (index.scene_objects > 0xffffffffu) r.fail("\"scene_objects\"", "must be at most 4294967295");
   index.local_model = r.text(j, "local_model", "top level");
   if (j.contains("cell_lookup")) index.cell_lookup = r.text(j, "cell_lookup", "top level");
   if (j.contains("options")) index.options = j["options"];

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 
 namespace fs = std::filesystem;
@@ -117,8 +118,9 @@ Camera JsonReader::camera(const nlohmann::json& j, const std::string& where) con
   cam.at = vec3(c, "at", at);
   cam.up = vec3(c, "up", at);
   cam.fov_y = float(number(c, "fov_y", at));
-  cam.width = int(count(c, "width", at));
-  cam.height = int(count(c, "height", at));
+  // An int conversion would wrap 2^32 + 512 to 512 and pass the camera's checks.
+  cam.width = checkedCast<int>(count(c, "width", at), source_, at + ": \"width\"");
+  cam.height = checkedCast<int>(count(c, "height", at), source_, at + ": \"height\"");
   cam.near_plane = float(number(c, "near", at));
   cam.far_plane = float(number(c, "far", at));
   try {
@@ -132,9 +134,11 @@ Camera JsonReader::camera(const nlohmann::json& j, const std::string& where) con
 void JsonReader::onlyKeys(const nlohmann::json& j, std::initializer_list<const char*> allowed,
                           const std::string& where) const {
   if (!j.is_object()) fail(where, "expected an object");
-  for (const auto& [key, value] : j.items())
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& key = it.key();  // a name, not a structured binding: clang 14 (the fuzz build) cannot capture one
     if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }))
       fail(where, "unknown member \"" + key + "\"");
+  }
 }
 
 void putCheck(nlohmann::json& j, const std::string& key, const std::string& file, const FileCheck& check,
