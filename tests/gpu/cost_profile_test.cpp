@@ -75,6 +75,19 @@ TEST(CostProfileTest, StrictReadNamesTheKey) {
   j = good;
   j["width"] = "wide";
   expectError(j, "width");
+  // Numbers beyond the fields' integer types (converting them was undefined behaviour), and fractions of a pixel.
+  j = good;
+  j["width"] = 1e300;
+  expectError(j, "\"width\": 1.0000000000000001e+300 is out of range");
+  j = good;
+  j["height"] = 4294967296.0;
+  expectError(j, "\"height\"");
+  j = good;
+  j["height"] = 360.5;
+  expectError(j, "\"height\": 360.5 is not a whole number");
+  j = good;
+  j["model"]["samples"] = 1e300;
+  expectError(j, "model: \"samples\"");
   EXPECT_THROW(loadCostProfile((test::scratchDir("cost_profile_missing") / "none.json").string()), Error);
   const std::string garbage = (test::scratchDir("cost_profile_garbage") / "bad.json").string();
   std::ofstream(garbage) << "{not json";

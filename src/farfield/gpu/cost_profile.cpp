@@ -5,6 +5,7 @@
 #include <fstream>
 #include <set>
 
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 
 namespace farfield::gpu {
@@ -53,12 +54,13 @@ CostProfile CostProfile::fromJson(const nlohmann::json& j, const std::string& so
   p.model.ms_per_mtriangle = number(m, "ms_per_mtriangle", ms, 0.0);
   p.model.ms_per_draw = number(m, "ms_per_draw", ms, 0.0);
   p.model.ms_per_mpixel = number(m, "ms_per_mpixel", ms, 0.0);
-  p.model.samples = size_t(number(m, "samples", ms, 0.0));
+  p.model.samples = wholeNumber<size_t>(number(m, "samples", ms, 0.0), ms, "\"samples\"");
   p.model.rms_error_ms = number(m, "rms_error_ms", ms, 0.0);
   p.model.r2 = number(m, "r2", ms, -1e300);
   p.safety_factor = number(j, "safety_factor", source, 1.0);
-  p.width = int(number(j, "width", source, 1.0));
-  p.height = int(number(j, "height", source, 1.0));
+  // The frame size: whole pixels of an int (a conversion of 1e300 to int is undefined behaviour).
+  p.width = wholeNumber<int>(number(j, "width", source, 1.0), source, "\"width\"");
+  p.height = wholeNumber<int>(number(j, "height", source, 1.0), source, "\"height\"");
   p.fov_y_deg = number(j, "fov_y_deg", source, 1e-3);
   if (!j.at("renderer").is_string()) throw Error(source, "\"renderer\" must be a string");
   p.renderer = j.at("renderer").get<std::string>();
