@@ -196,6 +196,9 @@ TEST(TerrainBench, BadOptionsNameTheOption) {
       {"--high-error/--low-error", [](TerrainBenchOptions& o) { o.high_error = 0.0f; }},
       {"--quality-stride", [](TerrainBenchOptions& o) { o.quality_stride = 0; }},
       {"--frames", [](TerrainBenchOptions& o) { o.frames = 1; }},
+      // Counts the flythrough's int cannot hold (it used to be an int conversion, then an allocation failure).
+      {"--frames", [](TerrainBenchOptions& o) { o.frames = size_t(5) << 30; }},
+      {"--sweep-frames", [](TerrainBenchOptions& o) { o.sweep_frames = {75, size_t(1) << 40}; }},
       {"--modes", [](TerrainBenchOptions& o) { o.modes = {"high", "low"}; }},
       {"mode 'no-such-mode'", [](TerrainBenchOptions& o) { o.modes.push_back("no-such-mode"); }},
       {"--sweep-epsilons", [](TerrainBenchOptions& o) { o.sweep_epsilons = {1.0, -2.0}; }},

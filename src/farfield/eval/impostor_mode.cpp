@@ -41,8 +41,7 @@ ImpostorMode::ImpostorMode(std::string technique, const ModeContext& context) : 
     throw Error("mode '" + technique_ + "'", "needs an impostor store: farfield bench --impostors DIR (or "
                                              "--mode-option impostor_dir=DIR), baked with farfield bake --technique " +
                                                  technique_);
-  o.gpu_budget_bytes =
-      uint64_t(numberOption(context, "gpu_budget_mb", double(o.gpu_budget_bytes >> 20), 1.0) * 1048576.0);
+  o.gpu_budget_bytes = mebibytesOption(context, "gpu_budget_mb", o.gpu_budget_bytes);
   o.read_ahead = switchOption(context, "read_ahead", true);
   o.object_ids = choiceOption(context, "impostor_ids", "object", {"object", "layer"}) == "object";
   o.cell_lookup = context.option("cell_lookup");

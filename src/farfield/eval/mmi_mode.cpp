@@ -35,7 +35,7 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
     throw Error(std::string("mode '") + runtime::representationName(representation) + "'",
                 "needs a pipeline store: farfield bench --impostors DIR (or --mode-option impostor_dir=DIR), baked "
                 "with farfield bake --pipeline pvs,near-far,single,mmi (placed: farfield place)");
-  o.gpu_budget_bytes = uint64_t(numberOption(context, "gpu_budget_mb", double(o.gpu_budget_bytes >> 20), 1.0) * 1048576.0);
+  o.gpu_budget_bytes = mebibytesOption(context, "gpu_budget_mb", o.gpu_budget_bytes);
   o.read_ahead = switchOption(context, "read_ahead", true);
   o.object_ids = choiceOption(context, "impostor_ids", "object", {"object", "layer"}) == "object";
   o.dynamic.object_ids = o.object_ids;
@@ -43,8 +43,8 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
   if (!o.cell_lookup.empty()) urban::parseCellLookup(o.cell_lookup, "--mode-option cell_lookup");
   o.frame_budget_ms = numberOption(context, "frame_budget_ms", o.frame_budget_ms, 0.0);
   o.dynamic_error_px = numberOption(context, "dynamic_error_px", o.dynamic_error_px, 0.0);
-  o.dynamic.resolution = int(countOption(context, "dynamic_resolution", 0, 0));
-  o.dynamic.grid_px = int(countOption(context, "dynamic_grid_px", size_t(o.dynamic.grid_px), 1));
+  o.dynamic.resolution = intOption(context, "dynamic_resolution", 0, 0, 16384);  // DynamicImpostor's range
+  o.dynamic.grid_px = intOption(context, "dynamic_grid_px", o.dynamic.grid_px, 1, 16384);
   o.max_updates = countOption(context, "dynamic_max_updates", o.max_updates);
   o.min_lifetime_frames = numberOption(context, "dynamic_min_lifetime", o.min_lifetime_frames, 0.0);
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);

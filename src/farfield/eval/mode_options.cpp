@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "farfield/core/check.h"
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 
 namespace farfield::eval {
@@ -51,17 +53,35 @@ double positiveOption(const ModeContext& context, const std::string& key, double
   }
 }
 
-size_t countOption(const ModeContext& context, const std::string& key, size_t fallback, size_t lo) {
+size_t countOption(const ModeContext& context, const std::string& key, size_t fallback, size_t lo, size_t hi) {
   const std::string text = context.option(key);
   if (text.empty()) return fallback;
+  const std::string expected = hi == std::numeric_limits<size_t>::max()
+                                   ? "a whole number >= " + std::to_string(lo)
+                                   : "a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
   try {
     size_t used = 0;
     const long long n = std::stoll(text, &used);
-    if (used != text.size() || n < 0 || size_t(n) < lo) throw std::invalid_argument("range");
+    if (used != text.size() || !fitsIn<size_t>(n) || size_t(n) < lo || size_t(n) > hi)
+      throw std::invalid_argument("range");
     return size_t(n);
   } catch (const std::exception&) {
-    throw bad(key, "a whole number >= " + std::to_string(lo), text);
+    throw bad(key, expected, text);
   }
+}
+
+int intOption(const ModeContext& context, const std::string& key, int fallback, int lo, int hi) {
+  FF_CHECK(0 <= lo && lo <= hi);
+  return checkedCast<int>(countOption(context, key, size_t(fallback), size_t(lo), size_t(hi)), "--mode-option " + key,
+                          "value");
+}
+
+uint64_t mebibytesOption(const ModeContext& context, const std::string& key, uint64_t fallback_bytes, double lo_mb,
+                         double hi_mb) {
+  if (context.option(key).empty()) return fallback_bytes;
+  // The range keeps the product within uint64_t; the checked conversion says so if a caller widens it too far.
+  return checkedCast<uint64_t>(numberOption(context, key, 0.0, lo_mb, hi_mb) * 1048576.0, "--mode-option " + key,
+                               "bytes");
 }
 
 std::string choiceOption(const ModeContext& context, const std::string& key, const std::string& fallback,

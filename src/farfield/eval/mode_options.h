@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <initializer_list>
 #include <limits>
 #include <string>
@@ -18,8 +19,15 @@ double numberOption(const ModeContext& context, const std::string& key, double f
                     double hi = std::numeric_limits<double>::max());
 // A finite number > 0; `fallback` when absent.
 double positiveOption(const ModeContext& context, const std::string& key, double fallback);
-// A whole number >= lo; `fallback` when absent.
-size_t countOption(const ModeContext& context, const std::string& key, size_t fallback, size_t lo = 1);
+// A whole number in [lo, hi]; `fallback` when absent.
+size_t countOption(const ModeContext& context, const std::string& key, size_t fallback, size_t lo = 1,
+                   size_t hi = std::numeric_limits<size_t>::max());
+// countOption for an int option: a whole number in [lo, hi] (0 <= lo <= hi); `fallback` when absent.
+int intOption(const ModeContext& context, const std::string& key, int fallback, int lo, int hi);
+// A memory size given in MiB (a finite number in [lo_mb, hi_mb], fractions allowed), in bytes; `fallback_bytes` when
+// absent. The default range ends at 16 TiB.
+uint64_t mebibytesOption(const ModeContext& context, const std::string& key, uint64_t fallback_bytes,
+                         double lo_mb = 1.0, double hi_mb = 16777216.0);
 // One of `choices`; `fallback` when absent.
 std::string choiceOption(const ModeContext& context, const std::string& key, const std::string& fallback,
                          std::initializer_list<const char*> choices);

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "farfield/core/check.h"
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
 #include "farfield/core/progress.h"
@@ -116,6 +117,10 @@ void checkOptions(const TerrainBenchOptions& o) {
     throw Error("--high-error/--low-error", "need 0 < high <= low (pixels)");
   if (o.quality_stride < 1) throw Error("--quality-stride", "must be at least 1");
   if (o.path.empty() && o.frames < 2) throw Error("--frames", "need at least 2 frames");
+  // Frame counts become the flythrough's int (checked here, before anything has run).
+  capSize<size_t>(o.frames, size_t(terrain::kMaxFlythroughFrames), "--frames", "frame count");
+  for (size_t n : o.sweep_frames)
+    capSize<size_t>(n, size_t(terrain::kMaxFlythroughFrames), "--sweep-frames", "frame count");
   for (const char* m : {"high", "low", "lod-sprite"})
     if (std::find(o.modes.begin(), o.modes.end(), m) == o.modes.end())
       throw Error("--modes", std::string("must include ") + m + " (the figures compare high, low and lod-sprite)");
@@ -150,7 +155,7 @@ struct Experiment {
 // The camera path (given, or Figure 8's kind of flythrough over this terrain) and Figure 8.
 void makePath(Experiment& x) {
   const TerrainBenchOptions& o = x.options;
-  x.fly.frames = int(o.frames);
+  x.fly.frames = checkedCast<int>(o.frames, "--frames", "frame count");
   x.generated = o.path.empty();
   if (x.generated) {
     terrain::FlythroughLandmarks landmarks;
@@ -379,7 +384,7 @@ void runSweeps(Experiment& x) {
     gen::CameraPath p;
     if (x.generated) {
       terrain::FlythroughOptions fly = x.fly;
-      fly.frames = int(n);
+      fly.frames = checkedCast<int>(n, "--sweep-frames", "frame count");
       p = flythroughCameraPath(data.hf, fly);
     } else {
       p = resampleCameraPath(x.path, n);

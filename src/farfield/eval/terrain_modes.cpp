@@ -5,6 +5,7 @@
 #include <exception>
 #include <stdexcept>
 
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 #include "farfield/eval/mode_options.h"
 
@@ -17,8 +18,10 @@ std::shared_ptr<TerrainRun> runFor(const ModeContext& context, const std::string
   if (!run) {
     auto loaded = std::make_shared<TerrainRun>();
     loaded->data = terrain::TerrainData::load(context.requireOption("terrain", mode));
-    loaded->high_error = float(positiveOption(context, "high_error", loaded->high_error));
-    loaded->low_error = float(positiveOption(context, "low_error", loaded->low_error));
+    loaded->high_error =
+        checkedCast<float>(positiveOption(context, "high_error", loaded->high_error), "--mode-option high_error", "value");
+    loaded->low_error =
+        checkedCast<float>(positiveOption(context, "low_error", loaded->low_error), "--mode-option low_error", "value");
     loaded->epsilon = positiveOption(context, "epsilon", loaded->epsilon);
     if (context.renderer) loaded->sky = context.renderer->light().sky_color;
     run = std::move(loaded);
