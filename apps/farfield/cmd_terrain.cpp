@@ -18,6 +18,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "farfield/core/allocator.h"
+#include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 #include "farfield/eval/terrain_bench.h"
 #include "farfield/eval/terrain_modes.h"
@@ -66,7 +67,8 @@ void runBench(BenchText& a) {
     if (!item.empty()) a.o.modes.push_back(item);
   a.o.sweep_epsilons = parseList("--sweep-epsilons", a.sweep_epsilons);
   a.o.sweep_frames.clear();
-  for (double v : parseList("--sweep-frames", a.sweep_frames)) a.o.sweep_frames.push_back(size_t(v));
+  for (double v : parseList("--sweep-frames", a.sweep_frames))
+    a.o.sweep_frames.push_back(wholeNumber<size_t>(v, "--sweep-frames", "frame count"));
   a.o.sweeps = !a.no_sweeps;
   a.o.plots = !a.no_plots;
   const eval::TerrainBenchResult result = eval::runTerrainBench(a.o);

@@ -50,3 +50,10 @@ expect_error("Bake twice" bake builtin:cubes --technique both -o ${WORK}/imp)
 expect_error("--technique" bake builtin:cubes --technique depth-mesh --pipeline near-far,single -o ${WORK}/imp)
 expect_error("--layer-mesh" bake builtin:cubes --technique grid-mesh --layer-mesh depth-mesh -o ${WORK}/imp)
 expect_error("--station-spacing" bake builtin:cubes --technique depth-mesh --station-spacing 5 -o ${WORK}/imp)
+
+# Numbers beyond the types the options are read into: errors naming the option, not conversions.
+expect_error("--sweep-frames: frame count: 1.0000000000000001e+300 is out of range" terrain bench fractal:33
+             --sweep-frames 75,1e300 -o ${WORK}/terrain)
+expect_error("--sweep-frames: frame count: 75.5 is not a whole number" terrain bench fractal:33 --sweep-frames 75.5
+             -o ${WORK}/terrain)
+expect_error("fractal:99999999999: SIZE" terrain info fractal:99999999999)
