@@ -35,5 +35,8 @@ if(FF_SYSTEM_TARGETS_MISSING)
   message(FATAL_ERROR "not found: ${FF_SYSTEM_TARGETS_MISSING} (run scripts/install-deps.sh)")
 endif()
 
+# meshoptimizer: simplification of the 3D Tiles export's heightfield impostors (store/export_tiles.h).
+find_package(meshoptimizer REQUIRED)
+
 # PROJ: geographic coordinates (OSM) to local metres (UTM) in the geodata module.
 pkg_check_modules(PROJ REQUIRED IMPORTED_TARGET proj)

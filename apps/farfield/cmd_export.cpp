@@ -52,7 +52,7 @@ void exportTileset(const scene::Scene& scene, const ExportArgs& args) {
     return impostor::captureView(renderer, gpu_scene, objects, camera);
   };
   const store::TilesetStats s = store::exportTiles(scene, capture, args.tiles, options);
-  std::printf("wrote %s/tileset.json: %zu tiles (%zu leaves of full geometry, %zu textured depth meshes), %d levels, "
+  std::printf("wrote %s/tileset.json: %zu tiles (%zu leaves of full geometry, %zu textured heightfield impostors), %d levels, "
               "%.1f MB, %d texels a side\n",
               args.tiles.c_str(), s.tiles.size(), s.leaves, s.inner, s.depth + 1, double(s.bytes) / 1e6, s.texels);
   std::printf("geometric error: root %.2f m, tileset %.2f m; frame: %s\n", s.root_error, s.tileset_error,

@@ -14,10 +14,12 @@
 
 #include "farfield/core/error.h"
 #include "farfield/core/progress.h"
-#include "farfield/impostor/depth_mesh.h"
+#include "farfield/impostor/contour.h"
+#include "farfield/impostor/impostor_mesh.h"
 #include "farfield/scene/export_gltf.h"
 #include "farfield/store/export_tiles_check.h"
 #include "farfield/store/export_tiles_deviation.h"
+#include "farfield/store/export_tiles_heightfield.h"
 
 namespace farfield::store {
 
@@ -52,7 +54,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-constexpr float kCaptureFovDeg = 10.0f;
+constexpr float kCaptureFovDeg = 10.0f;  // the widest top-down capture
 
 struct Node {
   Box2 square;
@@ -181,15 +183,20 @@ class TilesWriter {
   }
 
  private:
-  // A textured depth mesh of the node's objects seen from straight above (near-orthographic: 10 degrees).
+  // A textured heightfield mesh of the node's objects seen from straight above (export_tiles_heightfield.h).
   void writeInner(const Node& node, scene::GltfBuilder& builder, TileStats& tile, Box3& bounds) {
     Box3 objects;
     for (uint32_t id : node.objects) objects.expand(scene_.object(id).world_bounds);
     const int texels = stats_.texels;
-    const float half_fov = float(degToRad(kCaptureFovDeg)) * 0.5f;
     const Vec3 extent = objects.extent();
     // Two texels of margin around the objects' square.
     const float half_side = 0.5f * std::max({extent.x, extent.y, 1e-3f}) * (1.0f + 4.0f / float(texels));
+    // Near-orthographic: from so far that the top of the tallest object and the ground below it are seen at most
+    // half a texel apart across the image (perspective would show the ground beside a tall wall shifted by its
+    // height times the pixel offset over the distance, and the mesh would slant there); at most 10 degrees.
+    const float height = std::max(extent.z, 1.0f);
+    const float half_fov =
+        std::atan(std::min(std::tan(float(degToRad(kCaptureFovDeg)) * 0.5f), 0.5f * half_side / (height * float(texels))));
     const float distance = half_side / std::tan(half_fov);  // the roofs' plane fills the image
     Camera cam;
     const Vec3 c = objects.center();
@@ -201,18 +208,22 @@ class TilesWriter {
     cam.near_plane = 0.5f * distance;
     cam.far_plane = distance + extent.z + 1.0f;
     const impostor::ImpostorCapture shot = capture_(cam, node.objects);
-    impostor::DepthMeshOptions mesh_options;
-    // Depth steps of more than a texel (walls) are constraint lines; the camera's depth range is small next to its
-    // distance, so the default relative threshold would see none.
     tile.texel_m = 2.0 * double(distance + extent.z) * std::tan(double(half_fov)) / double(texels);
-    mesh_options.discrepancy.metric = impostor::DiscrepancyMetric::Absolute;
-    mesh_options.discrepancy.threshold = float(tile.texel_m);
-    mesh_options.grid_spacing_px = 16.0;
-    // glTF viewers interpolate uvs (no projective texturing): bound the texture warp to a texel.
-    mesh_options.max_texture_warp_px = 1.0;
-    const impostor::DepthMeshImpostor imp = impostor::buildDepthMesh(shot, mesh_options);
-    if (imp.empty() || !imp.texture) return;  // nothing seen: an inner tile without content
-    const Deviation dev = measureDeviation(imp.mesh, shot);
+    impostor::DepthMeshImpostor imp;
+    const scene::Mesh full = heightfieldMesh(shot);
+    if (full.indices.empty()) return;  // nothing seen: an inner tile without content
+    // meshoptimizer's error is an estimate: simplify under N s / 2, and again under tighter bounds while the measured
+    // deviation exceeds the bound's texel term N s (keeping the last, most faithful mesh).
+    const double target = options_.bound.pixels * tile.texel_m;
+    Deviation dev;
+    for (const double factor : {0.5, 0.1, 0.02}) {
+      imp.mesh = full;
+      simplifyMesh(imp.mesh, factor * target);
+      dev = measureDeviation(imp.mesh, shot);
+      if (dev.metres <= target) break;
+    }
+    // Alpha 0 off the data (sky, seen from below), as every impostor texture.
+    imp.texture = impostor::impostorTexture(shot.color, impostor::dataMask(shot.color, shot.depth));
     tile.deviation_m = dev.metres;
     tile.texel_m = std::max(tile.texel_m, dev.texel);
     tile.triangles = imp.mesh.triangleCount();
@@ -225,12 +236,13 @@ class TilesWriter {
     const int mesh = builder.addMesh(imp.mesh, m, {true, 0.5f, true}, m.name);
     builder.addNode(m.name, mesh, -1, scene::worldToGltf(),
                     json{{"farfield_tile",
-                          {{"kind", "textured depth mesh captured from above"},
+                          {{"kind", "textured heightfield mesh captured from above, simplified"},
                            {"objects", node.objects.size()},
                            {"deviation_m", dev.metres},
                            {"texel_m", tile.texel_m},
                            {"creation_camera",
-                            {{"eye", {cam.eye.x, cam.eye.y, cam.eye.z}}, {"fov_y_deg", kCaptureFovDeg}, {"texels", texels}}}}}});
+                            {{"eye", {cam.eye.x, cam.eye.y, cam.eye.z}}, {"fov_y_deg", radToDeg(double(cam.fov_y))},
+                             {"texels", texels}}}}}});
     bounds.expand(imp.mesh.bounds);
   }
 
@@ -306,7 +318,7 @@ TilesetStats exportTiles(const scene::Scene& scene, const CaptureFn& capture, co
                              {"height", options.bound.height}, {"fov_y_deg", radToDeg(options.bound.fov_y)}}},
             {"maximumScreenSpaceError", stats.max_sse},
             {"texels", stats.texels},
-            {"inner_tiles", "textured depth mesh captured from above"},
+            {"inner_tiles", "textured heightfield mesh captured from above, simplified"},
             {"geometric_error", "leaf 0; inner max(measured deviation, pixels * texel size, children's)"},
             {"frame", options.georeference ? "east-north-up at the georeference's origin" : "local, metres, Z up"}}}}}}},
       {"geometricError", stats.tileset_error},

@@ -157,6 +157,7 @@ Deviation measureDeviation(const scene::Mesh& mesh, const impostor::ImpostorCapt
       const double d = grid.nearest(p, [&](uint32_t tri) {
         return double(glm::distance(p, closestOnTriangle(p, corner(tri, 0), corner(tri, 1), corner(tri, 2))));
       });
+      if (d > out.surface_to_mesh) out.worst_surface = p;
       out.surface_to_mesh = std::max(out.surface_to_mesh, d);
     }
   }
@@ -174,6 +175,7 @@ Deviation measureDeviation(const scene::Mesh& mesh, const impostor::ImpostorCapt
           const Vec3 p = a + (b - a) * (float(i) / float(n)) + (c - a) * (float(j) / float(n));
           const double d =
               grid.nearest(p, [&](uint32_t k) { return double(glm::distance(p, surface[k])); });
+          if (d > out.mesh_to_surface) out.worst_mesh = p;
           out.mesh_to_surface = std::max(out.mesh_to_surface, d);
           ++out.mesh_samples;
         }

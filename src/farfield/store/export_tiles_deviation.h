@@ -22,6 +22,8 @@ struct Deviation {
   double surface_to_mesh = 0.0;    // the one-sided maxima, without the slack
   double mesh_to_surface = 0.0;
   double texel = 0.0;              // s
+  Vec3 worst_surface{0.0f};        // the surface sample farthest from the mesh
+  Vec3 worst_mesh{0.0f};           // the mesh point farthest from the surface
   size_t surface_samples = 0, mesh_samples = 0;
 };
 
