@@ -295,7 +295,7 @@ TEST(ExportTilesGl, SmallCityTilesetIsValidAndItsErrorsHold) {
     }
   EXPECT_EQ(names.size(), with_triangles);
 
-  // Inner tiles: the error covers the bound's texel term, and the depth mesh read back lies within its error of the
+  // Inner tiles: the error covers the bound's texel term, and the mesh read back lies within its error of the
   // city's triangles (mesh vertices -> geometry), and the city's roofs (faces turned up, seen from above) within it
   // of the mesh: brute force over every triangle, independent of measureDeviation's grids.
   const std::vector<uint32_t> all_ids = [&] {
