@@ -213,13 +213,17 @@ class TilesWriter {
     const scene::Mesh full = heightfieldMesh(shot);
     if (full.indices.empty()) return;  // nothing seen: an inner tile without content
     // meshoptimizer's error is an estimate: simplify under N s / 2, and again under tighter bounds while the measured
-    // deviation exceeds the bound's texel term N s (keeping the last, most faithful mesh).
+    // deviation exceeds the bound's texel term N s and tightening still lowers it by a tenth (a deviation the full
+    // heightfield has too, a spire thinner than a texel, is not worth the triangles).
     const double target = options_.bound.pixels * tile.texel_m;
     Deviation dev;
     for (const double factor : {0.5, 0.1, 0.02}) {
-      imp.mesh = full;
-      simplifyMesh(imp.mesh, factor * target);
-      dev = measureDeviation(imp.mesh, shot);
+      scene::Mesh mesh = full;
+      simplifyMesh(mesh, factor * target);
+      const Deviation d = measureDeviation(mesh, shot);
+      if (!imp.mesh.indices.empty() && d.metres > 0.9 * dev.metres) break;  // keep the simpler one
+      imp.mesh = std::move(mesh);
+      dev = d;
       if (dev.metres <= target) break;
     }
     // Alpha 0 off the data (sky, seen from below), as every impostor texture.

@@ -25,8 +25,8 @@
 // where delta is the measured two-sided distance between the tile's mesh and the city's surface seen from above at
 // the capture's resolution (its roofs and ground, and the walls at its depth steps: export_tiles_deviation.h), s is
 // the capture's texel size on the lowest ground of the tile, and N = bound.pixels. The mesh is simplified under
-// N s / 2, then N s / 10 and N s / 50 while delta exceeds N s (meshoptimizer's error is an estimate; delta is what
-// is written). A viewer refining by screen-space error shows a tile only from distances d >= g / theta (theta = bound.angle(), the angle of N pixels at the bound's
+// N s / 2, then N s / 10 and N s / 50 while delta exceeds N s and each tightening lowers it by a tenth
+// (meshoptimizer's error is an estimate; delta is what is written). A viewer refining by screen-space error shows a tile only from distances d >= g / theta (theta = bound.angle(), the angle of N pixels at the bound's
 // smallest pixel), where its geometric deviation spans at most N pixels and each of its texels at most one pixel.
 // Children never exceed their parent (the max above), as the specification requires. tileset.geometricError (nothing
 // drawn) is the root box's diagonal. CesiumJS and Cesium for Unreal compare g * f / d with maximumScreenSpaceError,
