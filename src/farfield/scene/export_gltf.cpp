@@ -325,11 +325,20 @@ void GltfBuilder::addObjects(const Scene& scene, std::span<const uint32_t> ids) 
 
 int GltfBuilder::addMesh(const Mesh& mesh, const Material& material, const GltfMaterialOptions& options,
                          const std::string& name) {
-  const Impl::Primitive acc = impl_->writeMesh(mesh, !material.unlit, name);
-  if (acc.position < 0) return -1;
+  return addMesh(std::vector<MeshPart>{{&mesh, material, options}}, name);
+}
+
+int GltfBuilder::addMesh(const std::vector<MeshPart>& parts, const std::string& name) {
   tinygltf::Mesh gm;
   gm.name = name;
-  gm.primitives.push_back(impl_->primitive(acc, impl_->writeMaterial(material, acc.uv >= 0, options)));
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const MeshPart& part = parts[i];
+    const Impl::Primitive acc =
+        impl_->writeMesh(*part.mesh, !part.material.unlit, name + " part " + std::to_string(i));
+    if (acc.position < 0) continue;
+    gm.primitives.push_back(impl_->primitive(acc, impl_->writeMaterial(part.material, acc.uv >= 0, part.options)));
+  }
+  if (gm.primitives.empty()) return -1;
   impl_->model.meshes.push_back(gm);
   return int(impl_->model.meshes.size() - 1);
 }

@@ -10,6 +10,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -56,6 +57,14 @@ class GltfBuilder {
   // own, returning its glTF mesh index for addNode, or -1 for a mesh without triangles. The mesh must pass
   // Mesh::validate. A material texture is written once per image whatever the number of meshes using it.
   int addMesh(const Mesh& mesh, const Material& material, const GltfMaterialOptions& options, const std::string& name);
+  // The same with one primitive per part (each with its own material), in one glTF mesh; parts without triangles are
+  // left out, -1 when none is left.
+  struct MeshPart {
+    const Mesh* mesh = nullptr;
+    Material material;
+    GltfMaterialOptions options;
+  };
+  int addMesh(const std::vector<MeshPart>& parts, const std::string& name);
 
   // A node (mesh -1: a group) under `parent` (-1: a root of the scene), with `matrix` (identity: none written) and
   // `extras` (a JSON object, or null for none). Returns its index, for children.

@@ -127,46 +127,53 @@ class PipelineExport {
 };
 
 // One quad per layer, as GpuLayeredImpostor draws it (layered.cpp) but with each layer's own image: uv (0, 0) at the
-// image's top-left texel, the capture's -right, +up corner; counter-clockwise seen from the viewers.
-std::vector<int> layeredMeshes(scene::GltfBuilder& builder, const impostor::LayeredImpostor& imp,
-                               const std::string& name) {
+// image's top-left texel, the capture's -right, +up corner; counter-clockwise seen from the viewers. One glTF mesh with
+// a primitive per layer (far to near), so a CPV drawing the impostor needs one node.
+int layeredMesh(scene::GltfBuilder& builder, const impostor::LayeredImpostor& imp, const std::string& name) {
   const impostor::LayeredPlan& plan = imp.plan;
-  std::vector<int> meshes;
+  std::vector<scene::Mesh> quads(plan.layers.size());
+  std::vector<scene::GltfBuilder::MeshPart> parts;
   for (size_t i = 0; i < plan.layers.size(); ++i) {
     const impostor::LayerPlan& lp = plan.layers[i];
     const Vec3 centre =
         plan.shaft.apex + lp.depth * plan.shaft.axis + lp.offset_u * plan.right + lp.offset_v * plan.up;
     const Vec3 du = lp.half_u * plan.right, dv = lp.half_v * plan.up;
-    scene::Mesh quad;
+    scene::Mesh& quad = quads[i];
     quad.positions = {centre - du + dv, centre + du + dv, centre + du - dv, centre - du - dv};
     quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     quad.indices = {3, 2, 1, 3, 1, 0};
     quad.computeBounds();
     auto texture = std::make_shared<const image::ColorImage>(imp.layers[i].color);
-    const std::string layer_name = name + " layer " + std::to_string(i);
-    meshes.push_back(builder.addMesh(quad, impostorMaterial(layer_name, texture), kImpostorMaterial, layer_name));
+    parts.push_back({&quad, impostorMaterial(name + " layer " + std::to_string(i), texture), kImpostorMaterial});
   }
-  return meshes;
+  return builder.addMesh(parts, name);
 }
 
 void exportPlacement(scene::GltfBuilder& builder, const std::string& dir, int root, const PlacementIndex& index,
                      ImpostorExportStats& stats) {
-  // Each impostor's layer meshes are written once; the nodes of every CPV drawing it share them.
-  std::map<uint32_t, std::vector<int>> layer_meshes;
+  // Each impostor's mesh is written once; the nodes of every CPV drawing it share it.
+  std::map<uint32_t, int> meshes;
   {
     Progress progress("export impostors", index.impostors.size());
     for (const StoredPlacedImpostor& rec : index.impostors) {
       const impostor::LayeredImpostor imp = loadPlacedImpostor(dir, rec);
-      layer_meshes[rec.id] = layeredMeshes(builder, imp, "impostor " + std::to_string(rec.id));
+      meshes[rec.id] = layeredMesh(builder, imp, "impostor " + std::to_string(rec.id));
       ++stats.impostors;
-      stats.meshes += imp.plan.layers.size();
+      ++stats.meshes;
       stats.layers += imp.plan.layers.size();
       stats.triangles += 2 * imp.plan.layers.size();
       progress.advance();
     }
   }
   std::map<uint32_t, size_t> drawn;
+  // The first node of an impostor describes it; the others (the same impostor drawn in other CPVs) name it.
   auto addImpostorNode = [&](int group, const StoredPlacedImpostor& rec) {
+    const std::string name = "impostor " + std::to_string(rec.id);
+    if (drawn.count(rec.id)) {
+      builder.addNode(name, meshes.at(rec.id), group, Mat4(1.0f),
+                      tagged({{"kind", "layered impostor"}, {"impostor", rec.id}}));
+      return;
+    }
     const impostor::LayeredPlan plan = impostor::planLayered(rec.box, rec.shaft, rec.bound, rec.options);
     json extras = {{"kind", "layered impostor"},
                    {"impostor", rec.id},
@@ -179,15 +186,14 @@ void exportPlacement(scene::GltfBuilder& builder, const std::string& dir, int ro
                               {"axis", vec3Json(rec.shaft.axis)},
                               {"apex_angle_rad", rec.shaft.apex_angle},
                               {"min_distance", rec.shaft.min_distance}}}};
-    const std::string name = "impostor " + std::to_string(rec.id);
-    const int node = builder.addNode(name, -1, group, Mat4(1.0f), tagged(extras));
-    for (size_t l = 0; l < rec.layers.size(); ++l)
-      builder.addNode(name + " layer " + std::to_string(l), layer_meshes.at(rec.id).at(l), node, Mat4(1.0f),
-                      tagged({{"kind", "layered impostor layer"}, {"impostor", rec.id}, {"layer", l},
-                              {"data_texels", rec.layers[l].data_texels}}));
+    json layers = json::array();
+    for (const StoredImpostorLayer& l : rec.layers) layers.push_back(l.data_texels);
+    extras["layer_data_texels"] = std::move(layers);
+    builder.addNode(name, meshes.at(rec.id), group, Mat4(1.0f), tagged(extras));
   };
   for (size_t k = 0; k < index.cpvs.size(); ++k) {
     const StoredCpv& cpv = index.cpvs[k];
+    if (cpv.impostors.empty()) continue;  // geometry only there: nothing to show
     json region = {{"kind", "conservative problem view"},
                    {"cpv", k},
                    {"region", box3Json(cpv.region)},

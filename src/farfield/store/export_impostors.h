@@ -8,9 +8,10 @@
 //     impostor's views and each MMI layer's views, and in stores of the Sillion layout each technique's mesh, as
 //     textured triangle meshes (the textured depth or grid mesh: world-space triangles, the captured colour as
 //     texture);
-//   - a placement database (`farfield place`, DIR/placement.json): per conservative problem view ("cpv K") one node
-//     per layered impostor drawn there, a mesh of one alpha-tested textured quad per layer (far to near). An impostor
-//     drawn in several CPVs is one glTF mesh shared by their nodes (its texels are written once).
+//   - a placement database (`farfield place`, DIR/placement.json): per conservative problem view ("cpv K") that draws
+//     impostors, one node per layered impostor drawn there, a mesh of one alpha-tested textured quad per layer (far to
+//     near, a primitive each). An impostor drawn in several CPVs is one glTF mesh shared by their nodes (its texels
+//     are written once); its first node's extras describe it, the others name it.
 // Impostor materials are unlit (KHR_materials_unlit: the captures hold lit colour), double-sided, alphaMode MASK
 // with cutoff 0.5 (the renderer's alpha test: alpha 0 is background) and sample their texture clamped to its edge.
 // Every node's extras hold {"farfield_impostor": {...}}: what it is ("kind": "street cell", "textured depth mesh",
