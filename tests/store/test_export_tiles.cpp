@@ -1,6 +1,7 @@
 // The 3D Tiles export: the tileset checks refuse hand-broken tilesets, the ENU transform against the ellipsoid, the
-// deviation measure on a constructed case, and a small generated city exported with GL (llvmpipe) whose structure,
-// content and geometric errors are checked against the city's own triangles by brute force.
+// georeference through PROJ against the meridian convergence, the deviation measure on a constructed case, and a
+// small generated city exported with GL (llvmpipe) whose structure, content and geometric errors are checked against
+// the city's own triangles by brute force.
 #include "farfield/store/export_tiles.h"
 
 #include <gtest/gtest.h>
@@ -20,6 +21,7 @@
 #include "farfield/scene/builtin.h"
 #include "farfield/scene/export_gltf.h"
 #include "farfield/scene/import.h"
+#include "farfield/store/export_georef.h"
 #include "farfield/store/export_tiles_check.h"
 #include "farfield/store/export_tiles_deviation.h"
 #include "support/test_support.h"
@@ -365,6 +367,45 @@ TEST(ExportTiles, RefusesBadInput) {
   const TilesetStats one = exportTiles(scene::builtinScene("cube"), none, test::scratchDir("tiles_one").string(), options);
   EXPECT_EQ(one.tiles.size(), 1u);
   EXPECT_EQ(one.leaves, 1u);
+}
+
+TEST(GeoOrigin, UtmOriginsAndTheirGridConvergence) {
+  const fs::path dir = test::scratchDir("tiles_georef");
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream((dir / name).string()) << text;
+    return (dir / name).string();
+  };
+  EXPECT_FALSE(readGeoOrigin((dir / "none.georef.json").string()));
+  // UTM zone 32N: easting 500 km is the central meridian (9 E); northing 0 the equator.
+  const auto o = readGeoOrigin(write(
+      "a.json", R"({"format": "farfield-georef", "version": 1, "crs": "EPSG:32632", "origin": [500000, 0, 0]})"));
+  ASSERT_TRUE(o);
+  EXPECT_NEAR(o->lon_deg, 9.0, 1e-9);
+  EXPECT_NEAR(o->lat_deg, 0.0, 1e-9);
+  EXPECT_NEAR(o->grid_rotation_rad, 0.0, 1e-9);
+  // 100 km east of it at 45 N: grid north lies east of true north by about (lon - 9 deg) sin(lat) (the first term
+  // of the meridian convergence), so the scene's +y is turned clockwise: a negative rotation.
+  const auto e = readGeoOrigin(write(
+      "b.json", R"({"format": "farfield-georef", "version": 1, "crs": "EPSG:32632", "origin": [600000, 5000000, 30]})"));
+  ASSERT_TRUE(e);
+  EXPECT_GT(e->lon_deg, 10.2);
+  EXPECT_LT(e->lon_deg, 10.35);
+  EXPECT_NEAR(e->lat_deg, 45.1, 0.1);
+  const double expected = -degToRad(e->lon_deg - 9.0) * std::sin(degToRad(e->lat_deg));
+  EXPECT_NEAR(e->grid_rotation_rad, expected, 0.02 * std::abs(expected));
+  EXPECT_NEAR(e->height_m, 30.0, 1e-6);
+  // Bad files name themselves.
+  for (const std::string& bad : {std::string("{"), std::string(R"({"format": "other"})"),
+                                 std::string(R"({"format": "farfield-georef", "crs": "EPSG:32632"})"),
+                                 std::string(R"({"format": "farfield-georef", "crs": "NOT:A:CRS", "origin": [0, 0, 0]})")}) {
+    const std::string path = write("bad.json", bad);
+    try {
+      readGeoOrigin(path);
+      ADD_FAILURE() << bad;
+    } catch (const Error& err) {
+      EXPECT_NE(std::string(err.what()).find("bad.json"), std::string::npos) << err.what();
+    }
+  }
 }
 
 }  // namespace
