@@ -3,12 +3,15 @@
 JOBS        ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD       ?= build/release
 BUILD_ASAN  ?= build/asan
+BUILD_FUZZ  ?= build/fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?=
 CMAKE_FLAGS ?=
 # Real windows for the viewer's tests come from Xvfb when it is installed and no display is set. -noreset: by default
 # Xvfb resets when its last client disconnects, and a test connecting during the reset fails to open the display.
 XVFB        := $(shell if [ -z "$$DISPLAY" ] && command -v xvfb-run >/dev/null 2>&1; then echo "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset'"; fi)
 
-.PHONY: all deps configure build build-cli demo test test-asan bench clean
+.PHONY: all deps configure build build-cli demo test test-asan fuzz bench clean
 
 all: build
 
@@ -35,6 +38,15 @@ test-asan: deps
 	@cmake -S . -B $(BUILD_ASAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFF_SANITIZE=ON -DFF_BUILD_BENCH=OFF $(CMAKE_FLAGS) >/dev/null
 	@cmake --build $(BUILD_ASAN) -j $(JOBS)
 	@cd $(BUILD_ASAN) && ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp UBSAN_OPTIONS=print_stacktrace=1 $(XVFB) ctest --output-on-failure -j $(JOBS) --timeout 1800
+
+# libFuzzer targets (clang, ASan + UBSan), one per input format (docs/FUZZING.md): seeds the corpora, runs each target
+# for FUZZ_SECONDS (FUZZ_TARGETS="osm dem" for some), prints executions, exec/s, coverage and crashes; fails on a crash.
+fuzz: deps
+	@CC=clang CXX=clang++ cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFF_FUZZ=ON -DFF_BUILD_TESTS=OFF \
+	  -DFF_BUILD_BENCH=OFF $(CMAKE_FLAGS) >/dev/null
+	@cmake --build $(BUILD_FUZZ) -j $(JOBS) --target fuzz
+	@bash fuzz/seed_corpus.sh $(BUILD_FUZZ) >/dev/null
+	@bash fuzz/run_fuzzers.sh $(BUILD_FUZZ) $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
 bench: build
 	@bash scripts/bench.sh $(BUILD)/bin out/bench

@@ -15,7 +15,7 @@ function(ff_module name)
     target_link_libraries(farfield_${name} PUBLIC ${ARG_DEPS} PRIVATE $<BUILD_INTERFACE:farfield_warnings>)
     target_compile_features(farfield_${name} PUBLIC cxx_std_20)
     set_target_properties(farfield_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
-    if(FF_SANITIZE)
+    if(FF_SANITIZE OR FF_FUZZ)
       # Instrumented objects need the sanitizer runtimes wherever they are linked, installed package included.
       target_link_options(farfield_${name} INTERFACE -fsanitize=address,undefined)
     endif()

@@ -5,8 +5,8 @@
 set -euo pipefail
 
 packages=(
-  # toolchain
-  cmake g++ make pkg-config
+  # toolchain (clang and its compiler-rt: the libFuzzer targets of `make fuzz`)
+  cmake g++ make pkg-config clang libclang-rt-14-dev
   # math, GL, windowing, UI
   libglm-dev libepoxy-dev libegl-dev libgl-dev libgl1-mesa-dri libegl-mesa0 libglfw3-dev libimgui-dev xvfb xauth
   # import / export / formats

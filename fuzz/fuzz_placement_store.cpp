@@ -1,0 +1,43 @@
+// The placement database of `farfield place` (store/placement_store.h): a crafted placement.json and its layer images
+// in the container of store_container.h. The index is read with readPlacementIndex (checksum, text form, the BSP and
+// CPV rules, each impostor's plan inputs), every impostor is loaded (plan re-derived, images checked against it), and
+// the CPV lookup runs at a few points of the view space.
+#include <algorithm>
+#include <filesystem>
+
+#include "farfield/store/placement_store.h"
+#include "store_container.h"
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  farfield::fuzz::quietLogs();
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace farfield;
+  const fuzz::StoreInput in = fuzz::splitStoreInput(data, size);
+  const std::filesystem::path dir = fuzz::freshDirectory("placement");
+  std::string index_text = in.index;
+  nlohmann::json j = nlohmann::json::parse(in.index, nullptr, false);
+  if (!j.is_discarded()) {
+    const auto checks = fuzz::placeFiles(j, dir, in.files);
+    if (!(in.mode & fuzz::kRawChecks) && j.is_object()) {
+      fuzz::repairChecks(j, checks);
+      if (j.is_object()) j.erase("checksum");
+      index_text = store::placementFileText(j);
+    }
+  }
+  fuzz::writeBytes(dir / store::kPlacementIndexFile, index_text);
+  fuzz::expectFarfieldErrors([&] {
+    const store::PlacementIndex index = store::readPlacementIndex(dir.string());
+    for (size_t i = 0; i < index.impostors.size() && i < 8; ++i)
+      store::loadPlacedImpostor(dir.string(), index.impostors[i]);
+    const Box3& b = index.view_space;
+    for (int k = 0; k < 27; ++k) {
+      const Vec3 t(float(k % 3) * 0.5f, float(k / 3 % 3) * 0.5f, float(k / 9) * 0.5f);
+      const Vec3 eye = b.lo + (b.hi - b.lo) * t;
+      store::lookupCpv(index, eye, Vec3(1.0f, float(k % 5) - 2.0f, 0.25f * float(k % 3) - 0.25f));
+    }
+  });
+  return 0;
+}
