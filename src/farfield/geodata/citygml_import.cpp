@@ -461,6 +461,9 @@ class Importer {
       RoadCentreLineStats cl;
       const std::vector<StreetPolyline> lines = roadCentreLines(road_plan, &cl);
       st_.centre_line_segments = lines.size();
+      if (cl.invalid_polygons > 0) st_.skipped["road surfaces not simple (no centre lines)"] += cl.invalid_polygons;
+      if (cl.degenerate_areas > 0)
+        st_.skipped["united road areas whose borders touch (no centre lines)"] += cl.degenerate_areas;
       if (!lines.empty()) graph = planarizeStreets(lines, options_.planarize, &st_.streets, source_);
     }
     st_.streets_s = clock.seconds();

@@ -3,16 +3,20 @@
 // inexact arithmetic turns into slivers); the skeleton with the inexact kernel CGAL recommends for it.
 #include "farfield/geodata/road_centrelines.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
 
+#include <CGAL/Arr_segment_traits_2.h>
 #include <CGAL/Boolean_set_operations_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_set_2.h>
 #include <CGAL/Polygon_with_holes_2.h>
+#include <CGAL/Surface_sweep_2_algorithms.h>
 #include <CGAL/create_straight_skeleton_from_polygon_with_holes_2.h>
+#include <set>
 
 namespace farfield::geodata {
 
@@ -44,6 +48,64 @@ IPolygon toInexact(const EPolygon& p) {
   for (auto v = p.vertices_begin(); v != p.vertices_end(); ++v)
     out.push_back(Ik::Point_2(CGAL::to_double(v->x()), CGAL::to_double(v->y())));
   return out;
+}
+
+// Vertices closer than this (metres) to the line through their neighbours, or to their predecessor, are dropped
+// before the skeleton: an unclosed ring's 1.5 cm notch left CGAL's skeleton builder reading freed memory (a fuzz
+// finding), and such vertices change the centre lines by less than a road marking is wide.
+constexpr double kCleanTolerance = 0.05;
+
+double distanceToSegment(const Ik::Point_2& p, const Ik::Point_2& a, const Ik::Point_2& b) {
+  const DVec2 pa(p.x() - a.x(), p.y() - a.y()), ba(b.x() - a.x(), b.y() - a.y());
+  const double len2 = glm::dot(ba, ba);
+  const double t = len2 > 0.0 ? std::clamp(glm::dot(pa, ba) / len2, 0.0, 1.0) : 0.0;
+  return glm::length(pa - t * ba);
+}
+
+// Drops near-duplicate and near-collinear vertices until none is left; returns how many were dropped.
+size_t cleanRing(IPolygon& ring) {
+  size_t dropped = 0;
+  for (bool changed = true; changed && ring.size() >= 3;) {
+    changed = false;
+    for (size_t i = 0; i < ring.size() && ring.size() >= 3; ++i) {
+      const size_t n = ring.size();
+      const Ik::Point_2& prev = ring[(i + n - 1) % n];
+      const Ik::Point_2& next = ring[(i + 1) % n];
+      if (distanceToSegment(ring[i], prev, next) < kCleanTolerance ||
+          distanceToSegment(ring[i], prev, prev) < kCleanTolerance) {
+        ring.erase(ring.vertices_begin() + std::ptrdiff_t(i));
+        ++dropped;
+        changed = true;
+      }
+    }
+  }
+  return dropped;
+}
+
+// True when the rings' edges meet only at the shared ends of neighbouring edges: no crossing, no touching, no
+// overlap, no vertex used twice. CGAL's straight skeleton requires this of its input and does not check it.
+bool ringsAreDisjointAndSimple(const IPolygonWithHoles& p) {
+  using Traits = CGAL::Arr_segment_traits_2<Ek>;
+  std::vector<Traits::Curve_2> edges;
+  std::set<std::pair<double, double>> vertices;
+  size_t vertex_count = 0;
+  auto add = [&](const IPolygon& ring) {
+    for (auto e = ring.edges_begin(); e != ring.edges_end(); ++e)
+      edges.emplace_back(Ek::Point_2(e->source().x(), e->source().y()), Ek::Point_2(e->target().x(), e->target().y()));
+    for (auto v = ring.vertices_begin(); v != ring.vertices_end(); ++v) vertices.emplace(v->x(), v->y());
+    vertex_count += ring.size();
+  };
+  add(p.outer_boundary());
+  for (auto h = p.holes_begin(); h != p.holes_end(); ++h) add(*h);
+  return vertices.size() == vertex_count && !CGAL::do_curves_intersect(edges.begin(), edges.end());
+}
+
+// The skeleton wants the outer ring counter-clockwise and the holes clockwise; cleaning can flip a sliver.
+bool orientationsHold(const IPolygonWithHoles& p) {
+  if (p.outer_boundary().orientation() != CGAL::COUNTERCLOCKWISE) return false;
+  for (auto h = p.holes_begin(); h != p.holes_end(); ++h)
+    if (h->orientation() != CGAL::CLOCKWISE) return false;
+  return true;
 }
 
 struct Segment {
@@ -99,8 +161,18 @@ std::vector<StreetPolyline> roadCentreLines(const std::vector<std::vector<std::v
   int node_base = 0;
   for (const EPolygonWithHoles& area : areas) {
     if (area.is_unbounded()) continue;
-    IPolygonWithHoles ip(toInexact(area.outer_boundary()));
-    for (auto h = area.holes_begin(); h != area.holes_end(); ++h) ip.add_hole(toInexact(*h));
+    IPolygon outer = toInexact(area.outer_boundary());
+    st.cleaned_vertices += cleanRing(outer);
+    IPolygonWithHoles ip(outer);
+    for (auto h = area.holes_begin(); h != area.holes_end(); ++h) {
+      IPolygon hole = toInexact(*h);
+      st.cleaned_vertices += cleanRing(hole);
+      if (hole.size() >= 3) ip.add_hole(hole);
+    }
+    if (outer.size() < 3 || !ringsAreDisjointAndSimple(ip) || !orientationsHold(ip)) {
+      ++st.degenerate_areas;
+      continue;
+    }
     auto skeleton = decltype(CGAL::create_interior_straight_skeleton_2(ip, Ik()))();
     try {
       skeleton = CGAL::create_interior_straight_skeleton_2(ip, Ik());

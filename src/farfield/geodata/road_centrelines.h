@@ -18,6 +18,8 @@ struct RoadCentreLineStats {
   size_t polygons = 0;          // road polygons given
   size_t invalid_polygons = 0;  // not simple (self-intersecting) or without area: left out of the union
   size_t united = 0;            // polygons (with holes) after the union
+  size_t cleaned_vertices = 0;  // near-duplicate or near-collinear vertices (under 5 cm) dropped before the skeleton
+  size_t degenerate_areas = 0;  // united areas whose rings still touch or cross after that: left without centre lines
   size_t skeleton_edges = 0;    // inner bisectors of their skeletons
   size_t spurs = 0;             // dead-end branches dropped
 };
