@@ -2,7 +2,7 @@
 // farfield terrain path DEM -o FILE [--frames N] [--fov DEG]
 // farfield terrain bench DEM [--path FILE | --frames N] [--epsilon PX] -o OUTDIR [--size WxH] [--high-error PX]
 //                        [--low-error PX] [--reference] [--quality-stride K] [--sweep-epsilons LIST]
-//                        [--sweep-frames LIST] [--no-sweeps] [--no-plots]
+//                        [--sweep-frames LIST] [--no-sweeps] [--no-plots] [--no-choice]
 // DEM: a GeoTIFF / netCDF / 16-bit PNG file or fractal:SIZE[:SEED].
 //
 // The LOD-sprite experiment (Chen et al. 1999) is eval::runTerrainBench (eval/terrain_bench.h). Its modes are
@@ -52,8 +52,8 @@ struct BenchText {
   std::string size = "512x512";
   std::string sweep_epsilons = "0.25,0.5,1,2,4,8";
   std::string sweep_frames = "75,150,300,600,1200,2400";
-  std::string modes = "high,low,lod-sprite,lod-sprite-predict,lod-sprite-cache";
-  bool no_sweeps = false, no_plots = false;
+  std::string modes = "high,low,lod-sprite,lod-sprite-always,lod-sprite-predict,lod-sprite-cache";
+  bool no_sweeps = false, no_plots = false, no_choice = false;
 };
 
 void runBench(BenchText& a) {
@@ -71,6 +71,7 @@ void runBench(BenchText& a) {
     a.o.sweep_frames.push_back(wholeNumber<size_t>(v, "--sweep-frames", "frame count"));
   a.o.sweeps = !a.no_sweeps;
   a.o.plots = !a.no_plots;
+  a.o.choice = !a.no_choice;
   const eval::TerrainBenchResult result = eval::runTerrainBench(a.o);
   std::printf("\n%s\n", result.markdown.c_str());
   std::printf("wrote %s/{bench.json,terrain.json,terrain.md,figures/} in %.0f s\n", a.o.out_dir.c_str(),
@@ -151,6 +152,8 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
   bench->add_option("--sweep-frames", a->sweep_frames, "Frame counts for Figure 12")->capture_default_str();
   bench->add_flag("--no-sweeps", a->no_sweeps, "Skip Figures 12-14");
   bench->add_flag("--no-plots", a->no_plots, "CSV only");
+  bench->add_flag("--no-choice", a->no_choice,
+                  "No cost calibration: lod-sprite takes the sprite path on every frame (as lod-sprite-always)");
   bench->add_option("--python", o.python, "Python interpreter for the plots");
   bench->add_option("--block", o.block, "LOD block size in cells")->capture_default_str();
   bench->callback([a] { runBench(*a); });

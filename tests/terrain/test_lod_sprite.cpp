@@ -277,3 +277,84 @@ TEST(LodSprite, KeyframesRenderedAheadAreUsed) {
 
 }  // namespace
 }  // namespace farfield::terrain
+
+namespace farfield::terrain {
+namespace {
+
+// Figure-8-like motion over the test fractal: forwards and a little sideways, 40 m a frame.
+std::vector<Camera> choicePath(const Heightfield& hf, int frames) {
+  const float top = hf.maxHeight();
+  std::vector<Camera> cameras;
+  for (int f = 0; f < frames; ++f)
+    cameras.push_back(makeCamera(Vec3(600.0f + 40.0f * f, 300.0f + 10.0f * f, top + 700.0f),
+                                 Vec3(900.0f + 40.0f * f, 1600.0f + 10.0f * f, 0.0f)));
+  return cameras;
+}
+
+// path_choice.h in the renderer: a machine where the sprite frame (two draw calls) costs more than the high LOD
+// (one) never takes the sprite path, and its frames are the high LOD's, pixel for pixel; the error metric still
+// trips where the render-free simulation says.
+TEST(LodSpriteGL, ChoiceDrawsTheHighLodWhenTheSpriteCostsMore) {
+  Scene scene(testFractal());
+  TerrainCost cost;
+  cost.frame.base_ms = 1.0;
+  cost.frame.ms_per_draw = 3.0;
+  LodSpriteOptions options;
+  options.sky_color = kSky;
+  options.cost = &cost;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const std::vector<Camera> cameras = choicePath(scene.hf, 12);
+  const std::vector<uint8_t> trips = simulateKeyframes(*scene.lod, cameras, options.low_error, options.epsilon);
+  gpu::RenderTarget frame(128, 128);
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    sprite.render(cameras[f], frame, &info);
+    EXPECT_EQ(info.path, TerrainPath::High) << "frame " << f;
+    EXPECT_EQ(info.source, SpriteSource::None) << "frame " << f;
+    EXPECT_EQ(info.keyframe_due, trips[f] != 0) << "frame " << f;
+    EXPECT_GT(info.predicted_sprite_ms, info.predicted_high_ms) << "frame " << f;
+    const image::ColorImage high = scene.renderLod(cameras[f], options.high_error);
+    EXPECT_EQ(frame.readColor().pixels(), high.pixels()) << "frame " << f;
+  }
+  EXPECT_EQ(sprite.counters().fresh_keyframes, 0u);
+  EXPECT_EQ(sprite.counters().high_frames, cameras.size());
+  EXPECT_GE(sprite.counters().virtual_keyframes, 2u);  // the metric ran: it tripped along the path
+}
+
+// ...and where the high LOD is expensive, once a sprite lifetime is known (the first keyframe is virtual: with no
+// lifetime measured, a keyframe is assumed to serve one frame, which never pays), every keyframe is rendered and every
+// frame after it takes the sprite path.
+TEST(LodSpriteGL, ChoiceTakesTheSpriteWhenTheHighLodIsExpensive) {
+  Scene scene(testFractal());
+  TerrainCost cost;
+  cost.frame.base_ms = 1.0;
+  cost.frame.ms_per_mtriangle = 1e6;
+  LodSpriteOptions options;
+  options.sky_color = kSky;
+  options.cost = &cost;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const std::vector<Camera> cameras = choicePath(scene.hf, 24);
+  const std::vector<uint8_t> trips = simulateKeyframes(*scene.lod, cameras, options.low_error, options.epsilon);
+  gpu::RenderTarget frame(128, 128);
+  size_t trip_count = 0;
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    sprite.render(cameras[f], frame, &info);
+    EXPECT_EQ(info.keyframe_due, trips[f] != 0) << "frame " << f;
+    trip_count += trips[f];
+    if (trip_count <= 1) {
+      EXPECT_EQ(info.path, TerrainPath::High) << "frame " << f;
+    } else {
+      EXPECT_EQ(info.path, TerrainPath::Sprite) << "frame " << f;
+      EXPECT_EQ(info.source, trips[f] ? SpriteSource::Fresh : SpriteSource::Kept) << "frame " << f;
+    }
+  }
+  ASSERT_GE(trip_count, 3u);  // the path trips the metric several times
+  EXPECT_EQ(sprite.counters().fresh_keyframes, trip_count - 1);
+  EXPECT_EQ(sprite.counters().virtual_keyframes, 1u);
+}
+
+}  // namespace
+}  // namespace farfield::terrain

@@ -220,6 +220,30 @@ double meanWithoutStalls(const std::vector<double>& times, double median) {
   return kept_n ? kept / double(kept_n) : 0.0;
 }
 
+// 0. The cost model of this machine's terrain frames, from 5 frames spread over the path (untimed, before the
+// harness), for lod-sprite's per-frame choice.
+void calibrate(Experiment& x) {
+  const TerrainBenchOptions& o = x.options;
+  gpu::sharedHeadlessContext().makeCurrent();
+  terrain::TerrainCostOptions c;
+  const size_t n = x.path.frames.size();
+  for (size_t k = 0; k < 5; ++k) c.views.push_back(x.cameraAt(x.path, std::min(n - 1, (2 * k + 1) * n / 10)));
+  const terrain::LodSpriteOptions sprite = spriteOptions(*x.run, SpriteVariant::Paper, o.epsilon);
+  const int mx = int(std::lround(sprite.keyframe_margin * float(o.width)));
+  const int my = int(std::lround(sprite.keyframe_margin * float(o.height)));
+  c.keyframe_width = o.width + 2 * mx;
+  c.keyframe_height = o.height + 2 * my;
+  c.pixel_errors = {o.high_error, 2.0f * o.high_error, o.low_error, 4.0f * o.low_error};
+  x.run->cost = terrain::calibrateTerrainCost(*x.data().lod, x.run->gpuRenderer(), c);
+  x.result.cost = x.run->cost;
+  const gpu::CostModel& m = x.run->cost->frame;
+  say(o,
+      "cost:    terrain frame = %.3f ms + %.3f ms/Mtriangle + %.3f ms/draw + %.3f ms/Mpixel (r2 %.3f, rms %.3f ms); "
+      "z-buffer read back %.3f ms/Mpixel\n",
+      m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.r2, m.rms_error_ms,
+      x.run->cost->readback_ms_per_mpixel);
+}
+
 // 1. The benchmark harness: every mode interleaved, timed, with bench.json.
 void runHarness(Experiment& x) {
   const TerrainBenchOptions& o = x.options;
@@ -348,20 +372,23 @@ void writePerFrameFigures(const Experiment& x) {
   const std::vector<SpriteLog>& log = x.result.sprite_log;
   std::ostringstream f9, f10, f11;
   f9 << "frame,path_frame,high,low,lod_sprite,keyframe\n";
-  f10 << "frame,path_frame,error_px,trigger_error_px,keyframe,source\n";
+  f10 << "frame,path_frame,error_px,trigger_error_px,keyframe,source,path,keyframe_due,predicted_high_ms,"
+         "predicted_sprite_ms,predicted_keyframe_ms,expected_lifetime\n";
   f11 << "frame,path_frame";
   for (const ModeResult& m : bench.modes) f11 << "," << m.name << "_ms";
-  f11 << ",lod_sprite_keyframe\n";
+  f11 << ",lod_sprite_keyframe,lod_sprite_path\n";
   for (size_t k = 0; k < bench.frame_indices.size(); ++k) {
     const bool key = log[k].info.source == terrain::SpriteSource::Fresh;
     f9 << k << "," << bench.frame_indices[k] << "," << high.frames[k].triangles << "," << low.frames[k].triangles
        << "," << sprite.frames[k].triangles << "," << key << "\n";
     f10 << k << "," << bench.frame_indices[k] << "," << num(log[k].info.error_px) << ","
         << num(log[k].info.trigger_error_px) << "," << key << "," << terrain::spriteSourceName(log[k].info.source)
-        << "\n";
+        << "," << terrain::terrainPathName(log[k].info.path) << "," << log[k].info.keyframe_due << ","
+        << num(log[k].info.predicted_high_ms, 3) << "," << num(log[k].info.predicted_sprite_ms, 3) << ","
+        << num(log[k].info.predicted_keyframe_ms, 3) << "," << num(log[k].info.expected_lifetime, 1) << "\n";
     f11 << k << "," << bench.frame_indices[k];
     for (const ModeResult& m : bench.modes) f11 << "," << num(m.frames[k].wall_ms, 3);
-    f11 << "," << key << "\n";
+    f11 << "," << key << "," << terrain::terrainPathName(log[k].info.path) << "\n";
   }
   writeText(x.figures / "fig09_triangles.csv", f9.str());
   writeText(x.figures / "fig10_error.csv", f10.str());
@@ -439,14 +466,17 @@ void runSweeps(Experiment& x) {
   const FrameSummary high_summary = summarize(high_times);
   const double high_mean = meanWithoutStalls(high_times, high_summary.median);
   std::ostringstream f13, f14;
-  f13 << "epsilon_px,keyframes,keyframe_fraction,keyframes_simulated\n";
+  f13 << "epsilon_px,keyframes,keyframe_fraction,keyframes_simulated,fresh_keyframes,high_frames\n";
   // Speedup = mean frame time of high / mean frame time of lod-sprite at the threshold, both from this sweep and
   // without stalls; total_ms is the raw sum.
   f14 << "epsilon_px,total_ms,mean_ms,median_ms,high_total_ms,speedup_total,speedup_median\n";
   for (size_t m = 0; m < modes.size(); ++m) {
     EpsilonSweepRow row;
     row.epsilon_px = o.sweep_epsilons[m];
-    row.keyframes = modes[m]->sprite().counters().fresh_keyframes;
+    const terrain::LodSpriteCounters& counters = modes[m]->sprite().counters();
+    row.keyframes = counters.fresh_keyframes + counters.virtual_keyframes;
+    row.fresh_keyframes = counters.fresh_keyframes;
+    row.high_frames = counters.high_frames;
     const auto sim = terrain::simulateKeyframes(*data.lod, cameras, o.low_error, row.epsilon_px);
     row.keyframes_simulated = size_t(std::accumulate(sim.begin(), sim.end(), 0));
     const FrameSummary s = summarize(times[m]);
@@ -457,7 +487,8 @@ void runSweeps(Experiment& x) {
     row.speedup_total = high_mean / row.mean_ms;
     row.speedup_median = high_summary.median / s.median;
     f13 << num(row.epsilon_px, 3) << "," << row.keyframes << ","
-        << num(double(row.keyframes) / double(cameras.size()), 5) << "," << row.keyframes_simulated << "\n";
+        << num(double(row.keyframes) / double(cameras.size()), 5) << "," << row.keyframes_simulated << ","
+        << row.fresh_keyframes << "," << row.high_frames << "\n";
     f14 << num(row.epsilon_px, 3) << "," << num(row.total_ms, 2) << "," << num(row.mean_ms, 3) << ","
         << num(row.median_ms, 3) << "," << num(row.high_total_ms, 2) << "," << num(row.speedup_total, 3) << ","
         << num(row.speedup_median, 3) << "\n";
@@ -557,6 +588,8 @@ void writeSummary(Experiment& x) {
       sweep_json["epsilon"].push_back({{"epsilon_px", e.epsilon_px},
                                        {"keyframes", e.keyframes},
                                        {"keyframes_simulated", e.keyframes_simulated},
+                                       {"fresh_keyframes", e.fresh_keyframes},
+                                       {"high_frames", e.high_frames},
                                        {"total_ms", e.total_ms},
                                        {"mean_ms_without_stalls", e.mean_ms},
                                        {"speedup_total", e.speedup_total}});
@@ -583,6 +616,7 @@ void writeSummary(Experiment& x) {
   summary["paper_speedup_at_1px"] = 9.9;
   summary["quality_stride"] = o.quality_stride;
   summary["stalled_frames_filtered"] = r.stalled_frames;
+  if (r.cost) summary["cost_model"] = r.cost->toJson();
   std::ostringstream md;
   md << "# LOD-sprite terrain benchmark\n\n- terrain: " << r.terrain << "\n- " << bench.frame_indices.size()
      << " frames at " << o.width << "x" << o.height << ", epsilon " << o.epsilon << " px, LOD thresholds high "
@@ -592,8 +626,8 @@ void writeSummary(Experiment& x) {
      << " frames left out: some mode took over max(1 s, 20x its median) there); raw total and median ratios in "
         "brackets; PSNR against the high-resolution frame (untimed quality pass)\n\n"
      << "| mode | mean ms | median ms | p99 ms | max ms | triangles | speedup vs high (raw, median) | "
-        "PSNR vs high dB | high-res renders | keyframe fraction |\n"
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        "PSNR vs high dB | high-res renders | keyframe fraction | high-LOD frames |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const ModeResult& m : bench.modes) {
     const double t = totalMs(m);
     const double filtered = filteredMs(m, stalled);
@@ -622,7 +656,8 @@ void writeSummary(Experiment& x) {
        << (r.psnr_mean.count(m.name) ? num(r.psnr_mean[m.name], 2)
                                      : std::string(m.name == "high" ? "(reference)" : "n/a"))
        << " | " << (info("high_resolution_renders") >= 0 ? num(info("high_resolution_renders"), 0) : "") << " | "
-       << (info("keyframe_fraction") >= 0 ? num(info("keyframe_fraction"), 4) : "") << " |\n";
+       << (info("keyframe_fraction") >= 0 ? num(info("keyframe_fraction"), 4) : "") << " | "
+       << (info("high_frames") >= 0 ? num(info("high_frames"), 0) : "") << " |\n";
   }
   summary["sweeps"] = sweep_json;
   summary["section5_back_and_forth"] = section5;
@@ -683,6 +718,7 @@ TerrainBenchResult runTerrainBench(const TerrainBenchOptions& options) {
                {}, {}};
   fs::create_directories(x.figures / "fig06");
   makePath(x);
+  if (options.choice) calibrate(x);
   runHarness(x);
   runQuality(x);
   writePerFrameFigures(x);

@@ -2,6 +2,8 @@
 // bench`.
 //
 // Over a camera path (given, or Figure 8's kind of flythrough over the terrain):
+// 0. (with choice) the terrain cost model fitted on this machine from a few of the path's frames
+//    (terrain/terrain_cost.h), which "lod-sprite" uses to choose per frame between the high LOD and the sprite path;
 // 1. the walkthrough benchmark harness (bench.h) runs the modes of terrain_modes.h, interleaved and timed, with the
 //    full-resolution mesh as the "full" baseline (bench.json, bench.md, frames.csv, report.md);
 // 2. an untimed quality pass: every mode's frame against the high-resolution frame (PSNR), and Figure 6's views;
@@ -27,6 +29,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,7 +49,9 @@ struct TerrainBenchOptions {
   int height = 512;
   float high_error = 1.0f;  // LOD thresholds, pixels: 0 < high_error <= low_error
   float low_error = 4.0f;
-  std::vector<std::string> modes{"high", "low", "lod-sprite", "lod-sprite-predict", "lod-sprite-cache"};
+  std::vector<std::string> modes{"high", "low", "lod-sprite", "lod-sprite-always", "lod-sprite-predict",
+                                 "lod-sprite-cache"};
+  bool choice = true;       // calibrate the cost model; "lod-sprite" chooses per frame (false: always the sprite)
   bool reference = false;   // also compare every mode with full-geometry frames (the harness)
   size_t quality_stride = 1;  // PSNR against high on every K-th measured frame (>= 1)
   std::vector<double> sweep_epsilons{0.25, 0.5, 1, 2, 4, 8};          // Figures 13 and 14 (each > 0)
@@ -75,7 +80,9 @@ struct KeyframesVsFrames {
 // Figures 13 and 14: lod-sprite at one threshold, timed interleaved with high over the measured frames.
 struct EpsilonSweepRow {
   double epsilon_px = 0.0;
-  size_t keyframes = 0;            // rendered by the timed pass
+  size_t keyframes = 0;            // where the timed pass's error metric tripped (keyframes rendered + virtual ones)
+  size_t fresh_keyframes = 0;      // keyframes rendered
+  size_t high_frames = 0;          // frames that drew the high LOD (the per-frame choice)
   size_t keyframes_simulated = 0;  // terrain::simulateKeyframes over the same cameras
   double total_ms = 0.0;           // raw sum of frame times
   double mean_ms = 0.0;            // without stalls (frames over max(1 s, 20x the median))
@@ -104,6 +111,7 @@ struct TerrainBenchResult {
   BenchResult bench;      // the harness run; each mode's info has speedup_vs_high_* and psnr_vs_high_db_mean
   std::vector<SpriteLog> sprite_log;       // lod-sprite, one per measured frame of the timed pass
   std::vector<uint8_t> keyframes_simulated;  // 1 where terrain::simulateKeyframes puts a keyframe, same frames
+  std::optional<terrain::TerrainCost> cost;  // the fitted cost model (with choice)
   size_t stalled_frames = 0;               // left out of the filtered totals
   std::vector<TerrainQualityRow> quality;
   std::map<std::string, double> psnr_mean;  // mode -> mean PSNR against high over `quality`

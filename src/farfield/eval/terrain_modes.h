@@ -1,6 +1,8 @@
 // The terrain benchmark modes of Chen et al. 1999 (LOD-sprite terrain): "high" and "low" (the quadtree LOD mesh at
-// two pixel thresholds, original texture), "lod-sprite" (the paper, section 3), "lod-sprite-predict" and
-// "lod-sprite-cache" (section 5's future work: keyframes rendered ahead; a cache of 8 keyframes).
+// two pixel thresholds, original texture), "lod-sprite" (the paper, section 3, choosing per frame between the high
+// LOD and the sprite path by the run's calibrated cost model when it has one: terrain/path_choice.h),
+// "lod-sprite-always" (the paper's technique on every frame), "lod-sprite-predict" and "lod-sprite-cache"
+// (section 5's future work: keyframes rendered ahead; a cache of 8 keyframes).
 //
 // The modes of one run share one TerrainRun: the terrain, its GPU buffers, the thresholds and the per-frame logs of
 // the sprite modes. `farfield terrain bench` (terrain_bench.h) sets it with ScopedTerrainRun; under `farfield bench`
@@ -11,6 +13,7 @@
 #include <cstddef>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +22,7 @@
 #include "farfield/gpu/terrain_renderer.h"
 #include "farfield/terrain/lod_sprite.h"
 #include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_cost.h"
 #include "farfield/terrain/terrain_data.h"
 
 namespace farfield::eval {
@@ -37,6 +41,7 @@ struct TerrainRun {
   float low_error = 4.0f;
   double epsilon = 1.0;     // LOD-sprite error threshold, pixels
   Vec4 sky{0.62f, 0.74f, 0.88f, 1.0f};
+  std::optional<terrain::TerrainCost> cost;  // calibrated on this machine; "lod-sprite" chooses per frame with it
   std::map<std::string, std::vector<SpriteLog>> logs;  // sprite mode name -> frames of its last pass
 
   gpu::TerrainRenderer& gpuRenderer();
@@ -70,12 +75,14 @@ class LodMode : public Mode {
   terrain::LodMesh mesh_;
 };
 
-enum class SpriteVariant { Paper, Predict, Cache };
+// Paper: "lod-sprite" (with the run's cost model, the per-frame choice); Always: "lod-sprite-always" (every frame the
+// sprite path, whatever it costs).
+enum class SpriteVariant { Paper, Always, Predict, Cache };
 
 // The LOD-sprite options of a variant with the run's thresholds (epsilon, pixels, > 0); the one place the
 // variants are defined, shared by the modes and the terrain bench's quality pass.
 terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon);
-// "lod-sprite" -> Paper, "lod-sprite-predict" -> Predict, "lod-sprite-cache" -> Cache; false for other names.
+// "lod-sprite" -> Paper, "lod-sprite-always" -> Always, "lod-sprite-predict" -> Predict, "lod-sprite-cache" -> Cache; false for other names.
 bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant);
 
 // `lod-sprite` and its section 5 variants. Each pass over the path (the harness's warm-up frame is one) starts
@@ -88,7 +95,8 @@ class SpriteMode : public Mode {
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
   // epsilon_px, frames, keyframes (fresh), keyframe_fraction, high_resolution_renders, predicted_rendered,
-  // predicted_used, predicted_discarded, cache_hits (of the last pass).
+  // predicted_used, predicted_discarded, cache_hits, high_frames, high_frame_fraction, virtual_keyframes,
+  // keyframe_decisions (fresh + virtual: where the error metric tripped) (of the last pass).
   std::map<std::string, double> info() const override;
   terrain::LodSpriteRenderer& sprite() { return *sprite_; }
 
@@ -102,7 +110,7 @@ class SpriteMode : public Mode {
   size_t last_frame_ = 0;
 };
 
-// Adds high, low, lod-sprite, lod-sprite-predict and lod-sprite-cache to the mode registry (mode.h). Idempotent.
+// Adds high, low, lod-sprite, lod-sprite-always, lod-sprite-predict and lod-sprite-cache to the mode registry (mode.h). Idempotent.
 // Called by runTerrainBench and by the executable at start-up (the eval library is static: a static registration
 // object in it would be dropped by the linker).
 void registerTerrainModes();

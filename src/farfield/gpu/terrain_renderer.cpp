@@ -63,6 +63,8 @@ void TerrainRenderer::drawRange(size_t first, size_t count) {
   glBindVertexArray(0);
 }
 
+void TerrainRenderer::finish() { glFinish(); }
+
 FrameStats TerrainRenderer::drawTextured(const Camera& camera, RenderTarget& target, size_t first, size_t count,
                                          int slot) {
   FF_CHECK(slot >= 0 && slot < kSlots && (first + count) * 3 <= index_count_[slot]);

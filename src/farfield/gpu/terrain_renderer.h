@@ -43,6 +43,9 @@ class TerrainRenderer {
   FrameStats drawSprite(const Camera& camera, RenderTarget& target, const Texture& sprite,
                         const Mat4& sprite_view_proj, size_t first, size_t count, int slot = 0);
 
+  // Waits until every command issued so far has completed (glFinish): the end of a timed terrain frame.
+  void finish();
+
   size_t vertexCount() const { return vertex_count_; }
   size_t gpuBytes() const;
 

@@ -51,6 +51,7 @@ const char* spriteSourceName(SpriteSource source) {
     case SpriteSource::Fresh: return "fresh";
     case SpriteSource::Predicted: return "predicted";
     case SpriteSource::Cached: return "cached";
+    case SpriteSource::None: return "none";
   }
   return "?";
 }
@@ -90,6 +91,7 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRendere
   if (width < 1 || height < 1) throw Error("lod-sprite", "frame size must be positive");
   if (!(options.keyframe_margin >= 0.0f && options.keyframe_margin <= 1.0f))
     throw Error("lod-sprite", "keyframe margin must be 0..1 (share of the frame size per side)");
+  if (options.lifetime_history < 1) throw Error("lod-sprite", "lifetime history must be at least 1 sprite");
 }
 
 LodSpriteRenderer::~LodSpriteRenderer() = default;
@@ -106,6 +108,10 @@ void LodSpriteRenderer::reset() {
   pending_chunk_ = 0;
   pending_chunks_ = 1;
   history_.clear();
+  anchored_ = false;
+  anchor_since_ = 0;
+  lifetimes_.clear();
+  high_triangles_frame_ = high_triangles_key_ = 0;
 }
 
 const Camera* LodSpriteRenderer::spriteCamera() const { return current_ ? &current_->camera : nullptr; }
@@ -162,6 +168,7 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
   k->target.clear(options_.sky_color);
   add(stats, renderer_.drawTextured(k->camera, k->target, 0, high_.triangleCount(), 0));
   info.keyframe_triangles += high_.triangleCount();
+  high_triangles_key_ = high_.triangleCount();
   k->depth = k->target.readDepth();
   k->ready = true;
   ++counters_.fresh_keyframes;
@@ -240,6 +247,33 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
   k.coverage_at_creation = probe_.visibleShare(probe_mesh_.indices);
 }
 
+PathCosts LodSpriteRenderer::predictCosts(size_t low_triangles) const {
+  const TerrainCost& c = *options_.cost;
+  const Camera key = keyframeCamera(Camera{});
+  const double area_ratio = double(key.width) * double(key.height) / (double(width_) * double(height_));
+  // The high LOD's size changes slowly along a path: the last one seen stands for this frame's. One camera's count
+  // stands for the other's, scaled by the image area, until both have been seen.
+  double frame_tris = double(high_triangles_frame_), key_tris = double(high_triangles_key_);
+  if (!high_triangles_frame_) frame_tris = key_tris / area_ratio;
+  if (!high_triangles_key_) key_tris = frame_tris * area_ratio;
+  PathCosts p;
+  p.high_ms = c.frameMs(frame_tris, 1.0, width_, height_);
+  p.sprite_ms = c.frameMs(double(low_triangles), 2.0, width_, height_);
+  p.keyframe_ms = c.frameMs(key_tris, 1.0, key.width, key.height) + c.readbackMs(key.width, key.height) + p.sprite_ms;
+  return p;
+}
+
+gpu::FrameStats LodSpriteRenderer::renderHigh(const Camera& camera, gpu::RenderTarget& target,
+                                              LodSpriteFrameInfo& info) {
+  info.path = TerrainPath::High;
+  ++counters_.high_frames;
+  const gpu::FrameStats stats =
+      renderLodFrame(lod_, renderer_, camera, LodSettings{options_.high_error, true, false}, target, high_);
+  info.high_triangles = high_.triangleCount();
+  high_triangles_frame_ = high_.triangleCount();
+  return stats;
+}
+
 gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo* out) {
   if (camera.width != width_ || camera.height != height_)
     throw Error("lod-sprite", "camera size differs from the renderer's frame size");
@@ -256,15 +290,32 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   const double beta = pixelAngle(camera);
   auto errorOf = [&](const Keyframe& k) { return spriteError(lod_, low_.quadrants, k.camera.eye, camera.eye); };
 
-  // Lines 3-5: error of the current sprite; a new one when it reaches the threshold.
-  bool due = current_ == nullptr;
-  if (current_) {
-    const SpriteError e = errorOf(*current_);
+  // Lines 3-5: error of the current sprite (or of the virtual keyframe the high LOD stands for); a new one when it
+  // reaches the threshold.
+  bool due = !anchored_;
+  if (anchored_) {
+    const SpriteError e = spriteError(lod_, low_.quadrants, anchor_eye_, camera.eye);
     info.trigger_error_px = info.error_px = e.pixels(beta);
     due = keyframeDue(e, beta, options_.epsilon);
   }
+  info.keyframe_due = due;
+  const bool choose = options_.cost != nullptr;
+  PathCosts costs;
+  if (choose) {
+    costs = predictCosts(low_.triangleCount());
+    info.predicted_high_ms = costs.high_ms;
+    info.predicted_sprite_ms = costs.sprite_ms;
+    info.predicted_keyframe_ms = costs.keyframe_ms;
+  }
   if (due) {
-    if (current_) last_lifetime_ = std::max<uint64_t>(frame_ - sprite_since_, 1);
+    if (anchored_) {
+      last_lifetime_ = std::max<uint64_t>(frame_ - anchor_since_, 1);
+      lifetimes_.push_back(last_lifetime_);
+      while (lifetimes_.size() > size_t(options_.lifetime_history)) lifetimes_.pop_front();
+    }
+    anchored_ = true;
+    anchor_eye_ = camera.eye;
+    anchor_since_ = frame_;
     Keyframe* chosen = nullptr;
     double chosen_error = 0.0;
     if (pending_ && pending_->ready) {
@@ -295,6 +346,20 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
         ++counters_.cache_hits;
       }
     }
+    if (chosen) anchor_eye_ = chosen->camera.eye;  // a reused sprite's error is measured from its own viewpoint
+    if (!chosen && choose) {
+      info.expected_lifetime = spriteLifetimeEstimate(lifetimes_, 1.0);
+      if (choosePath(costs, false, info.expected_lifetime) == TerrainPath::High) {
+        // No keyframe: this frame is the high LOD, and the metric goes on from a virtual keyframe here.
+        current_ = nullptr;
+        ++counters_.virtual_keyframes;
+        info.source = SpriteSource::None;
+        info.error_px = 0.0;
+        const gpu::FrameStats stats = renderHigh(camera, target, info);
+        if (out) *out = info;
+        return stats;
+      }
+    }
     if (!chosen) {
       chosen = renderKeyframe(camera, stats, info);
       chosen_error = 0.0;
@@ -305,6 +370,12 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     info.error_px = chosen_error;
     visibility_.reset(lod_, current_->camera, &current_->depth, options_.visibility);
     if (options_.predict) schedulePrediction(camera);
+  } else if (!current_ || (choose && choosePath(costs, true, 0.0) == TerrainPath::High)) {
+    // A virtual keyframe still valid, or a valid sprite that costs more to draw than the high LOD.
+    info.source = SpriteSource::None;
+    const gpu::FrameStats high_stats = renderHigh(camera, target, info);
+    if (out) *out = info;
+    return high_stats;
   }
   current_->last_used = frame_;
 

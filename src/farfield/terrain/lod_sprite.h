@@ -18,6 +18,11 @@
 // - cache_size > 1: the most recent keyframes are kept (least recently used replaced). When the error trips, the
 //   kept keyframe with the smallest error at the current viewpoint is reused if it passes the error test and
 //   covers the view; otherwise a new keyframe is rendered.
+// Never slower (path_choice.h): with a cost model (LodSpriteOptions::cost), each frame chooses between drawing the
+// high-resolution LOD and the sprite path by their predicted costs; when the error trips and a new keyframe would
+// not pay for itself over the expected sprite lifetime, the frame draws the high LOD and the error metric continues
+// from a virtual keyframe at that viewpoint (so the frames where the error trips stay those of simulateKeyframes).
+// Without a cost model every frame takes the sprite path, as the paper does.
 // "Covers the view": the share of the current low-resolution triangles visible in that keyframe is at least
 // reuse_coverage times the share its own low-resolution mesh had when it was rendered (a keyframe looking the other
 // way passes the angular test but would texture little of the view).
@@ -34,8 +39,10 @@
 #include "farfield/gpu/terrain_renderer.h"
 #include "farfield/image/image.h"
 #include "farfield/terrain/keyframe_visibility.h"
+#include "farfield/terrain/path_choice.h"
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/sprite_error.h"
+#include "farfield/terrain/terrain_cost.h"
 
 namespace farfield::terrain {
 
@@ -71,6 +78,10 @@ struct LodSpriteOptions {
   float predict_lead = 1.25f;
   int cache_size = 1;       // keyframes kept (1 = only the current one, as in the paper)
   double reuse_coverage = 0.95;
+  // The per-frame choice between the high LOD and the sprite path (path_choice.h); null = always the sprite path.
+  // Must outlive the renderer.
+  const TerrainCost* cost = nullptr;
+  int lifetime_history = 5;  // recent sprite lifetimes (real or virtual) the expected lifetime is the median of
 };
 
 enum class SpriteSource : uint8_t {
@@ -78,6 +89,7 @@ enum class SpriteSource : uint8_t {
   Fresh,      // a keyframe rendered in this frame
   Predicted,  // the keyframe rendered ahead was taken into use
   Cached,     // an earlier keyframe was reused
+  None,       // no sprite: the frame drew the high-resolution LOD (path_choice.h)
 };
 const char* spriteSourceName(SpriteSource source);
 
@@ -90,6 +102,14 @@ struct LodSpriteFrameInfo {
   uint64_t keyframe_triangles = 0;  // high-resolution triangles of a keyframe rendered in this frame
   uint64_t ahead_triangles = 0;     // triangles of the predicted keyframe drawn in this frame
   size_t quadrants = 0;             // n of equation 2
+  // The per-frame choice (with LodSpriteOptions::cost; otherwise path Sprite and no predictions).
+  TerrainPath path = TerrainPath::Sprite;
+  bool keyframe_due = false;        // the error tripped here (or first frame): a keyframe, real or virtual
+  uint64_t high_triangles = 0;      // triangles of the high LOD drawn as this frame (path High)
+  double predicted_high_ms = 0.0;   // path_choice.h's PathCosts for this frame
+  double predicted_sprite_ms = 0.0;
+  double predicted_keyframe_ms = 0.0;
+  double expected_lifetime = 0.0;   // frames, when a keyframe was due
 };
 
 struct LodSpriteCounters {
@@ -99,6 +119,8 @@ struct LodSpriteCounters {
   size_t predicted_used = 0;
   size_t predicted_discarded = 0;  // completed or started but never used
   size_t cache_hits = 0;
+  size_t high_frames = 0;          // frames that drew the high LOD (path_choice.h)
+  size_t virtual_keyframes = 0;    // error trips answered with the high LOD instead of a keyframe
   // Every high-resolution render, whatever became of it.
   size_t highResolutionRenders() const { return fresh_keyframes + predicted_rendered; }
 };
@@ -133,6 +155,8 @@ class LodSpriteRenderer {
   void schedulePrediction(const Camera& camera);
   void advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info);
   void keep(std::unique_ptr<Keyframe> keyframe);
+  PathCosts predictCosts(size_t low_triangles) const;
+  gpu::FrameStats renderHigh(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo& info);
 
   const QuadtreeLod& lod_;
   gpu::TerrainRenderer& renderer_;
@@ -151,6 +175,13 @@ class LodSpriteRenderer {
   size_t pending_chunks_ = 1;  // slices it is drawn in
   KeyframeVisibility visibility_, probe_;
   std::deque<std::pair<Vec3, Vec3>> history_;  // recent (eye, look-at)
+  // The per-frame choice: the viewpoint of the last keyframe, real or virtual, and recent sprite lifetimes.
+  bool anchored_ = false;
+  Vec3 anchor_eye_{0.0f};
+  uint64_t anchor_since_ = 0;
+  std::deque<uint64_t> lifetimes_;
+  uint64_t high_triangles_frame_ = 0;  // last high-LOD triangle counts seen at the frame's and the keyframe's camera
+  uint64_t high_triangles_key_ = 0;
 };
 
 }  // namespace farfield::terrain

@@ -1,0 +1,107 @@
+// Frame-time cost model of LOD-sprite terrain (Chen et al. 1999 section 3), fitted on the running machine.
+#include "farfield/terrain/terrain_cost.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "farfield/core/error.h"
+#include "farfield/core/timer.h"
+#include "farfield/gpu/render_target.h"
+
+namespace farfield::terrain {
+
+double TerrainCost::frameMs(double triangles, double draw_calls, int width, int height) const {
+  return frame.predict(triangles, draw_calls, double(width) * double(height)) * safety_factor;
+}
+
+double TerrainCost::readbackMs(int width, int height) const {
+  return readback_ms_per_mpixel * double(width) * double(height) * 1e-6 * safety_factor;
+}
+
+nlohmann::json TerrainCost::toJson() const {
+  return {{"frame", frame.toJson()},
+          {"readback_ms_per_mpixel", readback_ms_per_mpixel},
+          {"safety_factor", safety_factor}};
+}
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer,
+                                 const TerrainCostOptions& options) {
+  const char* where = "terrain cost calibration";
+  if (options.views.empty()) throw Error(where, "needs at least one view");
+  if (options.repeats < 1) throw Error(where, "repeats must be at least 1");
+  if (options.pixel_errors.empty()) throw Error(where, "no LOD thresholds to time");
+  for (float e : options.pixel_errors)
+    if (!(e > 0.0f)) throw Error(where, "LOD thresholds must be positive (pixels)");
+  for (const Camera& v : options.views) v.validate(where);
+  const int fw = options.views.front().width, fh = options.views.front().height;
+  const int kw = options.keyframe_width > 0 ? options.keyframe_width : fw;
+  const int kh = options.keyframe_height > 0 ? options.keyframe_height : fh;
+
+  std::vector<gpu::CostSample> samples;
+  std::vector<double> readback_ms;
+  LodMesh mesh;
+  const Vec4 sky{0.6f, 0.7f, 0.9f, 1.0f};
+  for (const int size : {0, 1}) {
+    const int w = size ? kw : fw, h = size ? kh : fh;
+    gpu::RenderTarget target(w, h), sprite(w, h);
+    sprite.clear(sky);
+    for (Camera camera : options.views) {
+      // The keyframe target is wider at the same pixel density (lod_sprite.h's guard band).
+      camera.fov_y = 2.0f * std::atan(std::tan(camera.fov_y * 0.5f) * float(h) / float(camera.height));
+      camera.width = w;
+      camera.height = h;
+      const Mat4 sprite_view_proj = camera.viewProjection();
+      // Warm-up (untimed): first use of this target and the densest mesh.
+      lod.build(camera, LodSettings{options.pixel_errors.front(), true, false}, mesh);
+      renderer.setIndices(mesh.indices, 0);
+      target.clear(sky);
+      renderer.drawTextured(camera, target, 0, mesh.triangleCount(), 0);
+      renderer.finish();
+      for (const float tau : options.pixel_errors)
+        for (const bool with_sprite : {false, true}) {
+          std::vector<double> times;
+          double triangles = 0.0;
+          for (int r = 0; r < options.repeats; ++r) {
+            Stopwatch clock;
+            target.clear(sky);
+            lod.build(camera, LodSettings{tau, true, with_sprite}, mesh);
+            renderer.setIndices(mesh.indices, 0);
+            const size_t n = mesh.triangleCount();
+            if (with_sprite) {
+              renderer.drawSprite(camera, target, sprite.colorTexture(), sprite_view_proj, 0, n / 2, 0);
+              renderer.drawTextured(camera, target, n / 2, n - n / 2, 0);
+            } else {
+              renderer.drawTextured(camera, target, 0, n, 0);
+            }
+            renderer.finish();
+            times.push_back(clock.milliseconds());
+            triangles = double(n);
+          }
+          samples.push_back({triangles, with_sprite ? 2.0 : 1.0, double(w) * double(h), median(times)});
+        }
+      if (size) {
+        for (int r = 0; r < options.repeats; ++r) {
+          Stopwatch clock;
+          const image::DepthImage depth = target.readDepth();
+          readback_ms.push_back(clock.milliseconds());
+        }
+      }
+    }
+  }
+  TerrainCost cost;
+  cost.frame = gpu::CostModel::fit(samples);
+  cost.readback_ms_per_mpixel = median(readback_ms) / (double(kw) * double(kh) * 1e-6);
+  return cost;
+}
+
+}  // namespace farfield::terrain

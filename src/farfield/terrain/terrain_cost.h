@@ -1,0 +1,49 @@
+// The frame-time cost model of LOD-sprite terrain (Chen et al. 1999 section 3, Figure 3's two kinds of frame),
+// fitted on the running machine: what path_choice.h needs to predict a high-resolution frame, a sprite frame and a
+// keyframe before drawing them.
+//
+// A terrain frame is gpu::CostModel's linear workload (gpu/cost_model.h) measured the way the terrain draws it: the
+// view-dependent LOD mesh built on the CPU, its indices uploaded, drawn, and glFinish; so ms_per_mtriangle holds the
+// LOD build as well as the rasterisation. A keyframe adds reading its z-buffer back (keyframe_visibility.h), a term
+// of its own, linear in the keyframe's pixels.
+#pragma once
+
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/cost_model.h"
+#include "farfield/gpu/terrain_renderer.h"
+#include "farfield/terrain/quadtree_lod.h"
+
+namespace farfield::terrain {
+
+struct TerrainCost {
+  gpu::CostModel frame;                   // LOD build + draw + finish of a frame
+  double readback_ms_per_mpixel = 0.0;    // z-buffer read back, per million keyframe pixels (>= 0)
+  double safety_factor = 1.0;             // predictions are multiplied by it (>= 1)
+
+  // A frame of `triangles` in `draw_calls` calls into a width x height target, ms.
+  double frameMs(double triangles, double draw_calls, int width, int height) const;
+  double readbackMs(int width, int height) const;
+  // {"frame": CostModel::toJson(), "readback_ms_per_mpixel", "safety_factor"}.
+  nlohmann::json toJson() const;
+};
+
+struct TerrainCostOptions {
+  std::vector<Camera> views;  // frames to time from (a few of the path's cameras); required, each a usable camera
+  int keyframe_width = 0;     // the keyframe target (frame plus guard band); 0 = the views' size
+  int keyframe_height = 0;
+  std::vector<float> pixel_errors{1.0f, 2.0f, 4.0f, 16.0f};  // LOD thresholds timed (the triangle term's spread)
+  int repeats = 2;            // timed renders per workload (median kept; one untimed warm-up per view and size)
+};
+
+// Times the LOD meshes of the views at each threshold, drawn with the original texture and (two draw calls, as a
+// sprite frame draws them) with a sprite, into a frame-size and a keyframe-size target, and the z-buffer read back
+// of the keyframe target; fits TerrainCost::frame (gpu::CostModel::fit) and the read-back term. Needs a current
+// context; must not run inside a timed frame. Throws farfield::Error for no views or bad options.
+TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer,
+                                 const TerrainCostOptions& options);
+
+}  // namespace farfield::terrain
