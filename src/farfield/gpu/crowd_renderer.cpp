@@ -1,0 +1,276 @@
+#include "farfield/gpu/crowd_renderer.h"
+
+#include <epoxy/gl.h>
+
+#include <cstddef>
+#include <cstring>
+#include <string>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+
+namespace farfield::gpu {
+namespace {
+
+struct SkinVertex {
+  float position[3];
+  float normal[3];
+  float uv[2];
+  uint16_t joints[4];
+  float weights[4];
+};
+static_assert(sizeof(SkinVertex) == 56);
+
+void setLight(const Program& p, const LightSettings& light) {
+  Vec3 dir = light.direction;
+  dir = glm::length(dir) > 0.0f ? glm::normalize(dir) : Vec3(0.0f, 0.0f, -1.0f);
+  p.set("u_light_dir", dir);
+  p.set("u_light_color", light.color);
+  p.set("u_ambient", light.ambient);
+}
+
+}  // namespace
+
+SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& model_to_agent,
+                                 const std::vector<std::vector<Mat4>>& poses)
+    : model_to_agent_(model_to_agent), base_color_(model.base_color) {
+  scene::validateSkinnedModel(model);
+  joint_count_ = uint32_t(model.skeleton.joints.size());
+  if (poses.empty()) throw Error(model.name, "no poses for the GPU palette");
+  std::vector<Mat4> palette;
+  palette.reserve(poses.size() * joint_count_);
+  for (size_t p = 0; p < poses.size(); ++p) {
+    if (poses[p].size() != joint_count_)
+      throw Error(model.name, "pose " + std::to_string(p) + " has " + std::to_string(poses[p].size()) +
+                                  " joint matrices for " + std::to_string(joint_count_) + " joints");
+    palette.insert(palette.end(), poses[p].begin(), poses[p].end());
+  }
+  pose_count_ = uint32_t(poses.size());
+  const size_t n = model.mesh.positions.size();
+  std::vector<SkinVertex> vertices(n);
+  for (size_t i = 0; i < n; ++i) {
+    SkinVertex& v = vertices[i];
+    const Vec3& p = model.mesh.positions[i];
+    const Vec3 nn = model.mesh.normals.empty() ? Vec3(0.0f) : model.mesh.normals[i];
+    const Vec2 uv = model.mesh.uvs.empty() ? Vec2(0.0f) : model.mesh.uvs[i];
+    v = {{p.x, p.y, p.z}, {nn.x, nn.y, nn.z}, {uv.x, uv.y}, {}, {}};
+    for (int k = 0; k < 4; ++k) {
+      v.joints[k] = model.joints[i][size_t(k)];
+      v.weights[k] = model.weights[i][k];
+    }
+  }
+  index_count_ = uint32_t(model.mesh.indices.size());
+  glCreateBuffers(1, &vbo_);
+  glNamedBufferStorage(vbo_, GLsizeiptr(n * sizeof(SkinVertex)), vertices.data(), 0);
+  glCreateBuffers(1, &ibo_);
+  glNamedBufferStorage(ibo_, GLsizeiptr(index_count_ * sizeof(uint32_t)), model.mesh.indices.data(), 0);
+  glCreateBuffers(1, &palette_);
+  glNamedBufferStorage(palette_, GLsizeiptr(palette.size() * sizeof(Mat4)), palette.data(), 0);
+  bytes_ = n * sizeof(SkinVertex) + index_count_ * sizeof(uint32_t) + palette.size() * sizeof(Mat4);
+  glCreateVertexArrays(1, &vao_);
+  glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(SkinVertex));
+  glVertexArrayElementBuffer(vao_, ibo_);
+  auto attrib = [&](GLuint loc, GLint size, GLenum type, size_t offset, bool integer) {
+    glEnableVertexArrayAttrib(vao_, loc);
+    if (integer)
+      glVertexArrayAttribIFormat(vao_, loc, size, type, GLuint(offset));
+    else
+      glVertexArrayAttribFormat(vao_, loc, size, type, GL_FALSE, GLuint(offset));
+    glVertexArrayAttribBinding(vao_, loc, 0);
+  };
+  attrib(0, 3, GL_FLOAT, offsetof(SkinVertex, position), false);
+  attrib(1, 3, GL_FLOAT, offsetof(SkinVertex, normal), false);
+  attrib(2, 2, GL_FLOAT, offsetof(SkinVertex, uv), false);
+  attrib(3, 4, GL_UNSIGNED_SHORT, offsetof(SkinVertex, joints), true);
+  attrib(4, 4, GL_FLOAT, offsetof(SkinVertex, weights), false);
+  if (model.texture) {
+    texture_ = Texture::fromImage(*model.texture, true);
+    textured_ = true;
+    bytes_ += texture_.byteSize();
+  }
+}
+
+SkinnedGpuModel::~SkinnedGpuModel() {
+  if (vao_) glDeleteVertexArrays(1, &vao_);
+  const GLuint buffers[3] = {vbo_, ibo_, palette_};
+  glDeleteBuffers(3, buffers);
+}
+
+ImpostorAtlasGpu::ImpostorAtlasGpu(const AtlasLayout& layout) : layout_(layout) {
+  if (layout.azimuths < 1 || layout.elevations < 1 || layout.cell_width < 1 || layout.cell_height < 1 ||
+      layout.frames < 1)
+    throw Error("impostor atlas", "empty layout");
+  GLint max_size = 0, max_layers = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  if (layout.width() > max_size || layout.height() > max_size || layout.frames > max_layers)
+    throw Error("impostor atlas", std::to_string(layout.width()) + " x " + std::to_string(layout.height()) + " x " +
+                                      std::to_string(layout.frames) + " exceeds the GL limits");
+  for (uint32_t* tex : {&albedo_, &normal_depth_}) {
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, tex);
+    glTextureStorage3D(*tex, 1, GL_RGBA8, layout.width(), layout.height(), layout.frames);
+    glTextureParameteri(*tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(*tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(*tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(*tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+  glCreateTextures(GL_TEXTURE_2D, 1, &depth_);
+  glTextureStorage2D(depth_, 1, GL_DEPTH_COMPONENT32F, layout.width(), layout.height());
+  glCreateFramebuffers(1, &fbo_);
+  glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_, 0);
+  const GLenum draw[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(fbo_, 2, draw);
+}
+
+ImpostorAtlasGpu::~ImpostorAtlasGpu() {
+  if (fbo_) glDeleteFramebuffers(1, &fbo_);
+  const GLuint tex[3] = {albedo_, normal_depth_, depth_};
+  glDeleteTextures(3, tex);
+}
+
+size_t ImpostorAtlasGpu::byteSize() const {
+  return size_t(layout_.width()) * size_t(layout_.height()) * size_t(layout_.frames) * 8;
+}
+
+namespace {
+image::ColorImage readLayer(uint32_t tex, int w, int h, int layer) {
+  image::ColorImage img(w, h);
+  glGetTextureSubImage(tex, 0, 0, 0, layer, w, h, 1, GL_RGBA, GL_UNSIGNED_BYTE, GLsizei(img.pixelCount() * 4),
+                       img.data());
+  return img;
+}
+}  // namespace
+
+image::ColorImage ImpostorAtlasGpu::readAlbedo(int layer) const {
+  return readLayer(albedo_, layout_.width(), layout_.height(), layer);
+}
+image::ColorImage ImpostorAtlasGpu::readNormalDepth(int layer) const {
+  return readLayer(normal_depth_, layout_.width(), layout_.height(), layer);
+}
+
+CrowdRenderer::CrowdRenderer()
+    : skinned_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl")),
+      capture_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_CAPTURE 1")),
+      impostor_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl")) {
+  glCreateBuffers(1, &agents_);
+  glCreateVertexArrays(1, &empty_vao_);
+}
+
+CrowdRenderer::~CrowdRenderer() {
+  if (agents_) glDeleteBuffers(1, &agents_);
+  if (empty_vao_) glDeleteVertexArrays(1, &empty_vao_);
+}
+
+uint32_t CrowdRenderer::uploadAgents(std::span<const CrowdAgentGpu> agents) {
+  // A fresh store per draw (orphaning): draws already queued keep reading the old one.
+  glNamedBufferData(agents_, GLsizeiptr(agents.size_bytes()), agents.data(), GL_STREAM_DRAW);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, agents_);
+  return agents_;
+}
+
+FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuModel& model,
+                                      std::span<const CrowdAgentGpu> agents, const LightSettings& light) {
+  FrameStats stats;
+  if (agents.empty() || model.index_count_ == 0) return stats;
+  for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
+  uploadAgents(agents);
+  skinned_.use();
+  skinned_.set("u_view_proj", camera.viewProjection());
+  skinned_.set("u_model_to_agent", model.model_to_agent_);
+  skinned_.set("u_joint_count", model.joint_count_);
+  skinned_.set("u_first_instance", 0u);
+  skinned_.set("u_base_color", model.base_color_);
+  skinned_.set("u_textured", model.textured_ ? 1 : 0);
+  setLight(skinned_, light);
+  if (model.textured_) model.texture_.bind(0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, model.palette_);
+  glBindVertexArray(model.vao_);
+  glEnable(GL_CULL_FACE);
+  glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, GLsizei(agents.size()));
+  glBindVertexArray(0);
+  stats.draw_calls = 1;
+  stats.triangles = model.triangleCount() * agents.size();
+  stats.objects = uint32_t(agents.size());
+  return stats;
+}
+
+FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas,
+                                        std::span<const CrowdAgentGpu> agents, const LightSettings& light) {
+  FrameStats stats;
+  if (agents.empty()) return stats;
+  const AtlasLayout& l = atlas.layout_;
+  for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < uint32_t(l.frames) && a.view < uint32_t(l.azimuths * l.elevations));
+  uploadAgents(agents);
+  impostor_.use();
+  impostor_.set("u_view_proj", camera.viewProjection());
+  impostor_.set("u_eye", camera.eye);
+  glUniform2f(impostor_.uniformLocation("u_half_size"), l.half_size.x, l.half_size.y);
+  impostor_.set("u_centre", l.centre);
+  impostor_.set("u_first_instance", 0u);
+  glUniform2i(impostor_.uniformLocation("u_grid"), l.azimuths, l.elevations);
+  impostor_.set("u_radius", l.radius);
+  setLight(impostor_, light);
+  glBindTextureUnit(0, atlas.albedo_);
+  glBindTextureUnit(1, atlas.normal_depth_);
+  glBindVertexArray(empty_vao_);
+  glDisable(GL_CULL_FACE);
+  glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(agents.size()));
+  glEnable(GL_CULL_FACE);
+  glBindVertexArray(0);
+  stats.draw_calls = 1;
+  stats.triangles = 2 * agents.size();
+  stats.objects = uint32_t(agents.size());
+  return stats;
+}
+
+void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, ImpostorAtlasGpu& atlas, int layer,
+                            std::span<const CaptureView> views) {
+  const AtlasLayout& l = atlas.layout_;
+  FF_CHECK(pose < model.pose_count_ && layer >= 0 && layer < l.frames);
+  glNamedFramebufferTextureLayer(atlas.fbo_, GL_COLOR_ATTACHMENT0, atlas.albedo_, 0, layer);
+  glNamedFramebufferTextureLayer(atlas.fbo_, GL_COLOR_ATTACHMENT1, atlas.normal_depth_, 0, layer);
+  FF_CHECK(glCheckNamedFramebufferStatus(atlas.fbo_, GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE);
+  glBindFramebuffer(GL_FRAMEBUFFER, atlas.fbo_);
+  glViewport(0, 0, l.width(), l.height());
+  glDisable(GL_SCISSOR_TEST);
+  glDisable(GL_BLEND);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  const float clear0[4] = {0, 0, 0, 0}, clear1[4] = {0.5f, 0.5f, 0.5f, 0.5f}, depth0 = 0.0f;
+  glClearNamedFramebufferfv(atlas.fbo_, GL_COLOR, 0, clear0);
+  glClearNamedFramebufferfv(atlas.fbo_, GL_COLOR, 1, clear1);
+  glClearNamedFramebufferfv(atlas.fbo_, GL_DEPTH, 0, &depth0);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glEnable(GL_CULL_FACE);
+  glFrontFace(GL_CCW);
+  const CrowdAgentGpu origin;  // identity agent: pose set below
+  CrowdAgentGpu agent = origin;
+  agent.index = pose;
+  uploadAgents(std::span<const CrowdAgentGpu>(&agent, 1));
+  capture_.use();
+  capture_.set("u_model_to_agent", model.model_to_agent_);
+  capture_.set("u_joint_count", model.joint_count_);
+  capture_.set("u_first_instance", 0u);
+  capture_.set("u_base_color", model.base_color_);
+  capture_.set("u_textured", model.textured_ ? 1 : 0);
+  capture_.set("u_capture_centre", l.centre);
+  capture_.set("u_capture_radius", l.radius);
+  if (model.textured_) model.texture_.bind(0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, model.palette_);
+  glBindVertexArray(model.vao_);
+  for (const CaptureView& v : views) {
+    FF_CHECK(v.cell >= 0 && v.cell < l.azimuths * l.elevations);
+    glViewport((v.cell % l.azimuths) * l.cell_width, (v.cell / l.azimuths) * l.cell_height, l.cell_width,
+               l.cell_height);
+    capture_.set("u_view_proj", v.view_proj);
+    capture_.set("u_capture_dir", v.to_camera);
+    glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, 1);
+  }
+  glBindVertexArray(0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void CrowdRenderer::finish() const { glFinish(); }
+
+}  // namespace farfield::gpu

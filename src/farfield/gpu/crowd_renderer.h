@@ -1,0 +1,129 @@
+// Crowd rendering: skinned models drawn for many agents with one instanced draw per model (joint matrices of a
+// palette of sampled poses in a storage buffer, agents in another), and multi-view impostor atlases drawn as one
+// instanced camera-facing quad per agent. Also the capture pass that bakes an atlas.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/program.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/gpu/texture.h"
+#include "farfield/scene/skin.h"
+
+namespace farfield::gpu {
+
+// One agent as the shaders read it (std430, 48 bytes). For skinned draws `index` is the palette pose; for
+// impostors it is the animation frame (atlas layer) and `view` the view cell (elevation * azimuths + azimuth).
+struct CrowdAgentGpu {
+  Vec4 pos_heading{0.0f};  // xyz metres, w heading (radians about +z)
+  Vec4 tint{1.0f};
+  uint32_t index = 0;
+  uint32_t view = 0;
+  uint32_t object_id = 0;
+  uint32_t pad = 0;
+};
+static_assert(sizeof(CrowdAgentGpu) == 48);
+
+// A skinned model on the GPU with its pose palette. model_to_agent places the skinned (Z-up) model in agent space:
+// feet on z = 0, facing +x, at the agent's scale.
+class SkinnedGpuModel {
+ public:
+  // poses[p] holds the joint matrices of pose p (one per joint, scene::jointMatrices). Throws farfield::Error for
+  // an empty palette or a pose with the wrong joint count (after validateSkinnedModel).
+  SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& model_to_agent,
+                  const std::vector<std::vector<Mat4>>& poses);
+  ~SkinnedGpuModel();
+  SkinnedGpuModel(const SkinnedGpuModel&) = delete;
+  SkinnedGpuModel& operator=(const SkinnedGpuModel&) = delete;
+
+  uint32_t jointCount() const { return joint_count_; }
+  uint32_t poseCount() const { return pose_count_; }
+  uint32_t indexCount() const { return index_count_; }
+  uint64_t triangleCount() const { return index_count_ / 3; }
+  const Mat4& modelToAgent() const { return model_to_agent_; }
+  size_t gpuBytes() const { return bytes_; }
+
+ private:
+  friend class CrowdRenderer;
+  uint32_t vao_ = 0, vbo_ = 0, ibo_ = 0, palette_ = 0;
+  uint32_t index_count_ = 0, joint_count_ = 0, pose_count_ = 0;
+  Mat4 model_to_agent_{1.0f};
+  Vec4 base_color_{1.0f};
+  Texture texture_;
+  bool textured_ = false;
+  size_t bytes_ = 0;
+};
+
+// Geometry of a multi-view atlas (impostor/multi_view.h chooses it): a grid of azimuths x elevations cells of
+// cell_width x cell_height texels per layer, one layer per animation frame.
+struct AtlasLayout {
+  int azimuths = 32;
+  int elevations = 8;
+  int cell_width = 32;
+  int cell_height = 64;
+  int frames = 16;
+  Vec2 half_size{1.0f};  // metres: the quad's half extent right and up
+  Vec3 centre{0.0f};     // agent space
+  float radius = 1.0f;   // metres: depth normalisation
+  int width() const { return azimuths * cell_width; }
+  int height() const { return elevations * cell_height; }
+};
+
+// Albedo (RGBA8) and normal + depth (RGBA8) texture arrays of an atlas, linear filtering, clamped.
+class ImpostorAtlasGpu {
+ public:
+  explicit ImpostorAtlasGpu(const AtlasLayout& layout);
+  ~ImpostorAtlasGpu();
+  ImpostorAtlasGpu(const ImpostorAtlasGpu&) = delete;
+  ImpostorAtlasGpu& operator=(const ImpostorAtlasGpu&) = delete;
+  const AtlasLayout& layout() const { return layout_; }
+  size_t byteSize() const;  // both arrays, uncompressed
+  // Readback of one layer (row 0 at the bottom of the layer, as GL stores it); for tests and sample images.
+  image::ColorImage readAlbedo(int layer) const;
+  image::ColorImage readNormalDepth(int layer) const;
+
+ private:
+  friend class CrowdRenderer;
+  AtlasLayout layout_;
+  uint32_t albedo_ = 0, normal_depth_ = 0, depth_ = 0, fbo_ = 0;
+};
+
+// One capture view of a bake: the orthographic view-projection, the unit direction towards the camera and the
+// atlas cell it fills.
+struct CaptureView {
+  Mat4 view_proj{1.0f};
+  Vec3 to_camera{1.0f, 0.0f, 0.0f};
+  int cell = 0;  // elevation * azimuths + azimuth
+};
+
+class CrowdRenderer {
+ public:
+  CrowdRenderer();  // needs a current context
+  ~CrowdRenderer();
+  CrowdRenderer(const CrowdRenderer&) = delete;
+  CrowdRenderer& operator=(const CrowdRenderer&) = delete;
+
+  // Draw into the bound target (RenderTarget::bindForOpaquePass), no clear, no wait: the agents of one model in one
+  // instanced draw. Agents' `index` must be < the model's pose count (FF_CHECK).
+  FrameStats drawSkinned(const Camera& camera, const SkinnedGpuModel& model, std::span<const CrowdAgentGpu> agents,
+                         const LightSettings& light);
+  // One instanced draw of quads; agents' `index` < frames and `view` < azimuths * elevations (FF_CHECK).
+  FrameStats drawImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas, std::span<const CrowdAgentGpu> agents,
+                           const LightSettings& light);
+  // Renders pose `pose` of the model (agent at the origin, heading 0) into `layer` of the atlas, one cell per view;
+  // clears the layer first. Leaves the default framebuffer state to the caller (rebind your target after).
+  void capture(const SkinnedGpuModel& model, uint32_t pose, ImpostorAtlasGpu& atlas, int layer,
+               std::span<const CaptureView> views);
+  // Waits for the GPU (glFinish): bake timings.
+  void finish() const;
+
+ private:
+  uint32_t uploadAgents(std::span<const CrowdAgentGpu> agents);
+  Program skinned_, capture_, impostor_;
+  uint32_t agents_ = 0, empty_vao_ = 0;
+};
+
+}  // namespace farfield::gpu

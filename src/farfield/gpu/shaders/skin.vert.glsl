@@ -1,0 +1,45 @@
+#version 450 core
+// Farfield instanced skinning: one draw per model draws every agent of it. Joint matrices of a palette of sampled
+// poses (binding 0, pose p's joint j at p * u_joint_count + j); per agent (binding 1): position and heading (radians
+// about +z), a colour tint, its pose and object id. world = agent(heading, position) * u_model_to_agent * skin * p.
+
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in uvec4 a_joints;
+layout(location = 4) in vec4 a_weights;
+
+struct Agent {
+  vec4 pos_heading;
+  vec4 tint;
+  uvec4 data;  // x: pose (palette index), y: unused here, z: object id
+};
+layout(std430, binding = 0) readonly buffer Palette { mat4 palette[]; };
+layout(std430, binding = 1) readonly buffer Agents { Agent agents[]; };
+
+uniform mat4 u_view_proj;
+uniform mat4 u_model_to_agent;
+uniform uint u_joint_count;
+uniform uint u_first_instance;
+
+out vec3 v_world;
+out vec3 v_normal;
+out vec2 v_uv;
+flat out vec4 v_tint;
+flat out uint v_id;
+
+void main() {
+  const Agent a = agents[u_first_instance + uint(gl_InstanceID)];
+  const uint base = a.data.x * u_joint_count;
+  const mat4 skin = a_weights.x * palette[base + a_joints.x] + a_weights.y * palette[base + a_joints.y] +
+                    a_weights.z * palette[base + a_joints.z] + a_weights.w * palette[base + a_joints.w];
+  const vec4 local = u_model_to_agent * (skin * vec4(a_position, 1.0));
+  const float c = cos(a.pos_heading.w), s = sin(a.pos_heading.w);
+  const mat3 turn = mat3(c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0);
+  v_world = turn * local.xyz + a.pos_heading.xyz;
+  v_normal = turn * (mat3(u_model_to_agent) * (mat3(skin) * a_normal));
+  v_uv = a_uv;
+  v_tint = a.tint;
+  v_id = a.data.z;
+  gl_Position = u_view_proj * vec4(v_world, 1.0);
+}

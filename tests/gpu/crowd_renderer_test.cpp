@@ -1,0 +1,98 @@
+// GPU skinning with instancing against CPU skinning of the same poses (GL test: the shared headless context).
+#include "farfield/gpu/crowd_renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "farfield/gpu/gpu_mesh.h"
+#include "farfield/scene/gltf_skin.h"
+#include "gpu/gpu_fixture.h"
+#include "support/test_support.h"
+
+namespace farfield::gpu {
+namespace {
+
+class CrowdRendererGl : public test::GpuTest {};
+
+struct Compare {
+  size_t covered = 0;  // pixels either image shows an agent
+  size_t bad = 0;      // of those, off by more than 8/255 in some channel
+};
+
+Compare compare(const image::ColorImage& a, const image::IdImage& ia, const image::ColorImage& b,
+                const image::IdImage& ib) {
+  Compare c;
+  for (size_t i = 0; i < a.pixelCount(); ++i) {
+    if (ia.pixels()[i] == 0 && ib.pixels()[i] == 0) continue;
+    ++c.covered;
+    const image::Rgba8 p = a.pixels()[i], q = b.pixels()[i];
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(int(p[k]) - int(q[k])) > 8) {
+        ++c.bad;
+        break;
+      }
+  }
+  return c;
+}
+
+TEST_F(CrowdRendererGl, InstancedGpuSkinningEqualsCpuSkinning) {
+  const scene::SkinnedModel man =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  const scene::Animation* walk = &man.animations[0];
+  std::vector<std::vector<Mat4>> poses;
+  for (int p = 0; p < 4; ++p) poses.push_back(scene::jointMatrices(man, walk, walk->start + 0.23f * float(p)));
+  const Mat4 to_agent = glm::rotate(Mat4(1.0f), 0.3f, Vec3(0, 0, 1));
+  SkinnedGpuModel gpu_model(man, to_agent, poses);
+  CrowdRenderer crowd;
+  Renderer renderer;
+  const Camera camera = test::testCamera(Vec3(0.3f, -3.6f, 1.3f), Vec3(0.3f, 0.0f, 0.8f), 160);
+
+  std::vector<CrowdAgentGpu> agents(3);
+  for (int i = 0; i < 3; ++i) {
+    agents[size_t(i)].pos_heading = Vec4(-1.0f + 1.2f * float(i), 0.3f * float(i), 0.0f, 0.9f * float(i) - 0.4f);
+    agents[size_t(i)].index = uint32_t(i + 1);
+    agents[size_t(i)].object_id = uint32_t(10 + i);
+    agents[size_t(i)].tint = Vec4(1.0f, 0.9f - 0.2f * float(i), 0.8f, 1.0f);
+  }
+  RenderTarget gpu_target(160, 160);
+  gpu_target.bindForOpaquePass();
+  gpu_target.clear(renderer.light().sky_color);
+  const FrameStats stats = crowd.drawSkinned(camera, gpu_model, agents, renderer.light());
+  EXPECT_EQ(stats.draw_calls, 1u);
+  EXPECT_EQ(stats.triangles, 3u * man.mesh.triangleCount());
+
+  // CPU: each agent's pose skinned on the CPU, drawn as a plain mesh with the agent's transform and tint.
+  auto cpuFrame = [&](int pose_shift, RenderTarget& target) {
+    std::vector<GpuMesh> meshes;
+    meshes.reserve(3);
+    std::vector<GpuMaterial> materials(3);
+    Texture texture = Texture::fromImage(*man.texture, true);
+    std::vector<DrawItem> items;
+    for (int i = 0; i < 3; ++i) {
+      const CrowdAgentGpu& a = agents[size_t(i)];
+      meshes.emplace_back(scene::skinMesh(man, poses[(a.index + uint32_t(pose_shift)) % 4]));
+      materials[size_t(i)].base_color = man.base_color * a.tint;
+      materials[size_t(i)].texture = &texture;
+      const Mat4 agent = glm::translate(Mat4(1.0f), Vec3(a.pos_heading)) *
+                         glm::rotate(Mat4(1.0f), a.pos_heading.w, Vec3(0, 0, 1)) * to_agent;
+      items.push_back(DrawItem{&meshes.back(), &materials[size_t(i)], agent, a.object_id});
+    }
+    renderer.render(camera, items, target);
+  };
+  RenderTarget cpu_target(160, 160);
+  cpuFrame(0, cpu_target);
+  const Compare same = compare(gpu_target.readColor(), gpu_target.readIds(), cpu_target.readColor(),
+                               cpu_target.readIds());
+  EXPECT_GT(same.covered, 1000u);  // the agents are in view
+  EXPECT_LT(double(same.bad), 0.01 * double(same.covered)) << same.bad << " of " << same.covered;
+  // And the comparison sees a wrong pose.
+  RenderTarget wrong_target(160, 160);
+  cpuFrame(1, wrong_target);
+  const Compare wrong = compare(gpu_target.readColor(), gpu_target.readIds(), wrong_target.readColor(),
+                                wrong_target.readIds());
+  EXPECT_GT(double(wrong.bad), 0.05 * double(wrong.covered)) << wrong.bad << " of " << wrong.covered;
+}
+
+}  // namespace
+}  // namespace farfield::gpu
