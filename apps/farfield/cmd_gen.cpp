@@ -1,4 +1,5 @@
-// farfield gen city --blocks N --seed S [--detail D] [--hill] [--objects blocks|buildings] -o city.glb
+// farfield gen city --blocks N --seed S [--detail D] [--hill] [--objects blocks|buildings] [--trees] -o city.glb
+// farfield gen forest [--size M] [--trees N] [--leaves L] [--seed S] -o forest.glb
 // Generates a procedural city (farfield/gen/city.h), writes it as binary glTF and its street graph as
 // city.streets.json next to it, and prints what was made and what it cost.
 #include <sys/resource.h>
@@ -12,6 +13,7 @@
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
 #include "farfield/gen/city.h"
+#include "farfield/gen/vegetation.h"
 #include "farfield/scene/export_gltf.h"
 
 namespace farfield::app {
@@ -23,6 +25,14 @@ struct CityArgs {
   int detail = 1;
   bool hill = false;
   std::string objects = "blocks";
+  bool trees = false;
+  float park_share = 0.1f;
+  int tree_leaves = 300;
+  std::string output;
+};
+
+struct ForestArgs {
+  gen::ForestOptions options;
   std::string output;
 };
 
@@ -39,6 +49,9 @@ void runCity(const CityArgs& args) {
   options.detail = args.detail;
   options.hill = args.hill;
   options.objects = args.objects == "buildings" ? gen::ObjectGrouping::Buildings : gen::ObjectGrouping::Blocks;
+  options.trees = args.trees;
+  options.park_share = args.park_share;
+  options.tree_leaves = args.tree_leaves;
 
   Stopwatch clock;
   const gen::City city = gen::generateCity(options);
@@ -60,6 +73,7 @@ void runCity(const CityArgs& args) {
   std::printf("streets:    %zu segments, %zu junctions\n", city.streets.streetCount(), city.streets.junctionCount());
   std::printf("buildings:  %zu (%zu landmarks)%s\n", city.buildings, city.landmarks,
               city.skipped_lots ? (", " + std::to_string(city.skipped_lots) + " degenerate lots dropped").c_str() : "");
+  if (args.trees) std::printf("trees:      %zu (%zu park blocks)\n", city.trees, city.parks);
   std::printf("objects:    %zu\n", s.objects);
   std::printf("triangles:  %llu\n", (unsigned long long)s.triangles);
   std::printf("vertices:   %llu\n", (unsigned long long)s.vertices);
@@ -71,6 +85,19 @@ void runCity(const CityArgs& args) {
   std::printf("time:       %.2f s generation, %.2f s writing\n", generate_s, write_s);
   std::printf("memory:     %.0f MiB peak resident\n", peakMemoryMiB());
   std::printf("wrote:      %s\n            %s\n", args.output.c_str(), streets.c_str());
+}
+
+void runForest(const ForestArgs& args) {
+  Stopwatch clock;
+  const scene::Scene forest = gen::generateForest(args.options);
+  const scene::SceneStats s = forest.stats();
+  ensureParentDirectory(args.output);
+  scene::exportGlb(forest, args.output);
+  std::printf("forest:     %.0f m square, %zu trees, seed %llu\n", args.options.size, s.objects - 1,
+              (unsigned long long)args.options.seed);
+  std::printf("triangles:  %llu\n", (unsigned long long)s.triangles);
+  std::printf("time:       %.2f s\n", clock.seconds());
+  std::printf("wrote:      %s\n", args.output.c_str());
 }
 
 const RegisterCommand reg("gen", [](CLI::App& app) {
@@ -88,7 +115,22 @@ const RegisterCommand reg("gen", [](CLI::App& app) {
   c->add_option("--objects", city->objects, "One object per block (blocks) or per building (buildings)")
       ->check(CLI::IsMember({"blocks", "buildings"}));
   c->add_option("-o,--output", city->output, "Output scene (.glb); the street graph goes next to it")->required();
+  c->add_flag("--trees", city->trees, "Street trees along the blocks and parks (gen/vegetation.h)");
+  c->add_option("--park-share", city->park_share, "With --trees: share of blocks turned into parks, 0..1")
+      ->check(CLI::Range(0.0f, 1.0f));
+  c->add_option("--tree-leaves", city->tree_leaves, "With --trees: leaf triangles per tree (about)")
+      ->check(CLI::Range(1, 100000));
   c->callback([city] { runCity(*city); });
+
+  auto forest = std::make_shared<ForestArgs>();
+  auto* f = cmd->add_subcommand("forest", "A forest of procedural trees on rolling ground (not a city).");
+  f->add_option("--size", forest->options.size, "Square side, metres")->check(CLI::Range(20.0f, 20000.0f));
+  f->add_option("--trees", forest->options.trees, "Number of trees")->check(CLI::Range(1, 200000));
+  f->add_option("--leaves", forest->options.tree.leaves, "Leaf triangles per tree (about)")
+      ->check(CLI::Range(1, 100000));
+  f->add_option("--seed", forest->options.seed, "Random seed");
+  f->add_option("-o,--output", forest->output, "Output scene (.glb)")->required();
+  f->callback([forest] { runForest(*forest); });
 });
 
 }  // namespace

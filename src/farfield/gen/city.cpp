@@ -17,6 +17,7 @@
 #include "farfield/gen/buildings.h"
 #include "farfield/gen/street_network.h"
 #include "farfield/gen/textures.h"
+#include "farfield/gen/vegetation.h"
 
 namespace farfield::gen {
 
@@ -71,6 +72,11 @@ void validate(const CityOptions& o) {
     throw Error("city options", "detail must be in [0, 4], got " + std::to_string(o.detail));
   if (o.objects != ObjectGrouping::Blocks && o.objects != ObjectGrouping::Buildings)
     throw Error("city options", "objects must be blocks or buildings");
+  if (o.trees && !(o.tree_spacing > 1.0f)) throw Error("city options", "tree spacing must exceed 1 m");
+  if (o.trees && !(o.park_share >= 0.0f && o.park_share <= 1.0f))
+    throw Error("city options", "park share must be in [0, 1]");
+  if (o.trees && (o.tree_leaves < 1 || o.tree_leaves > 100000))
+    throw Error("city options", "tree leaves must be in [1, 100000]");
 }
 
 // The ground: one grid over the ground rectangle whose lines are the rectangle's edges plus, with a hill, a
@@ -141,6 +147,7 @@ struct BlockJob {
   const Polygon2* footprint = nullptr;
   float height_scale = 1.0f;
   std::optional<Building> landmark;  // replaces the ordinary buildings
+  bool park = false;                 // trees instead of buildings (CityOptions::trees)
 };
 
 void buildBlock(const CityOptions& options, const Hill& hill, const BlockJob& job, BlockResult& result,
@@ -148,6 +155,7 @@ void buildBlock(const CityOptions& options, const Hill& hill, const BlockJob& jo
   const uint64_t seed = mixSeed(options.seed, job.face);
   Rng rng(mixSeed(seed, 0xb10c));
   result.facade_material = rng.uniformInt(0, 2);
+  if (job.park) return;
 
   std::vector<Building> buildings;
   if (job.landmark) {
@@ -271,6 +279,29 @@ std::string streetsPathFor(const std::string& glb_path) {
   return glb_path + ".streets.json";
 }
 
+// Street trees along every buildable block and scattered trees in the park blocks, after the blocks' objects.
+static void addCityTrees(const CityOptions& options, const Hill& hill, const std::vector<BlockFootprint>& blocks,
+                  const std::vector<BlockJob>& jobs, City& city) {
+  const VegetationMaterials materials = addVegetationMaterials(city.scene);
+  TreeOptions tree;
+  tree.leaves = options.tree_leaves;
+  auto ground = [&](Vec2 p) { return options.hill ? hillHeight(hill, p) : 0.0f; };
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    std::vector<Vec2> sites = streetTreeSites(std::span(&blocks[i].footprint, 1), options.tree_spacing, 2.0f);
+    if (jobs[i].park) {
+      ++city.parks;
+      const std::vector<Vec2> park =
+          parkTreeSites(blocks[i].footprint, 1.0f / 120.0f, 5.0f, 3.0f, mixSeed(options.seed, blocks[i].face));
+      sites.insert(sites.end(), park.begin(), park.end());
+    }
+    const std::vector<uint32_t> ids =
+        addTrees(city.scene, sites, ground, tree, mixSeed(options.seed, 0x7e3e0000ull + blocks[i].face), materials);
+    city.trees += ids.size();
+    city.object_block.insert(city.object_block.end(), ids.size(), int32_t(blocks[i].face));
+  }
+  city.scene.updateBounds();
+}
+
 City generateCity(const CityOptions& options) {
   validate(options);
   City city;
@@ -298,6 +329,9 @@ City generateCity(const CityOptions& options) {
     jobs[index].landmark = std::move(building);
     ++city.landmarks;
   }
+  if (options.trees)
+    for (BlockJob& job : jobs)
+      job.park = !job.landmark && Rng(mixSeed(options.seed, 0x9a4c0000ull + job.face)).uniform() < options.park_share;
 
   // Blocks are independent (each has its own seed), so workers build them in any order; the scene is assembled
   // in block order afterwards, so the result does not depend on the thread count.
@@ -371,6 +405,7 @@ City generateCity(const CityOptions& options) {
     r.objects.clear();
     r.objects.shrink_to_fit();
   }
+  if (options.trees) addCityTrees(options, hill, blocks, jobs, city);
   return city;
 }
 

@@ -18,6 +18,13 @@ struct CityOptions {
   int detail = 1;            // facade detail level 0..4: 0 = plain boxes, higher = windows, ledges, balconies
   bool hill = false;         // a hill in the middle of the city (as Montmartre), so panoramic views open up
   ObjectGrouping objects = ObjectGrouping::Blocks;
+  // Vegetation (gen/vegetation.h), off by default so the figures of cities without it stay valid: street trees
+  // every tree_spacing metres along the blocks (on the street's margin) and park_share of the blocks (not landmarks)
+  // turned into parks of scattered trees instead of buildings. One object per tree, after the blocks' objects.
+  bool trees = false;
+  float tree_spacing = 18.0f;   // metres, > 1
+  float park_share = 0.1f;      // 0..1
+  int tree_leaves = 300;        // leaf triangles per tree (about; varied per tree)
 };
 
 struct City {
@@ -30,6 +37,8 @@ struct City {
   size_t landmarks = 0;
   size_t skipped_blocks = 0;     // faces whose buildable area collapsed (street inset) or held no building
   size_t skipped_lots = 0;       // lots dropped as degenerate while subdividing blocks
+  size_t trees = 0;              // tree objects (CityOptions::trees)
+  size_t parks = 0;              // blocks turned into parks
 };
 
 // Deterministic for a given options value. Throws farfield::Error for options out of range.
