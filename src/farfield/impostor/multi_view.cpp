@@ -1,0 +1,121 @@
+// Tecchia, Loscos and Chrysanthou 2002 (Steed's lecture part 3, "Crowd using impostors"): precomputed views per
+// animation frame, the nearest one per agent.
+#include "farfield/impostor/multi_view.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "farfield/core/error.h"
+#include "farfield/core/timer.h"
+
+namespace farfield::impostor {
+
+namespace {
+
+Vec3 directionOf(float az, float el) {
+  return Vec3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+}
+
+}  // namespace
+
+Vec3 ViewGrid::direction(int cell) const { return directionOf(azimuth(cell % azimuths), elevation(cell / azimuths)); }
+
+int nearestView(const ViewGrid& grid, const Vec3& to_camera) {
+  const Vec3 d = glm::normalize(to_camera);
+  float az = std::atan2(d.y, d.x);
+  if (az < 0.0f) az += float(2.0 * kPi);
+  const int ai = int(std::lround(az / float(2.0 * kPi) * float(grid.azimuths))) % grid.azimuths;
+  // On a ring of fixed elevation the nearest view is the nearest azimuth; between the rings below and above the
+  // direction's elevation, compare the two candidates exactly (further rings are further still).
+  const float el = std::asin(std::clamp(d.z, -1.0f, 1.0f));
+  const float step = grid.max_elevation / float(grid.elevations);
+  const int below = std::clamp(int(std::floor(el / step)), 0, grid.elevations - 1);
+  const int above = std::min(below + 1, grid.elevations - 1);
+  const int a = below * grid.azimuths + ai, b = above * grid.azimuths + ai;
+  return glm::dot(grid.direction(a), d) >= glm::dot(grid.direction(b), d) ? a : b;
+}
+
+float worstViewAngle(const ViewGrid& grid) {
+  float worst = 0.0f;
+  const int n = 256;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j <= n / 4; ++j) {
+      const Vec3 d = directionOf(float(2.0 * kPi) * float(i) / float(n), grid.max_elevation * float(j) / float(n / 4));
+      const float c = std::clamp(glm::dot(grid.direction(nearestView(grid, d)), d), -1.0f, 1.0f);
+      worst = std::max(worst, std::acos(c));
+    }
+  return worst;
+}
+
+gpu::AtlasLayout atlasLayout(const Box3& bounds, const ViewGrid& grid, int frames, float texel_m) {
+  if (!(texel_m > 0.0f) || frames < 1) throw Error("multi-view atlas", "texel size and frame count must be positive");
+  gpu::AtlasLayout l;
+  l.azimuths = grid.azimuths;
+  l.elevations = grid.elevations;
+  l.frames = frames;
+  l.centre = bounds.center();
+  const Vec3 half = bounds.hi - l.centre;
+  // Seen from any azimuth the model stays within the vertical cylinder around the centre; from elevation e its
+  // vertical extent is at most half.z cos e + r sin e.
+  const float r = std::sqrt(half.x * half.x + half.y * half.y);
+  float hh = 0.0f;
+  for (int j = 0; j < grid.elevations; ++j) {
+    const float e = grid.elevation(j);
+    hh = std::max(hh, half.z * std::cos(e) + r * std::sin(e));
+  }
+  l.half_size = Vec2(r, hh) * 1.02f;
+  l.radius = glm::length(half) * 1.02f;
+  l.cell_width = std::max(4, int(std::ceil(2.0f * l.half_size.x / texel_m)));
+  l.cell_height = std::max(4, int(std::ceil(2.0f * l.half_size.y / texel_m)));
+  return l;
+}
+
+gpu::CaptureView captureView(const gpu::AtlasLayout& layout, const ViewGrid& grid, int cell) {
+  gpu::CaptureView v;
+  v.cell = cell;
+  v.to_camera = grid.direction(cell);
+  const Vec3 d = v.to_camera;
+  // Same axes as the runtime quad (multiview.vert.glsl): right = z x d, up = d x right.
+  Vec3 right = glm::cross(Vec3(0, 0, 1), d);
+  right = glm::dot(right, right) < 1e-8f ? Vec3(1, 0, 0) : glm::normalize(right);
+  const Vec3 up = glm::cross(d, right);
+  const Vec3 eye = layout.centre + d * (2.0f * layout.radius);
+  const Mat4 view = glm::lookAt(eye, layout.centre, up);
+  const Mat4 ortho = glm::orthoRH_ZO(-layout.half_size.x, layout.half_size.x, -layout.half_size.y, layout.half_size.y,
+                                     layout.radius * 0.999f, 3.0f * layout.radius * 1.001f);
+  Mat4 reverse(1.0f);  // z' = w - z: reversed Z, as every Farfield pass
+  reverse[2][2] = -1.0f;
+  reverse[3][2] = 1.0f;
+  v.view_proj = reverse * ortho * view;
+  return v;
+}
+
+SwitchDistances switchDistances(const gpu::AtlasLayout& layout, const ViewGrid& grid, double focal_px,
+                                double error_px) {
+  SwitchDistances s;
+  const double texel = 2.0 * double(layout.half_size.y) / double(layout.cell_height);
+  s.texel_m = texel * focal_px;
+  s.view_m = double(layout.half_size.x) * double(worstViewAngle(grid)) * focal_px / std::max(error_px, 1e-6);
+  return s;
+}
+
+MultiViewImpostor bakeMultiView(gpu::CrowdRenderer& renderer, const gpu::SkinnedGpuModel& model,
+                                const gpu::AtlasLayout& layout, const ViewGrid& grid) {
+  if (layout.frames < 1 || model.poseCount() % uint32_t(layout.frames) != 0)
+    throw Error("multi-view bake", std::to_string(model.poseCount()) + " palette poses are not a multiple of " +
+                                       std::to_string(layout.frames) + " frames");
+  Stopwatch clock;
+  MultiViewImpostor out;
+  out.grid = grid;
+  out.layout = layout;
+  out.atlas = std::make_unique<gpu::ImpostorAtlasGpu>(layout);
+  std::vector<gpu::CaptureView> views;
+  for (int c = 0; c < grid.viewCount(); ++c) views.push_back(captureView(layout, grid, c));
+  const uint32_t step = model.poseCount() / uint32_t(layout.frames);
+  for (int f = 0; f < layout.frames; ++f) renderer.capture(model, uint32_t(f) * step, *out.atlas, f, views);
+  renderer.finish();  // the bake time is the GPU's too
+  out.bake_seconds = clock.seconds();
+  return out;
+}
+
+}  // namespace farfield::impostor

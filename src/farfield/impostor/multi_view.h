@@ -1,0 +1,72 @@
+// Precomputed multi-view impostors for animated crowds: Tecchia, Loscos and Chrysanthou 2002, as in Steed's lecture
+// part 3, "Crowd using impostors" (32 azimuths x 8 elevations per animation frame, the best view chosen per agent).
+//
+// Views lie on a grid of azimuths (full circle, azimuth 0 = the agent's +x, its facing) and elevations (0 up to
+// below max_elevation, evenly spaced). Each view is an orthographic image of the model, centred on its capture centre,
+// of a fixed world extent (half_size) for every view so that one quad size fits all; an atlas layer holds every view
+// of one animation frame. Pure functions here (views, selection, error and memory estimates); the bake renders with
+// gpu::CrowdRenderer.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "farfield/core/bounds.h"
+#include "farfield/core/math.h"
+#include "farfield/gpu/crowd_renderer.h"
+
+namespace farfield::impostor {
+
+struct ViewGrid {
+  int azimuths = 32;
+  int elevations = 8;
+  float max_elevation = float(kPi / 2);  // radians: elevations j * max_elevation / elevations, j = 0..elevations-1
+
+  int viewCount() const { return azimuths * elevations; }
+  float azimuth(int i) const { return float(2.0 * kPi) * float(i) / float(azimuths); }
+  float elevation(int j) const { return max_elevation * float(j) / float(elevations); }
+  // Unit direction from the agent towards the camera of view `cell` (elevation * azimuths + azimuth), agent space.
+  Vec3 direction(int cell) const;
+};
+
+// The view whose direction is nearest (largest dot product) to the unit direction `to_camera` (agent space): the
+// nearest azimuth on the two elevation rings around the direction's elevation, compared exactly.
+int nearestView(const ViewGrid& grid, const Vec3& to_camera);
+
+// Largest angle (radians) between a direction with elevation in [0, max_elevation] and its nearest view, sampled
+// densely (a bound on the view quantisation the impostor shows).
+float worstViewAngle(const ViewGrid& grid);
+
+// The atlas for a model whose animated bounds (agent space: feet on z = 0, facing +x) are `bounds`: cells tall
+// enough that the texel is `texel_m` metres, each cell's world extent covering the model from every view of the grid.
+gpu::AtlasLayout atlasLayout(const Box3& bounds, const ViewGrid& grid, int frames, float texel_m);
+
+// Orthographic capture of view `cell` for the layout (reversed Z, depth range around the centre +- radius).
+gpu::CaptureView captureView(const gpu::AtlasLayout& layout, const ViewGrid& grid, int cell);
+
+// Distances (metres) beyond which an impostor keeps a promise, for a camera of `focal_px` (pixels per unit of
+// tangent, height / (2 tan(fov_y / 2))): Dobbyn et al.'s rule, a texel covers at most one pixel (texel_m *
+// focal_px); and the view error stays under `error_px` (the model's half width moves by at most radius * angle).
+struct SwitchDistances {
+  double texel_m = 0.0;
+  double view_m = 0.0;
+  double both() const { return std::max(texel_m, view_m); }
+};
+SwitchDistances switchDistances(const gpu::AtlasLayout& layout, const ViewGrid& grid, double focal_px,
+                                double error_px);
+
+// A baked model: layout, grid and the atlas on the GPU.
+struct MultiViewImpostor {
+  ViewGrid grid;
+  gpu::AtlasLayout layout;
+  std::unique_ptr<gpu::ImpostorAtlasGpu> atlas;
+  double bake_seconds = 0.0;
+  size_t byteSize() const { return atlas ? atlas->byteSize() : 0; }
+};
+
+// Renders every view of every frame: frame f shows palette pose f * model.poseCount() / layout.frames (the pose
+// count must be a multiple of the frame count; throws farfield::Error otherwise). Needs a current context.
+MultiViewImpostor bakeMultiView(gpu::CrowdRenderer& renderer, const gpu::SkinnedGpuModel& model,
+                                const gpu::AtlasLayout& layout, const ViewGrid& grid);
+
+}  // namespace farfield::impostor

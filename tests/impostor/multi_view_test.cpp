@@ -1,0 +1,142 @@
+#include "farfield/impostor/multi_view.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/scene/gltf_skin.h"
+#include "support/test_support.h"
+
+namespace farfield::impostor {
+namespace {
+
+TEST(MultiView, NearestViewIsTheBruteForceNearest) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (const ViewGrid grid : {ViewGrid{}, ViewGrid{8, 3, float(kPi / 4)}, ViewGrid{5, 7, float(kPi / 2)}}) {
+    for (int i = 0; i < 4000; ++i) {
+      Vec3 d(u(rng), u(rng), u(rng));
+      if (glm::length(d) < 1e-3f) continue;
+      d = glm::normalize(d);
+      float best = -2.0f;
+      for (int c = 0; c < grid.viewCount(); ++c) best = std::max(best, glm::dot(grid.direction(c), d));
+      const int got = nearestView(grid, d);
+      ASSERT_GE(got, 0);
+      ASSERT_LT(got, grid.viewCount());
+      EXPECT_NEAR(glm::dot(grid.direction(got), d), best, 1e-5f) << grid.azimuths << "x" << grid.elevations;
+    }
+  }
+}
+
+TEST(MultiView, LayoutCoversTheModelAndWorstAngleIsHalfASpacing) {
+  Box3 b;
+  b.expand(Vec3(-0.3f, -0.2f, 0.0f));
+  b.expand(Vec3(0.3f, 0.2f, 1.8f));
+  const ViewGrid grid;
+  const gpu::AtlasLayout l = atlasLayout(b, grid, 4, 0.03f);
+  EXPECT_GE(l.half_size.y, 0.9f);
+  EXPECT_GE(l.half_size.x, std::sqrt(0.3f * 0.3f + 0.2f * 0.2f));
+  EXPECT_EQ(l.cell_height, int(std::ceil(2.0f * l.half_size.y / 0.03f)));
+  // 32 x 8 over the quarter circle: azimuth spacing 11.25 deg, elevation spacing 11.25 deg; the worst direction
+  // lies between four views or above the top ring: more than half a spacing, at most one.
+  const float worst = float(radToDeg(worstViewAngle(grid)));
+  EXPECT_GT(worst, 5.6f);
+  EXPECT_LT(worst, 11.3f);  // the zenith, above the top ring (78.75 deg)
+}
+
+class MultiViewGl : public ::testing::Test {
+ protected:
+  void SetUp() override { gpu::sharedHeadlessContext(); }
+};
+
+struct Coverage {
+  size_t both = 0, either = 0, bad = 0;
+};
+
+Coverage compareAgents(const gpu::RenderTarget& a, const gpu::RenderTarget& b) {
+  const image::ColorImage ca = a.readColor(), cb = b.readColor();
+  const image::IdImage ia = a.readIds(), ib = b.readIds();
+  Coverage c;
+  for (size_t i = 0; i < ca.pixelCount(); ++i) {
+    const bool x = ia.pixels()[i] != 0, y = ib.pixels()[i] != 0;
+    if (!x && !y) continue;
+    ++c.either;
+    if (x && y) ++c.both;
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(int(ca.pixels()[i][k]) - int(cb.pixels()[i][k])) > 24) {
+        ++c.bad;
+        break;
+      }
+  }
+  return c;
+}
+
+// Seen from one of its capture views (a distant, narrow camera on the view's direction: nearly the orthographic
+// capture), the impostor shows what the skinned geometry shows: the same pixels covered, colours within 24/255 but
+// for texture detail resampled twice (atlas texels of 8 mm against pixels of 14 mm) and silhouette pixels.
+TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
+  const scene::SkinnedModel man =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  const scene::Animation* walk = &man.animations[0];
+  std::vector<std::vector<Mat4>> poses;
+  for (int p = 0; p < 2; ++p) poses.push_back(scene::jointMatrices(man, walk, walk->start + 0.4f * float(p)));
+  const Mat4 to_agent = glm::rotate(Mat4(1.0f), float(kPi / 2), Vec3(0, 0, 1));
+  gpu::SkinnedGpuModel model(man, to_agent, poses);
+  gpu::CrowdRenderer crowd;
+  const ViewGrid grid{8, 3, float(kPi / 4)};
+  Box3 bounds;
+  for (const auto& pose : poses)
+    for (const Vec3& p : scene::skinMesh(man, pose).positions) bounds.expand(Vec3(to_agent * Vec4(p, 1.0f)));
+  const gpu::AtlasLayout layout = atlasLayout(bounds, grid, 2, 0.008f);
+  MultiViewImpostor imp = bakeMultiView(crowd, model, layout, grid);
+  EXPECT_EQ(imp.byteSize(), size_t(layout.width()) * size_t(layout.height()) * 2 * 8);
+
+  gpu::LightSettings light;
+  const float heading = 0.7f;
+  for (const int cell : {3, 8 + 5, 16 + 1}) {
+    gpu::CrowdAgentGpu agent;
+    agent.pos_heading = Vec4(2.0f, -1.0f, 0.0f, heading);
+    agent.index = 1;
+    agent.object_id = 5;
+    const Vec3 local = grid.direction(cell);
+    const Vec3 world_dir = Vec3(glm::rotate(Mat4(1.0f), heading, Vec3(0, 0, 1)) * Vec4(local, 0.0f));
+    const Vec3 centre = Vec3(agent.pos_heading) +
+                        Vec3(glm::rotate(Mat4(1.0f), heading, Vec3(0, 0, 1)) * Vec4(layout.centre, 0.0f));
+    Camera camera;
+    camera.eye = centre + world_dir * 60.0f;
+    camera.at = centre;
+    camera.width = camera.height = 160;
+    camera.fov_y = float(2.0 * std::atan(1.1 / 60.0));
+    camera.near_plane = 10.0f;
+    camera.far_plane = 200.0f;
+    ASSERT_EQ(nearestView(grid, local), cell);
+
+    gpu::RenderTarget geo(160, 160), imp_target(160, 160), wrong(160, 160);
+    auto draw = [&](gpu::RenderTarget& t, int mode, uint32_t view) {
+      t.bindForOpaquePass();
+      t.clear(light.sky_color);
+      if (mode == 0) {
+        crowd.drawSkinned(camera, model, std::span(&agent, 1), light);
+      } else {
+        gpu::CrowdAgentGpu a = agent;
+        a.view = view;
+        crowd.drawImpostors(camera, *imp.atlas, std::span(&a, 1), light);
+      }
+    };
+    draw(geo, 0, 0);
+    draw(imp_target, 1, uint32_t(cell));
+    draw(wrong, 1, uint32_t((cell + 1) % grid.azimuths + (cell / grid.azimuths) * grid.azimuths));
+    const Coverage c = compareAgents(geo, imp_target);
+    EXPECT_GT(c.either, 1500u);
+    EXPECT_GT(double(c.both), 0.93 * double(c.either)) << "cell " << cell;
+    EXPECT_LT(double(c.bad), 0.15 * double(c.either)) << "cell " << cell << ": " << c.bad << " of " << c.either;
+    const Coverage w = compareAgents(geo, wrong);
+    EXPECT_LT(double(w.both), 0.85 * double(w.either)) << "cell " << cell << ": the wrong view must not match";
+  }
+}
+
+}  // namespace
+}  // namespace farfield::impostor
