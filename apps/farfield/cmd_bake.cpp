@@ -4,13 +4,14 @@
 //                [--layer-mesh grid|depth-mesh] [--grid-cells 30] [--views street|six] [--pvs-spacing M]
 //                [--pvs-face PX] [--near-radius M] [--landmarks IDS] [--landmark-boost X]
 //                [--resolution 512] [--fov DEG] [--eye-height M] [--path path.json]
-//                [--cells E,E,...] [--limit N] [--workers N] [--list] -o city.imp/
+//                [--cells E,E,...] [--limit N] [--workers N] [--list] [--shard K/N] [--resume] -o city.imp/
 // Runs the extractor pipeline (bake/pipeline.h, Decoret et al. 1999) over a city's viewing cells (oriented street
 // edges) into an impostor store directory (farfield/store/impostor_store.h): PVS, near/far split, the single mesh of
 // the far objects and the multi-mesh impostors, captures on the GL thread, meshes on the other core(s), with a
 // progress bar. `--technique depth-mesh|grid-mesh` (also the default without --pipeline) is Sillion et al. 1997's
 // cell impostor, which is the pipeline's single stage: `--pipeline near-far,single --layer-mesh depth-mesh|grid
-// --station-spacing 0` (one capture at each cell's start); it says so.
+// --station-spacing 0` (one capture at each cell's start); it says so. `--shard K/N` bakes part K of N of the cells
+// into a shard database (bake/shard.h; `farfield merge` joins them); `--resume` continues a killed bake.
 #include <algorithm>
 #include <cstdio>
 #include <functional>
@@ -65,6 +66,8 @@ struct BakeArgs {
   float near_radius = 0.0f;
   std::string landmarks;
   double landmark_boost = 2.0;
+  std::string shard;
+  bool resume = false;
 };
 
 std::vector<uint32_t> parseCells(const std::string& text, const char* what = "--cells") {
@@ -149,8 +152,24 @@ void runPipelineBake(const BakeArgs& args, const extract::PipelineSpec& spec, co
               extract::layerMeshName(options.mesh), options.grid_cells,
               options.grid_cells, extract::layerViewsName(options.views), options.base.resolution,
               options.base.resolution);
+  bake::BakeControl control;
+  if (!args.shard.empty()) control.shard = bake::parseShard(args.shard);
+  control.resume = args.resume;
   const bake::PipelineReport report = bake::bakePipeline(gpu::sharedHeadlessContext(), scene, cells, requested,
-                                                         spec, options, args.out_dir);
+                                                         spec, options, args.out_dir, control);
+  if (report.shard)
+    std::printf("shard:         %u/%u: %zu of the %zu cells of the view space\n", report.shard->index,
+                report.shard->count, report.cells.size(), report.view_space);
+  if (report.already_complete) {
+    std::printf("resume:        %s already holds this bake, complete (%zu cells): nothing to do\n",
+                args.out_dir.c_str(), report.cells.size());
+    return;
+  }
+  if (args.resume)
+    std::printf("resume:        %zu cells kept from the journal, %zu baked now (%zu rejected, %zu torn journal "
+                "line)\n",
+                report.resumed, report.cells.size() - report.resumed, report.resume_rejected,
+                report.torn_journal_lines);
   std::printf("threshold:     T = %.4f rad\n", report.threshold_rad);
   std::printf("cells:         %zu requested, %zu baked, %zu skipped (too short)\n", report.requested,
               report.cells.size(), report.skipped_degenerate.size());
@@ -247,6 +266,7 @@ void runBakeCommand(BakeArgs args, const std::function<bool(const char*)>& given
 
   // Cheap inputs first: pipeline options, streets and path fail before the scene is loaded.
   resolveTechnique(args, given);
+  if (!args.shard.empty()) bake::parseShard(args.shard);
   const extract::PipelineSpec spec = extract::parsePipeline(args.pipeline, args.online);
   const extract::PipelineOptions options = pipelineOptions(args);
   const std::string streets_file = args.streets.empty() ? gen::streetsPathFor(args.scene) : args.streets;
@@ -338,6 +358,10 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
   cmd->add_option("--near-radius", args->near_radius, "Near/far by distance to the street (metres) instead of the "
                                                       "local model (0)")
       ->capture_default_str();
+  cmd->add_option("--shard", args->shard, "Bake part K of N (0 <= K < N) of the cells, balanced by estimated work, "
+                                          "into a shard database; join the N shards with farfield merge");
+  cmd->add_flag("--resume", args->resume, "Continue the bake killed in the output directory (its journal), keeping "
+                                          "the cells it finished; a finished bake is left as it is");
   cmd->add_option("-o,--output", args->out_dir, "Impostor store directory")->required();
   cmd->callback([args, cmd] {
     runBakeCommand(*args, [cmd](const char* option) { return cmd->count(option) > 0; });

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <exception>
 #include <initializer_list>
+#include <map>
 #include <limits>
 #include <type_traits>
 #include <filesystem>
@@ -22,6 +23,8 @@
 #include "farfield/core/timer.h"
 #include "farfield/impostor/depth_mesh.h"
 #include "farfield/impostor/grid_mesh.h"
+#include "farfield/store/bake_journal.h"
+#include "farfield/store/store_compare.h"
 
 namespace fs = std::filesystem;
 
@@ -100,11 +103,89 @@ struct PipelineJob {
   store::CellEntry entry;
 };
 
+// A cell's report row from its record (a cell resumed from the journal).
+PipelineCellReport reportOf(const store::CellEntry& e) {
+  PipelineCellReport r;
+  r.half_edge = e.half_edge;
+  if (!e.pipeline) return r;
+  const store::CellPipeline& p = *e.pipeline;
+  r.pvs = p.pvs.size();
+  r.near = p.near.size();
+  r.far = p.far.size();
+  r.layers = p.layers.size();
+  for (const store::StoredLayer& l : p.layers)
+    for (const store::StoredView& v : l.views) r.layer_triangles += v.triangles;
+  for (const store::StoredView& v : p.single.views) r.single_triangles += v.triangles;
+  r.pvs_ms = p.pvs_ms;
+  r.weights_ms = p.weights_ms;
+  r.capture_ms = e.render_ms;
+  for (const store::StoredLayer* l : {&p.single})
+    for (const store::StoredView& v : l->views) r.build_ms += v.build_ms;
+  for (const store::StoredLayer& l : p.layers)
+    for (const store::StoredView& v : l.views) r.build_ms += v.build_ms;
+  return r;
+}
+
+// A cell's record as the index writes it (its "cells" element), for the journal.
+nlohmann::json cellRecord(const store::StoreIndex& header, const store::CellEntry& entry) {
+  store::StoreIndex one = header;
+  one.shard.reset();  // the record alone, not checked against the part
+  one.cells = {entry};
+  return store::indexToJson(one)["cells"][0];
+}
+
+// What identifies a bake for --resume: the index without its cells and storage, and the cells to bake.
+nlohmann::json bakeFingerprint(const store::StoreIndex& header, std::vector<uint32_t> todo) {
+  nlohmann::json j = store::indexToJson(header);
+  j.erase("cells");
+  j.erase("storage");
+  std::sort(todo.begin(), todo.end());
+  return {{"index", std::move(j)}, {"todo", todo}};
+}
+
+// Every file a cell's record names, with its check (a resumed cell must still have all of them, intact).
+bool cellFilesIntact(const std::string& dir, const store::CellEntry& e) {
+  if (!e.pipeline) return false;
+  std::vector<const store::StoredLayer*> layers{&e.pipeline->single};
+  for (const store::StoredLayer& l : e.pipeline->layers) layers.push_back(&l);
+  try {
+    for (const store::StoredLayer* l : layers)
+      for (const store::StoredView& v : l->views)
+        for (const auto& [name, check] : {std::pair{v.texture, v.texture_check}, std::pair{v.mesh, v.mesh_check},
+                                          std::pair{v.ids, v.ids_check}})
+          if (!name.empty()) store::readCheckedFile((fs::path(dir) / name).string(), check, "");
+  } catch (const Error&) {
+    return false;
+  }
+  return true;
+}
+
+// The finished database of this same bake in `dir`, if that is what it holds (--resume after the end).
+bool finishedAlready(const std::string& dir, store::StoreIndex header, const std::vector<uint32_t>& todo,
+                     const std::string& streets_text) {
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::path(dir) / store::kIndexFile, ec)) return false;
+  store::StoreIndex existing;
+  try {
+    existing = store::readIndex(dir);
+  } catch (const Error&) {
+    return false;
+  }
+  header.generation = existing.generation;
+  header.streets = store::streetsFileName(existing.generation);
+  header.streets_check = store::fileCheck(streets_text);
+  std::vector<uint32_t> have;
+  for (const store::CellEntry& e : existing.cells) have.push_back(e.half_edge);
+  std::vector<uint32_t> want = todo;
+  std::sort(want.begin(), want.end());
+  return have == want && bakeFingerprint(existing, {}) == bakeFingerprint(header, {});
+}
+
 }  // namespace
 
 PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, const urban::CellMap& cells,
                             std::vector<uint32_t> half_edges, const PipelineSpec& spec,
-                            const PipelineOptions& options, const std::string& out_dir) {
+                            const PipelineOptions& options, const std::string& out_dir, const BakeControl& control) {
   validatePipelineOptions(options);
   if (spec.stages.empty()) throw Error("--pipeline", "no stages given");
   if (options.base.workers < 0) throw Error("--workers", "must be 0 (automatic) or more");
@@ -114,21 +195,97 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
   Stopwatch wall;
   PipelineReport report;
   report.store_dir = out_dir;
+  report.shard = control.shard;
   CellSelection selection = selectCells(cells, std::move(half_edges));
-  const std::vector<uint32_t> todo = std::move(selection.todo);
+  std::vector<uint32_t> todo = std::move(selection.todo);
   report.skipped_degenerate = std::move(selection.skipped_degenerate);
   report.requested = selection.requested;
+  report.view_space = todo.size();
   {
     std::error_code ec;
     fs::create_directories(fs::path(out_dir) / "cells", ec);
     if (ec) throw Error(out_dir, "cannot create the store directory: " + ec.message());
   }
-  // A new generation of files next to those of the store being replaced (which stays readable until the new index
-  // is in place: store/impostor_store.h).
+  // The index's header, known before any cell is baked (the journal's fingerprint).
   store::StoreIndex index;
-  index.generation = store::nextGeneration(out_dir);
+  index.scene = options.base.scene_label;
+  index.scene_objects = scene.objects.size();
+  index.local_model = urban::localModelName(cells.options().local);
+  index.cell_lookup = urban::cellLookupName(cells.options().lookup);
+  index.pipeline = spec.stages;
+  index.online = spec.online();
+  index.options = {{"pipeline", pipelineOptionsToJson(options)}, {"block_margin", cells.options().block_margin}};
+  if (control.shard) {
+    store::ShardRecord shard;
+    shard.index = control.shard->index;
+    shard.count = control.shard->count;
+    shard.scene_crc32 = sceneDigest(scene);
+    shard.view_space = todo;
+    std::sort(shard.view_space.begin(), shard.view_space.end());
+    shard.cells = partitionCells(todo, cellWeights(cells, todo, options), shard.count)[shard.index];
+    todo = shard.cells;
+    index.shard = std::move(shard);
+  }
+  const std::string streets_text = cells.graph().toJson().dump() + "\n";
+
+  // Resume: the journal's generation and finished cells; otherwise a new generation of files next to those of the
+  // store being replaced (which stays readable until the new index is in place: store/impostor_store.h).
+  std::vector<store::CellEntry> entries;
+  std::vector<nlohmann::json> journal_cells;
+  std::optional<store::JournalContents> journal;
+  if (control.resume) journal = store::readJournal(out_dir);
+  const std::string journal_file = (fs::path(out_dir) / store::kJournalFile).string();
+  if (journal) {
+    const nlohmann::json& g = journal->header.contains("index") ? journal->header["index"].value("generation", nlohmann::json())
+                                                                 : nlohmann::json();
+    if (!g.is_number_unsigned() || g.get<uint64_t>() == 0)
+      throw Error(journal_file, "line 1: the header has no generation: start the bake without --resume");
+    index.generation = g.get<uint64_t>();
+  } else {
+    if (control.resume && finishedAlready(out_dir, index, todo, streets_text)) {
+      store::StoreIndex done = store::readIndex(out_dir);
+      for (const store::CellEntry& e : done.cells) report.cells.push_back(reportOf(e));
+      report.already_complete = true;
+      report.resumed = done.cells.size();
+      report.storage = done.storage;
+      report.wall_s = wall.seconds();
+      return report;
+    }
+    index.generation = store::nextGeneration(out_dir);
+  }
   const uint64_t generation = index.generation;
-  store::writeStreets(out_dir, index, cells.graph().toJson().dump() + "\n");
+  store::writeStreets(out_dir, index, streets_text);
+  const nlohmann::json fingerprint = bakeFingerprint(index, todo);
+  if (journal) {
+    if (journal->header != fingerprint)
+      throw Error(journal_file, "the bake in progress is another bake (" +
+                                    store::firstDifference(journal->header, fingerprint) +
+                                    "): run it with its own arguments, or without --resume to start again");
+    report.torn_journal_lines = journal->torn_lines;
+    // The journal's records, validated as an index holds them; a cell recorded twice keeps its last record.
+    std::map<uint32_t, nlohmann::json> by_cell;
+    for (const nlohmann::json& c : journal->cells)
+      if (c.is_object() && c.contains("half_edge") && c["half_edge"].is_number_unsigned())
+        by_cell[c["half_edge"].get<uint32_t>()] = c;
+    nlohmann::json j = store::indexToJson(index);
+    j["cells"] = nlohmann::json::array();
+    for (auto& [cell, record] : by_cell) j["cells"].push_back(record);
+    store::StoreIndex recorded = store::indexFromJson(j, journal_file);
+    for (store::CellEntry& e : recorded.cells) {
+      if (!std::binary_search(fingerprint["todo"].begin(), fingerprint["todo"].end(), nlohmann::json(e.half_edge)) ||
+          !cellFilesIntact(out_dir, e)) {
+        ++report.resume_rejected;
+        continue;
+      }
+      journal_cells.push_back(by_cell[e.half_edge]);
+      entries.push_back(std::move(e));
+    }
+    report.resumed = entries.size();
+    std::set<uint32_t> finished;
+    for (const store::CellEntry& e : entries) finished.insert(e.half_edge);
+    std::erase_if(todo, [&](uint32_t c) { return finished.count(c) > 0; });
+  }
+  store::JournalWriter journal_writer(out_dir, fingerprint, journal_cells);
 
   const std::vector<std::string> baked = spec.baked();
   const bool bake_images = std::find(baked.begin(), baked.end(), kStageMmi) != baked.end() ||
@@ -137,8 +294,8 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
   report.workers = workers;
 
   std::mutex results_mutex;
-  std::vector<store::CellEntry> entries;
   std::vector<PipelineCellReport> records;
+  for (const store::CellEntry& e : entries) records.push_back(reportOf(e));
   context.makeCurrent();
   gpu::GpuScene gpu_scene(scene);
   PipelineRunner runner(scene, gpu_scene, cells, options);  // outlives the workers, which build meshes with it
@@ -197,6 +354,9 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
     job.entry.pipeline = std::move(w.result);
     w.layer_views.clear();
     w.single_views.clear();
+    // The cell is finished once its files are durable and the journal names them.
+    store::syncCellFiles(out_dir);
+    journal_writer.append(cellRecord(index, job.entry));
     std::lock_guard<std::mutex> lock(results_mutex);
     records.push_back(r);
     entries.push_back(std::move(job.entry));
@@ -210,16 +370,10 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
   std::sort(records.begin(), records.end(),
             [](const PipelineCellReport& a, const PipelineCellReport& b) { return a.half_edge < b.half_edge; });
 
-  index.scene = options.base.scene_label;
-  index.scene_objects = scene.objects.size();
-  index.local_model = urban::localModelName(cells.options().local);
-  index.cell_lookup = urban::cellLookupName(cells.options().lookup);
-  index.pipeline = spec.stages;
-  index.online = spec.online();
-  index.options = {{"pipeline", pipelineOptionsToJson(options)}, {"block_margin", cells.options().block_margin}};
   index.cells = std::move(entries);
   index.storage = storageReport(index, out_dir, options, cells.cellCount());
   store::writeIndex(out_dir, index);
+  store::removeJournal(out_dir);
 
   report.cells = std::move(records);
   report.threshold_rad = threshold;

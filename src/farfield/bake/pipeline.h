@@ -5,12 +5,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "farfield/bake/bake.h"
+#include "farfield/bake/shard.h"
 #include "farfield/extract/pipeline_options.h"
 #include "farfield/extract/pipeline_runner.h"
 #include "farfield/gpu/context.h"
@@ -28,8 +30,20 @@ struct PipelineCellReport {
   double pvs_ms = 0.0, weights_ms = 0.0, capture_ms = 0.0, build_ms = 0.0;
 };
 
+// How a bake covers its view space (bake/shard.h, store/bake_journal.h).
+struct BakeControl {
+  std::optional<ShardSpec> shard;  // bake only this part of the view space, into a shard database
+  bool resume = false;             // continue the bake the journal in the output directory records
+};
+
 struct PipelineReport {
-  std::vector<PipelineCellReport> cells;  // sorted by half-edge
+  std::vector<PipelineCellReport> cells;  // sorted by half-edge (resumed cells included)
+  size_t view_space = 0;                  // cells of the whole bake (all shards)
+  std::optional<ShardSpec> shard;
+  size_t resumed = 0;                     // cells taken from the journal of a killed bake
+  size_t resume_rejected = 0;             // journal cells whose files failed their checks (baked again)
+  size_t torn_journal_lines = 0;          // the journal's cut last line (the cell the crash interrupted)
+  bool already_complete = false;          // --resume found the finished database: nothing was baked
   std::vector<uint32_t> skipped_degenerate;
   size_t requested = 0;
   size_t workers = 0;
@@ -51,8 +65,16 @@ nlohmann::json storageReport(const store::StoreIndex& index, const std::string& 
 // on the calling thread, meshes and files on worker threads, a progress bar. The store holds what the bench modes
 // local, visible, smi (and depth-mesh, grid-mesh: the single stage), mmi and mmi-dynamic need. Throws
 // farfield::Error for bad options or unwritable files.
+//
+// Each finished cell is recorded in out_dir's journal (store/bake_journal.h) and the index is written at the end,
+// so the previous database in out_dir stays readable until then. With control.resume, the cells the journal holds
+// (their files checked) are kept and the rest baked, into the same generation; a journal of another bake (other
+// options, scene, cells or shard) is an error; without a journal, a finished database of this same bake is left as
+// it is (already_complete) and anything else starts from the beginning. With control.shard, only that part of the
+// view space (bake/shard.h) is baked and the index records the shard (store/impostor_store.h) for `farfield merge`.
 PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, const urban::CellMap& cells,
                             std::vector<uint32_t> half_edges, const extract::PipelineSpec& spec,
-                            const extract::PipelineOptions& options, const std::string& out_dir);
+                            const extract::PipelineOptions& options, const std::string& out_dir,
+                            const BakeControl& control = {});
 
 }  // namespace farfield::bake

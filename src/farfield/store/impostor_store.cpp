@@ -320,6 +320,41 @@ CellPipeline readPipeline(const JsonReader& r, const nlohmann::json& j, const st
   return p;
 }
 
+// Cell ids, ascending without repeats.
+std::vector<uint32_t> readCellIds(const JsonReader& r, const nlohmann::json& j, const char* key,
+                                  const std::string& where) {
+  const nlohmann::json& list = r.member(j, key, where);
+  if (!list.is_array()) r.fail(where, std::string("\"") + key + "\" must be an array of cell ids");
+  std::vector<uint32_t> out;
+  for (const nlohmann::json& id : list) {
+    if (!id.is_number_unsigned() || id.get<uint64_t>() >= 0xffffffffu)
+      r.fail(where, std::string("\"") + key + "\" holds something that is not a cell id");
+    if (!out.empty() && id.get<uint32_t>() <= out.back())
+      r.fail(where, std::string("\"") + key + "\" must be ascending without repeats");
+    out.push_back(id.get<uint32_t>());
+  }
+  return out;
+}
+
+ShardRecord readShard(const JsonReader& r, const nlohmann::json& j, const std::vector<CellEntry>& cells) {
+  const std::string where = "\"shard\"";
+  if (!j.is_object()) r.fail(where, "must be an object");
+  r.onlyKeys(j, {"index", "count", "scene_crc32", "view_space", "cells"}, where);
+  ShardRecord s;
+  s.count = uint32_t(r.integer(j, "count", where, 1, 0xffffffffLL));
+  s.index = uint32_t(r.integer(j, "index", where, 0, int64_t(s.count) - 1));
+  s.scene_crc32 = uint32_t(r.integer(j, "scene_crc32", where, 0, 0xffffffffLL));
+  s.view_space = readCellIds(r, j, "view_space", where);
+  s.cells = readCellIds(r, j, "cells", where);
+  for (uint32_t c : s.cells)
+    if (!std::binary_search(s.view_space.begin(), s.view_space.end(), c))
+      r.fail(where, "cell " + std::to_string(c) + " of the shard's part is not in its view space");
+  for (const CellEntry& e : cells)
+    if (!std::binary_search(s.cells.begin(), s.cells.end(), e.half_edge))
+      r.fail("cells", "cell " + std::to_string(e.half_edge) + " is not in this shard's part (\"shard\".cells)");
+  return s;
+}
+
 }  // namespace
 
 const CellEntry* StoreIndex::find(uint32_t half_edge) const {
@@ -380,6 +415,10 @@ nlohmann::json indexToJson(const StoreIndex& index) {
     cells.push_back(std::move(cell));
   }
   j["cells"] = std::move(cells);
+  if (index.shard)
+    j["shard"] = {{"index", index.shard->index},           {"count", index.shard->count},
+                  {"scene_crc32", index.shard->scene_crc32}, {"view_space", index.shard->view_space},
+                  {"cells", index.shard->cells}};
   return j;
 }
 
@@ -495,6 +534,7 @@ StoreIndex indexFromJson(const nlohmann::json& j, const std::string& source) {
                                 legacy_single, e.half_edge);
     index.cells.push_back(std::move(e));
   }
+  if (j.contains("shard")) index.shard = readShard(r, j["shard"], index.cells);
   return index;
 }
 
@@ -734,6 +774,13 @@ void writeIndex(const std::string& dir, const StoreIndex& index) {
   syncDirectory(dir);
   writeFileAtomic(file, text, true);
   removeStaleFiles(dir, index);
+}
+
+void syncCellFiles(const std::string& dir) {
+  std::error_code ec;
+  const fs::path cells = fs::path(dir) / "cells";
+  if (fs::is_directory(cells, ec)) syncDirectory(cells.string());
+  syncDirectory(dir);
 }
 
 StoreIndex readIndex(const std::string& dir) {

@@ -73,6 +73,12 @@
 //   formats), the old layout is written. The Sillion records of versions 1-3 ("techniques", a cell's "texture" and
 //   "impostors") are still read and checked, but nothing writes them any more but writeCell (kept for the tests of
 //   the format) and nothing draws them: re-bake such a store with `farfield bake --technique`.
+//   A shard of a sharded bake (`farfield bake --shard K/N`, bake/shard.h) carries, in any version, what
+//   `farfield merge` checks before joining the shards into one database:
+//     "shard": {"index": K, "count": N, "scene_crc32": C,        // C: bake/shard.h's digest of the scene baked
+//               "view_space": [...],                              // every cell of the whole bake, ascending
+//               "cells": [...]}                                   // this shard's part of it, ascending
+//   and its "cells" records hold only cells of its part. A database without "shard" is whole.
 //   Cells are sorted by half-edge id, each at most once. Numbers are JSON numbers (floats written with enough digits
 //   to read back exactly).
 //
@@ -199,6 +205,15 @@ struct CellEntry {
   std::optional<CellPipeline> pipeline;              // stores written by `farfield bake --pipeline`
 };
 
+// The part of a sharded bake a database holds (see the format above).
+struct ShardRecord {
+  uint32_t index = 0;
+  uint32_t count = 1;
+  uint32_t scene_crc32 = 0;
+  std::vector<uint32_t> view_space;  // ascending
+  std::vector<uint32_t> cells;       // ascending, a subset of view_space
+};
+
 struct StoreIndex {
   int version = kIndexVersion;
   uint64_t generation = 0;               // number in the data file names (version 3; see the format above)
@@ -216,6 +231,7 @@ struct StoreIndex {
   std::vector<std::string> online;
   nlohmann::json storage = nlohmann::json::object();  // the paper's storage estimate next to the bytes written
   std::vector<CellEntry> cells;  // sorted by half_edge
+  std::optional<ShardRecord> shard;  // a shard of a sharded bake; none for a whole database
 
   // The entry of a half-edge, or null when the cell was not baked.
   const CellEntry* find(uint32_t half_edge) const;
@@ -252,6 +268,9 @@ void writeStreets(const std::string& dir, StoreIndex& index, std::string_view te
 FileCheck fileCheck(std::string_view bytes);
 // Writes `bytes` to path.tmp, fsyncs it and renames it over `path`; with sync_directory also fsyncs the directory.
 FileCheck writeFileAtomic(const std::string& path, std::string_view bytes, bool sync_directory = true);
+// fsyncs DIR/cells (and DIR): the data files renamed there so far become durable (what a journal line that names
+// them needs first: store/bake_journal.h).
+void syncCellFiles(const std::string& dir);
 // Reads a file named by the index and, when check.known, checks its size and CRC-32; throws farfield::Error
 // "PATH: RECORD: truncated: N of M bytes" / "... checksum mismatch ..." / "... cannot open ...".
 std::string readCheckedFile(const std::string& path, const FileCheck& check, const std::string& record);
