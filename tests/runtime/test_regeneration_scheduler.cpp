@@ -1,0 +1,69 @@
+// runtime/regeneration_scheduler.h against an exhaustive check of its rule: the prediction is the sum of what was
+// chosen, never above t_max when the all-geometry frame was not, and every skipped request that is more invalid
+// than a chosen one did not fit when its turn came.
+#include "farfield/runtime/regeneration_scheduler.h"
+
+#include <algorithm>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace farfield::runtime {
+namespace {
+
+TEST(RegenerationScheduler, MostInvalidFirstUnderTheBudget) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 500; ++trial) {
+    std::vector<RegenerationRequest> req(1 + trial % 20);
+    for (size_t i = 0; i < req.size(); ++i) {
+      req[i].node = uint32_t(i);
+      req[i].error_ratio = i % 7 == 3 ? std::numeric_limits<double>::infinity() : 1.0 + 5 * u(rng);
+      req[i].geometry_ms = 3 * u(rng);
+      req[i].regenerate_ms = req[i].geometry_ms + 0.2 + u(rng);
+      req[i].image_ms = 0.05;
+    }
+    const double base = 2.0;
+    double all_geometry = base;
+    for (const auto& r : req) all_geometry += r.geometry_ms;
+    const double t_max = all_geometry + 4 * u(rng);
+    const int cap = trial % 3 == 0 ? 2 : 100;
+    const RegenerationSchedule s = scheduleRegenerations(req, base, t_max, cap);
+    EXPECT_EQ(s.regenerate.size() + s.geometry.size(), req.size());
+    EXPECT_LE(int(s.regenerate.size()), cap);
+    double predicted = all_geometry;
+    for (const uint32_t n : s.regenerate) predicted += req[n].regenerate_ms + req[n].image_ms - req[n].geometry_ms;
+    EXPECT_NEAR(s.predicted_ms, predicted, 1e-9);
+    EXPECT_LE(s.predicted_ms, t_max + 1e-9);
+    // Replay in priority order: a skipped request did not fit at its turn (or the cap was reached).
+    std::vector<size_t> order(req.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return req[a].error_ratio > req[b].error_ratio; });
+    double running = all_geometry;
+    size_t next = 0;
+    for (const size_t i : order) {
+      const double delta = req[i].regenerate_ms + req[i].image_ms - req[i].geometry_ms;
+      const bool taken = next < s.regenerate.size() && s.regenerate[next] == req[i].node;
+      if (taken) {
+        running += delta;
+        ++next;
+      } else {
+        EXPECT_TRUE(running + delta > t_max || int(next) == cap) << "trial " << trial;
+      }
+    }
+    EXPECT_EQ(next, s.regenerate.size());
+  }
+}
+
+TEST(RegenerationScheduler, NoBudgetRegeneratesUpToTheCount) {
+  std::vector<RegenerationRequest> req(5);
+  for (size_t i = 0; i < req.size(); ++i) req[i] = {uint32_t(i), double(i) + 2, 10.0, 1.0, 0.0};
+  const RegenerationSchedule s = scheduleRegenerations(req, 0.0, 0.0, 3);
+  EXPECT_EQ(s.regenerate, (std::vector<uint32_t>{4, 3, 2}));
+  EXPECT_EQ(s.geometry, (std::vector<uint32_t>{1, 0}));
+}
+
+}  // namespace
+}  // namespace farfield::runtime
