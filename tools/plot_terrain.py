@@ -6,7 +6,8 @@ OUTDIR/figures, written next to them as PNG:
   fig06_views.png                  Figure 6/7 panels: low, high, LOD-sprite and the two difference images per view
   fig09_triangles.png              triangles per frame, semi-log (high, low, LOD-sprite)
   fig10_error.png                  LOD-sprite error (pixels) per frame
-  fig11_time.png                   frame time per frame for every mode
+  fig11_time.png                   frame time per frame for every mode (red ticks: frames where lod-sprite
+                                   chose the high LOD)
   fig12_keyframes_vs_frames.png    keyframe fraction against the number of frames over the same path
   fig13_keyframes_vs_epsilon.png   keyframe fraction against the error threshold
   fig14_speedup_vs_epsilon.png     speedup over high resolution against the error threshold
@@ -102,6 +103,12 @@ def main(argv):
             fig, ax = plt.subplots(figsize=(7, 4))
             keyframe_marks(ax, e["frame"], e["keyframe"])
             ax.plot(e["frame"], e["error_px"], label="error of the sprite in use")
+            if "path" in e:
+                high = [(f, v) for f, p, v in zip(e["frame"], e["path"], e["trigger_error_px"]) if p == "high"]
+                if high:
+                    ax.plot([f for f, _ in high], [0.0] * len(high), linestyle="none", marker="|", color="red",
+                            label="high LOD drawn (per-frame choice)")
+                ax.legend(fontsize=8)
             ax.set_xlabel("frame")
             ax.set_ylabel("error (pixels)")
             ax.set_title("LOD-sprite error per frame (Fig. 10; grey lines: keyframes)")
@@ -117,6 +124,12 @@ def main(argv):
             ax.set_yscale("log")
             ax.set_xlabel("frame")
             ax.set_ylabel("time (ms)")
+            if "lod_sprite_path" in tm:
+                high = [f for f, p in zip(tm["frame"], tm["lod_sprite_path"]) if p == "high"]
+                if high:
+                    lo = min(v for key in tm if key.endswith("_ms") for v in tm[key] if v == v and v > 0)
+                    ax.plot(high, [lo * 0.8] * len(high), linestyle="none", marker="|", color="red", markersize=6,
+                            label="lod-sprite drew the high LOD (%d frames)" % len(high))
             ax.set_title("Frame time (Fig. 11)")
             ax.legend(fontsize=8)
             save(fig, "fig11_time.png")

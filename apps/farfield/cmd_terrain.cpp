@@ -2,7 +2,8 @@
 // farfield terrain path DEM -o FILE [--frames N] [--fov DEG]
 // farfield terrain bench DEM [--path FILE | --frames N] [--epsilon PX] -o OUTDIR [--size WxH] [--high-error PX]
 //                        [--low-error PX] [--reference] [--quality-stride K] [--sweep-epsilons LIST]
-//                        [--sweep-frames LIST] [--no-sweeps] [--no-plots] [--no-choice]
+//                        [--sweep-frames LIST] [--no-sweeps] [--no-section5] [--no-plots] [--no-choice]
+//                        [--clearance M] [--full-max-triangles N]
 // DEM: a GeoTIFF / netCDF / 16-bit PNG file or fractal:SIZE[:SEED].
 //
 // The LOD-sprite experiment (Chen et al. 1999) is eval::runTerrainBench (eval/terrain_bench.h). Its modes are
@@ -53,7 +54,7 @@ struct BenchText {
   std::string sweep_epsilons = "0.25,0.5,1,2,4,8";
   std::string sweep_frames = "75,150,300,600,1200,2400";
   std::string modes = "high,low,lod-sprite,lod-sprite-always,lod-sprite-predict,lod-sprite-cache";
-  bool no_sweeps = false, no_plots = false, no_choice = false;
+  bool no_sweeps = false, no_plots = false, no_choice = false, no_section5 = false;
 };
 
 void runBench(BenchText& a) {
@@ -72,6 +73,7 @@ void runBench(BenchText& a) {
   a.o.sweeps = !a.no_sweeps;
   a.o.plots = !a.no_plots;
   a.o.choice = !a.no_choice;
+  a.o.section5 = !a.no_section5;
   const eval::TerrainBenchResult result = eval::runTerrainBench(a.o);
   std::printf("\n%s\n", result.markdown.c_str());
   std::printf("wrote %s/{bench.json,terrain.json,terrain.md,figures/} in %.0f s\n", a.o.out_dir.c_str(),
@@ -139,6 +141,8 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
   bench->add_option("--frames", o.frames, "Frames of the generated flythrough")
       ->capture_default_str()
       ->excludes(path_opt);
+  bench->add_option("--clearance", o.clearance, "Flythrough height above the ground near it, m (0 = 2% of the diagonal)")
+      ->capture_default_str();
   bench->add_option("--epsilon", o.epsilon, "LOD-sprite error threshold, pixels")->capture_default_str();
   bench->add_option("-o,--output", o.out_dir, "Output directory")->required();
   bench->add_option("--size", a->size, "Frame size WxH")->capture_default_str();
@@ -152,10 +156,14 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
   bench->add_option("--sweep-frames", a->sweep_frames, "Frame counts for Figure 12")->capture_default_str();
   bench->add_flag("--no-sweeps", a->no_sweeps, "Skip Figures 12-14");
   bench->add_flag("--no-plots", a->no_plots, "CSV only");
+  bench->add_flag("--no-section5", a->no_section5, "Skip section 5's variants on the back-and-forth stretch");
   bench->add_flag("--no-choice", a->no_choice,
                   "No cost calibration: lod-sprite takes the sprite path on every frame (as lod-sprite-always)");
   bench->add_option("--python", o.python, "Python interpreter for the plots");
   bench->add_option("--block", o.block, "LOD block size in cells")->capture_default_str();
+  bench->add_option("--full-max-triangles", o.full_max_triangles,
+                    "Above this many full-resolution triangles the harness's full baseline draws nothing")
+      ->capture_default_str();
   bench->callback([a] { runBench(*a); });
 });
 

@@ -271,6 +271,29 @@ TEST(TerrainSpec, FractalSpecsAreWholeNumbersOnly) {
   EXPECT_EQ(TerrainData::load("fractal:33:7")->source.width, 33);
 }
 
+TEST(TerrainSpec, FractalSpecsTakeReliefRoughnessAndCell) {
+  const FractalOptions f = parseFractalSpec("fractal:8193:23:relief=3000:roughness=0.75:cell=10");
+  EXPECT_EQ(f.size, 8193);
+  EXPECT_EQ(f.seed, 23u);
+  EXPECT_EQ(f.relief, 3000.0);
+  EXPECT_EQ(f.roughness, 0.75);
+  EXPECT_EQ(f.cell_size, 10.0);
+  EXPECT_EQ(parseFractalSpec("fractal:65:1:relief=10").roughness, FractalOptions{}.roughness);
+  for (const char* bad : {"fractal:33:1:relief", "fractal:33:1:relief=", "fractal:33:1:relief=-5",
+                          "fractal:33:1:relief=1e999", "fractal:33:1:relief=5x", "fractal:33:1:height=5",
+                          "fractal:33:1:cell=0", "fractal:33:relief=5"}) {
+    try {
+      parseFractalSpec(bad);
+      ADD_FAILURE() << bad << ": no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(std::string(bad) + ": ", 0), 0u) << e.what();
+    }
+  }
+  const auto data = TerrainData::load("fractal:33:7:relief=100:cell=5");
+  EXPECT_EQ(data->source.cell_x, 5.0);
+  EXPECT_NEAR(data->source.maxHeight() - data->source.minHeight(), 100.0, 1e-3);
+}
+
 TEST(Heightfield, FillNodataFillsHolesAndCounts) {
   Heightfield hf(9, 7, 1.0);
   hf.source = "plane";

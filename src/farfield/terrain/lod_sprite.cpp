@@ -112,6 +112,7 @@ void LodSpriteRenderer::reset() {
   anchor_since_ = 0;
   lifetimes_.clear();
   high_triangles_frame_ = high_triangles_key_ = 0;
+  high_latest_is_key_ = false;
 }
 
 const Camera* LodSpriteRenderer::spriteCamera() const { return current_ ? &current_->camera : nullptr; }
@@ -169,6 +170,7 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
   add(stats, renderer_.drawTextured(k->camera, k->target, 0, high_.triangleCount(), 0));
   info.keyframe_triangles += high_.triangleCount();
   high_triangles_key_ = high_.triangleCount();
+  high_latest_is_key_ = true;
   k->depth = k->target.readDepth();
   k->ready = true;
   ++counters_.fresh_keyframes;
@@ -251,11 +253,11 @@ PathCosts LodSpriteRenderer::predictCosts(size_t low_triangles) const {
   const TerrainCost& c = *options_.cost;
   const Camera key = keyframeCamera(Camera{});
   const double area_ratio = double(key.width) * double(key.height) / (double(width_) * double(height_));
-  // The high LOD's size changes slowly along a path: the last one seen stands for this frame's. One camera's count
-  // stands for the other's, scaled by the image area, until both have been seen.
+  // The high LOD's size changes slowly along a path: the latest count seen (at the frame's or at a keyframe's camera)
+  // stands for this frame's, scaled by the image area for the other camera.
   double frame_tris = double(high_triangles_frame_), key_tris = double(high_triangles_key_);
-  if (!high_triangles_frame_) frame_tris = key_tris / area_ratio;
-  if (!high_triangles_key_) key_tris = frame_tris * area_ratio;
+  if (high_latest_is_key_) frame_tris = key_tris / area_ratio;
+  else key_tris = frame_tris * area_ratio;
   PathCosts p;
   p.high_ms = c.frameMs(frame_tris, 1.0, width_, height_);
   p.sprite_ms = c.frameMs(double(low_triangles), 2.0, width_, height_);
@@ -271,6 +273,7 @@ gpu::FrameStats LodSpriteRenderer::renderHigh(const Camera& camera, gpu::RenderT
       renderLodFrame(lod_, renderer_, camera, LodSettings{options_.high_error, true, false}, target, high_);
   info.high_triangles = high_.triangleCount();
   high_triangles_frame_ = high_.triangleCount();
+  high_latest_is_key_ = false;
   return stats;
 }
 

@@ -182,6 +182,7 @@ class LodSpriteRenderer {
   std::deque<uint64_t> lifetimes_;
   uint64_t high_triangles_frame_ = 0;  // last high-LOD triangle counts seen at the frame's and the keyframe's camera
   uint64_t high_triangles_key_ = 0;
+  bool high_latest_is_key_ = false;
 };
 
 }  // namespace farfield::terrain

@@ -61,11 +61,13 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
       camera.width = w;
       camera.height = h;
       const Mat4 sprite_view_proj = camera.viewProjection();
-      // Warm-up (untimed): first use of this target and the densest mesh.
+      // Warm-up (untimed): first use of this target, of both programs (llvmpipe compiles a shader variant at its first
+      // draw) and the densest mesh.
       lod.build(camera, LodSettings{options.pixel_errors.front(), true, false}, mesh);
       renderer.setIndices(mesh.indices, 0);
       target.clear(sky);
       renderer.drawTextured(camera, target, 0, mesh.triangleCount(), 0);
+      renderer.drawSprite(camera, target, sprite.colorTexture(), sprite_view_proj, 0, mesh.triangleCount(), 0);
       renderer.finish();
       for (const float tau : options.pixel_errors)
         for (const bool with_sprite : {false, true}) {

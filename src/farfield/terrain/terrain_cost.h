@@ -36,7 +36,7 @@ struct TerrainCostOptions {
   int keyframe_width = 0;     // the keyframe target (frame plus guard band); 0 = the views' size
   int keyframe_height = 0;
   std::vector<float> pixel_errors{1.0f, 2.0f, 4.0f, 16.0f};  // LOD thresholds timed (the triangle term's spread)
-  int repeats = 2;            // timed renders per workload (median kept; one untimed warm-up per view and size)
+  int repeats = 3;            // timed renders per workload (median kept; one untimed warm-up per view and size)
 };
 
 // Times the LOD meshes of the views at each threshold, drawn with the original texture and (two draw calls, as a

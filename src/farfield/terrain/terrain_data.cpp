@@ -1,9 +1,11 @@
 #include "farfield/terrain/terrain_data.h"
 
 #include <charconv>
+#include <cmath>
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <vector>
 
 #include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
@@ -25,18 +27,37 @@ std::optional<uint64_t> decimal(std::string_view text) {
 }  // namespace
 
 FractalOptions parseFractalSpec(const std::string& spec) {
-  const std::string usage = "expected fractal:SIZE or fractal:SIZE:SEED (SIZE = 2^n + 1, e.g. fractal:513:7)";
+  const std::string usage =
+      "expected fractal:SIZE or fractal:SIZE:SEED, then optionally :relief=M :roughness=R :cell=M (SIZE = 2^n + 1, "
+      "e.g. fractal:513:7 or fractal:8193:3:relief=4000:roughness=0.62)";
   if (spec.rfind("fractal:", 0) != 0) throw Error(spec, usage);
-  const std::string_view rest = std::string_view(spec).substr(8);
-  const size_t colon = rest.find(':');
-  const std::optional<uint64_t> size = decimal(rest.substr(0, colon));
+  std::vector<std::string_view> parts;
+  std::string_view rest = std::string_view(spec).substr(8);
+  for (size_t colon; (colon = rest.find(':')) != std::string_view::npos; rest = rest.substr(colon + 1))
+    parts.push_back(rest.substr(0, colon));
+  parts.push_back(rest);
+  const std::optional<uint64_t> size = decimal(parts[0]);
   if (!size) throw Error(spec, usage);
   FractalOptions f;
   f.size = checkedCast<int>(*size, spec, "SIZE");
-  if (colon != std::string_view::npos) {
-    const std::optional<uint64_t> seed = decimal(rest.substr(colon + 1));
+  if (parts.size() > 1) {
+    const std::optional<uint64_t> seed = decimal(parts[1]);
     if (!seed) throw Error(spec, usage + "; SEED must be a whole number in 0..18446744073709551615");
     f.seed = *seed;
+  }
+  for (size_t k = 2; k < parts.size(); ++k) {
+    const size_t eq = parts[k].find('=');
+    if (eq == std::string_view::npos) throw Error(spec, usage);
+    const std::string key(parts[k].substr(0, eq)), text(parts[k].substr(eq + 1));
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (ec != std::errc() || end != text.data() + text.size() || text.empty() || !(value > 0.0) ||
+        !std::isfinite(value))
+      throw Error(spec, key + " must be a positive number, got '" + text + "'");
+    if (key == "relief") f.relief = value;
+    else if (key == "roughness") f.roughness = value;
+    else if (key == "cell") f.cell_size = value;
+    else throw Error(spec, "unknown fractal option '" + key + "' (relief, roughness, cell)");
   }
   return f;
 }

@@ -22,9 +22,10 @@ struct TerrainLoadOptions {
   DemLoadOptions dem;     // how a DEM file is read (band, cell size, height scale, size limit)
 };
 
-// "fractal:SIZE[:SEED]" -> the fractal's size and seed (the other options at their defaults). Throws farfield::Error
-// naming the spec for anything else: a sign, a space, trailing text, a SIZE beyond int or a SEED beyond 64 bits
-// (fractalTerrain then checks that SIZE is 2^n + 1).
+// "fractal:SIZE[:SEED][:relief=M][:roughness=R][:cell=M]" -> the fractal's options (the others at their defaults;
+// relief and cell in metres, see fractal.h). Throws farfield::Error naming the spec for anything else: a sign, a
+// space, trailing text, a SIZE beyond int, a SEED beyond 64 bits, an unknown key or a value that is not a positive
+// number (fractalTerrain then checks that SIZE is 2^n + 1 and the ranges).
 FractalOptions parseFractalSpec(const std::string& spec);
 
 struct TerrainData {
