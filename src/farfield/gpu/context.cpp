@@ -1,4 +1,5 @@
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/egl_device_choice.h"
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
@@ -264,6 +265,20 @@ std::unique_ptr<Context> tryDevicePlatform(const ContextOptions& options, bool s
   std::vector<EGLDeviceEXT> devices(static_cast<size_t>(count));
   eglQueryDevicesEXT(count, devices.data(), &count);
   devices.resize(size_t(count));
+  {  // The GPU a scheduler assigned first (gpu/egl_device_choice.h).
+    std::vector<int> cuda_ids;
+    for (EGLDeviceEXT d : devices) {
+      EGLAttrib id = -1;
+      const bool cuda = hasExtension(eglQueryDeviceStringEXT(d, EGL_EXTENSIONS), "EGL_NV_device_cuda") &&
+                        eglQueryDeviceAttribEXT(d, EGL_CUDA_DEVICE_NV, &id);
+      cuda_ids.push_back(cuda ? int(id) : -1);
+    }
+    std::vector<EGLDeviceEXT> ordered;
+    for (size_t i : eglDeviceOrder(cuda_ids, assignedGpu(std::getenv("SLURM_STEP_GPUS"), std::getenv("SLURM_JOB_GPUS"),
+                                                         std::getenv("CUDA_VISIBLE_DEVICES"))))
+      ordered.push_back(devices[i]);
+    devices = std::move(ordered);
+  }
   for (size_t i = 0; i < devices.size(); ++i) {
     const char* device_extensions = eglQueryDeviceStringEXT(devices[i], EGL_EXTENSIONS);
     std::string label = "egl-device " + std::to_string(i);
