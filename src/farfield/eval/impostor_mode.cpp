@@ -12,6 +12,7 @@
 #include <filesystem>
 
 #include "farfield/core/error.h"
+#include "farfield/eval/dynamic_modes.h"
 #include "farfield/eval/mmi_mode.h"
 #include "farfield/eval/mode_options.h"
 #include "farfield/extract/pipeline_options.h"
@@ -29,6 +30,7 @@ void registerImpostorModes() {
                "DIR from bake --technique grid-mesh",
                [](const ModeContext& c) { return std::make_unique<ImpostorMode>(extract::kGridMesh, c); });
   registerMmiModes();
+  registerDynamicModes();
 }
 
 ImpostorMode::ImpostorMode(std::string technique, const ModeContext& context) : technique_(std::move(technique)) {

@@ -106,6 +106,7 @@ PlanarImpostor::PlanarImpostor(gpu::Renderer& renderer, std::span<const gpu::Dra
   mesh_ = gpu::GpuMesh(quad);
   material_ = std::make_unique<gpu::GpuMaterial>();
   material_->texture = &target_->colorTexture();
+  material_->id_texture = &target_->idTexture();  // item buffers name the object of every image pixel
   material_->unlit = true;
   material_->double_sided = true;
   material_->projective_texture = true;

@@ -1,0 +1,167 @@
+// Bench modes for billboards and the hierarchical image cache with Shade's or Schaufler's metric
+// (steed-ibr-impostors-lecture, part 2, "billboard", "First metric - Shade", "Second metric - Schaufler").
+#include "farfield/eval/dynamic_modes.h"
+
+#include <algorithm>
+
+#include "farfield/core/error.h"
+#include "farfield/core/error_bound.h"
+#include "farfield/core/timer.h"
+#include "farfield/eval/mode_options.h"
+#include "farfield/gpu/cost_model.h"
+#include "farfield/impostor/capture.h"
+
+namespace farfield::eval {
+
+void registerDynamicModes() {
+  registerMode("billboard",
+               "the scene's trees (objects named tree) as billboards (8 captured views, cylindrical) where their "
+               "closed-form error keeps the bound (--mode-option error_px), geometry elsewhere; culled geometry",
+               [](const ModeContext& c) { return std::make_unique<BillboardMode>(c); });
+  registerMode("dynamic-shade",
+               "hierarchical image cache (Shade 1996): planar images on their best plane, regenerated when Shade's "
+               "angle over box corners exceeds the bound, inside t_max (--mode-option t_max_ms)",
+               [](const ModeContext& c) {
+                 return std::make_unique<DynamicImpostorMode>(impostor::ValidityMetric::Shade, c);
+               });
+  registerMode("dynamic-schaufler",
+               "hierarchical image cache, regenerated when Schaufler's translation or size angle exceeds the bound",
+               [](const ModeContext& c) {
+                 return std::make_unique<DynamicImpostorMode>(impostor::ValidityMetric::Schaufler, c);
+               });
+}
+
+// ---- billboard ----
+
+BillboardMode::BillboardMode(const ModeContext& context) {
+  error_px_ = numberOption(context, "error_px", 2.0, 0.01);
+  options_.kind = choiceOption(context, "billboard_kind", "cylindrical", {"cylindrical", "spherical"}) == "spherical"
+                      ? impostor::BillboardKind::Spherical
+                      : impostor::BillboardKind::Cylindrical;
+  options_.views = intOption(context, "billboard_views", 8, 1, 64);
+  options_.texels = intOption(context, "billboard_texels", 32, 4, 2048);
+  options_.elevation = options_.kind == impostor::BillboardKind::Spherical ? 0.15 : 0.0;
+}
+
+void BillboardMode::prepare(const ModeContext& context) {
+  Stopwatch clock;
+  gpu_scene_ = context.gpu_scene;
+  bvh_ = context.bvh;
+  const scene::Scene& scene = *context.scene;
+  tree_of_object_.assign(scene.objects.size() + 1, 0);
+  std::vector<impostor::Billboard> boards;
+  for (const scene::Object& o : scene.objects) {
+    if (o.name != "tree" || o.world_bounds.empty()) continue;
+    const uint32_t ids[] = {o.id};
+    boards.push_back(impostor::captureBillboard(*context.renderer, *context.gpu_scene, ids, o.world_bounds, options_));
+    tree_ids_.push_back(o.id);
+    tree_of_object_[o.id] = uint32_t(boards.size());
+  }
+  if (boards.empty())
+    throw Error("mode 'billboard'", "the scene has no objects named 'tree' (farfield gen city --trees, gen forest)");
+  batch_ = std::make_unique<impostor::BillboardBatch>(boards);
+  prepare_s_ = clock.seconds();
+}
+
+void BillboardMode::frame(FrameContext& frame) {
+  const Camera& cam = frame.camera();
+  const double theta = ErrorBound::forCamera(error_px_, cam).angle();
+  visible_.clear();
+  bvh_->queryFrustum(Frustum::fromMatrix(cam.viewProjection()), visible_);
+  std::sort(visible_.begin(), visible_.end());
+  geometry_.clear();
+  boards_.clear();
+  for (const uint32_t id : visible_) {
+    const uint32_t b = tree_of_object_[id];
+    if (b && batch_->shape(b - 1).errorAngle(cam.eye) <= theta) boards_.push_back(b - 1);
+    else geometry_.push_back(id);
+  }
+  if (!geometry_.empty()) gpu_scene_->appendDrawItems(geometry_, frame.items(), cam);
+  const size_t bytes = boards_.empty() ? 0 : batch_->build(boards_, cam.eye, frame.items());
+  ++frames_;
+  billboards_drawn_ += boards_.size();
+  trees_as_geometry_ += geometry_.size();
+  uploaded_bytes_ += bytes;
+}
+
+std::map<std::string, double> BillboardMode::info() const {
+  const double f = double(std::max<size_t>(frames_, 1));
+  return {{"error_bound_px", error_px_},
+          {"billboards", double(tree_ids_.size())},
+          {"views", double(options_.views)},
+          {"texels", double(options_.texels)},
+          {"texture_bytes", double(batch_ ? batch_->textureBytes() : 0)},
+          {"billboards_per_frame", double(billboards_drawn_) / f},
+          {"geometry_objects_per_frame", double(trees_as_geometry_) / f},
+          {"uploaded_bytes_per_frame", double(uploaded_bytes_) / f},
+          {"regenerations_per_frame", 0.0},
+          {"prepare_s", prepare_s_}};
+}
+
+// ---- dynamic-shade / dynamic-schaufler ----
+
+DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const ModeContext& context) {
+  options_.metric = metric;
+  options_.error_px = numberOption(context, "error_px", 2.0, 0.01);
+  options_.t_max_ms = numberOption(context, "t_max_ms", 0.0, 0.0);
+  options_.max_regenerations = intOption(context, "max_regenerations", 32, 0, 100000);
+  options_.audit_samples = intOption(context, "audit", 0, 0, 1000000);
+}
+
+std::string DynamicImpostorMode::name() const {
+  return std::string("dynamic-") + impostor::validityMetricName(options_.metric);
+}
+
+void DynamicImpostorMode::prepare(const ModeContext& context) {
+  scene_ = context.scene;
+  gpu_scene_ = context.gpu_scene;
+  Stopwatch clock;
+  gpu::CalibrationOptions calibration;
+  calibration.repeats = 1;
+  calibration.sizes = {256, 512};
+  calibration.max_triangles = 200000;
+  options_.cost = gpu::calibrateCostModel(*context.renderer, *context.gpu_scene, calibration);
+  calibrate_s_ = clock.seconds();
+  cache_ = std::make_unique<runtime::ImageCache>(*context.scene, *context.gpu_scene, options_);
+}
+
+void DynamicImpostorMode::frame(FrameContext& frame) {
+  frame.beginOwnPass();
+  per_frame_[frame.pathFrame()] = cache_->frame(frame.renderer(), frame.camera(), frame.pathFrame(), frame.items());
+}
+
+std::map<std::string, double> DynamicImpostorMode::info() const {
+  double regen = 0, regen_max = 0, images = 0, geometry = 0, written = 0, uploaded = 0, tex_max = 0, audited = 0,
+         unneeded = 0, missed = 0, frames_with_regen = 0;
+  for (const auto& [k, s] : per_frame_) {
+    regen += double(s.regenerations);
+    regen_max = std::max(regen_max, double(s.regenerations));
+    frames_with_regen += s.regenerations > 0;
+    images += double(s.images_drawn);
+    geometry += double(s.geometry_nodes);
+    written += double(s.texels_written_bytes);
+    uploaded += double(s.uploaded_bytes);
+    tex_max = std::max(tex_max, double(s.texture_bytes));
+    audited += double(s.audited);
+    unneeded += double(s.unneeded);
+    missed += double(s.missed);
+  }
+  const double f = double(std::max<size_t>(per_frame_.size(), 1));
+  return {{"error_bound_px", options_.error_px},
+          {"t_max_ms", options_.t_max_ms},
+          {"nodes", double(cache_ ? cache_->nodeCount() : 0)},
+          {"regenerations_per_frame", regen / f},
+          {"regenerations_max", regen_max},
+          {"frames_with_regenerations", frames_with_regen},
+          {"images_per_frame", images / f},
+          {"invalid_as_geometry_per_frame", geometry / f},
+          {"texels_written_bytes_per_frame", written / f},
+          {"uploaded_bytes_per_frame", uploaded / f},
+          {"texture_bytes_max", tex_max},
+          {"audited", audited},
+          {"unneeded_regenerations", unneeded},
+          {"missed_regenerations", missed},
+          {"calibrate_s", calibrate_s_}};
+}
+
+}  // namespace farfield::eval

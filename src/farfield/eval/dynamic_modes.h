@@ -1,0 +1,69 @@
+// Bench modes of the lecture's impostor kinds (steed-ibr-impostors-lecture, part 2): "billboard" (the scene's trees
+// as cylindrical or spherical billboards where they keep the bound, geometry elsewhere), "dynamic-shade" and
+// "dynamic-schaufler" (the hierarchical image cache, runtime/image_cache.h, judged by each metric). Thin adapters
+// over impostor/billboard.h and runtime/image_cache.h; their numbers go to bench.json "modes.<name>.info".
+//
+// Mode options (--mode-option key=value, shared by the run's modes):
+//   error_px=P        the bound in pixels of the frame (default 2)
+//   t_max_ms=T        frame budget for regenerations (dynamic-*, default 0 = none)
+//   max_regenerations=N (dynamic-*, default 32), audit=N (dynamic-*: N mesh vertices per node measure the error
+//                     the metric is checked against, default 0 = off; costs frame time)
+//   billboard_kind=cylindrical|spherical, billboard_views=N (default 8), billboard_texels=N (default 32)
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "farfield/eval/mode.h"
+#include "farfield/impostor/billboard.h"
+#include "farfield/impostor/dynamic.h"
+#include "farfield/runtime/image_cache.h"
+
+namespace farfield::eval {
+
+// Registers billboard, dynamic-shade and dynamic-schaufler (called by registerImpostorModes()).
+void registerDynamicModes();
+
+class BillboardMode final : public Mode {
+ public:
+  explicit BillboardMode(const ModeContext& context);
+  std::string name() const override { return "billboard"; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::map<std::string, double> info() const override;
+
+ private:
+  impostor::BillboardOptions options_;
+  double error_px_ = 2.0;
+  const gpu::GpuScene* gpu_scene_ = nullptr;
+  const scene::Bvh* bvh_ = nullptr;
+  std::vector<uint32_t> tree_of_object_;  // per object id: billboard index + 1, 0 = not a tree
+  std::vector<uint32_t> tree_ids_;
+  std::unique_ptr<impostor::BillboardBatch> batch_;
+  std::vector<uint32_t> visible_, geometry_, boards_;
+  double prepare_s_ = 0.0;
+  size_t frames_ = 0, billboards_drawn_ = 0, trees_as_geometry_ = 0, uploaded_bytes_ = 0;
+};
+
+class DynamicImpostorMode final : public Mode {
+ public:
+  DynamicImpostorMode(impostor::ValidityMetric metric, const ModeContext& context);
+  std::string name() const override;
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::map<std::string, double> info() const override;
+
+ private:
+  runtime::ImageCacheOptions options_;
+  std::unique_ptr<runtime::ImageCache> cache_;
+  const scene::Scene* scene_ = nullptr;
+  const gpu::GpuScene* gpu_scene_ = nullptr;
+  size_t last_frame_ = size_t(-1);
+  // Sums over measured frames (a repeated frame counts once: its last run).
+  std::map<size_t, runtime::ImageCacheFrameStats> per_frame_;
+  double calibrate_s_ = 0.0;
+};
+
+}  // namespace farfield::eval

@@ -1,0 +1,99 @@
+// Hierarchical image cache (Shade et al. 1996, as the steed-ibr-impostors-lecture, part 2, presents it: "Impostors
+// ... the same image can be reused for several frames; when the viewpoint changes, the impostor image must be
+// updated"): a k-d hierarchy over the scene's objects; per frame, the highest nodes far enough from the eye are drawn
+// as cached planar images (impostor/dynamic.h) while the chosen validity metric keeps them under the error bound;
+// invalid images are regenerated most invalid first inside the frame budget (runtime/regeneration_scheduler.h) and
+// drawn as geometry when there is no time left. Near nodes descend to geometry.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "farfield/core/bounds.h"
+#include "farfield/core/camera.h"
+#include "farfield/gpu/cost_model.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/impostor/dynamic.h"
+#include "farfield/scene/scene.h"
+
+namespace farfield::runtime {
+
+struct ImageCacheOptions {
+  impostor::ValidityMetric metric = impostor::ValidityMetric::Schaufler;
+  double error_px = 1.0;        // the bound, pixels of the frame (ErrorBound::angle of the viewer camera)
+  double t_max_ms = 0.0;        // frame budget; <= 0: every invalid image is regenerated (up to the count)
+  int max_regenerations = 32;   // per frame
+  int leaf_objects = 8;         // k-d leaves hold at most this many objects
+  double min_distance_radii = 2.5;  // a node is an image only with the eye farther than this many radii away
+  float max_object_radius = 150.0f; // larger objects (the ground) are always geometry
+  size_t byte_budget = size_t(512) << 20;  // images kept (least recently used dropped first)
+  int shade_samples = 64;       // Shade's points per node: the objects' box corners, evenly thinned to this
+  int audit_samples = 0;        // > 0: per drawn image, Shade's angle over this many mesh vertices too (the
+                                // "measured" error the bench checks the metric against); costs frame time
+  impostor::PlanarImpostorOptions impostor;
+  gpu::CostModel cost;          // predicts geometry and regeneration times (all 0: no prediction)
+  double regeneration_overhead_ms = 0.3;  // per regeneration: target, clear, state
+};
+
+struct ImageCacheFrameStats {
+  size_t images_drawn = 0;         // cached images drawn (valid or regenerated this frame)
+  size_t regenerations = 0;
+  size_t geometry_nodes = 0;       // invalid nodes drawn as geometry (no time to regenerate)
+  size_t near_objects = 0;         // objects drawn as geometry because they are near (or large)
+  double predicted_ms = 0.0;
+  size_t texture_bytes = 0;        // all cached images (after this frame)
+  size_t texels_written_bytes = 0; // colour written into images this frame (the update's traffic)
+  size_t uploaded_bytes = 0;       // quad meshes of regenerated images
+  // Audit (ImageCacheOptions::audit_samples > 0): per image the metric judged this frame, against the measured
+  // error (Shade's angle over mesh vertices).
+  size_t audited = 0;
+  size_t unneeded = 0;  // the metric said invalid, the measured error was within the bound
+  size_t missed = 0;    // the metric said valid, the measured error was over the bound
+};
+
+class ImageCache {
+ public:
+  // Keeps references to the scene and its GPU copy. Throws farfield::Error for bad options.
+  ImageCache(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const ImageCacheOptions& options);
+  ~ImageCache();
+
+  // The frame for `camera`: regenerates images with Renderer::draw (call inside a frame after the frame's own-pass
+  // start), appends the main pass (geometry and images) to `out`. A call with the same frame_index as the previous
+  // call repeats that frame's work (the same regenerations), so repeated timings of one frame time the same work.
+  ImageCacheFrameStats frame(gpu::Renderer& renderer, const Camera& camera, size_t frame_index,
+                             std::vector<gpu::DrawItem>& out);
+
+  size_t nodeCount() const { return nodes_.size(); }
+  size_t textureBytes() const { return texture_bytes_; }
+
+ private:
+  struct Node {
+    Box3 bounds;
+    std::vector<uint32_t> objects;  // all objects below
+    int left = -1, right = -1;
+    std::vector<DVec3> samples;        // Shade's
+    std::vector<DVec3> audit_points;   // mesh vertices (audit)
+    uint64_t triangles = 0;
+    uint32_t draws = 0;
+    std::unique_ptr<impostor::PlanarImpostor> image;
+    size_t last_used = 0;
+    std::optional<size_t> regenerated_in;
+  };
+  int build(std::vector<uint32_t> objects, int depth);
+  void evict(size_t frame_index);
+
+  const scene::Scene& scene_;
+  const gpu::GpuScene& gpu_scene_;
+  ImageCacheOptions options_;
+  std::vector<Node> nodes_;
+  std::vector<uint32_t> always_geometry_;
+  size_t texture_bytes_ = 0;
+  std::optional<size_t> last_frame_;
+  std::vector<gpu::DrawItem> scratch_;
+};
+
+}  // namespace farfield::runtime
