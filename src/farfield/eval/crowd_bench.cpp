@@ -1,0 +1,331 @@
+#include "farfield/eval/crowd_bench.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "farfield/core/error.h"
+#include "farfield/core/log.h"
+#include "farfield/core/timer.h"
+#include "farfield/eval/crowd_metrics.h"
+#include "farfield/eval/frame_runner.h"
+#include "farfield/eval/mode.h"
+#include "farfield/gen/camera_path.h"
+#include "farfield/gen/city.h"
+#include "farfield/gen/crowd.h"
+#include "farfield/image/metrics.h"
+#include "farfield/image/png_io.h"
+#include "farfield/scene/gltf_skin.h"
+
+namespace fs = std::filesystem;
+
+namespace farfield::eval {
+namespace {
+
+constexpr float kNominalSpeed = 1.3f;  // m/s at which a model's walk cycle is played at its own rate
+
+struct ModeSpec {
+  std::string name;
+  runtime::CrowdPolicy policy;
+};
+
+std::vector<ModeSpec> modeSpecs() {
+  return {{"crowd-geometry", runtime::CrowdPolicy::Geometry},
+          {"crowd-impostor", runtime::CrowdPolicy::Impostor},
+          {"crowd-mixed", runtime::CrowdPolicy::Mixed}};
+}
+
+// An elevated path: the pedestrian walk raised by 14 m, looking 20 m ahead down to the street.
+gen::CameraPath elevated(const gen::CameraPath& walk) {
+  gen::CameraPath out = walk;
+  out.kind = "elevated";
+  for (gen::PathFrame& f : out.frames) {
+    Vec3 forward = f.at - f.eye;
+    forward.z = 0.0f;
+    forward = glm::length(forward) > 1e-6f ? glm::normalize(forward) : Vec3(1, 0, 0);
+    const float ground = f.eye.z - 1.7f;
+    f.eye.z += 14.0f;
+    f.at = Vec3(f.eye.x, f.eye.y, ground) + forward * 20.0f;
+  }
+  return out;
+}
+
+std::vector<runtime::CrowdAgentState> agentStates(const gen::Crowd& crowd, const runtime::CrowdRuntime& rt, float t) {
+  std::vector<runtime::CrowdAgentState> states(crowd.agents.size());
+  for (size_t i = 0; i < crowd.agents.size(); ++i) {
+    const gen::CrowdAgent& a = crowd.agents[i];
+    const gen::AgentPose p = gen::agentPose(crowd, i, t);
+    runtime::CrowdAgentState& s = states[i];
+    s.model = a.model;
+    s.position = p.position;
+    s.heading = p.heading;
+    const float stride = kNominalSpeed * rt.cycleSeconds(a.model);
+    const float phase = a.phase + p.walked / stride;
+    s.phase = phase - std::floor(phase);
+    s.tint = a.tint;
+    s.object_id = kCrowdIdBit | uint32_t(i);
+  }
+  return states;
+}
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), f, v);
+  return buf;
+}
+
+std::string thousands(size_t v) {
+  const std::string digits = std::to_string(v);
+  std::string out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out.push_back(',');
+    out.push_back(digits[i]);
+  }
+  return out;
+}
+
+}  // namespace
+
+CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& options) {
+  if (options.models.empty()) throw Error("crowd bench", "no models given");
+  if (options.model_heights.size() < options.models.size() || options.model_shares.size() < options.models.size())
+    throw Error("crowd bench", "one height and one share per model");
+  if (options.frames < 2) throw Error("crowd bench", "need at least 2 frames (popping compares consecutive frames)");
+  if (options.width < 16 || options.height < 16) throw Error("crowd bench", "frame size too small");
+  context.makeCurrent();
+  CrowdBenchResult result;
+  result.renderer = context.description();
+
+  std::vector<scene::SkinnedModel> models;
+  std::vector<runtime::CrowdModelOptions> model_options;
+  for (size_t m = 0; m < options.models.size(); ++m) {
+    scene::SkinImportStats stats;
+    models.push_back(scene::importSkinnedModel(options.models[m], &stats));
+    for (const std::string& w : stats.warnings()) FF_WARN(options.models[m] << ": " << w);
+    runtime::CrowdModelOptions mo;
+    mo.height_m = options.model_heights[m];
+    model_options.push_back(mo);
+    result.model_names.push_back(fs::path(options.models[m]).filename().string());
+  }
+
+  Stopwatch city_clock;
+  gen::CityOptions co;
+  co.blocks = options.blocks;
+  co.detail = options.detail;
+  co.seed = options.city_seed;
+  gen::City city = gen::generateCity(co);
+  result.city_seconds = city_clock.seconds();
+  for (const scene::Mesh& mesh : city.scene.meshes) result.city_triangles += mesh.triangleCount();
+  ModeRunResources res(city.scene, options.width, options.height, {});
+  gpu::Renderer& renderer = res.renderer;
+  gpu::RenderTarget& target = res.target;
+  gpu::RenderTarget reference_target(options.width, options.height);
+
+  runtime::CrowdRuntime rt(models, model_options, options.runtime);
+  result.bake_seconds = rt.bakeSeconds();
+  for (size_t m = 0; m < rt.modelCount(); ++m) {
+    result.layouts.push_back(rt.impostor(m).layout);
+    result.atlas_bytes.push_back(rt.impostor(m).byteSize());
+    result.model_triangles.push_back(rt.modelTriangles(m));
+  }
+
+  gen::StreetWalkOptions wo;
+  wo.frames = int(options.frames * options.frame_step + 1);
+  wo.seed = options.path_seed;
+  const gen::CameraPath walk = gen::streetWalk(city.streets, wo);
+  {
+    const Camera c = pathCamera(walk, 0, options.width, options.height);
+    for (size_t m = 0; m < rt.modelCount(); ++m) result.switch_m.push_back(rt.switchDistances(m, c).both());
+  }
+  if (!options.out_dir.empty()) fs::create_directories(fs::path(options.out_dir) / "frames");
+  const std::vector<ModeSpec> specs = modeSpecs();
+  const gpu::LightSettings light = renderer.light();
+
+  for (const std::string& path_name : options.paths) {
+    if (path_name != "pedestrian" && path_name != "elevated")
+      throw Error("crowd bench", "unknown path '" + path_name + "' (pedestrian, elevated)");
+    const gen::CameraPath path = path_name == "pedestrian" ? walk : elevated(walk);
+    for (size_t count : options.agent_counts) {
+      gen::CrowdOptions cro;
+      cro.agents = count;
+      cro.seed = options.crowd_seed;
+      cro.model_shares.assign(options.model_shares.begin(), options.model_shares.begin() + long(models.size()));
+      const gen::Crowd crowd = gen::generateCrowd(city.streets, cro);
+      FF_INFO("crowd bench: " << count << " agents, " << path_name << " path");
+      CrowdRun run;
+      run.agents = count;
+      run.path = path_name;
+      std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), psnr(specs.size()),
+          bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
+          in_view(specs.size()), tris(specs.size());
+      std::vector<image::ColorImage> prev(specs.size());
+      std::vector<image::IdImage> prev_ids(specs.size());
+      image::ColorImage prev_ref;
+      image::IdImage prev_ref_ids;
+      double ref_change = 0.0;
+      std::vector<uint32_t> ids;
+      std::vector<gpu::DrawItem> items;
+      const size_t sample_every = options.samples > 0 ? std::max<size_t>(1, options.frames / size_t(options.samples)) : 0;
+      for (size_t k = 0; k <= options.frames; ++k) {  // k = 0: the untimed warm-up frame
+        const size_t pf = std::min(k * options.frame_step, path.frames.size() - 1);
+        const Camera camera = pathCamera(path, pf, options.width, options.height);
+        const float t = float(pf) / path.fps;
+        const std::vector<runtime::CrowdAgentState> states = agentStates(crowd, rt, t);
+        ids.clear();
+        items.clear();
+        res.bvh.queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids);
+        std::sort(ids.begin(), ids.end());
+        if (!ids.empty()) res.gpu_scene.appendDrawItems(ids, items, camera);
+        // Reference: the city and every agent as skinned geometry.
+        reference_target.bindForOpaquePass();
+        reference_target.clear(light.sky_color);
+        renderer.draw(camera, items, reference_target);
+        reference_target.bindForOpaquePass();
+        rt.draw(camera, states, runtime::CrowdPolicy::Geometry, light);
+        rt.finish();
+        const image::ColorImage ref = reference_target.readColor();
+        const image::IdImage ref_ids = reference_target.readIds();
+        const bool sample = k > 0 && sample_every > 0 && !options.out_dir.empty() && (k - 1) % sample_every == 0;
+        const std::string tag = "a" + std::to_string(count) + "_" + path_name + "_f" + std::to_string(pf);
+        if (sample) image::writePng((fs::path(options.out_dir) / "frames" / (tag + "_reference.png")).string(), ref);
+        for (size_t j = 0; j < specs.size(); ++j) {
+          const size_t m = (j + k) % specs.size();  // rotated order
+          Stopwatch clock;
+          target.bindForOpaquePass();
+          target.clear(light.sky_color);
+          renderer.draw(camera, items, target);
+          rt.finish();
+          const double city_ms = clock.milliseconds();
+          target.bindForOpaquePass();
+          const runtime::CrowdFrameStats st = rt.draw(camera, states, specs[m].policy, light);
+          rt.finish();
+          const double total = clock.milliseconds();
+          if (k == 0) continue;
+          wall[m].push_back(total);
+          crowd_ms[m].push_back(total - city_ms);
+          geo[m].push_back(double(st.geometry));
+          imp[m].push_back(double(st.impostors));
+          in_view[m].push_back(double(st.in_view));
+          tris[m].push_back(double(st.draw.triangles));
+          image::ColorImage frame = target.readColor();
+          image::IdImage frame_ids = target.readIds();
+          const CrowdPixelError e = crowdPixelError(ref, ref_ids, frame, frame_ids);
+          psnr[m].push_back(e.psnr_db);
+          bad[m].push_back(e.bad_share);
+          pixels[m].push_back(double(e.pixels));
+          if (k > 1)
+            popping[m].push_back(crowdPopping(prev[m], prev_ids[m], frame, frame_ids, prev_ref, prev_ref_ids, ref, ref_ids));
+          if (sample) {
+            const fs::path dir = fs::path(options.out_dir) / "frames";
+            image::writePng((dir / (tag + "_" + specs[m].name + ".png")).string(), frame);
+            image::writePng((dir / (tag + "_" + specs[m].name + "_diff.png")).string(), image::diffHeatmap(ref, frame));
+          }
+          prev[m] = std::move(frame);
+          prev_ids[m] = std::move(frame_ids);
+        }
+        if (k > 1) {
+          // The reference's own change on its crowd pixels, for scale.
+          const CrowdPixelError change = crowdPixelError(prev_ref, prev_ref_ids, ref, ref_ids, 8);
+          ref_change += change.mae;
+        }
+        prev_ref = ref;
+        prev_ref_ids = ref_ids;
+      }
+      run.reference_popping_mean = options.frames > 1 ? ref_change / double(options.frames - 1) : 0.0;
+      auto mean = [](const std::vector<double>& v) {
+        double s = 0.0;
+        for (double x : v) s += x;
+        return v.empty() ? 0.0 : s / double(v.size());
+      };
+      for (size_t m = 0; m < specs.size(); ++m) {
+        CrowdModeResult r;
+        r.name = specs[m].name;
+        r.wall = summarize(wall[m]);
+        r.crowd = summarize(crowd_ms[m]);
+        r.psnr_mean = mean(psnr[m]);
+        r.psnr_min = psnr[m].empty() ? 0.0 : *std::min_element(psnr[m].begin(), psnr[m].end());
+        r.bad_share_mean = mean(bad[m]);
+        r.crowd_pixels_mean = mean(pixels[m]);
+        r.popping_mean = mean(popping[m]);
+        r.popping_max = popping[m].empty() ? 0.0 : *std::max_element(popping[m].begin(), popping[m].end());
+        r.geometry_agents = mean(geo[m]);
+        r.impostor_agents = mean(imp[m]);
+        r.in_view = mean(in_view[m]);
+        r.triangles = mean(tris[m]);
+        run.modes.push_back(r);
+      }
+      for (CrowdModeResult& r : run.modes) {
+        r.speedup = r.wall.median > 0.0 ? run.modes[0].wall.median / r.wall.median : 0.0;
+        r.crowd_speedup = r.crowd.median > 0.0 ? run.modes[0].crowd.median / r.crowd.median : 0.0;
+      }
+      result.runs.push_back(std::move(run));
+    }
+  }
+
+  // Report.
+  std::ostringstream md;
+  md << "- city: generated, " << options.blocks << " blocks, detail " << options.detail << ", seed " << options.city_seed
+     << " (" << thousands(result.city_triangles) << " triangles, view-frustum culled in every mode)\n";
+  md << "- size " << options.width << "x" << options.height << ", " << options.frames << " measured frames per run (every "
+     << options.frame_step << "th frame of a 30 fps street walk, seed " << options.path_seed << "), one warm-up frame\n";
+  md << "- renderer: " << result.renderer << "\n";
+  for (size_t m = 0; m < result.layouts.size(); ++m) {
+    const gpu::AtlasLayout& l = result.layouts[m];
+    md << "- " << result.model_names[m] << ": " << thousands(result.model_triangles[m]) << " triangles; atlas "
+       << l.azimuths << "x" << l.elevations << " views x " << l.frames << " frames, cells " << l.cell_width << "x"
+       << l.cell_height << " texels (" << fmt("%.3f", options.runtime.texel_m) << " m), "
+       << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0) << " MiB uncompressed ("
+       << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames) << " KiB per frame); switch to impostor beyond "
+       << fmt("%.1f", result.switch_m[m]) << " m\n";
+  }
+  md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
+  md << "| agents | path | mode | median ms | crowd ms | speedup | crowd speedup | geometry / impostor agents | "
+        "triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) |\n";
+  md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const CrowdRun& run : result.runs)
+    for (const CrowdModeResult& r : run.modes)
+      md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << fmt("%.1f", r.wall.median)
+         << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.2fx", r.speedup) << " | "
+         << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
+         << fmt("%.0f", r.impostor_agents) << " | " << thousands(size_t(r.triangles)) << " | "
+         << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
+         << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
+         << fmt("%.2f", run.reference_popping_mean) << ") |\n";
+  result.markdown = md.str();
+
+  if (!options.out_dir.empty()) {
+    nlohmann::json j;
+    j["renderer"] = result.renderer;
+    j["city"] = {{"blocks", options.blocks}, {"detail", options.detail}, {"seed", options.city_seed},
+                 {"triangles", result.city_triangles}, {"gen_seconds", result.city_seconds}};
+    j["size"] = {options.width, options.height};
+    j["bake_seconds"] = result.bake_seconds;
+    for (size_t m = 0; m < result.layouts.size(); ++m) {
+      const gpu::AtlasLayout& l = result.layouts[m];
+      j["models"].push_back({{"file", result.model_names[m]}, {"triangles", result.model_triangles[m]},
+                             {"azimuths", l.azimuths}, {"elevations", l.elevations}, {"frames", l.frames},
+                             {"cell", {l.cell_width, l.cell_height}}, {"atlas_bytes", result.atlas_bytes[m]},
+                             {"switch_m", result.switch_m[m]}});
+    }
+    for (const CrowdRun& run : result.runs)
+      for (const CrowdModeResult& r : run.modes)
+        j["runs"].push_back({{"agents", run.agents}, {"path", run.path}, {"mode", r.name},
+                             {"median_ms", r.wall.median}, {"p95_ms", r.wall.p95}, {"crowd_median_ms", r.crowd.median},
+                             {"speedup", r.speedup}, {"crowd_speedup", r.crowd_speedup}, {"psnr_db_mean", r.psnr_mean},
+                             {"psnr_db_min", r.psnr_min}, {"bad_pixel_share_mean", r.bad_share_mean},
+                             {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
+                             {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
+                             {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
+                             {"in_view", r.in_view}, {"triangles", r.triangles}});
+    std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
+    std::ofstream(fs::path(options.out_dir) / "crowd.md") << result.markdown;
+  }
+  return result;
+}
+
+}  // namespace farfield::eval

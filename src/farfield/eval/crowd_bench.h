@@ -1,0 +1,76 @@
+// `farfield crowd bench`: animated crowds on a generated city (Tecchia, Loscos and Chrysanthou's multi-view impostors;
+// Steed's lecture part 3). For each crowd size and camera path, three modes run interleaved on the same frames:
+// crowd-geometry (every agent in view as skinned instanced geometry: the baseline), crowd-impostor (every agent as a
+// multi-view impostor) and crowd-mixed (geometry near, impostors where they keep their promises). Every frame is also
+// rendered as the full-geometry reference (every agent skinned, no culling) and each mode is compared with it on the
+// crowd's pixels (eval/crowd_metrics.h): PSNR, share over 8/255, popping. The city (view-frustum culled, identical in
+// every mode) is drawn first; frame time covers city and crowd, crowd time the crowd pass alone.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "farfield/eval/frame_stats.h"
+#include "farfield/gpu/context.h"
+#include "farfield/runtime/crowd_runtime.h"
+
+namespace farfield::eval {
+
+struct CrowdBenchOptions {
+  int blocks = 400;  // the default city: gen city --blocks 400 --detail 2 --seed 1
+  int detail = 2;
+  uint64_t city_seed = 1;
+  std::vector<size_t> agent_counts{1000, 10000};
+  uint64_t crowd_seed = 2;
+  std::vector<std::string> paths{"pedestrian", "elevated"};
+  uint64_t path_seed = 5;
+  size_t frames = 8;        // measured frames per run
+  size_t frame_step = 15;   // path frames between measured frames (30 fps path: 0.5 s)
+  int width = 512;
+  int height = 512;
+  std::vector<std::string> models;  // glTF files; default ../shared/data/models CesiumMan.glb and Fox.glb
+  std::vector<float> model_heights{1.75f, 0.8f};
+  std::vector<float> model_shares{0.7f, 0.3f};
+  runtime::CrowdRuntimeOptions runtime;
+  std::string out_dir;
+  int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)
+};
+
+struct CrowdModeResult {
+  std::string name;
+  FrameSummary wall;   // city + crowd, ms
+  FrameSummary crowd;  // crowd pass alone, ms
+  double speedup = 0.0;        // median wall of crowd-geometry / this mode's
+  double crowd_speedup = 0.0;  // the same on crowd time
+  double psnr_mean = 0.0, psnr_min = 0.0, bad_share_mean = 0.0, crowd_pixels_mean = 0.0;
+  double popping_mean = 0.0, popping_max = 0.0;
+  double geometry_agents = 0.0, impostor_agents = 0.0, in_view = 0.0, triangles = 0.0;  // means per frame
+};
+
+struct CrowdRun {
+  size_t agents = 0;
+  std::string path;
+  double reference_popping_mean = 0.0;  // the reference's own frame-to-frame change on crowd pixels (MAE)
+  std::vector<CrowdModeResult> modes;
+};
+
+struct CrowdBenchResult {
+  std::vector<CrowdRun> runs;
+  std::vector<std::string> model_names;
+  std::vector<gpu::AtlasLayout> layouts;
+  std::vector<size_t> atlas_bytes;
+  std::vector<uint64_t> model_triangles;
+  std::vector<double> switch_m;  // per model at the bench's camera
+  double bake_seconds = 0.0;
+  double city_seconds = 0.0;
+  uint64_t city_triangles = 0;
+  std::string renderer;
+  std::string markdown;
+};
+
+// Throws farfield::Error for bad options or unreadable models. Writes OUT_DIR/crowd.json, crowd.md and sample
+// frames under OUT_DIR/frames when out_dir is set.
+CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& options);
+
+}  // namespace farfield::eval
