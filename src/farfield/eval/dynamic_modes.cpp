@@ -10,6 +10,7 @@
 #include "farfield/eval/mode_options.h"
 #include "farfield/gpu/cost_model.h"
 #include "farfield/impostor/capture.h"
+#include "farfield/scene/mesh.h"
 
 namespace farfield::eval {
 
@@ -29,6 +30,10 @@ void registerDynamicModes() {
                [](const ModeContext& c) {
                  return std::make_unique<DynamicImpostorMode>(impostor::ValidityMetric::Schaufler, c);
                });
+  registerMode("warp",
+               "post-render warping: culled-geometry keyframes every warp_interval frames, frames between warped "
+               "from the latest keyframe with holes filled from the one before (3D warping using depth)",
+               [](const ModeContext& c) { return std::make_unique<WarpMode>(c); });
 }
 
 // ---- billboard ----
@@ -162,6 +167,100 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
           {"unneeded_regenerations", unneeded},
           {"missed_regenerations", missed},
           {"calibrate_s", calibrate_s_}};
+}
+
+}  // namespace farfield::eval
+
+namespace farfield::eval {
+
+// ---- warp ----
+
+WarpMode::WarpMode(const ModeContext& context) {
+  interval_ = countOption(context, "warp_interval", 4, 1, 1000);
+}
+
+void WarpMode::prepare(const ModeContext& context) {
+  gpu_scene_ = context.gpu_scene;
+  bvh_ = context.bvh;
+  texture_ = std::make_unique<gpu::Texture>(context.width, context.height, gpu::TextureFormat::Rgba8);
+  texture_->setClampToEdge();
+  material_ = std::make_unique<gpu::GpuMaterial>();
+  material_->texture = texture_.get();
+  material_->unlit = true;
+  material_->double_sided = true;
+}
+
+void WarpMode::drawScreenQuad(FrameContext& frame, const image::ColorImage& image) {
+  texture_->upload(image);
+  const Camera& cam = frame.camera();
+  // A quad just beyond the near plane covering the view exactly: pixel (x, y) of the image lands on pixel (x, y).
+  const Vec3 f = cam.forward();
+  const Vec3 r = glm::normalize(glm::cross(f, cam.up)), u = glm::cross(r, f);
+  const float d = cam.near_plane * 1.5f, t = std::tan(0.5f * cam.fov_y) * d, s = t * cam.aspect();
+  const Vec3 c = cam.eye + d * f;
+  scene::Mesh m;
+  m.positions = {c - s * r - t * u, c + s * r - t * u, c + s * r + t * u, c - s * r + t * u};
+  m.normals.assign(4, -f);
+  m.uvs = {Vec2(0, 1), Vec2(1, 1), Vec2(1, 0), Vec2(0, 0)};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  m.computeBounds();
+  quad_ = gpu::GpuMesh(m);
+  gpu::DrawItem item;
+  item.mesh = &quad_;
+  item.material = material_.get();
+  frame.items().push_back(item);
+}
+
+void WarpMode::frame(FrameContext& frame) {
+  const size_t k = frame.pathFrame();
+  const Camera& cam = frame.camera();
+  gpu::RenderTarget& target = frame.beginOwnPass();
+  const bool repeat_of_key = !keys_.empty() && keys_.back().path_frame == k;
+  const bool new_pass = !keys_.empty() && k < keys_.back().path_frame;
+  if (new_pass) keys_.clear();
+  if (keys_.empty() || repeat_of_key || k - keys_.back().path_frame >= interval_) {
+    ids_.clear();
+    bvh_->queryFrustum(Frustum::fromMatrix(cam.viewProjection()), ids_);
+    std::sort(ids_.begin(), ids_.end());
+    std::vector<gpu::DrawItem> items;
+    if (!ids_.empty()) gpu_scene_->appendDrawItems(ids_, items, cam);
+    frame.drawPass(items);
+    Keyframe key{target.readColor(), target.readDepth(), cam, k};
+    if (repeat_of_key) keys_.back() = std::move(key);
+    else keys_.push_back(std::move(key));
+    if (keys_.size() > 2) keys_.erase(keys_.begin());
+    per_frame_[k] = {1.0, double(cam.width) * cam.height * 8.0, 0.0, 0.0};
+    return;
+  }
+  const Keyframe& latest = keys_.back();
+  const impostor::DepthView primary{&latest.color, &latest.depth, latest.camera};
+  impostor::WarpedImage w = keys_.size() > 1
+                                ? impostor::warpWithHoleFilling(
+                                      primary, {&keys_.front().color, &keys_.front().depth, keys_.front().camera}, cam)
+                                : impostor::warpDepthImage(primary, cam);
+  size_t holes = 0;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) holes += w.source.at(x, y) == 0;
+  drawScreenQuad(frame, w.color);
+  per_frame_[k] = {0.0, 0.0, double(cam.width) * cam.height * 4.0 + double(quad_.byteSize()), double(holes)};
+}
+
+std::map<std::string, double> WarpMode::info() const {
+  double keys = 0, read = 0, up = 0, empty = 0;
+  for (const auto& [k, v] : per_frame_) {
+    keys += v[0];
+    read += v[1];
+    up += v[2];
+    empty += v[3];
+  }
+  const double f = double(std::max<size_t>(per_frame_.size(), 1));
+  return {{"warp_interval", double(interval_)},
+          {"keyframes_per_frame", keys / f},
+          {"regenerations_per_frame", keys / f},
+          {"readback_bytes_per_frame", read / f},
+          {"uploaded_bytes_per_frame", up / f},
+          {"empty_pixels_per_warped_frame", empty / std::max(1.0, f - keys)},  // holes left and sky
+          {"texture_bytes", double(texture_ ? texture_->byteSize() : 0)}};
 }
 
 }  // namespace farfield::eval

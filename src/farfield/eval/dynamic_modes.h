@@ -8,9 +8,11 @@
 //   t_max_ms=T        frame budget for regenerations (dynamic-*, default 0 = none)
 //   max_regenerations=N (dynamic-*, default 32), audit=N (dynamic-*: N mesh vertices per node measure the error
 //                     the metric is checked against, default 0 = off; costs frame time)
+//   warp_interval=N   (warp) a keyframe of culled geometry every N path frames (default 4)
 //   billboard_kind=cylindrical|spherical, billboard_views=N (default 8), billboard_texels=N (default 32)
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <string>
@@ -19,11 +21,12 @@
 #include "farfield/eval/mode.h"
 #include "farfield/impostor/billboard.h"
 #include "farfield/impostor/dynamic.h"
+#include "farfield/impostor/warp.h"
 #include "farfield/runtime/image_cache.h"
 
 namespace farfield::eval {
 
-// Registers billboard, dynamic-shade and dynamic-schaufler (called by registerImpostorModes()).
+// Registers billboard, dynamic-shade, dynamic-schaufler and warp (called by registerImpostorModes()).
 void registerDynamicModes();
 
 class BillboardMode final : public Mode {
@@ -64,6 +67,37 @@ class DynamicImpostorMode final : public Mode {
   // Sums over measured frames (a repeated frame counts once: its last run).
   std::map<size_t, runtime::ImageCacheFrameStats> per_frame_;
   double calibrate_s_ = 0.0;
+};
+
+// Post-render warping (the lecture's "Post-render warping (Mark et al.)" and "3D warping using depth"): every
+// warp_interval path frames a keyframe of culled geometry is rendered and read back (colour and depth); the frames
+// between warp the latest keyframe to their camera, filling its holes from the one before (impostor/warp.h), and
+// draw the result as one screen quad (an upload per frame).
+class WarpMode final : public Mode {
+ public:
+  explicit WarpMode(const ModeContext& context);
+  std::string name() const override { return "warp"; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::map<std::string, double> info() const override;
+
+ private:
+  struct Keyframe {
+    image::ColorImage color;
+    image::DepthImage depth;
+    Camera camera;
+    size_t path_frame = 0;
+  };
+  void drawScreenQuad(FrameContext& frame, const image::ColorImage& image);
+  size_t interval_ = 4;
+  const gpu::GpuScene* gpu_scene_ = nullptr;
+  const scene::Bvh* bvh_ = nullptr;
+  std::vector<Keyframe> keys_;  // at most two, oldest first
+  std::vector<uint32_t> ids_;
+  std::unique_ptr<gpu::Texture> texture_;
+  std::unique_ptr<gpu::GpuMaterial> material_;
+  gpu::GpuMesh quad_;
+  std::map<size_t, std::array<double, 4>> per_frame_;  // keyframe?, bytes read back, bytes uploaded, holes
 };
 
 }  // namespace farfield::eval
