@@ -45,6 +45,7 @@ struct BenchArgs {
   std::string plot_script;
   std::string python;
   std::vector<std::string> mode_options;
+  std::string memory_budget_mb;  // --memory-budget: the mode option memory_budget_mb
   std::string impostors;
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
@@ -99,6 +100,7 @@ void runBenchCommand(const BenchArgs& args) {
   options.reference = args.reference;
   options.out_dir = args.out_dir;
   options.mode_options = eval::parseModeOptions(args.mode_options);
+  if (!args.memory_budget_mb.empty()) options.mode_options["memory_budget_mb"] = args.memory_budget_mb;
   if (!args.impostors.empty()) options.mode_options["impostor_dir"] = args.impostors;
   options.scene_label = args.scene;
   options.path_label = args.path;
@@ -202,6 +204,8 @@ const RegisterCommand reg("bench", [](CLI::App& app) {
   cmd->add_flag("--no-plots", args->no_plots, "Do not run tools/plot_bench.py");
   cmd->add_option("--plot-script", args->plot_script, "Path of plot_bench.py (default: found automatically)");
   cmd->add_option("--python", args->python, "Python interpreter for the plots (default: python3)");
+  cmd->add_option("--memory-budget", args->memory_budget_mb, "Impostor modes: MB of the database held in memory "
+                                                           "(resident impostors and cells read ahead)");
   cmd->add_option("--mode-option", args->mode_options, "key=value passed to the modes (repeatable)");
   cmd->add_option("--impostors", args->impostors,
                   "Impostor store of farfield bake for the depth-mesh and grid-mesh modes (= --mode-option "

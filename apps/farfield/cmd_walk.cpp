@@ -29,6 +29,7 @@ struct WalkArgs {
   std::string frames_dir;
   int every = 10;
   std::vector<std::string> mode_options;
+  std::string memory_budget_mb;  // --memory-budget: the mode option memory_budget_mb
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
 };
@@ -45,6 +46,7 @@ void runWalkCommand(const WalkArgs& args) {
   if (args.every < 1) throw Error("--every", "must be at least 1, got " + std::to_string(args.every));
   options.every = args.every;
   options.mode_options = eval::parseModeOptions(args.mode_options);
+  if (!args.memory_budget_mb.empty()) options.mode_options["memory_budget_mb"] = args.memory_budget_mb;
   options.near_plane = args.near_plane;
   options.far_plane = args.far_plane;
   if (!(args.near_plane > 0.0f && args.far_plane > args.near_plane))
@@ -84,6 +86,8 @@ const RegisterCommand reg("walk", [](CLI::App& app) {
   cmd->add_option("--csv", args->csv, "Write per-frame numbers to this CSV file");
   cmd->add_option("--frames-dir", args->frames_dir, "Write every K-th frame as PNG into this directory");
   cmd->add_option("--every", args->every, "K for --frames-dir")->capture_default_str();
+  cmd->add_option("--memory-budget", args->memory_budget_mb, "Impostor modes: MB of the database held in memory "
+                                                           "(resident impostors and cells read ahead)");
   cmd->add_option("--mode-option", args->mode_options, "key=value passed to the mode (repeatable)");
   cmd->add_option("--near", args->near_plane, "Near plane, metres")->capture_default_str();
   cmd->add_option("--far", args->far_plane, "Far plane, metres")->capture_default_str();

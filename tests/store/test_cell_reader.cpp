@@ -1,10 +1,12 @@
 // The paged reader (store/cell_reader.h): cells read ahead on the background thread equal the cells read on the
 // calling thread; a cell taken without a prefetch is read at once; the waiting bytes never exceed the budget (the
-// oldest read is dropped and read again when taken); a damaged file read ahead is reported by take(), naming the file.
+// oldest read is dropped and read again when taken), also under random prefetches and takes of cells of random
+// sizes, some larger than the budget; a damaged file read ahead is reported by take(), naming the file.
 #include "farfield/store/cell_reader.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <chrono>
@@ -128,13 +130,64 @@ TEST(CellReaderTest, WaitingBytesStayUnderTheBudget) {
   const CellReader::Stats s = reader.stats();
   ASSERT_EQ(s.read_ahead, 4u);
   EXPECT_EQ(s.dropped, 3u);
-  EXPECT_LE(s.held_bytes_max, options.budget_bytes + cell_bytes);  // one cell over, before the oldest is dropped
+  EXPECT_LE(s.held_bytes_max, options.budget_bytes);  // room is made before a read is kept
   EXPECT_LE(reader.heldBytes(), options.budget_bytes);
   const char* how = nullptr;
   expectSameViews(*reader.take(6, &how), readCellViews(dir, index, 6, true, true));  // the newest stayed
   EXPECT_EQ(std::string(how), "ready");
   expectSameViews(*reader.take(0, &how), readCellViews(dir, index, 0, true, true));  // dropped: read again
   EXPECT_EQ(std::string(how), "cold");
+}
+
+TEST(CellReaderTest, TheBudgetHoldsAtEveryMomentUnderRandomPrefetchesAndTakes) {
+  const std::string dir = test::scratchDir("cell_reader_random_budget").string();
+  // Cells of 1 to 6 views of 8 to 48 texels: sizes spread over a factor of about 200.
+  StoreIndex index;
+  std::mt19937 rng(1604);
+  for (uint32_t c = 0; c < 14; ++c) {
+    CellEntry entry;
+    entry.half_edge = c;
+    CellPipeline p;
+    p.has_mmi = true;
+    StoredLayer layer;
+    const int views = 1 + int(rng() % 6), size = 8 + 8 * int(rng() % 6);
+    for (int v = 0; v < views; ++v)
+      layer.views.push_back(writeLayerView(dir, layerFileStem(c, "mmi", 0, size_t(v)), randomView(size, c * 10 + uint32_t(v))));
+    p.layers.push_back(layer);
+    entry.pipeline = p;
+    index.cells.push_back(entry);
+  }
+  std::vector<uint64_t> bytes;
+  for (uint32_t c = 0; c < 14; ++c) bytes.push_back(readCellViews(dir, index, c, true, false).bytes);
+  const uint64_t largest = *std::max_element(bytes.begin(), bytes.end());
+  for (const double share : {0.3, 0.8, 1.5, 3.0}) {
+    CellReader::Options options;
+    options.budget_bytes = uint64_t(double(largest) * share);
+    CellReader reader(dir, index, options);
+    uint64_t watched_max = 0;
+    for (int step = 0; step < 60; ++step) {
+      const uint32_t c = uint32_t(rng() % 14);
+      if (rng() % 3 == 0) {
+        const auto views = reader.take(c);
+        EXPECT_EQ(views->bytes, bytes[c]);
+        EXPECT_EQ(views->half_edge, c);
+      } else {
+        reader.prefetch(c);
+      }
+      watched_max = std::max(watched_max, reader.heldBytes());
+      if (step % 10 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(3));
+    }
+    for (int i = 0; i < 200 && reader.stats().read_ahead < reader.stats().prefetch_requests; ++i) {
+      watched_max = std::max(watched_max, reader.heldBytes());
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    const CellReader::Stats s = reader.stats();
+    EXPECT_LE(s.held_bytes_max, options.budget_bytes) << "budget " << share << " x the largest cell";
+    EXPECT_LE(watched_max, options.budget_bytes);
+    if (share < 1.0) {
+      EXPECT_GT(s.too_large, 0u);
+    }
+  }
 }
 
 TEST(CellReaderTest, DamagedFileReadAheadIsReportedByTake) {

@@ -45,6 +45,8 @@ ImpostorMode::ImpostorMode(std::string technique, const ModeContext& context) : 
                                                  technique_);
   o.gpu_budget_bytes = mebibytesOption(context, "gpu_budget_mb", o.gpu_budget_bytes);
   o.read_ahead = switchOption(context, "read_ahead", true);
+  o.memory_budget_bytes = mebibytesOption(context, "memory_budget_mb", 0);
+  o.streaming_csv = context.option("streaming_csv");
   o.object_ids = choiceOption(context, "impostor_ids", "object", {"object", "layer"}) == "object";
   o.cell_lookup = context.option("cell_lookup");
   if (!o.cell_lookup.empty()) urban::parseCellLookup(o.cell_lookup, "--mode-option cell_lookup");

@@ -16,7 +16,7 @@
 //                         grid-mesh): a store holds one kind
 //   depth_mesh_dir=DIR    store for the depth-mesh mode only (overrides impostor_dir), likewise grid_mesh_dir=DIR:
 //                         for the two stores of `bake --technique depth-mesh -o A` and `--technique grid-mesh -o B`
-//   error_px=PX, gpu_budget_mb=MB, read_ahead=on|off, impostor_ids=object|layer, cell_lookup=street|nearest
+//   error_px=PX, gpu_budget_mb=MB, memory_budget_mb=MB, streaming_csv=FILE (as mmi_mode.h), read_ahead=on|off, impostor_ids=object|layer, cell_lookup=street|nearest
 //                         as for the smi mode (eval/mmi_mode.h)
 #pragma once
 

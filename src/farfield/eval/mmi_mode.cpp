@@ -37,6 +37,8 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
                 "with farfield bake --pipeline pvs,near-far,single,mmi (placed: farfield place)");
   o.gpu_budget_bytes = mebibytesOption(context, "gpu_budget_mb", o.gpu_budget_bytes);
   o.read_ahead = switchOption(context, "read_ahead", true);
+  o.memory_budget_bytes = mebibytesOption(context, "memory_budget_mb", 0);
+  o.streaming_csv = context.option("streaming_csv");
   o.object_ids = choiceOption(context, "impostor_ids", "object", {"object", "layer"}) == "object";
   o.dynamic.object_ids = o.object_ids;
   o.cell_lookup = context.option("cell_lookup");

@@ -15,6 +15,9 @@
 //   impostor_dir=DIR        the pipeline store (mmi_dir=DIR overrides it for these modes)
 //   gpu_budget_mb=MB        GPU bytes of resident impostors, least recently used cells evicted (default 512)
 //   read_ahead=on|off       read the cells ahead of the viewer on a background thread (default on)
+//   memory_budget_mb=MB     one budget for the database in memory (resident impostors and cells read ahead;
+//                           replaces gpu_budget_mb; `--memory-budget` of walk and bench)
+//   streaming_csv=FILE      per-frame streaming log: cell entered, stall, resident bytes (runtime/streaming.h)
 //   impostor_ids=object|layer  item buffers show, per impostor pixel, the object captured there (default: the
 //                           views' per-texel ids as an id texture) or one id per layer
 //   cell_lookup=street|nearest  as for the depth-mesh mode

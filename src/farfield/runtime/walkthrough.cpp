@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "farfield/core/check.h"
@@ -9,6 +10,7 @@
 #include "farfield/core/error_bound.h"
 #include "farfield/core/timer.h"
 #include "farfield/runtime/database.h"
+#include "farfield/runtime/prefetch.h"
 #include "farfield/runtime/walkthrough_placed.h"
 
 namespace farfield::runtime {
@@ -134,6 +136,12 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
     cell_map_ = std::make_unique<urban::CellMap>(graph_, scene, cell_options);
     runner_ = std::make_unique<extract::PipelineRunner>(scene, gpu_scene, *cell_map_, pipeline_options);
   }
+  if (options_.memory_budget_bytes > 0) {
+    options_.read_ahead_bytes = options_.memory_budget_bytes / 4;
+    options_.gpu_budget_bytes = options_.memory_budget_bytes - options_.read_ahead_bytes;
+  }
+  streaming_ = StreamingLog(options_.memory_budget_bytes);
+  if (!options_.streaming_csv.empty()) StreamingLog().writeCsv(options_.streaming_csv);  // writable: fail now
   const bool draws_impostors = kind != Representation::Local && kind != Representation::Visible;
   if (online_stages_.empty() && draws_impostors) {
     store::CellReader::Options reader;
@@ -163,7 +171,14 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
   }
 }
 
-Walkthrough::~Walkthrough() = default;
+Walkthrough::~Walkthrough() {
+  if (options_.streaming_csv.empty()) return;
+  try {
+    streaming_.writeCsv(options_.streaming_csv);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "warning: %s\n", e.what());  // checked writable at construction; a destructor cannot throw
+  }
+}
 
 std::unique_ptr<Walkthrough::Cell> Walkthrough::loadCell(const store::CellEntry& entry) {
   if (!entry.pipeline)
@@ -228,6 +243,7 @@ Walkthrough::Cell& Walkthrough::cell(uint32_t half_edge, bool* loaded) {
   Stopwatch timer;
   std::unique_ptr<Cell> fresh = loadCell(*entry);
   const double ms = timer.milliseconds();
+  plan_.report.load_ms = ms;
   *loaded = true;
   ++stats_.loads;
   stats_.load_ms_total += ms;
@@ -251,14 +267,20 @@ void Walkthrough::evict(uint32_t keep) {
   }
 }
 
-// The cells the viewer may enter next: the streets leaving the junction ahead (the way back included). Queued once
-// per cell change; what was queued for an earlier cell and not started is dropped (the viewer went elsewhere).
-void Walkthrough::readAhead(uint32_t half_edge) {
-  if (!reader_ || !options_.read_ahead || half_edge == ahead_of_) return;
+// The cells the viewer may enter next, in the direction of motion (runtime/prefetch.h). Queued when the cell or the
+// junction the viewer heads for changes; what was queued before and not started is dropped (the viewer went
+// elsewhere). The motion is measured from where the eye was when it last changed by a metre or more.
+void Walkthrough::readAhead(uint32_t half_edge, const Vec3& eye) {
+  if (!reader_ || !options_.read_ahead) return;
+  const Vec2 motion(eye.x - motion_from_.x, eye.y - motion_from_.y);
+  if (glm::length(motion) >= 1.0f) motion_from_ = eye;
+  const PrefetchChoice choice = prefetchCells(graph_, half_edge, motion, options_.prefetch_cells);
+  if (half_edge == ahead_of_ && choice.exit_junction == ahead_junction_) return;
   ahead_of_ = half_edge;
+  ahead_junction_ = choice.exit_junction;
   reader_->cancelQueued();
-  for (uint32_t next : graph_.outgoing(graph_.destination(half_edge)))
-    if (next != half_edge && !cells_.count(next)) reader_->prefetch(next);
+  for (uint32_t next : choice.cells)
+    if (!cells_.count(next)) reader_->prefetch(next);
 }
 
 const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<void()>& before_gpu_work) {
@@ -283,7 +305,7 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   if (entry) {
     ++stats_.visited[half_edge];
     current = &cell(half_edge, &report.loaded);
-    readAhead(half_edge);
+    readAhead(half_edge, camera.eye);
     // Fast motion and stale dynamic impostors first: a layer that loses its dynamic impostor is judged by its
     // baked views' validity below.
     if (options_.representation == Representation::MmiDynamic) dropStaleDynamic(camera, *current);
@@ -334,6 +356,16 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
     ++stats_.fallback_frames;  // not baked: everything in the frustum, as the culled mode
   }
   report.resident_bytes = resident_bytes_;
+  report.read_ahead_bytes = reader_ ? reader_->heldBytes() : 0;
+  {
+    StreamingFrame f;
+    f.cell = half_edge;
+    if (report.loaded) f.read = report.read;
+    f.load_ms = report.load_ms;
+    f.gpu_bytes = report.resident_bytes;
+    f.read_ahead_bytes = report.read_ahead_bytes;
+    streaming_.add(f);
+  }
   report.over_gpu_budget = resident_bytes_ > options_.gpu_budget_bytes;
   stats_.resident_bytes_max = std::max(stats_.resident_bytes_max, resident_bytes_);
   if (report.over_gpu_budget) ++stats_.over_gpu_budget_frames;
@@ -518,7 +550,10 @@ std::map<std::string, double> Walkthrough::statistics() const {
     out["cells_entered_cold"] = double(r.taken_cold);
     out["read_ahead_dropped"] = double(r.dropped);
     out["read_ahead_wait_ms_total"] = r.wait_ms_total;
+    out["read_ahead_held_bytes_max"] = double(r.held_bytes_max);
+    out["read_ahead_budget_bytes"] = double(options_.read_ahead_bytes);
   }
+  for (const auto& [key, value] : streaming_.summary()) out[key] = value;
   out["online_runs"] = double(s.online_runs);
   out["online_ms_mean"] = s.online_runs ? s.online_ms_total / double(s.online_runs) : 0.0;
   out["mean_geometry_triangles"] = s.geometry_triangles / n;

@@ -41,6 +41,7 @@
 #include "farfield/impostor/validity.h"
 #include "farfield/gpu/cost_model.h"
 #include "farfield/runtime/dynamic_impostor.h"
+#include "farfield/runtime/streaming.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/store/cell_reader.h"
 #include "farfield/store/impostor_store.h"
@@ -76,6 +77,12 @@ struct WalkthroughOptions {
   uint64_t gpu_budget_bytes = uint64_t(512) << 20;
   bool read_ahead = true;                      // read the cells ahead on a background thread
   uint64_t read_ahead_bytes = uint64_t(256) << 20;  // decoded bytes of cells read ahead and not yet entered
+  // One budget for the database in memory (> 0 replaces the two above): a quarter for the cells read ahead, the rest
+  // for the resident impostors; the current cell stays even when it alone exceeds it.
+  uint64_t memory_budget_bytes = 0;
+  size_t prefetch_cells = 3;                   // cells read ahead in the direction of motion (runtime/prefetch.h)
+  std::string streaming_csv;                   // when set, the per-frame streaming log (runtime/streaming.h) is
+                                               // written there when the walkthrough ends
   bool object_ids = true;                      // impostors carry per-texel object ids (item buffers show objects)
   std::string cell_lookup;                     // "street" or "nearest"; "" = the database's
   // MmiDynamic.
@@ -126,6 +133,8 @@ struct FrameReport {
   bool baked = false;             // false: the database does not hold the cell (frustum-culled geometry)
   bool loaded = false;            // the cell was read (and its online stages run) in this frame
   const char* read = "";          // when loaded: "ready" (read ahead), "waited" (read ahead, unfinished), "cold"
+  double load_ms = 0.0;           // when loaded: the time the frame spent on it (a stall unless "ready")
+  uint64_t read_ahead_bytes = 0;  // decoded cells read ahead and not yet entered, after this frame
   uint64_t resident_bytes = 0;    // GPU bytes of resident impostors after this frame's loads and evictions
   bool over_gpu_budget = false;   // the current cell alone exceeds gpu_budget_bytes
   double bound_px = 0.0;
@@ -176,7 +185,7 @@ class Walkthrough {
   std::unique_ptr<Placed> placed_;
   Cell& cell(uint32_t half_edge, bool* loaded);
   std::unique_ptr<Cell> loadCell(const store::CellEntry& entry);
-  void readAhead(uint32_t half_edge);
+  void readAhead(uint32_t half_edge, const Vec3& eye);
   void evict(uint32_t keep);
   void dropStaleDynamic(const Camera& camera, Cell& cell);
   void updateDynamic(const Camera& camera, Cell& cell, const std::function<void()>& before_gpu_work);
@@ -197,6 +206,9 @@ class Walkthrough {
   std::list<uint32_t> order_;                       // LRU of loaded cells, most recent first
   uint64_t resident_bytes_ = 0;
   uint32_t ahead_of_ = urban::kNone;                // the cell whose successors were last queued
+  uint32_t ahead_junction_ = urban::kNone;          // ... towards this junction
+  Vec3 motion_from_{0.0f};                          // the eye where the current motion started
+  StreamingLog streaming_;
   std::unordered_map<uint32_t, std::unique_ptr<Cell>> cells_;
   std::vector<uint64_t> object_triangles_;
   std::vector<uint32_t> ids_;

@@ -91,23 +91,33 @@ void CellReader::run() {
       error = std::current_exception();
     }
     lock.lock();
+    ++stats_.read_ahead;
+    // Room first, so that the waiting bytes stay under the budget at every moment: older reads are dropped, and a
+    // cell larger than the whole budget is not kept (take() reads it again).
+    const uint64_t bytes = views ? views->bytes : 0;
+    if (bytes > options_.budget_bytes) {
+      slots_.erase(cell);
+      ++stats_.dropped;
+      ++stats_.too_large;
+      finished_.notify_all();
+      continue;
+    }
+    makeRoom(bytes);
     Slot& slot = slots_[cell];
     slot.views = std::move(views);
     slot.error = error;
     slot.done = true;
     slot.order = ++finished_count_;
-    ++stats_.read_ahead;
-    if (slot.views) held_ += slot.views->bytes;
+    held_ += bytes;
     stats_.held_bytes_max = std::max(stats_.held_bytes_max, held_);
-    enforceBudget();
     finished_.notify_all();
   }
 }
 
-// Drops the oldest finished reads while the waiting bytes exceed the budget (a failed read holds no bytes and stays,
+// Drops the oldest finished reads until `incoming` more bytes fit the budget (a failed read holds no bytes and stays,
 // so that take() can report it).
-void CellReader::enforceBudget() {
-  while (held_ > options_.budget_bytes) {
+void CellReader::makeRoom(uint64_t incoming) {
+  while (held_ + incoming > options_.budget_bytes) {
     auto oldest = slots_.end();
     for (auto it = slots_.begin(); it != slots_.end(); ++it)
       if (it->second.done && it->second.views && (oldest == slots_.end() || it->second.order < oldest->second.order))

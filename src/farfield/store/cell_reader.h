@@ -4,8 +4,10 @@
 // read took 166 ms per cell on average, 240 ms at worst: every cell entry broke the frame budget).
 //
 // The runtime asks for the cells the viewer may enter next (prefetch) and takes the current one (take). Prefetched
-// cells wait in memory, oldest dropped first when their decoded bytes exceed the budget; a cell taken before it was
-// prefetched is read on the calling thread. Errors of a background read (a damaged file) are raised by take(), with
+// cells wait in memory under a byte budget of decoded bytes that holds at every moment: before a finished read is
+// kept, the oldest waiting reads are dropped until it fits, and a cell larger than the whole budget is not kept (the
+// bytes of the one read in progress are counted when it finishes). A cell taken before it was prefetched, or
+// dropped, is read on the calling thread. Errors of a background read (a damaged file) are raised by take(), with
 // the message loadLayerView gives (file and record), never lost and never thrown on the reader thread.
 //
 // Thread safety: prefetch() and take() may be called from one thread (the render thread) while the reader runs; the
@@ -59,6 +61,7 @@ class CellReader {
     size_t taken_waited = 0;       // taken while being read (the caller waited for the rest)
     size_t taken_cold = 0;         // taken without a prefetch (read on the calling thread)
     size_t dropped = 0;            // prefetched cells dropped for the budget
+    size_t too_large = 0;          // of them, cells larger than the whole budget (never kept)
     uint64_t held_bytes_max = 0;   // largest decoded bytes waiting at once
     double wait_ms_total = 0.0;    // time take() waited for a background read
   };
@@ -88,7 +91,7 @@ class CellReader {
     uint64_t order = 0;  // when it finished, for dropping the oldest
   };
   void run();
-  void enforceBudget();  // with mutex_ held
+  void makeRoom(uint64_t incoming);  // with mutex_ held
 
   std::string dir_;
   const StoreIndex& index_;

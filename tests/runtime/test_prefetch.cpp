@@ -1,0 +1,161 @@
+// Prefetch in the direction of motion (runtime/prefetch.h, Sillion et al. 1997, section 5.1): on a hand-made
+// junction the cells are ranked by their agreement with the motion, computed here from the junction positions; and
+// a walkthrough along a straight street chain of a baked city, prefetching one cell only, finds every cell it enters
+// after the first already read ("ready": loaded before the viewer entered it), while without read-ahead every entry
+// stalls (the test can fail both ways).
+#include "farfield/runtime/prefetch.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "farfield/bake/pipeline.h"
+#include "farfield/gen/city.h"
+#include "farfield/gpu/context.h"
+#include "farfield/runtime/walkthrough.h"
+#include "support/test_support.h"
+
+namespace farfield::runtime {
+namespace {
+
+// A junction J1 at (100, 0) with streets to the west (J0), east (J2), north (J3) and south (J4).
+struct Cross {
+  urban::StreetGraph graph = urban::StreetGraph::build({{0, 0}, {100, 0}, {200, 0}, {100, 100}, {100, -100}},
+                                                       {{0, 1}, {1, 2}, {1, 3}, {1, 4}});
+  // The half-edge from junction a to b.
+  uint32_t edge(uint32_t a, uint32_t b) const {
+    for (uint32_t e : graph.outgoing(a))
+      if (graph.destination(e) == b) return e;
+    ADD_FAILURE() << "no street " << a << " -> " << b;
+    return 0;
+  }
+};
+
+TEST(PrefetchTest, CellsAreRankedByTheirAgreementWithTheMotion) {
+  const Cross x;
+  const uint32_t east = x.edge(0, 1);
+  // Along the cell (east): the junction ahead is J1; straight on first, the way back last.
+  PrefetchChoice c = prefetchCells(x.graph, east, Vec2(1.0f, 0.0f), 0);
+  EXPECT_EQ(c.exit_junction, 1u);
+  ASSERT_EQ(c.cells.size(), 4u);
+  EXPECT_EQ(c.cells[0], x.edge(1, 2));
+  EXPECT_EQ(c.cells[3], x.edge(1, 0));
+  // Veering north: north before south. The motion's ranking against a brute-force one from the positions.
+  const Vec2 motion(1.0f, 0.6f);
+  c = prefetchCells(x.graph, east, motion, 0);
+  std::vector<std::pair<float, uint32_t>> expected;
+  for (uint32_t j : {0u, 2u, 3u, 4u}) {
+    const Vec2 d = glm::normalize(x.graph.position(j) - x.graph.position(1));
+    expected.emplace_back(-glm::dot(d, glm::normalize(motion)), x.edge(1, j));
+  }
+  std::sort(expected.begin(), expected.end());
+  ASSERT_EQ(c.cells.size(), expected.size());
+  for (size_t k = 0; k < expected.size(); ++k) EXPECT_EQ(c.cells[k], expected[k].second) << k;
+  EXPECT_EQ(c.cells[1], x.edge(1, 3));
+  // At most two.
+  EXPECT_EQ(prefetchCells(x.graph, east, motion, 2).cells.size(), 2u);
+  // Backwards (west) in the eastbound cell: the junction behind, whose only other street is this one: the twin.
+  c = prefetchCells(x.graph, east, Vec2(-1.0f, 0.0f), 0);
+  EXPECT_EQ(c.exit_junction, 0u);
+  EXPECT_EQ(c.cells, std::vector<uint32_t>{x.edge(1, 0)});
+  // Standing still: as if moving along the cell.
+  EXPECT_EQ(prefetchCells(x.graph, east, Vec2(0.0f), 1).cells, std::vector<uint32_t>{x.edge(1, 2)});
+}
+
+// A chain of cells going as straight as the street graph allows from `start`: each the best-aligned street leaving
+// the previous one's end.
+std::vector<uint32_t> straightChain(const urban::StreetGraph& g, uint32_t start, size_t length) {
+  std::vector<uint32_t> chain{start};
+  while (chain.size() < length) {
+    const uint32_t e = chain.back();
+    uint32_t best = urban::kNone;
+    float best_dot = 0.9f;  // at most about 25 degrees off
+    for (uint32_t n : g.outgoing(g.destination(e)))
+      if (n != urban::StreetGraph::twin(e) && glm::dot(g.direction(n), g.direction(e)) > best_dot) {
+        best_dot = glm::dot(g.direction(n), g.direction(e));
+        best = n;
+      }
+    if (best == urban::kNone) break;
+    chain.push_back(best);
+  }
+  return chain;
+}
+
+TEST(PrefetchWalkTest, OnAStraightPathTheNextCellIsLoadedBeforeTheViewerEntersIt) {
+  gpu::sharedHeadlessContext();
+  gen::CityOptions o;
+  o.blocks = 16;
+  o.detail = 0;
+  o.seed = 19;
+  const gen::City city = gen::generateCity(o);
+  const urban::CellMap cells(city.streets, city.scene);
+  const urban::StreetGraph& g = city.streets;
+  std::vector<uint32_t> chain;
+  for (uint32_t e = 0; e < g.halfEdgeCount() && chain.size() < 3; ++e) {
+    std::vector<uint32_t> c = straightChain(g, e, 3);
+    bool usable = c.size() == 3;
+    for (uint32_t id : c) usable = usable && !cells.degenerate(id) && g.length(id) > 20.0f;
+    if (usable) chain = c;
+  }
+  ASSERT_EQ(chain.size(), 3u) << "no straight chain of three cells in this city";
+  // The camera along the chain's centrelines at eye height, looking ahead, 2 m apart.
+  gen::CameraPath path;
+  for (uint32_t e : chain) {
+    const Vec2 a = g.originPosition(e), b = g.destinationPosition(e);
+    const int steps = int(glm::length(b - a) / 2.0f);
+    for (int s = 1; s < steps; ++s) {
+      const Vec2 p = a + (b - a) * (float(s) / float(steps));
+      gen::PathFrame f;
+      f.eye = Vec3(p, 1.7f);
+      f.at = f.eye + Vec3(g.direction(e), 0.0f);
+      path.frames.push_back(f);
+    }
+  }
+  extract::PipelineOptions options;
+  options.base.resolution = 64;
+  options.base.progress = false;
+  options.pvs.spacing = 15.0f;
+  options.pvs.face_size = 32;
+  options.grid_cells = 10;
+  options.station_spacing = 0.0f;
+  const std::string store = test::scratchDir("prefetch_store").string();
+  bake::bakePipeline(gpu::sharedHeadlessContext(), city.scene, cells, chain,
+                     extract::parsePipeline("pvs,near-far,mmi"), options, store);
+
+  const gpu::GpuScene gpu_scene(city.scene);
+  const scene::Bvh bvh(city.scene);
+  gpu::Renderer renderer;
+  for (const bool read_ahead : {true, false}) {
+    WalkthroughOptions w;
+    w.database = store;
+    w.read_ahead = read_ahead;
+    w.prefetch_cells = 1;  // the straight continuation only: the direction of motion must pick it
+    w.memory_budget_bytes = uint64_t(64) << 20;
+    Walkthrough walkthrough(city.scene, gpu_scene, bvh, renderer, w);
+    std::vector<std::string> entries;
+    std::vector<uint32_t> entered;
+    for (size_t f = 0; f < path.frames.size(); ++f) {
+      const FramePlan& plan = walkthrough.plan(path.camera(f, 64, 36));
+      if (plan.report.loaded) {
+        entries.push_back(plan.report.read);
+        entered.push_back(plan.report.cell);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));  // a frame's time: the reader thread runs
+    }
+    ASSERT_EQ(entered, chain) << "the path should enter the chain's cells in order";
+    const auto stats = walkthrough.statistics();
+    if (read_ahead) {
+      EXPECT_EQ(entries, (std::vector<std::string>{"cold", "ready", "ready"}));
+      EXPECT_EQ(stats.at("stall_frames"), 1.0);  // the first cell only
+    } else {
+      EXPECT_EQ(entries, (std::vector<std::string>{"cold", "cold", "cold"}));
+      EXPECT_EQ(stats.at("stall_frames"), 3.0);
+    }
+    EXPECT_EQ(stats.at("frames_over_memory_budget"), 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace farfield::runtime
