@@ -30,6 +30,13 @@ void registerDynamicModes() {
                [](const ModeContext& c) {
                  return std::make_unique<DynamicImpostorMode>(impostor::ValidityMetric::Schaufler, c);
                });
+  registerMode("layered",
+               "hierarchical image cache of layered impostors (impostor/layered.h, depth slices by alpha test), each "
+               "planned for a shaft around the eye it was captured from and regenerated when the eye leaves it",
+               [](const ModeContext& c) {
+                 return std::make_unique<DynamicImpostorMode>(impostor::ValidityMetric::Schaufler, c,
+                                                              runtime::CachedImageKind::Layered);
+               });
   registerMode("warp",
                "post-render warping: culled-geometry keyframes every warp_interval frames, frames between warped "
                "from the latest keyframe with holes filled from the one before (3D warping using depth)",
@@ -105,7 +112,9 @@ std::map<std::string, double> BillboardMode::info() const {
 
 // ---- dynamic-shade / dynamic-schaufler ----
 
-DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const ModeContext& context) {
+DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const ModeContext& context,
+                                         runtime::CachedImageKind kind) {
+  options_.kind = kind;
   options_.metric = metric;
   options_.error_px = numberOption(context, "error_px", 2.0, 0.01);
   options_.t_max_ms = numberOption(context, "t_max_ms", 0.0, 0.0);
@@ -114,6 +123,7 @@ DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const 
 }
 
 std::string DynamicImpostorMode::name() const {
+  if (options_.kind == runtime::CachedImageKind::Layered) return "layered";
   return std::string("dynamic-") + impostor::validityMetricName(options_.metric);
 }
 

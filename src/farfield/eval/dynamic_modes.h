@@ -26,7 +26,7 @@
 
 namespace farfield::eval {
 
-// Registers billboard, dynamic-shade, dynamic-schaufler and warp (called by registerImpostorModes()).
+// Registers billboard, dynamic-shade, dynamic-schaufler, layered and warp (called by registerImpostorModes()).
 void registerDynamicModes();
 
 class BillboardMode final : public Mode {
@@ -52,7 +52,8 @@ class BillboardMode final : public Mode {
 
 class DynamicImpostorMode final : public Mode {
  public:
-  DynamicImpostorMode(impostor::ValidityMetric metric, const ModeContext& context);
+  DynamicImpostorMode(impostor::ValidityMetric metric, const ModeContext& context,
+                      runtime::CachedImageKind kind = runtime::CachedImageKind::Planar);
   std::string name() const override;
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;

@@ -90,14 +90,24 @@ int ImageCache::build(std::vector<uint32_t> objects, int depth) {
   return index;
 }
 
+size_t ImageCache::imageBytes(const Node& n) const {
+  return n.image ? n.image->textureBytes() : n.layered ? n.layered_bytes : 0;
+}
+
+void ImageCache::dropImage(Node& n) {
+  texture_bytes_ -= imageBytes(n);
+  n.image.reset();
+  n.layered.reset();
+  n.layered_bytes = 0;
+}
+
 void ImageCache::evict(size_t frame_index) {
   while (texture_bytes_ > options_.byte_budget) {
     Node* oldest = nullptr;
     for (Node& n : nodes_)
-      if (n.image && n.last_used < frame_index && (!oldest || n.last_used < oldest->last_used)) oldest = &n;
+      if (hasImage(n) && n.last_used < frame_index && (!oldest || n.last_used < oldest->last_used)) oldest = &n;
     if (!oldest) break;
-    texture_bytes_ -= oldest->image->textureBytes();
-    oldest->image.reset();
+    dropImage(*oldest);
   }
 }
 
@@ -145,6 +155,15 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
   for (const int i : cut) {
     Node& n = nodes_[size_t(i)];
     double ratio = std::numeric_limits<double>::infinity();
+    if (n.layered && !(repeat && n.regenerated_in == frame_index)) {
+      // Outside the shaft by angle or by distance: how far outside is the priority.
+      const DVec3 to = eye - DVec3(n.shaft.apex);
+      const double dist = glm::length(to);
+      const double angle = std::acos(std::clamp(glm::dot(to / std::max(dist, 1e-9), DVec3(n.shaft.axis)), -1.0, 1.0));
+      ratio = n.shaft.contains(camera.eye) ? 0.0
+                                           : std::max({angle / (0.5 * n.shaft.apex_angle),
+                                                       double(n.shaft.min_distance) / std::max(dist, 1e-9), 1.0 + 1e-9});
+    }
     if (n.image && !(repeat && n.regenerated_in == frame_index)) {
       const double e = n.image->error(options_.metric, camera.eye);
       ratio = e / theta;
@@ -167,7 +186,10 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
                                  2.0 * std::asin(std::min(1.0, 1.02 * objectRadius(n.bounds) /
                                                                    glm::length(eye - DVec3(n.bounds.center())))) /
                                      pixel_angle / options_.impostor.texel_pixels);
-    r.regenerate_ms = r.geometry_ms + options_.regeneration_overhead_ms + c.ms_per_mpixel * side * side / 1e6;
+    // A layered capture renders the node once per layer (about 8 at the usual bounds; the plan is made only when
+    // the node is regenerated).
+    const double renders = options_.kind == CachedImageKind::Layered ? 8.0 : 1.0;
+    r.regenerate_ms = renders * (r.geometry_ms + options_.regeneration_overhead_ms + c.ms_per_mpixel * side * side / 1e6);
     r.image_ms = c.ms_per_draw;
     requests.push_back(r);
   }
@@ -187,22 +209,50 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
 
   for (const uint32_t i : schedule.regenerate) {
     Node& n = nodes_[i];
-    scratch_.clear();
-    gpu_scene_.appendDrawItems(n.objects, scratch_);
-    if (n.image) texture_bytes_ -= n.image->textureBytes();
-    n.image = std::make_unique<impostor::PlanarImpostor>(renderer, scratch_, n.bounds, n.samples, camera.eye,
-                                                         pixel_angle, options_.impostor);
-    texture_bytes_ += n.image->textureBytes();
+    dropImage(n);
+    if (options_.kind == CachedImageKind::Layered) {
+      const DVec3 centre(n.bounds.center());
+      const double dist = glm::length(eye - centre);
+      n.shaft = Shaft::make(Vec3(centre), Vec3((eye - centre) / dist), float(options_.layered_apex_angle),
+                            float(options_.layered_approach * dist), "image cache shaft");
+      impostor::LayeredOptions lo;
+      lo.max_texture_size = options_.impostor.max_texels;
+      lo.max_layers = 16;
+      impostor::LayeredPlan plan;
+      try {
+        plan = impostor::planLayered(n.bounds, n.shaft, bound, lo);
+      } catch (const Error&) {
+        // The shaft's minimum distance does not clear the cluster (its layers' quads reach out further than its
+        // box): too near for a layered image; its geometry is drawn.
+        gpu_scene_.appendDrawItems(n.objects, out, camera);
+        ++st.geometry_nodes;
+        continue;
+      }
+      const impostor::LayeredImpostor captured =
+          impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene_, n.objects, plan));
+      n.layered = std::make_unique<impostor::GpuLayeredImpostor>(captured);
+      n.layered_bytes = n.layered->gpuBytes();
+      texture_bytes_ += n.layered_bytes;
+      st.texels_written_bytes += size_t(captured.plan.texels) * 4;
+      st.uploaded_bytes += n.layered_bytes;  // read back per layer, cropped, uploaded again
+    } else {
+      scratch_.clear();
+      gpu_scene_.appendDrawItems(n.objects, scratch_);
+      n.image = std::make_unique<impostor::PlanarImpostor>(renderer, scratch_, n.bounds, n.samples, camera.eye,
+                                                           pixel_angle, options_.impostor);
+      texture_bytes_ += n.image->textureBytes();
+      st.texels_written_bytes += n.image->texelBytes();
+      st.uploaded_bytes += n.image->meshBytes();
+    }
     n.regenerated_in = frame_index;
     ++st.regenerations;
-    st.texels_written_bytes += n.image->texelBytes();
-    st.uploaded_bytes += n.image->meshBytes();
     valid.push_back(int(i));
   }
   for (const int i : valid) {
     Node& n = nodes_[size_t(i)];
     n.last_used = frame_index;
-    n.image->appendDrawItems(out, 0);
+    if (n.layered) n.layered->appendDrawItems(out, 0);
+    else n.image->appendDrawItems(out, 0);
     ++st.images_drawn;
   }
   for (const uint32_t i : schedule.geometry) {

@@ -17,12 +17,22 @@
 #include "farfield/core/camera.h"
 #include "farfield/gpu/cost_model.h"
 #include "farfield/gpu/renderer.h"
+#include "farfield/core/shaft.h"
 #include "farfield/impostor/dynamic.h"
+#include "farfield/impostor/layered.h"
 #include "farfield/scene/scene.h"
 
 namespace farfield::runtime {
 
+// What a node's image is: a planar image judged by a metric, or a layered impostor (impostor/layered.h; the
+// lecture's "hardware assisted image warping", depth slices selected by alpha test) planned for a shaft around the
+// eye it was captured from, valid while the eye stays in that shaft (no metric: the plan keeps the bound there).
+enum class CachedImageKind { Planar, Layered };
+
 struct ImageCacheOptions {
+  CachedImageKind kind = CachedImageKind::Planar;
+  double layered_apex_angle = degToRad(16.0);  // the shaft's opening (Layered)
+  double layered_approach = 0.8;                // the shaft's minimum distance, times the capture distance (0..1)
   impostor::ValidityMetric metric = impostor::ValidityMetric::Schaufler;
   double error_px = 1.0;        // the bound, pixels of the frame (ErrorBound::angle of the viewer camera)
   double t_max_ms = 0.0;        // frame budget; <= 0: every invalid image is regenerated (up to the count)
@@ -80,11 +90,17 @@ class ImageCache {
     uint64_t triangles = 0;
     uint32_t draws = 0;
     std::unique_ptr<impostor::PlanarImpostor> image;
+    std::unique_ptr<impostor::GpuLayeredImpostor> layered;
+    Shaft shaft;              // the layered image's validity region
+    size_t layered_bytes = 0;
     size_t last_used = 0;
     std::optional<size_t> regenerated_in;
   };
   int build(std::vector<uint32_t> objects, int depth);
   void evict(size_t frame_index);
+  bool hasImage(const Node& n) const { return n.image || n.layered; }
+  size_t imageBytes(const Node& n) const;
+  void dropImage(Node& n);
 
   const scene::Scene& scene_;
   const gpu::GpuScene& gpu_scene_;
