@@ -93,8 +93,10 @@ std::string thousands(size_t v) {
 
 CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& options) {
   if (options.models.empty()) throw Error("crowd bench", "no models given");
-  if (options.model_heights.size() < options.models.size() || options.model_shares.size() < options.models.size())
-    throw Error("crowd bench", "one height and one share per model");
+  if (options.model_heights.size() < options.models.size() || options.model_shares.size() < options.models.size() ||
+      options.model_facing_deg.size() < options.models.size())
+    throw Error("crowd bench", "one height, facing and share per model (at most " +
+                                   std::to_string(options.model_heights.size()) + " models)");
   if (options.frames < 2) throw Error("crowd bench", "need at least 2 frames (popping compares consecutive frames)");
   if (options.width < 16 || options.height < 16) throw Error("crowd bench", "frame size too small");
   context.makeCurrent();
@@ -109,6 +111,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
     for (const std::string& w : stats.warnings()) FF_WARN(options.models[m] << ": " << w);
     runtime::CrowdModelOptions mo;
     mo.height_m = options.model_heights[m];
+    mo.facing_deg = options.model_facing_deg[m];
     model_options.push_back(mo);
     result.model_names.push_back(fs::path(options.models[m]).filename().string());
   }

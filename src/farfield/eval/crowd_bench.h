@@ -31,6 +31,8 @@ struct CrowdBenchOptions {
   int height = 512;
   std::vector<std::string> models;  // glTF files; default ../shared/data/models CesiumMan.glb and Fox.glb
   std::vector<float> model_heights{1.75f, 0.8f};
+  // Turn bringing each model's front to +x (CesiumMan walks along +x once Z up; the Fox faces glTF's +z, -y).
+  std::vector<float> model_facing_deg{0.0f, 90.0f};
   std::vector<float> model_shares{0.7f, 0.3f};
   runtime::CrowdRuntimeOptions runtime;
   std::string out_dir;

@@ -1,0 +1,78 @@
+// The crowd runtime's choice of representation and its frames (GL test: the shared headless context).
+#include "farfield/runtime/crowd_runtime.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/scene/gltf_skin.h"
+#include "support/test_support.h"
+
+namespace farfield::runtime {
+namespace {
+
+class CrowdRuntimeGl : public ::testing::Test {
+ protected:
+  void SetUp() override { gpu::sharedHeadlessContext(); }
+};
+
+TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
+  const scene::SkinnedModel fox =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  CrowdRuntimeOptions o;
+  o.palette_poses = 8;
+  o.frames = 4;
+  o.grid = impostor::ViewGrid{8, 3, float(kPi / 4)};
+  o.texel_m = 0.02f;
+  CrowdModelOptions mo;
+  mo.height_m = 0.8f;
+  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), o);
+  EXPECT_GT(rt.atlasBytes(), 0u);
+
+  Camera camera;
+  camera.eye = Vec3(0, 0, 1.7f);
+  camera.at = Vec3(10, 0, 1.0f);
+  camera.width = camera.height = 128;
+  const impostor::SwitchDistances sw = rt.switchDistances(0, camera);
+  // Dobbyn's rule: a texel of the atlas covers one pixel at texel * focal metres.
+  const double focal = 128.0 / (2.0 * std::tan(double(camera.fov_y) / 2.0));
+  const gpu::AtlasLayout& l = rt.impostor(0).layout;
+  EXPECT_NEAR(sw.texel_m, 2.0 * l.half_size.y / l.cell_height * focal, 1e-3);
+  const double d = sw.both();
+  ASSERT_GT(d, 2.0);
+
+  std::vector<CrowdAgentState> agents(3);
+  agents[0].position = Vec3(0.5 * d, 0.0, 0.0);  // near: geometry
+  agents[1].position = Vec3(1.5 * d, 0.5, 0.0);  // far: impostor
+  agents[2].position = Vec3(-5.0, 0.0, 0.0);     // behind the camera: culled
+  for (size_t i = 0; i < 3; ++i) agents[i].object_id = uint32_t(i + 1);
+  gpu::RenderTarget target(128, 128);
+  gpu::LightSettings light;
+  auto drawWith = [&](CrowdPolicy policy) {
+    target.bindForOpaquePass();
+    target.clear(light.sky_color);
+    return rt.draw(camera, agents, policy, light);
+  };
+  const CrowdFrameStats mixed = drawWith(CrowdPolicy::Mixed);
+  EXPECT_EQ(mixed.in_view, 2u);
+  EXPECT_EQ(mixed.geometry, 1u);
+  EXPECT_EQ(mixed.impostors, 1u);
+  EXPECT_EQ(mixed.draw.draw_calls, 2u);
+  const image::IdImage ids = target.readIds();
+  size_t seen[4] = {0, 0, 0, 0};
+  for (uint32_t id : ids.pixels()) seen[std::min<uint32_t>(id, 3)]++;
+  EXPECT_GT(seen[1], 5u);  // both visible agents show (a 0.8 m fox, the far one a few pixels)
+  EXPECT_GT(seen[2], 0u);
+  EXPECT_EQ(seen[3], 0u);
+  const CrowdFrameStats all_geometry = drawWith(CrowdPolicy::Geometry);
+  EXPECT_EQ(all_geometry.geometry, 2u);
+  EXPECT_EQ(all_geometry.draw.triangles, 2u * fox.mesh.triangleCount());
+  const CrowdFrameStats all_impostors = drawWith(CrowdPolicy::Impostor);
+  EXPECT_EQ(all_impostors.impostors, 2u);
+  EXPECT_EQ(all_impostors.draw.triangles, 4u);
+}
+
+}  // namespace
+}  // namespace farfield::runtime
