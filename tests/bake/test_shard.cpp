@@ -8,6 +8,7 @@
 #include <map>
 #include <numeric>
 #include <random>
+#include <set>
 
 #include "farfield/bake/merge.h"
 #include "farfield/bake/pipeline.h"
@@ -78,6 +79,43 @@ TEST(ShardPartitionTest, CoversEveryCellExactlyOnceAndStaysBalancedForManyN) {
       EXPECT_EQ(partitionCells(c2, w2, n), parts) << "n = " << n;
     }
   }
+}
+
+TEST(ShardPartitionTest, GroupedCellsShareAPartAndEveryCellIsPlacedOnce) {
+  std::mt19937 rng(1606);
+  std::vector<uint32_t> cells, groups;
+  std::vector<double> weights;
+  for (uint32_t e = 0; e < 300; ++e)
+    if (rng() % 4 != 0) {
+      cells.push_back(e);
+      groups.push_back(e / 2);  // a street's two cells
+      weights.push_back(std::uniform_real_distribution<double>(1.0, 30.0)(rng));
+    }
+  double total = 0.0, heaviest_unit = 0.0;
+  std::map<uint32_t, double> unit_weight;
+  for (size_t k = 0; k < cells.size(); ++k) unit_weight[groups[k]] += weights[k];
+  for (const auto& [g, w] : unit_weight) {
+    total += w;
+    heaviest_unit = std::max(heaviest_unit, w);
+  }
+  for (uint32_t n : {1u, 2u, 3u, 8u, 13u, 64u}) {
+    const auto parts = partitionCells(cells, weights, n, groups);
+    std::map<uint32_t, std::set<size_t>> parts_of_group;
+    std::map<uint32_t, int> seen;
+    for (size_t p = 0; p < parts.size(); ++p) {
+      double load = 0.0;
+      for (uint32_t c : parts[p]) {
+        ++seen[c];
+        parts_of_group[c / 2].insert(p);
+        load += weights[size_t(std::find(cells.begin(), cells.end(), c) - cells.begin())];
+      }
+      EXPECT_LE(load, total / double(n) + heaviest_unit + 1e-9);
+    }
+    EXPECT_EQ(seen.size(), cells.size());
+    for (const auto& [c, times] : seen) EXPECT_EQ(times, 1);
+    for (const auto& [g, in] : parts_of_group) EXPECT_EQ(in.size(), 1u) << "street " << g << ", n = " << n;
+  }
+  EXPECT_THROW(partitionCells({1, 2}, {1.0, 1.0}, 2, {0}), Error);
 }
 
 TEST(ShardPartitionTest, ParsesKOfNAndRejectsTheRest) {

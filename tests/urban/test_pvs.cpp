@@ -160,6 +160,47 @@ TEST_F(PvsTest, SinglePointSeesLessThanTheWholeCell) {
   EXPECT_TRUE(east_seen[b5]);
 }
 
+TEST(PvsSamplePoints, AStreetsTwoDirectionsShareTheirPointsBitForBit) {
+  std::mt19937 rng(1605);
+  std::uniform_real_distribution<float> u(-3000.0f, 3000.0f), h(0.5f, 40.0f);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Vec3 p(u(rng), u(rng), h(rng)), q(u(rng), u(rng), h(rng));
+    const float spacing = 0.5f + float(trial % 9);
+    std::vector<Vec3> forward = pvsSamplePoints(p, q, spacing), backward = pvsSamplePoints(q, p, spacing);
+    std::reverse(backward.begin(), backward.end());
+    ASSERT_EQ(forward.size(), backward.size());
+    for (size_t k = 0; k < forward.size(); ++k)
+      ASSERT_TRUE(forward[k] == backward[k]) << "trial " << trial << " point " << k;
+    EXPECT_TRUE(forward.front() == p && forward.back() == q);
+  }
+}
+
+TEST_F(PvsTest, ReusedViewpointsGiveThePvsOfFreshRenders) {
+  const TestCity city;
+  const gpu::GpuScene gpu_scene(city.scene);
+  PvsOptions fresh_options;
+  fresh_options.spacing = 4.0f;
+  fresh_options.face_size = 64;
+  fresh_options.reuse_viewpoints = false;
+  PvsOptions reuse_options = fresh_options;
+  reuse_options.reuse_viewpoints = true;
+  PvsSampler reusing(gpu_scene, reuse_options);
+  const Vec3 r = kQ + Vec3(0.0f, 30.0f, 0.0f);  // a street leaving the junction at kQ
+  const std::vector<std::pair<Vec3, Vec3>> cells = {{kP, kQ}, {kQ, kP}, {kQ, r}, {kP, kQ}};
+  for (size_t c = 0; c < cells.size(); ++c) {
+    PvsSampler fresh(gpu_scene, fresh_options);  // no earlier cell
+    const Pvs expected = fresh.sample(cells[c].first, cells[c].second);
+    const Pvs got = reusing.sample(cells[c].first, cells[c].second);
+    EXPECT_EQ(got.ids, expected.ids) << "cell " << c;
+    EXPECT_EQ(got.sample_points, expected.sample_points);
+    EXPECT_EQ(expected.views, expected.sample_points * 6);
+    EXPECT_EQ(got.views + 6 * got.reused_points, got.sample_points * 6);
+  }
+  // The twin renders nothing; the street from the junction reuses the junction's point; the repeat renders nothing.
+  EXPECT_EQ(reusing.sample(kQ, kP).reused_points, pvsSamplePoints(kQ, kP, 4.0f).size());
+  EXPECT_EQ(reusing.sample(kQ, r + Vec3(0.0f, 9.0f, 0.0f)).reused_points, 1u);
+}
+
 TEST_F(PvsTest, BadOptionsThrow) {
   const TestCity city;
   const gpu::GpuScene gpu_scene(city.scene);

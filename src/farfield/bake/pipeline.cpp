@@ -222,7 +222,9 @@ PipelineReport bakePipeline(gpu::Context& context, const scene::Scene& scene, co
     shard.scene_crc32 = sceneDigest(scene);
     shard.view_space = todo;
     std::sort(shard.view_space.begin(), shard.view_space.end());
-    shard.cells = partitionCells(todo, cellWeights(cells, todo, options), shard.count)[shard.index];
+    std::vector<uint32_t> streets;  // a street's two cells in one shard: they share their PVS views
+    for (uint32_t c : todo) streets.push_back(c / 2);
+    shard.cells = partitionCells(todo, cellWeights(cells, todo, options), shard.count, streets)[shard.index];
     todo = shard.cells;
     index.shard = std::move(shard);
   }

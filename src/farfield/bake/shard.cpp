@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "farfield/core/error.h"
@@ -40,24 +41,38 @@ std::vector<double> cellWeights(const urban::CellMap& map, const std::vector<uin
 }
 
 std::vector<std::vector<uint32_t>> partitionCells(const std::vector<uint32_t>& cells,
-                                                  const std::vector<double>& weights, uint32_t count) {
+                                                  const std::vector<double>& weights, uint32_t count,
+                                                  const std::vector<uint32_t>& groups) {
   if (count == 0) throw Error("--shard", "the number of shards must be at least 1");
-  if (weights.size() != cells.size())
+  if (weights.size() != cells.size() || (!groups.empty() && groups.size() != cells.size()))
     throw Error("partition", std::to_string(cells.size()) + " cells but " + std::to_string(weights.size()) +
-                                 " weights");
-  std::vector<size_t> order(cells.size());
-  std::iota(order.begin(), order.end(), size_t(0));
-  // Heaviest first; equal weights by id, so that the input's order does not matter.
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    if (weights[a] != weights[b]) return weights[a] > weights[b];
-    return cells[a] < cells[b];
+                                 " weights and " + std::to_string(groups.size()) + " groups");
+  // Units: the cells of one group (each cell alone without groups), with their summed weight and smallest id.
+  struct Unit {
+    double weight = 0.0;
+    uint32_t first = 0xffffffffu;
+    std::vector<uint32_t> cells;
+  };
+  std::map<uint64_t, Unit> by_group;
+  for (size_t k = 0; k < cells.size(); ++k) {
+    Unit& u = by_group[groups.empty() ? uint64_t(cells[k]) : (uint64_t(1) << 32) | groups[k]];
+    u.weight += weights[k];
+    u.first = std::min(u.first, cells[k]);
+    u.cells.push_back(cells[k]);
+  }
+  std::vector<Unit> units;
+  for (auto& [key, u] : by_group) units.push_back(std::move(u));
+  // Heaviest first; equal weights by smallest id, so that the input's order does not matter.
+  std::sort(units.begin(), units.end(), [](const Unit& a, const Unit& b) {
+    if (a.weight != b.weight) return a.weight > b.weight;
+    return a.first < b.first;
   });
   std::vector<std::vector<uint32_t>> parts(count);
   std::vector<double> load(count, 0.0);
-  for (size_t k : order) {
+  for (const Unit& u : units) {
     const size_t lightest = size_t(std::min_element(load.begin(), load.end()) - load.begin());  // first of equals
-    parts[lightest].push_back(cells[k]);
-    load[lightest] += weights[k];
+    parts[lightest].insert(parts[lightest].end(), u.cells.begin(), u.cells.end());
+    load[lightest] += u.weight;
   }
   for (std::vector<uint32_t>& p : parts) std::sort(p.begin(), p.end());
   return parts;

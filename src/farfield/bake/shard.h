@@ -4,7 +4,7 @@
 // Balance: a cell's work grows with its length (PVS sample points every pvs.spacing metres, capture stations every
 // station_spacing metres), so each cell gets that estimate as its weight and the cells are dealt out heaviest first
 // to the lightest part (Graham's LPT list scheduling: the heaviest part weighs at most total / N + the heaviest
-// cell). Ties break on the cell id and the part number, so every process computes the same partition from the same
+// unit), a street's two cells together. Ties break on the cell id and the part number, so every process computes the same partition from the same
 // view space without talking to the others.
 #pragma once
 
@@ -31,9 +31,13 @@ std::vector<double> cellWeights(const urban::CellMap& map, const std::vector<uin
                                 const extract::PipelineOptions& options);
 
 // Splits `cells` (distinct ids) with their `weights` into `count` parts: every cell in exactly one part, each part
-// ascending, the same result for the same input in any order. Throws farfield::Error for count 0 or a size mismatch.
+// ascending, the same result for the same input in any order. Cells with the same `groups` value (one per cell;
+// empty = every cell alone) go to the same part, dealt out as one unit of their summed weight: the bake groups a
+// street's two cells, which share their PVS sample points (urban/pvs.h reuses their views). Throws farfield::Error
+// for count 0 or a size mismatch.
 std::vector<std::vector<uint32_t>> partitionCells(const std::vector<uint32_t>& cells,
-                                                  const std::vector<double>& weights, uint32_t count);
+                                                  const std::vector<double>& weights, uint32_t count,
+                                                  const std::vector<uint32_t>& groups = {});
 
 // A digest of the scene a shard was baked from (object names, world bounds and footprints, triangle count): shards
 // of different scenes differ (merge checks it), the same scene loaded by any process gives the same value.

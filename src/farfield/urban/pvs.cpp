@@ -3,9 +3,11 @@
 #include "farfield/urban/pvs.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <unordered_set>
 
 #include "farfield/core/error.h"
@@ -25,6 +27,12 @@ std::vector<Vec3> pvsSamplePoints(const Vec3& p, const Vec3& q, float spacing) {
     throw Error("PVS options", "sample spacing must be a positive number of metres, got " + std::to_string(spacing));
   const double length = glm::length(DVec3(q) - DVec3(p));
   if (length == 0.0) return {p};
+  // One canonical direction, so that a street's two cells get the same points (reversed), bit for bit.
+  if (std::tie(q.x, q.y, q.z) < std::tie(p.x, p.y, p.z)) {
+    std::vector<Vec3> points = pvsSamplePoints(q, p, spacing);
+    std::reverse(points.begin(), points.end());
+    return points;
+  }
   const size_t intervals = size_t(std::max(1.0, std::ceil(length / double(spacing))));
   std::vector<Vec3> points;
   points.reserve(intervals + 1);
@@ -88,13 +96,39 @@ void PvsSampler::sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen) {
   }
 }
 
+// A view depends on the eye only (the scene, the faces and the planes are the sampler's), so the ids a sample point
+// saw are kept and reused by the next cell with that point: a whole-city bake renders each street's points once,
+// not once per direction, and each junction's point once for all its streets.
 Pvs PvsSampler::sample(const Vec3& p, const Vec3& q) {
   const std::vector<Vec3> points = pvsSamplePoints(p, q, options_.spacing);
   std::vector<uint8_t> seen;
-  for (const Vec3& eye : points) sampleViewpoint(eye, seen);
   Pvs pvs;
+  for (const Vec3& eye : points) {
+    if (!options_.reuse_viewpoints) {
+      sampleViewpoint(eye, seen);
+      pvs.views += 6;
+      continue;
+    }
+    const std::array<uint32_t, 3> key = {std::bit_cast<uint32_t>(eye.x), std::bit_cast<uint32_t>(eye.y),
+                                         std::bit_cast<uint32_t>(eye.z)};
+    auto it = views_.find(key);
+    if (it != views_.end()) {
+      ++pvs.reused_points;
+    } else {
+      std::vector<uint8_t> here;
+      sampleViewpoint(eye, here);
+      pvs.views += 6;
+      std::vector<uint32_t> ids;
+      for (size_t id = 1; id < here.size(); ++id)
+        if (here[id]) ids.push_back(uint32_t(id));
+      it = views_.emplace(key, std::move(ids)).first;
+    }
+    for (uint32_t id : it->second) {
+      if (id >= seen.size()) seen.resize(size_t(id) + 1, 0);
+      seen[id] = 1;
+    }
+  }
   pvs.sample_points = points.size();
-  pvs.views = points.size() * 6;
   for (size_t id = 1; id < seen.size(); ++id)
     if (seen[id]) pvs.ids.push_back(uint32_t(id));
   return pvs;

@@ -2,6 +2,9 @@
 // (Decoret et al. 1999, sections 5.3 and 5.4).
 #pragma once
 
+#include <array>
+#include <map>
+
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -20,16 +23,21 @@ struct PvsOptions {
   int face_size = 128;         // pixels per side of each cube face (90-degree field of view)
   float near_plane = 0.25f;    // metres
   float far_plane = 20000.0f;  // metres
+  // Reuse the 360-degree view of a sample point an earlier cell rendered (the same result: a view depends on the eye
+  // only). A street's two cells have the same sample points, and cells meeting at a junction share it.
+  bool reuse_viewpoints = true;
 };
 
 struct Pvs {
   std::vector<uint32_t> ids;  // object ids seen from at least one sample point, sorted, no 0 (background)
   size_t sample_points = 0;
-  size_t views = 0;           // cube faces rendered (6 per sample point)
+  size_t views = 0;           // cube faces rendered (6 per sample point not reused)
+  size_t reused_points = 0;   // sample points whose view an earlier cell rendered (PvsOptions::reuse_viewpoints)
 };
 
 // Points along [p, q]: both end points and evenly spaced ones between, no farther apart than `spacing`
-// (ceil(|pq| / spacing) + 1 points; one point when p == q). Throws farfield::Error for a non-finite end point or a
+// (ceil(|pq| / spacing) + 1 points; one point when p == q). The points of [q, p] are those of [p, q] in reverse
+// order, bit for bit (so the two cells of a street share their views). Throws farfield::Error for a non-finite end point or a
 // spacing that is not a positive finite number.
 std::vector<Vec3> pvsSamplePoints(const Vec3& p, const Vec3& q, float spacing);
 
@@ -59,6 +67,7 @@ class PvsSampler {
   std::vector<gpu::DrawItem> items_;
   std::vector<Box3> item_bounds_;  // world bounds per draw item, for culling each face
   std::vector<gpu::DrawItem> visible_items_;
+  std::map<std::array<uint32_t, 3>, std::vector<uint32_t>> views_;  // eye (float bits) -> ids seen, ascending
 };
 
 struct NearFarSplit {
