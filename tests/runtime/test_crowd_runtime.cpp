@@ -76,3 +76,52 @@ TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
 
 }  // namespace
 }  // namespace farfield::runtime
+
+namespace farfield::runtime {
+namespace {
+
+// Agents at any heading and between capture views: the impostor covers nearly the pixels the geometry covers
+// (a telephoto camera, so that the agent is large on screen).
+TEST_F(CrowdRuntimeGl, ImpostorCoversTheGeometryAtAnyHeading) {
+  const scene::SkinnedModel fox =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  CrowdRuntimeOptions o;
+  o.palette_poses = 4;
+  o.frames = 4;
+  o.texel_m = 0.01f;  // the lecture's 32 x 8 views
+  CrowdModelOptions mo;
+  mo.height_m = 0.8f;
+  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), o);
+  Camera camera;
+  camera.eye = Vec3(0, 0, 1.7f);
+  camera.at = Vec3(25, 0, 0.4f);
+  camera.width = camera.height = 160;
+  camera.fov_y = float(degToRad(4.0));
+  gpu::RenderTarget target(160, 160);
+  gpu::LightSettings light;
+  for (float heading : {0.0f, 0.5f, 1.9f, 3.0f, 4.4f}) {
+    std::vector<CrowdAgentState> agents(1);
+    agents[0].position = Vec3(25, 0, 0);
+    agents[0].heading = heading;
+    agents[0].phase = 0.25f;
+    agents[0].object_id = 1;
+    image::IdImage masks[2];
+    for (int p = 0; p < 2; ++p) {
+      target.bindForOpaquePass();
+      target.clear(light.sky_color);
+      rt.draw(camera, agents, p == 0 ? CrowdPolicy::Geometry : CrowdPolicy::Impostor, light);
+      masks[p] = target.readIds();
+    }
+    size_t both = 0, either = 0;
+    for (size_t i = 0; i < masks[0].pixelCount(); ++i) {
+      const bool a = masks[0].pixels()[i] != 0, b = masks[1].pixels()[i] != 0;
+      both += a && b;
+      either += a || b;
+    }
+    EXPECT_GT(either, 800u) << heading;
+    EXPECT_GT(double(both), 0.7 * double(either)) << "heading " << heading;
+  }
+}
+
+}  // namespace
+}  // namespace farfield::runtime

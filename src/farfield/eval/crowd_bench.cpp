@@ -40,7 +40,8 @@ std::vector<ModeSpec> modeSpecs() {
           {"crowd-mixed", runtime::CrowdPolicy::Mixed}};
 }
 
-// An elevated path: the pedestrian walk raised by 14 m, looking 20 m ahead down to the street.
+// An elevated path: the pedestrian walk raised by 14 m (a first-floor balcony, a bus roof), looking down the street
+// to a point on the ground 50 m ahead.
 gen::CameraPath elevated(const gen::CameraPath& walk) {
   gen::CameraPath out = walk;
   out.kind = "elevated";
@@ -50,7 +51,7 @@ gen::CameraPath elevated(const gen::CameraPath& walk) {
     forward = glm::length(forward) > 1e-6f ? glm::normalize(forward) : Vec3(1, 0, 0);
     const float ground = f.eye.z - 1.7f;
     f.eye.z += 14.0f;
-    f.at = Vec3(f.eye.x, f.eye.y, ground) + forward * 20.0f;
+    f.at = Vec3(f.eye.x, f.eye.y, ground) + forward * 50.0f;
   }
   return out;
 }
