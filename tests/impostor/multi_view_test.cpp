@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/scene/gltf_skin.h"
@@ -136,6 +137,31 @@ TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
     const Coverage w = compareAgents(geo, wrong);
     EXPECT_LT(double(w.both), 0.85 * double(w.either)) << "cell " << cell << ": the wrong view must not match";
   }
+}
+
+}  // namespace
+}  // namespace farfield::impostor
+
+namespace farfield::impostor {
+namespace {
+
+TEST(MultiView, ChoiceFromTheBoundKeepsTheBoundAndIsNotWasteful) {
+  // 512 px at 60 degrees (focal 443 px), a 0.35 m half width, impostors from 20 m on.
+  const double focal = 512.0 / (2.0 * std::tan(kPi / 6.0));
+  for (double error_px : {1.0, 2.0, 4.0}) {
+    const BoundChoice c = chooseForBound(error_px, focal, 20.0, 0.35);
+    EXPECT_NEAR(c.texel_m, 20.0 / focal, 1e-6);
+    const double allowed = error_px * 20.0 / (focal * 0.35);
+    EXPECT_LE(worstViewAngle(c.grid), allowed + 1e-6) << error_px;
+    // One elevation fewer (and its azimuths) breaks the bound: the choice is the coarsest of its family.
+    ViewGrid coarser = c.grid;
+    coarser.elevations -= 1;
+    coarser.azimuths = std::max(3, int(std::ceil(2.0 * kPi / (double(coarser.max_elevation) / coarser.elevations))));
+    if (coarser.elevations >= 1) {
+      EXPECT_GT(worstViewAngle(coarser), allowed) << error_px;
+    }
+  }
+  EXPECT_THROW(chooseForBound(0.0, focal, 20.0, 0.35), Error);
 }
 
 }  // namespace

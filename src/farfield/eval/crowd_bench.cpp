@@ -285,7 +285,13 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
        << l.cell_height << " texels (" << fmt("%.3f", options.runtime.texel_m) << " m), "
        << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0) << " MiB uncompressed ("
        << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames) << " KiB per frame); switch to impostor beyond "
-       << fmt("%.1f", result.switch_m[m]) << " m\n";
+       << fmt("%.1f", result.switch_m[m]) << " m";
+    // What the bound would choose for impostors from 20 m on (impostor::chooseForBound).
+    const double focal = double(options.height) / (2.0 * std::tan(degToRad(60.0) / 2.0));
+    const impostor::BoundChoice bc =
+        impostor::chooseForBound(options.runtime.error_px, focal, 20.0, double(l.half_size.x));
+    md << "; for " << fmt("%.1f", options.runtime.error_px) << " px from 20 m on the bound asks for "
+       << bc.grid.azimuths << "x" << bc.grid.elevations << " views and " << fmt("%.3f", bc.texel_m) << " m texels\n";
   }
   md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
   md << "| agents | path | mode | median ms | crowd ms | speedup | crowd speedup | geometry / impostor agents | "

@@ -99,6 +99,25 @@ SwitchDistances switchDistances(const gpu::AtlasLayout& layout, const ViewGrid& 
   return s;
 }
 
+BoundChoice chooseForBound(double error_px, double focal_px, double switch_m, double half_width_m,
+                           float max_elevation) {
+  if (!(error_px > 0.0) || !(focal_px > 0.0) || !(switch_m > 0.0) || !(half_width_m > 0.0) || !(max_elevation > 0.0f))
+    throw Error("multi-view bound", "error, focal length, switch distance and half width must be positive");
+  BoundChoice c;
+  c.texel_m = float(switch_m / focal_px);
+  const double allowed = error_px * switch_m / (focal_px * half_width_m);
+  // Equal spacing s: the worst angle is s at the top ring's gap and s / sqrt(2) between four views; start from the
+  // spacing equal to the allowed angle and refine until the measured worst angle fits.
+  for (int n = std::max(1, int(std::ceil(double(max_elevation) / std::min(allowed, double(max_elevation))))); n < 4096;
+       ++n) {
+    c.grid.elevations = n;
+    c.grid.max_elevation = max_elevation;
+    c.grid.azimuths = std::max(3, int(std::ceil(2.0 * kPi / (double(max_elevation) / n))));
+    if (double(worstViewAngle(c.grid)) <= allowed) break;
+  }
+  return c;
+}
+
 MultiViewImpostor bakeMultiView(gpu::CrowdRenderer& renderer, const gpu::SkinnedGpuModel& model,
                                 const gpu::AtlasLayout& layout, const ViewGrid& grid) {
   if (layout.frames < 1 || model.poseCount() % uint32_t(layout.frames) != 0)

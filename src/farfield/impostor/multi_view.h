@@ -55,6 +55,18 @@ struct SwitchDistances {
 SwitchDistances switchDistances(const gpu::AtlasLayout& layout, const ViewGrid& grid, double focal_px,
                                 double error_px);
 
+// Views and texel size chosen from the error bound instead of fixed numbers: for impostors drawn from `switch_m`
+// metres on (a camera of `focal_px`), the texel that covers one pixel there (Dobbyn's rule: switch_m / focal_px) and
+// the coarsest grid of equal azimuth and elevation spacing whose worst view angle keeps a model of half width
+// `half_width_m` within `error_px` there (worstViewAngle(grid) <= error_px * switch_m / (focal_px * half_width_m)).
+// Throws farfield::Error for non-positive arguments.
+struct BoundChoice {
+  ViewGrid grid;
+  float texel_m = 0.0f;
+};
+BoundChoice chooseForBound(double error_px, double focal_px, double switch_m, double half_width_m,
+                           float max_elevation = float(kPi / 2));
+
 // A baked model: layout, grid and the atlas on the GPU.
 struct MultiViewImpostor {
   ViewGrid grid;
