@@ -147,7 +147,7 @@ void DynamicImpostorMode::frame(FrameContext& frame) {
 
 std::map<std::string, double> DynamicImpostorMode::info() const {
   double regen = 0, regen_max = 0, images = 0, geometry = 0, written = 0, uploaded = 0, tex_max = 0, audited = 0,
-         unneeded = 0, missed = 0, frames_with_regen = 0;
+         unneeded = 0, missed = 0, frames_with_regen = 0, predicted = 0;
   for (const auto& [k, s] : per_frame_) {
     regen += double(s.regenerations);
     regen_max = std::max(regen_max, double(s.regenerations));
@@ -160,10 +160,12 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
     audited += double(s.audited);
     unneeded += double(s.unneeded);
     missed += double(s.missed);
+    predicted += s.predicted_ms;
   }
   const double f = double(std::max<size_t>(per_frame_.size(), 1));
   return {{"error_bound_px", options_.error_px},
           {"t_max_ms", options_.t_max_ms},
+          {"predicted_ms_mean", predicted / f},
           {"nodes", double(cache_ ? cache_->nodeCount() : 0)},
           {"regenerations_per_frame", regen / f},
           {"regenerations_max", regen_max},

@@ -61,7 +61,7 @@ ValidityMetric parseValidityMetric(const std::string& name, const std::string& w
 
 PlanarImpostor::PlanarImpostor(gpu::Renderer& renderer, std::span<const gpu::DrawItem> items, const Box3& bounds,
                                std::span<const DVec3> samples, const Vec3& eye, double pixel_angle,
-                               const PlanarImpostorOptions& o) {
+                               const PlanarImpostorOptions& o, const Vec3& fill) {
   if (samples.empty()) throw Error("planar impostor", "no sample points");
   if (!(o.texel_pixels > 0.0) || o.min_texels < 4 || o.max_texels > 4096 || o.min_texels > o.max_texels)
     throw Error("planar impostor", "bad options (texel_pixels > 0, 4 <= min_texels <= max_texels <= 4096)");
@@ -93,6 +93,7 @@ PlanarImpostor::PlanarImpostor(gpu::Renderer& renderer, std::span<const gpu::Dra
 
   target_ = std::make_unique<gpu::RenderTarget>(side, side);
   Vec4 clear = renderer.light().sky_color;
+  if (fill.r >= 0.0f && fill.g >= 0.0f && fill.b >= 0.0f) clear = Vec4(fill, 0.0f);
   clear.a = 0.0f;
   target_->clear(clear);
   if (!items.empty()) renderer.draw(camera_, items, *target_);

@@ -30,7 +30,9 @@ const char* validityMetricName(ValidityMetric metric);  // "shade", "schaufler"
 ValidityMetric parseValidityMetric(const std::string& name, const std::string& where);
 
 struct PlanarImpostorOptions {
-  double texel_pixels = 1.0;  // texel size in pixels of the viewer's frame at the capture distance (> 0)
+  // Texel size in pixels of the viewer's frame at the capture distance (> 0). On the forest 0.5 (four times the
+  // texels) gave 24.0 dB against 23.0 dB at 1.0 over 8 frames: the loss there is elsewhere (docs/BENCHMARKS.md).
+  double texel_pixels = 1.0;
   int min_texels = 16;        // texture side bounds (4..4096)
   int max_texels = 512;
   double max_tilt = degToRad(60.0);  // the best plane's normal stays this close to the view direction
@@ -43,9 +45,12 @@ class PlanarImpostor {
   // with Renderer::draw into a target of its own cleared to transparent (allowed inside a timed frame). `samples`:
   // points of the objects (Shade's metric and the best plane use them; at least one). Throws farfield::Error for an
   // eye within the bounding sphere, no samples, or bad options. Needs a current context.
+  // `fill`: the colour of the transparent texels (alpha 0) when its components are >= 0, else the sky colour. The
+  // texture is filtered bilinearly, so texels at a silhouette mix it in; with small features (leaves) that shows,
+  // and the objects' mean colour hides it (runtime/image_cache.cpp passes it).
   PlanarImpostor(gpu::Renderer& renderer, std::span<const gpu::DrawItem> items, const Box3& bounds,
                  std::span<const DVec3> samples, const Vec3& eye, double pixel_angle,
-                 const PlanarImpostorOptions& options = {});
+                 const PlanarImpostorOptions& options = {}, const Vec3& fill = Vec3(-1.0f));
   PlanarImpostor(PlanarImpostor&&) noexcept;
   PlanarImpostor& operator=(PlanarImpostor&&) noexcept;
   ~PlanarImpostor();

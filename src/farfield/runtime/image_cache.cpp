@@ -44,7 +44,30 @@ ImageCache::ImageCache(const scene::Scene& scene, const gpu::GpuScene& gpu_scene
   nodes_.reserve(2 * small.size() / size_t(options.leaf_objects) + 2);
   if (!small.empty()) build(std::move(small), 0);
   const std::vector<gpu::ObjectDrawCost> costs = gpu_scene.objectDrawCosts();
+  // Mean colour of each material (base colour times its texture's mean), lit by about the renderer's ambient plus
+  // half its light: what a silhouette texel of the image should blend towards.
+  std::vector<Vec3> material_color;
+  for (const scene::Material& m : scene.materials) {
+    Vec3 c(m.base_color);
+    if (m.texture && m.texture->width() > 0) {
+      DVec3 sum(0.0);
+      const size_t step = std::max<size_t>(1, m.texture->pixelCount() / 4096);
+      size_t n = 0;
+      for (size_t i = 0; i < m.texture->pixelCount(); i += step, ++n) sum += DVec3(glm::dvec4(m.texture->pixels()[i]));
+      c *= Vec3(sum / (255.0 * double(std::max<size_t>(n, 1))));
+    }
+    material_color.push_back(m.unlit ? c : c * 0.7f);
+  }
   for (Node& n : nodes_) {
+    DVec3 color_sum(0.0);
+    double color_weight = 0.0;
+    for (const uint32_t id : n.objects)
+      for (const scene::Part& p : scene.objects[id - 1].parts) {
+        const double w = double(scene.meshes[p.mesh].triangleCount());
+        color_sum += w * DVec3(material_color[p.material]);
+        color_weight += w;
+      }
+    if (color_weight > 0.0) n.mean_color = Vec3(color_sum / color_weight);
     for (const uint32_t id : n.objects) {
       n.triangles += costs[id].triangles;
       n.draws += costs[id].draws;
@@ -239,7 +262,7 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
       scratch_.clear();
       gpu_scene_.appendDrawItems(n.objects, scratch_);
       n.image = std::make_unique<impostor::PlanarImpostor>(renderer, scratch_, n.bounds, n.samples, camera.eye,
-                                                           pixel_angle, options_.impostor);
+                                                           pixel_angle, options_.impostor, n.mean_color);
       texture_bytes_ += n.image->textureBytes();
       st.texels_written_bytes += n.image->texelBytes();
       st.uploaded_bytes += n.image->meshBytes();

@@ -89,6 +89,7 @@ class ImageCache {
     std::vector<DVec3> audit_points;   // mesh vertices (audit)
     uint64_t triangles = 0;
     uint32_t draws = 0;
+    Vec3 mean_color{-1.0f};  // the objects' mean lit colour: the fill of the image's transparent texels
     std::unique_ptr<impostor::PlanarImpostor> image;
     std::unique_ptr<impostor::GpuLayeredImpostor> layered;
     Shaft shaft;              // the layered image's validity region
