@@ -113,16 +113,22 @@ TEST(TerrainBenchGL, KeyframesAreWhereTheSimulationPutsThem) {
   ASSERT_EQ(r.sprite_log.size(), kFrames);
   ASSERT_EQ(r.keyframes_simulated.size(), kFrames);
   // With the per-frame choice (terrain/path_choice.h) a trip of the metric is a rendered keyframe or a virtual one
-  // (the frame drew the high LOD); fresh keyframes happen only at trips.
+  // (the frame drew the high LOD); a keyframe is rendered only at a trip or at a switch (the virtual keyframe's age
+  // made one pay). Until the first switch the trips are the simulation's; lod-sprite-always, the paper's technique,
+  // has a keyframe at every simulated one.
   size_t keyframes = 0, fresh_keyframes = 0;
+  bool switched = false;
   for (size_t k = 0; k < kFrames; ++k) {
     const terrain::LodSpriteFrameInfo& info = r.sprite_log[k].info;
     const bool fresh = info.source == terrain::SpriteSource::Fresh;
-    EXPECT_EQ(info.keyframe_due, r.keyframes_simulated[k] != 0) << "frame " << k;
-    if (fresh) {
-      EXPECT_TRUE(info.keyframe_due) << "frame " << k;
+    switched = switched || info.switched;
+    if (!switched) {
+      EXPECT_EQ(info.keyframe_due, r.keyframes_simulated[k] != 0) << "frame " << k;
     }
-    keyframes += info.keyframe_due;
+    if (fresh) {
+      EXPECT_TRUE(info.keyframe_due || info.switched) << "frame " << k;
+    }
+    keyframes += r.keyframes_simulated[k];
     fresh_keyframes += fresh;
   }
   // Not trivially true: the first frame is a keyframe, some later frame is one, and some frame reuses a sprite.
@@ -132,7 +138,6 @@ TEST(TerrainBenchGL, KeyframesAreWhereTheSimulationPutsThem) {
   const ModeResult* sprite = r.bench.mode("lod-sprite");
   ASSERT_NE(sprite, nullptr);
   EXPECT_EQ(sprite->info.at("keyframes"), double(fresh_keyframes));
-  EXPECT_EQ(sprite->info.at("keyframe_decisions"), double(keyframes));
   // lod-sprite-always is the paper's technique: a keyframe at every trip.
   const ModeResult* always = r.bench.mode("lod-sprite-always");
   ASSERT_NE(always, nullptr);
@@ -141,7 +146,9 @@ TEST(TerrainBenchGL, KeyframesAreWhereTheSimulationPutsThem) {
 
   ASSERT_EQ(r.epsilon_sweep.size(), 2u);
   for (const EpsilonSweepRow& row : r.epsilon_sweep) {
-    EXPECT_EQ(row.keyframes, row.keyframes_simulated) << "epsilon " << row.epsilon_px;
+    if (row.switches == 0) {
+      EXPECT_EQ(row.keyframes, row.keyframes_simulated) << "epsilon " << row.epsilon_px;
+    }
     EXPECT_GE(row.keyframes, 1u);
   }
   ASSERT_EQ(r.keyframes_vs_frames.size(), 2u);
@@ -157,7 +164,7 @@ TEST(TerrainBenchGL, EverySpriteIsWithinTheThreshold) {
   for (size_t k = 0; k < run.result.sprite_log.size(); ++k) {
     const terrain::LodSpriteFrameInfo& info = run.result.sprite_log[k].info;
     EXPECT_LT(info.error_px, epsilon) << "frame " << k;
-    if (k > 0 && info.source == terrain::SpriteSource::Fresh) {
+    if (k > 0 && info.source == terrain::SpriteSource::Fresh && !info.switched) {
       EXPECT_GE(info.trigger_error_px, epsilon) << "frame " << k;
     }
     if (info.source == terrain::SpriteSource::Kept) {

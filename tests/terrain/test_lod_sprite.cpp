@@ -322,9 +322,10 @@ TEST(LodSpriteGL, ChoiceDrawsTheHighLodWhenTheSpriteCostsMore) {
   EXPECT_GE(sprite.counters().virtual_keyframes, 2u);  // the metric ran: it tripped along the path
 }
 
-// ...and where the high LOD is expensive, once a sprite lifetime is known (the first keyframe is virtual: with no
-// lifetime measured, a keyframe is assumed to serve one frame, which never pays), every keyframe is rendered and every
-// frame after it takes the sprite path.
+// ...and where the high LOD is expensive: the run starts on the high LOD (no sprite lifetime known: a keyframe is
+// assumed to serve one frame, which never pays), takes a keyframe as soon as a measured lifetime or the virtual
+// keyframe's age makes one pay, and from then on every frame takes the sprite path, with a new keyframe exactly where
+// equation 2, recomputed here from the last keyframe's eye, reaches the threshold.
 TEST(LodSpriteGL, ChoiceTakesTheSpriteWhenTheHighLodIsExpensive) {
   Scene scene(testFractal());
   TerrainCost cost;
@@ -335,25 +336,66 @@ TEST(LodSpriteGL, ChoiceTakesTheSpriteWhenTheHighLodIsExpensive) {
   options.cost = &cost;
   LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
   const std::vector<Camera> cameras = choicePath(scene.hf, 24);
-  const std::vector<uint8_t> trips = simulateKeyframes(*scene.lod, cameras, options.low_error, options.epsilon);
   gpu::RenderTarget frame(128, 128);
-  size_t trip_count = 0;
+  bool started = false;  // the first keyframe was taken (at a trip, or by a switch)
+  size_t keyframes_after_start = 0;
+  Vec3 key_eye(0.0f);
   for (size_t f = 0; f < cameras.size(); ++f) {
     frame.clear(kSky);
     LodSpriteFrameInfo info;
+    const LodMesh low = scene.lod->build(cameras[f], LodSettings{options.low_error, true, true});
+    const bool due = started && keyframeDue(spriteError(*scene.lod, low.quadrants, key_eye, cameras[f].eye),
+                                            pixelAngle(cameras[f]), options.epsilon);
     sprite.render(cameras[f], frame, &info);
-    EXPECT_EQ(info.keyframe_due, trips[f] != 0) << "frame " << f;
-    trip_count += trips[f];
-    if (trip_count <= 1) {
-      EXPECT_EQ(info.path, TerrainPath::High) << "frame " << f;
-    } else {
-      EXPECT_EQ(info.path, TerrainPath::Sprite) << "frame " << f;
-      EXPECT_EQ(info.source, trips[f] ? SpriteSource::Fresh : SpriteSource::Kept) << "frame " << f;
+    if (!started && info.source == SpriteSource::Fresh) {
+      started = true;
+      EXPECT_GE(f, 1u) << "with no lifetime known the first frame draws the high LOD";
+    } else if (started) {
+      EXPECT_FALSE(info.switched) << "frame " << f;
+      EXPECT_EQ(info.source, due ? SpriteSource::Fresh : SpriteSource::Kept) << "frame " << f;
+      keyframes_after_start += due;
     }
+    EXPECT_EQ(info.path, started ? TerrainPath::Sprite : TerrainPath::High) << "frame " << f;
+    if (info.source == SpriteSource::Fresh) key_eye = sprite.spriteCamera()->eye;
   }
-  ASSERT_GE(trip_count, 3u);  // the path trips the metric several times
-  EXPECT_EQ(sprite.counters().fresh_keyframes, trip_count - 1);
-  EXPECT_EQ(sprite.counters().virtual_keyframes, 1u);
+  EXPECT_TRUE(started);
+  EXPECT_GE(keyframes_after_start, 2u);  // the path trips the metric several times
+  EXPECT_EQ(sprite.counters().fresh_keyframes, keyframes_after_start + 1);
+}
+
+// A switch: a viewer that holds still never trips the metric, so the first (virtual) keyframe would last forever;
+// its age alone must make a real keyframe pay, after which the sprite path is taken.
+TEST(LodSpriteGL, ChoiceSwitchesToTheSpriteWhenTheVirtualKeyframeLastsLongEnough) {
+  Scene scene(testFractal());
+  TerrainCost cost;
+  cost.frame.base_ms = 1.0;
+  cost.frame.ms_per_mtriangle = 1e6;
+  LodSpriteOptions options;
+  options.sky_color = kSky;
+  options.cost = &cost;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const Camera still = choicePath(scene.hf, 1).front();
+  gpu::RenderTarget frame(128, 128);
+  std::vector<LodSpriteFrameInfo> infos(6);
+  for (LodSpriteFrameInfo& info : infos) sprite.render(still, frame, &info);
+  EXPECT_EQ(infos[0].path, TerrainPath::High);
+  EXPECT_TRUE(infos[0].keyframe_due);
+  size_t first_sprite = infos.size();
+  for (size_t f = 1; f < infos.size(); ++f) {
+    EXPECT_FALSE(infos[f].keyframe_due) << "frame " << f;  // the viewer does not move
+    if (infos[f].path == TerrainPath::Sprite && first_sprite == infos.size()) first_sprite = f;
+  }
+  ASSERT_LT(first_sprite, infos.size());
+  EXPECT_TRUE(infos[first_sprite].switched);
+  EXPECT_EQ(infos[first_sprite].source, SpriteSource::Fresh);
+  // Independent check of when: at the switch's age one keyframe plus sprite frames beat as many high frames, and one
+  // frame earlier they did not.
+  const LodSpriteFrameInfo& s = infos[first_sprite];
+  const double age = double(first_sprite);
+  EXPECT_LT(s.predicted_keyframe_ms + (age - 1.0) * s.predicted_sprite_ms, age * s.predicted_high_ms);
+  EXPECT_GE(s.predicted_keyframe_ms + (age - 2.0) * s.predicted_sprite_ms, (age - 1.0) * s.predicted_high_ms);
+  for (size_t f = first_sprite + 1; f < infos.size(); ++f) EXPECT_EQ(infos[f].source, SpriteSource::Kept);
+  EXPECT_EQ(sprite.counters().switches, 1u);
 }
 
 }  // namespace

@@ -381,7 +381,7 @@ void writePerFrameFigures(const Experiment& x) {
   std::ostringstream f9, f10, f11;
   f9 << "frame,path_frame,high,low,lod_sprite,keyframe\n";
   f10 << "frame,path_frame,error_px,trigger_error_px,keyframe,source,path,keyframe_due,predicted_high_ms,"
-         "predicted_sprite_ms,predicted_keyframe_ms,expected_lifetime\n";
+         "predicted_sprite_ms,predicted_keyframe_ms,expected_lifetime,switched\n";
   f11 << "frame,path_frame";
   for (const ModeResult& m : bench.modes) f11 << "," << m.name << "_ms";
   f11 << ",lod_sprite_keyframe,lod_sprite_path\n";
@@ -393,7 +393,8 @@ void writePerFrameFigures(const Experiment& x) {
         << num(log[k].info.trigger_error_px) << "," << key << "," << terrain::spriteSourceName(log[k].info.source)
         << "," << terrain::terrainPathName(log[k].info.path) << "," << log[k].info.keyframe_due << ","
         << num(log[k].info.predicted_high_ms, 3) << "," << num(log[k].info.predicted_sprite_ms, 3) << ","
-        << num(log[k].info.predicted_keyframe_ms, 3) << "," << num(log[k].info.expected_lifetime, 1) << "\n";
+        << num(log[k].info.predicted_keyframe_ms, 3) << "," << num(log[k].info.expected_lifetime, 1) << ","
+        << log[k].info.switched << "\n";
     f11 << k << "," << bench.frame_indices[k];
     for (const ModeResult& m : bench.modes) f11 << "," << num(m.frames[k].wall_ms, 3);
     f11 << "," << key << "," << terrain::terrainPathName(log[k].info.path) << "\n";
@@ -474,7 +475,7 @@ void runSweeps(Experiment& x) {
   const FrameSummary high_summary = summarize(high_times);
   const double high_mean = meanWithoutStalls(high_times, high_summary.median);
   std::ostringstream f13, f14;
-  f13 << "epsilon_px,keyframes,keyframe_fraction,keyframes_simulated,fresh_keyframes,high_frames\n";
+  f13 << "epsilon_px,keyframes,keyframe_fraction,keyframes_simulated,fresh_keyframes,high_frames,switches\n";
   // Speedup = mean frame time of high / mean frame time of lod-sprite at the threshold, both from this sweep and
   // without stalls; total_ms is the raw sum.
   f14 << "epsilon_px,total_ms,mean_ms,median_ms,high_total_ms,speedup_total,speedup_median\n";
@@ -482,7 +483,8 @@ void runSweeps(Experiment& x) {
     EpsilonSweepRow row;
     row.epsilon_px = o.sweep_epsilons[m];
     const terrain::LodSpriteCounters& counters = modes[m]->sprite().counters();
-    row.keyframes = counters.fresh_keyframes + counters.virtual_keyframes;
+    row.keyframes = counters.fresh_keyframes - counters.switches + counters.virtual_keyframes;
+    row.switches = counters.switches;
     row.fresh_keyframes = counters.fresh_keyframes;
     row.high_frames = counters.high_frames;
     const auto sim = terrain::simulateKeyframes(*data.lod, cameras, o.low_error, row.epsilon_px);
@@ -496,7 +498,7 @@ void runSweeps(Experiment& x) {
     row.speedup_median = high_summary.median / s.median;
     f13 << num(row.epsilon_px, 3) << "," << row.keyframes << ","
         << num(double(row.keyframes) / double(cameras.size()), 5) << "," << row.keyframes_simulated << ","
-        << row.fresh_keyframes << "," << row.high_frames << "\n";
+        << row.fresh_keyframes << "," << row.high_frames << "," << row.switches << "\n";
     f14 << num(row.epsilon_px, 3) << "," << num(row.total_ms, 2) << "," << num(row.mean_ms, 3) << ","
         << num(row.median_ms, 3) << "," << num(row.high_total_ms, 2) << "," << num(row.speedup_total, 3) << ","
         << num(row.speedup_median, 3) << "\n";
@@ -598,6 +600,7 @@ void writeSummary(Experiment& x) {
                                        {"keyframes_simulated", e.keyframes_simulated},
                                        {"fresh_keyframes", e.fresh_keyframes},
                                        {"high_frames", e.high_frames},
+                                       {"switches", e.switches},
                                        {"total_ms", e.total_ms},
                                        {"mean_ms_without_stalls", e.mean_ms},
                                        {"speedup_total", e.speedup_total}});
@@ -626,7 +629,26 @@ void writeSummary(Experiment& x) {
   summary["stalled_frames_filtered"] = r.stalled_frames;
   const size_t full_triangles = size_t(x.data().hf.width - 1) * size_t(x.data().hf.height - 1) * 2;
   summary["full_baseline_drawn"] = full_triangles <= o.full_max_triangles;
-  if (r.cost) summary["cost_model"] = r.cost->toJson();
+  if (r.cost) {
+    // How well the cost model predicted this run: measured / predicted per frame, for the high mode's frames (against
+    // lod-sprite's prediction of the high LOD at the same frame) and for lod-sprite's kept-sprite frames.
+    const ModeResult* sprite = bench.mode("lod-sprite");
+    std::vector<double> high_ratio, sprite_ratio;
+    for (size_t k = 0; sprite && k < r.sprite_log.size() && k < high.frames.size(); ++k) {
+      const terrain::LodSpriteFrameInfo& info = r.sprite_log[k].info;
+      if (info.predicted_high_ms > 0.0) high_ratio.push_back(high.frames[k].wall_ms / info.predicted_high_ms);
+      if (info.source == terrain::SpriteSource::Kept && info.predicted_sprite_ms > 0.0)
+        sprite_ratio.push_back(sprite->frames[k].wall_ms / info.predicted_sprite_ms);
+    }
+    nlohmann::ordered_json check;
+    for (const auto& [name, v] : {std::pair{"high", &high_ratio}, std::pair{"sprite_kept", &sprite_ratio}})
+      if (!v->empty()) {
+        const FrameSummary s = summarize(*v);
+        check[name] = {{"frames", v->size()}, {"median", s.median}, {"p95", s.p95}};
+      }
+    summary["cost_model"] = r.cost->toJson();
+    summary["cost_model"]["measured_over_predicted"] = check;
+  }
   std::ostringstream md;
   md << "# LOD-sprite terrain benchmark\n\n- terrain: " << r.terrain << "\n- " << bench.frame_indices.size()
      << " frames at " << o.width << "x" << o.height << ", epsilon " << o.epsilon << " px, LOD thresholds high "
@@ -672,6 +694,19 @@ void writeSummary(Experiment& x) {
        << " | " << (info("high_resolution_renders") >= 0 ? num(info("high_resolution_renders"), 0) : "") << " | "
        << (info("keyframe_fraction") >= 0 ? num(info("keyframe_fraction"), 4) : "") << " | "
        << (info("high_frames") >= 0 ? num(info("high_frames"), 0) : "") << " |\n";
+  }
+  if (r.cost) {
+    const gpu::CostModel& c = r.cost->frame;
+    md << "\nCost model (fitted at the start of the run, for lod-sprite's per-frame choice): " << num(c.base_ms, 3)
+       << " ms + " << num(c.ms_per_mtriangle, 1) << " ms/Mtriangle + " << num(c.ms_per_draw, 3) << " ms/draw + "
+       << num(c.ms_per_mpixel, 2) << " ms/Mpixel (r2 " << num(c.r2, 3) << "), z-buffer read back "
+       << num(r.cost->readback_ms_per_mpixel, 3) << " ms/Mpixel";
+    const auto& check = summary["cost_model"]["measured_over_predicted"];
+    for (const char* k : {"high", "sprite_kept"})
+      if (check.contains(k))
+        md << "; measured / predicted " << k << " frames: median " << num(check[k]["median"].get<double>(), 2)
+           << ", p95 " << num(check[k]["p95"].get<double>(), 2);
+    md << ".\n";
   }
   summary["sweeps"] = sweep_json;
   summary["section5_back_and_forth"] = section5;

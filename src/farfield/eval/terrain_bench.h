@@ -85,9 +85,10 @@ struct KeyframesVsFrames {
 // Figures 13 and 14: lod-sprite at one threshold, timed interleaved with high over the measured frames.
 struct EpsilonSweepRow {
   double epsilon_px = 0.0;
-  size_t keyframes = 0;            // where the timed pass's error metric tripped (keyframes rendered + virtual ones)
+  size_t keyframes = 0;            // where the timed pass's error metric tripped (keyframes at trips + virtual ones)
   size_t fresh_keyframes = 0;      // keyframes rendered
   size_t high_frames = 0;          // frames that drew the high LOD (the per-frame choice)
+  size_t switches = 0;             // keyframes taken before the metric tripped (terrain/lod_sprite.h)
   size_t keyframes_simulated = 0;  // terrain::simulateKeyframes over the same cameras
   double total_ms = 0.0;           // raw sum of frame times
   double mean_ms = 0.0;            // without stalls (frames over max(1 s, 20x the median))

@@ -119,7 +119,8 @@ std::map<std::string, double> SpriteMode::info() const {
           {"high_frames", double(c.high_frames)},
           {"high_frame_fraction", double(c.high_frames) / frames},
           {"virtual_keyframes", double(c.virtual_keyframes)},
-          {"keyframe_decisions", double(c.fresh_keyframes + c.virtual_keyframes)}};
+          {"switches", double(c.switches)},
+          {"keyframe_decisions", double(c.fresh_keyframes - c.switches + c.virtual_keyframes)}};
 }
 
 void registerTerrainModes() {

@@ -310,8 +310,19 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     info.predicted_sprite_ms = costs.sprite_ms;
     info.predicted_keyframe_ms = costs.keyframe_ms;
   }
-  if (due) {
-    if (anchored_) {
+  // While the high LOD stands in for a virtual keyframe, that keyframe has already lasted `age` frames: a sprite
+  // lives at least that long here, so a keyframe may be taken now, before the metric trips, when that pays (the run's
+  // first sprite has no lifetime measured yet, and a sprite that would last the whole path never trips).
+  bool switch_now = false;
+  if (!due && !current_ && choose) {
+    const double age = double(frame_ - anchor_since_);
+    info.expected_lifetime = std::max(spriteLifetimeEstimate(lifetimes_, 1.0), age);
+    switch_now = choosePath(costs, false, info.expected_lifetime) == TerrainPath::Sprite;
+  }
+  info.switched = switch_now;
+  if (due || switch_now) {
+    if (switch_now) ++counters_.switches;
+    if (due && anchored_) {
       last_lifetime_ = std::max<uint64_t>(frame_ - anchor_since_, 1);
       lifetimes_.push_back(last_lifetime_);
       while (lifetimes_.size() > size_t(options_.lifetime_history)) lifetimes_.pop_front();
@@ -350,7 +361,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       }
     }
     if (chosen) anchor_eye_ = chosen->camera.eye;  // a reused sprite's error is measured from its own viewpoint
-    if (!chosen && choose) {
+    if (!chosen && choose && !switch_now) {
       info.expected_lifetime = spriteLifetimeEstimate(lifetimes_, 1.0);
       if (choosePath(costs, false, info.expected_lifetime) == TerrainPath::High) {
         // No keyframe: this frame is the high LOD, and the metric goes on from a virtual keyframe here.

@@ -21,7 +21,9 @@
 // Never slower (path_choice.h): with a cost model (LodSpriteOptions::cost), each frame chooses between drawing the
 // high-resolution LOD and the sprite path by their predicted costs; when the error trips and a new keyframe would
 // not pay for itself over the expected sprite lifetime, the frame draws the high LOD and the error metric continues
-// from a virtual keyframe at that viewpoint (so the frames where the error trips stay those of simulateKeyframes).
+// from a virtual keyframe at that viewpoint; once that virtual keyframe has lasted long enough for a real one to pay,
+// a keyframe is taken (a "switch", before the metric trips; without switches the frames where the error trips are
+// those of simulateKeyframes).
 // Without a cost model every frame takes the sprite path, as the paper does.
 // "Covers the view": the share of the current low-resolution triangles visible in that keyframe is at least
 // reuse_coverage times the share its own low-resolution mesh had when it was rendered (a keyframe looking the other
@@ -105,6 +107,7 @@ struct LodSpriteFrameInfo {
   // The per-frame choice (with LodSpriteOptions::cost; otherwise path Sprite and no predictions).
   TerrainPath path = TerrainPath::Sprite;
   bool keyframe_due = false;        // the error tripped here (or first frame): a keyframe, real or virtual
+  bool switched = false;            // a keyframe taken before the virtual one tripped (its age made it pay)
   uint64_t high_triangles = 0;      // triangles of the high LOD drawn as this frame (path High)
   double predicted_high_ms = 0.0;   // path_choice.h's PathCosts for this frame
   double predicted_sprite_ms = 0.0;
@@ -121,6 +124,7 @@ struct LodSpriteCounters {
   size_t cache_hits = 0;
   size_t high_frames = 0;          // frames that drew the high LOD (path_choice.h)
   size_t virtual_keyframes = 0;    // error trips answered with the high LOD instead of a keyframe
+  size_t switches = 0;             // keyframes taken while a virtual keyframe was still valid
   // Every high-resolution render, whatever became of it.
   size_t highResolutionRenders() const { return fresh_keyframes + predicted_rendered; }
 };

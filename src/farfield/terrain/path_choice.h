@@ -10,7 +10,8 @@
 // - when a new sprite is due, it is taken only when its predicted cost over its expected life is lower:
 //   keyframe_ms + (L - 1) * sprite_ms < L * high_ms, L the expected lifetime in frames (recent lifetimes,
 //   spriteLifetimeEstimate). Otherwise the frame draws the high LOD, and the error metric keeps running from a
-//   "virtual" keyframe at this viewpoint, so lifetimes keep being measured while no sprite exists.
+//   "virtual" keyframe at this viewpoint, so lifetimes keep being measured while no sprite exists; the virtual
+//   keyframe's age is itself a lower bound of the lifetime, so a keyframe is taken as soon as that age makes it pay.
 // Pure data in and out: no GL.
 #pragma once
 
