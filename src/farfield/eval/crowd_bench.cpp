@@ -195,7 +195,9 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         const image::ColorImage ref = reference_target.readColor();
         const image::IdImage ref_ids = reference_target.readIds();
         const bool sample = k > 0 && sample_every > 0 && !options.out_dir.empty() && (k - 1) % sample_every == 0;
-        const std::string tag = "a" + std::to_string(count) + "_" + path_name + "_f" + std::to_string(pf);
+        std::ostringstream tag_stream;  // (not string + literal: GCC 12 warns falsely with -Wrestrict)
+        tag_stream << "a" << count << "_" << path_name << "_f" << pf;
+        const std::string tag = tag_stream.str();
         if (sample) image::writePng((fs::path(options.out_dir) / "frames" / (tag + "_reference.png")).string(), ref);
         for (size_t j = 0; j < specs.size(); ++j) {
           const size_t m = (j + k) % specs.size();  // rotated order
