@@ -120,6 +120,7 @@ DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const 
   options_.t_max_ms = numberOption(context, "t_max_ms", 0.0, 0.0);
   options_.max_regenerations = intOption(context, "max_regenerations", 32, 0, 100000);
   options_.audit_samples = intOption(context, "audit", 0, 0, 1000000);
+  options_.impostor.plane_in_front = choiceOption(context, "plane", "best", {"best", "front"}) == "front";
 }
 
 std::string DynamicImpostorMode::name() const {

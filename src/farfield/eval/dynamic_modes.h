@@ -8,6 +8,7 @@
 //   t_max_ms=T        frame budget for regenerations (dynamic-*, default 0 = none)
 //   max_regenerations=N (dynamic-*, default 32), audit=N (dynamic-*: N mesh vertices per node measure the error
 //                     the metric is checked against, default 0 = off; costs frame time)
+//   plane=best|front  (dynamic-*) the best plane, or the best plane moved in front of the node's samples
 //   warp_interval=N   (warp) a keyframe of culled geometry every N path frames (default 4)
 //   billboard_kind=cylindrical|spherical, billboard_views=N (default 8), billboard_texels=N (default 32)
 #pragma once

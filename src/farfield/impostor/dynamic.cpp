@@ -85,6 +85,11 @@ PlanarImpostor::PlanarImpostor(gpu::Renderer& renderer, std::span<const gpu::Dra
   camera_.far_plane = float(d + radius_ * 1.05);
 
   plane_ = bestPlane(samples_, DVec3(eye), o.max_tilt).plane;
+  if (o.plane_in_front) {
+    double ahead = 0.0;
+    for (const DVec3& p : samples_) ahead = std::max(ahead, glm::dot(p - plane_.point, plane_.normal));
+    plane_.point += ahead * plane_.normal;
+  }
   std::array<Vec3, 4> corners;
   if (!cornersOnPlane(camera_, plane_, corners)) {
     plane_ = ImpostorPlane{centre_, glm::normalize(DVec3(eye) - centre_)};

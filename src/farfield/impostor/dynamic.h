@@ -36,6 +36,10 @@ struct PlanarImpostorOptions {
   int min_texels = 16;        // texture side bounds (4..4096)
   int max_texels = 512;
   double max_tilt = degToRad(60.0);  // the best plane's normal stays this close to the view direction
+  // Move the best plane towards the eye until every sample lies behind it: nothing of the node pokes out in front
+  // of its image, so geometry drawn around the image (the ground) cannot cut into it from within the node's own
+  // bounds; the parallax grows with the distance from the plane, which Shade's metric sees and Schaufler's does not.
+  bool plane_in_front = false;
 };
 
 class PlanarImpostor {
