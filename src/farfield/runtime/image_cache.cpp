@@ -209,9 +209,22 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
                                  2.0 * std::asin(std::min(1.0, 1.02 * objectRadius(n.bounds) /
                                                                    glm::length(eye - DVec3(n.bounds.center())))) /
                                      pixel_angle / options_.impostor.texel_pixels);
-    // A layered capture renders the node once per layer (about 8 at the usual bounds; the plan is made only when
-    // the node is regenerated).
-    const double renders = options_.kind == CachedImageKind::Layered ? 8.0 : 1.0;
+    // A layered capture renders the node once per layer: the plan it would get (pure arithmetic) says how many.
+    double renders = 1.0;
+    if (options_.kind == CachedImageKind::Layered) {
+      const DVec3 centre(n.bounds.center());
+      const double dist = glm::length(eye - centre);
+      try {
+        const Shaft shaft = Shaft::make(Vec3(centre), Vec3((eye - centre) / dist), float(options_.layered_apex_angle),
+                                        float(options_.layered_approach * dist), "image cache shaft");
+        impostor::LayeredOptions lo;
+        lo.max_texture_size = options_.impostor.max_texels;
+        lo.max_layers = 16;
+        renders = double(std::max<size_t>(1, impostor::planLayered(n.bounds, shaft, bound, lo).layers.size()));
+      } catch (const Error&) {
+        renders = 1.0;  // too near for layers: regenerating draws the geometry (see below)
+      }
+    }
     r.regenerate_ms = renders * (r.geometry_ms + options_.regeneration_overhead_ms + c.ms_per_mpixel * side * side / 1e6);
     r.image_ms = c.ms_per_draw;
     requests.push_back(r);
