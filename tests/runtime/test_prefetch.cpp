@@ -7,8 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <thread>
 
 #include "farfield/bake/pipeline.h"
@@ -39,24 +41,27 @@ TEST(PrefetchTest, CellsAreRankedByTheirAgreementWithTheMotion) {
   // Along the cell (east): the junction ahead is J1; straight on first, the way back last.
   PrefetchChoice c = prefetchCells(x.graph, east, Vec2(1.0f, 0.0f), 0);
   EXPECT_EQ(c.exit_junction, 1u);
-  ASSERT_EQ(c.cells.size(), 4u);
+  ASSERT_EQ(c.cells.size(), 7u);  // every cell touching J1 but this one
   EXPECT_EQ(c.cells[0], x.edge(1, 2));
-  EXPECT_EQ(c.cells[3], x.edge(1, 0));
-  // Veering north: north before south. The motion's ranking against a brute-force one from the positions.
+  EXPECT_EQ(std::set<uint32_t>(c.cells.begin() + 5, c.cells.end()), (std::set<uint32_t>{x.edge(1, 0), x.edge(2, 1)}));
+  // Veering north: north before south. The motion's ranking against a brute-force one from the positions: the
+  // streets leaving J1 and those towards it.
   const Vec2 motion(1.0f, 0.6f);
   c = prefetchCells(x.graph, east, motion, 0);
   std::vector<std::pair<float, uint32_t>> expected;
   for (uint32_t j : {0u, 2u, 3u, 4u}) {
     const Vec2 d = glm::normalize(x.graph.position(j) - x.graph.position(1));
     expected.emplace_back(-glm::dot(d, glm::normalize(motion)), x.edge(1, j));
+    if (j != 0) expected.emplace_back(glm::dot(d, glm::normalize(motion)), x.edge(j, 1));
   }
   std::sort(expected.begin(), expected.end());
   ASSERT_EQ(c.cells.size(), expected.size());
   for (size_t k = 0; k < expected.size(); ++k) EXPECT_EQ(c.cells[k], expected[k].second) << k;
-  EXPECT_EQ(c.cells[1], x.edge(1, 3));
+  EXPECT_EQ(c.cells[1], x.edge(1, 3));  // turning north
+  EXPECT_EQ(c.cells[2], x.edge(4, 1));  // northbound, towards J1: where a turning viewer is found for a few frames
   // At most two.
   EXPECT_EQ(prefetchCells(x.graph, east, motion, 2).cells.size(), 2u);
-  // Backwards (west) in the eastbound cell: the junction behind, whose only other street is this one: the twin.
+  // Backwards (west) in the eastbound cell: the junction behind, whose only street is this one: its twin.
   c = prefetchCells(x.graph, east, Vec2(-1.0f, 0.0f), 0);
   EXPECT_EQ(c.exit_junction, 0u);
   EXPECT_EQ(c.cells, std::vector<uint32_t>{x.edge(1, 0)});

@@ -14,9 +14,13 @@ PrefetchChoice prefetchCells(const urban::StreetGraph& graph, uint32_t cell, Vec
   motion = glm::normalize(motion);
   const bool forward = glm::dot(motion, along) >= 0.0f;
   out.exit_junction = forward ? graph.destination(cell) : graph.origin(cell);
+  // Every cell touching the junction: the streets leaving it, and the same streets towards it (at a junction the
+  // cell lookup follows the view, which turns before the viewer leaves the junction: a turning car is found in the
+  // cell of the street it turns into, pointing at the junction, for a few frames).
   std::vector<std::pair<float, uint32_t>> ranked;
-  for (uint32_t next : graph.outgoing(out.exit_junction))
-    if (next != cell) ranked.emplace_back(-glm::dot(graph.direction(next), motion), next);
+  for (uint32_t leaving : graph.outgoing(out.exit_junction))
+    for (uint32_t next : {leaving, urban::StreetGraph::twin(leaving)})
+      if (next != cell) ranked.emplace_back(-glm::dot(graph.direction(next), motion), next);
   std::sort(ranked.begin(), ranked.end());  // best agreement first, then by id
   for (const auto& [score, next] : ranked) out.cells.push_back(next);
   const uint32_t twin = urban::StreetGraph::twin(cell);

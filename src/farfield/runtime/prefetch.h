@@ -17,9 +17,10 @@ struct PrefetchChoice {
 };
 
 // The cells the viewer in `cell` may enter next, moving by `motion` (world xy; a zero motion is taken as moving along
-// the cell): the streets leaving the junction it heads for (the cell's destination when it moves along the cell,
-// its origin when it moves backwards), ordered by how well their direction agrees with the motion (the way back
-// last), then the cell's twin (the viewer turning round where it stands); at most max_cells (0 = all).
+// the cell): the cells of the streets at the junction it heads for (the cell's destination when it moves along the
+// cell, its origin when it moves backwards), both directions of each, ordered by how well their direction agrees with
+// the motion (ties by id), then the cell's twin if not among them (the viewer turning round where it stands); at
+// most max_cells (0 = all).
 PrefetchChoice prefetchCells(const urban::StreetGraph& graph, uint32_t cell, Vec2 motion, size_t max_cells);
 
 }  // namespace farfield::runtime

@@ -80,7 +80,7 @@ struct WalkthroughOptions {
   // One budget for the database in memory (> 0 replaces the two above): a quarter for the cells read ahead, the rest
   // for the resident impostors; the current cell stays even when it alone exceeds it.
   uint64_t memory_budget_bytes = 0;
-  size_t prefetch_cells = 3;                   // cells read ahead in the direction of motion (runtime/prefetch.h)
+  size_t prefetch_cells = 6;                   // cells read ahead in the direction of motion (runtime/prefetch.h)
   std::string streaming_csv;                   // when set, the per-frame streaming log (runtime/streaming.h) is
                                                // written there when the walkthrough ends
   bool object_ids = true;                      // impostors carry per-texel object ids (item buffers show objects)
