@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -147,6 +148,49 @@ TEST(GltfSkin, ReadsTheRealModels) {
   const Box3 b = animatedBounds(man, &man.animations[0], 4);
   EXPECT_GT(b.hi.z - b.lo.z, 1.2f);
   EXPECT_GT(b.hi.z - b.lo.z, b.hi.x - b.lo.x);
+}
+
+}  // namespace
+}  // namespace farfield::scene
+
+namespace farfield::scene {
+namespace {
+
+// Every truncation of a real skinned model (and a flipped byte in its JSON chunk) is a clear error naming the file,
+// or a model that passes validation; never a crash.
+TEST(GltfSkin, TruncatedAndCorruptedRealModelsFailCleanly) {
+  const std::filesystem::path src = farfield::test::sharedDataDir() / "models/Fox.glb";
+  std::ifstream in(src, std::ios::binary);
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 1000u);
+  const std::filesystem::path dir = farfield::test::scratchDir("skin_truncated");
+  size_t errors = 0;
+  for (int k = 1; k < 24; ++k) {
+    const size_t n = bytes.size() * size_t(k) / 24;
+    std::string name = "t";  // (not literal + string: GCC 12 warns falsely with -Wrestrict)
+    name += std::to_string(k);
+    name += ".glb";
+    const std::string file = (dir / name).string();
+    std::ofstream(file, std::ios::binary).write(bytes.data(), std::streamsize(n));
+    const std::string e = errorOf([&] { importSkinnedModel(file); });
+    EXPECT_NE(e.find(file), std::string::npos) << "cut at " << n << ": " << e;
+    errors += e.empty() ? 0 : 1;
+  }
+  EXPECT_EQ(errors, 23u);
+  for (size_t at : {size_t(30), size_t(200), size_t(600)}) {
+    std::vector<char> flipped = bytes;
+    flipped[at] = char(flipped[at] ^ 0x5a);
+    std::string name = "f";
+    name += std::to_string(at);
+    name += ".glb";
+    const std::string file = (dir / name).string();
+    std::ofstream(file, std::ios::binary).write(flipped.data(), std::streamsize(flipped.size()));
+    try {
+      validateSkinnedModel(importSkinnedModel(file));
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace
