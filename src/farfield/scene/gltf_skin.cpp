@@ -11,6 +11,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
+#include "farfield/scene/gltf_accessor.h"
 #include "farfield/scene/import.h"
 
 namespace farfield::scene {
@@ -70,67 +71,11 @@ class SkinReader {
  private:
   [[noreturn]] void fail(const std::string& what) const { throw Error(path_, what); }
 
-  struct View {
-    const unsigned char* data = nullptr;
-    size_t stride = 0;
-    size_t count = 0;
-    int component_type = 0;
-    int components = 0;
-    bool normalized = false;
-  };
+  using View = GltfView;
 
-  View view(int index, const std::string& what) const {
-    if (index < 0 || size_t(index) >= model_.accessors.size())
-      fail(what + ": accessor " + std::to_string(index) + " out of range");
-    const tinygltf::Accessor& a = model_.accessors[size_t(index)];
-    const std::string where = what + " (accessor " + std::to_string(index) + ")";
-    if (a.sparse.isSparse) fail(where + ": sparse accessors are not supported");
-    if (a.bufferView < 0 || size_t(a.bufferView) >= model_.bufferViews.size())
-      fail(where + ": buffer view out of range");
-    const tinygltf::BufferView& bv = model_.bufferViews[size_t(a.bufferView)];
-    if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size()) fail(where + ": buffer out of range");
-    const tinygltf::Buffer& buf = model_.buffers[size_t(bv.buffer)];
-    const int comp_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
-    const int comps = tinygltf::GetNumComponentsInType(uint32_t(a.type));
-    if (comp_size <= 0 || comps <= 0) fail(where + ": unknown component or element type");
-    const uint64_t elem = uint64_t(comp_size) * uint64_t(comps);
-    const uint64_t stride = bv.byteStride > 0 ? uint64_t(bv.byteStride) : elem;
-    const uint64_t view_end = uint64_t(bv.byteOffset) + uint64_t(bv.byteLength);
-    if (stride < elem || view_end > buf.data.size()) fail(where + ": buffer view past the buffer (truncated file?)");
-    const uint64_t start = uint64_t(bv.byteOffset) + uint64_t(a.byteOffset);
-    if (a.count > 0 && start + stride * (uint64_t(a.count) - 1) + elem > view_end)
-      fail(where + ": elements do not fit in the buffer view (truncated file?)");
-    return View{buf.data.data() + start, size_t(stride), a.count, a.componentType, comps, a.normalized};
-  }
+  View view(int index, const std::string& what) const { return gltfAccessor(model_, index, what, path_); }
 
-  static double component(const View& v, size_t i, int c) {
-    const unsigned char* p = v.data + i * v.stride;
-    switch (v.component_type) {
-      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-        float f;
-        std::memcpy(&f, p + 4 * c, 4);
-        return f;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return v.normalized ? p[c] / 255.0 : p[c];
-      case TINYGLTF_COMPONENT_TYPE_BYTE: return v.normalized ? std::max(int8_t(p[c]) / 127.0, -1.0) : int8_t(p[c]);
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        uint16_t s;
-        std::memcpy(&s, p + 2 * c, 2);
-        return v.normalized ? s / 65535.0 : s;
-      }
-      case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        int16_t s;
-        std::memcpy(&s, p + 2 * c, 2);
-        return v.normalized ? std::max(s / 32767.0, -1.0) : s;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        uint32_t u;
-        std::memcpy(&u, p + 4 * c, 4);
-        return u;
-      }
-      default: return std::nan("");
-    }
-  }
+  static double component(const View& v, size_t i, int c) { return gltfComponent(v, i, c); }
 
   void readNodes(Skeleton& skeleton) {
     // Parents before children: order the nodes breadth-first from the roots; `order_[gltf index]` = our index.

@@ -32,6 +32,7 @@
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
+#include "farfield/scene/gltf_accessor.h"
 #include "farfield/scene/builtin.h"
 
 namespace farfield::scene {
@@ -242,82 +243,13 @@ class GltfReader {
     return uint32_t(default_material_);
   }
 
-  // An accessor's elements, bounds-checked against its buffer view and buffer so that corrupt offsets give an
-  // Error instead of reading outside the file's data.
-  struct View {
-    const unsigned char* data = nullptr;
-    size_t stride = 0;
-    size_t count = 0;
-    int component_type = 0;
-    int components = 0;
-    bool normalized = false;
-  };
+  using View = GltfView;
 
   View view(int accessor_index, const std::string& what) const {
-    if (accessor_index < 0 || size_t(accessor_index) >= model_.accessors.size())
-      fail(what + ": accessor " + std::to_string(accessor_index) + " out of range");
-    const tinygltf::Accessor& a = model_.accessors[size_t(accessor_index)];
-    const std::string where = what + " (accessor " + std::to_string(accessor_index) + ")";
-    if (a.sparse.isSparse) fail(where + ": sparse accessors are not supported");
-    if (a.bufferView < 0 || size_t(a.bufferView) >= model_.bufferViews.size())
-      fail(where + ": buffer view " + std::to_string(a.bufferView) + " out of range");
-    const tinygltf::BufferView& bv = model_.bufferViews[size_t(a.bufferView)];
-    if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size())
-      fail(where + ": buffer " + std::to_string(bv.buffer) + " out of range");
-    const tinygltf::Buffer& buf = model_.buffers[size_t(bv.buffer)];
-    const int comp_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
-    const int comps = tinygltf::GetNumComponentsInType(uint32_t(a.type));
-    if (comp_size <= 0 || comps <= 0) fail(where + ": unknown component or element type");
-    const uint64_t elem = uint64_t(comp_size) * uint64_t(comps);
-    const uint64_t stride = bv.byteStride > 0 ? uint64_t(bv.byteStride) : elem;
-    if (stride < elem) fail(where + ": byte stride smaller than one element");
-    const uint64_t view_end = uint64_t(bv.byteOffset) + uint64_t(bv.byteLength);
-    if (view_end > buf.data.size())
-      fail(where + ": buffer view ends at byte " + std::to_string(view_end) + " past the buffer's " +
-           std::to_string(buf.data.size()) + " bytes (truncated file?)");
-    const uint64_t start = uint64_t(bv.byteOffset) + uint64_t(a.byteOffset);
-    if (a.count > 0 && start + stride * (uint64_t(a.count) - 1) + elem > view_end)
-      fail(where + ": " + std::to_string(a.count) + " elements do not fit in the buffer view (truncated file?)");
-    View v;
-    v.data = buf.data.data() + start;
-    v.stride = size_t(stride);
-    v.count = a.count;
-    v.component_type = a.componentType;
-    v.components = comps;
-    v.normalized = a.normalized;
-    return v;
+    return gltfAccessor(model_, accessor_index, what, path_);
   }
 
-  static float component(const View& v, size_t i, int c) {
-    const unsigned char* p = v.data + i * v.stride;
-    switch (v.component_type) {
-      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-        float f;
-        std::memcpy(&f, p + 4 * c, 4);
-        return f;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-        const float x = float(p[c]);
-        return v.normalized ? x / 255.0f : x;
-      }
-      case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        const float x = float(int8_t(p[c]));
-        return v.normalized ? std::max(x / 127.0f, -1.0f) : x;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        uint16_t s;
-        std::memcpy(&s, p + 2 * c, 2);
-        return v.normalized ? float(s) / 65535.0f : float(s);
-      }
-      case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        int16_t s;
-        std::memcpy(&s, p + 2 * c, 2);
-        return v.normalized ? std::max(float(s) / 32767.0f, -1.0f) : float(s);
-      }
-      default:
-        return std::numeric_limits<float>::quiet_NaN();  // rejected by Mesh::validate
-    }
-  }
+  static float component(const View& v, size_t i, int c) { return float(gltfComponent(v, i, c)); }
 
   static uint32_t indexAt(const View& v, size_t i) {
     const unsigned char* p = v.data + i * v.stride;

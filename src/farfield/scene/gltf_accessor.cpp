@@ -1,0 +1,79 @@
+#include "farfield/scene/gltf_accessor.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#include "farfield/core/error.h"
+
+namespace farfield::scene {
+
+GltfView gltfAccessor(const tinygltf::Model& model, int index, const std::string& what, const std::string& path) {
+  auto fail = [&](const std::string& message) { throw Error(path, message); };
+  if (index < 0 || size_t(index) >= model.accessors.size())
+    fail(what + ": accessor " + std::to_string(index) + " out of range");
+  const tinygltf::Accessor& a = model.accessors[size_t(index)];
+  const std::string where = what + " (accessor " + std::to_string(index) + ")";
+  if (a.sparse.isSparse) fail(where + ": sparse accessors are not supported");
+  if (a.bufferView < 0 || size_t(a.bufferView) >= model.bufferViews.size())
+    fail(where + ": buffer view " + std::to_string(a.bufferView) + " out of range");
+  const tinygltf::BufferView& bv = model.bufferViews[size_t(a.bufferView)];
+  if (bv.buffer < 0 || size_t(bv.buffer) >= model.buffers.size())
+    fail(where + ": buffer " + std::to_string(bv.buffer) + " out of range");
+  const tinygltf::Buffer& buf = model.buffers[size_t(bv.buffer)];
+  const int comp_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+  const int comps = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+  if (comp_size <= 0 || comps <= 0) fail(where + ": unknown component or element type");
+  const uint64_t elem = uint64_t(comp_size) * uint64_t(comps);
+  const uint64_t stride = bv.byteStride > 0 ? uint64_t(bv.byteStride) : elem;
+  if (stride < elem) fail(where + ": byte stride smaller than one element");
+  const uint64_t view_end = uint64_t(bv.byteOffset) + uint64_t(bv.byteLength);
+  if (view_end > buf.data.size())
+    fail(where + ": buffer view ends at byte " + std::to_string(view_end) + " past the buffer's " +
+         std::to_string(buf.data.size()) + " bytes (truncated file?)");
+  const uint64_t start = uint64_t(bv.byteOffset) + uint64_t(a.byteOffset);
+  if (a.count > 0 && start + stride * (uint64_t(a.count) - 1) + elem > view_end)
+    fail(where + ": " + std::to_string(a.count) + " elements do not fit in the buffer view (truncated file?)");
+  GltfView v;
+  v.data = buf.data.data() + start;
+  v.stride = size_t(stride);
+  v.count = a.count;
+  v.component_type = a.componentType;
+  v.components = comps;
+  v.normalized = a.normalized;
+  return v;
+}
+
+double gltfComponent(const GltfView& v, size_t i, int c) {
+  const unsigned char* p = v.data + i * v.stride;
+  switch (v.component_type) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+      float f;
+      std::memcpy(&f, p + 4 * c, 4);
+      return f;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return v.normalized ? p[c] / 255.0 : p[c];
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return v.normalized ? std::max(int8_t(p[c]) / 127.0, -1.0) : int8_t(p[c]);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t s;
+      std::memcpy(&s, p + 2 * c, 2);
+      return v.normalized ? s / 65535.0 : s;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t s;
+      std::memcpy(&s, p + 2 * c, 2);
+      return v.normalized ? std::max(s / 32767.0, -1.0) : s;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t u;
+      std::memcpy(&u, p + 4 * c, 4);
+      return u;
+    }
+    default: return std::nan("");
+  }
+}
+
+}  // namespace farfield::scene
