@@ -143,6 +143,11 @@ PY
 plain gltf "$tmp/quad.gltf"
 plain gltf "$tmp/quad.glb"
 
+# Skinned glTF: the shared data's two animated models (read from ../shared/data, never copied into the repository),
+# and the static quads (no skin: an error the target expects).
+for f in "$root/../shared/data/models"/*.glb; do if [ -e "$f" ]; then plain gltf_skin "$f"; fi; done
+plain gltf_skin "$tmp/quad.glb"
+
 # CityGML (once the importer exists): the project's CityGML test files.
 if [ -x "$build/bin/fuzz_citygml" ]; then
   for f in "$data"/geodata/*.gml "$data"/geodata/*.citygml; do if [ -e "$f" ]; then plain citygml "$f"; fi; done
