@@ -92,6 +92,78 @@ std::string thousands(size_t v) {
 
 }  // namespace
 
+namespace {
+
+// The run as a Markdown table with the city, models, atlases and bake time above it.
+std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOptions& options) {
+  std::ostringstream md;
+  md << "- city: generated, " << options.blocks << " blocks, detail " << options.detail << ", seed " << options.city_seed
+     << " (" << thousands(result.city_triangles) << " triangles, view-frustum culled in every mode)\n";
+  md << "- size " << options.width << "x" << options.height << ", " << options.frames << " measured frames per run (every "
+     << options.frame_step << "th frame of a 30 fps street walk, seed " << options.path_seed << "), one warm-up frame\n";
+  md << "- renderer: " << result.renderer << "\n";
+  for (size_t m = 0; m < result.layouts.size(); ++m) {
+    const gpu::AtlasLayout& l = result.layouts[m];
+    md << "- " << result.model_names[m] << ": " << thousands(result.model_triangles[m]) << " triangles; atlas "
+       << l.azimuths << "x" << l.elevations << " views x " << l.frames << " frames, cells " << l.cell_width << "x"
+       << l.cell_height << " texels (" << fmt("%.3f", options.runtime.texel_m) << " m), "
+       << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0) << " MiB uncompressed ("
+       << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames) << " KiB per frame); switch to impostor beyond "
+       << fmt("%.1f", result.switch_m[m]) << " m";
+    // What the bound would choose for impostors from 20 m on (impostor::chooseForBound).
+    const double focal = double(options.height) / (2.0 * std::tan(degToRad(60.0) / 2.0));
+    const impostor::BoundChoice bc =
+        impostor::chooseForBound(options.runtime.error_px, focal, 20.0, double(l.half_size.x));
+    md << "; for " << fmt("%.1f", options.runtime.error_px) << " px from 20 m on the bound asks for "
+       << bc.grid.azimuths << "x" << bc.grid.elevations << " views and " << fmt("%.3f", bc.texel_m) << " m texels\n";
+  }
+  md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
+  md << "| agents | path | mode | median ms | crowd ms | speedup | crowd speedup | geometry / impostor agents | "
+        "triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) |\n";
+  md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const CrowdRun& run : result.runs)
+    for (const CrowdModeResult& r : run.modes)
+      md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << fmt("%.1f", r.wall.median)
+         << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.2fx", r.speedup) << " | "
+         << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
+         << fmt("%.0f", r.impostor_agents) << " | " << thousands(size_t(r.triangles)) << " | "
+         << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
+         << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
+         << fmt("%.2f", run.reference_popping_mean) << ") |\n";
+  return md.str();
+}
+
+// crowd.json and crowd.md in the output directory.
+void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& options) {
+  nlohmann::json j;
+  j["renderer"] = result.renderer;
+  j["city"] = {{"blocks", options.blocks}, {"detail", options.detail}, {"seed", options.city_seed},
+               {"triangles", result.city_triangles}, {"gen_seconds", result.city_seconds}};
+  j["size"] = {options.width, options.height};
+  j["bake_seconds"] = result.bake_seconds;
+  for (size_t m = 0; m < result.layouts.size(); ++m) {
+    const gpu::AtlasLayout& l = result.layouts[m];
+    j["models"].push_back({{"file", result.model_names[m]}, {"triangles", result.model_triangles[m]},
+                           {"azimuths", l.azimuths}, {"elevations", l.elevations}, {"frames", l.frames},
+                           {"cell", {l.cell_width, l.cell_height}}, {"atlas_bytes", result.atlas_bytes[m]},
+                           {"switch_m", result.switch_m[m]}});
+  }
+  for (const CrowdRun& run : result.runs)
+    for (const CrowdModeResult& r : run.modes)
+      j["runs"].push_back({{"agents", run.agents}, {"path", run.path}, {"mode", r.name},
+                           {"median_ms", r.wall.median}, {"p95_ms", r.wall.p95}, {"crowd_median_ms", r.crowd.median},
+                           {"speedup", r.speedup}, {"crowd_speedup", r.crowd_speedup}, {"psnr_db_mean", r.psnr_mean},
+                           {"psnr_db_min", r.psnr_min}, {"bad_pixel_share_mean", r.bad_share_mean},
+                           {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
+                           {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
+                           {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
+                           {"in_view", r.in_view}, {"triangles", r.triangles}});
+  std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
+  std::ofstream(fs::path(options.out_dir) / "crowd.md") << result.markdown;
+}
+
+}  // namespace
+
 CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& options) {
   if (options.models.empty()) throw Error("crowd bench", "no models given");
   if (options.model_heights.size() < options.models.size() || options.model_shares.size() < options.models.size() ||
@@ -273,70 +345,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
     }
   }
 
-  // Report.
-  std::ostringstream md;
-  md << "- city: generated, " << options.blocks << " blocks, detail " << options.detail << ", seed " << options.city_seed
-     << " (" << thousands(result.city_triangles) << " triangles, view-frustum culled in every mode)\n";
-  md << "- size " << options.width << "x" << options.height << ", " << options.frames << " measured frames per run (every "
-     << options.frame_step << "th frame of a 30 fps street walk, seed " << options.path_seed << "), one warm-up frame\n";
-  md << "- renderer: " << result.renderer << "\n";
-  for (size_t m = 0; m < result.layouts.size(); ++m) {
-    const gpu::AtlasLayout& l = result.layouts[m];
-    md << "- " << result.model_names[m] << ": " << thousands(result.model_triangles[m]) << " triangles; atlas "
-       << l.azimuths << "x" << l.elevations << " views x " << l.frames << " frames, cells " << l.cell_width << "x"
-       << l.cell_height << " texels (" << fmt("%.3f", options.runtime.texel_m) << " m), "
-       << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0) << " MiB uncompressed ("
-       << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames) << " KiB per frame); switch to impostor beyond "
-       << fmt("%.1f", result.switch_m[m]) << " m";
-    // What the bound would choose for impostors from 20 m on (impostor::chooseForBound).
-    const double focal = double(options.height) / (2.0 * std::tan(degToRad(60.0) / 2.0));
-    const impostor::BoundChoice bc =
-        impostor::chooseForBound(options.runtime.error_px, focal, 20.0, double(l.half_size.x));
-    md << "; for " << fmt("%.1f", options.runtime.error_px) << " px from 20 m on the bound asks for "
-       << bc.grid.azimuths << "x" << bc.grid.elevations << " views and " << fmt("%.3f", bc.texel_m) << " m texels\n";
-  }
-  md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
-  md << "| agents | path | mode | median ms | crowd ms | speedup | crowd speedup | geometry / impostor agents | "
-        "triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) |\n";
-  md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const CrowdRun& run : result.runs)
-    for (const CrowdModeResult& r : run.modes)
-      md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << fmt("%.1f", r.wall.median)
-         << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.2fx", r.speedup) << " | "
-         << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
-         << fmt("%.0f", r.impostor_agents) << " | " << thousands(size_t(r.triangles)) << " | "
-         << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
-         << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
-         << fmt("%.2f", run.reference_popping_mean) << ") |\n";
-  result.markdown = md.str();
-
-  if (!options.out_dir.empty()) {
-    nlohmann::json j;
-    j["renderer"] = result.renderer;
-    j["city"] = {{"blocks", options.blocks}, {"detail", options.detail}, {"seed", options.city_seed},
-                 {"triangles", result.city_triangles}, {"gen_seconds", result.city_seconds}};
-    j["size"] = {options.width, options.height};
-    j["bake_seconds"] = result.bake_seconds;
-    for (size_t m = 0; m < result.layouts.size(); ++m) {
-      const gpu::AtlasLayout& l = result.layouts[m];
-      j["models"].push_back({{"file", result.model_names[m]}, {"triangles", result.model_triangles[m]},
-                             {"azimuths", l.azimuths}, {"elevations", l.elevations}, {"frames", l.frames},
-                             {"cell", {l.cell_width, l.cell_height}}, {"atlas_bytes", result.atlas_bytes[m]},
-                             {"switch_m", result.switch_m[m]}});
-    }
-    for (const CrowdRun& run : result.runs)
-      for (const CrowdModeResult& r : run.modes)
-        j["runs"].push_back({{"agents", run.agents}, {"path", run.path}, {"mode", r.name},
-                             {"median_ms", r.wall.median}, {"p95_ms", r.wall.p95}, {"crowd_median_ms", r.crowd.median},
-                             {"speedup", r.speedup}, {"crowd_speedup", r.crowd_speedup}, {"psnr_db_mean", r.psnr_mean},
-                             {"psnr_db_min", r.psnr_min}, {"bad_pixel_share_mean", r.bad_share_mean},
-                             {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
-                             {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
-                             {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
-                             {"in_view", r.in_view}, {"triangles", r.triangles}});
-    std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
-    std::ofstream(fs::path(options.out_dir) / "crowd.md") << result.markdown;
-  }
+  result.markdown = crowdMarkdown(result, options);
+  if (!options.out_dir.empty()) writeCrowdReport(result, options);
   return result;
 }
 

@@ -1,0 +1,72 @@
+// The crowd bench end to end on a tiny city and crowd: crowd-geometry draws what the reference draws (identical
+// frames), the impostor modes differ from it and draw impostors, speedups are relative to crowd-geometry, and the
+// report files are written; bad options are errors.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "farfield/core/error.h"
+#include "farfield/eval/crowd_bench.h"
+#include "farfield/gpu/context.h"
+#include "support/test_support.h"
+
+using namespace farfield;
+
+namespace {
+
+eval::CrowdBenchOptions tinyOptions() {
+  eval::CrowdBenchOptions o;
+  o.blocks = 10;
+  o.detail = 0;
+  o.agent_counts = {60};
+  o.paths = {"pedestrian"};
+  o.frames = 3;
+  o.frame_step = 10;
+  o.width = o.height = 64;
+  o.models = {(test::sharedDataDir() / "models" / "CesiumMan.glb").string(),
+              (test::sharedDataDir() / "models" / "Fox.glb").string()};
+  o.runtime.grid.azimuths = 8;
+  o.runtime.grid.elevations = 2;
+  o.runtime.frames = 2;
+  o.runtime.palette_poses = 4;
+  o.samples = 0;
+  return o;
+}
+
+}  // namespace
+
+TEST(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgainstIt) {
+  eval::CrowdBenchOptions o = tinyOptions();
+  o.out_dir = test::scratchDir("crowd_bench").string();
+  const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), o);
+  ASSERT_EQ(r.runs.size(), 1u);
+  const eval::CrowdRun& run = r.runs[0];
+  ASSERT_EQ(run.modes.size(), 3u);
+  EXPECT_EQ(run.modes[0].name, "crowd-geometry");
+  EXPECT_DOUBLE_EQ(run.modes[0].speedup, 1.0);
+  EXPECT_GT(run.modes[0].in_view, 0.0) << "the walk must see agents for the comparison to mean anything";
+  // The same policy as the reference: the same pixels.
+  EXPECT_GE(run.modes[0].psnr_min, 99.0);
+  EXPECT_EQ(run.modes[0].bad_share_mean, 0.0);
+  EXPECT_EQ(run.modes[0].impostor_agents, 0.0);
+  // crowd-impostor draws every agent in view as an impostor, and its pixels are not the reference's.
+  EXPECT_EQ(run.modes[1].name, "crowd-impostor");
+  EXPECT_DOUBLE_EQ(run.modes[1].impostor_agents, run.modes[1].in_view);
+  EXPECT_LT(run.modes[1].psnr_mean, 99.0);
+  EXPECT_GT(run.modes[1].speedup, 0.0);
+  for (const char* file : {"crowd.json", "crowd.md"})
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(o.out_dir) / file)) << file;
+  EXPECT_NE(r.markdown.find("crowd-mixed"), std::string::npos);
+}
+
+TEST(CrowdBench, BadOptionsAreErrors) {
+  eval::CrowdBenchOptions o = tinyOptions();
+  o.frames = 1;
+  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
+  o = tinyOptions();
+  o.models.clear();
+  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
+  o = tinyOptions();
+  o.paths = {"sideways"};
+  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
+}
