@@ -25,6 +25,7 @@
 #include "farfield/store/impostor_store.h"
 #include "farfield/urban/cells.h"
 #include "farfield/urban/visibility_events.h"
+#include "support/expect_error.h"
 #include "support/test_support.h"
 
 namespace fs = std::filesystem;
@@ -33,17 +34,7 @@ namespace farfield::bake {
 using namespace farfield::extract;
 namespace {
 
-// Runs `call`, which must throw farfield::Error whose message holds every one of `parts`.
-template <typename F>
-void expectErrorMentions(F call, const std::vector<std::string>& parts) {
-  try {
-    call();
-    ADD_FAILURE() << "expected farfield::Error mentioning " << parts.back();
-  } catch (const Error& e) {
-    for (const std::string& part : parts)
-      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' in: " << e.what();
-  }
-}
+using test::expectErrorMentions;
 
 // ---------------------------------------------------------------------------------------------------------------
 // parsePipeline

@@ -19,6 +19,7 @@
 #include "farfield/store/impostor_store.h"
 #include "farfield/store/store_compare.h"
 #include "farfield/urban/cells.h"
+#include "support/expect_error.h"
 #include "support/test_support.h"
 
 namespace fs = std::filesystem;
@@ -26,16 +27,7 @@ namespace fs = std::filesystem;
 namespace farfield::bake {
 namespace {
 
-template <typename F>
-void expectErrorMentions(F call, const std::vector<std::string>& parts) {
-  try {
-    call();
-    ADD_FAILURE() << "expected farfield::Error mentioning " << parts.back();
-  } catch (const Error& e) {
-    for (const std::string& part : parts)
-      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' in: " << e.what();
-  }
-}
+using test::expectErrorMentions;
 
 TEST(ShardPartitionTest, CoversEveryCellExactlyOnceAndStaysBalancedForManyN) {
   std::mt19937 rng(1601);

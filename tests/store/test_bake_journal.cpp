@@ -8,6 +8,7 @@
 #include "farfield/core/error.h"
 #include "farfield/store/bake_journal.h"
 #include "farfield/store/impostor_store.h"
+#include "support/expect_error.h"
 #include "support/test_support.h"
 
 namespace fs = std::filesystem;
@@ -24,16 +25,7 @@ void spill(const fs::path& p, const std::string& text) {
   out << text;
 }
 
-template <typename F>
-void expectErrorMentions(F call, const std::vector<std::string>& parts) {
-  try {
-    call();
-    ADD_FAILURE() << "expected farfield::Error mentioning " << parts.back();
-  } catch (const Error& e) {
-    for (const std::string& part : parts)
-      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "'" << part << "' in: " << e.what();
-  }
-}
+using test::expectErrorMentions;
 
 TEST(BakeJournalTest, ReadsBackWhatWasAppendedAndDropsOnlyACutLastLine) {
   const fs::path dir = test::scratchDir("journal");
