@@ -19,16 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace farfield;
   const fuzz::StoreInput in = fuzz::splitStoreInput(data, size);
   const std::filesystem::path dir = fuzz::freshDirectory("store");
-  std::string index_text = in.index;
-  nlohmann::json j = nlohmann::json::parse(in.index, nullptr, false);
-  if (!j.is_discarded()) {
-    const auto checks = fuzz::placeFiles(j, dir, in.files);
-    if (!(in.mode & fuzz::kRawChecks) && j.is_object()) {
-      fuzz::repairChecks(j, checks);
-      index_text = store::indexFileText(j);
-    }
-  }
-  fuzz::writeBytes(dir / store::kIndexFile, index_text);
+  fuzz::writeStore(in, dir, store::kIndexFile, [](nlohmann::json& j) { return store::indexFileText(j); });
   fuzz::expectFarfieldErrors([&] {
     const store::StoreIndex index = store::readIndex(dir.string());
     const size_t cells = std::min<size_t>(index.cells.size(), 8);

@@ -17,17 +17,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace farfield;
   const fuzz::StoreInput in = fuzz::splitStoreInput(data, size);
   const std::filesystem::path dir = fuzz::freshDirectory("placement");
-  std::string index_text = in.index;
-  nlohmann::json j = nlohmann::json::parse(in.index, nullptr, false);
-  if (!j.is_discarded()) {
-    const auto checks = fuzz::placeFiles(j, dir, in.files);
-    if (!(in.mode & fuzz::kRawChecks) && j.is_object()) {
-      fuzz::repairChecks(j, checks);
-      if (j.is_object()) j.erase("checksum");
-      index_text = store::placementFileText(j);
-    }
-  }
-  fuzz::writeBytes(dir / store::kPlacementIndexFile, index_text);
+  fuzz::writeStore(in, dir, store::kPlacementIndexFile, [](nlohmann::json& j) {
+    j.erase("checksum");
+    return store::placementFileText(j);
+  });
   fuzz::expectFarfieldErrors([&] {
     const store::PlacementIndex index = store::readPlacementIndex(dir.string());
     for (size_t i = 0; i < index.impostors.size() && i < 8; ++i)

@@ -118,6 +118,23 @@ inline std::map<std::string, store::FileCheck> placeFiles(const nlohmann::json& 
   return checks;
 }
 
+// Writes the input's files under `dir` and its index to `dir / index_name`. Unless the MODE bit kRawChecks is set,
+// the index's file checks are repaired to match the files and the index is written in its checksummed text form
+// (`text`: the store's writer of that form), so that the fuzzer reaches past the checksums.
+template <typename IndexText>
+void writeStore(const StoreInput& in, const std::filesystem::path& dir, const std::string& index_name, IndexText text) {
+  std::string index_text = in.index;
+  nlohmann::json j = nlohmann::json::parse(in.index, nullptr, false);
+  if (!j.is_discarded()) {
+    const auto checks = placeFiles(j, dir, in.files);
+    if (!(in.mode & kRawChecks) && j.is_object()) {
+      repairChecks(j, checks);
+      index_text = text(j);
+    }
+  }
+  writeBytes(dir / index_name, index_text);
+}
+
 // The input as one byte string (what the seed writer produces from a database written by Farfield's writers).
 inline std::string joinStoreInput(uint8_t mode, const std::string& index, const std::vector<std::string>& files) {
   std::string out(1, char(mode));
