@@ -1,6 +1,7 @@
 // farfield crowd bench -o OUTDIR [--agents 1000,10000] [--paths pedestrian,elevated] [--frames N] [--step K]
 //                      [--size WxH] [--blocks N] [--detail D] [--models A.glb,B.glb] [--texel M] [--cycle-frames F]
-//                      [--azimuths A] [--elevations E] [--error-px PX]
+//                      [--azimuths A] [--elevations E] [--error-px PX] [--atlas-from-bound] [--bound-switch M]
+//                      [--outfits N] [--no-shadows] [--shadow-map N] [--shadow-distance M]
 // Animated crowds with multi-view impostors on a generated city: eval::runCrowdBench (eval/crowd_bench.h).
 #include <cstdio>
 #include <memory>
@@ -52,6 +53,9 @@ void run(CrowdArgs& a) {
     }
   }
   a.o.paths = splitList(a.paths);
+  if (a.o.outfits < 1) throw Error("--outfits", "must be at least 1");
+  if (a.o.shadow.map_size < 16 || !(a.o.shadow.distance_m > 0.0f))
+    throw Error("--shadow-map/--shadow-distance", "must be at least 16 texels and a positive distance");
   a.o.models = splitList(a.models);
   if (a.o.runtime.grid.azimuths < 1 || a.o.runtime.grid.elevations < 1)
     throw Error("--azimuths/--elevations", "must be at least 1");
@@ -85,6 +89,15 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
   bench->add_option("--elevations", o.runtime.grid.elevations, "Impostor view elevations")->capture_default_str();
   bench->add_option("--error-px", o.runtime.error_px, "View error bound (pixels) of crowd-mixed")->capture_default_str();
   bench->add_option("--samples", o.samples, "Sample frames saved per run")->capture_default_str();
+  bench->add_flag("--atlas-from-bound", o.runtime.atlas_from_bound,
+                  "Choose views, frames and texel per model from --error-px for impostors from --bound-switch on");
+  bench->add_option("--bound-switch", o.runtime.bound_switch_m, "Distance (m) from which the bound's atlas holds")
+      ->capture_default_str();
+  bench->add_option("--outfits", o.outfits, "Colour-region outfits (16 region tints each)")->capture_default_str();
+  bench->add_flag("!--no-shadows", o.shadows, "No agent shadows");
+  bench->add_option("--shadow-map", o.shadow.map_size, "Shadow map texels per side")->capture_default_str();
+  bench->add_option("--shadow-distance", o.shadow.distance_m, "Shadow receivers up to this distance (m)")
+      ->capture_default_str();
   bench->callback([a] { run(*a); });
 });
 

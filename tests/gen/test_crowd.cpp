@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "farfield/core/error.h"
@@ -43,7 +44,11 @@ TEST(Crowd, DeterministicForASeed) {
     EXPECT_EQ(a.agents[i].model, b.agents[i].model);
     EXPECT_EQ(a.agents[i].tint, b.agents[i].tint);
     EXPECT_EQ(a.agents[i].phase, b.agents[i].phase);
+    EXPECT_EQ(a.agents[i].outfit, b.agents[i].outfit);
+    EXPECT_LT(a.agents[i].outfit, o.outfits);
   }
+  EXPECT_EQ(a.region_tints, b.region_tints);
+  EXPECT_EQ(a.region_tints, crowdRegionTints(9, o.outfits));
   EXPECT_GT(differ, 550u);  // another seed, another crowd
   // Both models appear, roughly in their shares (0.7 / 0.3).
   size_t model1 = 0;
@@ -91,6 +96,23 @@ TEST(Crowd, BadOptionsAreErrors) {
   o = CrowdOptions{};
   o.min_speed = 0.0f;
   EXPECT_THROW(generateCrowd(g, o), Error);
+}
+
+}  // namespace
+}  // namespace farfield::gen
+
+namespace farfield::gen {
+namespace {
+
+TEST(CrowdOutfits, OutfitsAreDeterministicAndTheTableDoesNotDependOnTheCrowdSize) {
+  EXPECT_EQ(crowdRegionTints(4, 8).size(), 8 * kCrowdRegions);
+  EXPECT_EQ(crowdRegionTints(4, 8), crowdRegionTints(4, 8));
+  EXPECT_NE(crowdRegionTints(4, 8), crowdRegionTints(5, 8));
+  const std::vector<Vec4> t = crowdRegionTints(4, 8);
+  const size_t white = size_t(std::count(t.begin(), t.end(), Vec4(1.0f)));
+  EXPECT_GT(white, t.size() / 8);  // about a third left white
+  EXPECT_LT(white, t.size() / 2);
+  EXPECT_THROW(crowdRegionTints(4, 0), Error);
 }
 
 }  // namespace

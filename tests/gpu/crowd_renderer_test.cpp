@@ -1,10 +1,12 @@
-// GPU skinning with instancing against CPU skinning of the same poses (GL test: the shared headless context).
+// GPU skinning with instancing against CPU skinning of the same poses, colour regions tinted per agent outfit (GL
+// test: the shared headless context).
 #include "farfield/gpu/crowd_renderer.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "farfield/core/error.h"
 #include "farfield/gpu/gpu_mesh.h"
 #include "farfield/scene/gltf_skin.h"
 #include "gpu/gpu_fixture.h"
@@ -45,6 +47,12 @@ TEST_F(CrowdRendererGl, InstancedGpuSkinningEqualsCpuSkinning) {
   const Mat4 to_agent = glm::rotate(Mat4(1.0f), 0.3f, Vec3(0, 0, 1));
   SkinnedGpuModel gpu_model(man, to_agent, poses);
   CrowdRenderer crowd;
+  // Three outfits of distinct region tints; agent i wears outfit i + 1 (mod 3).
+  std::vector<Vec4> tints(3 * scene::kColorRegions);
+  for (size_t k = 0; k < tints.size(); ++k)
+    tints[k] = Vec4(0.4f + 0.6f * float(k % 2), 0.4f + 0.6f * float((k / 2) % 2), 0.4f + 0.6f * float((k / 5) % 2), 1.0f);
+  crowd.setRegionTints(tints);
+  EXPECT_THROW(crowd.setRegionTints(std::span(tints).first(5)), Error);
   Renderer renderer;
   const Camera camera = test::testCamera(Vec3(0.3f, -3.6f, 1.3f), Vec3(0.3f, 0.0f, 0.8f), 160);
 
@@ -54,6 +62,7 @@ TEST_F(CrowdRendererGl, InstancedGpuSkinningEqualsCpuSkinning) {
     agents[size_t(i)].index = uint32_t(i + 1);
     agents[size_t(i)].object_id = uint32_t(10 + i);
     agents[size_t(i)].tint = Vec4(1.0f, 0.9f - 0.2f * float(i), 0.8f, 1.0f);
+    agents[size_t(i)].outfit = uint32_t(i + 4);  // outfit (i + 1) mod 3
   }
   RenderTarget gpu_target(160, 160);
   gpu_target.bindForOpaquePass();
@@ -62,21 +71,32 @@ TEST_F(CrowdRendererGl, InstancedGpuSkinningEqualsCpuSkinning) {
   EXPECT_EQ(stats.draw_calls, 1u);
   EXPECT_EQ(stats.triangles, 3u * man.mesh.triangleCount());
 
-  // CPU: each agent's pose skinned on the CPU, drawn as a plain mesh with the agent's transform and tint.
+  // CPU: each agent's pose skinned on the CPU, split by colour region, each part drawn as a plain mesh with the
+  // agent's transform and tint times its region's tint in the agent's outfit.
+  ASSERT_EQ(man.regions.size(), man.mesh.triangleCount());
   auto cpuFrame = [&](int pose_shift, RenderTarget& target) {
     std::vector<GpuMesh> meshes;
-    meshes.reserve(3);
-    std::vector<GpuMaterial> materials(3);
+    meshes.reserve(3 * scene::kColorRegions);
+    std::vector<GpuMaterial> materials(3 * scene::kColorRegions);
     Texture texture = Texture::fromImage(*man.texture, true);
     std::vector<DrawItem> items;
     for (int i = 0; i < 3; ++i) {
       const CrowdAgentGpu& a = agents[size_t(i)];
-      meshes.emplace_back(scene::skinMesh(man, poses[(a.index + uint32_t(pose_shift)) % 4]));
-      materials[size_t(i)].base_color = man.base_color * a.tint;
-      materials[size_t(i)].texture = &texture;
+      const scene::Mesh posed = scene::skinMesh(man, poses[(a.index + uint32_t(pose_shift)) % 4]);
       const Mat4 agent = glm::translate(Mat4(1.0f), Vec3(a.pos_heading)) *
                          glm::rotate(Mat4(1.0f), a.pos_heading.w, Vec3(0, 0, 1)) * to_agent;
-      items.push_back(DrawItem{&meshes.back(), &materials[size_t(i)], agent, a.object_id});
+      for (int r = 0; r < scene::kColorRegions; ++r) {
+        scene::Mesh part = posed;
+        part.indices.clear();
+        for (size_t t = 0; t < posed.triangleCount(); ++t)
+          if (man.regions[t] == r) part.indices.insert(part.indices.end(), &posed.indices[3 * t], &posed.indices[3 * t] + 3);
+        if (part.indices.empty()) continue;
+        meshes.emplace_back(part);
+        GpuMaterial& mat = materials[size_t(i * scene::kColorRegions + r)];
+        mat.base_color = man.base_color * a.tint * tints[(a.outfit % 3) * scene::kColorRegions + size_t(r)];
+        mat.texture = &texture;
+        items.push_back(DrawItem{&meshes.back(), &mat, agent, a.object_id});
+      }
     }
     renderer.render(camera, items, target);
   };

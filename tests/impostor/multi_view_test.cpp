@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
@@ -77,7 +78,8 @@ Coverage compareAgents(const gpu::RenderTarget& a, const gpu::RenderTarget& b) {
 
 // Seen from one of its capture views (a distant, narrow camera on the view's direction: nearly the orthographic
 // capture), the impostor shows what the skinned geometry shows: the same pixels covered, colours within 24/255 but
-// for texture detail resampled twice (atlas texels of 8 mm against pixels of 14 mm) and silhouette pixels.
+// for texture detail resampled twice (atlas texels of 8 mm against pixels of 14 mm) and silhouette pixels; with an
+// outfit of strong, distinct colour-region tints, both tinted alike (and not like another outfit).
 TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
   const scene::SkinnedModel man =
       scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
@@ -87,6 +89,14 @@ TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
   const Mat4 to_agent = glm::rotate(Mat4(1.0f), float(kPi / 2), Vec3(0, 0, 1));
   gpu::SkinnedGpuModel model(man, to_agent, poses);
   gpu::CrowdRenderer crowd;
+  std::vector<Vec4> tints(2 * scene::kColorRegions, Vec4(1.0f));  // outfit 0 white, outfit 1 a colour per region
+  for (int r = 0; r < scene::kColorRegions; ++r)
+    tints[size_t(scene::kColorRegions + r)] =
+        Vec4(0.3f + 0.7f * float(r % 2), 0.3f + 0.7f * float((r / 2) % 2), 0.3f + 0.7f * float((r / 4) % 2), 1.0f);
+  crowd.setRegionTints(tints);
+  EXPECT_EQ(crowd.outfitCount(), 2u);
+  std::set<uint8_t> regions(man.regions.begin(), man.regions.end());
+  EXPECT_GE(regions.size(), 8u) << "CesiumMan's one material is split by joints";
   const ViewGrid grid{8, 3, float(kPi / 4)};
   Box3 bounds;
   for (const auto& pose : poses)
@@ -102,6 +112,7 @@ TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
     agent.pos_heading = Vec4(2.0f, -1.0f, 0.0f, heading);
     agent.index = 1;
     agent.object_id = 5;
+    agent.outfit = 1;
     const Vec3 local = grid.direction(cell);
     const Vec3 world_dir = Vec3(glm::rotate(Mat4(1.0f), heading, Vec3(0, 0, 1)) * Vec4(local, 0.0f));
     const Vec3 centre = Vec3(agent.pos_heading) +
@@ -115,20 +126,24 @@ TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
     camera.far_plane = 200.0f;
     ASSERT_EQ(nearestView(grid, local), cell);
 
-    gpu::RenderTarget geo(160, 160), imp_target(160, 160), wrong(160, 160);
-    auto draw = [&](gpu::RenderTarget& t, int mode, uint32_t view) {
+    gpu::RenderTarget geo(160, 160), imp_target(160, 160), wrong(160, 160), other_outfit(160, 160);
+    auto draw = [&](gpu::RenderTarget& t, int mode, uint32_t view, uint32_t outfit = 1) {
       t.bindForOpaquePass();
       t.clear(light.sky_color);
+      gpu::CrowdAgentGpu a = agent;
+      a.outfit = outfit;
       if (mode == 0) {
-        crowd.drawSkinned(camera, model, std::span(&agent, 1), light);
+        crowd.drawSkinned(camera, model, std::span(&a, 1), light);
       } else {
-        gpu::CrowdAgentGpu a = agent;
         a.view = view;
         crowd.drawImpostors(camera, *imp.atlas, std::span(&a, 1), light);
       }
     };
     draw(geo, 0, 0);
     draw(imp_target, 1, uint32_t(cell));
+    draw(other_outfit, 1, uint32_t(cell), 0);
+    const Coverage o = compareAgents(geo, other_outfit);
+    EXPECT_GT(double(o.bad), 0.3 * double(o.either)) << "cell " << cell << ": the tints must show";
     draw(wrong, 1, uint32_t((cell + 1) % grid.azimuths + (cell / grid.azimuths) * grid.azimuths));
     const Coverage c = compareAgents(geo, imp_target);
     EXPECT_GT(c.either, 1500u);
@@ -162,6 +177,34 @@ TEST(MultiView, ChoiceFromTheBoundKeepsTheBoundAndIsNotWasteful) {
     }
   }
   EXPECT_THROW(chooseForBound(0.0, focal, 20.0, 0.35), Error);
+}
+
+}  // namespace
+}  // namespace farfield::impostor
+
+namespace farfield::impostor {
+namespace {
+
+// A vertex on a unit circle, one turn per cycle of 16 poses: the frame shown for pose p is k poses away, k at most
+// half the frame spacing, and the error is the chord 2 sin(pi k / 16).
+TEST(MultiView, FramesFromTheBoundAreTheFewestThatKeepIt) {
+  const int poses = 16;
+  std::vector<std::vector<Vec3>> positions(poses);
+  for (int p = 0; p < poses; ++p) {
+    const float a = float(2.0 * kPi) * float(p) / float(poses);
+    positions[size_t(p)] = {Vec3(std::cos(a), std::sin(a), 0.0f), Vec3(0.0f)};
+  }
+  auto chord = [&](int k) { return 2.0 * std::sin(kPi * double(k) / double(poses)); };
+  EXPECT_NEAR(frameError(positions, 16), 0.0, 1e-6);
+  EXPECT_NEAR(frameError(positions, 8), chord(1), 1e-5);
+  EXPECT_NEAR(frameError(positions, 4), chord(2), 1e-5);
+  EXPECT_NEAR(frameError(positions, 2), chord(4), 1e-5);
+  EXPECT_NEAR(frameError(positions, 1), chord(8), 1e-5);
+  EXPECT_EQ(framesForBound(positions, 0.5), 8);
+  EXPECT_EQ(framesForBound(positions, 0.2), 16);
+  EXPECT_EQ(framesForBound(positions, 1.5), 2);
+  EXPECT_EQ(framesForBound(positions, 2.5), 1);
+  EXPECT_THROW(frameError(positions, 3), Error);
 }
 
 }  // namespace

@@ -69,9 +69,20 @@ std::vector<runtime::CrowdAgentState> agentStates(const gen::Crowd& crowd, const
     const float phase = a.phase + p.walked / stride;
     s.phase = phase - std::floor(phase);
     s.tint = a.tint;
+    s.outfit = a.outfit;
     s.object_id = kCrowdIdBit | uint32_t(i);
   }
   return states;
+}
+
+// The crowd into `target` (holding the city), with or without the agents' shadows.
+runtime::CrowdFrameStats drawCrowd(runtime::CrowdRuntime& rt, const Camera& camera,
+                                   std::span<const runtime::CrowdAgentState> states, runtime::CrowdPolicy policy,
+                                   const gpu::LightSettings& light, const gpu::RenderTarget& target,
+                                   const CrowdBenchOptions& options) {
+  if (options.shadows) return rt.drawShadowed(camera, states, policy, light, target, options.shadow);
+  target.bindForOpaquePass();
+  return rt.draw(camera, states, policy, light);
 }
 
 std::string fmt(const char* f, double v) {
@@ -104,23 +115,25 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
   md << "- renderer: " << result.renderer << "\n";
   for (size_t m = 0; m < result.layouts.size(); ++m) {
     const gpu::AtlasLayout& l = result.layouts[m];
+    const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
     md << "- " << result.model_names[m] << ": " << thousands(result.model_triangles[m]) << " triangles; atlas "
-       << l.azimuths << "x" << l.elevations << " views x " << l.frames << " frames, cells " << l.cell_width << "x"
-       << l.cell_height << " texels (" << fmt("%.3f", options.runtime.texel_m) << " m), "
-       << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0) << " MiB uncompressed ("
-       << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames) << " KiB per frame); switch to impostor beyond "
-       << fmt("%.1f", result.switch_m[m]) << " m";
-    // What the bound would choose for impostors from 20 m on (impostor::chooseForBound).
-    const double focal = double(options.height) / (2.0 * std::tan(degToRad(60.0) / 2.0));
-    const impostor::BoundChoice bc =
-        impostor::chooseForBound(options.runtime.error_px, focal, 20.0, double(l.half_size.x));
-    md << "; for " << fmt("%.1f", options.runtime.error_px) << " px from 20 m on the bound asks for "
-       << bc.grid.azimuths << "x" << bc.grid.elevations << " views and " << fmt("%.3f", bc.texel_m) << " m texels\n";
+       << (c.from_bound ? "chosen from the bound (" + fmt("%.2f", options.runtime.error_px) + " px from " +
+                              fmt("%.1f", options.runtime.bound_switch_m) + " m on)"
+                        : std::string("fixed"))
+       << ": " << l.azimuths << "x" << l.elevations << " views x " << l.frames << " frames (frame error "
+       << fmt("%.3f", c.frame_error_m) << " m), cells " << l.cell_width << "x" << l.cell_height << " texels ("
+       << fmt("%.3f", c.texel_m) << " m), " << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0)
+       << " MiB uncompressed (" << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames)
+       << " KiB per frame, the lecture: about 256 KB compressed); switch to impostor beyond "
+       << fmt("%.1f", result.switch_m[m]) << " m\n";
   }
+  if (options.shadows)
+    md << "- shadows: one " << options.shadow.map_size << "x" << options.shadow.map_size << " map, receivers within "
+       << fmt("%.0f", options.shadow.distance_m) << " m, in the reference and every mode\n";
   md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
   md << "| agents | path | mode | median ms | crowd ms | speedup | crowd speedup | geometry / impostor agents | "
-        "triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) |\n";
-  md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        "triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) | shadow casters / receiver px off |\n";
+  md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const CrowdRun& run : result.runs)
     for (const CrowdModeResult& r : run.modes)
       md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << fmt("%.1f", r.wall.median)
@@ -129,7 +142,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
          << fmt("%.0f", r.impostor_agents) << " | " << thousands(size_t(r.triangles)) << " | "
          << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
          << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
-         << fmt("%.2f", run.reference_popping_mean) << ") |\n";
+         << fmt("%.2f", run.reference_popping_mean) << ") | " << fmt("%.0f", r.shadow_casters) << " / "
+         << fmt("%.0f", r.receiver_bad_pixels) << " |\n";
   return md.str();
 }
 
@@ -143,9 +157,13 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
   j["bake_seconds"] = result.bake_seconds;
   for (size_t m = 0; m < result.layouts.size(); ++m) {
     const gpu::AtlasLayout& l = result.layouts[m];
+    const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
     j["models"].push_back({{"file", result.model_names[m]}, {"triangles", result.model_triangles[m]},
                            {"azimuths", l.azimuths}, {"elevations", l.elevations}, {"frames", l.frames},
-                           {"cell", {l.cell_width, l.cell_height}}, {"atlas_bytes", result.atlas_bytes[m]},
+                           {"cell", {l.cell_width, l.cell_height}}, {"texel_m", c.texel_m},
+                           {"frame_error_m", c.frame_error_m}, {"from_bound", c.from_bound},
+                           {"atlas_bytes", result.atlas_bytes[m]},
+                           {"atlas_kib_per_frame", double(result.atlas_bytes[m]) / 1024.0 / l.frames},
                            {"switch_m", result.switch_m[m]}});
   }
   for (const CrowdRun& run : result.runs)
@@ -157,7 +175,9 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
                            {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
                            {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
-                           {"in_view", r.in_view}, {"triangles", r.triangles}});
+                           {"in_view", r.in_view}, {"triangles", r.triangles},
+                           {"shadow_casters", r.shadow_casters}, {"shadow_texel_m", r.shadow_texel_m},
+                           {"receiver_bad_pixels", r.receiver_bad_pixels}});
   std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
   std::ofstream(fs::path(options.out_dir) / "crowd.md") << result.markdown;
 }
@@ -202,10 +222,14 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
   gpu::RenderTarget& target = res.target;
   gpu::RenderTarget reference_target(options.width, options.height);
 
-  runtime::CrowdRuntime rt(models, model_options, options.runtime);
+  runtime::CrowdRuntimeOptions rt_options = options.runtime;
+  rt_options.bound_focal_px = double(options.height) / (2.0 * std::tan(double(Camera{}.fov_y) / 2.0));
+  rt_options.region_tints = gen::crowdRegionTints(options.crowd_seed, options.outfits);
+  runtime::CrowdRuntime rt(models, model_options, rt_options);
   result.bake_seconds = rt.bakeSeconds();
   for (size_t m = 0; m < rt.modelCount(); ++m) {
     result.layouts.push_back(rt.impostor(m).layout);
+    result.atlas_choices.push_back(rt.atlasChoice(m));
     result.atlas_bytes.push_back(rt.impostor(m).byteSize());
     result.model_triangles.push_back(rt.modelTriangles(m));
   }
@@ -231,6 +255,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       cro.agents = count;
       cro.seed = options.crowd_seed;
       cro.model_shares.assign(options.model_shares.begin(), options.model_shares.begin() + long(models.size()));
+      cro.outfits = options.outfits;
       const gen::Crowd crowd = gen::generateCrowd(city.streets, cro);
       FF_INFO("crowd bench: " << count << " agents, " << path_name << " path");
       CrowdRun run;
@@ -238,7 +263,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       run.path = path_name;
       std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), psnr(specs.size()),
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
-          in_view(specs.size()), tris(specs.size());
+          in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
+          receiver_bad(specs.size());
       std::vector<image::ColorImage> prev(specs.size());
       std::vector<image::IdImage> prev_ids(specs.size());
       image::ColorImage prev_ref;
@@ -261,8 +287,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         reference_target.bindForOpaquePass();
         reference_target.clear(light.sky_color);
         renderer.draw(camera, items, reference_target);
-        reference_target.bindForOpaquePass();
-        rt.draw(camera, states, runtime::CrowdPolicy::Geometry, light);
+        drawCrowd(rt, camera, states, runtime::CrowdPolicy::Geometry, light, reference_target, options);
         rt.finish();
         const image::ColorImage ref = reference_target.readColor();
         const image::IdImage ref_ids = reference_target.readIds();
@@ -279,8 +304,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           renderer.draw(camera, items, target);
           rt.finish();
           const double city_ms = clock.milliseconds();
-          target.bindForOpaquePass();
-          const runtime::CrowdFrameStats st = rt.draw(camera, states, specs[m].policy, light);
+          const runtime::CrowdFrameStats st = drawCrowd(rt, camera, states, specs[m].policy, light, target, options);
           rt.finish();
           const double total = clock.milliseconds();
           if (k == 0) continue;
@@ -290,12 +314,15 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           imp[m].push_back(double(st.impostors));
           in_view[m].push_back(double(st.in_view));
           tris[m].push_back(double(st.draw.triangles));
+          casters[m].push_back(double(st.shadow_casters));
+          shadow_texel[m].push_back(double(st.shadow_texel_m));
           image::ColorImage frame = target.readColor();
           image::IdImage frame_ids = target.readIds();
           const CrowdPixelError e = crowdPixelError(ref, ref_ids, frame, frame_ids);
           psnr[m].push_back(e.psnr_db);
           bad[m].push_back(e.bad_share);
           pixels[m].push_back(double(e.pixels));
+          receiver_bad[m].push_back(double(receiverBadPixels(ref, ref_ids, frame, frame_ids)));
           if (k > 1)
             popping[m].push_back(crowdPopping(prev[m], prev_ids[m], frame, frame_ids, prev_ref, prev_ref_ids, ref, ref_ids));
           if (sample) {
@@ -335,6 +362,9 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.impostor_agents = mean(imp[m]);
         r.in_view = mean(in_view[m]);
         r.triangles = mean(tris[m]);
+        r.shadow_casters = mean(casters[m]);
+        r.shadow_texel_m = mean(shadow_texel[m]);
+        r.receiver_bad_pixels = mean(receiver_bad[m]);
         run.modes.push_back(r);
       }
       for (CrowdModeResult& r : run.modes) {

@@ -34,7 +34,10 @@ struct CrowdBenchOptions {
   // Turn bringing each model's front to +x (CesiumMan walks along +x once Z up; the Fox faces glTF's +z, -y).
   std::vector<float> model_facing_deg{0.0f, 90.0f};
   std::vector<float> model_shares{0.7f, 0.3f};
-  runtime::CrowdRuntimeOptions runtime;
+  runtime::CrowdRuntimeOptions runtime;  // its bound_focal_px is set from the frame size (60 degrees)
+  size_t outfits = 32;                   // colour-region outfits drawn from
+  bool shadows = true;                   // agents cast shadows (reference and every mode)
+  runtime::CrowdShadowOptions shadow;
   std::string out_dir;
   int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)
 };
@@ -48,6 +51,8 @@ struct CrowdModeResult {
   double psnr_mean = 0.0, psnr_min = 0.0, bad_share_mean = 0.0, crowd_pixels_mean = 0.0;
   double popping_mean = 0.0, popping_max = 0.0;
   double geometry_agents = 0.0, impostor_agents = 0.0, in_view = 0.0, triangles = 0.0;  // means per frame
+  double shadow_casters = 0.0, shadow_texel_m = 0.0;  // means per frame
+  double receiver_bad_pixels = 0.0;  // mean per frame: non-agent pixels off by > 8/255 (shadow differences)
 };
 
 struct CrowdRun {
@@ -61,6 +66,7 @@ struct CrowdBenchResult {
   std::vector<CrowdRun> runs;
   std::vector<std::string> model_names;
   std::vector<gpu::AtlasLayout> layouts;
+  std::vector<runtime::CrowdAtlasChoice> atlas_choices;
   std::vector<size_t> atlas_bytes;
   std::vector<uint64_t> model_triangles;
   std::vector<double> switch_m;  // per model at the bench's camera

@@ -40,6 +40,22 @@ CrowdPixelError crowdPixelError(const image::ColorImage& reference, const image:
   return e;
 }
 
+size_t receiverBadPixels(const image::ColorImage& reference, const image::IdImage& reference_ids,
+                         const image::ColorImage& frame, const image::IdImage& frame_ids, int threshold) {
+  FF_CHECK(reference.pixelCount() == frame.pixelCount() && reference_ids.pixelCount() == frame.pixelCount() &&
+           frame_ids.pixelCount() == frame.pixelCount());
+  size_t bad = 0;
+  for (size_t i = 0; i < frame.pixelCount(); ++i) {
+    if (crowd(reference_ids, i) || crowd(frame_ids, i)) continue;
+    for (int c = 0; c < 3; ++c)
+      if (channelDiff(reference.pixels()[i], frame.pixels()[i], c) > threshold) {
+        ++bad;
+        break;
+      }
+  }
+  return bad;
+}
+
 double crowdPopping(const image::ColorImage& previous, const image::IdImage& previous_ids,
                     const image::ColorImage& frame, const image::IdImage& frame_ids,
                     const image::ColorImage& previous_reference, const image::IdImage& previous_reference_ids,

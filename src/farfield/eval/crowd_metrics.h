@@ -5,10 +5,11 @@
 #include <cstdint>
 
 #include "farfield/image/image.h"
+#include "farfield/runtime/crowd_runtime.h"
 
 namespace farfield::eval {
 
-inline constexpr uint32_t kCrowdIdBit = 0x80000000u;
+inline constexpr uint32_t kCrowdIdBit = runtime::kAgentIdBit;  // agents do not receive the crowd's shadows
 
 struct CrowdPixelError {
   size_t pixels = 0;         // crowd pixels (either image)
@@ -19,6 +20,12 @@ struct CrowdPixelError {
 
 CrowdPixelError crowdPixelError(const image::ColorImage& reference, const image::IdImage& reference_ids,
                                 const image::ColorImage& frame, const image::IdImage& frame_ids, int threshold = 8);
+
+// The shadows' error: pixels that show no agent in either image (the city and the ground, which receive the agents'
+// shadows) and differ by more than `threshold` in some channel. The city is identical in every mode, so these are
+// the pixels where a mode's shadows differ from the reference's.
+size_t receiverBadPixels(const image::ColorImage& reference, const image::IdImage& reference_ids,
+                         const image::ColorImage& frame, const image::IdImage& frame_ids, int threshold = 8);
 
 // Popping on the crowd's pixels (eval/temporal_error.h's definition, masked): the mode's mean absolute change between
 // consecutive frames minus the reference's, over the pixels where any of the four frames shows an agent; >= 0.

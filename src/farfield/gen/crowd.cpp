@@ -66,6 +66,7 @@ Crowd generateCrowd(const urban::StreetGraph& streets, const CrowdOptions& optio
   if (!(options.min_speed > 0.0f) || !(options.max_speed >= options.min_speed))
     throw Error("crowd", "speeds must be positive, min <= max");
   if (!(options.sidewalk_offset >= 0.0f)) throw Error("crowd", "sidewalk offset must be >= 0");
+  if (options.outfits < 1) throw Error("crowd", "need at least one outfit");
   Crowd crowd;
   crowd.ground_height = options.ground_height;
   for (const BlockFootprint& block : buildableBlocks(streets)) {
@@ -108,7 +109,21 @@ Crowd generateCrowd(const urban::StreetGraph& streets, const CrowdOptions& optio
     }
     a.tint = tintOf(rng);
   }
+  // Outfits from their own streams, so that positions, speeds and tints stay those of earlier versions.
+  crowd.region_tints = crowdRegionTints(options.seed, options.outfits);
+  std::mt19937_64 outfit_rng(options.seed * 0xD1B54A32D192ED03ull + 29);
+  std::uniform_int_distribution<uint32_t> pick_outfit(0, uint32_t(options.outfits - 1));
+  for (CrowdAgent& a : crowd.agents) a.outfit = pick_outfit(outfit_rng);
   return crowd;
+}
+
+std::vector<Vec4> crowdRegionTints(uint64_t seed, size_t outfits) {
+  if (outfits < 1) throw Error("crowd", "need at least one outfit");
+  std::mt19937_64 rng(seed * 0xA24BAED4963EE407ull + 31);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  std::vector<Vec4> tints(outfits * kCrowdRegions);
+  for (Vec4& t : tints) t = u01(rng) < 0.33f ? Vec4(1.0f) : tintOf(rng);
+  return tints;
 }
 
 AgentPose agentPose(const Crowd& crowd, size_t i, float t) {

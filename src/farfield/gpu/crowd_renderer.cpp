@@ -66,7 +66,13 @@ SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& m
   glNamedBufferStorage(ibo_, GLsizeiptr(index_count_ * sizeof(uint32_t)), model.mesh.indices.data(), 0);
   glCreateBuffers(1, &palette_);
   glNamedBufferStorage(palette_, GLsizeiptr(palette.size() * sizeof(Mat4)), palette.data(), 0);
-  bytes_ = n * sizeof(SkinVertex) + index_count_ * sizeof(uint32_t) + palette.size() * sizeof(Mat4);
+  std::vector<uint32_t> regions(index_count_ / 3, 0u);  // one uint per triangle, read by gl_PrimitiveID
+  for (size_t t = 0; t < model.regions.size() && t < regions.size(); ++t) regions[t] = model.regions[t];
+  if (regions.empty()) regions.push_back(0u);
+  glCreateBuffers(1, &regions_);
+  glNamedBufferStorage(regions_, GLsizeiptr(regions.size() * sizeof(uint32_t)), regions.data(), 0);
+  bytes_ = n * sizeof(SkinVertex) + index_count_ * sizeof(uint32_t) + palette.size() * sizeof(Mat4) +
+           regions.size() * sizeof(uint32_t);
   glCreateVertexArrays(1, &vao_);
   glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(SkinVertex));
   glVertexArrayElementBuffer(vao_, ibo_);
@@ -92,8 +98,8 @@ SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& m
 
 SkinnedGpuModel::~SkinnedGpuModel() {
   if (vao_) glDeleteVertexArrays(1, &vao_);
-  const GLuint buffers[3] = {vbo_, ibo_, palette_};
-  glDeleteBuffers(3, buffers);
+  const GLuint buffers[4] = {vbo_, ibo_, palette_, regions_};
+  glDeleteBuffers(4, buffers);
 }
 
 ImpostorAtlasGpu::ImpostorAtlasGpu(const AtlasLayout& layout) : layout_(layout) {
@@ -151,14 +157,52 @@ image::ColorImage ImpostorAtlasGpu::readNormalDepth(int layer) const {
 CrowdRenderer::CrowdRenderer()
     : skinned_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl")),
       capture_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_CAPTURE 1")),
-      impostor_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl")) {
+      impostor_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl")),
+      skinned_depth_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_DEPTH_ONLY 1")),
+      impostor_depth_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl", "#define FF_DEPTH_ONLY 1")) {
   glCreateBuffers(1, &agents_);
   glCreateVertexArrays(1, &empty_vao_);
+  glCreateBuffers(1, &tints_);
+  const std::vector<Vec4> white(size_t(scene::kColorRegions), Vec4(1.0f));
+  setRegionTints(white);
 }
 
 CrowdRenderer::~CrowdRenderer() {
   if (agents_) glDeleteBuffers(1, &agents_);
+  if (tints_) glDeleteBuffers(1, &tints_);
   if (empty_vao_) glDeleteVertexArrays(1, &empty_vao_);
+}
+
+void CrowdRenderer::setRegionTints(std::span<const Vec4> tints) {
+  if (tints.empty() || tints.size() % size_t(scene::kColorRegions) != 0)
+    throw Error("crowd region tints", std::to_string(tints.size()) + " tints are not a whole number of outfits of " +
+                                          std::to_string(scene::kColorRegions) + " regions");
+  glNamedBufferData(tints_, GLsizeiptr(tints.size_bytes()), tints.data(), GL_STATIC_DRAW);
+  outfits_ = uint32_t(tints.size() / size_t(scene::kColorRegions));
+}
+
+void CrowdRenderer::bindModel(const Program& p, const SkinnedGpuModel& model) const {
+  p.set("u_model_to_agent", model.model_to_agent_);
+  p.set("u_joint_count", model.joint_count_);
+  p.set("u_first_instance", 0u);
+  p.set("u_base_color", model.base_color_);
+  p.set("u_textured", model.textured_ ? 1 : 0);
+  if (model.textured_) model.texture_.bind(0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, model.palette_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, tints_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, model.regions_);
+}
+
+void CrowdRenderer::bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const {
+  const AtlasLayout& l = atlas.layout_;
+  glUniform2f(p.uniformLocation("u_half_size"), l.half_size.x, l.half_size.y);
+  p.set("u_centre", l.centre);
+  p.set("u_first_instance", 0u);
+  glUniform2i(p.uniformLocation("u_grid"), l.azimuths, l.elevations);
+  p.set("u_radius", l.radius);
+  glBindTextureUnit(0, atlas.albedo_);
+  glBindTextureUnit(1, atlas.normal_depth_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, tints_);
 }
 
 uint32_t CrowdRenderer::uploadAgents(std::span<const CrowdAgentGpu> agents) {
@@ -176,14 +220,9 @@ FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuMode
   uploadAgents(agents);
   skinned_.use();
   skinned_.set("u_view_proj", camera.viewProjection());
-  skinned_.set("u_model_to_agent", model.model_to_agent_);
-  skinned_.set("u_joint_count", model.joint_count_);
-  skinned_.set("u_first_instance", 0u);
-  skinned_.set("u_base_color", model.base_color_);
-  skinned_.set("u_textured", model.textured_ ? 1 : 0);
+  skinned_.set("u_outfits", outfits_);
+  bindModel(skinned_, model);
   setLight(skinned_, light);
-  if (model.textured_) model.texture_.bind(0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, model.palette_);
   glBindVertexArray(model.vao_);
   glEnable(GL_CULL_FACE);
   glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, GLsizei(agents.size()));
@@ -204,14 +243,10 @@ FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtla
   impostor_.use();
   impostor_.set("u_view_proj", camera.viewProjection());
   impostor_.set("u_eye", camera.eye);
-  glUniform2f(impostor_.uniformLocation("u_half_size"), l.half_size.x, l.half_size.y);
-  impostor_.set("u_centre", l.centre);
-  impostor_.set("u_first_instance", 0u);
-  glUniform2i(impostor_.uniformLocation("u_grid"), l.azimuths, l.elevations);
-  impostor_.set("u_radius", l.radius);
+  impostor_.set("u_fixed_dir", Vec3(0.0f));
+  impostor_.set("u_outfits", outfits_);
+  bindAtlas(impostor_, atlas);
   setLight(impostor_, light);
-  glBindTextureUnit(0, atlas.albedo_);
-  glBindTextureUnit(1, atlas.normal_depth_);
   glBindVertexArray(empty_vao_);
   glDisable(GL_CULL_FACE);
   glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(agents.size()));
@@ -249,15 +284,9 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
   agent.index = pose;
   uploadAgents(std::span<const CrowdAgentGpu>(&agent, 1));
   capture_.use();
-  capture_.set("u_model_to_agent", model.model_to_agent_);
-  capture_.set("u_joint_count", model.joint_count_);
-  capture_.set("u_first_instance", 0u);
-  capture_.set("u_base_color", model.base_color_);
-  capture_.set("u_textured", model.textured_ ? 1 : 0);
+  bindModel(capture_, model);
   capture_.set("u_capture_centre", l.centre);
   capture_.set("u_capture_radius", l.radius);
-  if (model.textured_) model.texture_.bind(0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, model.palette_);
   glBindVertexArray(model.vao_);
   for (const CaptureView& v : views) {
     FF_CHECK(v.cell >= 0 && v.cell < l.azimuths * l.elevations);
@@ -269,6 +298,45 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
   }
   glBindVertexArray(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+FrameStats CrowdRenderer::drawSkinnedDepth(const Mat4& light_view_proj, const SkinnedGpuModel& model,
+                                           std::span<const CrowdAgentGpu> agents) {
+  FrameStats stats;
+  if (agents.empty() || model.index_count_ == 0) return stats;
+  for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
+  uploadAgents(agents);
+  skinned_depth_.use();
+  skinned_depth_.set("u_view_proj", light_view_proj);
+  bindModel(skinned_depth_, model);
+  glBindVertexArray(model.vao_);
+  glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, GLsizei(agents.size()));
+  glBindVertexArray(0);
+  stats.draw_calls = 1;
+  stats.triangles = model.triangleCount() * agents.size();
+  stats.objects = uint32_t(agents.size());
+  return stats;
+}
+
+FrameStats CrowdRenderer::drawImpostorDepth(const Mat4& light_view_proj, const Vec3& to_light,
+                                            const ImpostorAtlasGpu& atlas, std::span<const CrowdAgentGpu> agents) {
+  FrameStats stats;
+  if (agents.empty()) return stats;
+  const AtlasLayout& l = atlas.layout_;
+  for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < uint32_t(l.frames) && a.view < uint32_t(l.azimuths * l.elevations));
+  uploadAgents(agents);
+  impostor_depth_.use();
+  impostor_depth_.set("u_view_proj", light_view_proj);
+  impostor_depth_.set("u_eye", Vec3(0.0f));
+  impostor_depth_.set("u_fixed_dir", glm::normalize(to_light));
+  bindAtlas(impostor_depth_, atlas);
+  glBindVertexArray(empty_vao_);
+  glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(agents.size()));
+  glBindVertexArray(0);
+  stats.draw_calls = 1;
+  stats.triangles = 2 * agents.size();
+  stats.objects = uint32_t(agents.size());
+  return stats;
 }
 
 void CrowdRenderer::finish() const { glFinish(); }

@@ -1,6 +1,7 @@
 // Crowd rendering: skinned models drawn for many agents with one instanced draw per model (joint matrices of a
 // palette of sampled poses in a storage buffer, agents in another), and multi-view impostor atlases drawn as one
-// instanced camera-facing quad per agent. Also the capture pass that bakes an atlas.
+// instanced camera-facing quad per agent. Also the capture pass that bakes an atlas, the agents' colour regions
+// tinted per agent (16 per outfit, the lecture's colour variety) and the shadow casters' depth-only draws.
 #pragma once
 
 #include <cstdint>
@@ -17,13 +18,14 @@ namespace farfield::gpu {
 
 // One agent as the shaders read it (std430, 48 bytes). For skinned draws `index` is the palette pose; for
 // impostors it is the animation frame (atlas layer) and `view` the view cell (elevation * azimuths + azimuth).
+// `outfit` picks the row of colour-region tints (CrowdRenderer::setRegionTints) that modulates the agent.
 struct CrowdAgentGpu {
   Vec4 pos_heading{0.0f};  // xyz metres, w heading (radians about +z)
   Vec4 tint{1.0f};
   uint32_t index = 0;
   uint32_t view = 0;
   uint32_t object_id = 0;
-  uint32_t pad = 0;
+  uint32_t outfit = 0;
 };
 static_assert(sizeof(CrowdAgentGpu) == 48);
 
@@ -48,7 +50,7 @@ class SkinnedGpuModel {
 
  private:
   friend class CrowdRenderer;
-  uint32_t vao_ = 0, vbo_ = 0, ibo_ = 0, palette_ = 0;
+  uint32_t vao_ = 0, vbo_ = 0, ibo_ = 0, palette_ = 0, regions_ = 0;
   uint32_t index_count_ = 0, joint_count_ = 0, pose_count_ = 0;
   Mat4 model_to_agent_{1.0f};
   Vec4 base_color_{1.0f};
@@ -72,7 +74,8 @@ struct AtlasLayout {
   int height() const { return elevations * cell_height; }
 };
 
-// Albedo (RGBA8) and normal + depth (RGBA8) texture arrays of an atlas, linear filtering, clamped.
+// Albedo (RGBA8) and normal + depth (RGBA8) texture arrays of an atlas, linear filtering, clamped. The albedo's alpha
+// codes coverage and the colour region (crowd.frag.glsl: 0 = empty, (16 (r + 1) - 1) / 255 = region r).
 class ImpostorAtlasGpu {
  public:
   explicit ImpostorAtlasGpu(const AtlasLayout& layout);
@@ -120,10 +123,27 @@ class CrowdRenderer {
   // Waits for the GPU (glFinish): bake timings.
   void finish() const;
 
+  // The colour-region tints of every outfit: outfit o, region r at tints[o * scene::kColorRegions + r] (RGB used).
+  // Agents read outfit `outfit mod outfitCount()`. Initially one outfit of white. Throws farfield::Error for an empty
+  // table or one that is not a whole number of outfits.
+  void setRegionTints(std::span<const Vec4> tints);
+  uint32_t outfitCount() const { return outfits_; }
+
+  // Shadow casters, drawn into the bound depth-only target (ShadowMap::bindForCasters) with the light's
+  // orthographic view-projection; no colour, no ids. Skinned agents as drawSkinned. Impostor agents as quads facing
+  // `to_light` (unit, towards the light), each agent's `view` being its view cell towards the light, with the
+  // baked depth per texel.
+  FrameStats drawSkinnedDepth(const Mat4& light_view_proj, const SkinnedGpuModel& model,
+                              std::span<const CrowdAgentGpu> agents);
+  FrameStats drawImpostorDepth(const Mat4& light_view_proj, const Vec3& to_light, const ImpostorAtlasGpu& atlas,
+                               std::span<const CrowdAgentGpu> agents);
+
  private:
   uint32_t uploadAgents(std::span<const CrowdAgentGpu> agents);
-  Program skinned_, capture_, impostor_;
-  uint32_t agents_ = 0, empty_vao_ = 0;
+  void bindModel(const Program& p, const SkinnedGpuModel& model) const;
+  void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
+  Program skinned_, capture_, impostor_, skinned_depth_, impostor_depth_;
+  uint32_t agents_ = 0, empty_vao_ = 0, tints_ = 0, outfits_ = 0;
 };
 
 }  // namespace farfield::gpu

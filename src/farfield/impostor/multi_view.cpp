@@ -91,12 +91,36 @@ gpu::CaptureView captureView(const gpu::AtlasLayout& layout, const ViewGrid& gri
 }
 
 SwitchDistances switchDistances(const gpu::AtlasLayout& layout, const ViewGrid& grid, double focal_px,
-                                double error_px) {
+                                double error_px, double frame_error_m) {
   SwitchDistances s;
   const double texel = 2.0 * double(layout.half_size.y) / double(layout.cell_height);
   s.texel_m = texel * focal_px;
   s.view_m = double(layout.half_size.x) * double(worstViewAngle(grid)) * focal_px / std::max(error_px, 1e-6);
+  s.frame_m = frame_error_m * focal_px / std::max(error_px, 1e-6);
   return s;
+}
+
+double frameError(std::span<const std::vector<Vec3>> pose_positions, int frames) {
+  const size_t poses = pose_positions.size();
+  if (frames < 1 || poses == 0 || poses % size_t(frames) != 0)
+    throw Error("multi-view frames", std::to_string(frames) + " frames do not divide " + std::to_string(poses) +
+                                         " poses");
+  double worst = 0.0;
+  for (size_t p = 0; p < poses; ++p) {
+    const size_t frame = size_t(std::lround(double(p) * double(frames) / double(poses))) % size_t(frames);
+    const std::vector<Vec3>& a = pose_positions[p];
+    const std::vector<Vec3>& b = pose_positions[frame * poses / size_t(frames)];
+    if (a.size() != b.size()) throw Error("multi-view frames", "poses with different vertex counts");
+    for (size_t v = 0; v < a.size(); ++v) worst = std::max(worst, double(glm::length(a[v] - b[v])));
+  }
+  return worst;
+}
+
+int framesForBound(std::span<const std::vector<Vec3>> pose_positions, double max_m) {
+  const int poses = int(pose_positions.size());
+  for (int f = 1; f < poses; ++f)
+    if (poses % f == 0 && frameError(pose_positions, f) <= max_m) return f;
+  return std::max(poses, 1);
 }
 
 BoundChoice chooseForBound(double error_px, double focal_px, double switch_m, double half_width_m,

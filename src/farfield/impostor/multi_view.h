@@ -8,7 +8,9 @@
 // gpu::CrowdRenderer.
 #pragma once
 
+#include <algorithm>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "farfield/core/bounds.h"
@@ -46,14 +48,25 @@ gpu::CaptureView captureView(const gpu::AtlasLayout& layout, const ViewGrid& gri
 
 // Distances (metres) beyond which an impostor keeps a promise, for a camera of `focal_px` (pixels per unit of
 // tangent, height / (2 tan(fov_y / 2))): Dobbyn et al.'s rule, a texel covers at most one pixel (texel_m *
-// focal_px); and the view error stays under `error_px` (the model's half width moves by at most radius * angle).
+// focal_px); the view error stays under `error_px` (the model's half width moves by at most radius * angle); and the
+// animation frame's error (frame_error_m, frameError below: a vertex's distance to where the geometry shows it)
+// stays under `error_px`.
 struct SwitchDistances {
   double texel_m = 0.0;
   double view_m = 0.0;
-  double both() const { return std::max(texel_m, view_m); }
+  double frame_m = 0.0;
+  double both() const { return std::max({texel_m, view_m, frame_m}); }
 };
 SwitchDistances switchDistances(const gpu::AtlasLayout& layout, const ViewGrid& grid, double focal_px,
-                                double error_px);
+                                double error_px, double frame_error_m = 0.0);
+
+// Animation frames from the error bound. pose_positions[p]: the model's vertices (agent space, metres) in palette
+// pose p of P (one walk cycle, evenly spaced; the same vertex count each). frameError: the largest distance between
+// a vertex in pose p and in the pose the impostor shows for it (frame round(p * frames / P) mod frames, palette pose
+// frame * P / frames), over every p and vertex; frames must divide P (throws farfield::Error otherwise).
+// framesForBound: the fewest frames among the divisors of P whose frameError is at most max_m (P when none is).
+double frameError(std::span<const std::vector<Vec3>> pose_positions, int frames);
+int framesForBound(std::span<const std::vector<Vec3>> pose_positions, double max_m);
 
 // Views and texel size chosen from the error bound instead of fixed numbers: for impostors drawn from `switch_m`
 // metres on (a camera of `focal_px`), the texel that covers one pixel there (Dobbyn's rule: switch_m / focal_px) and

@@ -4,15 +4,32 @@
 #include <cmath>
 
 #include "farfield/core/error.h"
+#include "farfield/runtime/crowd_shadows.h"
 
 namespace farfield::runtime {
+
+namespace {
+
+double focalOf(const Camera& camera) { return double(camera.height) / (2.0 * std::tan(double(camera.fov_y) / 2.0)); }
+
+// Agent space -> world for an agent at `position` with `heading` (a turn about +z).
+Vec3 turn(float heading, const Vec3& v) {
+  const float c = std::cos(heading), s = std::sin(heading);
+  return Vec3(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
+}
+
+}  // namespace
 
 CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
                            std::span<const CrowdModelOptions> model_options, const CrowdRuntimeOptions& options)
     : options_(options) {
   if (models.size() != model_options.size()) throw Error("crowd runtime", "one option set per model");
-  if (options.frames < 1 || options.palette_poses < options.frames || options.palette_poses % options.frames != 0)
+  if (options.palette_poses < 1 ||
+      (!options.atlas_from_bound && (options.frames < 1 || options.palette_poses % options.frames != 0)))
     throw Error("crowd runtime", "palette poses must be a positive multiple of the impostor frames");
+  if (options.atlas_from_bound && (!(options.bound_switch_m > 0.0) || !(options.bound_focal_px > 0.0)))
+    throw Error("crowd runtime", "the bound's switch distance and focal length must be positive");
+  if (!options.region_tints.empty()) renderer_.setRegionTints(options.region_tints);
   for (size_t m = 0; m < models.size(); ++m) {
     const scene::SkinnedModel& sm = models[m];
     const int a = sm.findAnimation(model_options[m].animation);
@@ -24,35 +41,58 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
     for (int p = 0; p < options.palette_poses; ++p)
       poses.push_back(scene::jointMatrices(sm, &anim, anim.start + anim.duration * float(p) / float(options.palette_poses)));
     // Agent space: the front turned to +x, scaled to the height, feet on z = 0, centred on the vertical axis.
-    const Mat4 turn = glm::rotate(Mat4(1.0f), float(degToRad(model_options[m].facing_deg)), Vec3(0, 0, 1));
+    const Mat4 facing = glm::rotate(Mat4(1.0f), float(degToRad(model_options[m].facing_deg)), Vec3(0, 0, 1));
     Box3 raw;
     for (int p = 0; p < options.palette_poses; p += std::max(1, options.palette_poses / 8))
-      for (const Vec3& v : scene::skinMesh(sm, poses[size_t(p)]).positions) raw.expand(Vec3(turn * Vec4(v, 1.0f)));
+      for (const Vec3& v : scene::skinMesh(sm, poses[size_t(p)]).positions) raw.expand(Vec3(facing * Vec4(v, 1.0f)));
     const float height = raw.hi.z - raw.lo.z;
     if (!(height > 0.0f)) throw Error(sm.name, "the animated model has no height");
     const float s = model_options[m].height_m / height;
     const Vec3 c = raw.center();
-    const Mat4 to_agent = glm::scale(Mat4(1.0f), Vec3(s)) * glm::translate(Mat4(1.0f), Vec3(-c.x, -c.y, -raw.lo.z)) * turn;
+    const Mat4 to_agent = glm::scale(Mat4(1.0f), Vec3(s)) * glm::translate(Mat4(1.0f), Vec3(-c.x, -c.y, -raw.lo.z)) * facing;
     model.gpu = std::make_unique<gpu::SkinnedGpuModel>(sm, to_agent, poses);
     Box3 agent_bounds;
-    for (const auto& pose : poses)
-      for (const Vec3& v : scene::skinMesh(sm, pose).positions) agent_bounds.expand(Vec3(to_agent * Vec4(v, 1.0f)));
+    std::vector<std::vector<Vec3>> pose_positions(poses.size());
+    for (size_t p = 0; p < poses.size(); ++p)
+      for (const Vec3& v : scene::skinMesh(sm, poses[p]).positions) {
+        pose_positions[p].push_back(Vec3(to_agent * Vec4(v, 1.0f)));
+        agent_bounds.expand(pose_positions[p].back());
+      }
     model.centre = agent_bounds.center();
     model.radius = glm::length(agent_bounds.hi - model.centre);
-    const gpu::AtlasLayout layout = impostor::atlasLayout(agent_bounds, options.grid, options.frames, options.texel_m);
+    CrowdAtlasChoice& choice = model.choice;
+    if (options.atlas_from_bound) {
+      const Vec3 half = agent_bounds.hi - model.centre;
+      const impostor::BoundChoice bc = impostor::chooseForBound(options.error_px, options.bound_focal_px,
+                                                                options.bound_switch_m, std::hypot(half.x, half.y));
+      choice.grid = bc.grid;
+      choice.texel_m = bc.texel_m;
+      choice.frames = impostor::framesForBound(pose_positions,
+                                               options.error_px * options.bound_switch_m / options.bound_focal_px);
+      choice.from_bound = true;
+    } else {
+      choice.grid = options.grid;
+      choice.texel_m = options.texel_m;
+      choice.frames = options.frames;
+    }
+    choice.frame_error_m = impostor::frameError(pose_positions, choice.frames);
+    const gpu::AtlasLayout layout = impostor::atlasLayout(agent_bounds, choice.grid, choice.frames, choice.texel_m);
     model.impostor = std::make_unique<impostor::MultiViewImpostor>(
-        impostor::bakeMultiView(renderer_, *model.gpu, layout, options.grid));
+        impostor::bakeMultiView(renderer_, *model.gpu, layout, choice.grid));
     models_.push_back(std::move(model));
   }
-  geometry_.resize(models_.size());
-  impostors_.resize(models_.size());
+  for (Lists* l : {&lists_, &caster_lists_}) {
+    l->geometry.resize(models_.size());
+    l->impostors.resize(models_.size());
+  }
 }
 
 CrowdRuntime::~CrowdRuntime() = default;
 
 impostor::SwitchDistances CrowdRuntime::switchDistances(size_t m, const Camera& camera) const {
-  const double focal = double(camera.height) / (2.0 * std::tan(double(camera.fov_y) / 2.0));
-  return impostor::switchDistances(models_[m].impostor->layout, options_.grid, focal, options_.error_px);
+  const Model& model = models_[m];
+  return impostor::switchDistances(model.impostor->layout, model.choice.grid, focalOf(camera), options_.error_px,
+                                   model.choice.frame_error_m);
 }
 
 double CrowdRuntime::bakeSeconds() const {
@@ -67,24 +107,34 @@ size_t CrowdRuntime::atlasBytes() const {
   return b;
 }
 
-CrowdFrameStats CrowdRuntime::draw(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
-                                   const gpu::LightSettings& light) {
-  CrowdFrameStats stats;
+Vec3 CrowdRuntime::agentCentre(const CrowdAgentState& a) const {
+  if (a.model >= models_.size()) throw Error("crowd runtime", "agent of model " + std::to_string(a.model) + " out of range");
+  return a.position + turn(a.heading, models_[a.model].centre);
+}
+
+gpu::CrowdAgentGpu CrowdRuntime::record(const CrowdAgentState& a) const {
+  gpu::CrowdAgentGpu g;
+  g.pos_heading = Vec4(a.position, a.heading);
+  g.tint = a.tint;
+  g.object_id = a.object_id;
+  g.outfit = a.outfit;
+  return g;
+}
+
+void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
+                            CrowdFrameStats& stats) {
   Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
   for (Vec4& p : frustum.planes) p /= std::max(glm::length(Vec3(p)), 1e-20f);
   std::vector<double> switch_m(models_.size());
   for (size_t m = 0; m < models_.size(); ++m) {
-    geometry_[m].clear();
-    impostors_[m].clear();
+    lists_.geometry[m].clear();
+    lists_.impostors[m].clear();
     switch_m[m] = switchDistances(m, camera).both();
   }
-  const int frames = options_.frames;
+  const int poses = options_.palette_poses;
   for (const CrowdAgentState& a : agents) {
-    if (a.model >= models_.size()) throw Error("crowd runtime", "agent of model " + std::to_string(a.model) + " out of range");
+    const Vec3 centre = agentCentre(a);
     const Model& model = models_[a.model];
-    const float c = std::cos(a.heading), s = std::sin(a.heading);
-    const Vec3 centre = a.position + Vec3(c * model.centre.x - s * model.centre.y, s * model.centre.x + c * model.centre.y,
-                                          model.centre.z);
     bool visible = true;
     for (const Vec4& p : frustum.planes)
       if (glm::dot(Vec3(p), centre) + p.w < -model.radius) {
@@ -93,36 +143,104 @@ CrowdFrameStats CrowdRuntime::draw(const Camera& camera, std::span<const CrowdAg
       }
     if (!visible) continue;
     ++stats.in_view;
-    float phase = a.phase - std::floor(a.phase);
-    gpu::CrowdAgentGpu g;
-    g.pos_heading = Vec4(a.position, a.heading);
-    g.tint = a.tint;
-    g.object_id = a.object_id;
+    const float phase = a.phase - std::floor(a.phase);
+    gpu::CrowdAgentGpu g = record(a);
     const Vec3 to_eye = camera.eye - centre;
     const bool impostor = policy == CrowdPolicy::Impostor ||
                           (policy == CrowdPolicy::Mixed && double(glm::length(to_eye)) >= switch_m[a.model]);
     if (!impostor) {
-      g.index = uint32_t(std::lround(phase * float(options_.palette_poses))) % uint32_t(options_.palette_poses);
-      geometry_[a.model].push_back(g);
+      g.index = uint32_t(std::lround(phase * float(poses))) % uint32_t(poses);
+      lists_.geometry[a.model].push_back(g);
       continue;
     }
+    const int frames = model.choice.frames;
     g.index = uint32_t(std::lround(phase * float(frames))) % uint32_t(frames);
-    // The view direction in agent space: the eye turned back by the heading.
-    const Vec3 local(c * to_eye.x + s * to_eye.y, -s * to_eye.x + c * to_eye.y, to_eye.z);
+    const Vec3 local = turn(-a.heading, to_eye);  // the eye in agent space
     g.view = uint32_t(impostor::nearestView(model.impostor->grid, glm::length(local) > 0.0f ? local : Vec3(1, 0, 0)));
-    impostors_[a.model].push_back(g);
+    lists_.impostors[a.model].push_back(g);
   }
+}
+
+CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats) {
   for (size_t m = 0; m < models_.size(); ++m) {
-    stats.geometry += geometry_[m].size();
-    stats.impostors += impostors_[m].size();
+    stats.geometry += lists_.geometry[m].size();
+    stats.impostors += lists_.impostors[m].size();
     auto add = [&](const gpu::FrameStats& f) {
       stats.draw.triangles += f.triangles;
       stats.draw.draw_calls += f.draw_calls;
       stats.draw.objects += f.objects;
     };
-    add(renderer_.drawSkinned(camera, *models_[m].gpu, geometry_[m], light));
-    add(renderer_.drawImpostors(camera, *models_[m].impostor->atlas, impostors_[m], light));
+    add(renderer_.drawSkinned(camera, *models_[m].gpu, lists_.geometry[m], light));
+    add(renderer_.drawImpostors(camera, *models_[m].impostor->atlas, lists_.impostors[m], light));
   }
+  return stats;
+}
+
+CrowdFrameStats CrowdRuntime::draw(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
+                                   const gpu::LightSettings& light) {
+  CrowdFrameStats stats;
+  classify(camera, agents, policy, stats);
+  return drawLists(camera, light, stats);
+}
+
+void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
+                               const gpu::LightSettings& light, const CrowdShadowOptions& shadows,
+                               CrowdFrameStats& stats) {
+  std::vector<CasterSphere> spheres(agents.size());
+  for (size_t i = 0; i < agents.size(); ++i) spheres[i] = {agentCentre(agents[i]), models_[agents[i].model].radius};
+  const ShadowFit fit = fitShadow(camera, light.direction, spheres, shadows.distance_m, shadows.map_size);
+  if (!shadow_map_ || shadow_map_->size() != shadows.map_size)
+    shadow_map_ = std::make_unique<gpu::ShadowMap>(shadows.map_size);
+  shadow_map_->bindForCasters();  // cleared: no caster
+  shadow_projection_ = fit.projection;
+  stats.shadow_texel_m = fit.projection.texel_m;
+  if (fit.casters.empty()) return;
+  const Vec3 to_light = -glm::normalize(light.direction);
+  std::vector<double> switch_m(models_.size());
+  for (size_t m = 0; m < models_.size(); ++m) {
+    caster_lists_.geometry[m].clear();
+    caster_lists_.impostors[m].clear();
+    switch_m[m] = switchDistances(m, camera).both();
+  }
+  // Each caster in the representation the camera's policy gives it; impostors show their view towards the light.
+  for (uint32_t i : fit.casters) {
+    const CrowdAgentState& a = agents[i];
+    const Model& model = models_[a.model];
+    const float phase = a.phase - std::floor(a.phase);
+    gpu::CrowdAgentGpu g = record(a);
+    const bool impostor =
+        policy == CrowdPolicy::Impostor ||
+        (policy == CrowdPolicy::Mixed && double(glm::length(camera.eye - spheres[i].centre)) >= switch_m[a.model]);
+    if (!impostor) {
+      g.index = uint32_t(std::lround(phase * float(options_.palette_poses))) % uint32_t(options_.palette_poses);
+      caster_lists_.geometry[a.model].push_back(g);
+    } else {
+      g.index = uint32_t(std::lround(phase * float(model.choice.frames))) % uint32_t(model.choice.frames);
+      g.view = uint32_t(impostor::nearestView(model.impostor->grid, turn(-a.heading, to_light)));
+      caster_lists_.impostors[a.model].push_back(g);
+    }
+  }
+  for (size_t m = 0; m < models_.size(); ++m) {
+    renderer_.drawSkinnedDepth(fit.projection.view_proj, *models_[m].gpu, caster_lists_.geometry[m]);
+    renderer_.drawImpostorDepth(fit.projection.view_proj, to_light, *models_[m].impostor->atlas,
+                                caster_lists_.impostors[m]);
+  }
+  stats.shadow_casters = fit.casters.size();
+}
+
+CrowdFrameStats CrowdRuntime::drawShadowed(const Camera& camera, std::span<const CrowdAgentState> agents,
+                                           CrowdPolicy policy, const gpu::LightSettings& light,
+                                           const gpu::RenderTarget& target, const CrowdShadowOptions& shadows) {
+  CrowdFrameStats stats;
+  castShadows(camera, agents, policy, light, shadows, stats);
+  classify(camera, agents, policy, stats);
+  target.bindForOpaquePass();
+  stats = drawLists(camera, light, stats);
+  if (stats.shadow_casters > 0) {
+    if (!receiver_) receiver_ = std::make_unique<gpu::ShadowReceiver>();
+    receiver_->apply(camera, *shadow_map_, shadow_projection_, target, light, shadows.agent_id_mask, shadows.bias_m);
+  }
+  target.bindForOpaquePass();
   return stats;
 }
 

@@ -1,7 +1,9 @@
 // Crowd runtime: per frame, each agent in view is drawn as skinned instanced geometry or as a multi-view impostor
 // (Tecchia, Loscos and Chrysanthou; Steed's lecture part 3), chosen by the impostor's promises: geometry where a
 // texel of the atlas would cover more than a pixel (Dobbyn et al.'s switch) or where the view quantisation error
-// would exceed the error bound; the nearest view and animation frame per agent otherwise.
+// would exceed the error bound; the nearest view and animation frame per agent otherwise. Agents are tinted per
+// colour region by their outfit, identically in both representations, and may cast shadows onto the city and the
+// ground through one shadow map (drawShadowed).
 #pragma once
 
 #include <memory>
@@ -11,10 +13,15 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/gpu/crowd_renderer.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/shadow_map.h"
 #include "farfield/impostor/multi_view.h"
 #include "farfield/scene/skin.h"
 
 namespace farfield::runtime {
+
+// Object-id bit of agents: pixels with it set do not receive the crowd's shadows (CrowdShadowOptions).
+inline constexpr uint32_t kAgentIdBit = 0x80000000u;
 
 // What the caller (a crowd simulation, eval's generated crowd) gives per agent and frame.
 struct CrowdAgentState {
@@ -23,6 +30,7 @@ struct CrowdAgentState {
   float heading = 0.0f;  // radians about +z, facing
   float phase = 0.0f;    // animation phase in [0, 1)
   Vec4 tint{1.0f};
+  uint32_t outfit = 0;     // row of CrowdRuntimeOptions::region_tints (mod the outfit count)
   uint32_t object_id = 0;  // for the id buffer
 };
 
@@ -36,10 +44,37 @@ enum class CrowdPolicy { Geometry, Impostor, Mixed };
 
 struct CrowdRuntimeOptions {
   int palette_poses = 64;  // skinned poses per animation cycle (geometry)
-  int frames = 16;         // impostor frames per cycle (divides palette_poses)
-  impostor::ViewGrid grid;  // 32 x 8 as in the lecture
-  float texel_m = 0.03f;   // atlas texel size, metres
-  double error_px = 2.0;   // bound on the view quantisation error (pixels) for Mixed
+  // The atlas, fixed: frames per cycle (divides palette_poses), views (32 x 8 as in the lecture), texel (metres).
+  int frames = 16;
+  impostor::ViewGrid grid;
+  float texel_m = 0.03f;
+  double error_px = 2.0;  // the error bound (pixels): Mixed's switch (view, texel and frame errors)
+  // Or chosen per model from the error bound (atlas_from_bound; frames, grid and texel_m above are then not used):
+  // for impostors from bound_switch_m metres on at a camera of bound_focal_px (pixels per unit tangent), the texel
+  // and views of impostor::chooseForBound and the fewest frames dividing palette_poses whose frame error
+  // (impostor::framesForBound) stays under error_px there.
+  bool atlas_from_bound = false;
+  double bound_switch_m = 20.0;
+  double bound_focal_px = 443.4;  // 512 px at 60 degrees
+  // Colour-region tints: outfit o, region r at o * scene::kColorRegions + r; empty = one outfit of white.
+  std::vector<Vec4> region_tints;
+};
+
+// The crowd's shadows (drawShadowed).
+struct CrowdShadowOptions {
+  int map_size = 2048;         // texels per side
+  float distance_m = 120.0f;   // receivers up to this far along the view
+  float bias_m = 0.03f;        // depth bias, metres along the light
+  uint32_t agent_id_mask = kAgentIdBit;  // pixels whose id has these bits receive no shadow
+};
+
+// What the atlas of a model holds and why (CrowdRuntimeOptions).
+struct CrowdAtlasChoice {
+  impostor::ViewGrid grid;
+  int frames = 0;
+  float texel_m = 0.0f;
+  double frame_error_m = 0.0;  // impostor::frameError of the frames
+  bool from_bound = false;
 };
 
 // Agents drawn in a frame, by representation.
@@ -47,6 +82,8 @@ struct CrowdFrameStats {
   size_t in_view = 0;
   size_t geometry = 0;
   size_t impostors = 0;
+  size_t shadow_casters = 0;  // drawShadowed: agents drawn into the shadow map
+  float shadow_texel_m = 0.0f;
   gpu::FrameStats draw;
 };
 
@@ -62,6 +99,13 @@ class CrowdRuntime {
   // spheres) and the policy: Geometry = all skinned, Impostor = all impostors, Mixed = the switch above.
   CrowdFrameStats draw(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                        const gpu::LightSettings& light);
+  // As draw, into `target` (already holding the city; left bound for an opaque pass), with the agents' shadows:
+  // every agent whose shadow may fall on what the camera sees within shadows.distance_m casts into one shadow map
+  // from the light, in the representation the policy gives it (impostors show their view towards the light), and
+  // the target's receivers are darkened (gpu::ShadowReceiver).
+  CrowdFrameStats drawShadowed(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
+                               const gpu::LightSettings& light, const gpu::RenderTarget& target,
+                               const CrowdShadowOptions& shadows = {});
 
   // Waits for the GPU (frame timings).
   void finish() const { renderer_.finish(); }
@@ -69,6 +113,8 @@ class CrowdRuntime {
   impostor::SwitchDistances switchDistances(size_t m, const Camera& camera) const;
   size_t modelCount() const { return models_.size(); }
   const impostor::MultiViewImpostor& impostor(size_t m) const { return *models_[m].impostor; }
+  const CrowdAtlasChoice& atlasChoice(size_t m) const { return models_[m].choice; }
+  const gpu::SkinnedGpuModel& gpuModel(size_t m) const { return *models_[m].gpu; }
   double bakeSeconds() const;
   size_t atlasBytes() const;
   float cycleSeconds(size_t m) const { return models_[m].cycle_s; }
@@ -81,11 +127,27 @@ class CrowdRuntime {
     Vec3 centre{0.0f};  // agent space
     float radius = 1.0f;
     float cycle_s = 1.0f;
+    CrowdAtlasChoice choice;
   };
+  // Agents' GPU records by model and representation (culled with the camera's frustum unless null).
+  struct Lists {
+    std::vector<std::vector<gpu::CrowdAgentGpu>> geometry, impostors;  // per model
+  };
+  void classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
+                CrowdFrameStats& stats);
+  CrowdFrameStats drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats);
+  void castShadows(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
+                   const gpu::LightSettings& light, const CrowdShadowOptions& shadows, CrowdFrameStats& stats);
+  gpu::CrowdAgentGpu record(const CrowdAgentState& a) const;
+  Vec3 agentCentre(const CrowdAgentState& a) const;
+
   CrowdRuntimeOptions options_;
   gpu::CrowdRenderer renderer_;
   std::vector<Model> models_;
-  std::vector<std::vector<gpu::CrowdAgentGpu>> geometry_, impostors_;  // per model, reused per frame
+  Lists lists_, caster_lists_;  // reused per frame
+  std::unique_ptr<gpu::ShadowMap> shadow_map_;
+  std::unique_ptr<gpu::ShadowReceiver> receiver_;
+  gpu::ShadowProjection shadow_projection_;
 };
 
 }  // namespace farfield::runtime

@@ -13,6 +13,7 @@
 #include "farfield/core/log.h"
 #include "farfield/scene/gltf_accessor.h"
 #include "farfield/scene/import.h"
+#include "farfield/scene/skin_regions.h"
 
 namespace farfield::scene {
 
@@ -55,13 +56,17 @@ class SkinReader {
     readSkin(model_.skins[size_t(node.skin)], out.skeleton);
     const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
     int material = -1;
-    for (size_t p = 0; p < mesh.primitives.size(); ++p)
+    std::vector<uint32_t> primitive_of_triangle;
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
       if (readPrimitive(mesh.primitives[p], "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p),
                         out) &&
           material < 0)
         material = mesh.primitives[p].material;
+      primitive_of_triangle.resize(out.mesh.triangleCount(), uint32_t(p));
+    }
     if (out.mesh.indices.empty()) fail("the skinned mesh has no triangles");
     readMaterial(material, out);
+    out.regions = colorRegions(out, primitive_of_triangle);
     for (size_t a = 0; a < model_.animations.size(); ++a) readAnimation(model_.animations[a], a, out);
     validateSkinnedModel(out);
     out.mesh.computeBounds();

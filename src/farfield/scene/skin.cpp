@@ -125,6 +125,13 @@ void validateSkinnedModel(const SkinnedModel& model) {
     if (std::abs(sum - 1.0f) > 1e-3f)
       throw Error(src, "skin: vertex " + std::to_string(v) + ": weights sum to " + std::to_string(sum));
   }
+  if (!model.regions.empty() && model.regions.size() != model.mesh.triangleCount())
+    throw Error(src, "skin: " + std::to_string(model.regions.size()) + " colour regions for " +
+                         std::to_string(model.mesh.triangleCount()) + " triangles");
+  for (size_t t = 0; t < model.regions.size(); ++t)
+    if (model.regions[t] >= kColorRegions)
+      throw Error(src, "skin: triangle " + std::to_string(t) + ": colour region " + std::to_string(model.regions[t]) +
+                           " out of range (" + std::to_string(kColorRegions) + " regions)");
   for (const Animation& a : model.animations)
     for (const AnimationChannel& c : a.channels)
       if (c.node >= sk.nodes.size() || c.times.empty() || c.times.size() != c.values.size())

@@ -32,6 +32,9 @@ struct Skeleton {
   Mat4 root{1.0f};
 };
 
+// Colour regions per model (Steed's lecture part 3: "16 independent regions"), each tinted per agent.
+inline constexpr int kColorRegions = 16;
+
 struct SkinnedModel {
   std::string name;  // the file, for messages
   Mesh mesh;         // bind-pose vertices (the mesh's space as the file gives it), normals, uvs
@@ -41,6 +44,8 @@ struct SkinnedModel {
   std::vector<Animation> animations;
   std::shared_ptr<const image::ColorImage> texture;  // base colour texture; may be null
   Vec4 base_color{1.0f};
+  // Per triangle: its colour region (< kColorRegions, scene/skin_regions.h); empty = every triangle in region 0.
+  std::vector<uint8_t> regions;
 
   // Index of the animation named `name` (case-insensitive substring, e.g. "walk"), else 0; -1 without animations.
   int findAnimation(const std::string& name) const;
@@ -60,7 +65,8 @@ Box3 animatedBounds(const SkinnedModel& model, const Animation* animation, int s
 
 // Throws farfield::Error naming model.name when the model cannot be skinned: per-vertex arrays of the wrong size,
 // a joint index out of range, non-finite or negative weights, weights summing to 0, a skeleton whose joints or
-// parents are out of range or not ordered parents first, non-finite inverse bind matrices.
+// parents are out of range or not ordered parents first, non-finite inverse bind matrices, colour regions not one
+// per triangle or out of range.
 void validateSkinnedModel(const SkinnedModel& model);
 
 }  // namespace farfield::scene

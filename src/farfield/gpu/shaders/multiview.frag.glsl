@@ -1,41 +1,64 @@
 #version 450 core
-// Farfield multi-view impostor fragment: the atlas cell's albedo (alpha < 0.5 cut out) times the agent's tint, lit
-// from the baked normal turned by the agent's heading (as crowd.frag.glsl lights the geometry); the depth moved
-// from the quad along the view by the baked depth, so agents intersect the scene and each other per texel.
+// Farfield multi-view impostor fragment: the atlas cell's albedo times the agent's tint and the tint of the texel's
+// colour region in the agent's outfit (as crowd.frag.glsl tints the geometry), lit from the baked normal turned by
+// the agent's heading; the depth moved from the quad along the view by the baked depth, so agents intersect the
+// scene and each other per texel. Coverage and region come from the albedo's alpha (crowd.frag.glsl's FF_CAPTURE
+// code): the four texels around the sample, a texel covered when its alpha is at least 8/255; the fragment is kept
+// where the bilinear weight of covered texels reaches 0.5 (the silhouette of a bilinear 0/1 mask), its region is
+// that of the covered texel of largest weight, and its colour, normal and depth the bilinear ones of the covered texels alone.
+// FF_DEPTH_ONLY (shadow casters): coverage and depth alone.
 
 in vec2 v_cell_uv;
 in vec3 v_world;
 flat in vec3 v_to_eye;
 flat in vec4 v_tint;
-flat in uvec3 v_data;
+flat in uvec4 v_data;
 flat in float v_heading;
-
-layout(location = 0) out vec4 o_color;
-layout(location = 1) out uint o_id;
 
 layout(binding = 0) uniform sampler2DArray u_albedo;
 layout(binding = 1) uniform sampler2DArray u_normal_depth;
 uniform ivec2 u_grid;  // azimuths, elevations
 uniform float u_radius;
 uniform mat4 u_view_proj;
+#ifndef FF_DEPTH_ONLY
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out uint o_id;
 uniform vec3 u_light_dir;
 uniform vec3 u_light_color;
 uniform float u_ambient;
+layout(std430, binding = 2) readonly buffer Tints { vec4 tints[]; };
+uniform uint u_outfits;
+#endif
 
 void main() {
   const int view = int(v_data.y);
   const vec2 cell = vec2(float(view % u_grid.x), float(view / u_grid.x));
   const vec3 uvw = vec3((cell + v_cell_uv) / vec2(u_grid), float(v_data.x));
-  const vec4 albedo = texture(u_albedo, uvw) * v_tint;
-  if (albedo.a < 0.5) discard;
-  const vec4 nd = texture(u_normal_depth, uvw);
+  // textureGather order: (u0, v1), (u1, v1), (u1, v0), (u0, v0) around the sample.
+  const vec2 f = fract(uvw.xy * vec2(textureSize(u_albedo, 0).xy) - 0.5);
+  const vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+  const uvec4 alpha = uvec4(round(textureGather(u_albedo, uvw, 3) * 255.0));
+  const vec4 covered = vec4(greaterThanEqual(alpha, uvec4(8u)));
+  const float coverage = dot(w, covered);
+  if (coverage < 0.5) discard;
+  // Empty texels hold 0.5 (the bake's clear): the covered texels' own bilinear normal and depth.
+  const vec4 nd = (texture(u_normal_depth, uvw) - 0.5 * (1.0 - coverage)) / coverage;
+  const vec3 world = v_world + v_to_eye * ((nd.w * 2.0 - 1.0) * u_radius);
+  const vec4 clip = u_view_proj * vec4(world, 1.0);
+  gl_FragDepth = clip.z / clip.w;
+#ifndef FF_DEPTH_ONLY
+  const vec4 wc = w * covered;
+  int k = 0;
+  for (int i = 1; i < 4; ++i)
+    if (wc[i] > wc[k]) k = i;
+  const uint region = (alpha[k] + 1u) / 16u - 1u;
+  const vec3 rgb = texture(u_albedo, uvw).rgb / coverage;
+  const vec3 albedo = rgb * v_tint.rgb * tints[(v_data.w % u_outfits) * 16u + region].rgb;
   const vec3 nl = nd.xyz * 2.0 - 1.0;
   const float c = cos(v_heading), s = sin(v_heading);
   vec3 n = vec3(c * nl.x - s * nl.y, s * nl.x + c * nl.y, nl.z);
   n = dot(n, n) > 1e-8 ? normalize(n) : v_to_eye;
-  const vec3 world = v_world + v_to_eye * ((nd.w * 2.0 - 1.0) * u_radius);
-  const vec4 clip = u_view_proj * vec4(world, 1.0);
-  gl_FragDepth = clip.z / clip.w;
-  o_color = vec4(albedo.rgb * (vec3(u_ambient) + u_light_color * max(dot(n, -u_light_dir), 0.0)), 1.0);
+  o_color = vec4(albedo * (vec3(u_ambient) + u_light_color * max(dot(n, -u_light_dir), 0.0)), 1.0);
   o_id = v_data.z;
+#endif
 }

@@ -1,7 +1,8 @@
 #version 450 core
 // Farfield instanced skinning: one draw per model draws every agent of it. Joint matrices of a palette of sampled
 // poses (binding 0, pose p's joint j at p * u_joint_count + j); per agent (binding 1): position and heading (radians
-// about +z), a colour tint, its pose and object id. world = agent(heading, position) * u_model_to_agent * skin * p.
+// about +z), a colour tint, its pose, object id and outfit (a row of the colour-region tints crowd.frag.glsl reads).
+// world = agent(heading, position) * u_model_to_agent * skin * p.
 
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
@@ -12,7 +13,7 @@ layout(location = 4) in vec4 a_weights;
 struct Agent {
   vec4 pos_heading;
   vec4 tint;
-  uvec4 data;  // x: pose (palette index), y: unused here, z: object id
+  uvec4 data;  // x: pose (palette index), y: unused here, z: object id, w: outfit
 };
 layout(std430, binding = 0) readonly buffer Palette { mat4 palette[]; };
 layout(std430, binding = 1) readonly buffer Agents { Agent agents[]; };
@@ -27,6 +28,7 @@ out vec3 v_normal;
 out vec2 v_uv;
 flat out vec4 v_tint;
 flat out uint v_id;
+flat out uint v_outfit;
 
 void main() {
   const Agent a = agents[u_first_instance + uint(gl_InstanceID)];
@@ -41,5 +43,6 @@ void main() {
   v_uv = a_uv;
   v_tint = a.tint;
   v_id = a.data.z;
+  v_outfit = a.data.w;
   gl_Position = u_view_proj * vec4(v_world, 1.0);
 }

@@ -1,0 +1,34 @@
+// Where the crowd's shadow map looks (Steed's lecture part 3, "Impostors & shadowmaps"; gpu/shadow_map.h): an
+// orthographic box along the scene's light, fitted per frame to the receivers the camera sees nearby and to the
+// agents that shadow them. Pure geometry, no GL.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/shadow_map.h"
+
+namespace farfield::runtime {
+
+struct CasterSphere {
+  Vec3 centre{0.0f};
+  float radius = 0.0f;
+};
+
+struct ShadowFit {
+  gpu::ShadowProjection projection;
+  std::vector<uint32_t> casters;  // indices of the spheres inside the box, increasing
+};
+
+// Receivers: what `camera` sees up to `distance_m` along its view (the frustum cut there). Light space: x, y across
+// the light, z along `light_dir` (the direction the light travels). Casters: the spheres whose light-space footprint
+// (a disc of their radius: an orthographic shadow never leaves it) overlaps the receivers' light-space bounds. The
+// map covers the union of the casters' footprints clipped to those bounds (square texels, map_size per side) and the
+// casters' depth range. No caster: an empty list (the projection is then unused). Throws farfield::Error for a
+// zero light direction, a non-positive distance or a map under 16 texels.
+ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const CasterSphere> spheres,
+                    float distance_m, int map_size);
+
+}  // namespace farfield::runtime
