@@ -125,3 +125,66 @@ TEST_F(CrowdRuntimeGl, ImpostorCoversTheGeometryAtAnyHeading) {
 
 }  // namespace
 }  // namespace farfield::runtime
+
+namespace farfield::runtime {
+namespace {
+
+// With the atlas chosen from the bound, the bake uses the bound's views, texel and frames, and at the bound's
+// camera every impostor promise (texel, view, frame) holds from the bound's distance on: the switch is no farther.
+TEST_F(CrowdRuntimeGl, AtlasFromTheBoundIsWhatTheBakeUsesAndKeepsTheBound) {
+  const scene::SkinnedModel fox =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  CrowdRuntimeOptions o;
+  o.palette_poses = 16;
+  o.atlas_from_bound = true;
+  o.error_px = 2.0;
+  o.bound_switch_m = 12.0;
+  o.bound_focal_px = 128.0 / (2.0 * std::tan(double(Camera{}.fov_y) / 2.0));
+  o.frames = 5;  // not a divisor of 16: unused with the bound
+  CrowdModelOptions mo;
+  mo.height_m = 0.8f;
+  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), o);
+  const CrowdAtlasChoice& c = rt.atlasChoice(0);
+  ASSERT_TRUE(c.from_bound);
+  const gpu::AtlasLayout& l = rt.impostor(0).layout;
+  EXPECT_EQ(l.azimuths, c.grid.azimuths);
+  EXPECT_EQ(l.elevations, c.grid.elevations);
+  EXPECT_EQ(l.frames, c.frames);
+  EXPECT_EQ(16 % c.frames, 0);
+  EXPECT_NEAR(c.texel_m, 12.0 / o.bound_focal_px, 1e-6);
+  EXPECT_EQ(l.cell_height, int(std::ceil(2.0f * l.half_size.y / c.texel_m)));
+  // The frame error, recomputed from CPU skinning of the palette in agent space, against the bound: the chosen
+  // frame count keeps it, the next smaller divisor of 16 does not (when there is one).
+  const int a = fox.findAnimation("walk");
+  const scene::Animation& anim = fox.animations[size_t(a)];
+  std::vector<std::vector<Vec3>> positions(16);
+  for (int p = 0; p < 16; ++p)
+    for (const Vec3& v :
+         scene::skinMesh(fox, scene::jointMatrices(fox, &anim, anim.start + anim.duration * float(p) / 16.0f)).positions)
+      positions[size_t(p)].push_back(Vec3(rt.gpuModel(0).modelToAgent() * Vec4(v, 1.0f)));
+  auto worst = [&](int frames) {
+    double w = 0.0;
+    for (int p = 0; p < 16; ++p) {
+      const int q = (int(std::lround(double(p) * frames / 16.0)) % frames) * (16 / frames);
+      for (size_t v = 0; v < positions[0].size(); ++v)
+        w = std::max(w, double(glm::length(positions[size_t(p)][v] - positions[size_t(q)][v])));
+    }
+    return w;
+  };
+  const double max_m = o.error_px * o.bound_switch_m / o.bound_focal_px;
+  EXPECT_NEAR(c.frame_error_m, worst(c.frames), 1e-5);
+  EXPECT_LE(worst(c.frames), max_m);
+  if (c.frames > 1) {
+    EXPECT_GT(worst(c.frames / 2), max_m);
+  }
+  Camera camera;
+  camera.width = camera.height = 128;
+  const impostor::SwitchDistances sw = rt.switchDistances(0, camera);
+  EXPECT_LE(sw.texel_m, 12.0 + 1e-6);  // cells rounded up to whole texels: a little finer
+  EXPECT_GT(sw.texel_m, 10.0);
+  EXPECT_LE(sw.view_m, 12.0 + 1e-6);
+  EXPECT_LE(sw.frame_m, 12.0 + 1e-6);
+}
+
+}  // namespace
+}  // namespace farfield::runtime
