@@ -56,6 +56,7 @@ void runCity(const CityArgs& args) {
   Stopwatch clock;
   const gen::City city = gen::generateCity(options);
   const double generate_s = clock.seconds();
+  const double generate_peak_mib = peakMemoryMiB();
   const scene::SceneStats s = city.scene.stats();
 
   clock.restart();
@@ -83,7 +84,7 @@ void runCity(const CityArgs& args) {
     std::printf("bounds:     [%.1f, %.1f, %.1f] .. [%.1f, %.1f, %.1f] m\n", s.bounds.lo.x, s.bounds.lo.y, s.bounds.lo.z,
                 s.bounds.hi.x, s.bounds.hi.y, s.bounds.hi.z);
   std::printf("time:       %.2f s generation, %.2f s writing\n", generate_s, write_s);
-  std::printf("memory:     %.0f MiB peak resident\n", peakMemoryMiB());
+  std::printf("memory:     %.0f MiB peak resident (%.0f MiB after generation)\n", peakMemoryMiB(), generate_peak_mib);
   std::printf("wrote:      %s\n            %s\n", args.output.c_str(), streets.c_str());
 }
 
@@ -106,8 +107,8 @@ const RegisterCommand reg("gen", [](CLI::App& app) {
 
   auto city = std::make_shared<CityArgs>();
   auto* c = cmd->add_subcommand("city", "A procedural city: street graph, blocks of buildings, landmarks.");
-  c->add_option("--blocks", city->blocks, "Number of blocks (street graph faces), 10..50000")
-      ->check(CLI::Range(10, 50000));
+  c->add_option("--blocks", city->blocks, "Number of blocks (street graph faces), 10..200000")
+      ->check(CLI::Range(10, 200000));
   c->add_option("--seed", city->seed, "Random seed (the same seed gives the same city)");
   c->add_option("--detail", city->detail, "Facade detail 0..4 (0 plain, 1 ledges, 2 windows, 3 balconies, 4 dense)")
       ->check(CLI::Range(0, 4));

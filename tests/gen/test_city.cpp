@@ -189,7 +189,7 @@ TEST(City, PerBuildingObjectsHoldTheSameTriangles) {
 
 TEST(City, OptionsOutOfRangeThrow) {
   EXPECT_THROW(generateCity(small(9, 1, 1)), Error);
-  EXPECT_THROW(generateCity(small(50001, 1, 1)), Error);
+  EXPECT_THROW(generateCity(small(200001, 1, 1)), Error);
   EXPECT_THROW(generateCity(small(20, 1, -1)), Error);
   EXPECT_THROW(generateCity(small(20, 1, 5)), Error);
   try {

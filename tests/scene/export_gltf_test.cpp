@@ -160,6 +160,71 @@ TEST(GltfBuilder, SubsetsFreeMeshesAndNodes) {
     EXPECT_NEAR(glm::distance(Vec3(o.transform * Vec4(bm.positions[v], 1.0f)), quad.positions[v]), 0.0f, 1e-5f);
 }
 
+// The buffer is streamed from the scene's meshes at write(): every accessor must hold exactly the mesh's data, normals
+// made unit length at write time (computed when a mesh has none), the chunk lengths must add up to the file's size,
+// and a free mesh that is gone before write() must still be written (the builder copies it).
+const unsigned char* accessorBytes(const tinygltf::Model& model, int accessor) {
+  const tinygltf::BufferView& view = model.bufferViews[size_t(model.accessors[size_t(accessor)].bufferView)];
+  return model.buffers[size_t(view.buffer)].data.data() + view.byteOffset;
+}
+
+TEST(GltfBuilder, StreamedBufferHoldsEveryMeshAsGiven) {
+  Scene src;
+  Material plain;
+  plain.name = "plain";
+  const uint32_t material = src.addMaterial(plain);
+  Mesh scaled;  // normals of length 3 and one of length 0
+  scaled.positions = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 1}};
+  scaled.normals = {{0, 0, 3}, {0, 3, 0}, {3, 0, 0}, {0, 0, 0}};
+  scaled.indices = {0, 1, 2, 0, 2, 3};
+  Mesh bare;  // no normals: computed
+  bare.positions = {{5, 0, 0}, {6, 0, 0}, {5, 1, 0}};
+  bare.indices = {0, 1, 2};
+  for (const Mesh* m : {&scaled, &bare}) {
+    Object o;
+    o.name = m == &scaled ? "scaled" : "bare";
+    o.parts = {{src.addMesh(*m), material}};
+    src.addObject(o);
+  }
+  const std::string path = (test::scratchDir("gltf_streamed") / "streamed.glb").string();
+  GltfBuilder builder(path);
+  builder.addObjects(src);
+  {
+    Mesh gone;
+    gone.positions = {{0, 0, 9}, {1, 0, 9}, {0, 1, 9}};
+    gone.indices = {0, 2, 1};
+    builder.addMesh(gone, plain, {}, "gone");
+  }
+  const size_t written = builder.write();
+  EXPECT_EQ(written, std::filesystem::file_size(path));
+
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, path)) << err;
+  ASSERT_EQ(model.buffers.size(), 1u);
+  ASSERT_EQ(model.meshes.size(), 3u);
+  Mesh expected_gone;
+  expected_gone.positions = {{0, 0, 9}, {1, 0, 9}, {0, 1, 9}};
+  expected_gone.indices = {0, 2, 1};
+  const std::vector<std::vector<Vec3>> expected_normals = {
+      {{0, 0, 1}, {0, 1, 0}, {1, 0, 0}, {0, 0, 1}}, {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}}, {{0, 0, -1}, {0, 0, -1}, {0, 0, -1}}};
+  const Mesh* meshes[] = {&src.meshes[0], &src.meshes[1], &expected_gone};
+  for (size_t i = 0; i < 3; ++i) {
+    const tinygltf::Primitive& prim = model.meshes[i].primitives.at(0);
+    const Mesh& m = *meshes[i];
+    const auto* positions = reinterpret_cast<const Vec3*>(accessorBytes(model, prim.attributes.at("POSITION")));
+    const auto* normals = reinterpret_cast<const Vec3*>(accessorBytes(model, prim.attributes.at("NORMAL")));
+    const auto* indices = reinterpret_cast<const uint32_t*>(accessorBytes(model, prim.indices));
+    ASSERT_EQ(model.accessors[size_t(prim.indices)].count, m.indices.size());
+    for (size_t v = 0; v < m.positions.size(); ++v) {
+      EXPECT_EQ(positions[v], m.positions[v]) << "mesh " << i << " vertex " << v;
+      EXPECT_NEAR(glm::distance(normals[v], expected_normals[i][v]), 0.0f, 1e-6f) << "mesh " << i << " vertex " << v;
+    }
+    for (size_t k = 0; k < m.indices.size(); ++k) EXPECT_EQ(indices[k], m.indices[k]) << "mesh " << i;
+  }
+}
+
 TEST(ExportGlb, TruncatedFileGivesError) {
   const auto dir = test::scratchDir("export_glb_truncated");
   const std::string good = (dir / "cube.glb").string();

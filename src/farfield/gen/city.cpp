@@ -24,7 +24,7 @@ namespace farfield::gen {
 namespace {
 
 constexpr int kMinBlocks = 10;
-constexpr int kMaxBlocks = 50000;
+constexpr int kMaxBlocks = 200000;
 constexpr float kGroundMargin = 40.0f;    // the ground reaches this far beyond the outermost streets
 constexpr float kGroundTile = 8.0f;       // metres per asphalt texture repeat
 constexpr float kBaseBelowGround = 1.0f;  // walls reach this far below the lowest ground under a building

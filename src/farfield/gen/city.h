@@ -13,7 +13,7 @@ namespace farfield::gen {
 enum class ObjectGrouping { Blocks, Buildings };  // one object per block (Sillion, Decoret) or per building (Jeschke)
 
 struct CityOptions {
-  int blocks = 100;          // number of blocks (faces of the street graph), 10..50000
+  int blocks = 100;          // number of blocks (faces of the street graph), 10..200000
   uint64_t seed = 1;
   int detail = 1;            // facade detail level 0..4: 0 = plain boxes, higher = windows, ledges, balconies
   bool hill = false;         // a hill in the middle of the city (as Montmartre), so panoramic views open up

@@ -48,14 +48,16 @@ class GltfBuilder {
   // Every object of `scene` as a root node in id order (what exportGlb writes), or only the listed ids (1-based, in
   // the order given). Each node's matrix is worldToGltf() * transform and its extras hold {"farfield": {"name",
   // "footprint", "parent"}}, which importScene reads back. Meshes, materials and textures are written once per
-  // builder however many objects share them, and only when some object written uses them. Throws farfield::Error for
-  // a part naming a missing mesh or material, an id out of range, a bad mesh or an empty texture.
+  // builder however many objects share them, and only when some object written uses them. The builder points into
+  // the scene's meshes (the .glb is streamed from them by write()), so `scene` must stay alive and unchanged until
+  // write(). Throws farfield::Error for a part naming a missing mesh or material, an id out of range, a bad mesh or
+  // an empty texture.
   void addObjects(const Scene& scene);
   void addObjects(const Scene& scene, std::span<const uint32_t> ids);
 
   // A mesh (positions, optional normals (computed when missing) and uvs, triangle indices) with one material of its
   // own, returning its glTF mesh index for addNode, or -1 for a mesh without triangles. The mesh must pass
-  // Mesh::validate. A material texture is written once per image whatever the number of meshes using it.
+  // Mesh::validate; the builder keeps a copy of its data (the mesh may go away before write()). A material texture is written once per image whatever the number of meshes using it.
   int addMesh(const Mesh& mesh, const Material& material, const GltfMaterialOptions& options, const std::string& name);
   // The same with one primitive per part (each with its own material), in one glTF mesh; parts without triangles are
   // left out, -1 when none is left.
@@ -70,7 +72,8 @@ class GltfBuilder {
   // `extras` (a JSON object, or null for none). Returns its index, for children.
   int addNode(const std::string& name, int mesh, int parent, const Mat4& matrix, const nlohmann::json& extras);
 
-  // Serialises the model as .glb to the path given at construction, replacing the file. Throws farfield::Error
+  // Serialises the model as .glb to the path given at construction, replacing the file: the JSON chunk, then the
+  // buffer streamed piece by piece (memory: the JSON and one mesh's normals). Throws farfield::Error
   // naming it when it cannot be written or the data exceed the 4 GiB limit of a .glb. Returns the bytes written.
   size_t write();
 
