@@ -8,7 +8,9 @@
 # rows: other error bounds, halved and doubled CPVs, fewer candidates. tools/place_table.py makes the tables.
 # Usage: scripts/bench_place.sh FARFIELD OUT [SEED] [BLOCKS] [FRAMES] [STRIDE]
 # Environment: TMAXES (default "18 20 22 25 28"), BOUND (px, default 2), REF_TMAX (default 20), BOUNDS (default
-# "1 4"), SIZE (default 512x512), ROWS=0 to skip the extra rows.
+# "1 4"), SIZE (default 512x512), ROWS=0 to skip the extra rows, FALLBACK (default "2,4": place --fallback-bounds;
+# "" for none), MODEL_PROFILE (a profile whose frame model and safety factor replace the fresh calibration's, its
+# layered terms kept: for a machine loaded by other jobs while calibrating, with an earlier quiet calibration).
 set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
 OUT=${2:-out/bench/place}
@@ -27,8 +29,23 @@ PLACE_COMMON=(--profile "$OUT/profile.json" --max-pitch 20 --size "$SIZE" --fov 
 
 [ -f "$OUT/city.glb" ] || "$FARFIELD" gen city --blocks "$BLOCKS" --seed "$SEED" --objects buildings -o "$OUT/city.glb" \
   > "$OUT/gen.txt"
-[ -f "$OUT/profile.json" ] || "$FARFIELD" calibrate "$OUT/city.glb" -o "$OUT/profile.json" --views 500 --size "$SIZE" \
-  --fov 45 --csv "$OUT/calibration.csv" > "$OUT/calibrate.txt"
+# CAL_VIEWS (default 500): validation views of the frame model (8 is enough when MODEL_PROFILE replaces it).
+[ -f "$OUT/calibrated.json" ] || "$FARFIELD" calibrate "$OUT/city.glb" -o "$OUT/calibrated.json" --views "${CAL_VIEWS:-500}" \
+  --size "$SIZE" --fov 45 --csv "$OUT/calibration.csv" > "$OUT/calibrate.txt"
+if [ -n "${MODEL_PROFILE:-}" ]; then
+  python3 - "$OUT/calibrated.json" "$MODEL_PROFILE" "$OUT/profile.json" <<'PY'
+import json, sys
+fresh, quiet = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+for key in ("model", "safety_factor", "validation"):
+    fresh[key] = quiet[key]
+fresh["validation"]["model_from"] = sys.argv[2]
+json.dump(fresh, open(sys.argv[3], "w"), indent=2)
+PY
+else
+  cp "$OUT/calibrated.json" "$OUT/profile.json"
+fi
+FALLBACK=${FALLBACK-2,4}
+[ -n "$FALLBACK" ] && PLACE_COMMON+=(--fallback-bounds "$FALLBACK")
 "$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 2 --fov 45 --seed "$SEED" -o "$OUT/walk.json" \
   > /dev/null
 "$FARFIELD" path street "$OUT/city.streets.json" --frames "$FRAMES" --fps 10 --fov 45 --car --seed "$((SEED + 1))" \

@@ -56,6 +56,20 @@ void runCalibrateCommand(CalibrateArgs& args) {
   std::printf("safety factor:      %.3f (quantile %.3f of measured/predicted); views over prediction x factor: %zu of %zu\n",
               r.profile.safety_factor, o.margin_quantile, r.over_bound, r.checks.size());
   std::printf("views slower than predicted (before the factor): %zu\n", r.under_predicted);
+  if (r.profile.layered.calibrated) {
+    const gpu::LayeredCost& l = r.profile.layered;
+    const eval::LayeredCalibrateResult& lr = r.layered;
+    std::printf("layered draw:       %.3f ms + %.4f ms/layer + %.3f ms/Mpixel of quads (fit r2 %.3f, %zu samples)\n",
+                l.draw.base_ms, l.draw.ms_per_draw, l.draw.ms_per_mpixel, l.draw.r2, l.draw.samples);
+    std::printf("layered capture:    %.3f ms + %.3f ms/Mtri + %.4f ms/layer + %.3f ms/Mtexel (fit r2 %.3f)\n",
+                l.capture.base_ms, l.capture.ms_per_mtriangle, l.capture.ms_per_draw, l.capture.ms_per_mpixel,
+                l.capture.r2);
+    std::printf("layered validation: %zu clusters; draw measured/predicted p50 %.3f p95 %.3f max %.3f (factor %.3f); "
+                "capture p50 %.3f p95 %.3f max %.3f (factor %.3f); %zu plans skipped\n",
+                lr.checks.size(), lr.draw_ratio_p50, lr.draw_ratio_p95, lr.draw_ratio_max, l.draw_safety_factor,
+                lr.capture_ratio_p50, lr.capture_ratio_p95, lr.capture_ratio_max, l.capture_safety_factor,
+                lr.skipped);
+  }
   std::printf("wall:               %.1f s\n", r.wall_s);
   std::printf("profile:            %s\n", args.out.c_str());
   if (!args.csv.empty()) std::printf("csv:                %s\n", args.csv.c_str());
@@ -81,6 +95,11 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
   cmd->add_option("--margin-quantile", args->options.margin_quantile,
                   "Safety factor = this quantile of measured/predicted (1 = the maximum)")->capture_default_str();
   cmd->add_option("--csv", args->csv, "Per-view predicted and measured times");
+  cmd->add_option("--layered-samples", args->options.layered_samples,
+                  "Layered impostors the draw and capture terms are fitted on (as many validate them; 0: none)")
+      ->capture_default_str();
+  cmd->add_option("--layered-error-px", args->options.layered_error_px,
+                  "Error bound of the layered impostors calibrated on, pixels")->capture_default_str();
   cmd->callback([args] { runCalibrateCommand(*args); });
 });
 

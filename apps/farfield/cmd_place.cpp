@@ -62,6 +62,13 @@ void runPlaceCommand(PlaceArgs& args) {
               r.impostors_generated, r.impostors, r.impostors_freed, r.greedy_s, r.capture_s);
   std::printf("CPVs:             slowest %.2f ms before, %.2f ms after; %zu unsolved (still over t_max)\n",
               r.t_enc_max_ms, r.t_after_max_ms, r.unsolved_cpvs);
+  std::printf("cost model:       layered fill %s\n",
+              r.layered_fill_in_model ? "in the impostors' times (profile's layered terms)"
+                                      : "NOT in the impostors' times (profile without layered terms)");
+  if (!o.fallback_bound_factors.empty())
+    std::printf("fallback:         %zu CPVs over t_max at the bound; coarser passes kept %zu impostors shown in %zu "
+                "(CPV, impostor) pairs; %zu CPVs left over t_max\n",
+                r.unsolved_at_bound, r.fallback_impostors, r.fallback_cpv_impostors, r.unsolved_cpvs);
   std::printf("memory:           %.2f MB of impostors (GPU), %.2f MB on disk\n", r.memory_bytes / 1048576.0,
               double(r.written_bytes) / 1048576.0);
   std::printf("                  of which %.2f MB object-id textures (for measurement); layers cropped to their "
@@ -109,6 +116,10 @@ const RegisterCommand reg("place", [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--texel-px", args->texel_px, "Impostor texel size in pixels of the frames at the nearest "
                                                  "viewpoint (0: the error bound)")->capture_default_str();
+  cmd->add_option("--fallback-bounds", o.fallback_bound_factors,
+                  "For CPVs left over t_max: more greedy passes with impostors under the bound times each factor "
+                  "(e.g. 2,4; each > 1); default none")
+      ->delimiter(',');
   cmd->add_flag("--bound-cracks", o.layered.bound_cracks, "Halve layer spacing so cracks also stay under the bound");
   cmd->add_flag("!--no-id-textures", o.layered.id_textures, "Leave out the per-texel object ids (half the impostors' "
                                                              "memory; bench then cannot measure their parallax)");

@@ -27,6 +27,16 @@ CostProfile oddProfile() {
   p.fov_y_deg = 52.5;
   p.renderer = "test renderer";
   p.validation = {{"views", 500}};
+  p.layered.calibrated = true;
+  p.layered.draw.base_ms = 0.125;
+  p.layered.draw.ms_per_draw = 0.25;
+  p.layered.draw.ms_per_mpixel = 4.0;
+  p.layered.capture.ms_per_mtriangle = 8.0;
+  p.layered.capture.ms_per_draw = 0.5;
+  p.layered.capture.ms_per_mpixel = 16.0;
+  p.layered.draw_safety_factor = 2.0;
+  p.layered.capture_safety_factor = 1.25;
+  p.layered.validation = {{"draw_samples", 40}};
   return p;
 }
 
@@ -38,6 +48,28 @@ TEST(CostProfileTest, RoundTripAndBound) {
   EXPECT_EQ(q.toJson(), p.toJson());
   // By hand: (1.25 + 3.5 * 2 + 0.0625 * 100 + 0.75 * 1) * 1.5.
   EXPECT_DOUBLE_EQ(q.boundMs(2e6, 100, 1e6), (1.25 + 7.0 + 6.25 + 0.75) * 1.5);
+  // The layered terms by hand: draw (0.125 + 0.25 * 10 + 4 * 0.5) * 2; capture (8 * 1 + 0.5 * 10 + 16 * 0.25) * 1.25.
+  EXPECT_DOUBLE_EQ(q.layered.drawBoundMs(10, 5e5), (0.125 + 2.5 + 2.0) * 2.0);
+  EXPECT_DOUBLE_EQ(q.layered.captureBoundMs(1e6, 10, 2.5e5), (8.0 + 5.0 + 4.0) * 1.25);
+  // Not calibrated: no layered cost, saved as null and read back so.
+  CostProfile none = p;
+  none.layered = {};
+  saveCostProfile(none, file);
+  const CostProfile r = loadCostProfile(file);
+  EXPECT_FALSE(r.layered.calibrated);
+  EXPECT_EQ(r.layered.drawBoundMs(10, 5e5), 0.0);
+  EXPECT_TRUE(r.toJson()["layered"].is_null());
+}
+
+TEST(CostProfileTest, VersionOneHasNoLayeredTerms) {
+  nlohmann::json j = oddProfile().toJson();
+  j["version"] = 1;
+  j.erase("layered");
+  const CostProfile p = CostProfile::fromJson(j, "old.json");
+  EXPECT_FALSE(p.layered.calibrated);
+  EXPECT_DOUBLE_EQ(p.model.ms_per_draw, 0.0625);
+  j["layered"] = nullptr;  // a key version 1 did not have
+  EXPECT_THROW(CostProfile::fromJson(j, "old.json"), Error);
 }
 
 TEST(CostProfileTest, StrictReadNamesTheKey) {
@@ -67,8 +99,17 @@ TEST(CostProfileTest, StrictReadNamesTheKey) {
   j["model"]["colour"] = 1;
   expectError(j, "colour");
   j = good;
-  j["version"] = 2;
+  j["version"] = 3;
   expectError(j, "version");
+  j = good;
+  j.erase("layered");
+  expectError(j, "layered");
+  j = good;
+  j["layered"]["draw_safety_factor"] = 0.5;
+  expectError(j, "draw_safety_factor");
+  j = good;
+  j["layered"]["capture"]["ms_per_mpixel"] = -1.0;
+  expectError(j, "layered.capture");
   j = good;
   j["format"] = "something";
   expectError(j, "format");

@@ -87,5 +87,53 @@ TEST(ImageCacheGl, ReusesRegeneratesAndFallsBackUnderTheBudget) {
   EXPECT_THROW(ImageCache(s, gs, o), Error);
 }
 
+// The layered kind's regenerations are scheduled with the calibrated capture and draw bounds: a capture that costs
+// more than the budget per layer is never started (the nodes are drawn as geometry, counted), a cheap one is, and the
+// prediction of a scheduled frame stays under t_max and equals the scheduler's sum.
+TEST(ImageCacheGl, LayeredRegenerationsKeepTheCalibratedBudget) {
+  gpu::sharedHeadlessContext();
+  const scene::Scene s = grid();
+  const gpu::GpuScene gs(s);
+  gpu::Renderer renderer;
+  Camera cam;
+  cam.eye = Vec3(-120, -140, 40);
+  cam.at = Vec3(35, 35, 0);
+  cam.width = 160;
+  cam.height = 90;
+  ImageCacheOptions o;
+  o.kind = CachedImageKind::Layered;
+  o.error_px = 2.0;
+  o.leaf_objects = 4;
+  o.t_max_ms = 100.0;
+  o.cost.ms_per_draw = 0.01;
+  o.layered_cost.calibrated = true;
+  o.layered_cost.capture.ms_per_draw = 1000.0;  // per layer: no capture fits 100 ms
+  std::vector<gpu::DrawItem> items;
+  ImageCache dear(s, gs, o);
+  const ImageCacheFrameStats none = dear.frame(renderer, cam, 0, items);
+  EXPECT_EQ(none.regenerations, 0u);
+  EXPECT_GT(none.geometry_nodes, 0u);
+  EXPECT_LE(none.predicted_ms, o.t_max_ms);
+
+  o.layered_cost.capture.ms_per_draw = 1.0;  // 1 ms a layer, 4 ms a filled megapixel of quads
+  o.layered_cost.draw.ms_per_mpixel = 4.0;
+  o.t_max_ms = 30.0;
+  ImageCache cheap(s, gs, o);
+  items.clear();
+  const ImageCacheFrameStats some = cheap.frame(renderer, cam, 0, items);
+  EXPECT_GT(some.regenerations, 0u);
+  EXPECT_LE(some.predicted_ms, o.t_max_ms);
+  // Without a budget more (or as many) nodes are regenerated, at a predicted cost over what the budget allowed.
+  o.t_max_ms = 0.0;
+  ImageCache free(s, gs, o);
+  items.clear();
+  const ImageCacheFrameStats all = free.frame(renderer, cam, 0, items);
+  EXPECT_GE(all.regenerations, some.regenerations);
+  EXPECT_EQ(all.geometry_nodes + all.regenerations, some.geometry_nodes + some.regenerations);
+  if (all.regenerations > some.regenerations) EXPECT_GT(all.predicted_ms, 30.0);
+  o.cost_safety_factor = 0.5;
+  EXPECT_THROW(ImageCache(s, gs, o), Error);
+}
+
 }  // namespace
 }  // namespace farfield::runtime

@@ -17,6 +17,7 @@
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
 #include "farfield/gpu/renderer.h"
+#include "farfield/impostor/layered_fill.h"
 #include "farfield/placement/greedy.h"
 #include "farfield/placement/placement_problem.h"
 #include "farfield/placement/view_space.h"
@@ -41,6 +42,8 @@ void validate(const PlaceOptions& o) {
   if (!(o.max_pitch_deg > 0.0f && o.max_pitch_deg <= 90.0f)) throw Error("--max-pitch", "must be in (0, 90] degrees");
   if (!(o.max_object_share > 0.0f)) throw Error("place options", "max_object_share must be positive");
   if (!(o.near_plane > 0.0f && o.far_plane > o.near_plane)) throw Error("--near/--far", "need 0 < near < far");
+  for (double f : o.fallback_bound_factors)
+    if (!(f > 1.0) || !std::isfinite(f)) throw Error("--fallback-bounds", "each factor must be a number > 1");
 }
 
 // The smallest |pitch| (radians) of the directions of a VDI, from its boundary sampled densely (0 when it crosses
@@ -94,6 +97,10 @@ nlohmann::json PlaceReport::toJson() const {
           {"impostors_generated", impostors_generated},
           {"impostors_freed", impostors_freed},
           {"unsolved_cpvs", unsolved_cpvs},
+          {"unsolved_at_bound", unsolved_at_bound},
+          {"fallback_impostors", fallback_impostors},
+          {"fallback_cpv_impostors", fallback_cpv_impostors},
+          {"layered_fill_in_model", layered_fill_in_model},
           {"memory_bytes", memory_bytes},
           {"id_texture_bytes", id_texture_bytes},
           {"layer_texels", layer_texels},
@@ -122,6 +129,10 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   context.makeCurrent();
   const Box3 space = options.view_space.empty() ? defaultPlaceViewSpace(scene) : options.view_space;
   if (space.empty() || !isFinite(space.lo) || !isFinite(space.hi)) throw Error("--view-min/--view-max", "empty view space");
+  if (!profile.layered.calibrated)
+    FF_WARN("place: the cost profile has no layered impostor terms (a version-1 profile): the layers' fill is not in "
+            "the estimates, so the frame-time guarantee does not cover it; run farfield calibrate again");
+  report.layered_fill_in_model = profile.layered.calibrated;
   const gpu::GpuScene gpu_scene(scene);
   const scene::Bvh bvh(scene);
   gpu::Renderer renderer;
@@ -277,42 +288,21 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
                     << options.t_max_ms << " ms (slowest " << report.t_enc_max_ms << " ms) in "
                     << report.view_space_s << " s");
 
-  // 3. Candidates and their layered plans.
+  // 3-4. Candidates with their layered plans, estimates and the greedy, once at the bound and then, for the CPVs it
+  // leaves over t_max, once per fallback bound (coarser impostors: fewer layers and texels, a larger parallax).
   step = Stopwatch();
-  placement::CandidateSet all = placement::generateCandidates(hierarchy, view_space, lens, options.candidates);
+  const placement::CandidateSet all = placement::generateCandidates(hierarchy, view_space, lens, options.candidates);
   report.candidate_counts = all.counts;
-  placement::CandidateSet kept;
-  kept.counts = all.counts;
-  std::vector<impostor::LayeredPlan> plans;
-  for (placement::Candidate& c : all.candidates) {
-    const Shaft* shaft = std::get_if<Shaft>(&c.cell);
-    if (!shaft) {
-      ++report.candidates_unplannable;  // box cells need a shaft around them: not planned yet
-      continue;
-    }
-    try {
-      impostor::LayeredPlan plan = impostor::planLayered(hierarchy.nodes()[size_t(c.node)].bounds, *shaft, bound,
-                                                         options.layered);
-      if (!plan.keepsBound()) {
-        ++report.candidates_unplannable;
-        continue;
-      }
-      plans.push_back(std::move(plan));
-      kept.candidates.push_back(std::move(c));
-    } catch (const Error&) {
-      ++report.candidates_unplannable;  // the shaft does not clear the cluster
-    }
-  }
   report.candidates_s = step.seconds();
-  FF_INFO("place: " << all.counts.considered << " candidates considered, " << all.counts.kept << " serve a CPV, "
-                    << kept.candidates.size() << " with a layered plan under " << options.error_px << " px ("
-                    << report.candidates_s << " s)");
-
-  // 4. Estimates and the greedy.
-  step = Stopwatch();
   const std::vector<Frustum> frusta = placement::cpvFrusta(view_space, lens);
-  const placement::Candidate* first = nullptr;
-  placement::PlacementEstimates estimates;
+  const std::vector<int> parents = hierarchy.parents();
+  const auto related = [&](int a, int b) {
+    for (int at = a; at >= 0; at = parents[size_t(at)])
+      if (at == b) return true;
+    for (int at = b; at >= 0; at = parents[size_t(at)])
+      if (at == a) return true;
+    return false;
+  };
   std::unordered_map<uint64_t, double> t_object_memo;
   const auto tObject = [&](int node, uint32_t cpv) {
     const uint64_t key = (uint64_t(uint32_t(node)) << 32) | cpv;
@@ -328,62 +318,134 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
       }
     return t_object_memo[key] = geometryMs(triangles, draws);
   };
-  const auto tImpostor = [&](size_t k) {
-    return geometryMs(2 * uint64_t(plans[k].quads()), plans[k].draws());
+  // An impostor's time: its quads and draw calls as geometry, plus what its alpha-tested layers fill (the profile's
+  // layered draw term over the plan's quads seen from the nearest viewpoint on the axis; 0 for a profile without it).
+  // The fill is estimated from the CPV's region's nearest point to the shaft's apex (impostor::layeredFillPixels).
+  const auto tImpostor = [&](const impostor::LayeredPlan& plan, uint32_t cpv) {
+    const Box3& region = view_space.cpvs[cpv].region;
+    const Vec3 nearest = glm::clamp(plan.shaft.apex, region.lo, region.hi);
+    const double fill = impostor::layeredFillPixels(plan, double(glm::length(nearest - plan.shaft.apex)), bound);
+    return geometryMs(2 * uint64_t(plan.quads()), plan.draws()) +
+           profile.layered.drawBoundMs(double(plan.quads()), fill);
   };
-  // A CPV where the node's visible geometry costs no more than its impostor gains nothing from it: dropped before the
-  // greedy (keeps its input small).
-  for (size_t k = 0; k < kept.candidates.size(); ++k) {
-    placement::Candidate& c = kept.candidates[k];
-    const size_t before = c.cpvs.size();
-    c.cpvs.erase(std::remove_if(c.cpvs.begin(), c.cpvs.end(),
-                                [&](uint32_t cpv) { return tObject(c.node, cpv) <= tImpostor(k); }),
-                 c.cpvs.end());
-    report.serves_dropped += before - c.cpvs.size();
-  }
-  {
-    std::vector<placement::Candidate> useful;
-    std::vector<impostor::LayeredPlan> useful_plans;
-    for (size_t k = 0; k < kept.candidates.size(); ++k)
-      if (!kept.candidates[k].cpvs.empty()) {
-        useful.push_back(std::move(kept.candidates[k]));
-        useful_plans.push_back(std::move(plans[k]));
-      }
-    kept.candidates = std::move(useful);
-    plans = std::move(useful_plans);
-  }
-  first = kept.candidates.empty() ? nullptr : &kept.candidates.front();
-  estimates.t_object = tObject;
-  estimates.t_impostor = [&](const placement::Candidate& c, uint32_t) { return tImpostor(size_t(&c - first)); };
-  estimates.memory = [&](const placement::Candidate& c) { return double(plans[size_t(&c - first)].bytes()); };
-  const placement::GreedyProblem problem = placement::makeGreedyProblem(view_space, hierarchy, kept, estimates);
-  report.estimates_s = step.seconds();
 
-  step = Stopwatch();
   fs::create_directories(out_dir);
   const uint64_t generation = store::nextPlacementGeneration(out_dir);
-  std::map<size_t, store::StoredPlacedImpostor> written;  // candidate -> record
-  std::map<size_t, double> id_bytes;                      // candidate -> bytes of its id textures
-  double capture_s = 0.0;
-  const placement::GreedyResult result = placement::placeGreedy(problem, [&](size_t k) {
-    Stopwatch capture;
-    const placement::Candidate& c = kept.candidates[k];
-    std::vector<uint32_t> objects(hierarchy.objects(c.node).begin(), hierarchy.objects(c.node).end());
-    std::sort(objects.begin(), objects.end());
-    // Each layer keeps only the rectangle its slab's objects cover (cropLayered: the same image, fewer texels).
-    const impostor::LayeredImpostor imp =
-        impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene, objects, plans[k]));
-    written[k] = store::writePlacedImpostor(out_dir, generation, uint32_t(k), uint32_t(c.node), objects, imp,
-                                            hierarchy.nodes()[size_t(c.node)].bounds, std::get<Shaft>(c.cell), bound,
-                                            options.layered);
-    id_bytes[k] = imp.plan.id_textures ? 0.5 * double(imp.plan.texture_bytes) : 0.0;
-    capture_s += capture.seconds();
-    ++report.impostors_generated;
-    if (options.progress && report.impostors_generated % 25 == 0)
-      FF_INFO("place: " << report.impostors_generated << " impostors generated");
-    return placement::GeneratedImpostor{double(imp.plan.bytes()), {}};
-  });
-  report.greedy_s = step.seconds() - capture_s;
+  std::map<uint32_t, store::StoredPlacedImpostor> written;  // impostor id -> record
+  std::map<uint32_t, double> id_bytes;                      // impostor id -> bytes of its id textures
+  std::map<uint32_t, impostor::LayeredPlan> chosen_plans;   // impostor id -> its plan (uncropped)
+  std::vector<double> cpv_t;                                // per CPV: its time with the impostors shown so far
+  for (const placement::Cpv& c : view_space.cpvs) cpv_t.push_back(c.t_enc);
+  std::vector<std::vector<std::pair<uint32_t, int>>> cpv_shown(view_space.cpvs.size());  // (impostor id, node)
+  std::map<uint32_t, size_t> uses;  // impostor id -> CPVs showing it
+  uint32_t next_id = 0;
+  double capture_s = 0.0, greedy_total_s = 0.0;
+  std::vector<double> factors{1.0};
+  for (double f : options.fallback_bound_factors) factors.push_back(f);
+  for (size_t pass = 0; pass < factors.size(); ++pass) {
+    std::vector<uint8_t> open(view_space.cpvs.size(), 0);
+    size_t open_count = 0;
+    for (size_t c = 0; c < cpv_t.size(); ++c)
+      if (cpv_t[c] > options.t_max_ms) open[c] = 1, ++open_count;
+    if (pass == 1) report.unsolved_at_bound = open_count;
+    if (open_count == 0) break;
+    ErrorBound pass_bound = bound;
+    pass_bound.pixels *= factors[pass];
+    Stopwatch plan_clock;
+    placement::CandidateSet kept;
+    kept.counts = all.counts;
+    std::vector<impostor::LayeredPlan> plans;
+    for (const placement::Candidate& original : all.candidates) {
+      const Shaft* shaft = std::get_if<Shaft>(&original.cell);
+      if (!shaft) {
+        if (pass == 0) ++report.candidates_unplannable;  // box cells need a shaft around them: not planned yet
+        continue;
+      }
+      placement::Candidate c = original;
+      // Later passes: only the CPVs still over t_max, and not where an impostor of a related node is shown already.
+      if (pass > 0)
+        c.cpvs.erase(std::remove_if(c.cpvs.begin(), c.cpvs.end(),
+                                    [&](uint32_t cpv) {
+                                      if (!open[cpv]) return true;
+                                      for (const auto& [id, node] : cpv_shown[cpv])
+                                        if (related(node, c.node)) return true;
+                                      return false;
+                                    }),
+                     c.cpvs.end());
+      if (c.cpvs.empty()) continue;
+      try {
+        impostor::LayeredPlan plan = impostor::planLayered(hierarchy.nodes()[size_t(c.node)].bounds, *shaft,
+                                                           pass_bound, options.layered);
+        if (!plan.keepsBound()) {
+          if (pass == 0) ++report.candidates_unplannable;
+          continue;
+        }
+        // A CPV where the node's visible geometry costs no more than its impostor gains nothing from it.
+        const size_t before = c.cpvs.size();
+        c.cpvs.erase(std::remove_if(c.cpvs.begin(), c.cpvs.end(),
+                                    [&](uint32_t cpv) { return tObject(c.node, cpv) <= tImpostor(plan, cpv); }),
+                     c.cpvs.end());
+        report.serves_dropped += before - c.cpvs.size();
+        if (c.cpvs.empty()) continue;
+        plans.push_back(std::move(plan));
+        kept.candidates.push_back(std::move(c));
+      } catch (const Error&) {
+        if (pass == 0) ++report.candidates_unplannable;  // the shaft does not clear the cluster
+      }
+    }
+    if (pass == 0) report.candidates_s += plan_clock.seconds();
+    FF_INFO("place: pass at " << pass_bound.pixels << " px: " << kept.candidates.size()
+                              << " candidates with a layered plan serve " << open_count << " CPVs over t_max");
+    const placement::Candidate* first = kept.candidates.empty() ? nullptr : &kept.candidates.front();
+    placement::PlacementEstimates estimates;
+    estimates.t_object = tObject;
+    estimates.t_impostor = [&](const placement::Candidate& c, uint32_t cpv) {
+      return tImpostor(plans[size_t(&c - first)], cpv);
+    };
+    estimates.memory = [&](const placement::Candidate& c) { return double(plans[size_t(&c - first)].bytes()); };
+    Stopwatch estimate_clock;
+    placement::GreedyProblem problem = placement::makeGreedyProblem(view_space, hierarchy, kept, estimates);
+    problem.cpv_times = cpv_t;
+    report.estimates_s += estimate_clock.seconds();
+
+    Stopwatch greedy_clock;
+    std::map<size_t, uint32_t> id_of;  // candidate of this pass -> impostor id
+    const double capture_before = capture_s;
+    const placement::GreedyResult result = placement::placeGreedy(problem, [&](size_t k) {
+      Stopwatch capture;
+      const placement::Candidate& c = kept.candidates[k];
+      std::vector<uint32_t> objects(hierarchy.objects(c.node).begin(), hierarchy.objects(c.node).end());
+      std::sort(objects.begin(), objects.end());
+      // Each layer keeps only the rectangle its slab's objects cover (cropLayered: the same image, fewer texels).
+      const impostor::LayeredImpostor imp =
+          impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene, objects, plans[k]));
+      const uint32_t id = next_id++;
+      id_of[k] = id;
+      written[id] = store::writePlacedImpostor(out_dir, generation, id, uint32_t(c.node), objects, imp,
+                                               hierarchy.nodes()[size_t(c.node)].bounds, std::get<Shaft>(c.cell),
+                                               pass_bound, options.layered);
+      id_bytes[id] = imp.plan.id_textures ? 0.5 * double(imp.plan.texture_bytes) : 0.0;
+      chosen_plans[id] = plans[k];
+      capture_s += capture.seconds();
+      ++report.impostors_generated;
+      if (options.progress && report.impostors_generated % 25 == 0)
+        FF_INFO("place: " << report.impostors_generated << " impostors generated");
+      return placement::GeneratedImpostor{double(imp.plan.bytes()), {}};
+    });
+    greedy_total_s += greedy_clock.seconds() - (capture_s - capture_before);
+    for (size_t c = 0; c < cpv_t.size(); ++c) {
+      cpv_t[c] = result.cpv_times[c];
+      for (uint32_t i : result.cpv_impostors[c]) {
+        const uint32_t id = id_of.at(result.impostors[i].candidate);
+        cpv_shown[c].push_back({id, kept.candidates[result.impostors[i].candidate].node});
+        ++uses[id];
+        if (pass > 0) ++report.fallback_cpv_impostors;
+      }
+    }
+    if (pass > 0) report.fallback_impostors += result.impostors.size();
+  }
+  if (factors.size() == 1) report.unsolved_at_bound = 0;
+  report.greedy_s = greedy_total_s;
   report.capture_s = capture_s;
 
   // 5. The database: the kept impostors with their candidate numbers as ids.
@@ -410,34 +472,33 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     }
     index.nodes.push_back(s);
   }
-  std::vector<size_t> kept_candidates;
-  for (const placement::ChosenImpostor& chosen : result.impostors) kept_candidates.push_back(chosen.candidate);
-  std::sort(kept_candidates.begin(), kept_candidates.end());  // the index lists ids ascending
-  for (size_t k : kept_candidates) {
-    index.impostors.push_back(written.at(k));
-    report.layer_texels += plans[k].texels;
-    for (const store::StoredImpostorLayer& layer : written.at(k).layers) {
+  for (const auto& [id, n] : uses) {  // ascending ids, as the index lists them
+    if (n == 0) continue;
+    index.impostors.push_back(written.at(id));
+    const impostor::LayeredPlan& plan = chosen_plans.at(id);
+    report.layer_texels += plan.texels;
+    for (const store::StoredImpostorLayer& layer : written.at(id).layers) {
       report.stored_texels += uint64_t(layer.crop.width) * uint64_t(layer.crop.height);
       report.covered_texels += layer.data_texels;
     }
-    report.id_texture_bytes += id_bytes.at(k);
-    report.estimated_bytes += double(plans[k].bytes());
+    report.id_texture_bytes += id_bytes.at(id);
+    report.estimated_bytes += double(plan.bytes());
+    report.memory_bytes += double(written.at(id).bytes);
+    ++report.impostors;
   }
   for (size_t c = 0; c < view_space.cpvs.size(); ++c) {
     store::StoredCpv s;
     s.region = view_space.cpvs[c].region;
     s.vdi = view_space.cpvs[c].vdi;
     s.t_enc = view_space.cpvs[c].t_enc;
-    s.t_after = result.cpv_times[c];
-    for (uint32_t i : result.cpv_impostors[c]) s.impostors.push_back(uint32_t(result.impostors[i].candidate));
+    s.t_after = cpv_t[c];
+    for (const auto& [id, node] : cpv_shown[c]) s.impostors.push_back(id);
     std::sort(s.impostors.begin(), s.impostors.end());
+    if (s.t_after > options.t_max_ms) ++report.unsolved_cpvs;
     report.t_after_max_ms = std::max(report.t_after_max_ms, s.t_after);
     index.cpvs.push_back(std::move(s));
   }
-  report.impostors = result.impostors.size();
   report.impostors_freed = report.impostors_generated - report.impostors;
-  report.unsolved_cpvs = result.unsolved.size();
-  report.memory_bytes = result.memory;
   for (const store::StoredPlacedImpostor& imp : index.impostors)  // the data files (the index comes on top)
     for (const store::StoredImpostorLayer& l : imp.layers) report.written_bytes += l.texture_check.bytes + l.ids_check.bytes;
   index.summary = report.toJson();
@@ -475,6 +536,7 @@ nlohmann::json placeOptionsToJson(const PlaceOptions& o) {
           {"visibility", o.visibility},
           {"visibility_face", o.visibility_face},
           {"seed", o.seed},
+          {"fallback_bound_factors", o.fallback_bound_factors},
           {"hierarchy", {{"max_levels", o.hierarchy.max_levels},
                          {"min_objects_to_split", o.hierarchy.min_objects_to_split}}},
           {"candidates", {{"shafts", c.shafts},
@@ -522,6 +584,7 @@ PlaceOptions placeOptionsFromJson(const nlohmann::json& j, const std::string& so
   o.visibility = r.boolean("visibility");
   r.number("visibility_face", o.visibility_face);
   r.number("seed", o.seed);
+  r.numbers("fallback_bound_factors", o.fallback_bound_factors);
   StrictJson h = r.object("hierarchy");
   h.number("max_levels", o.hierarchy.max_levels);
   h.number("min_objects_to_split", o.hierarchy.min_objects_to_split);

@@ -63,6 +63,11 @@ struct PlaceOptions {
   // An object whose bounds are wider (x or y) than this share of the view space's larger side is never clustered
   // into an impostor (the ground of a city); it stays geometry in every view.
   float max_object_share = 0.5f;
+  // Fallback for the CPVs that impostors under the bound leave over t_max: one more greedy pass per factor, over
+  // those CPVs only, with impostors planned under the bound times the factor (coarser: fewer layers and texels). Those
+  // views keep the frame budget at a larger parallax (the record keeps its own bound, and the runtime counts the
+  // impostors it draws at a coarser bound). Empty: none (the views stay over t_max, reported unsolved). Each > 1.
+  std::vector<double> fallback_bound_factors;
   bool progress = true;
   std::string scene_label;          // recorded in the database
   uint32_t seed = 0;                // reserved for sampling; recorded
@@ -80,6 +85,10 @@ struct PlaceReport {
   size_t candidates_unplannable = 0;  // dropped: no layered plan keeps the bound from the cell
   size_t impostors = 0, impostors_generated = 0, impostors_freed = 0;
   size_t unsolved_cpvs = 0;
+  // Fallback (PlaceOptions::fallback_bound_factors): CPVs over t_max after the pass at the bound, impostors kept from
+  // the coarser passes and (CPV, impostor) pairs they are shown in. unsolved_cpvs counts what is left after all passes.
+  size_t unsolved_at_bound = 0, fallback_impostors = 0, fallback_cpv_impostors = 0;
+  bool layered_fill_in_model = false;  // the profile's layered draw term was part of the impostors' times
   double memory_bytes = 0.0;        // kept impostors, GPU bytes (each layer cropped to its data: cropLayered)
   double estimated_bytes = 0.0;     // the same impostors as the optimiser estimated them (uncropped plans)
   // What that memory holds (kept impostors): per-texel object ids (for measurement; half of the texture bytes when

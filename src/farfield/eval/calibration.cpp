@@ -147,6 +147,21 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   profile.safety_factor = std::max(1.0, quantile(ratios, options.margin_quantile));
   for (const ViewCheck& c : result.checks)
     if (c.measured_ms / std::max(c.predicted_ms, 1e-6) > profile.safety_factor) ++result.over_bound;  // as ratios
+  if (options.layered_samples > 0) {
+    LayeredCalibrateOptions lo;
+    lo.width = options.width;
+    lo.height = options.height;
+    lo.fov_deg = options.fov_deg;
+    lo.error_px = options.layered_error_px;
+    lo.view_space = space;
+    lo.fit_samples = options.layered_samples;
+    lo.validation_samples = options.layered_samples;
+    lo.repeats = options.repeats;
+    lo.seed = options.seed + 17u;
+    lo.progress = options.progress;
+    result.layered = calibrateLayered(renderer, gpu_scene, scene, lo);
+    profile.layered = result.layered.cost;
+  }
   result.wall_s = wall.seconds();
   profile.validation = {{"views", result.checks.size()},
                         {"repeats", options.repeats},

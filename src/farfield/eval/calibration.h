@@ -15,6 +15,7 @@
 #include "farfield/core/camera.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/cost_profile.h"
+#include "farfield/eval/layered_calibration.h"
 #include "farfield/scene/scene.h"
 
 namespace farfield::eval {
@@ -32,6 +33,10 @@ struct CalibrateOptions {
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
   bool progress = true;
+  // The layered impostor's draw and capture terms (eval/layered_calibration.h) on clusters of the same scene and
+  // view space, at the same frame size; 0 samples: none (the profile's layered cost stays uncalibrated).
+  size_t layered_samples = 40;  // fitting samples; as many again validate
+  double layered_error_px = 2.0;
 };
 
 struct ViewCheck {
@@ -51,6 +56,7 @@ struct CalibrateResult {
   size_t under_predicted = 0;  // views slower than predicted (before the safety factor)
   size_t over_bound = 0;       // views slower than predicted * safety factor
   double wall_s = 0.0;
+  LayeredCalibrateResult layered;  // empty when CalibrateOptions::layered_samples is 0
 };
 
 // The validation cameras: eyes uniform in the view space, yaw uniform, pitch within +-10 degrees. Deterministic in

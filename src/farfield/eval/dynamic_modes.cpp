@@ -7,8 +7,10 @@
 #include "farfield/core/error.h"
 #include "farfield/core/error_bound.h"
 #include "farfield/core/timer.h"
+#include "farfield/eval/layered_calibration.h"
 #include "farfield/eval/mode_options.h"
 #include "farfield/gpu/cost_model.h"
+#include "farfield/gpu/cost_profile.h"
 #include "farfield/impostor/capture.h"
 #include "farfield/scene/mesh.h"
 
@@ -121,6 +123,7 @@ DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const 
   options_.max_regenerations = intOption(context, "max_regenerations", 32, 0, 100000);
   options_.audit_samples = intOption(context, "audit", 0, 0, 1000000);
   options_.impostor.plane_in_front = choiceOption(context, "plane", "best", {"best", "front"}) == "front";
+  profile_path_ = context.option("profile");
 }
 
 std::string DynamicImpostorMode::name() const {
@@ -132,11 +135,34 @@ void DynamicImpostorMode::prepare(const ModeContext& context) {
   scene_ = context.scene;
   gpu_scene_ = context.gpu_scene;
   Stopwatch clock;
-  gpu::CalibrationOptions calibration;
-  calibration.repeats = 1;
-  calibration.sizes = {256, 512};
-  calibration.max_triangles = 200000;
-  options_.cost = gpu::calibrateCostModel(*context.renderer, *context.gpu_scene, calibration);
+  if (!profile_path_.empty()) {
+    // The machine's validated profile (farfield calibrate on this scene's view space): its model, its safety factor
+    // and its layered terms.
+    const gpu::CostProfile profile = gpu::loadCostProfile(profile_path_);
+    options_.cost = profile.model;
+    options_.cost_safety_factor = profile.safety_factor;
+    options_.layered_cost = profile.layered;
+  } else {
+    gpu::CalibrationOptions calibration;
+    calibration.repeats = 1;
+    calibration.sizes = {256, 512};
+    calibration.max_triangles = 200000;
+    options_.cost = gpu::calibrateCostModel(*context.renderer, *context.gpu_scene, calibration);
+    if (options_.kind == runtime::CachedImageKind::Layered) {
+      // A quick fit of the layered draw and capture terms on the scene's clusters seen from anywhere in its bounds.
+      LayeredCalibrateOptions lo;
+      lo.width = context.width;
+      lo.height = context.height;
+      lo.error_px = options_.error_px;
+      lo.view_space = context.scene->bounds();
+      lo.fit_samples = 12;
+      lo.validation_samples = 8;
+      lo.repeats = 1;
+      lo.layered.max_texture_size = options_.impostor.max_texels;
+      lo.layered.max_layers = 16;
+      options_.layered_cost = calibrateLayered(*context.renderer, *context.gpu_scene, *context.scene, lo).cost;
+    }
+  }
   calibrate_s_ = clock.seconds();
   cache_ = std::make_unique<runtime::ImageCache>(*context.scene, *context.gpu_scene, options_);
 }
@@ -148,7 +174,7 @@ void DynamicImpostorMode::frame(FrameContext& frame) {
 
 std::map<std::string, double> DynamicImpostorMode::info() const {
   double regen = 0, regen_max = 0, images = 0, geometry = 0, written = 0, uploaded = 0, tex_max = 0, audited = 0,
-         unneeded = 0, missed = 0, frames_with_regen = 0, predicted = 0;
+         unneeded = 0, missed = 0, frames_with_regen = 0, predicted = 0, deferred = 0, frames_with_deferred = 0;
   for (const auto& [k, s] : per_frame_) {
     regen += double(s.regenerations);
     regen_max = std::max(regen_max, double(s.regenerations));
@@ -162,6 +188,8 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
     unneeded += double(s.unneeded);
     missed += double(s.missed);
     predicted += s.predicted_ms;
+    deferred += double(s.geometry_nodes);
+    frames_with_deferred += s.geometry_nodes > 0;
   }
   const double f = double(std::max<size_t>(per_frame_.size(), 1));
   return {{"error_bound_px", options_.error_px},
@@ -179,7 +207,11 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
           {"audited", audited},
           {"unneeded_regenerations", unneeded},
           {"missed_regenerations", missed},
-          {"calibrate_s", calibrate_s_}};
+          {"calibrate_s", calibrate_s_},
+          {"cost_safety_factor", options_.cost_safety_factor},
+          {"layered_cost_calibrated", options_.layered_cost.calibrated ? 1.0 : 0.0},
+          {"deferred_regenerations_per_frame", deferred / f},
+          {"frames_with_deferred", frames_with_deferred}};
 }
 
 }  // namespace farfield::eval

@@ -9,6 +9,8 @@
 //   max_regenerations=N (dynamic-*, default 32), audit=N (dynamic-*: N mesh vertices per node measure the error
 //                     the metric is checked against, default 0 = off; costs frame time)
 //   plane=best|front  (dynamic-*) the best plane, or the best plane moved in front of the node's samples
+//   profile=FILE      (dynamic-*, layered) a cost profile of this machine (farfield calibrate over the path's view
+//                     space): its model, safety factor and layered terms predict the frame; default: a quick fit here
 //   warp_interval=N   (warp) a keyframe of culled geometry every N path frames (default 4)
 //   billboard_kind=cylindrical|spherical, billboard_views=N (default 8), billboard_texels=N (default 32)
 #pragma once
@@ -69,6 +71,7 @@ class DynamicImpostorMode final : public Mode {
   // Sums over measured frames (a repeated frame counts once: its last run).
   std::map<size_t, runtime::ImageCacheFrameStats> per_frame_;
   double calibrate_s_ = 0.0;
+  std::string profile_path_;  // --mode-option profile=FILE: the cost profile to predict with ("" = calibrate here)
 };
 
 // Post-render warping (the lecture's "Post-render warping (Mark et al.)" and "3D warping using depth"): every

@@ -30,33 +30,61 @@ void onlyKeys(const nlohmann::json& j, const std::set<std::string>& keys, const 
     if (!j.contains(key)) throw Error(source, "missing key \"" + key + "\"");
 }
 
+CostModel modelFromJson(const nlohmann::json& m, const std::string& ms) {
+  onlyKeys(m, {"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "samples", "rms_error_ms", "r2"}, ms);
+  CostModel model;
+  model.base_ms = number(m, "base_ms", ms, 0.0);
+  model.ms_per_mtriangle = number(m, "ms_per_mtriangle", ms, 0.0);
+  model.ms_per_draw = number(m, "ms_per_draw", ms, 0.0);
+  model.ms_per_mpixel = number(m, "ms_per_mpixel", ms, 0.0);
+  model.samples = wholeNumber<size_t>(number(m, "samples", ms, 0.0), ms, "\"samples\"");
+  model.rms_error_ms = number(m, "rms_error_ms", ms, 0.0);
+  model.r2 = number(m, "r2", ms, -1e300);
+  return model;
+}
+
 }  // namespace
+
+nlohmann::json LayeredCost::toJson() const {
+  if (!calibrated) return nullptr;
+  return {{"draw", draw.toJson()}, {"capture", capture.toJson()}, {"draw_safety_factor", draw_safety_factor},
+          {"capture_safety_factor", capture_safety_factor}, {"validation", validation}};
+}
+
+LayeredCost LayeredCost::fromJson(const nlohmann::json& j, const std::string& source) {
+  LayeredCost c;
+  if (j.is_null()) return c;
+  onlyKeys(j, {"draw", "capture", "draw_safety_factor", "capture_safety_factor", "validation"}, source);
+  c.calibrated = true;
+  c.draw = modelFromJson(j.at("draw"), source + ".draw");
+  c.capture = modelFromJson(j.at("capture"), source + ".capture");
+  c.draw_safety_factor = number(j, "draw_safety_factor", source, 1.0);
+  c.capture_safety_factor = number(j, "capture_safety_factor", source, 1.0);
+  c.validation = j.at("validation");
+  return c;
+}
 
 nlohmann::json CostProfile::toJson() const {
   return {{"format", kCostProfileFormat}, {"version", kCostProfileVersion}, {"model", model.toJson()},
           {"safety_factor", safety_factor}, {"width", width}, {"height", height}, {"fov_y_deg", fov_y_deg},
-          {"renderer", renderer}, {"validation", validation}};
+          {"renderer", renderer}, {"validation", validation}, {"layered", layered.toJson()}};
 }
 
 CostProfile CostProfile::fromJson(const nlohmann::json& j, const std::string& source) {
-  onlyKeys(j, {"format", "version", "model", "safety_factor", "width", "height", "fov_y_deg", "renderer", "validation"},
-           source);
+  // Version 1 has no "layered" key; later versions must have it.
+  const bool v1 = j.is_object() && j.contains("version") && j.at("version") == 1;
+  std::set<std::string> keys{"format", "version", "model", "safety_factor", "width", "height", "fov_y_deg",
+                             "renderer", "validation"};
+  if (!v1) keys.insert("layered");
+  onlyKeys(j, keys, source);
   if (j.at("format") != kCostProfileFormat)
     throw Error(source, std::string("\"format\" is not \"") + kCostProfileFormat + "\"");
-  if (j.at("version") != kCostProfileVersion)
-    throw Error(source, "version " + j.at("version").dump() + " (this build reads version " +
+  if (!v1 && j.at("version") != kCostProfileVersion)
+    throw Error(source, "version " + j.at("version").dump() + " (this build reads versions 1 and " +
                             std::to_string(kCostProfileVersion) + ")");
   CostProfile p;
-  const nlohmann::json& m = j.at("model");
-  const std::string ms = source + ": model";
-  onlyKeys(m, {"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "samples", "rms_error_ms", "r2"}, ms);
-  p.model.base_ms = number(m, "base_ms", ms, 0.0);
-  p.model.ms_per_mtriangle = number(m, "ms_per_mtriangle", ms, 0.0);
-  p.model.ms_per_draw = number(m, "ms_per_draw", ms, 0.0);
-  p.model.ms_per_mpixel = number(m, "ms_per_mpixel", ms, 0.0);
-  p.model.samples = wholeNumber<size_t>(number(m, "samples", ms, 0.0), ms, "\"samples\"");
-  p.model.rms_error_ms = number(m, "rms_error_ms", ms, 0.0);
-  p.model.r2 = number(m, "r2", ms, -1e300);
+  p.model = modelFromJson(j.at("model"), source + ": model");
+  if (!v1) p.layered = LayeredCost::fromJson(j.at("layered"), source + ": layered");
   p.safety_factor = number(j, "safety_factor", source, 1.0);
   // The frame size: whole pixels of an int (a conversion of 1e300 to int is undefined behaviour).
   p.width = wholeNumber<int>(number(j, "width", source, 1.0), source, "\"width\"");

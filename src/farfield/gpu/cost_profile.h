@@ -3,8 +3,14 @@
 // `farfield calibrate`). Placement (Jeschke et al. 2005, section 3) bounds a view's time by
 // predict(...) * safety_factor, so the frame-time guarantee rests on a measured distribution, stated in the profile.
 //
+// Layered impostors (impostor/layered.h) cost what the linear frame model does not see: every alpha-tested layer is
+// filled over its whole quad, transparent texels included, and regenerating one renders, reads back, crops and
+// uploads one image per layer. LayeredCost holds two more linear models for them, fitted and validated on this machine
+// (eval/layered_calibration.h), each with its own safety factor.
+//
 // Saved whole and read back strictly: a missing or unknown key, or a value of the wrong type or out of range, is a
-// farfield::Error naming the file and the key.
+// farfield::Error naming the file and the key. Version 1 profiles (before the layered terms) are read with
+// LayeredCost::calibrated false; version 2 has the key "layered" (null when not calibrated).
 #pragma once
 
 #include <string>
@@ -16,7 +22,31 @@
 namespace farfield::gpu {
 
 inline constexpr char kCostProfileFormat[] = "farfield-cost-profile";
-inline constexpr int kCostProfileVersion = 1;
+inline constexpr int kCostProfileVersion = 2;
+
+// The layered impostor's two costs. The models reuse CostModel's four columns with these meanings:
+// - draw: ms added to a frame by drawing one layered impostor = base + ms_per_draw * layers + ms_per_mpixel * the
+//   frame pixels its quads cover (impostor::layeredFillPixels; transparent texels included); triangles unused (0);
+// - capture: ms of one regeneration (captureLayered, cropLayered, upload) = base + ms_per_mtriangle * triangles
+//   rendered (the cluster's, once per layer) + ms_per_draw * layers + ms_per_mpixel * texels captured.
+struct LayeredCost {
+  bool calibrated = false;  // false: no layered terms (a version-1 profile); every prediction is 0
+  CostModel draw;
+  CostModel capture;
+  double draw_safety_factor = 1.0;     // >= 1: measured / predicted over the validation samples (the largest)
+  double capture_safety_factor = 1.0;  // >= 1
+  nlohmann::json validation = nlohmann::json::object();  // samples and quantiles; informative
+
+  // Upper bounds (prediction x factor), ms; 0 when not calibrated.
+  double drawBoundMs(double layers, double fill_pixels) const {
+    return calibrated ? draw.predict(0.0, layers, fill_pixels) * draw_safety_factor : 0.0;
+  }
+  double captureBoundMs(double triangles, double layers, double texels) const {
+    return calibrated ? capture.predict(triangles, layers, texels) * capture_safety_factor : 0.0;
+  }
+  nlohmann::json toJson() const;  // null when not calibrated
+  static LayeredCost fromJson(const nlohmann::json& json, const std::string& source);
+};
 
 struct CostProfile {
   CostModel model;
@@ -27,6 +57,7 @@ struct CostProfile {
   std::string renderer;        // GL_RENDERER of the machine
   // The validation it was derived from (views, quantiles of measured / predicted); informative, kept whole.
   nlohmann::json validation = nlohmann::json::object();
+  LayeredCost layered;
 
   // An upper bound of the frame time (ms) of a workload, in the units of CostSample.
   double boundMs(double triangles, double draw_calls, double pixels) const {

@@ -12,6 +12,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/core/error_bound.h"
+#include "farfield/impostor/layered_fill.h"
 #include "farfield/runtime/regeneration_scheduler.h"
 
 namespace farfield::runtime {
@@ -35,6 +36,7 @@ ImageCache::ImageCache(const scene::Scene& scene, const gpu::GpuScene& gpu_scene
   if (options.leaf_objects < 1) throw Error("image cache", "leaf_objects must be >= 1");
   if (!(options.min_distance_radii > 1.0)) throw Error("image cache", "min_distance_radii must be > 1");
   if (options.shade_samples < 1) throw Error("image cache", "shade_samples must be >= 1");
+  if (!(options.cost_safety_factor >= 1.0)) throw Error("image cache", "cost_safety_factor must be >= 1");
   std::vector<uint32_t> small;
   for (const scene::Object& o : scene.objects) {
     if (o.world_bounds.empty()) continue;
@@ -122,6 +124,7 @@ void ImageCache::dropImage(Node& n) {
   n.image.reset();
   n.layered.reset();
   n.layered_bytes = 0;
+  n.layered_draw_ms = 0.0;
 }
 
 void ImageCache::evict(size_t frame_index) {
@@ -170,8 +173,10 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
 
   // Requests: images missing or judged invalid by the metric (on a repeat, the nodes this frame regenerated).
   const gpu::CostModel& c = options_.cost;
+  const double k = options_.cost_safety_factor;
+  const gpu::LayeredCost& lc = options_.layered_cost;
   auto geometryMs = [&](const Node& n) {
-    return c.ms_per_mtriangle * double(n.triangles) / 1e6 + c.ms_per_draw * double(n.draws);
+    return k * (c.ms_per_mtriangle * double(n.triangles) / 1e6 + c.ms_per_draw * double(n.draws));
   };
   std::vector<RegenerationRequest> requests;
   std::vector<int> valid;
@@ -211,6 +216,8 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
                                      pixel_angle / options_.impostor.texel_pixels);
     // A layered capture renders the node once per layer: the plan it would get (pure arithmetic) says how many.
     double renders = 1.0;
+    r.image_ms = k * c.ms_per_draw;
+    r.regenerate_ms = -1.0;
     if (options_.kind == CachedImageKind::Layered) {
       const DVec3 centre(n.bounds.center());
       const double dist = glm::length(eye - centre);
@@ -220,13 +227,20 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
         impostor::LayeredOptions lo;
         lo.max_texture_size = options_.impostor.max_texels;
         lo.max_layers = 16;
-        renders = double(std::max<size_t>(1, impostor::planLayered(n.bounds, shaft, bound, lo).layers.size()));
+        const impostor::LayeredPlan plan = impostor::planLayered(n.bounds, shaft, bound, lo);
+        renders = double(std::max<size_t>(1, plan.layers.size()));
+        if (lc.calibrated) {  // the calibrated capture (render, readback, crop, upload) and the layers' fill
+          r.regenerate_ms = lc.captureBoundMs(double(n.triangles) * renders, renders, double(plan.texels));
+          r.image_ms = k * c.ms_per_draw * double(plan.draws()) +
+                       lc.drawBoundMs(renders, impostor::layeredFillPixels(plan, dist, bound));
+        }
       } catch (const Error&) {
         renders = 1.0;  // too near for layers: regenerating draws the geometry (see below)
       }
     }
-    r.regenerate_ms = renders * (r.geometry_ms + options_.regeneration_overhead_ms + c.ms_per_mpixel * side * side / 1e6);
-    r.image_ms = c.ms_per_draw;
+    if (r.regenerate_ms < 0.0)
+      r.regenerate_ms =
+          renders * (r.geometry_ms + options_.regeneration_overhead_ms + k * c.ms_per_mpixel * side * side / 1e6);
     requests.push_back(r);
   }
   double base = c.base_ms + c.ms_per_mpixel * pixels / 1e6;
@@ -236,7 +250,9 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
     gpu_scene_.appendDrawItems(near_objects, scratch_, camera);
     for (const gpu::DrawItem& it : scratch_) tris += it.triangleCount();
     draws = scratch_.size();
-    base += c.ms_per_mtriangle * double(tris) / 1e6 + c.ms_per_draw * double(draws) + c.ms_per_draw * double(valid.size());
+    base = k * (base + c.ms_per_mtriangle * double(tris) / 1e6 + c.ms_per_draw * double(draws) +
+                c.ms_per_draw * double(valid.size()));
+    for (const int i : valid) base += nodes_[size_t(i)].layered_draw_ms;  // the valid layered images' fill
     out.insert(out.end(), scratch_.begin(), scratch_.end());
   }
   const RegenerationSchedule schedule =
@@ -268,6 +284,8 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
           impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene_, n.objects, plan));
       n.layered = std::make_unique<impostor::GpuLayeredImpostor>(captured);
       n.layered_bytes = n.layered->gpuBytes();
+      // Valid while the eye stays in the shaft: bounded from its nearest viewpoints.
+      n.layered_draw_ms = lc.drawBoundMs(double(plan.quads()), impostor::layeredFillPixels(plan, 0.0, bound));
       texture_bytes_ += n.layered_bytes;
       st.texels_written_bytes += size_t(captured.plan.texels) * 4;
       st.uploaded_bytes += n.layered_bytes;  // read back per layer, cropped, uploaded again

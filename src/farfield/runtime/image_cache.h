@@ -16,6 +16,7 @@
 #include "farfield/core/bounds.h"
 #include "farfield/core/camera.h"
 #include "farfield/gpu/cost_model.h"
+#include "farfield/gpu/cost_profile.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/core/shaft.h"
 #include "farfield/impostor/dynamic.h"
@@ -46,6 +47,10 @@ struct ImageCacheOptions {
                                 // "measured" error the bench checks the metric against); costs frame time
   impostor::PlanarImpostorOptions impostor;
   gpu::CostModel cost;          // predicts geometry and regeneration times (all 0: no prediction)
+  double cost_safety_factor = 1.0;  // >= 1: every prediction of `cost` is multiplied by it (gpu::CostProfile's)
+  // Layered images: drawing (per layer, per pixel of their quads) and regenerating (per layer, per texel: render,
+  // readback, crop, upload) bounds; not calibrated: a layered regeneration is estimated as renders of the geometry.
+  gpu::LayeredCost layered_cost;
   double regeneration_overhead_ms = 0.3;  // per regeneration: target, clear, state
 };
 
@@ -94,6 +99,7 @@ class ImageCache {
     std::unique_ptr<impostor::GpuLayeredImpostor> layered;
     Shaft shaft;              // the layered image's validity region
     size_t layered_bytes = 0;
+    double layered_draw_ms = 0.0;  // bound of drawing the layered image (its plan's layers and fill)
     size_t last_used = 0;
     std::optional<size_t> regenerated_in;
   };

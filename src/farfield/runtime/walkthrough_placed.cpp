@@ -96,8 +96,14 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
       }
       // The impostor keeps this frame's bound where the eye is in its shaft and its plan's error fits the frame's
       // pixel (a camera narrower or larger than the placement's frames has smaller pixels).
-      const double theta = bound.angleWithin(frameRadius(camera, record.box));
+      // A fallback impostor (placed under a coarser bound for a CPV the bound could not bring under t_max, see
+      // bake::PlaceOptions::fallback_bound_factors) is held to its own bound, and counted.
+      const double radius = frameRadius(camera, record.box);
+      const bool coarse = record.bound.pixels > options_.error_px * (1.0 + 1e-9);
+      const double theta = coarse ? ErrorBound::forCamera(record.bound.pixels, camera).angleWithin(radius)
+                                  : bound.angleWithin(radius);
       if (record.shaft.contains(camera.eye) && it->second.error_rad <= theta) {
+        if (coarse) ++p.stats.coarse_draws;
         plan.layers.push_back(ClusterAsImpostor{id, uint32_t(record.objects.size()), it->second.error_rad, theta});
         for (uint32_t o : record.objects) p.hidden[o] = 1;
         drawn.push_back(id);
@@ -155,6 +161,7 @@ std::map<std::string, double> Walkthrough::placedStatistics() const {
   out["mean_impostor_quads"] = s.impostor_quads / n;
   out["mean_geometry_triangles"] = s.geometry_triangles / n;
   out["impostors_drawn_as_geometry"] = double(s.geometry_fallbacks);
+  out["impostors_drawn_at_a_coarser_bound"] = double(s.coarse_draws);
   out["impostor_loads"] = double(s.loads);
   out["impostor_load_ms_mean"] = s.loads ? s.load_ms_total / double(s.loads) : 0.0;
   out["impostor_load_ms_max"] = s.load_ms_max;

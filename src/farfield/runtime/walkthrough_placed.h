@@ -31,6 +31,7 @@ struct Walkthrough::Placed {
     double load_ms_total = 0.0, load_ms_max = 0.0, geometry_triangles = 0.0, impostor_quads = 0.0;
     uint64_t resident_bytes_max = 0;
     size_t over_gpu_budget_frames = 0;
+    size_t coarse_draws = 0;  // fallback impostors drawn (placed under a coarser bound than the walkthrough's)
   } stats;
 };
 
