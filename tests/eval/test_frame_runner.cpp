@@ -66,6 +66,7 @@ TEST(CulledMode, SameImagesAsFullWithFewerTriangles) {
   Harness h;
   auto full = h.make("full");
   auto culled = h.make("culled");
+  auto frustum = h.make("frustum");
   FrameRunner runner(*h.renderer, *h.target);
   const gen::CameraPath path = test::sideWalkPath(4);
   uint64_t all_triangles = 0;
@@ -79,19 +80,27 @@ TEST(CulledMode, SameImagesAsFullWithFewerTriangles) {
     const image::ColorImage full_image = h.target->readColor();
     const FrameRecord c = runner.run(*culled, camera, i);
     const image::ColorImage culled_image = h.target->readColor();
+    const FrameRecord fr = runner.run(*frustum, camera, i);
+    const image::ColorImage frustum_image = h.target->readColor();
 
     // The view shows geometry (so the comparison means something): most pixels are not the sky.
     const image::Rgba8 sky = full_image.at(kSize / 2, 0);
     EXPECT_GT(pixelsNotEqualTo(full_image, sky), size_t(kSize * kSize / 4));
-    const double psnr = image::psnr(full_image, culled_image);
-    EXPECT_TRUE(std::isinf(psnr) || psnr > 50.0) << "PSNR " << psnr;
+    for (const image::ColorImage* image : {&culled_image, &frustum_image}) {
+      const double psnr = image::psnr(full_image, *image);
+      EXPECT_TRUE(std::isinf(psnr) || psnr > 50.0) << "PSNR " << psnr;
+    }
+    // Occlusion culling is exact: the frame of "culled" is the frame of "frustum", from fewer triangles or as many.
+    EXPECT_TRUE(culled_image.pixels() == frustum_image.pixels());
+    EXPECT_LE(c.triangles, fr.triangles);
 
     EXPECT_EQ(f.triangles, all_triangles);
     EXPECT_EQ(f.objects, uint32_t(h.scene.objects.size()));
     EXPECT_LT(c.triangles, f.triangles);
     EXPECT_LT(c.objects, f.objects);
-    // Culling is conservative: everything whose bounds touch the frustum is drawn.
-    EXPECT_GE(c.triangles, bruteForceVisibleTriangles(h.scene, camera));
+    // Frustum culling is conservative: everything whose bounds touch the frustum is drawn.
+    EXPECT_LT(fr.triangles, f.triangles);
+    EXPECT_GE(fr.triangles, bruteForceVisibleTriangles(h.scene, camera));
     EXPECT_GT(f.wall_ms, 0.0);
     EXPECT_GT(c.wall_ms, 0.0);
     EXPECT_EQ(c.path_frame, i);

@@ -128,10 +128,10 @@ size_t framesOver(const ModeResult& m, double bound) {
 TEST(ImpostorModeTest, WalkKeepsTheBoundAndDrawsFewerTrianglesThanFull) {
   const SmallCity& s = smallCity();
   ASSERT_GE(s.visited.size(), 2u) << "the walk should cross at least one junction";
-  const BenchResult r = runModes(s, {"full", "culled", "depth-mesh", "grid-mesh"}, bothStores(s));
+  const BenchResult r = runModes(s, {"full", "frustum", "depth-mesh", "grid-mesh"}, bothStores(s));
   const BenchResult strict = runModes(s, {"depth-mesh"}, {{"impostor_dir", s.strict_store}});
   const ModeResult* full = r.mode("full");
-  const ModeResult* culled = r.mode("culled");
+  const ModeResult* culled = r.mode("frustum");
   const ModeResult* strict_depth = strict.mode("depth-mesh");
   ASSERT_TRUE(full && culled && strict_depth);
   EXPECT_EQ(full->crack_share_mean, 0.0);
@@ -305,12 +305,12 @@ TEST(ImpostorModeTest, CellsWithoutImpostorFallBackToCulledGeometry) {
     expected_fallbacks += cells.lookup(f.eye, f.at - f.eye) != s.visited.front() ? 1 : 0;
   ASSERT_GT(expected_fallbacks, 0u);
 
-  const BenchResult r = runModes(s, {"culled", "depth-mesh"}, {{"impostor_dir", dir}});
+  const BenchResult r = runModes(s, {"frustum", "depth-mesh"}, {{"impostor_dir", dir}});
   const ModeResult* depth = r.mode("depth-mesh");
-  const ModeResult* culled = r.mode("culled");
+  const ModeResult* culled = r.mode("frustum");
   EXPECT_EQ(depth->info.at("fallback_frames"), double(expected_fallbacks));
   EXPECT_EQ(depth->info.at("cell_loads"), 1.0);
-  // Fallback frames are the culled mode's frames: identical images and triangle counts.
+  // Fallback frames are the frustum-culled frames (the runtime's geometry): identical images and triangle counts.
   for (size_t k = 0; k < depth->frames.size(); ++k) {
     const gen::PathFrame& f = s.path.frames[depth->frames[k].path_frame];
     if (cells.lookup(f.eye, f.at - f.eye) == s.visited.front()) continue;

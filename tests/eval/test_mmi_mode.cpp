@@ -100,9 +100,9 @@ class MmiModeTest : public ::testing::Test {
 TEST_F(MmiModeTest, TheFiveModesRunOverTheBakedWalk) {
   const MmiCity& s = mmiCity();
   ASSERT_GE(s.visited.size(), 2u) << "the walk should cross at least one junction";
-  const BenchResult r = runModes(s.path, {"culled", "local", "visible", "smi", "mmi", "mmi-dynamic"}, s.store);
+  const BenchResult r = runModes(s.path, {"frustum", "local", "visible", "smi", "mmi", "mmi-dynamic"}, s.store);
   const ModeResult* full = r.mode("full");
-  const ModeResult* culled = r.mode("culled");
+  const ModeResult* culled = r.mode("frustum");  // the runtime's geometry is frustum-culled
   const ModeResult* local = r.mode("local");
   const ModeResult* visible = r.mode("visible");
   const ModeResult* smi = r.mode("smi");

@@ -1,10 +1,12 @@
 #include "farfield/eval/mode.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <mutex>
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/gpu/occlusion_culler.h"
 
 namespace farfield::eval {
 
@@ -92,11 +94,17 @@ class FullMode final : public Mode {
 };
 
 // View-frustum culling: object bounds through the BVH, then the clusters of those objects' meshes (GpuScene's
-// culling units: in the frustum and not all facing away); what a plain renderer does before any impostor.
+// culling units: in the frustum and not all facing away); what a plain renderer does before any impostor. With
+// occlusion (the "culled" mode), the nearest clusters are drawn first and the others hidden behind their depth are
+// dropped (gpu::OcclusionCuller: exact, the frame stays the frame of "frustum").
 class CulledMode final : public Mode {
  public:
-  explicit CulledMode(const ModeContext& context) : gpu_scene_(context.gpu_scene), bvh_(context.bvh) {}
-  std::string name() const override { return "culled"; }
+  CulledMode(const ModeContext& context, bool occlusion)
+      : gpu_scene_(context.gpu_scene),
+        bvh_(context.bvh),
+        occlusion_(occlusion),
+        culler_(occlusion ? parseShare(context.option("occluder_share", "0.1")) : 0.1) {}
+  std::string name() const override { return occlusion_ ? "culled" : "frustum"; }
   void frame(FrameContext& frame) override {
     ids_.clear();
     bvh_->queryFrustum(Frustum::fromMatrix(frame.camera().viewProjection()), ids_);
@@ -104,13 +112,50 @@ class CulledMode final : public Mode {
     if (ids_.empty()) return;
     // Same order as "full" (ascending ids), so objects at equal depth resolve the same way in both modes.
     std::sort(ids_.begin(), ids_.end());
-    gpu_scene_->appendDrawItems(ids_, frame.items(), frame.camera());
+    if (!occlusion_) {
+      gpu_scene_->appendDrawItems(ids_, frame.items(), frame.camera());
+      return;
+    }
+    candidates_.clear();
+    bounds_.clear();
+    gpu_scene_->appendDrawItems(ids_, candidates_, frame.camera(), &bounds_);
+    const gpu::OcclusionStats stats = culler_.cull(
+        frame.camera(), candidates_, bounds_, frame.beginOwnPass(),
+        [&](std::span<const gpu::DrawItem> occluders) { frame.drawPass(occluders); }, frame.items());
+    ++frames_;
+    hidden_ += stats.hidden;
+    hidden_triangles_ += double(stats.hidden_triangles);
+    occluders_ += stats.occluders;
+    readback_ms_ += stats.readback_ms;
+    test_ms_ += stats.pyramid_ms;
+  }
+  static double parseShare(const std::string& text) {
+    char* end = nullptr;
+    const double share = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !(share >= 0.0 && share <= 1.0))
+      throw Error("mode 'culled'", "occluder_share must be a number in [0, 1], got '" + text + "'");
+    return share;
+  }
+  std::map<std::string, double> info() const override {
+    if (!occlusion_ || frames_ == 0) return {};
+    const double n = double(frames_);
+    return {{"occlusion_hidden_items_per_frame", double(hidden_) / n},
+            {"occlusion_hidden_triangles_per_frame", hidden_triangles_ / n},
+            {"occlusion_occluder_items_per_frame", double(occluders_) / n},
+            {"occlusion_readback_ms_per_frame", readback_ms_ / n},
+            {"occlusion_test_ms_per_frame", test_ms_ / n}};
   }
 
  private:
   const gpu::GpuScene* gpu_scene_;
   const scene::Bvh* bvh_;
+  bool occlusion_;
   std::vector<uint32_t> ids_;
+  std::vector<gpu::DrawItem> candidates_;
+  std::vector<Box3> bounds_;
+  gpu::OcclusionCuller culler_;
+  uint64_t frames_ = 0, hidden_ = 0, occluders_ = 0;
+  double hidden_triangles_ = 0.0, readback_ms_ = 0.0, test_ms_ = 0.0;
 };
 
 struct Entry {
@@ -130,8 +175,10 @@ Registry& registry() {
     auto* reg = new Registry;
     reg->entries["full"] = {"every object of the scene (the baseline)",
                             [](const ModeContext&) { return std::make_unique<FullMode>(); }};
-    reg->entries["culled"] = {"objects whose bounds intersect the view frustum (BVH)",
-                              [](const ModeContext& c) { return std::make_unique<CulledMode>(c); }};
+    reg->entries["culled"] = {"clusters in the view frustum (BVH), not facing away, not hidden behind the nearest ones",
+                              [](const ModeContext& c) { return std::make_unique<CulledMode>(c, true); }};
+    reg->entries["frustum"] = {"clusters in the view frustum (BVH) and not facing away: culled without occlusion",
+                               [](const ModeContext& c) { return std::make_unique<CulledMode>(c, false); }};
     return reg;
   }();
   return *r;

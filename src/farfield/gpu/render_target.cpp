@@ -117,6 +117,14 @@ image::DepthImage RenderTarget::readDepth() const {
   return readTexture<float>(depth_, GL_DEPTH_COMPONENT, GL_FLOAT);
 }
 
+void RenderTarget::readDepthRows(std::vector<float>& rows) const {
+  rows.resize(size_t(width_) * size_t(height_));
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glGetTextureImage(depth_.handle(), 0, GL_DEPTH_COMPONENT, GL_FLOAT, GLsizei(rows.size() * sizeof(float)), rows.data());
+}
+
 image::IdImage RenderTarget::readIds() const { return readTexture<uint32_t>(ids_, GL_RED_INTEGER, GL_UNSIGNED_INT); }
 
 }  // namespace farfield::gpu

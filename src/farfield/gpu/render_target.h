@@ -1,6 +1,8 @@
 // Off-screen render target: colour RGBA8 + depth 32F + object id R32UI, with readback into image::Image.
 #pragma once
 
+#include <vector>
+
 #include "farfield/gpu/texture.h"
 #include "farfield/image/image.h"
 
@@ -29,6 +31,9 @@ class RenderTarget {
   image::ColorImage readColor() const;
   image::DepthImage readDepth() const;  // window depth in [0,1], reversed Z: 0 = far/background
   image::IdImage readIds() const;
+  // The depth attachment as GL stores it (row 0 at the bottom) into `rows`, resized to width x height: the
+  // readback of a frame's own depth for occlusion culling, with no flip and no allocation once sized.
+  void readDepthRows(std::vector<float>& rows) const;
 
   const Texture& colorTexture() const { return color_; }
   const Texture& depthTexture() const { return depth_; }

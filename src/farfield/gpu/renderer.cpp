@@ -296,16 +296,16 @@ void GpuScene::appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawIt
 
 void GpuScene::appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out,
                                const Frustum& frustum) const {
-  appendCulled(ids, out, frustum, nullptr);
+  appendCulled(ids, out, frustum, nullptr, nullptr);
 }
 
-void GpuScene::appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out,
-                               const Camera& camera) const {
-  appendCulled(ids, out, Frustum::fromMatrix(camera.viewProjection()), &camera.eye);
+void GpuScene::appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out, const Camera& camera,
+                               std::vector<Box3>* item_bounds) const {
+  appendCulled(ids, out, Frustum::fromMatrix(camera.viewProjection()), &camera.eye, item_bounds);
 }
 
 void GpuScene::appendCulled(std::span<const uint32_t> ids, std::vector<DrawItem>& out, const Frustum& frustum,
-                            const Vec3* eye) const {
+                            const Vec3* eye, std::vector<Box3>* item_bounds) const {
   auto append = [&](const scene::Object& object) {
     checkParts(object);
     // The planes in the object's own space (a world plane p met by the point M x is the plane p M in x), so the
@@ -331,8 +331,10 @@ void GpuScene::appendCulled(std::span<const uint32_t> ids, std::vector<DrawItem>
         if (!drawn) continue;
         if (open && cluster.first_index - open_end <= bridge_indices_) {
           out.back().index_count = cluster.first_index + cluster.index_count - out.back().first_index;
+          if (item_bounds) item_bounds->back().expand(cluster.bounds);
         } else {
           out.push_back({mesh, material, object.transform, object.id, cluster.first_index, cluster.index_count});
+          if (item_bounds) item_bounds->push_back(cluster.bounds);
           open = true;
         }
         open_end = cluster.first_index + cluster.index_count;

@@ -134,7 +134,10 @@ class GpuScene {
   // The same for the camera's frustum, less the clusters of single-sided materials whose triangles all face away
   // from the camera's eye (facesAway: back-face culling would draw none of their pixels). Pixel-identical to all
   // items of the listed objects drawn with this camera.
-  void appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out, const Camera& camera) const;
+  // item_bounds, when given, receives for each item appended the bounds of its clusters in its mesh's own space
+  // (the item's transform takes them to the world), parallel to out (occlusion culling tests them).
+  void appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out, const Camera& camera,
+                       std::vector<Box3>* item_bounds = nullptr) const;
   std::vector<DrawItem> drawItems() const;
   // Per object id (index 0 unused, size objects + 1): the triangles and draw items of appendDrawItems for it alone.
   std::vector<ObjectDrawCost> objectDrawCosts() const;
@@ -148,7 +151,7 @@ class GpuScene {
   const scene::Object& checkedObject(uint32_t id) const;
   void checkParts(const scene::Object& object) const;
   void appendCulled(std::span<const uint32_t> ids, std::vector<DrawItem>& out, const Frustum& frustum,
-                    const Vec3* eye) const;
+                    const Vec3* eye, std::vector<Box3>* item_bounds) const;
 
   const scene::Scene* scene_;
   std::vector<GpuMesh> meshes_;
