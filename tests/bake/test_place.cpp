@@ -18,6 +18,7 @@
 #include "farfield/eval/parallax_error.h"
 #include "farfield/gen/city.h"
 #include "farfield/gpu/render_target.h"
+#include "farfield/impostor/layered_fill.h"
 #include "farfield/runtime/walkthrough.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/store/placement_store.h"
@@ -164,6 +165,74 @@ TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
   EXPECT_GT(with_impostors, 5u);
   std::printf("guarded views %zu, with impostors %zu, worst parallax p99 %.2f px\n", guarded, with_impostors,
               worst_parallax);
+}
+
+// The layered impostors' fill in the cost model, and the fallback to coarser bounds: with a profile whose layered draw
+// term is dear, every view the runtime plans where its CPV was solved is predicted under t_max from what it draws,
+// the impostors' fill included (recomputed here from each drawn impostor's plan at the eye's distance); the fallback
+// passes leave no more CPVs over t_max than the bound alone, and the database's impostors placed under a coarser
+// bound are the ones the report counts.
+TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
+  const gen::City city = test::smallPlacementCity();
+  gpu::CostProfile profile = test::handProfile();
+  profile.layered.calibrated = true;
+  profile.layered.draw.ms_per_draw = 0.05;      // per layer
+  profile.layered.draw.ms_per_mpixel = 40.0;    // per million pixels of quads
+  profile.layered.draw_safety_factor = 1.5;
+  PlaceOptions options = test::smallPlaceOptions(city.scene);
+  options.fallback_bound_factors = {2.0, 4.0};
+  const std::string dir = test::scratchDir("place_fill_fallback").string();
+  const PlaceReport r = placeImpostors(gpu::sharedHeadlessContext(), city.scene, profile, options, dir);
+  EXPECT_TRUE(r.layered_fill_in_model);
+  EXPECT_LE(r.unsolved_cpvs, r.unsolved_at_bound);
+  const store::PlacementIndex index = store::readPlacementIndex(dir);
+  size_t coarse = 0;
+  for (const store::StoredPlacedImpostor& imp : index.impostors) coarse += imp.bound.pixels > options.error_px;
+  EXPECT_EQ(coarse, r.fallback_impostors);
+  size_t unsolved = 0;
+  for (const store::StoredCpv& c : index.cpvs) unsolved += c.t_after > options.t_max_ms;
+  EXPECT_EQ(unsolved, r.unsolved_cpvs);
+
+  gpu::sharedHeadlessContext().makeCurrent();
+  const gpu::GpuScene gpu_scene(city.scene);
+  const scene::Bvh bvh(city.scene);
+  gpu::Renderer renderer;
+  runtime::WalkthroughOptions wo;
+  wo.database = dir;
+  wo.representation = runtime::Representation::Placed;
+  runtime::Walkthrough walkthrough(city.scene, gpu_scene, bvh, renderer, wo);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  size_t guarded = 0, drawn = 0;
+  for (int k = 0; k < 200; ++k) {
+    Camera camera;
+    camera.eye = index.view_space.lo + (index.view_space.hi - index.view_space.lo) * Vec3(u(rng), u(rng), u(rng));
+    const float yaw = float(2.0 * kPi) * u(rng);
+    camera.at = camera.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
+    camera.width = camera.height = 128;
+    camera.fov_y = float(degToRad(45.0));
+    const runtime::FramePlan& plan = walkthrough.plan(camera);
+    uint64_t triangles = 0;
+    for (const gpu::DrawItem& item : plan.items) triangles += item.triangleCount();
+    double predicted = profile.boundMs(double(triangles), double(plan.items.size()), 128.0 * 128.0);
+    for (const runtime::LayerDecision& d : plan.layers)
+      if (const auto* i = std::get_if<runtime::ClusterAsImpostor>(&d)) {
+        const store::StoredPlacedImpostor& rec = *index.find(i->impostor);
+        const impostor::LayeredPlan lp = impostor::planLayered(rec.box, rec.shaft, rec.bound, rec.options);
+        const ErrorBound frame{options.error_px, 128, 128, degToRad(45.0)};
+        predicted += profile.layered.drawBoundMs(
+            double(lp.quads()), impostor::layeredFillPixels(lp, double(glm::length(camera.eye - rec.shaft.apex)), frame));
+        ++drawn;
+      }
+    if (plan.report.cpv == urban::kNone || plan.report.cpv_t_after_ms <= options.t_max_ms) {
+      ++guarded;
+      EXPECT_LE(predicted, options.t_max_ms + 1e-9) << "view " << k << " cpv " << plan.report.cpv;
+    }
+  }
+  EXPECT_GT(guarded, 30u);
+  std::printf("fill charged: %zu CPVs over t_max at the bound, %zu after the fallback (%zu coarser impostors); %zu "
+              "guarded views, %zu impostors drawn\n",
+              r.unsolved_at_bound, r.unsolved_cpvs, r.fallback_impostors, guarded, drawn);
 }
 
 TEST(PlaceTest, BadOptionsAreErrors) {

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The frame budget of the dynamic impostor modes (docs/BENCHMARKS.md, "Billboards, dynamic impostors, warping"): the
+# default city with trees along a drive and a forest on rolling ground along a flyover, each with a cost profile of
+# this machine calibrated over the path's district (frame model, safety factor, layered draw and capture terms), then
+# the modes that regenerate images inside t_max (dynamic-shade, dynamic-schaufler, layered) against culled, every
+# frame rendered 3 times and the fastest kept, against full-geometry reference frames.
+# Usage: scripts/bench_dynamic_budget.sh FARFIELD OUT [TMAX_MS] [FRAMES] [STRIDE]
+set -euo pipefail
+FARFIELD=${1:-build/release/bin/farfield}
+OUT=${2:-out/bench/dynamic-budget}
+TMAX=${3:-200}
+FRAMES=${4:-40}
+STRIDE=${5:-3}
+mkdir -p "$OUT"
+[ -f "$OUT/city_trees.glb" ] || "$FARFIELD" gen city --trees -o "$OUT/city_trees.glb" > "$OUT/gen_city.txt"
+[ -f "$OUT/drive2.json" ] || "$FARFIELD" path street "$OUT/city_trees.streets.json" --car --frames 400 --seed 2 \
+  -o "$OUT/drive2.json" > /dev/null
+[ -f "$OUT/forest5.glb" ] || "$FARFIELD" gen forest --seed 5 --trees 600 -o "$OUT/forest5.glb" > "$OUT/gen_forest.txt"
+[ -f "$OUT/fly5.json" ] || "$FARFIELD" path flyover "$OUT/forest5.glb" --frames 300 --altitude 25 -o "$OUT/fly5.json" \
+  > /dev/null
+for run in "city city_trees.glb drive2.json" "forest forest5.glb fly5.json"; do
+  set -- $run
+  name=$1 scene=$OUT/$2 path=$OUT/$3
+  [ -f "$OUT/profile-$name.json" ] || "$FARFIELD" calibrate "$scene" -o "$OUT/profile-$name.json" --size 640x360 \
+    --fov 60 --around "$path" --margin 20 --views "${CAL_VIEWS:-100}" --fit-views 50 --layered-samples 30 \
+    --layered-error-px 2 > "$OUT/calibrate-$name.txt" 2>&1
+  "$FARFIELD" bench "$scene" --path "$path" --modes culled,dynamic-shade,dynamic-schaufler,layered --reference \
+    --repeats 3 --tmax "$TMAX" --frames "$FRAMES" --stride "$STRIDE" --mode-option error_px=2 \
+    --mode-option t_max_ms="$TMAX" --mode-option profile="$OUT/profile-$name.json" -o "$OUT/bench-$name" \
+    > "$OUT/bench-$name.txt" 2>&1
+done
