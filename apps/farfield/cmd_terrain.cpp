@@ -4,6 +4,8 @@
 //                        [--low-error PX] [--reference] [--quality-stride K] [--sweep-epsilons LIST]
 //                        [--sweep-frames LIST] [--no-sweeps] [--no-section5] [--no-plots] [--no-choice]
 //                        [--clearance M] [--full-max-triangles N]
+// farfield terrain tiles DEM -o OUTDIR [--budget-mb MB] [--block N] [--tile-blocks N] [--frames N] [--cache FILE]
+//                        [--reuse-cache] [--pixel-error PX] [--check-stride K] [--clearance M] [--size WxH]
 // DEM: a GeoTIFF / netCDF / 16-bit PNG file or fractal:SIZE[:SEED].
 //
 // The LOD-sprite experiment (Chen et al. 1999) is eval::runTerrainBench (eval/terrain_bench.h). Its modes are
@@ -14,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli_util.h"
@@ -24,6 +27,7 @@
 #include "farfield/eval/terrain_bench.h"
 #include "farfield/eval/terrain_modes.h"
 #include "farfield/eval/terrain_paths.h"
+#include "farfield/eval/terrain_tiles.h"
 #include "farfield/terrain/terrain_data.h"
 
 namespace farfield::app {
@@ -107,6 +111,16 @@ void runPath(const std::string& dem, const std::string& output, int frames, floa
               output.c_str(), frames, l.plain.x, l.plain.y, l.mountains.x, l.mountains.y, l.beyond.x, l.beyond.y);
 }
 
+void runTiles(eval::TerrainTilesOptions& o, const std::string& size) {
+  const IVec2 s = parseSize("--size", size);
+  o.width = s.x;
+  o.height = s.y;
+  const eval::TerrainTilesResult result = eval::runTerrainTiles(o);
+  std::printf("%s\nwrote %s/{tiles.json,tiles.md,tiles_frames.csv} in %.0f s\n", result.markdown.c_str(),
+              o.out_dir.c_str(), result.seconds);
+  if (result.check_mismatches > 0) throw Error("--check-stride", "the tiled LOD differed from the whole grid's");
+}
+
 const RegisterCommand reg("terrain", [](CLI::App& app) {
   auto* cmd = app.add_subcommand("terrain", "Terrain: DEM info, flythrough paths, LOD-sprite benchmark");
   cmd->require_subcommand(1);
@@ -165,6 +179,26 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
                     "Above this many full-resolution triangles the harness's full baseline draws nothing")
       ->capture_default_str();
   bench->callback([a] { runBench(*a); });
+
+  auto t = std::make_shared<std::pair<eval::TerrainTilesOptions, std::string>>();
+  t->second = "512x512";
+  eval::TerrainTilesOptions& to = t->first;
+  auto* tiles = cmd->add_subcommand("tiles", "Large terrain in tiles paged under a memory budget: write the tile "
+                                             "cache, fly through it building the LOD per tile, report the paging");
+  tiles->add_option("dem", to.dem, "DEM file or fractal:SIZE[:SEED]")->required();
+  tiles->add_option("-o,--output", to.out_dir, "Output directory")->required();
+  tiles->add_option("--budget-mb", to.budget_mb, "Tile memory budget, MiB")->capture_default_str();
+  tiles->add_option("--block", to.block, "LOD block size in cells")->capture_default_str();
+  tiles->add_option("--tile-blocks", to.tile_blocks, "LOD blocks per tile side")->capture_default_str();
+  tiles->add_option("--frames", to.frames, "Frames of the flythrough")->capture_default_str();
+  tiles->add_option("--cache", to.cache, "Tile cache file (default OUTDIR/terrain.tiles)");
+  tiles->add_flag("--reuse-cache", to.reuse_cache, "Read the existing tile cache instead of writing it");
+  tiles->add_option("--pixel-error", to.pixel_error, "LOD threshold, pixels")->capture_default_str();
+  tiles->add_option("--check-stride", to.check_stride, "Compare with the whole grid's LOD every K-th frame")
+      ->capture_default_str();
+  tiles->add_option("--clearance", to.clearance, "Flythrough clearance, m (0 = the default)")->capture_default_str();
+  tiles->add_option("--size", t->second, "Frame size WxH")->capture_default_str();
+  tiles->callback([t] { runTiles(t->first, t->second); });
 });
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
@@ -97,7 +98,24 @@ LodVertexKind lodVertexKind(int x, int y, int block, int* scale) {
   return kind;
 }
 
-QuadtreeLod::QuadtreeLod(const Heightfield& hf, int block) : hf_(&hf) {
+QuadtreeLod::QuadtreeLod(const Heightfield& hf, int block, IVec2 origin) : hf_(&hf), origin_(origin) {
+  init(block, 1);
+  computeErrors();
+}
+
+QuadtreeLod::QuadtreeLod(const Heightfield& hf, int block, IVec2 origin, int step, std::vector<float> delta,
+                         std::vector<float> radius)
+    : hf_(&hf), origin_(origin), delta_(std::move(delta)), radius_(std::move(radius)) {
+  if (step < 1 || (step & (step - 1)) != 0)
+    throw Error(hf.source, "LOD step " + std::to_string(step) + " is not a power of two");
+  if (delta_.size() != hf.size() || radius_.size() != hf.size())
+    throw Error(hf.source, "precomputed LOD errors do not match the " + std::to_string(hf.width) + "x" +
+                               std::to_string(hf.height) + " grid");
+  init(block, step);
+}
+
+void QuadtreeLod::init(int block, int step) {
+  const Heightfield& hf = *hf_;
   const int w = hf.width, h = hf.height;
   if (w < 3 || h < 3) throw Error(hf.source, "grid too small for the quadtree LOD (need at least 3x3 points)");
   if (block == 0) {
@@ -109,10 +127,19 @@ QuadtreeLod::QuadtreeLod(const Heightfield& hf, int block) : hf_(&hf) {
                                " grid is not made of whole LOD blocks of " + std::to_string(block) +
                                " cells (need (a * block + 1) x (b * block + 1) points; crop with cropForBlocks)");
   block_ = block;
+  step_ = step;
+  // The full grid's cell: exact, step being a power of two.
+  const double cell_x = hf.cell_x / step, cell_y = hf.cell_y / step;
   positions_.resize(hf.size());
   for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) positions_[hf.index(i, j)] = hf.position(i, j);
-  computeErrors();
+    for (int i = 0; i < w; ++i)
+      positions_[hf.index(i, j)] = Vec3(float((i * step + origin_.x) * cell_x),
+                                        float((j * step + origin_.y) * cell_y), hf.at(i, j));
+}
+
+size_t QuadtreeLod::bytes() const {
+  return positions_.capacity() * sizeof(Vec3) + delta_.capacity() * sizeof(float) +
+         radius_.capacity() * sizeof(float);
 }
 
 int QuadtreeLod::parents(uint32_t v, std::array<uint32_t, 2>& out) const {
@@ -208,6 +235,12 @@ struct QuadtreeLod::Build {
   float tau = 0.0f;
   std::vector<uint32_t>* indices = nullptr;
   std::vector<uint32_t>* quad_centres = nullptr;
+  const LodWindow* window = nullptr;
+
+  uint32_t out(Point p) const {
+    if (!window) return uint32_t(p.x + p.y * w);
+    return uint32_t(p.x * lod.step_ + lod.origin_.x) + uint32_t(p.y * lod.step_ + lod.origin_.y) * window->global_width;
+  }
 
   // -1: sphere outside the frustum, 1: inside, 0: crossing.
   int classify(uint32_t v) const {
@@ -239,16 +272,18 @@ struct QuadtreeLod::Build {
       refine(m, a, b, sphere, inside);
       return;
     }
-    indices->push_back(uint32_t(a.x + a.y * w));
-    indices->push_back(uint32_t(b.x + b.y * w));
-    indices->push_back(uint32_t(c.x + c.y * w));
+    indices->push_back(out(a));
+    indices->push_back(out(b));
+    indices->push_back(out(c));
     if (has_split && quad_centres) quad_centres->push_back(mi);
   }
 
   void run() {
     const int s = lod.block_;
-    for (int y0 = 0; y0 + s < lod.hf_->height; y0 += s)
-      for (int x0 = 0; x0 + s < w; x0 += s) {
+    const int bx0 = window ? window->block_x0 : 0, by0 = window ? window->block_y0 : 0;
+    const int bx1 = window ? window->block_x1 : lod.blocksX(), by1 = window ? window->block_y1 : lod.blocksY();
+    for (int y0 = by0 * s; y0 < by1 * s; y0 += s)
+      for (int x0 = bx0 * s; x0 < bx1 * s; x0 += s) {
         const int x1 = x0 + s, y1 = y0 + s;
         const uint32_t centre = uint32_t((x0 + s / 2) + (y0 + s / 2) * w);
         refine({x1, y0}, {x1, y1}, {x0, y0}, centre, false);
@@ -257,8 +292,12 @@ struct QuadtreeLod::Build {
   }
 };
 
-void QuadtreeLod::build(const Camera& camera, const LodSettings& settings, LodMesh& out) const {
+void QuadtreeLod::build(const Camera& camera, const LodSettings& settings, LodMesh& out,
+                        const LodWindow* window) const {
   out.clear();
+  if (window)
+    FF_CHECK(window->block_x0 >= 0 && window->block_y0 >= 0 && window->block_x1 <= blocksX() &&
+             window->block_y1 <= blocksY() && window->global_width >= uint32_t(origin_.x + width()));
   std::vector<uint32_t> centres;
   Build b(*this, false, settings.cull);
   b.frustum = Frustum::fromMatrix(camera.viewProjection());
@@ -267,6 +306,7 @@ void QuadtreeLod::build(const Camera& camera, const LodSettings& settings, LodMe
   b.tau = settings.pixel_error;
   b.indices = &out.indices;
   b.quad_centres = settings.collect_quadrants ? &centres : nullptr;
+  b.window = window;
   b.run();
   if (!settings.collect_quadrants) return;
 
@@ -280,11 +320,11 @@ void QuadtreeLod::build(const Camera& camera, const LodSettings& settings, LodMe
     const LodVertexKind kind = lodVertexKind(x, y, block_, &scale);
     const int half = scale / 2;
     LodQuadrant q;
-    q.centre = v;
+    q.centre = b.out({x, y});
     q.corner_count = 0;
     auto add = [&](int px, int py) {
       if (px < 0 || py < 0 || px >= w || py >= h) return;
-      q.corners[q.corner_count++] = uint32_t(px + py * w);
+      q.corners[q.corner_count++] = b.out({px, py});
     };
     if (kind == LodVertexKind::SquareCentre) {
       add(x - half, y - half), add(x + half, y - half), add(x + half, y + half), add(x - half, y + half);

@@ -58,17 +58,40 @@ struct LodMesh {
   }
 };
 
+// Part of a LOD to build, for a LOD over one tile of a larger grid (tiled_lod.h): only the blocks
+// [block_x0, block_x1) x [block_y0, block_y1) are refined, and the mesh's indices (and quadrants) are grid indices
+// of the larger grid, (x * step + origin.x) + (y * step + origin.y) * global_width for the LOD's grid point (x, y).
+struct LodWindow {
+  int block_x0 = 0, block_y0 = 0, block_x1 = 0, block_y1 = 0;
+  uint32_t global_width = 0;
+};
+
 class QuadtreeLod {
  public:
   // hf must be (a * block + 1) x (b * block + 1) points, block a power of two >= 2 (cropForBlocks makes such a
   // grid); block 0 picks the largest power of two (at most 512) that fits. Throws farfield::Error otherwise. Keeps a
-  // reference to hf, which must outlive the LOD.
-  explicit QuadtreeLod(const Heightfield& hf, int block = 0);
+  // reference to hf, which must outlive the LOD. origin: where hf's grid point (0, 0) lies in a larger grid of the
+  // same cell size (a tile, tiled_lod.h); positions are those of that grid's local frame, (i + origin.x) * cell_x,
+  // computed exactly as the larger grid's own LOD computes them, so a tile's errors, spheres and choices match it.
+  explicit QuadtreeLod(const Heightfield& hf, int block = 0, IVec2 origin = IVec2(0));
+  // A LOD whose errors and spheres were computed beforehand on the full-resolution grid (tile_cache.h): hf holds
+  // every step-th grid point (step a power of two; hf.cell_x = step * the full grid's cell), block is in hf's
+  // points, origin in full-grid points, and delta / radius are the full grid's saturated values at hf's points.
+  // Positions are computed as the full grid's (exactly), so every vertex hf keeps is active exactly when it is
+  // in the full-resolution LOD. Throws farfield::Error for arrays that do not match hf.
+  QuadtreeLod(const Heightfield& hf, int block, IVec2 origin, int step, std::vector<float> delta,
+              std::vector<float> radius);
 
   const Heightfield& heightfield() const { return *hf_; }
   int block() const { return block_; }
   int width() const { return hf_->width; }
   int height() const { return hf_->height; }
+  IVec2 origin() const { return origin_; }
+  int step() const { return step_; }
+  int blocksX() const { return (hf_->width - 1) / block_; }
+  int blocksY() const { return (hf_->height - 1) / block_; }
+  // Bytes held by the LOD's own arrays (positions, errors, spheres), not counting the heightfield.
+  size_t bytes() const;
   // Saturated object-space error (metres) and sphere radius of a grid vertex; block corners give +infinity / 0.
   float objectError(uint32_t v) const { return delta_[v]; }
   float radius(uint32_t v) const { return radius_[v]; }
@@ -76,22 +99,29 @@ class QuadtreeLod {
   int parents(uint32_t v, std::array<uint32_t, 2>& out) const;
   Vec3 position(uint32_t v) const { return positions_[v]; }
   const std::vector<Vec3>& positions() const { return positions_; }
+  const std::vector<float>& objectErrors() const { return delta_; }
+  const std::vector<float>& radii() const { return radius_; }
 
   static double pixelsPerRadian(const Camera& camera);
   bool active(uint32_t v, const Vec3& eye, double lambda, float tau) const;
 
   // The view-dependent mesh for a camera (its eye, frustum and image height) and threshold.
-  void build(const Camera& camera, const LodSettings& settings, LodMesh& out) const;
+  // window: null = every block, local indices; otherwise see LodWindow (out is cleared either way).
+  void build(const Camera& camera, const LodSettings& settings, LodMesh& out,
+             const LodWindow* window = nullptr) const;
   LodMesh build(const Camera& camera, const LodSettings& settings) const;
   // The grid at full resolution (two triangles per cell), counter-clockwise seen from above.
   std::vector<uint32_t> fullResolutionIndices() const;
 
  private:
   struct Build;
+  void init(int block, int step);
   void computeErrors();
 
   const Heightfield* hf_;
   int block_ = 0;
+  IVec2 origin_{0};
+  int step_ = 1;  // full-grid points between neighbouring points of hf (precomputed LODs of tiles)
   std::vector<Vec3> positions_;
   std::vector<float> delta_;
   std::vector<float> radius_;

@@ -1,0 +1,209 @@
+// The tiled-terrain experiment (issue 18; see terrain_tiles.h).
+#include "farfield/eval/terrain_tiles.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
+
+#include "farfield/core/error.h"
+#include "farfield/core/timer.h"
+#include "farfield/eval/terrain_paths.h"
+#include "farfield/terrain/dem_io.h"
+#include "farfield/terrain/fractal.h"
+#include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_data.h"
+#include "farfield/terrain/tile_cache.h"
+#include "farfield/terrain/tile_pager.h"
+#include "farfield/terrain/tiled_lod.h"
+
+namespace farfield::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Resident set of this process, bytes (Linux; 0 elsewhere).
+size_t residentSetBytes() {
+  std::ifstream in("/proc/self/statm");
+  size_t pages = 0, resident = 0;
+  if (!(in >> pages >> resident)) return 0;
+  return resident * size_t(sysconf(_SC_PAGESIZE));
+}
+
+void writeFile(const fs::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out) throw Error(file.string(), "cannot write");
+}
+
+double mib(size_t bytes) { return double(bytes) / (1024.0 * 1024.0); }
+
+struct FrameRow {
+  size_t triangles = 0;
+  terrain::TiledLodFrame tiles;
+  size_t resident = 0, loads = 0, evictions = 0;
+  double ms = 0.0;
+  int check = -1;  // -1 not checked, 0 same, 1 differs
+};
+
+}  // namespace
+
+TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
+  if (o.frames < 2) throw Error("--frames", "need at least 2 frames");
+  if (!(o.budget_mb > 0.0)) throw Error("--budget-mb", "must be positive");
+  if (o.tile_blocks < 1) throw Error("--tile-blocks", "must be at least 1");
+  if (!(o.pixel_error > 0.0f)) throw Error("--pixel-error", "must be positive");
+  const Stopwatch total;
+  const fs::path out(o.out_dir);
+  fs::create_directories(out);
+  const std::string cache_path = o.cache.empty() ? (out / "terrain.tiles").string() : o.cache;
+
+  // The heightfield is needed to write the cache and to place the flythrough; then it is dropped (unless checked).
+  auto hf = std::make_unique<terrain::Heightfield>(
+      terrain::cropForBlocks(o.dem.rfind("fractal:", 0) == 0 ? terrain::fractalTerrain(terrain::parseFractalSpec(o.dem))
+                                                             : terrain::loadDem(o.dem),
+                             o.block));
+  const std::string source = hf->source;
+  const int grid_w = hf->width, grid_h = hf->height;
+  double write_seconds = 0.0;
+  if (!o.reuse_cache) {
+    const Stopwatch w;
+    terrain::TileCache::write(*hf, o.block, o.tile_blocks, cache_path);
+    write_seconds = w.seconds();
+  }
+  terrain::FlythroughOptions fo;
+  fo.frames = o.frames;
+  fo.clearance = o.clearance;
+  const gen::CameraPath path = flythroughCameraPath(*hf, fo);
+  const ClipPlanes clip = terrainClipPlanes(*hf, path);
+  std::unique_ptr<terrain::QuadtreeLod> whole;
+  if (o.check_stride > 0) whole = std::make_unique<terrain::QuadtreeLod>(*hf, o.block);
+  else hf.reset();
+  const size_t rss_after_drop = residentSetBytes();
+
+  const terrain::TileCache cache(cache_path);
+  if (cache.layout().width != grid_w || cache.layout().height != grid_h || cache.layout().block != o.block)
+    throw Error(cache_path, "tile cache does not match " + source + " at block " + std::to_string(o.block));
+  terrain::TilePager pager(cache, size_t(o.budget_mb * 1024.0 * 1024.0));
+  terrain::LodSettings settings;
+  settings.pixel_error = o.pixel_error;
+  std::vector<FrameRow> rows;
+  terrain::LodMesh mesh, check;
+  TerrainTilesResult result;
+  size_t rss_peak = rss_after_drop;
+  for (size_t f = 0; f < path.frames.size(); ++f) {
+    const Camera camera = path.camera(f, o.width, o.height, clip.near_plane, clip.far_plane);
+    FrameRow row;
+    const Stopwatch sw;
+    terrain::buildTiledLod(pager, camera, settings, mesh, &row.tiles);
+    row.ms = sw.milliseconds();
+    row.triangles = mesh.triangleCount();
+    row.resident = pager.stats().resident_bytes;
+    row.loads = pager.stats().loads;
+    row.evictions = pager.stats().evictions;
+    if (whole && f % o.check_stride == 0) {
+      terrain::LodSettings all = settings;
+      all.cull = false;
+      buildTiledLod(pager, camera, all, mesh);
+      whole->build(camera, all, check);
+      std::vector<uint32_t> a = mesh.indices, b = check.indices;
+      // Same triangles, whatever their order (each triangle's indices keep their rotation: both start at the
+      // triangle's right angle).
+      auto sorted = [](std::vector<uint32_t>& v) {
+        std::vector<std::array<uint32_t, 3>> t(v.size() / 3);
+        for (size_t i = 0; i < t.size(); ++i) t[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+        std::sort(t.begin(), t.end());
+        return t;
+      };
+      row.check = sorted(a) == sorted(b) ? 0 : 1;
+      result.check_mismatches += size_t(row.check);
+    }
+    if (f % 50 == 0) rss_peak = std::max(rss_peak, residentSetBytes());
+    rows.push_back(row);
+  }
+  const terrain::TilePagerStats& st = pager.stats();
+
+  std::ostringstream csv;
+  csv << "frame,triangles,tiles_in_view,tiles_culled,full_resolution_tiles,coarsest_step,resident_bytes,loads,"
+         "evictions,lod_ms,check\n";
+  size_t max_tri = 0, sum_tri = 0;
+  double sum_ms = 0.0;
+  std::vector<double> ms;
+  for (size_t f = 0; f < rows.size(); ++f) {
+    const FrameRow& r = rows[f];
+    csv << f << ',' << r.triangles << ',' << r.tiles.tiles_in_view << ',' << r.tiles.tiles_culled << ','
+        << r.tiles.full_resolution_tiles << ',' << r.tiles.coarsest_step << ',' << r.resident << ',' << r.loads << ','
+        << r.evictions << ',' << r.ms << ',' << r.check << '\n';
+    max_tri = std::max(max_tri, r.triangles);
+    sum_tri += r.triangles;
+    sum_ms += r.ms;
+    ms.push_back(r.ms);
+  }
+  std::sort(ms.begin(), ms.end());
+  writeFile(out / "tiles_frames.csv", csv.str());
+  const double mean_tri = double(sum_tri) / double(rows.size());
+  size_t full_bytes = 0;
+  for (int ty = 0; ty < cache.layout().tilesY(); ++ty)
+    for (int tx = 0; tx < cache.layout().tilesX(); ++tx) full_bytes += cache.residentBytes(tx, ty, 1);
+
+  nlohmann::ordered_json j;
+  j["terrain"] = source;
+  j["grid"] = {grid_w, grid_h};
+  j["block"] = o.block;
+  j["tile_blocks"] = o.tile_blocks;
+  j["tiles"] = {cache.layout().tilesX(), cache.layout().tilesY()};
+  j["cache_file"] = cache_path;
+  j["cache_bytes"] = fs::file_size(cache_path);
+  j["cache_write_seconds"] = write_seconds;
+  j["all_tiles_full_resolution_bytes"] = full_bytes;
+  j["budget_bytes"] = pager.budget();
+  j["peak_resident_bytes"] = st.peak_resident_bytes;
+  j["loads"] = st.loads;
+  j["evictions"] = st.evictions;
+  j["hits"] = st.hits;
+  j["requests"] = st.requests;
+  j["bytes_loaded"] = st.bytes_loaded;
+  j["load_seconds"] = st.load_seconds;
+  j["frames"] = rows.size();
+  j["pixel_error"] = o.pixel_error;
+  j["triangles_mean"] = mean_tri;
+  j["triangles_max"] = max_tri;
+  j["lod_ms_mean"] = sum_ms / double(rows.size());
+  j["lod_ms_median"] = ms[ms.size() / 2];
+  j["process_rss_after_dropping_heightfield"] = rss_after_drop;
+  j["process_rss_peak_during_flythrough"] = rss_peak;
+  j["checked_frames"] = o.check_stride ? (rows.size() + o.check_stride - 1) / o.check_stride : 0;
+  j["check_mismatches"] = result.check_mismatches;
+  writeFile(out / "tiles.json", j.dump(2) + "\n");
+
+  std::ostringstream md;
+  md << "| terrain | tiles | budget MiB | peak resident MiB (all tiles at full resolution) | loads / evictions / hits "
+        "| triangles mean / max | LOD build ms mean / median (loads included) | checked frames, mismatches |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|\n";
+  char line[1024];
+  std::snprintf(line, sizeof line, "| %s | %dx%d of %d cells | %.0f | %.1f (%.1f) | %zu / %zu / %zu | %.0f / %zu | %.1f / %.1f | %zu, %zu |\n",
+                source.c_str(), cache.layout().tilesX(), cache.layout().tilesY(),
+                o.block * o.tile_blocks, o.budget_mb, mib(st.peak_resident_bytes), mib(full_bytes), st.loads,
+                st.evictions, st.hits, mean_tri, max_tri, sum_ms / double(rows.size()), ms[ms.size() / 2],
+                size_t(j["checked_frames"]), result.check_mismatches);
+  md << line;
+  std::snprintf(line, sizeof line,
+                "\ncache %.0f MiB written in %.1f s; tiles loaded %.0f MiB in %.1f s; process RSS %.0f MiB after "
+                "dropping the heightfield, at most %.0f MiB sampled during the flythrough\n",
+                mib(fs::file_size(cache_path)), write_seconds, mib(st.bytes_loaded), st.load_seconds,
+                mib(rss_after_drop), mib(rss_peak));
+  md << line;
+  result.markdown = md.str();
+  writeFile(out / "tiles.md", result.markdown);
+  result.seconds = total.seconds();
+  return result;
+}
+
+}  // namespace farfield::eval

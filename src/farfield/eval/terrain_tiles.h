@@ -1,0 +1,38 @@
+// The tiled-terrain experiment (issue 18: large terrains held in tiles and paged under a memory budget, the
+// quadtree LOD of Chen et al. 1999 section 2.2 built per tile): a DEM or fractal is written as a tile cache
+// (terrain/tile_cache.h), the heightfield is dropped, and a flythrough builds the LOD every frame from tiles paged
+// under the budget (terrain/tile_pager.h, terrain/tiled_lod.h). Reports per frame the triangles, the tiles in view
+// and at full resolution, the resident bytes, loads and evictions; optionally checks the mesh against the whole
+// grid's LOD on every K-th frame (small terrains: that LOD holds the whole grid).
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+namespace farfield::eval {
+
+struct TerrainTilesOptions {
+  std::string dem;         // DEM file or fractal:SIZE[:SEED][...] (terrain_data.h)
+  std::string out_dir;     // tiles.json, tiles.md, tiles_frames.csv (and terrain.tiles unless cache is set)
+  std::string cache;       // tile cache path; "" = OUT/terrain.tiles
+  bool reuse_cache = false;  // read an existing cache instead of writing it (the flythrough still needs the DEM)
+  int block = 128;         // LOD block, cells
+  int tile_blocks = 8;     // blocks per tile side
+  double budget_mb = 256;  // the pager's budget, MiB
+  int frames = 600;
+  float clearance = 0.0f;  // flythrough clearance, m (0 = the generator's default)
+  int width = 512, height = 512;
+  float pixel_error = 1.0f;  // LOD threshold, pixels (the high LOD)
+  size_t check_stride = 0;   // compare with the whole grid's LOD (no culling) every K-th frame; 0 = never
+};
+
+struct TerrainTilesResult {
+  std::string markdown;
+  double seconds = 0.0;
+  size_t check_mismatches = 0;  // checked frames whose mesh differed from the whole grid's
+};
+
+// Throws farfield::Error for bad options or input.
+TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& options);
+
+}  // namespace farfield::eval

@@ -1,0 +1,40 @@
+// The quadtree LOD built tile by tile from paged tiles (issue 18; see tiled_lod.h).
+#include "farfield/terrain/tiled_lod.h"
+
+#include <algorithm>
+
+namespace farfield::terrain {
+
+void buildTiledLod(TilePager& pager, const Camera& camera, const LodSettings& settings, LodMesh& out,
+                   TiledLodFrame* frame) {
+  out.clear();
+  TiledLodFrame f;
+  const TileCache& cache = pager.cache();
+  const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  const double lambda = QuadtreeLod::pixelsPerRadian(camera);
+  LodMesh piece;
+  for (int ty = 0; ty < cache.layout().tilesY(); ++ty)
+    for (int tx = 0; tx < cache.layout().tilesX(); ++tx) {
+      if (settings.cull && !frustum.intersects(cache.tileBox(tx, ty))) {
+        ++f.tiles_culled;
+        continue;
+      }
+      const int step = cache.stepFor(tx, ty, camera.eye, lambda, settings.pixel_error);
+      const TerrainTile& tile = pager.acquire(tx, ty, step);
+      tile.lod->build(camera, settings, piece, &tile.window);
+      out.indices.insert(out.indices.end(), piece.indices.begin(), piece.indices.end());
+      out.quadrants.insert(out.quadrants.end(), piece.quadrants.begin(), piece.quadrants.end());
+      ++f.tiles_in_view;
+      f.full_resolution_tiles += tile.grid.step == 1 ? 1 : 0;
+      f.coarsest_step = std::max(f.coarsest_step, tile.grid.step);
+    }
+  // A quadrant on a tile's edge comes from both tiles (its two triangles lie on either side).
+  std::sort(out.quadrants.begin(), out.quadrants.end(),
+            [](const LodQuadrant& a, const LodQuadrant& b) { return a.centre < b.centre; });
+  out.quadrants.erase(std::unique(out.quadrants.begin(), out.quadrants.end(),
+                                  [](const LodQuadrant& a, const LodQuadrant& b) { return a.centre == b.centre; }),
+                      out.quadrants.end());
+  if (frame) *frame = f;
+}
+
+}  // namespace farfield::terrain
