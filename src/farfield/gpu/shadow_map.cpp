@@ -63,7 +63,7 @@ ShadowReceiver::~ShadowReceiver() {
 
 void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const ShadowProjection& projection,
                            const RenderTarget& target, const LightSettings& light, uint32_t agent_id_mask,
-                           float bias_m) {
+                           float bias_m, float max_distance_m) {
   // The target's colour alone (its depth and ids are read as textures: no feedback loop).
   glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, target.colorTexture().handle(), 0);
   glNamedFramebufferDrawBuffer(fbo_, GL_COLOR_ATTACHMENT0);
@@ -88,6 +88,8 @@ void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const Sha
   program_.set("u_light_color", light.color);
   program_.set("u_ambient", light.ambient);
   program_.set("u_eye", camera.eye);
+  program_.set("u_forward", camera.forward());
+  program_.set("u_max_distance", max_distance_m);
   glBindTextureUnit(0, target.depthTexture().handle());
   glBindTextureUnit(1, target.idTexture().handle());
   glBindTextureUnit(2, map.depthTexture());

@@ -49,13 +49,14 @@ class ShadowReceiver {
   ShadowReceiver& operator=(const ShadowReceiver&) = delete;
 
   // Darkens the colour of `target` (drawn with `camera`) where the map shadows a receiver: every pixel with depth
-  // (not sky) whose object id has none of `agent_id_mask`'s bits. A receiver at light depth z is shadowed by a map
-  // texel holding less than z - bias_m (metres, over the projection's depth range); a 3x3 filter of compared texels
-  // gives the lit share s, and the colour is multiplied by mix(ambient / (ambient + light_color * max(n . -l, 0)), 1,
-  // s) per channel: what the renderer's lighting (mesh.frag.glsl) gives without the direct term, n being the
+  // (not sky) within max_distance_m along the view whose object id has none of `agent_id_mask`'s bits. A receiver at light depth z is shadowed by a map
+  // texel holding less than z - bias_m (metres, over the projection's depth range); the share s of the 4x4 texels
+  // around it that leave it lit weighs the colour's factor mix(ambient / (ambient + light_color * max(n . -l, 0)),
+  // 1, s) per channel: what the renderer's lighting (mesh.frag.glsl) gives without the direct term, n being the
   // surface normal rebuilt from the depth buffer. Leaves the target unbound.
   void apply(const Camera& camera, const ShadowMap& map, const ShadowProjection& projection,
-             const RenderTarget& target, const LightSettings& light, uint32_t agent_id_mask, float bias_m = 0.03f);
+             const RenderTarget& target, const LightSettings& light, uint32_t agent_id_mask, float bias_m = 0.03f,
+             float max_distance_m = 1e30f);
 
  private:
   Program program_;

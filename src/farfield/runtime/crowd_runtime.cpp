@@ -238,7 +238,8 @@ CrowdFrameStats CrowdRuntime::drawShadowed(const Camera& camera, std::span<const
   stats = drawLists(camera, light, stats);
   if (stats.shadow_casters > 0) {
     if (!receiver_) receiver_ = std::make_unique<gpu::ShadowReceiver>();
-    receiver_->apply(camera, *shadow_map_, shadow_projection_, target, light, shadows.agent_id_mask, shadows.bias_m);
+    receiver_->apply(camera, *shadow_map_, shadow_projection_, target, light, shadows.agent_id_mask, shadows.bias_m,
+                     shadows.distance_m);
   }
   target.bindForOpaquePass();
   return stats;

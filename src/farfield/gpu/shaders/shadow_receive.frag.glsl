@@ -1,7 +1,7 @@
 #version 450 core
 // Farfield shadow receivers (Steed's lecture part 3, "Impostors & shadowmaps"; gpu/shadow_map.h): for each pixel of
-// the frame that is neither sky nor an agent, the world point from the depth buffer, its light-space depth compared
-// with the agents' shadow map over 3x3 bilinear taps (lit share s), and the colour multiplied (blending: dst * src)
+// the frame that is neither sky nor an agent, within u_max_distance along the view, the world point from the depth buffer, its light-space depth compared
+// with the agents' shadow map over the 4x4 texels around it (four gathers of compared texels: lit share s), and the colour multiplied (blending: dst * src)
 // by mix(ambient / (ambient + light * max(n . -l, 0)), 1, s): the lighting of mesh.frag.glsl without its direct
 // term. The normal n comes from the depth buffer: on each axis the nearer of the two neighbours, facing the eye.
 
@@ -18,6 +18,8 @@ uniform vec3 u_light_dir;
 uniform vec3 u_light_color;
 uniform float u_ambient;
 uniform vec3 u_eye;
+uniform vec3 u_forward;       // unit view direction
+uniform float u_max_distance;  // receivers up to this far along the view (metres)
 
 vec3 worldAt(ivec2 p, float depth) {
   const vec2 ndc = (vec2(p) + 0.5) / vec2(textureSize(u_depth, 0)) * 2.0 - 1.0;
@@ -41,6 +43,7 @@ void main() {
   const float depth = texelFetch(u_depth, p, 0).r;
   if (depth <= 0.0 || (texelFetch(u_ids, p, 0).r & u_agent_mask) != 0u) discard;
   const vec3 world = worldAt(p, depth);
+  if (dot(world - u_eye, u_forward) > u_max_distance) discard;
   const vec4 lc = u_light_view_proj * vec4(world, 1.0);
   const vec3 l = lc.xyz / lc.w;
   if (any(greaterThan(abs(l.xy), vec2(1.0)))) discard;  // outside the map: no caster
@@ -49,10 +52,11 @@ void main() {
   const vec2 uv = l.xy * 0.5 + 0.5;
   const float ref = min(l.z, 1.0) - u_bias;
   const vec2 texel = 1.0 / vec2(textureSize(u_shadow, 0));
-  float lit = 0.0;
-  for (int y = -1; y <= 1; ++y)
-    for (int x = -1; x <= 1; ++x) lit += texture(u_shadow, vec3(uv + vec2(x, y) * texel, ref));
-  lit /= 9.0;
+  const vec4 ones = vec4(1.0);
+  const float lit = (dot(textureGather(u_shadow, uv + vec2(-1.0, -1.0) * texel, ref), ones) +
+                     dot(textureGather(u_shadow, uv + vec2(1.0, -1.0) * texel, ref), ones) +
+                     dot(textureGather(u_shadow, uv + vec2(-1.0, 1.0) * texel, ref), ones) +
+                     dot(textureGather(u_shadow, uv + vec2(1.0, 1.0) * texel, ref), ones)) / 16.0;
   if (lit >= 1.0) discard;
   vec3 n = cross(tangent(p, ivec2(1, 0), world, depth), tangent(p, ivec2(0, 1), world, depth));
   if (dot(n, n) < 1e-20) discard;

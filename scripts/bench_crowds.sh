@@ -1,0 +1,23 @@
+#!/bin/sh
+# The crowd figures of docs/BENCHMARKS.md ("Crowds"): farfield crowd bench on the default city, 512x512, pedestrian
+# and elevated paths (path seed 7), every run writing OUT/<run>/{crowd.json,crowd.md,frames/}.
+# Usage: scripts/bench_crowds.sh [OUT] (default out/crowd); FARFIELD=path/to/farfield to pick the binary.
+set -eu
+out=${1:-out/crowd}
+ff=${FARFIELD:-build/release/bin/farfield}
+run() {
+  name=$1
+  shift
+  mkdir -p "$out"
+  xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' "$ff" crowd bench -o "$out/$name" --size 512x512 --path-seed 7 "$@" \
+    > "$out/$name.log" 2>&1
+  grep '^|\|^- ' "$out/$name.log"
+}
+# The lecture's fixed atlas (32 x 8 views x 16 frames, 3 cm texels), agents' shadows on (1024 map, 60 m).
+run main --agents 1000,10000 --frames 6
+# The same without shadows: what the shadow pass costs.
+run noshadow --agents 10000 --frames 4 --samples 1 --no-shadows
+# Views, frames and texel chosen from the error bound for impostors from 20 m on.
+run bound2 --agents 10000 --frames 4 --samples 1 --atlas-from-bound --error-px 2 --bound-switch 20
+run bound1 --agents 10000 --frames 4 --samples 1 --atlas-from-bound --error-px 1 --bound-switch 20
+run a100k --agents 100000 --frames 3 --samples 1
