@@ -6,6 +6,7 @@
 //                        [--clearance M] [--full-max-triangles N]
 // farfield terrain tiles DEM -o OUTDIR [--budget-mb MB] [--block N] [--tile-blocks N] [--frames N] [--cache FILE]
 //                        [--reuse-cache] [--pixel-error PX] [--check-stride K] [--clearance M] [--size WxH]
+//                        [--sprite-tiles CELLS] [--epsilon PX] [--low-error PX]
 // DEM: a GeoTIFF / netCDF / 16-bit PNG file or fractal:SIZE[:SEED].
 //
 // The LOD-sprite experiment (Chen et al. 1999) is eval::runTerrainBench (eval/terrain_bench.h). Its modes are
@@ -198,6 +199,10 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
       ->capture_default_str();
   tiles->add_option("--clearance", to.clearance, "Flythrough clearance, m (0 = the default)")->capture_default_str();
   tiles->add_option("--size", t->second, "Frame size WxH")->capture_default_str();
+  tiles->add_option("--sprite-tiles", to.sprite_tile_cells, "Compare sprites per tile of this many cells with the "
+                                                            "whole-frame sprite (0 = no)")->capture_default_str();
+  tiles->add_option("--epsilon", to.epsilon, "Sprite error threshold, pixels")->capture_default_str();
+  tiles->add_option("--low-error", to.low_error, "Low-resolution LOD threshold, pixels")->capture_default_str();
   tiles->callback([t] { runTiles(t->first, t->second); });
 });
 

@@ -22,6 +22,7 @@
 #include "farfield/terrain/terrain_data.h"
 #include "farfield/terrain/tile_cache.h"
 #include "farfield/terrain/tile_pager.h"
+#include "farfield/terrain/tile_sprites.h"
 #include "farfield/terrain/tiled_lod.h"
 
 namespace farfield::eval {
@@ -51,6 +52,7 @@ struct FrameRow {
   size_t resident = 0, loads = 0, evictions = 0;
   double ms = 0.0;
   int check = -1;  // -1 not checked, 0 same, 1 differs
+  terrain::TileSpriteFrame sprites;
 };
 
 }  // namespace
@@ -84,7 +86,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   const gen::CameraPath path = flythroughCameraPath(*hf, fo);
   const ClipPlanes clip = terrainClipPlanes(*hf, path);
   std::unique_ptr<terrain::QuadtreeLod> whole;
-  if (o.check_stride > 0) whole = std::make_unique<terrain::QuadtreeLod>(*hf, o.block);
+  if (o.check_stride > 0 || o.sprite_tile_cells > 0) whole = std::make_unique<terrain::QuadtreeLod>(*hf, o.block);
   else hf.reset();
   const size_t rss_after_drop = residentSetBytes();
 
@@ -98,6 +100,10 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   terrain::LodMesh mesh, check;
   TerrainTilesResult result;
   size_t rss_peak = rss_after_drop;
+  std::unique_ptr<terrain::TileSprites> tile_sprites;
+  if (o.sprite_tile_cells > 0)
+    tile_sprites = std::make_unique<terrain::TileSprites>(
+        *whole, terrain::TileSpriteOptions{o.sprite_tile_cells, o.epsilon, o.low_error, o.pixel_error});
   for (size_t f = 0; f < path.frames.size(); ++f) {
     const Camera camera = path.camera(f, o.width, o.height, clip.near_plane, clip.far_plane);
     FrameRow row;
@@ -108,7 +114,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     row.resident = pager.stats().resident_bytes;
     row.loads = pager.stats().loads;
     row.evictions = pager.stats().evictions;
-    if (whole && f % o.check_stride == 0) {
+    if (o.check_stride > 0 && f % o.check_stride == 0) {
       terrain::LodSettings all = settings;
       all.cull = false;
       buildTiledLod(pager, camera, all, mesh);
@@ -125,6 +131,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
       row.check = sorted(a) == sorted(b) ? 0 : 1;
       result.check_mismatches += size_t(row.check);
     }
+    if (tile_sprites) row.sprites = tile_sprites->advance(camera);
     if (f % 50 == 0) rss_peak = std::max(rss_peak, residentSetBytes());
     rows.push_back(row);
   }
@@ -132,7 +139,12 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
 
   std::ostringstream csv;
   csv << "frame,triangles,tiles_in_view,tiles_culled,full_resolution_tiles,coarsest_step,resident_bytes,loads,"
-         "evictions,lod_ms,check\n";
+         "evictions,lod_ms,check,sprite_tiles_in_view,sprite_tiles_refreshed,sprite_tiles_triangles,"
+         "whole_keyframe,whole_keyframe_triangles\n";
+  struct {
+    size_t tile_refreshes = 0, tile_views = 0, whole_keyframes = 0;
+    uint64_t tile_triangles = 0, whole_triangles = 0;
+  } sprite;
   size_t max_tri = 0, sum_tri = 0;
   double sum_ms = 0.0;
   std::vector<double> ms;
@@ -140,7 +152,14 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     const FrameRow& r = rows[f];
     csv << f << ',' << r.triangles << ',' << r.tiles.tiles_in_view << ',' << r.tiles.tiles_culled << ','
         << r.tiles.full_resolution_tiles << ',' << r.tiles.coarsest_step << ',' << r.resident << ',' << r.loads << ','
-        << r.evictions << ',' << r.ms << ',' << r.check << '\n';
+        << r.evictions << ',' << r.ms << ',' << r.check << ',' << r.sprites.tiles_in_view << ','
+        << r.sprites.tiles_refreshed << ',' << r.sprites.refreshed_triangles << ',' << int(r.sprites.whole_keyframe)
+        << ',' << r.sprites.whole_triangles << '\n';
+    sprite.tile_refreshes += r.sprites.tiles_refreshed;
+    sprite.tile_views += r.sprites.tiles_in_view;
+    sprite.tile_triangles += r.sprites.refreshed_triangles;
+    sprite.whole_keyframes += r.sprites.whole_keyframe ? 1 : 0;
+    sprite.whole_triangles += r.sprites.whole_triangles;
     max_tri = std::max(max_tri, r.triangles);
     sum_tri += r.triangles;
     sum_ms += r.ms;
@@ -181,6 +200,17 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   j["process_rss_peak_during_flythrough"] = rss_peak;
   j["checked_frames"] = o.check_stride ? (rows.size() + o.check_stride - 1) / o.check_stride : 0;
   j["check_mismatches"] = result.check_mismatches;
+  if (tile_sprites) {
+    j["sprite_tile_cells"] = o.sprite_tile_cells;
+    j["epsilon"] = o.epsilon;
+    j["low_error"] = o.low_error;
+    j["tile_sprite_refreshes"] = sprite.tile_refreshes;
+    j["tile_sprite_refresh_fraction"] = double(sprite.tile_refreshes) / double(std::max<size_t>(sprite.tile_views, 1));
+    j["tile_sprite_keyframe_triangles"] = sprite.tile_triangles;
+    j["whole_keyframes"] = sprite.whole_keyframes;
+    j["whole_keyframe_fraction"] = double(sprite.whole_keyframes) / double(rows.size());
+    j["whole_keyframe_triangles"] = sprite.whole_triangles;
+  }
   writeFile(out / "tiles.json", j.dump(2) + "\n");
 
   std::ostringstream md;
@@ -200,6 +230,18 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                 mib(fs::file_size(cache_path)), write_seconds, mib(st.bytes_loaded), st.load_seconds,
                 mib(rss_after_drop), mib(rss_peak));
   md << line;
+  if (tile_sprites) {
+    std::snprintf(line, sizeof line,
+                  "\nsprites per tile of %d cells at %.2g px: %zu tile refreshes in %zu tile-frames in view (%.1f%%), "
+                  "%.0f high-resolution triangles re-rendered per frame; whole-frame sprite: %zu keyframes in %zu "
+                  "frames (%.1f%%), %.0f triangles per frame\n",
+                  o.sprite_tile_cells, o.epsilon, sprite.tile_refreshes, sprite.tile_views,
+                  100.0 * double(sprite.tile_refreshes) / double(std::max<size_t>(sprite.tile_views, 1)),
+                  double(sprite.tile_triangles) / double(rows.size()), sprite.whole_keyframes, rows.size(),
+                  100.0 * double(sprite.whole_keyframes) / double(rows.size()),
+                  double(sprite.whole_triangles) / double(rows.size()));
+    md << line;
+  }
   result.markdown = md.str();
   writeFile(out / "tiles.md", result.markdown);
   result.seconds = total.seconds();

@@ -3,7 +3,8 @@
 // (terrain/tile_cache.h), the heightfield is dropped, and a flythrough builds the LOD every frame from tiles paged
 // under the budget (terrain/tile_pager.h, terrain/tiled_lod.h). Reports per frame the triangles, the tiles in view
 // and at full resolution, the resident bytes, loads and evictions; optionally checks the mesh against the whole
-// grid's LOD on every K-th frame (small terrains: that LOD holds the whole grid).
+// grid's LOD on every K-th frame (small terrains: that LOD holds the whole grid), and compares sprites per tile with
+// the whole-frame sprite (terrain/tile_sprites.h).
 #pragma once
 
 #include <cstddef>
@@ -24,6 +25,12 @@ struct TerrainTilesOptions {
   int width = 512, height = 512;
   float pixel_error = 1.0f;  // LOD threshold, pixels (the high LOD)
   size_t check_stride = 0;   // compare with the whole grid's LOD (no culling) every K-th frame; 0 = never
+  // Sprites per tile (terrain/tile_sprites.h) against the whole-frame sprite on the same frames, render-free:
+  // tiles of this many cells (0 = not run; needs the whole grid's LOD in memory), at epsilon pixels, the low LOD at
+  // low_error pixels and keyframes at pixel_error.
+  int sprite_tile_cells = 0;
+  double epsilon = 1.0;
+  float low_error = 4.0f;
 };
 
 struct TerrainTilesResult {
