@@ -1,6 +1,7 @@
 // Tiled quadtree LOD against the whole grid's LOD: the same triangles and quadrants for every camera and threshold
 // (without culling exactly; with culling, differences only outside the frustum: the tiles' boxes and coarse tiles'
-// spheres cull differently there), while far tiles are read at coarser steps.
+// spheres cull differently there), while far tiles are read at coarser steps; and on the GPU the tiled mesh's frame
+// equals the whole grid's, pixel for pixel.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,7 +10,12 @@
 #include <tuple>
 #include <vector>
 
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/terrain_renderer.h"
+#include "farfield/terrain/lod_sprite.h"
 #include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_texture.h"
 #include "farfield/terrain/tile_pager.h"
 #include "farfield/terrain/tiled_lod.h"
 #include "terrain/tiled_test_terrain.h"
@@ -102,6 +108,40 @@ TEST(TiledLod, WithCullingDifferencesOnlyOutsideTheFrustum) {
     EXPECT_LE(differ.size(), expected.size() / 10 + 10);
   }
   EXPECT_GT(culled_tiles, 0u);
+}
+
+TEST(TiledLodGL, FramesEqualTheWholeGridsFrames) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  const Heightfield hf = test::tiledTestFractal(13);
+  const QuadtreeLod whole(hf, 16);
+  const image::ColorImage texture = terrainTexture(hf);
+  Vec2 scale, offset;
+  texCoordTransform(hf, scale, offset);
+  gpu::TerrainRenderer renderer(whole.positions(), texture, scale, offset);
+  const TileCache cache(test::writeTestCache(hf, "tiled_lod_gl"));
+  TilePager pager(cache, cache.residentBytes(1, 1, 1) * 3);  // paging while rendering
+  const Vec4 sky(0.62f, 0.74f, 0.88f, 1.0f);
+  size_t coarse = 0;
+  for (const Camera& camera : test::tiledTestCameras(hf)) {
+    LodSettings settings;
+    gpu::RenderTarget a(camera.width, camera.height), b(camera.width, camera.height);
+    a.clear(sky);
+    LodMesh mesh;
+    renderLodFrame(whole, renderer, camera, settings, a, mesh);
+    const image::ColorImage expected = a.readColor();
+    TiledLodFrame frame;
+    buildTiledLod(pager, camera, settings, mesh, &frame);
+    coarse += frame.tiles_in_view - frame.full_resolution_tiles;
+    b.clear(sky);
+    renderer.setIndices(mesh.indices, 0);
+    renderer.drawTextured(camera, b, 0, mesh.triangleCount(), 0);
+    const image::ColorImage tiled = b.readColor();
+    size_t sky_pixels = 0;
+    for (const auto& p : expected.pixels()) sky_pixels += p == expected.pixels().front() ? 1 : 0;
+    EXPECT_LT(sky_pixels, expected.pixels().size());  // the terrain is in view
+    EXPECT_EQ(tiled.pixels(), expected.pixels());
+  }
+  EXPECT_GT(coarse, 0u);
 }
 
 }  // namespace
