@@ -24,8 +24,9 @@ for run in "city city_trees.glb drive2.json" "forest forest5.glb fly5.json"; do
   [ -f "$OUT/profile-$name.json" ] || "$FARFIELD" calibrate "$scene" -o "$OUT/profile-$name.json" --size 640x360 \
     --fov 60 --around "$path" --margin 20 --views "${CAL_VIEWS:-100}" --fit-views 50 --layered-samples 30 \
     --layered-error-px 2 > "$OUT/calibrate-$name.txt" 2>&1
+  [ -f "$OUT/bench-$name-t$TMAX/bench.json" ] && continue
   "$FARFIELD" bench "$scene" --path "$path" --modes culled,dynamic-shade,dynamic-schaufler,layered --reference \
     --repeats 3 --tmax "$TMAX" --frames "$FRAMES" --stride "$STRIDE" --mode-option error_px=2 \
-    --mode-option t_max_ms="$TMAX" --mode-option profile="$OUT/profile-$name.json" -o "$OUT/bench-$name" \
-    > "$OUT/bench-$name.txt" 2>&1
+    --mode-option t_max_ms="$TMAX" --mode-option profile="$OUT/profile-$name.json" -o "$OUT/bench-$name-t$TMAX" \
+    > "$OUT/bench-$name-t$TMAX.txt" 2>&1
 done

@@ -192,7 +192,13 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
     frames_with_deferred += s.geometry_nodes > 0;
   }
   const double f = double(std::max<size_t>(per_frame_.size(), 1));
-  return {{"error_bound_px", options_.error_px},
+  std::map<std::string, double> out;
+  // Which path frames regenerated (to check their measured times against t_max): "regenerations_at_frame_K", for at
+  // most 500 such frames.
+  size_t listed = 0;
+  for (const auto& [k, s] : per_frame_)
+    if (s.regenerations > 0 && listed++ < 500) out["regenerations_at_frame_" + std::to_string(k)] = double(s.regenerations);
+  out.merge(std::map<std::string, double>{{"error_bound_px", options_.error_px},
           {"t_max_ms", options_.t_max_ms},
           {"predicted_ms_mean", predicted / f},
           {"nodes", double(cache_ ? cache_->nodeCount() : 0)},
@@ -211,7 +217,8 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
           {"cost_safety_factor", options_.cost_safety_factor},
           {"layered_cost_calibrated", options_.layered_cost.calibrated ? 1.0 : 0.0},
           {"deferred_regenerations_per_frame", deferred / f},
-          {"frames_with_deferred", frames_with_deferred}};
+          {"frames_with_deferred", frames_with_deferred}});
+  return out;
 }
 
 }  // namespace farfield::eval
