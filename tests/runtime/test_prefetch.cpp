@@ -2,7 +2,8 @@
 // junction the cells are ranked by their agreement with the motion, computed here from the junction positions; and
 // a walkthrough along a straight street chain of a baked city, prefetching one cell only, finds every cell it enters
 // after the first already read ("ready": loaded before the viewer entered it), while without read-ahead every entry
-// stalls (the test can fail both ways).
+// stalls (the test can fail both ways); under a memory budget that holds one cell and not three, the resident
+// impostors and the cells read ahead stay within it at every frame while each entry evicts.
 #include "farfield/runtime/prefetch.h"
 
 #include <gtest/gtest.h>
@@ -132,6 +133,7 @@ TEST(PrefetchWalkTest, OnAStraightPathTheNextCellIsLoadedBeforeTheViewerEntersIt
   const gpu::GpuScene gpu_scene(city.scene);
   const scene::Bvh bvh(city.scene);
   gpu::Renderer renderer;
+  std::vector<uint64_t> resident_at_entry;  // with read-ahead and a budget that never binds
   for (const bool read_ahead : {true, false}) {
     WalkthroughOptions w;
     w.database = store;
@@ -146,6 +148,7 @@ TEST(PrefetchWalkTest, OnAStraightPathTheNextCellIsLoadedBeforeTheViewerEntersIt
       if (plan.report.loaded) {
         entries.push_back(plan.report.read);
         entered.push_back(plan.report.cell);
+        if (read_ahead) resident_at_entry.push_back(plan.report.resident_bytes);
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(1));  // a frame's time: the reader thread runs
     }
@@ -160,6 +163,35 @@ TEST(PrefetchWalkTest, OnAStraightPathTheNextCellIsLoadedBeforeTheViewerEntersIt
     }
     EXPECT_EQ(stats.at("frames_over_memory_budget"), 0.0);
   }
+
+  // A budget that binds: its GPU share (3/4) holds the largest cell and a tenth more, not the three cells, so each
+  // entry evicts. At no frame may the resident impostors and the cells read ahead exceed it, and every cell must
+  // still be entered in order.
+  ASSERT_EQ(resident_at_entry.size(), 3u);
+  std::vector<uint64_t> cell_bytes{resident_at_entry[0]};
+  for (size_t k = 1; k < 3; ++k) cell_bytes.push_back(resident_at_entry[k] - resident_at_entry[k - 1]);
+  const uint64_t largest = *std::max_element(cell_bytes.begin(), cell_bytes.end());
+  const uint64_t budget = largest * 4 / 3 * 11 / 10;
+  ASSERT_GT(resident_at_entry[2], budget * 3 / 4) << "the three cells fit the GPU share: the budget would not bind";
+  WalkthroughOptions w;
+  w.database = store;
+  w.prefetch_cells = 1;
+  w.memory_budget_bytes = budget;
+  Walkthrough walkthrough(city.scene, gpu_scene, bvh, renderer, w);
+  std::vector<uint32_t> entered;
+  uint64_t held_max = 0;
+  for (size_t f = 0; f < path.frames.size(); ++f) {
+    const FramePlan& plan = walkthrough.plan(path.camera(f, 64, 36));
+    if (plan.report.loaded) entered.push_back(plan.report.cell);
+    const uint64_t held = plan.report.resident_bytes + plan.report.read_ahead_bytes;
+    EXPECT_LE(held, budget) << "frame " << f;
+    EXPECT_FALSE(plan.report.over_gpu_budget) << "frame " << f;
+    held_max = std::max(held_max, held);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(entered, chain);
+  EXPECT_GE(held_max, largest);  // the largest cell was resident
+  EXPECT_EQ(walkthrough.statistics().at("frames_over_memory_budget"), 0.0);
 }
 
 }  // namespace
