@@ -78,6 +78,25 @@ TEST(TileCache, DamagedFilesNameTheFile) {
   }
   farfield::test::expectErrorMentions([&] { TileCache c(cut); }, {cut, "inconsistent"});
   farfield::test::expectErrorMentions([&] { TileCache c(path + ".missing"); }, {".missing", "cannot open"});
+
+  // A flipped byte in a tile's data: the index still reads, the tile does not (at full resolution; a coarse step
+  // that skips the row does not see it).
+  std::filesystem::copy_file(path, cut, std::filesystem::copy_options::overwrite_existing);
+  const TileCache good(path);
+  {
+    std::fstream f(cut, std::ios::in | std::ios::out | std::ios::binary);
+    const auto at = std::streamoff(good.info(2, 1).offset + 97 * 4 + 3);  // row 1 of the heights
+    f.seekg(at);
+    char c = 0;
+    f.read(&c, 1);
+    c = char(c ^ 0x10);
+    f.seekp(at);
+    f.write(&c, 1);
+  }
+  const TileCache damaged(cut);
+  EXPECT_NO_THROW(damaged.read(1, 1, 1));
+  EXPECT_NO_THROW(damaged.read(2, 1, 2));
+  farfield::test::expectErrorMentions([&] { damaged.read(2, 1, 1); }, {cut, "tile (2, 1)", "row 1", "heights", "checksum"});
 }
 
 }  // namespace

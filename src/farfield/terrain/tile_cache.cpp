@@ -21,7 +21,16 @@ namespace farfield::terrain {
 namespace {
 
 constexpr char kMagic[8] = {'F', 'F', 'T', 'I', 'L', 'E', 'S', '1'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;
+const char* const kPlaneNames[3] = {"heights", "errors", "radii"};
+
+// FNV-1a, 64 bits, over one row of a plane: a reader checks every row it reads (a far tile reads only some rows).
+uint64_t rowChecksum(const float* row, size_t n) {
+  uint64_t h = 14695981039346656037ull;
+  const auto* bytes = reinterpret_cast<const unsigned char*>(row);
+  for (size_t i = 0; i < n * sizeof(float); ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+  return h;
+}
 
 int storedWidth(const BlockRect& r, int block) { return (r.x1 - r.x0) * block + 1; }
 int storedHeight(const BlockRect& r, int block) { return (r.y1 - r.y0) * block + 1; }
@@ -139,6 +148,11 @@ void TileCache::write(const Heightfield& hf, int block, int tile_blocks, const s
       out.write(reinterpret_cast<const char*>(lod.objectErrors().data()),
                 std::streamsize(grid.size() * sizeof(float)));
       out.write(reinterpret_cast<const char*>(lod.radii().data()), std::streamsize(grid.size() * sizeof(float)));
+      for (const float* plane : {grid.heights.data(), lod.objectErrors().data(), lod.radii().data()})
+        for (int y = 0; y < grid.height; ++y) {
+          const uint64_t sum = rowChecksum(plane + size_t(y) * size_t(grid.width), size_t(grid.width));
+          put(out, sum);
+        }
       infos.push_back(std::move(info));
     }
   out.seekp(std::streamoff(index_at));
@@ -203,7 +217,8 @@ TileCache::TileCache(const std::string& path) : path_(path) {
       for (float& rr : info.level_radius) rr = ir.get<float>();
       info.offset = ir.get<uint64_t>();
       const BlockRect s = l.storedBlocks(tx, ty);
-      const uint64_t bytes = uint64_t(storedWidth(s, l.block)) * uint64_t(storedHeight(s, l.block)) * 12;
+      const uint64_t bytes = uint64_t(storedWidth(s, l.block)) * uint64_t(storedHeight(s, l.block)) * 12 +
+                             uint64_t(storedHeight(s, l.block)) * 3 * sizeof(uint64_t);
       if (info.offset < headerBytes() + index.size() || info.offset + bytes > file_size_ ||
           !(info.z_min <= info.z_max))
         throw Error(path, "tile (" + std::to_string(tx) + ", " + std::to_string(ty) +
@@ -276,9 +291,17 @@ TileGrid TileCache::read(int tx, int ty, int step) const {
     for (int j = 0; j < hs; ++j) {
       const uint64_t at = info(tx, ty).offset + uint64_t(p) * plane_bytes + uint64_t(j) * step * w * sizeof(float);
       const size_t want = row.size() * sizeof(float);
-      if (::pread(fd, row.data(), want, off_t(at)) != ssize_t(want)) {
+      const uint64_t sum_at = info(tx, ty).offset + 3 * plane_bytes + (uint64_t(p) * uint64_t(h) + uint64_t(j) * step) * 8;
+      uint64_t sum = 0;
+      if (::pread(fd, row.data(), want, off_t(at)) != ssize_t(want) ||
+          ::pread(fd, &sum, sizeof sum, off_t(sum_at)) != ssize_t(sizeof sum)) {
         ::close(fd);
         throw Error(path_, "tile (" + std::to_string(tx) + ", " + std::to_string(ty) + "): cannot read its data");
+      }
+      if (sum != rowChecksum(row.data(), row.size())) {
+        ::close(fd);
+        throw Error(path_, "tile (" + std::to_string(tx) + ", " + std::to_string(ty) + "): row " +
+                               std::to_string(j * step) + " of its " + kPlaneNames[p] + " fails its checksum");
       }
       float* dst = planes[p] + size_t(j) * size_t(ws);
       for (int i = 0; i < ws; ++i) dst[i] = row[size_t(i) * size_t(step)];
