@@ -17,7 +17,10 @@ run() {
 run main --agents 1000,10000 --frames 6
 # The same without shadows: what the shadow pass costs.
 run noshadow --agents 10000 --frames 4 --samples 1 --no-shadows
-# Views, frames and texel chosen from the error bound for impostors from 20 m on.
+# Views, frames and texel chosen from the error bound (2 px) for impostors from 20 m on, then from 40 m on.
 run bound2 --agents 10000 --frames 4 --samples 1 --atlas-from-bound --error-px 2 --bound-switch 20
-run bound1 --agents 10000 --frames 4 --samples 1 --atlas-from-bound --error-px 1 --bound-switch 20
+run bound40 --agents 10000 --frames 4 --samples 1 --atlas-from-bound --error-px 2 --bound-switch 40
 run a100k --agents 100000 --frames 3 --samples 1
+# Popping at 30 fps: the nearest view against the four blended views.
+run pop --agents 10000 --frames 12 --step 1 --samples 0
+run popblend --agents 10000 --frames 12 --step 1 --samples 0 --blend-views

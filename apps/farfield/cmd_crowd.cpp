@@ -1,7 +1,7 @@
 // farfield crowd bench -o OUTDIR [--agents 1000,10000] [--paths pedestrian,elevated] [--frames N] [--step K]
 //                      [--size WxH] [--blocks N] [--detail D] [--models A.glb,B.glb] [--texel M] [--cycle-frames F]
 //                      [--azimuths A] [--elevations E] [--error-px PX] [--atlas-from-bound] [--bound-switch M]
-//                      [--outfits N] [--no-shadows] [--shadow-map N] [--shadow-distance M]
+//                      [--blend-views] [--outfits N] [--no-shadows] [--shadow-map N] [--shadow-distance M]
 // Animated crowds with multi-view impostors on a generated city: eval::runCrowdBench (eval/crowd_bench.h).
 #include <cstdio>
 #include <memory>
@@ -93,6 +93,7 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
                   "Choose views, frames and texel per model from --error-px for impostors from --bound-switch on");
   bench->add_option("--bound-switch", o.runtime.bound_switch_m, "Distance (m) from which the bound's atlas holds")
       ->capture_default_str();
+  bench->add_flag("--blend-views", o.runtime.blend_views, "Impostors blend the four views around the eye direction");
   bench->add_option("--outfits", o.outfits, "Colour-region outfits (16 region tints each)")->capture_default_str();
   bench->add_flag("!--no-shadows", o.shadows, "No agent shadows");
   bench->add_option("--shadow-map", o.shadow.map_size, "Shadow map texels per side")->capture_default_str();

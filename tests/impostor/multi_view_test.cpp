@@ -127,7 +127,7 @@ TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
     ASSERT_EQ(nearestView(grid, local), cell);
 
     gpu::RenderTarget geo(160, 160), imp_target(160, 160), wrong(160, 160), other_outfit(160, 160);
-    auto draw = [&](gpu::RenderTarget& t, int mode, uint32_t view, uint32_t outfit = 1) {
+    auto draw = [&](gpu::RenderTarget& t, int mode, uint32_t view, uint32_t outfit = 1, bool blend = false) {
       t.bindForOpaquePass();
       t.clear(light.sky_color);
       gpu::CrowdAgentGpu a = agent;
@@ -136,12 +136,18 @@ TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
         crowd.drawSkinned(camera, model, std::span(&a, 1), light);
       } else {
         a.view = view;
-        crowd.drawImpostors(camera, *imp.atlas, std::span(&a, 1), light);
+        crowd.drawImpostors(camera, *imp.atlas, std::span(&a, 1), light, blend);
       }
     };
     draw(geo, 0, 0);
     draw(imp_target, 1, uint32_t(cell));
     draw(other_outfit, 1, uint32_t(cell), 0);
+    // Blending the views around the capture direction gives (almost) all the weight to the capture view.
+    gpu::RenderTarget blended(160, 160);
+    draw(blended, 1, 0u, 1, true);
+    const Coverage b = compareAgents(geo, blended);
+    EXPECT_GT(double(b.both), 0.93 * double(b.either)) << "cell " << cell << " blended";
+    EXPECT_LT(double(b.bad), 0.15 * double(b.either)) << "cell " << cell << " blended: " << b.bad << " of " << b.either;
     const Coverage o = compareAgents(geo, other_outfit);
     EXPECT_GT(double(o.bad), 0.3 * double(o.either)) << "cell " << cell << ": the tints must show";
     draw(wrong, 1, uint32_t((cell + 1) % grid.azimuths + (cell / grid.azimuths) * grid.azimuths));

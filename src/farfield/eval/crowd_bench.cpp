@@ -127,6 +127,7 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
        << " KiB per frame, the lecture: about 256 KB compressed); switch to impostor beyond "
        << fmt("%.1f", result.switch_m[m]) << " m\n";
   }
+  if (options.runtime.blend_views) md << "- impostors blend the four views around the direction to the eye\n";
   if (options.shadows)
     md << "- shadows: one " << options.shadow.map_size << "x" << options.shadow.map_size << " map, receivers within "
        << fmt("%.0f", options.shadow.distance_m) << " m, in the reference and every mode\n";

@@ -158,6 +158,7 @@ CrowdRenderer::CrowdRenderer()
     : skinned_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl")),
       capture_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_CAPTURE 1")),
       impostor_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl")),
+      impostor_blend_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl", "#define FF_BLEND_VIEWS 1")),
       skinned_depth_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_DEPTH_ONLY 1")),
       impostor_depth_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl", "#define FF_DEPTH_ONLY 1")) {
   glCreateBuffers(1, &agents_);
@@ -234,19 +235,22 @@ FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuMode
 }
 
 FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas,
-                                        std::span<const CrowdAgentGpu> agents, const LightSettings& light) {
+                                        std::span<const CrowdAgentGpu> agents, const LightSettings& light,
+                                        bool blend_views) {
   FrameStats stats;
   if (agents.empty()) return stats;
   const AtlasLayout& l = atlas.layout_;
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < uint32_t(l.frames) && a.view < uint32_t(l.azimuths * l.elevations));
   uploadAgents(agents);
-  impostor_.use();
-  impostor_.set("u_view_proj", camera.viewProjection());
-  impostor_.set("u_eye", camera.eye);
-  impostor_.set("u_fixed_dir", Vec3(0.0f));
-  impostor_.set("u_outfits", outfits_);
-  bindAtlas(impostor_, atlas);
-  setLight(impostor_, light);
+  const Program& p = blend_views ? impostor_blend_ : impostor_;
+  p.use();
+  p.set("u_view_proj", camera.viewProjection());
+  p.set("u_eye", camera.eye);
+  p.set("u_fixed_dir", Vec3(0.0f));
+  p.set("u_outfits", outfits_);
+  p.set("u_max_elevation", l.max_elevation);
+  bindAtlas(p, atlas);
+  setLight(p, light);
   glBindVertexArray(empty_vao_);
   glDisable(GL_CULL_FACE);
   glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(agents.size()));

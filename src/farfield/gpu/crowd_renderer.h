@@ -70,6 +70,7 @@ struct AtlasLayout {
   Vec2 half_size{1.0f};  // metres: the quad's half extent right and up
   Vec3 centre{0.0f};     // agent space
   float radius = 1.0f;   // metres: depth normalisation
+  float max_elevation = 1.5707964f;  // radians: ring j at j * max_elevation / elevations (view blending)
   int width() const { return azimuths * cell_width; }
   int height() const { return elevations * cell_height; }
 };
@@ -113,9 +114,11 @@ class CrowdRenderer {
   // instanced draw. Agents' `index` must be < the model's pose count (FF_CHECK).
   FrameStats drawSkinned(const Camera& camera, const SkinnedGpuModel& model, std::span<const CrowdAgentGpu> agents,
                          const LightSettings& light);
-  // One instanced draw of quads; agents' `index` < frames and `view` < azimuths * elevations (FF_CHECK).
+  // One instanced draw of quads; agents' `index` < frames and `view` < azimuths * elevations (FF_CHECK). With
+  // blend_views, each quad blends the four views around its direction to the eye (bilinear in azimuth and
+  // elevation) instead of showing `view`.
   FrameStats drawImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas, std::span<const CrowdAgentGpu> agents,
-                           const LightSettings& light);
+                           const LightSettings& light, bool blend_views = false);
   // Renders pose `pose` of the model (agent at the origin, heading 0) into `layer` of the atlas, one cell per view;
   // clears the layer first. Leaves the default framebuffer state to the caller (rebind your target after).
   void capture(const SkinnedGpuModel& model, uint32_t pose, ImpostorAtlasGpu& atlas, int layer,
@@ -142,7 +145,7 @@ class CrowdRenderer {
   uint32_t uploadAgents(std::span<const CrowdAgentGpu> agents);
   void bindModel(const Program& p, const SkinnedGpuModel& model) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
-  Program skinned_, capture_, impostor_, skinned_depth_, impostor_depth_;
+  Program skinned_, capture_, impostor_, impostor_blend_, skinned_depth_, impostor_depth_;
   uint32_t agents_ = 0, empty_vao_ = 0, tints_ = 0, outfits_ = 0;
 };
 

@@ -51,6 +51,7 @@ gpu::AtlasLayout atlasLayout(const Box3& bounds, const ViewGrid& grid, int frame
   if (!(texel_m > 0.0f) || frames < 1) throw Error("multi-view atlas", "texel size and frame count must be positive");
   gpu::AtlasLayout l;
   l.azimuths = grid.azimuths;
+  l.max_elevation = grid.max_elevation;
   l.elevations = grid.elevations;
   l.frames = frames;
   l.centre = bounds.center();

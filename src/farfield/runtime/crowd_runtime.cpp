@@ -171,7 +171,7 @@ CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSe
       stats.draw.objects += f.objects;
     };
     add(renderer_.drawSkinned(camera, *models_[m].gpu, lists_.geometry[m], light));
-    add(renderer_.drawImpostors(camera, *models_[m].impostor->atlas, lists_.impostors[m], light));
+    add(renderer_.drawImpostors(camera, *models_[m].impostor->atlas, lists_.impostors[m], light, options_.blend_views));
   }
   return stats;
 }

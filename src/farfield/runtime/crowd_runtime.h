@@ -56,6 +56,9 @@ struct CrowdRuntimeOptions {
   bool atlas_from_bound = false;
   double bound_switch_m = 20.0;
   double bound_focal_px = 443.4;  // 512 px at 60 degrees
+  // Impostors blend the four views around their direction to the eye instead of showing the nearest (an option,
+  // as octahedral impostors blend their three nearest views); shadow casters keep the nearest view to the light.
+  bool blend_views = false;
   // Colour-region tints: outfit o, region r at o * scene::kColorRegions + r; empty = one outfit of white.
   std::vector<Vec4> region_tints;
 };

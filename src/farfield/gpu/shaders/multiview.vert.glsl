@@ -3,7 +3,9 @@
 // camera-facing quad per agent, spanning the model's capture extent (u_half_size metres right and up) around its
 // centre, showing the atlas cell of the agent's view (data.y) and animation frame (data.x, the array layer).
 // Drawn as a 4-vertex triangle strip per instance, no vertex buffer. With u_fixed_dir non-zero (an orthographic
-// light: shadow casters) every quad faces that unit direction instead of the eye.
+// light: shadow casters) every quad faces that unit direction instead of the eye. FF_BLEND_VIEWS: the four views
+// around the direction to the eye (two azimuths on the two elevation rings around it) with bilinear weights in
+// azimuth and elevation, for the fragment shader to blend (the agent's own `view` is then unused).
 
 struct Agent {
   vec4 pos_heading;
@@ -25,6 +27,12 @@ flat out vec3 v_to_eye;
 flat out vec4 v_tint;
 flat out uvec4 v_data;
 flat out float v_heading;
+#ifdef FF_BLEND_VIEWS
+uniform ivec2 u_grid;  // azimuths, elevations
+uniform float u_max_elevation;
+flat out uvec4 v_views;
+flat out vec4 v_weights;
+#endif
 
 void main() {
   const Agent a = agents[u_first_instance + uint(gl_InstanceID)];
@@ -42,5 +50,19 @@ void main() {
   v_tint = a.tint;
   v_data = a.data;
   v_heading = a.pos_heading.w;
+#ifdef FF_BLEND_VIEWS
+  const vec3 local = vec3(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);  // towards the eye, agent space
+  float az = atan(local.y, local.x);
+  if (az < 0.0) az += 6.28318530718;
+  const float fa = az / 6.28318530718 * float(u_grid.x);
+  const int a0 = int(floor(fa)) % u_grid.x, a1 = (a0 + 1) % u_grid.x;
+  const float ta = fract(fa);
+  const float fe = clamp(asin(clamp(local.z, -1.0, 1.0)) / (u_max_elevation / float(u_grid.y)), 0.0,
+                         float(u_grid.y - 1));
+  const int e0 = min(int(floor(fe)), u_grid.y - 1), e1 = min(e0 + 1, u_grid.y - 1);
+  const float te = fe - float(e0);
+  v_views = uvec4(e0 * u_grid.x + a0, e0 * u_grid.x + a1, e1 * u_grid.x + a0, e1 * u_grid.x + a1);
+  v_weights = vec4((1.0 - ta) * (1.0 - te), ta * (1.0 - te), (1.0 - ta) * te, ta * te);
+#endif
   gl_Position = u_view_proj * vec4(v_world, 1.0);
 }
