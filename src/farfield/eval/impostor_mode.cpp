@@ -51,6 +51,7 @@ ImpostorMode::ImpostorMode(std::string technique, const ModeContext& context) : 
   o.cell_lookup = context.option("cell_lookup");
   if (!o.cell_lookup.empty()) urban::parseCellLookup(o.cell_lookup, "--mode-option cell_lookup");
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);
+  if (switchOption(context, "occlusion", true)) occlusion_.emplace(occluderShareOption(context, technique_));
 }
 
 ImpostorMode::~ImpostorMode() = default;
@@ -82,11 +83,13 @@ void ImpostorMode::prepare(const ModeContext& context) {
 
 void ImpostorMode::frame(FrameContext& frame) {
   const runtime::FramePlan& plan = walkthrough_->plan(frame.camera());
-  frame.items().insert(frame.items().end(), plan.items.begin(), plan.items.end());
+  submitPlan(frame, plan, occlusion_ ? &*occlusion_ : nullptr);
 }
 
 std::map<std::string, double> ImpostorMode::info() const {
-  return walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
+  std::map<std::string, double> info = walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
+  if (occlusion_) info.merge(occlusion_->info());
+  return info;
 }
 
 }  // namespace farfield::eval

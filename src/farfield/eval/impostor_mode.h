@@ -16,15 +16,18 @@
 //                         grid-mesh): a store holds one kind
 //   depth_mesh_dir=DIR    store for the depth-mesh mode only (overrides impostor_dir), likewise grid_mesh_dir=DIR:
 //                         for the two stores of `bake --technique depth-mesh -o A` and `--technique grid-mesh -o B`
-//   error_px=PX, gpu_budget_mb=MB, memory_budget_mb=MB, streaming_csv=FILE (as mmi_mode.h), read_ahead=on|off, impostor_ids=object|layer, cell_lookup=street|nearest
+//   error_px=PX, gpu_budget_mb=MB, memory_budget_mb=MB, streaming_csv=FILE, occlusion=on|off, occluder_share=S (as
+//   mmi_mode.h), read_ahead=on|off, impostor_ids=object|layer, cell_lookup=street|nearest
 //                         as for the smi mode (eval/mmi_mode.h)
 #pragma once
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "farfield/eval/mode.h"
+#include "farfield/eval/occlusion_pass.h"
 #include "farfield/runtime/walkthrough.h"
 
 namespace farfield::eval {
@@ -54,6 +57,7 @@ class ImpostorMode final : public Mode {
   std::string technique_;
   runtime::WalkthroughOptions options_;
   std::unique_ptr<runtime::Walkthrough> walkthrough_;
+  std::optional<OcclusionPass> occlusion_;  // the plans' geometry occlusion-culled (--mode-option occlusion=on)
 };
 
 }  // namespace farfield::eval

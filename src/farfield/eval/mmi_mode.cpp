@@ -50,6 +50,8 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
   o.max_updates = countOption(context, "dynamic_max_updates", o.max_updates);
   o.min_lifetime_frames = numberOption(context, "dynamic_min_lifetime", o.min_lifetime_frames, 0.0);
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);
+  if (switchOption(context, "occlusion", true))
+    occlusion_.emplace(occluderShareOption(context, runtime::representationName(representation)));
 }
 
 MmiMode::~MmiMode() = default;
@@ -63,13 +65,15 @@ void MmiMode::prepare(const ModeContext& context) {
 
 void MmiMode::frame(FrameContext& frame) {
   const runtime::FramePlan& plan = walkthrough_->plan(frame.camera(), [&] { frame.beginOwnPass(); });
-  frame.items().insert(frame.items().end(), plan.items.begin(), plan.items.end());
+  submitPlan(frame, plan, occlusion_ ? &*occlusion_ : nullptr);
   if (plan.report.updates > 0) frame.addStats(plan.report.update_stats);
 }
 
 std::map<std::string, double> MmiMode::info() const {
   // The walkthrough reports its bound (error_bound_px) for the representations that draw impostors only.
-  return walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
+  std::map<std::string, double> info = walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
+  if (occlusion_) info.merge(occlusion_->info());
+  return info;
 }
 
 }  // namespace farfield::eval

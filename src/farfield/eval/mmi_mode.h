@@ -23,6 +23,8 @@
 //   cell_lookup=street|nearest  as for the depth-mesh mode
 //   error_px=PX             the error bound in pixels of this walk's frames (default: the bake's --error-px); the
 //                           bound's angle follows from the frame size and field of view (core/error_bound.h)
+//   occlusion=on|off        the plan's geometry occlusion-culled against the depth of its nearest items (exact:
+//                           the same frame; default on); occluder_share=S the triangle share drawn first (0.1)
 //   mmi-dynamic only:
 //   frame_budget_ms=MS      the desired frame time (default 33.3: 30 Hz)
 //   dynamic_error_px=PX     a layer is refreshed when its error angle exceeds PX pixels (default 2)
@@ -35,9 +37,11 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "farfield/eval/mode.h"
+#include "farfield/eval/occlusion_pass.h"
 #include "farfield/runtime/walkthrough.h"
 
 namespace farfield::eval {
@@ -58,6 +62,7 @@ class MmiMode final : public Mode {
  private:
   runtime::WalkthroughOptions options_;
   std::unique_ptr<runtime::Walkthrough> walkthrough_;
+  std::optional<OcclusionPass> occlusion_;  // the plans' geometry occlusion-culled (--mode-option occlusion=on)
 };
 
 }  // namespace farfield::eval

@@ -1,12 +1,12 @@
 #include "farfield/eval/mode.h"
 
 #include <algorithm>
-#include <cstdlib>
+#include <optional>
 #include <mutex>
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
-#include "farfield/gpu/occlusion_culler.h"
+#include "farfield/eval/occlusion_pass.h"
 
 namespace farfield::eval {
 
@@ -99,11 +99,9 @@ class FullMode final : public Mode {
 // dropped (gpu::OcclusionCuller: exact, the frame stays the frame of "frustum").
 class CulledMode final : public Mode {
  public:
-  CulledMode(const ModeContext& context, bool occlusion)
-      : gpu_scene_(context.gpu_scene),
-        bvh_(context.bvh),
-        occlusion_(occlusion),
-        culler_(occlusion ? parseShare(context.option("occluder_share", "0.1")) : 0.1) {}
+  CulledMode(const ModeContext& context, bool occlusion) : gpu_scene_(context.gpu_scene), bvh_(context.bvh) {
+    if (occlusion) occlusion_.emplace(occluderShareOption(context, "culled"));
+  }
   std::string name() const override { return occlusion_ ? "culled" : "frustum"; }
   void frame(FrameContext& frame) override {
     ids_.clear();
@@ -119,43 +117,20 @@ class CulledMode final : public Mode {
     candidates_.clear();
     bounds_.clear();
     gpu_scene_->appendDrawItems(ids_, candidates_, frame.camera(), &bounds_);
-    const gpu::OcclusionStats stats = culler_.cull(
-        frame.camera(), candidates_, bounds_, frame.beginOwnPass(),
-        [&](std::span<const gpu::DrawItem> occluders) { frame.drawPass(occluders); }, frame.items());
-    ++frames_;
-    hidden_ += stats.hidden;
-    hidden_triangles_ += double(stats.hidden_triangles);
-    occluders_ += stats.occluders;
-    readback_ms_ += stats.readback_ms;
-    test_ms_ += stats.pyramid_ms;
-  }
-  static double parseShare(const std::string& text) {
-    char* end = nullptr;
-    const double share = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || *end != '\0' || !(share >= 0.0 && share <= 1.0))
-      throw Error("mode 'culled'", "occluder_share must be a number in [0, 1], got '" + text + "'");
-    return share;
+    occlusion_->run(frame, candidates_, bounds_);
   }
   std::map<std::string, double> info() const override {
-    if (!occlusion_ || frames_ == 0) return {};
-    const double n = double(frames_);
-    return {{"occlusion_hidden_items_per_frame", double(hidden_) / n},
-            {"occlusion_hidden_triangles_per_frame", hidden_triangles_ / n},
-            {"occlusion_occluder_items_per_frame", double(occluders_) / n},
-            {"occlusion_readback_ms_per_frame", readback_ms_ / n},
-            {"occlusion_test_ms_per_frame", test_ms_ / n}};
+    if (!occlusion_) return {};
+    return occlusion_->info();
   }
 
  private:
   const gpu::GpuScene* gpu_scene_;
   const scene::Bvh* bvh_;
-  bool occlusion_;
+  std::optional<OcclusionPass> occlusion_;
   std::vector<uint32_t> ids_;
   std::vector<gpu::DrawItem> candidates_;
   std::vector<Box3> bounds_;
-  gpu::OcclusionCuller culler_;
-  uint64_t frames_ = 0, hidden_ = 0, occluders_ = 0;
-  double hidden_triangles_ = 0.0, readback_ms_ = 0.0, test_ms_ = 0.0;
 };
 
 struct Entry {

@@ -287,6 +287,8 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   if (placed_) return planPlaced(camera);
   FramePlan& plan = plan_;
   plan.items.clear();
+  plan.geometry_bounds.clear();
+  plan.geometry_items = 0;
   plan.layers.clear();
   plan.report = {};
   FrameReport& report = plan.report;
@@ -371,7 +373,8 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   if (report.over_gpu_budget) ++stats_.over_gpu_budget_frames;
   std::sort(ids_.begin(), ids_.end());
   // GpuScene::appendDrawItems takes an empty list as "all objects".
-  if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera);
+  if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera, &plan.geometry_bounds);
+  plan.geometry_items = plan.items.size();
   for (const gpu::DrawItem& item : plan.items) report.geometry_triangles += item.triangleCount();
   stats_.geometry_triangles += double(report.geometry_triangles);
   if (report.layers_as_geometry > 0) ++stats_.invalid_frames;

@@ -152,6 +152,11 @@ struct FrameReport {
 
 struct FramePlan {
   std::vector<gpu::DrawItem> items;   // the frame's main pass: geometry and impostors
+  // items[0, geometry_items) are scene geometry, with the bounds of each in its mesh's own space in geometry_bounds
+  // (parallel): an engine may occlusion-cull them against the depth of the nearest ones (gpu::OcclusionCuller, exact:
+  // the frame stays the same) before it draws the rest of the items.
+  size_t geometry_items = 0;
+  std::vector<Box3> geometry_bounds;
   std::vector<LayerDecision> layers;  // per layer of the current cell, or per impostor of the current CPV (Placed)
   FrameReport report;
 };
