@@ -94,6 +94,22 @@ TEST(TerrainModesGL, LoadTheTerrainFromTheModeOptions) {
   currentTerrainRun().reset();
 }
 
+TEST(TerrainModesGL, HighTilesDrawsTheHighLodFromPagedTiles) {
+  registerTerrainModes();
+  currentTerrainRun().reset();
+  const Terrain t;
+  BenchOptions o = t.options({{"terrain", "fractal:65:2"}, {"tile_blocks", "1"}, {"tile_budget_mb", "1"}});
+  o.modes = {"high", "high-tiles"};
+  const BenchResult r = runBench(gpu::sharedHeadlessContext(), t.scene, t.path, o);
+  const ModeResult* tiles = r.mode("high-tiles");
+  ASSERT_NE(tiles, nullptr);
+  // The same mesh as `high` but for triangles outside the frustum (test_tiled_lod.cpp has the exact checks).
+  EXPECT_NEAR(tiles->mean_triangles, r.mode("high")->mean_triangles, 0.1 * r.mode("high")->mean_triangles + 10.0);
+  EXPECT_GT(tiles->info.at("tile_loads"), 0.0);
+  EXPECT_LE(tiles->info.at("tile_peak_resident_bytes"), tiles->info.at("tile_budget_bytes"));
+  currentTerrainRun().reset();
+}
+
 TEST(TerrainModesGL, BadModeOptionsNameTheKey) {
   registerTerrainModes();
   const Terrain t;

@@ -1,13 +1,18 @@
 // Benchmark modes of Chen et al. 1999, LOD-sprite terrain (section 3 and section 5's future work).
 #include "farfield/eval/terrain_modes.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
 #include <exception>
+#include <filesystem>
 #include <stdexcept>
 
 #include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
 #include "farfield/eval/mode_options.h"
+#include "farfield/terrain/tiled_lod.h"
 
 namespace farfield::eval {
 namespace {
@@ -59,6 +64,46 @@ void LodMode::frame(FrameContext& frame) {
 
 std::map<std::string, double> LodMode::info() const {
   return {{"pixel_error", high_ ? run_->high_error : run_->low_error}};
+}
+
+TiledLodMode::~TiledLodMode() {
+  pager_.reset();
+  cache_.reset();
+  if (!cache_path_.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(cache_path_, ec);
+  }
+}
+
+void TiledLodMode::prepare(const ModeContext& context) {
+  run_ = runFor(context, name());
+  run_->gpuRenderer();
+  const int tile_blocks = intOption(context, "tile_blocks", 4, 1, 1 << 16);
+  const uint64_t budget = mebibytesOption(context, "tile_budget_mb", uint64_t(256) << 20);
+  static std::atomic<int> serial{0};
+  cache_path_ = (std::filesystem::temp_directory_path() /
+                 ("farfield-high-tiles-" + std::to_string(::getpid()) + "-" + std::to_string(serial++) + ".tiles"))
+                    .string();
+  terrain::TileCache::write(run_->data->hf, run_->data->lod->block(), tile_blocks, cache_path_);
+  cache_ = std::make_unique<terrain::TileCache>(cache_path_);
+  pager_ = std::make_unique<terrain::TilePager>(*cache_, size_t(budget));
+}
+
+void TiledLodMode::frame(FrameContext& frame) {
+  gpu::RenderTarget& target = frame.beginOwnPass();
+  terrain::buildTiledLod(*pager_, frame.camera(), terrain::LodSettings{run_->high_error, true, false}, mesh_);
+  gpu::TerrainRenderer& renderer = run_->gpuRenderer();
+  renderer.setIndices(mesh_.indices, 0);
+  frame.addStats(renderer.drawTextured(frame.camera(), target, 0, mesh_.triangleCount(), 0));
+}
+
+std::map<std::string, double> TiledLodMode::info() const {
+  const terrain::TilePagerStats& s = pager_->stats();
+  return {{"pixel_error", run_->high_error},
+          {"tile_loads", double(s.loads)},
+          {"tile_evictions", double(s.evictions)},
+          {"tile_peak_resident_bytes", double(s.peak_resident_bytes)},
+          {"tile_budget_bytes", double(pager_->budget())}};
 }
 
 terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon) {
@@ -126,6 +171,10 @@ std::map<std::string, double> SpriteMode::info() const {
 void registerTerrainModes() {
   registerMode("high", "terrain: high-resolution quadtree LOD (--mode-option terrain=DEM)",
                [](const ModeContext&) { return std::make_unique<LodMode>("high", true); });
+  registerMode("high-tiles",
+               "terrain: the high LOD built per tile from tiles paged under a budget (--mode-option terrain=DEM, "
+               "tile_blocks=N, tile_budget_mb=MB)",
+               [](const ModeContext&) { return std::make_unique<TiledLodMode>(); });
   registerMode("low", "terrain: low-resolution quadtree LOD (--mode-option terrain=DEM)",
                [](const ModeContext&) { return std::make_unique<LodMode>("low", false); });
   registerMode("lod-sprite",

@@ -24,6 +24,8 @@
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_cost.h"
 #include "farfield/terrain/terrain_data.h"
+#include "farfield/terrain/tile_cache.h"
+#include "farfield/terrain/tile_pager.h"
 
 namespace farfield::eval {
 
@@ -75,6 +77,27 @@ class LodMode : public Mode {
   terrain::LodMesh mesh_;
 };
 
+// `high-tiles`: the high LOD built per tile from a tile cache of the run's terrain paged under a budget
+// (terrain/tiled_lod.h; the same mesh as `high` up to triangles outside the frustum). Mode options: tile_blocks=N
+// (LOD blocks per tile side, default 4), tile_budget_mb=MB (default 256). The cache is written at prepare() to a
+// temporary file, removed with the mode. info(): pixel_error, tile loads, evictions, peak resident bytes.
+class TiledLodMode : public Mode {
+ public:
+  TiledLodMode() = default;
+  ~TiledLodMode() override;
+  std::string name() const override { return "high-tiles"; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::map<std::string, double> info() const override;
+
+ private:
+  std::shared_ptr<TerrainRun> run_;
+  std::string cache_path_;
+  std::unique_ptr<terrain::TileCache> cache_;
+  std::unique_ptr<terrain::TilePager> pager_;
+  terrain::LodMesh mesh_;
+};
+
 // Paper: "lod-sprite" (with the run's cost model, the per-frame choice); Always: "lod-sprite-always" (every frame the
 // sprite path, whatever it costs).
 enum class SpriteVariant { Paper, Always, Predict, Cache };
@@ -110,7 +133,7 @@ class SpriteMode : public Mode {
   size_t last_frame_ = 0;
 };
 
-// Adds high, low, lod-sprite, lod-sprite-always, lod-sprite-predict and lod-sprite-cache to the mode registry (mode.h). Idempotent.
+// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict and lod-sprite-cache to the mode registry (mode.h). Idempotent.
 // Called by runTerrainBench and by the executable at start-up (the eval library is static: a static registration
 // object in it would be dropped by the linker).
 void registerTerrainModes();
