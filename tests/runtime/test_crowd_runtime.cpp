@@ -188,3 +188,64 @@ TEST_F(CrowdRuntimeGl, AtlasFromTheBoundIsWhatTheBakeUsesAndKeepsTheBound) {
 
 }  // namespace
 }  // namespace farfield::runtime
+
+namespace farfield::runtime {
+namespace {
+
+// Turning an agent through one azimuth step of the view grid: showing the nearest view, the image jumps once at the
+// midpoint; blending the four views around the direction spreads that change over the turn.
+TEST_F(CrowdRuntimeGl, BlendedViewsChangeSmoothlyWhereTheNearestViewJumps) {
+  const scene::SkinnedModel fox =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  CrowdRuntimeOptions o;
+  o.palette_poses = 4;
+  o.frames = 4;
+  o.grid = impostor::ViewGrid{12, 3, float(kPi / 4)};
+  o.texel_m = 0.01f;
+  CrowdModelOptions mo;
+  mo.height_m = 0.8f;
+  CrowdRuntime nearest(std::span(&fox, 1), std::span(&mo, 1), o);
+  o.blend_views = true;
+  CrowdRuntime blended(std::span(&fox, 1), std::span(&mo, 1), o);
+  Camera camera;
+  camera.eye = Vec3(0, 0, 1.7f);
+  camera.at = Vec3(25, 0, 0.4f);
+  camera.width = camera.height = 160;
+  camera.fov_y = float(degToRad(4.0));
+  gpu::RenderTarget target(160, 160);
+  gpu::LightSettings light;
+  auto largestStep = [&](CrowdRuntime& rt) {
+    image::ColorImage previous;
+    int largest = 0;
+    const int steps = 12;
+    for (int k = 0; k <= steps; ++k) {
+      std::vector<CrowdAgentState> agents(1);
+      agents[0].position = Vec3(25, 0, 0);
+      agents[0].heading = float(2.0 * kPi / 12.0) * (0.1f + 0.8f * float(k) / float(steps));  // across a midpoint
+      agents[0].phase = 0.25f;
+      agents[0].object_id = 1;
+      target.bindForOpaquePass();
+      target.clear(light.sky_color);
+      rt.draw(camera, agents, CrowdPolicy::Impostor, light);
+      image::ColorImage frame = target.readColor();
+      if (k > 0) {
+        int changed = 0;
+        for (size_t i = 0; i < frame.pixelCount(); ++i)
+          for (int c = 0; c < 3; ++c)
+            if (std::abs(int(frame.pixels()[i][c]) - int(previous.pixels()[i][c])) > 24) {
+              ++changed;
+              break;
+            }
+        largest = std::max(largest, changed);
+      }
+      previous = std::move(frame);
+    }
+    return largest;
+  };
+  const int jump = largestStep(nearest), smooth = largestStep(blended);
+  EXPECT_GT(jump, 300) << "the nearest view must jump across the midpoint";
+  EXPECT_LT(double(smooth), 0.6 * double(jump)) << smooth << " against " << jump;
+}
+
+}  // namespace
+}  // namespace farfield::runtime
