@@ -63,7 +63,8 @@ ShadowReceiver::~ShadowReceiver() {
 
 void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const ShadowProjection& projection,
                            const RenderTarget& target, const LightSettings& light, uint32_t agent_id_mask,
-                           float bias_m, float max_distance_m) {
+                           float bias_m, float max_distance_m, const glm::ivec4* scissor) {
+  if (scissor && (scissor->z <= scissor->x || scissor->w <= scissor->y)) return;  // nothing to shade
   // The target's colour alone (its depth and ids are read as textures: no feedback loop).
   glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, target.colorTexture().handle(), 0);
   glNamedFramebufferDrawBuffer(fbo_, GL_COLOR_ATTACHMENT0);
@@ -73,7 +74,12 @@ void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const Sha
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_FALSE);
   glDisable(GL_CULL_FACE);
-  glDisable(GL_SCISSOR_TEST);
+  if (scissor) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(scissor->x, scissor->y, scissor->z - scissor->x, scissor->w - scissor->y);
+  } else {
+    glDisable(GL_SCISSOR_TEST);
+  }
   glEnable(GL_BLEND);
   glBlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_ONE);  // colour *= factor, alpha kept
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -97,6 +103,7 @@ void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const Sha
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);
   glDisable(GL_BLEND);
+  glDisable(GL_SCISSOR_TEST);
   glDepthMask(GL_TRUE);
   glEnable(GL_DEPTH_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -53,10 +53,11 @@ class ShadowReceiver {
   // texel holding less than z - bias_m (metres, over the projection's depth range); the share s of the 4x4 texels
   // around it that leave it lit weighs the colour's factor mix(ambient / (ambient + light_color * max(n . -l, 0)),
   // 1, s) per channel: what the renderer's lighting (mesh.frag.glsl) gives without the direct term, n being the
-  // surface normal rebuilt from the depth buffer. Leaves the target unbound.
+  // surface normal rebuilt from the depth buffer. Only within `scissor` (x0, y0, x1, y1 from the bottom left,
+  // exclusive ends) when given. Leaves the target unbound.
   void apply(const Camera& camera, const ShadowMap& map, const ShadowProjection& projection,
              const RenderTarget& target, const LightSettings& light, uint32_t agent_id_mask, float bias_m = 0.03f,
-             float max_distance_m = 1e30f);
+             float max_distance_m = 1e30f, const glm::ivec4* scissor = nullptr);
 
  private:
   Program program_;

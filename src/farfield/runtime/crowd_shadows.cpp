@@ -8,7 +8,7 @@
 namespace farfield::runtime {
 
 ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const CasterSphere> spheres,
-                    float distance_m, int map_size) {
+                    float distance_m, int map_size, float drop_m) {
   if (!(glm::length(light_dir) > 0.0f)) throw Error("crowd shadows", "the light has no direction");
   if (!(distance_m > 0.0f) || map_size < 16) throw Error("crowd shadows", "shadow distance and map size must be positive");
   const Vec3 f = glm::normalize(light_dir);
@@ -68,6 +68,37 @@ ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const
   fit.projection.view_proj = m;
   fit.projection.depth_range_m = zhi - zlo;
   fit.projection.texel_m = side / float(map_size);
+
+  // Screen bounds of the shadows: each caster's sphere at its centre and where the light carries it down to drop_m
+  // below its lowest point (the sphere's bounds in between follow: the swept sphere is their convex hull).
+  const Mat4 vp = camera.viewProjection();
+  const float focal = float(camera.height) / (2.0f * ty);
+  Vec2 slo(1e30f), shi(-1e30f);
+  bool whole = false;
+  for (uint32_t i : fit.casters) {
+    const CasterSphere& s = spheres[i];
+    const float t = f.z < -1e-3f ? (2.0f * s.radius + drop_m) / -f.z : 0.0f;
+    for (const Vec3& c : {s.centre, s.centre + f * t}) {
+      const Vec4 clip = vp * Vec4(c, 1.0f);
+      if (clip.w < camera.near_plane + s.radius) {
+        whole = true;
+        break;
+      }
+      const Vec2 p = (Vec2(clip) / clip.w * 0.5f + 0.5f) * Vec2(float(camera.width), float(camera.height));
+      const float r = s.radius * focal / clip.w * 1.5f;  // off-axis spheres project a little wider: margin
+      slo = glm::min(slo, p - r);
+      shi = glm::max(shi, p + r);
+    }
+    if (whole) break;
+  }
+  if (whole || f.z >= -1e-3f) {
+    fit.screen = glm::ivec4(0, 0, camera.width, camera.height);
+  } else {
+    fit.screen = glm::ivec4(std::clamp(int(std::floor(slo.x)), 0, camera.width),
+                            std::clamp(int(std::floor(slo.y)), 0, camera.height),
+                            std::clamp(int(std::ceil(shi.x)) + 1, 0, camera.width),
+                            std::clamp(int(std::ceil(shi.y)) + 1, 0, camera.height));
+  }
   return fit;
 }
 

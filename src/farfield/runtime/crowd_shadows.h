@@ -20,6 +20,10 @@ struct CasterSphere {
 struct ShadowFit {
   gpu::ShadowProjection projection;
   std::vector<uint32_t> casters;  // indices of the spheres inside the box, increasing
+  // Pixels (x0, y0, x1, y1; row 0 at the bottom, as GL scissors; exclusive ends) that can hold a caster's shadow on a
+  // receiver no lower than `drop_m` below the caster's sphere: each caster's sphere swept along the light down to
+  // there, projected; the whole frame when a swept sphere reaches behind the near plane.
+  glm::ivec4 screen{0, 0, 0, 0};
 };
 
 // Receivers: what `camera` sees up to `distance_m` along its view (the frustum cut there). Light space: x, y across
@@ -29,6 +33,6 @@ struct ShadowFit {
 // casters' depth range. No caster: an empty list (the projection is then unused). Throws farfield::Error for a
 // zero light direction, a non-positive distance or a map under 16 texels.
 ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const CasterSphere> spheres,
-                    float distance_m, int map_size);
+                    float distance_m, int map_size, float drop_m = 1.0f);
 
 }  // namespace farfield::runtime
