@@ -26,9 +26,12 @@ def rows(out):
                 continue
             j = json.load(open(bench))
             modes = j["modes"]
-            full, culled = modes["full"]["median_ms"], modes["culled"]["median_ms"]
+            # "vs culled" divides by the frustum-only culling of the earlier runs when the run has it (mode
+            # "frustum"), so rows stay comparable; "culled" (occlusion culling) is then a row of its own.
+            base = "frustum" if "frustum" in modes else "culled"
+            full, culled = modes["full"]["median_ms"], modes[base]["median_ms"]
             store = os.path.join(out, "imp-%s-%d" % (path, 10 if bound >= 5 else 2))
-            for name in ("culled", "smi", "mmi"):
+            for name in ("frustum", "culled", "smi", "mmi"):
                 m = modes.get(name)
                 if m is None:
                     continue
@@ -39,9 +42,9 @@ def rows(out):
                     city, path, bound, name, m["median_ms"], m["p99_ms"], full / m["median_ms"], culled / m["median_ms"],
                     fmt(m.get("psnr_db_mean"), ".1f"), 100.0 * (m.get("crack_share_mean") or 0.0),
                     fmt(m.get("parallax_p99_px_mean"), ".2f"), fmt(m.get("parallax_p99_px_max"), ".1f"),
-                    "-" if name == "culled" else "%s of %d" % (over, checked),
+                    "-" if name in ("frustum", "culled") else "%s of %d" % (over, checked),
                     fmt(m.get("mean_triangles"), ",.0f"),
-                    "-" if name == "culled" else "%.1f MB" % (store_bytes(store) / 1e6))
+                    "-" if name in ("frustum", "culled") else "%.1f MB" % (store_bytes(store) / 1e6))
 
 
 def main():

@@ -73,8 +73,10 @@ class BoxGrid {
     Box2 all;
     for (const Box2& b : boxes) all.expand(b);
     if (all.empty()) return;
-    // At most ~4 million cells, whatever the extent (a whole region's extract).
-    while ((double(all.extent().x) / cell_ + 1.0) * (double(all.extent().y) / cell_ + 1.0) > 4.0e6) cell_ *= 2.0f;
+    // At most a few cells per box and ~4 million in all, whatever the extent (a whole region's extract, or two
+    // buildings far apart: a grid of millions of empty cells for them took seconds to build and free).
+    const double max_cells = std::clamp(4.0 * double(boxes.size()), 1024.0, 4.0e6);
+    while ((double(all.extent().x) / cell_ + 1.0) * (double(all.extent().y) / cell_ + 1.0) > max_cells) cell_ *= 2.0f;
     cell = cell_;
     lo_ = all.lo;
     nx_ = std::max(1, int(std::ceil(all.extent().x / cell)) + 1);
