@@ -9,24 +9,12 @@
 #include "farfield/core/error.h"
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
+#include "farfield/eval/frame_stats.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/scene/bvh.h"
 
 namespace farfield::eval {
-
-namespace {
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * double(v.size() - 1);
-  const size_t i = size_t(std::floor(pos));
-  const size_t j = std::min(i + 1, v.size() - 1);
-  return v[i] + (pos - double(i)) * (v[j] - v[i]);
-}
-
-}  // namespace
 
 std::vector<Camera> randomViews(const Box3& view_space, size_t count, uint32_t seed, int width, int height,
                                 float fov_deg, float near_plane, float far_plane) {
@@ -137,14 +125,14 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     errors.push_back(std::abs(c.measured_ms - c.predicted_ms));
     if (c.measured_ms > c.predicted_ms) ++result.under_predicted;
   }
-  result.ratio_p50 = quantile(ratios, 0.5);
-  result.ratio_p95 = quantile(ratios, 0.95);
-  result.ratio_p99 = quantile(ratios, 0.99);
-  result.ratio_max = quantile(ratios, 1.0);
-  result.abs_error_p50_ms = quantile(errors, 0.5);
-  result.abs_error_p95_ms = quantile(errors, 0.95);
-  result.abs_error_max_ms = quantile(errors, 1.0);
-  profile.safety_factor = std::max(1.0, quantile(ratios, options.margin_quantile));
+  result.ratio_p50 = percentile(ratios, 50.0);
+  result.ratio_p95 = percentile(ratios, 95.0);
+  result.ratio_p99 = percentile(ratios, 99.0);
+  result.ratio_max = percentile(ratios, 100.0);
+  result.abs_error_p50_ms = percentile(errors, 50.0);
+  result.abs_error_p95_ms = percentile(errors, 95.0);
+  result.abs_error_max_ms = percentile(errors, 100.0);
+  profile.safety_factor = std::max(1.0, percentile(ratios, 100.0 * options.margin_quantile));
   for (const ViewCheck& c : result.checks)
     if (c.measured_ms / std::max(c.predicted_ms, 1e-6) > profile.safety_factor) ++result.over_bound;  // as ratios
   if (options.layered_samples > 0) {

@@ -17,21 +17,13 @@
 #include "farfield/core/progress.h"
 #include "farfield/core/shaft.h"
 #include "farfield/core/timer.h"
+#include "farfield/eval/frame_stats.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/impostor/layered_fill.h"
 
 namespace farfield::eval {
 
 namespace {
-
-double quantileOf(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * double(v.size() - 1);
-  const size_t i = size_t(std::floor(pos));
-  const size_t j = std::min(i + 1, v.size() - 1);
-  return v[i] + (pos - double(i)) * (v[j] - v[i]);
-}
 
 double objectRadius(const Box3& b) { return 0.5 * double(glm::length(b.extent())); }
 
@@ -167,12 +159,12 @@ LayeredCalibrateResult calibrateLayered(gpu::Renderer& renderer, const gpu::GpuS
     draw_ratios.push_back(s.draw_ms / std::max(s.draw_predicted_ms, o.noise_floor_ms));
     capture_ratios.push_back(s.capture_ms / std::max(s.capture_predicted_ms, o.noise_floor_ms));
   }
-  result.draw_ratio_p50 = quantileOf(draw_ratios, 0.5);
-  result.draw_ratio_p95 = quantileOf(draw_ratios, 0.95);
-  result.draw_ratio_max = quantileOf(draw_ratios, 1.0);
-  result.capture_ratio_p50 = quantileOf(capture_ratios, 0.5);
-  result.capture_ratio_p95 = quantileOf(capture_ratios, 0.95);
-  result.capture_ratio_max = quantileOf(capture_ratios, 1.0);
+  result.draw_ratio_p50 = percentile(draw_ratios, 50.0);
+  result.draw_ratio_p95 = percentile(draw_ratios, 95.0);
+  result.draw_ratio_max = percentile(draw_ratios, 100.0);
+  result.capture_ratio_p50 = percentile(capture_ratios, 50.0);
+  result.capture_ratio_p95 = percentile(capture_ratios, 95.0);
+  result.capture_ratio_max = percentile(capture_ratios, 100.0);
   cost.draw_safety_factor = std::max(1.0, result.draw_ratio_max);
   cost.capture_safety_factor = std::max(1.0, result.capture_ratio_max);
   // A prediction below the noise floor is bounded by the floor times the factor (see the ratios above).
