@@ -34,6 +34,7 @@
 #include "farfield/core/log.h"
 #include "farfield/scene/gltf_accessor.h"
 #include "farfield/scene/builtin.h"
+#include "farfield/scene/off_check.h"
 
 namespace farfield::scene {
 
@@ -752,6 +753,7 @@ Scene importScene(const std::string& path, const ImportOptions& options, ImportS
     Assimp::Importer probe;
     if (ext.empty() || !probe.IsExtensionSupported(ext))
       throw Error(path, "unknown scene format '" + ext + "' (accepted: " + acceptedFormats(probe) + ")");
+    if (ext == ".off") checkOffFile(path);  // assimp's OFF reader crashes on some damaged files
     scene = importAssimp(path, options, st);
   }
   if (!stats)
