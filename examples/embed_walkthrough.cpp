@@ -7,13 +7,17 @@
 // (the draw items and, per layer, impostor or geometry and why), the engine draws the items. The program prints
 // what the walkthrough decided and kept, and writes the last frame.
 #include <cstdio>
+#include <cstdint>
 #include <exception>
+#include <span>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/image/png_io.h"
@@ -47,10 +51,25 @@ int main(int argc, char** argv) {
     std::printf("error bound: %.2f px\n", walkthrough.errorBoundPx());
 
     size_t impostor_layers = 0, geometry_layers = 0;
+    uint64_t hidden_triangles = 0;
+    gpu::OcclusionCuller occlusion;  // optional: drops the plan's geometry hidden behind its nearest items (exact)
+    std::vector<gpu::DrawItem> visible;
     for (size_t f = 0; f < path.frames.size(); ++f) {
       const Camera camera = path.camera(f, width, height);
       const runtime::FramePlan& plan = walkthrough.plan(camera);
-      renderer.render(camera, plan.items, target);
+      // The engine draws the plan: its geometry items (the first geometry_items, with their bounds) through the
+      // occlusion culler, which draws the nearest of them at once, then the rest of the geometry and the impostors.
+      target.bind();
+      target.clear(renderer.light().sky_color);
+      visible.clear();
+      const std::span<const gpu::DrawItem> geometry(plan.items.data(), plan.geometry_items);
+      hidden_triangles += occlusion
+                              .cull(camera, geometry, plan.geometry_bounds, target,
+                                    [&](std::span<const gpu::DrawItem> nearest) { renderer.draw(camera, nearest, target); },
+                                    visible)
+                              .hidden_triangles;
+      visible.insert(visible.end(), plan.items.begin() + std::ptrdiff_t(plan.geometry_items), plan.items.end());
+      renderer.draw(camera, visible, target);
       for (const runtime::LayerDecision& d : plan.layers) {
         impostor_layers += std::holds_alternative<runtime::LayerAsImpostor>(d) ? 1 : 0;
         geometry_layers += std::holds_alternative<runtime::LayerAsGeometry>(d) ? 1 : 0;
@@ -61,7 +80,8 @@ int main(int argc, char** argv) {
                     plan.report.bound_px, static_cast<unsigned long long>(plan.report.geometry_triangles),
                     static_cast<unsigned long long>(plan.report.impostor_triangles));
     }
-    std::printf("layers drawn as impostors %zu times, as geometry %zu times\n", impostor_layers, geometry_layers);
+    std::printf("layers drawn as impostors %zu times, as geometry %zu times; %llu geometry triangles hidden\n",
+                impostor_layers, geometry_layers, static_cast<unsigned long long>(hidden_triangles));
     if (argc > 5) image::writePng(argv[5], target.readColor());
     return 0;
   } catch (const std::exception& e) {
