@@ -344,10 +344,14 @@ urban::StreetGraph planarizeStreets(const std::vector<StreetPolyline>& polylines
       if ((bx1 - bx0 + 1) * (by1 - by0 + 1) <= 64) {
         for (int64_t y = by0; y <= by1; ++y)
           for (int64_t x = bx0; x <= bx1; ++x) visit_bucket(x, y);
+      } else if (const double len = std::hypot(double(bx - ax), double(by - ay)) / double(kBucket);
+                 9.0 * (2.0 * len + 2.0) > double(buckets.size())) {
+        // A segment longer than there are occupied buckets to visit (kilometres across a sparse or damaged extract):
+        // every occupied bucket, each point tested against the segment as above.
+        for (const auto& [key, points] : buckets) visit_bucket(int32_t(uint32_t(key >> 32)), int32_t(uint32_t(key & 0xffffffffu)));
       } else {
         // A long diagonal street: only the buckets along it (samples every half bucket, with their neighbours).
         std::vector<uint64_t> along;
-        const double len = std::hypot(double(bx - ax), double(by - ay)) / double(kBucket);
         const int64_t samples = int64_t(std::ceil(2.0 * len)) + 1;
         for (int64_t k = 0; k <= samples; ++k) {
           const double t = double(k) / double(samples);
