@@ -12,7 +12,6 @@
 #include <span>
 #include <string>
 #include <variant>
-#include <vector>
 
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
@@ -53,7 +52,6 @@ int main(int argc, char** argv) {
     size_t impostor_layers = 0, geometry_layers = 0;
     uint64_t hidden_triangles = 0;
     gpu::OcclusionCuller occlusion;  // optional: drops the plan's geometry hidden behind its nearest items (exact)
-    std::vector<gpu::DrawItem> visible;
     for (size_t f = 0; f < path.frames.size(); ++f) {
       const Camera camera = path.camera(f, width, height);
       const runtime::FramePlan& plan = walkthrough.plan(camera);
@@ -61,15 +59,11 @@ int main(int argc, char** argv) {
       // occlusion culler, which draws the nearest of them at once, then the rest of the geometry and the impostors.
       target.bind();
       target.clear(renderer.light().sky_color);
-      visible.clear();
-      const std::span<const gpu::DrawItem> geometry(plan.items.data(), plan.geometry_items);
+      const std::span<const gpu::DrawItem> items(plan.items);
       hidden_triangles += occlusion
-                              .cull(camera, geometry, plan.geometry_bounds, target,
-                                    [&](std::span<const gpu::DrawItem> nearest) { renderer.draw(camera, nearest, target); },
-                                    visible)
+                              .draw(renderer, camera, items.first(plan.geometry_items), plan.geometry_bounds, target,
+                                    items.subspan(plan.geometry_items))
                               .hidden_triangles;
-      visible.insert(visible.end(), plan.items.begin() + std::ptrdiff_t(plan.geometry_items), plan.items.end());
-      renderer.draw(camera, visible, target);
       for (const runtime::LayerDecision& d : plan.layers) {
         impostor_layers += std::holds_alternative<runtime::LayerAsImpostor>(d) ? 1 : 0;
         geometry_layers += std::holds_alternative<runtime::LayerAsGeometry>(d) ? 1 : 0;

@@ -273,7 +273,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       image::IdImage prev_ref_ids;
       double ref_change = 0.0;
       std::vector<uint32_t> ids;
-      std::vector<gpu::DrawItem> items, city_rest;
+      std::vector<gpu::DrawItem> items;
       std::vector<Box3> item_bounds;
       gpu::OcclusionCuller city_culler;
       const size_t sample_every = options.samples > 0 ? std::max<size_t>(1, options.frames / size_t(options.samples)) : 0;
@@ -307,11 +307,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           target.bindForOpaquePass();
           target.clear(light.sky_color);
           // The city as the culled mode draws it (occlusion culling is exact: the reference's city pixels).
-          city_rest.clear();
-          city_culler.cull(
-              camera, items, item_bounds, target,
-              [&](std::span<const gpu::DrawItem> occluders) { renderer.draw(camera, occluders, target); }, city_rest);
-          renderer.draw(camera, city_rest, target);
+          city_culler.draw(renderer, camera, items, item_bounds, target);
           rt.finish();
           const double city_ms = clock.milliseconds();
           const runtime::CrowdFrameStats st = drawCrowd(rt, camera, states, specs[m].policy, light, target, options);

@@ -213,10 +213,20 @@ uint32_t CrowdRenderer::uploadAgents(std::span<const CrowdAgentGpu> agents) {
   return agents_;
 }
 
+FrameStats CrowdRenderer::drawAgents(const SkinnedGpuModel& model, size_t count) const {
+  glBindVertexArray(model.vao_);
+  glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, GLsizei(count));
+  glBindVertexArray(0);
+  FrameStats stats;
+  stats.draw_calls = 1;
+  stats.triangles = model.triangleCount() * count;
+  stats.objects = uint32_t(count);
+  return stats;
+}
+
 FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuModel& model,
                                       std::span<const CrowdAgentGpu> agents, const LightSettings& light) {
-  FrameStats stats;
-  if (agents.empty() || model.index_count_ == 0) return stats;
+  if (agents.empty() || model.index_count_ == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
   skinned_.use();
@@ -224,14 +234,8 @@ FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuMode
   skinned_.set("u_outfits", outfits_);
   bindModel(skinned_, model);
   setLight(skinned_, light);
-  glBindVertexArray(model.vao_);
   glEnable(GL_CULL_FACE);
-  glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, GLsizei(agents.size()));
-  glBindVertexArray(0);
-  stats.draw_calls = 1;
-  stats.triangles = model.triangleCount() * agents.size();
-  stats.objects = uint32_t(agents.size());
-  return stats;
+  return drawAgents(model, agents.size());
 }
 
 FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas,
@@ -306,20 +310,13 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
 
 FrameStats CrowdRenderer::drawSkinnedDepth(const Mat4& light_view_proj, const SkinnedGpuModel& model,
                                            std::span<const CrowdAgentGpu> agents) {
-  FrameStats stats;
-  if (agents.empty() || model.index_count_ == 0) return stats;
+  if (agents.empty() || model.index_count_ == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
   skinned_depth_.use();
   skinned_depth_.set("u_view_proj", light_view_proj);
   bindModel(skinned_depth_, model);
-  glBindVertexArray(model.vao_);
-  glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, GLsizei(agents.size()));
-  glBindVertexArray(0);
-  stats.draw_calls = 1;
-  stats.triangles = model.triangleCount() * agents.size();
-  stats.objects = uint32_t(agents.size());
-  return stats;
+  return drawAgents(model, agents.size());
 }
 
 FrameStats CrowdRenderer::drawImpostorDepth(const Mat4& light_view_proj, const Vec3& to_light,

@@ -144,6 +144,8 @@ class CrowdRenderer {
  private:
   uint32_t uploadAgents(std::span<const CrowdAgentGpu> agents);
   void bindModel(const Program& p, const SkinnedGpuModel& model) const;
+  // One instanced draw of the model's mesh for `count` agents (program, model and agents bound), and its counts.
+  FrameStats drawAgents(const SkinnedGpuModel& model, size_t count) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
   Program skinned_, capture_, impostor_, impostor_blend_, skinned_depth_, impostor_depth_;
   uint32_t agents_ = 0, empty_vao_ = 0, tints_ = 0, outfits_ = 0;

@@ -150,4 +150,16 @@ OcclusionStats OcclusionCuller::cull(const Camera& camera, std::span<const DrawI
   return stats;
 }
 
+OcclusionStats OcclusionCuller::draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,
+                                     std::span<const Box3> bounds, RenderTarget& target,
+                                     std::span<const DrawItem> also) {
+  rest_.clear();
+  const OcclusionStats stats = cull(
+      camera, items, bounds, target,
+      [&](std::span<const DrawItem> occluders) { renderer.draw(camera, occluders, target); }, rest_);
+  rest_.insert(rest_.end(), also.begin(), also.end());
+  renderer.draw(camera, rest_, target);
+  return stats;
+}
+
 }  // namespace farfield::gpu

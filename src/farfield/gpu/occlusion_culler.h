@@ -81,12 +81,17 @@ class OcclusionCuller {
                       const RenderTarget& target,
                       const std::function<void(std::span<const DrawItem>)>& draw_occluders,
                       std::vector<DrawItem>& rest);
+  // Both passes with `renderer` (Renderer::draw: no clear, no wait): the occluders, then the items not hidden, then
+  // `also` (items drawn after them as they are, such as impostors).
+  OcclusionStats draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,
+                      std::span<const Box3> bounds, RenderTarget& target, std::span<const DrawItem> also = {});
 
  private:
   double occluder_share_;
   std::vector<ScreenBox> boxes_;
   std::vector<uint32_t> order_;
   std::vector<DrawItem> occluders_;
+  std::vector<DrawItem> rest_;  // draw()'s second pass
   std::vector<float> depth_;
   DepthPyramid pyramid_;
 };
