@@ -7,6 +7,9 @@
 #
 # Usage: fuzz/run_fuzzers.sh BUILD_DIR SECONDS [TARGET...]   (targets: names without "fuzz_"; default all built)
 # Extra libFuzzer flags: FUZZ_FLAGS="-runs=1000000". FUZZ_NICE (default 10) is the nice level of each run.
+# FUZZ_CHUNK=S runs each target as a series of fresh processes of S seconds over the same corpus until SECONDS are
+# spent (for a library that leaks on damaged input, whose RSS would otherwise reach the limit): executions are
+# summed over the series, the rate is their mean, the coverage and corpus are the last run's.
 set -uo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${1:?usage: run_fuzzers.sh BUILD_DIR SECONDS [TARGET...]}"
@@ -38,15 +41,27 @@ for t in "${targets[@]}"; do
   # Slow units (slow-unit-*: slower than 10 s, saved for a look) are not crashes.
   before=$(find "$crashes" -type f ! -name 'slow-unit-*' | wc -l)
   echo "fuzz_$t: ${seconds}s on $(find "$corpus" -type f | wc -l) inputs (log: $log)"
-  # shellcheck disable=SC2086
-  nice -n "${FUZZ_NICE:-10}" "$bin" -max_total_time="$seconds" -timeout=30 -rss_limit_mb=2560 -print_final_stats=1 \
-    -artifact_prefix="$crashes/" "${dict[@]}" "${flags[@]}" ${FUZZ_FLAGS:-} "$corpus" > "$log" 2>&1
-  rc=$?
+  chunk="${FUZZ_CHUNK:-$seconds}"
+  left="$seconds"
+  execs=0
+  : > "$log"
+  rc=0
+  while [ "$left" -gt 0 ] && [ "$rc" -eq 0 ]; do
+    run=$(( left < chunk ? left : chunk ))
+    # shellcheck disable=SC2086
+    nice -n "${FUZZ_NICE:-10}" "$bin" -max_total_time="$run" -timeout=30 -rss_limit_mb=2560 -print_final_stats=1 \
+      -artifact_prefix="$crashes/" "${dict[@]}" "${flags[@]}" ${FUZZ_FLAGS:-} "$corpus" > "$log.part" 2>&1
+    rc=$?
+    cat "$log.part" >> "$log"
+    n=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log.part" | tail -1 | grep -o '[0-9]*$')
+    execs=$((execs + ${n:-0}))
+    left=$((left - run))
+  done
+  rm -f "$log.part"
   after=$(find "$crashes" -type f ! -name 'slow-unit-*' | wc -l)
   # Undefined behaviour of a check built to recover (fuzz/ubsan.supp) is printed, not fatal: still a finding.
   if [ "$rc" -eq 0 ] && grep -q "runtime error:" "$log"; then rc=1; fi
-  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$')
-  rate=$(grep -o 'stat::average_exec_per_sec: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$')
+  rate=$((execs / seconds))
   status=$(grep -E '^#[0-9]+' "$log" | grep -E 'cov: ' | tail -1)
   cov=$(echo "$status" | grep -o 'cov: [0-9]*' | grep -o '[0-9]*')
   ft=$(echo "$status" | grep -o 'ft: [0-9]*' | grep -o '[0-9]*')

@@ -12,11 +12,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <random>
+#include <span>
 #include <variant>
 
 #include "farfield/core/error.h"
 #include "farfield/eval/parallax_error.h"
 #include "farfield/gen/city.h"
+#include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/impostor/layered_fill.h"
 #include "farfield/runtime/walkthrough.h"
@@ -109,7 +111,9 @@ TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
   runtime::Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
   const store::PlacementIndex index = store::readPlacementIndex(s.dir);
   const Box3 space = index.view_space;
-  gpu::RenderTarget target(128, 128), reference_target(128, 128);
+  gpu::RenderTarget target(128, 128), reference_target(128, 128), culled_target(128, 128);
+  gpu::OcclusionCuller culler;
+  uint64_t hidden_triangles = 0;
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   size_t guarded = 0, with_impostors = 0, checked_images = 0;
@@ -158,11 +162,22 @@ TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
         worst_parallax = std::max(worst_parallax, e.object_percentile_px);
         EXPECT_LE(e.object_percentile_px, s.options.error_px + s.options.layered.texel_pixels) << "view " << k;
         ++checked_images;
+        // The plan's geometry through the occlusion culler and its impostors after it: the same item buffer.
+        ASSERT_EQ(plan.geometry_bounds.size(), plan.geometry_items);
+        const std::span<const gpu::DrawItem> all(plan.items);
+        culled_target.clear(Vec4(0.0f));
+        hidden_triangles += culler
+                                .draw(renderer, camera, all.first(plan.geometry_items), plan.geometry_bounds,
+                                      culled_target, all.subspan(plan.geometry_items))
+                                .hidden_triangles;
+        const image::IdImage want = target.readIds(), got = culled_target.readIds();
+        EXPECT_TRUE(std::equal(want.pixels().begin(), want.pixels().end(), got.pixels().begin())) << "view " << k;
       }
     }
   }
   EXPECT_GT(guarded, 30u);
   EXPECT_GT(with_impostors, 5u);
+  EXPECT_GT(hidden_triangles, 0u);  // the comparison above saw culled frames
   std::printf("guarded views %zu, with impostors %zu, worst parallax p99 %.2f px\n", guarded, with_impostors,
               worst_parallax);
 }

@@ -130,7 +130,9 @@ TEST(ImageCacheGl, LayeredRegenerationsKeepTheCalibratedBudget) {
   const ImageCacheFrameStats all = free.frame(renderer, cam, 0, items);
   EXPECT_GE(all.regenerations, some.regenerations);
   EXPECT_EQ(all.geometry_nodes + all.regenerations, some.geometry_nodes + some.regenerations);
-  if (all.regenerations > some.regenerations) EXPECT_GT(all.predicted_ms, 30.0);
+  if (all.regenerations > some.regenerations) {
+    EXPECT_GT(all.predicted_ms, 30.0);
+  }
   o.cost_safety_factor = 0.5;
   EXPECT_THROW(ImageCache(s, gs, o), Error);
 }

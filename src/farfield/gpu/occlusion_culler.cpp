@@ -152,13 +152,13 @@ OcclusionStats OcclusionCuller::cull(const Camera& camera, std::span<const DrawI
 
 OcclusionStats OcclusionCuller::draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,
                                      std::span<const Box3> bounds, RenderTarget& target,
-                                     std::span<const DrawItem> also) {
+                                     std::span<const DrawItem> also, RenderMode mode) {
   rest_.clear();
   const OcclusionStats stats = cull(
       camera, items, bounds, target,
-      [&](std::span<const DrawItem> occluders) { renderer.draw(camera, occluders, target); }, rest_);
+      [&](std::span<const DrawItem> occluders) { renderer.draw(camera, occluders, target, mode); }, rest_);
   rest_.insert(rest_.end(), also.begin(), also.end());
-  renderer.draw(camera, rest_, target);
+  renderer.draw(camera, rest_, target, mode);
   return stats;
 }
 

@@ -82,9 +82,10 @@ class OcclusionCuller {
                       const std::function<void(std::span<const DrawItem>)>& draw_occluders,
                       std::vector<DrawItem>& rest);
   // Both passes with `renderer` (Renderer::draw: no clear, no wait): the occluders, then the items not hidden, then
-  // `also` (items drawn after them as they are, such as impostors).
+  // `also` (items drawn after them as they are, such as impostors), all in `mode`.
   OcclusionStats draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,
-                      std::span<const Box3> bounds, RenderTarget& target, std::span<const DrawItem> also = {});
+                      std::span<const Box3> bounds, RenderTarget& target, std::span<const DrawItem> also = {},
+                      RenderMode mode = RenderMode::Shaded);
 
  private:
   double occluder_share_;

@@ -40,6 +40,8 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   Placed& p = *placed_;
   FramePlan& plan = plan_;
   plan.items.clear();
+  plan.geometry_bounds.clear();
+  plan.geometry_items = 0;
   plan.layers.clear();
   plan.report = {};
   FrameReport& report = plan.report;
@@ -119,7 +121,9 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   }
   // Geometry: every object in the frustum that no impostor of this frame stands for.
   ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [&](uint32_t id) { return p.hidden[id] != 0; }), ids_.end());
-  if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera);
+  // The geometry items come first, with their bounds, so an engine can occlusion-cull them (gpu::OcclusionCuller).
+  if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera, &plan.geometry_bounds);
+  plan.geometry_items = plan.items.size();
   for (const gpu::DrawItem& item : plan.items) report.geometry_triangles += item.triangleCount();
   for (uint32_t id : drawn) {
     const Placed::Resident& r = p.resident.at(id);

@@ -64,29 +64,42 @@ std::vector<Camera> cubeFaceCameras(const Vec3& eye, int face_size, float near_p
   return cameras;
 }
 
-PvsSampler::PvsSampler(const gpu::GpuScene& scene, const PvsOptions& options) : scene_(&scene), options_(options) {
+PvsSampler::PvsSampler(const gpu::GpuScene& scene, const PvsOptions& options)
+    : scene_(&scene), options_(options), culler_(std::clamp(options.occluder_share, 0.0, 1.0)) {
   if (options.face_size < 1 || options.face_size > 4096)
     throw Error("PVS options", "face size must be 1..4096 pixels, got " + std::to_string(options.face_size));
   if (!(options.near_plane > 0.0f) || !(options.far_plane > options.near_plane) || !std::isfinite(options.far_plane))
     throw Error("PVS options", "need 0 < near plane < far plane (finite)");
+  if (!(options.occluder_share >= 0.0 && options.occluder_share <= 1.0))
+    throw Error("PVS options", "occluder share must be in [0, 1], got " + std::to_string(options.occluder_share));
   target_ = gpu::RenderTarget(options.face_size, options.face_size);
-  items_ = scene_->drawItems();
-  item_bounds_.reserve(items_.size());
-  for (const gpu::DrawItem& item : items_) item_bounds_.push_back(transformBox(item.mesh->bounds(), item.transform));
 }
 
 // Section 5.3: full 360-degree views from closely spaced points of the cell, the objects' ids in an item buffer;
 // every id found is in the PVS. It is an estimate from below: an object seen only between the sample points, or
 // only through gaps narrower than a pixel of the cube faces, is missed; the spacing and the face size bound that.
-// Each face draws only the items whose bounds meet its frustum (the renderer does not cull).
-void PvsSampler::sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen) {
+// At street level a face sees the first row of buildings and little else, so occlusion culling leaves out most of
+// the triangles in its frustum: the whole city behind that row.
+ViewpointStats PvsSampler::sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen) {
+  ViewpointStats stats;
   for (const Camera& camera : cubeFaceCameras(eye, options_.face_size, options_.near_plane, options_.far_plane)) {
-    const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
-    visible_items_.clear();
-    for (size_t i = 0; i < items_.size(); ++i)
-      if (frustum.intersects(item_bounds_[i])) visible_items_.push_back(items_[i]);
-    if (visible_items_.empty()) continue;
-    renderer_.render(camera, visible_items_, target_, gpu::RenderMode::ItemBuffer);
+    face_items_.clear();
+    face_bounds_.clear();
+    scene_->appendDrawItems({}, face_items_, camera, &face_bounds_);
+    if (face_items_.empty()) continue;
+    uint64_t triangles = 0;
+    for (const gpu::DrawItem& item : face_items_) triangles += item.triangleCount();
+    if (options_.occlusion_culling) {
+      target_.bind();
+      target_.clear(Vec4(0.0f, 0.0f, 0.0f, 1.0f));  // what an item buffer's background is (Renderer::render)
+      const gpu::OcclusionStats culled =
+          culler_.draw(renderer_, camera, face_items_, face_bounds_, target_, {}, gpu::RenderMode::ItemBuffer);
+      stats.triangles_hidden += culled.hidden_triangles;
+      triangles -= culled.hidden_triangles;
+    } else {
+      renderer_.render(camera, face_items_, target_, gpu::RenderMode::ItemBuffer);
+    }
+    stats.triangles_drawn += triangles;
     const image::IdImage ids = target_.readIds();
     for (uint32_t id : ids.pixels()) {
       if (id == 0) continue;
@@ -94,6 +107,7 @@ void PvsSampler::sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen) {
       seen[id] = 1;
     }
   }
+  return stats;
 }
 
 // A view depends on the eye only (the scene, the faces and the planes are the sampler's), so the ids a sample point
@@ -104,9 +118,13 @@ Pvs PvsSampler::sample(const Vec3& p, const Vec3& q) {
   std::vector<uint8_t> seen;
   Pvs pvs;
   for (const Vec3& eye : points) {
-    if (!options_.reuse_viewpoints) {
-      sampleViewpoint(eye, seen);
+    auto count = [&](const ViewpointStats& drawn) {
       pvs.views += 6;
+      pvs.triangles_drawn += drawn.triangles_drawn;
+      pvs.triangles_hidden += drawn.triangles_hidden;
+    };
+    if (!options_.reuse_viewpoints) {
+      count(sampleViewpoint(eye, seen));
       continue;
     }
     const std::array<uint32_t, 3> key = {std::bit_cast<uint32_t>(eye.x), std::bit_cast<uint32_t>(eye.y),
@@ -116,8 +134,7 @@ Pvs PvsSampler::sample(const Vec3& p, const Vec3& q) {
       ++pvs.reused_points;
     } else {
       std::vector<uint8_t> here;
-      sampleViewpoint(eye, here);
-      pvs.views += 6;
+      count(sampleViewpoint(eye, here));
       std::vector<uint32_t> ids;
       for (size_t id = 1; id < here.size(); ++id)
         if (here[id]) ids.push_back(uint32_t(id));

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "farfield/core/math.h"
+#include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/scene/scene.h"
@@ -26,6 +27,13 @@ struct PvsOptions {
   // Reuse the 360-degree view of a sample point an earlier cell rendered (the same result: a view depends on the eye
   // only). A street's two cells have the same sample points, and cells meeting at a junction share it.
   bool reuse_viewpoints = true;
+  // Each face draws the scene's clusters that meet its frustum and face the eye (GpuScene::appendDrawItems), through
+  // gpu::OcclusionCuller: the nearest clusters first, then only those not hidden behind their depth. Both are exact
+  // (a cluster left out would draw no pixel), so the ids seen are those of drawing every object; off draws every
+  // cluster in the frustum (the reference the tests and `farfield pvs-speed` compare against).
+  bool occlusion_culling = true;
+  // The first pass's share of a face's triangles (nearest clusters first).
+  double occluder_share = 0.1;
 };
 
 struct Pvs {
@@ -33,6 +41,14 @@ struct Pvs {
   size_t sample_points = 0;
   size_t views = 0;           // cube faces rendered (6 per sample point not reused)
   size_t reused_points = 0;   // sample points whose view an earlier cell rendered (PvsOptions::reuse_viewpoints)
+  uint64_t triangles_drawn = 0;   // over the faces rendered
+  uint64_t triangles_hidden = 0;  // in the frusta but dropped by occlusion culling
+};
+
+// What drawing one 360-degree view cost.
+struct ViewpointStats {
+  uint64_t triangles_drawn = 0;
+  uint64_t triangles_hidden = 0;
 };
 
 // Points along [p, q]: both end points and evenly spaced ones between, no farther apart than `spacing`
@@ -55,7 +71,7 @@ class PvsSampler {
   // p and q are eye positions (the street's centreline end points at eye height above the ground).
   Pvs sample(const Vec3& p, const Vec3& q);
   // Adds to `seen` (indexed by id, grown as needed) the ids visible in a 360-degree view from `eye`.
-  void sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen);
+  ViewpointStats sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen);
 
   const PvsOptions& options() const { return options_; }
 
@@ -64,9 +80,9 @@ class PvsSampler {
   PvsOptions options_;
   gpu::Renderer renderer_;
   gpu::RenderTarget target_;
-  std::vector<gpu::DrawItem> items_;
-  std::vector<Box3> item_bounds_;  // world bounds per draw item, for culling each face
-  std::vector<gpu::DrawItem> visible_items_;
+  gpu::OcclusionCuller culler_;
+  std::vector<gpu::DrawItem> face_items_;  // the clusters of one face's frustum
+  std::vector<Box3> face_bounds_;          // their bounds in mesh space (for the culler)
   std::map<std::array<uint32_t, 3>, std::vector<uint32_t>> views_;  // eye (float bits) -> ids seen, ascending
 };
 
