@@ -9,8 +9,8 @@ set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
 OUT=${2:-out/bench/pvs}
 POINTS=${3:-40}
-CASES=${FF_PVS_CASES:-"400 7 2 blocks;400 7 2 buildings;2000 19 1 blocks;10000 3 1 blocks"}
-SHARES=${FF_PVS_SHARES:-0.02,0.1,0.3}
+CASES=${FF_PVS_CASES:-"400 7 2 blocks;400 7 2 buildings;2000 19 1 blocks;10000 3 1 blocks;100000 3 0 blocks"}
+SHARES=${FF_PVS_SHARES:-0.02,0.05,0.1}
 FACE=${FF_PVS_FACE:-64}
 mkdir -p "$OUT"
 table="$OUT/pvs.md"

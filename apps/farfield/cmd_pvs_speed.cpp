@@ -36,11 +36,11 @@ void runPvsSpeed(PvsSpeedArgs& args) {
   std::printf("%zu viewpoints of %s, %d px cube faces, scene %.2f M triangles\n", report.points, args.path.c_str(),
               args.options.pvs.face_size, double(report.scene_triangles) * 1e-6);
   std::printf("%-10s %8s %10s %8s %14s %14s %10s\n", "occlusion", "share", "ms/point", "speedup", "Mtri drawn",
-              "Mtri hidden", "differ");
+              "objects hidden", "differ");
   for (const eval::PvsSpeedRun& r : report.runs)
-    std::printf("%-10s %8.3f %10.1f %7.2fx %14.2f %14.2f %10zu\n", r.occlusion ? "on" : "off", r.occluder_share,
+    std::printf("%-10s %8.3f %10.1f %7.2fx %14.2f %14llu %10zu\n", r.occlusion ? "on" : "off", r.occluder_share,
                 r.ms / double(report.points), report.runs.front().ms / r.ms, double(r.triangles_drawn) * 1e-6,
-                double(r.triangles_hidden) * 1e-6, r.mismatched_points);
+                static_cast<unsigned long long>(r.objects_hidden), r.mismatched_points);
   if (!args.output.empty()) {
     ensureParentDirectory(args.output);
     store::writeFileAtomic(args.output, report.toJson().dump(1) + "\n");

@@ -47,7 +47,7 @@ PvsSpeedReport measurePvsSpeed(const gpu::GpuScene& scene, std::span<const Vec3>
       }
       run.ms += best;
       run.triangles_drawn += stats.triangles_drawn;
-      run.triangles_hidden += stats.triangles_hidden;
+      run.objects_hidden += stats.objects_hidden;
       if (r == 0) {
         reference = seen;
         continue;
@@ -78,7 +78,7 @@ nlohmann::json PvsSpeedReport::toJson() const {
                     {"ms_per_point", points ? r.ms / double(points) : 0.0},
                     {"speedup", r.ms > 0.0 ? runs.front().ms / r.ms : 0.0},
                     {"triangles_drawn", r.triangles_drawn},
-                    {"triangles_hidden", r.triangles_hidden},
+                    {"objects_hidden", r.objects_hidden},
                     {"mismatched_points", r.mismatched_points},
                     {"ids_missing", r.ids_missing},
                     {"ids_extra", r.ids_extra}});

@@ -24,7 +24,8 @@ struct PvsSpeedRun {
   bool occlusion = false;
   double occluder_share = 0.0;
   double ms = 0.0;  // all viewpoints, fastest repeat each
-  uint64_t triangles_drawn = 0, triangles_hidden = 0;
+  uint64_t triangles_drawn = 0;
+  uint64_t objects_hidden = 0;  // summed over the faces
   size_t mismatched_points = 0;  // viewpoints whose ids differ from the unculled run's
   size_t ids_missing = 0, ids_extra = 0;
 };

@@ -139,6 +139,7 @@ class GpuScene {
   void appendDrawItems(std::span<const uint32_t> ids, std::vector<DrawItem>& out, const Camera& camera,
                        std::vector<Box3>* item_bounds = nullptr) const;
   std::vector<DrawItem> drawItems() const;
+  const scene::Scene& scene() const { return *scene_; }
   // Per object id (index 0 unused, size objects + 1): the triangles and draw items of appendDrawItems for it alone.
   std::vector<ObjectDrawCost> objectDrawCosts() const;
   size_t gpuBytes() const;

@@ -64,8 +64,7 @@ std::vector<Camera> cubeFaceCameras(const Vec3& eye, int face_size, float near_p
   return cameras;
 }
 
-PvsSampler::PvsSampler(const gpu::GpuScene& scene, const PvsOptions& options)
-    : scene_(&scene), options_(options), culler_(std::clamp(options.occluder_share, 0.0, 1.0)) {
+PvsSampler::PvsSampler(const gpu::GpuScene& scene, const PvsOptions& options) : scene_(&scene), options_(options) {
   if (options.face_size < 1 || options.face_size > 4096)
     throw Error("PVS options", "face size must be 1..4096 pixels, got " + std::to_string(options.face_size));
   if (!(options.near_plane > 0.0f) || !(options.far_plane > options.near_plane) || !std::isfinite(options.far_plane))
@@ -73,33 +72,95 @@ PvsSampler::PvsSampler(const gpu::GpuScene& scene, const PvsOptions& options)
   if (!(options.occluder_share >= 0.0 && options.occluder_share <= 1.0))
     throw Error("PVS options", "occluder share must be in [0, 1], got " + std::to_string(options.occluder_share));
   target_ = gpu::RenderTarget(options.face_size, options.face_size);
+  for (const gpu::ObjectDrawCost& cost : scene.objectDrawCosts()) object_triangles_.push_back(cost.triangles);
+}
+
+ViewpointStats PvsSampler::drawFace(const Camera& camera) {
+  ViewpointStats stats;
+  face_items_.clear();
+  scene_->appendDrawItems({}, face_items_, camera);
+  for (const gpu::DrawItem& item : face_items_) stats.triangles_drawn += item.triangleCount();
+  renderer_.render(camera, face_items_, target_, gpu::RenderMode::ItemBuffer);
+  return stats;
+}
+
+// Occlusion culling in two levels, so that a face's cost follows what it sees rather than the size of the city. The
+// nearest objects (a share of the triangles in the frustum, and every object whose box reaches behind the eye) go
+// through gpu::OcclusionCuller cluster by cluster: their nearest clusters first, then those not hidden behind them.
+// Their depth is read back, and every other object is tested whole against it (one test per object: a street-level
+// face of a city sees the first row of buildings, and the city behind it is dropped without looking at its
+// clusters), then the clusters of the objects left. The same exactness argument throughout: whatever lies behind
+// the depth already stored over its whole footprint draws no pixel (reversed Z, GL_GREATER).
+ViewpointStats PvsSampler::drawFaceCulled(const Camera& camera) {
+  ViewpointStats stats;
+  const Mat4 view_proj = camera.viewProjection();
+  const Frustum frustum = Frustum::fromMatrix(view_proj);
+  const int size = options_.face_size;
+  candidates_.clear();
+  uint64_t total = 0;
+  for (const scene::Object& object : scene_->scene().objects) {
+    if (object.world_bounds.empty() || !frustum.intersects(object.world_bounds)) continue;
+    const gpu::ScreenBox box = gpu::projectBox(object.world_bounds, view_proj, size, size);
+    if (!box.onScreen()) continue;  // covers no pixel centre: draws nothing
+    candidates_.push_back({box, object.id});
+    total += object_triangles_[object.id];
+  }
+  // Nearest first (boxes reaching the eye are infinitely near); ties by id, for a deterministic split.
+  std::sort(candidates_.begin(), candidates_.end(), [](const auto& a, const auto& b) {
+    return a.first.nearest != b.first.nearest ? a.first.nearest > b.first.nearest : a.second < b.second;
+  });
+  const double share = options_.occluder_share * double(total);
+  uint64_t near_triangles = 0;
+  size_t split = 0;
+  face_ids_.clear();
+  while (split < candidates_.size() && (double(near_triangles) < share || candidates_[split].first.reaches_eye)) {
+    face_ids_.push_back(candidates_[split].second);
+    near_triangles += object_triangles_[candidates_[split].second];
+    ++split;
+  }
+  target_.bind();
+  target_.clear(Vec4(0.0f, 0.0f, 0.0f, 1.0f));  // an item buffer's background (Renderer::render)
+  face_items_.clear();
+  face_bounds_.clear();
+  if (!face_ids_.empty()) scene_->appendDrawItems(face_ids_, face_items_, camera, &face_bounds_);
+  for (const gpu::DrawItem& item : face_items_) stats.triangles_drawn += item.triangleCount();
+  stats.triangles_drawn -=
+      culler_.draw(renderer_, camera, face_items_, face_bounds_, target_, {}, gpu::RenderMode::ItemBuffer)
+          .hidden_triangles;
+  if (split == candidates_.size()) return stats;
+
+  target_.readDepthRows(depth_);
+  pyramid_.build(depth_, size, size);
+  face_ids_.clear();
+  for (size_t k = split; k < candidates_.size(); ++k) {
+    if (pyramid_.hides(candidates_[k].first))
+      ++stats.objects_hidden;
+    else
+      face_ids_.push_back(candidates_[k].second);
+  }
+  if (face_ids_.empty()) return stats;
+  face_items_.clear();
+  face_bounds_.clear();
+  scene_->appendDrawItems(face_ids_, face_items_, camera, &face_bounds_);
+  drawn_items_.clear();
+  for (size_t i = 0; i < face_items_.size(); ++i) {
+    if (pyramid_.hides(gpu::projectBox(face_bounds_[i], view_proj * face_items_[i].transform, size, size))) continue;
+    drawn_items_.push_back(face_items_[i]);
+    stats.triangles_drawn += face_items_[i].triangleCount();
+  }
+  renderer_.draw(camera, drawn_items_, target_, gpu::RenderMode::ItemBuffer);
+  return stats;
 }
 
 // Section 5.3: full 360-degree views from closely spaced points of the cell, the objects' ids in an item buffer;
 // every id found is in the PVS. It is an estimate from below: an object seen only between the sample points, or
 // only through gaps narrower than a pixel of the cube faces, is missed; the spacing and the face size bound that.
-// At street level a face sees the first row of buildings and little else, so occlusion culling leaves out most of
-// the triangles in its frustum: the whole city behind that row.
 ViewpointStats PvsSampler::sampleViewpoint(const Vec3& eye, std::vector<uint8_t>& seen) {
   ViewpointStats stats;
   for (const Camera& camera : cubeFaceCameras(eye, options_.face_size, options_.near_plane, options_.far_plane)) {
-    face_items_.clear();
-    face_bounds_.clear();
-    scene_->appendDrawItems({}, face_items_, camera, &face_bounds_);
-    if (face_items_.empty()) continue;
-    uint64_t triangles = 0;
-    for (const gpu::DrawItem& item : face_items_) triangles += item.triangleCount();
-    if (options_.occlusion_culling) {
-      target_.bind();
-      target_.clear(Vec4(0.0f, 0.0f, 0.0f, 1.0f));  // what an item buffer's background is (Renderer::render)
-      const gpu::OcclusionStats culled =
-          culler_.draw(renderer_, camera, face_items_, face_bounds_, target_, {}, gpu::RenderMode::ItemBuffer);
-      stats.triangles_hidden += culled.hidden_triangles;
-      triangles -= culled.hidden_triangles;
-    } else {
-      renderer_.render(camera, face_items_, target_, gpu::RenderMode::ItemBuffer);
-    }
-    stats.triangles_drawn += triangles;
+    const ViewpointStats face = options_.occlusion_culling ? drawFaceCulled(camera) : drawFace(camera);
+    stats.triangles_drawn += face.triangles_drawn;
+    stats.objects_hidden += face.objects_hidden;
     const image::IdImage ids = target_.readIds();
     for (uint32_t id : ids.pixels()) {
       if (id == 0) continue;
@@ -121,7 +182,7 @@ Pvs PvsSampler::sample(const Vec3& p, const Vec3& q) {
     auto count = [&](const ViewpointStats& drawn) {
       pvs.views += 6;
       pvs.triangles_drawn += drawn.triangles_drawn;
-      pvs.triangles_hidden += drawn.triangles_hidden;
+      pvs.objects_hidden += drawn.objects_hidden;
     };
     if (!options_.reuse_viewpoints) {
       count(sampleViewpoint(eye, seen));

@@ -27,13 +27,14 @@ struct PvsOptions {
   // Reuse the 360-degree view of a sample point an earlier cell rendered (the same result: a view depends on the eye
   // only). A street's two cells have the same sample points, and cells meeting at a junction share it.
   bool reuse_viewpoints = true;
-  // Each face draws the scene's clusters that meet its frustum and face the eye (GpuScene::appendDrawItems), through
-  // gpu::OcclusionCuller: the nearest clusters first, then only those not hidden behind their depth. Both are exact
-  // (a cluster left out would draw no pixel), so the ids seen are those of drawing every object; off draws every
-  // cluster in the frustum (the reference the tests and `farfield pvs-speed` compare against).
+  // Each face draws the clusters that meet its frustum and face the eye (GpuScene::appendDrawItems). With occlusion
+  // culling it first draws the nearest objects (through gpu::OcclusionCuller), reads their depth back, drops every
+  // other object whose box lies behind that depth, then every cluster of the objects left that does. Each
+  // test is exact (what it drops would draw no pixel), so the ids seen are those of drawing every object; off draws
+  // every cluster in the frustum (the reference the tests and `farfield pvs-speed` compare against).
   bool occlusion_culling = true;
-  // The first pass's share of a face's triangles (nearest clusters first).
-  double occluder_share = 0.1;
+  // The first pass's share of the triangles of the objects in a face's frustum (nearest objects first).
+  double occluder_share = 0.05;
 };
 
 struct Pvs {
@@ -41,14 +42,14 @@ struct Pvs {
   size_t sample_points = 0;
   size_t views = 0;           // cube faces rendered (6 per sample point not reused)
   size_t reused_points = 0;   // sample points whose view an earlier cell rendered (PvsOptions::reuse_viewpoints)
-  uint64_t triangles_drawn = 0;   // over the faces rendered
-  uint64_t triangles_hidden = 0;  // in the frusta but dropped by occlusion culling
+  uint64_t triangles_drawn = 0;  // over the faces rendered
+  uint64_t objects_hidden = 0;   // over the faces: objects in a frustum dropped whole by occlusion culling
 };
 
 // What drawing one 360-degree view cost.
 struct ViewpointStats {
   uint64_t triangles_drawn = 0;
-  uint64_t triangles_hidden = 0;
+  uint64_t objects_hidden = 0;  // per face, summed
 };
 
 // Points along [p, q]: both end points and evenly spaced ones between, no farther apart than `spacing`
@@ -80,9 +81,19 @@ class PvsSampler {
   PvsOptions options_;
   gpu::Renderer renderer_;
   gpu::RenderTarget target_;
-  gpu::OcclusionCuller culler_;
-  std::vector<gpu::DrawItem> face_items_;  // the clusters of one face's frustum
-  std::vector<Box3> face_bounds_;          // their bounds in mesh space (for the culler)
+  // One face: the ids it sees are left in target_.
+  ViewpointStats drawFace(const Camera& camera);
+  ViewpointStats drawFaceCulled(const Camera& camera);
+
+  gpu::OcclusionCuller culler_;             // the nearest objects' clusters
+  std::vector<uint64_t> object_triangles_;  // per object id (index 0 unused)
+  std::vector<gpu::DrawItem> face_items_;   // the clusters of one face's frustum
+  std::vector<Box3> face_bounds_;           // their bounds in mesh space
+  std::vector<gpu::DrawItem> drawn_items_;
+  std::vector<std::pair<gpu::ScreenBox, uint32_t>> candidates_;  // objects in the frustum: footprint, id
+  std::vector<uint32_t> face_ids_;
+  std::vector<float> depth_;
+  gpu::DepthPyramid pyramid_;
   std::map<std::array<uint32_t, 3>, std::vector<uint32_t>> views_;  // eye (float bits) -> ids seen, ascending
 };
 
