@@ -2,7 +2,7 @@
 //                (--pipeline pvs,near-far,single,mmi [--online mmi] | --technique depth-mesh|grid-mesh)
 //                [--error-px 10] [--frame-size 640x360] [--frame-fov 60] [--station-spacing 5]
 //                [--layer-mesh grid|depth-mesh] [--grid-cells 30] [--views street|six] [--pvs-spacing M]
-//                [--pvs-face PX] [--near-radius M] [--landmarks IDS] [--landmark-boost X]
+//                [--pvs-face PX] [--pvs-no-occlusion] [--near-radius M] [--landmarks IDS] [--landmark-boost X]
 //                [--resolution 512] [--fov DEG] [--eye-height M] [--path path.json]
 //                [--cells E,E,...] [--limit N] [--workers N] [--list] [--shard K/N] [--resume] -o city.imp/
 // Runs the extractor pipeline (bake/pipeline.h, Decoret et al. 1999) over a city's viewing cells (oriented street
@@ -62,6 +62,7 @@ struct BakeArgs {
   std::string views = "street";
   float pvs_spacing = 2.0f;
   int pvs_face = 128;
+  bool pvs_no_occlusion = false;
   float near_radius = 0.0f;
   std::string landmarks;
   double landmark_boost = 2.0;
@@ -107,6 +108,7 @@ extract::PipelineOptions pipelineOptions(const BakeArgs& args) {
   options.views = extract::parseLayerViews(args.views);
   options.pvs.spacing = args.pvs_spacing;
   options.pvs.face_size = args.pvs_face;
+  options.pvs.occlusion_culling = !args.pvs_no_occlusion;
   options.near_radius = args.near_radius;
   if (!args.landmarks.empty()) options.landmarks = parseCells(args.landmarks, "--landmarks");
   options.events.landmark_boost = args.landmark_boost;
@@ -239,6 +241,9 @@ const RegisterCommand reg("bake", [](CLI::App& app) {
   cmd->add_option("--pvs-spacing", args->pvs_spacing, "PVS: metres between sample points along the cell")
       ->capture_default_str();
   cmd->add_option("--pvs-face", args->pvs_face, "PVS: cube face size, pixels")->capture_default_str();
+  cmd->add_flag("--pvs-no-occlusion", args->pvs_no_occlusion,
+                "PVS: draw every cluster in each face's frustum, without occlusion culling (the same PVS, slower: "
+                "a reference for measurements)");
   cmd->add_option("--landmarks", args->landmarks, "MMI layering: object ids of landmarks (comma-separated), whose "
                                                   "visibility-event weights are boosted");
   cmd->add_option("--landmark-boost", args->landmark_boost, "MMI layering: weight factor of landmark relations (>= 1)")
