@@ -25,7 +25,7 @@ BOUNDS=${BOUNDS:-"1 4"}
 SIZE=${SIZE:-512x512}
 here=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$OUT"
-PLACE_COMMON=(--profile "$OUT/profile.json" --max-pitch 20 --size "$SIZE" --fov 45 --visibility-cache "$OUT/visibility.json")
+PLACE_COMMON=(--profile "$OUT/profile.json" --max-pitch 20 --size "$SIZE" --fov 45)
 
 [ -f "$OUT/city.glb" ] || "$FARFIELD" gen city --blocks "$BLOCKS" --seed "$SEED" --objects buildings -o "$OUT/city.glb" \
   > "$OUT/gen.txt"
@@ -61,7 +61,10 @@ place() {  # NAME ARGS...
   grep -q '"version": 3,' "$OUT/$name/placement.json" 2>/dev/null && return 0
   rm -rf "${OUT:?}/$name"
   PLACED=1
-  /usr/bin/time -f "%e s, %M kB" -o "$OUT/$name.time" "$FARFIELD" place "$OUT/city.glb" "${PLACE_COMMON[@]}" \
+  # The view space's visibility cache, unless the row brings its own (other CPV sizes: other regions).
+  local cache=(--visibility-cache "$OUT/visibility.json")
+  case " $* " in *" --visibility-cache "*) cache=() ;; esac
+  /usr/bin/time -f "%e s, %M kB" -o "$OUT/$name.time" "$FARFIELD" place "$OUT/city.glb" "${PLACE_COMMON[@]}" "${cache[@]}" \
     -o "$OUT/$name" "$@" > "$OUT/$name.txt" 2>&1
 }
 
