@@ -18,9 +18,12 @@ class CrowdRuntimeGl : public ::testing::Test {
   void SetUp() override { gpu::sharedHeadlessContext(); }
 };
 
+scene::SkinnedModel loadFox() {
+  return scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+}
+
 TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
-  const scene::SkinnedModel fox =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  const scene::SkinnedModel fox = loadFox();
   CrowdRuntimeOptions o;
   o.palette_poses = 8;
   o.frames = 4;
@@ -74,17 +77,11 @@ TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
   EXPECT_EQ(all_impostors.draw.triangles, 4u);
 }
 
-}  // namespace
-}  // namespace farfield::runtime
-
-namespace farfield::runtime {
-namespace {
 
 // Agents at any heading and between capture views: the impostor covers nearly the pixels the geometry covers
 // (a telephoto camera, so that the agent is large on screen).
 TEST_F(CrowdRuntimeGl, ImpostorCoversTheGeometryAtAnyHeading) {
-  const scene::SkinnedModel fox =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  const scene::SkinnedModel fox = loadFox();
   CrowdRuntimeOptions o;
   o.palette_poses = 4;
   o.frames = 4;
@@ -123,17 +120,11 @@ TEST_F(CrowdRuntimeGl, ImpostorCoversTheGeometryAtAnyHeading) {
   }
 }
 
-}  // namespace
-}  // namespace farfield::runtime
-
-namespace farfield::runtime {
-namespace {
 
 // With the atlas chosen from the bound, the bake uses the bound's views, texel and frames, and at the bound's
 // camera every impostor promise (texel, view, frame) holds from the bound's distance on: the switch is no farther.
 TEST_F(CrowdRuntimeGl, AtlasFromTheBoundIsWhatTheBakeUsesAndKeepsTheBound) {
-  const scene::SkinnedModel fox =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  const scene::SkinnedModel fox = loadFox();
   CrowdRuntimeOptions o;
   o.palette_poses = 16;
   o.atlas_from_bound = true;
@@ -186,17 +177,11 @@ TEST_F(CrowdRuntimeGl, AtlasFromTheBoundIsWhatTheBakeUsesAndKeepsTheBound) {
   EXPECT_LE(sw.frame_m, 12.0 + 1e-6);
 }
 
-}  // namespace
-}  // namespace farfield::runtime
-
-namespace farfield::runtime {
-namespace {
 
 // Turning an agent through one azimuth step of the view grid: showing the nearest view, the image jumps once at the
 // midpoint; blending the four views around the direction spreads that change over the turn.
 TEST_F(CrowdRuntimeGl, BlendedViewsChangeSmoothlyWhereTheNearestViewJumps) {
-  const scene::SkinnedModel fox =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  const scene::SkinnedModel fox = loadFox();
   CrowdRuntimeOptions o;
   o.palette_poses = 4;
   o.frames = 4;

@@ -94,6 +94,23 @@ bool DepthPyramid::hides(const ScreenBox& box) const {
 
 // ---------------------------------------------------------------------------------------------------------------
 
+size_t splitNearestFirst(std::vector<uint32_t>& order, std::span<const ScreenBox> boxes,
+                         const std::function<uint64_t(uint32_t)>& triangles, double share) {
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return boxes[a].nearest != boxes[b].nearest ? boxes[a].nearest > boxes[b].nearest : a < b;
+  });
+  uint64_t total = 0;
+  for (uint32_t i : order) total += triangles(i);
+  const double wanted = share * double(total);
+  uint64_t drawn = 0;
+  size_t split = 0;
+  while (split < order.size() && (double(drawn) < wanted || boxes[order[split]].reaches_eye)) {
+    drawn += triangles(order[split]);
+    ++split;
+  }
+  return split;
+}
+
 OcclusionCuller::OcclusionCuller(double occluder_share) : occluder_share_(occluder_share) {
   FF_CHECK(occluder_share >= 0.0 && occluder_share <= 1.0);
 }
@@ -109,25 +126,14 @@ OcclusionStats OcclusionCuller::cull(const Camera& camera, std::span<const DrawI
   const Mat4 view_proj = camera.viewProjection();
   boxes_.resize(items.size());
   order_.resize(items.size());
-  uint64_t total = 0;
   for (size_t i = 0; i < items.size(); ++i) {
     boxes_[i] = projectBox(bounds[i], view_proj * items[i].transform, width, height);
     order_[i] = uint32_t(i);
-    total += items[i].triangleCount();
   }
-  // Nearest first (boxes reaching the eye are infinitely near); ties by index for a deterministic split.
-  std::sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) {
-    return boxes_[a].nearest != boxes_[b].nearest ? boxes_[a].nearest > boxes_[b].nearest : a < b;
-  });
+  const size_t split = splitNearestFirst(
+      order_, boxes_, [&](uint32_t i) { return items[i].triangleCount(); }, occluder_share_);
   occluders_.clear();
-  const double share = occluder_share_ * double(total);
-  uint64_t drawn = 0;
-  size_t split = 0;
-  while (split < order_.size() && (double(drawn) < share || boxes_[order_[split]].reaches_eye)) {
-    occluders_.push_back(items[order_[split]]);
-    drawn += items[order_[split]].triangleCount();
-    ++split;
-  }
+  for (size_t k = 0; k < split; ++k) occluders_.push_back(items[order_[k]]);
   stats.occluders = uint32_t(occluders_.size());
   draw_occluders(occluders_);
   if (split == order_.size()) return stats;

@@ -60,6 +60,13 @@ class DepthPyramid {
   std::vector<std::pair<int, int>> sizes_;
 };
 
+// The split of occlusion culling's first pass: sorts `order` (indices into `boxes`) nearest first (boxes reaching
+// the eye are infinitely near; ties by index, for a deterministic split) and returns how many of its first entries
+// are occluders: the nearest until they hold `share` of the triangles of all (triangles(i) for index i), and every
+// box that reaches the eye.
+size_t splitNearestFirst(std::vector<uint32_t>& order, std::span<const ScreenBox> boxes,
+                         const std::function<uint64_t(uint32_t)>& triangles, double share);
+
 struct OcclusionStats {
   uint32_t items = 0;      // items offered
   uint32_t occluders = 0;  // drawn in the first pass

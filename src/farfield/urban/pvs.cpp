@@ -96,29 +96,22 @@ ViewpointStats PvsSampler::drawFaceCulled(const Camera& camera) {
   const Mat4 view_proj = camera.viewProjection();
   const Frustum frustum = Frustum::fromMatrix(view_proj);
   const int size = options_.face_size;
-  candidates_.clear();
-  uint64_t total = 0;
+  candidate_boxes_.clear();
+  candidate_ids_.clear();
   for (const scene::Object& object : scene_->scene().objects) {
     if (object.world_bounds.empty() || !frustum.intersects(object.world_bounds)) continue;
     const gpu::ScreenBox box = gpu::projectBox(object.world_bounds, view_proj, size, size);
     if (!box.onScreen()) continue;  // covers no pixel centre: draws nothing
-    candidates_.push_back({box, object.id});
-    total += object_triangles_[object.id];
+    candidate_boxes_.push_back(box);
+    candidate_ids_.push_back(object.id);
   }
-  // Nearest first (boxes reaching the eye are infinitely near); ties by id, for a deterministic split.
-  std::sort(candidates_.begin(), candidates_.end(), [](const auto& a, const auto& b) {
-    return a.first.nearest != b.first.nearest ? a.first.nearest > b.first.nearest : a.second < b.second;
-  });
-  const double share = options_.occluder_share * double(total);
-  uint64_t near_triangles = 0;
-  size_t split = 0;
+  order_.resize(candidate_ids_.size());
+  for (size_t i = 0; i < order_.size(); ++i) order_[i] = uint32_t(i);
+  const size_t split = gpu::splitNearestFirst(
+      order_, candidate_boxes_, [&](uint32_t i) { return object_triangles_[candidate_ids_[i]]; },
+      options_.occluder_share);
   face_ids_.clear();
-  while (split < candidates_.size() && (double(near_triangles) < share || candidates_[split].first.reaches_eye)) {
-    face_ids_.push_back(candidates_[split].second);
-    near_triangles += object_triangles_[candidates_[split].second];
-    ++split;
-  }
-  target_.bind();
+  for (size_t k = 0; k < split; ++k) face_ids_.push_back(candidate_ids_[order_[k]]);
   target_.clear(Vec4(0.0f, 0.0f, 0.0f, 1.0f));  // an item buffer's background (Renderer::render)
   face_items_.clear();
   face_bounds_.clear();
@@ -127,16 +120,16 @@ ViewpointStats PvsSampler::drawFaceCulled(const Camera& camera) {
   stats.triangles_drawn -=
       culler_.draw(renderer_, camera, face_items_, face_bounds_, target_, {}, gpu::RenderMode::ItemBuffer)
           .hidden_triangles;
-  if (split == candidates_.size()) return stats;
+  if (split == order_.size()) return stats;
 
   target_.readDepthRows(depth_);
   pyramid_.build(depth_, size, size);
   face_ids_.clear();
-  for (size_t k = split; k < candidates_.size(); ++k) {
-    if (pyramid_.hides(candidates_[k].first))
+  for (size_t k = split; k < order_.size(); ++k) {
+    if (pyramid_.hides(candidate_boxes_[order_[k]]))
       ++stats.objects_hidden;
     else
-      face_ids_.push_back(candidates_[k].second);
+      face_ids_.push_back(candidate_ids_[order_[k]]);
   }
   if (face_ids_.empty()) return stats;
   face_items_.clear();

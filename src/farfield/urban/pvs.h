@@ -90,7 +90,9 @@ class PvsSampler {
   std::vector<gpu::DrawItem> face_items_;   // the clusters of one face's frustum
   std::vector<Box3> face_bounds_;           // their bounds in mesh space
   std::vector<gpu::DrawItem> drawn_items_;
-  std::vector<std::pair<gpu::ScreenBox, uint32_t>> candidates_;  // objects in the frustum: footprint, id
+  std::vector<gpu::ScreenBox> candidate_boxes_;  // the objects in the frustum: footprints
+  std::vector<uint32_t> candidate_ids_;          // and ids
+  std::vector<uint32_t> order_;                  // nearest first (gpu::splitNearestFirst)
   std::vector<uint32_t> face_ids_;
   std::vector<float> depth_;
   gpu::DepthPyramid pyramid_;
