@@ -32,6 +32,7 @@ struct TinySkin {
   float weight0 = 1.0f;       // first weight of vertex 1 (the other three 0)
   bool inverse_bind = true;
   bool truncate = false;
+  bool image_past_buffer = false;  // a textured material whose image's buffer view ends 100 kB past the buffer
 
   std::string write(const std::string& name) const {
     std::vector<unsigned char> bin;
@@ -60,14 +61,19 @@ struct TinySkin {
     std::string skin = inverse_bind ? R"({"joints": [1, 2], "inverseBindMatrices": 3})" : R"({"joints": [1, 2]})";
     const std::string json = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
  "nodes": [{"mesh": 0, "skin": 0}, {"children": [2]}, {"translation": [1, 0, 0]}],
- "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}}]}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2})" +
+                             std::string(image_past_buffer ? R"(, "material": 0)" : "") + R"(}]}],)" +
+                             std::string(image_past_buffer ? R"(
+ "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+ "textures": [{"source": 0}], "images": [{"bufferView": 6, "mimeType": "image/png"}],)" : "") + R"(
  "skins": [)" + skin + R"(],
  "animations": [{"name": "Walk", "channels": [{"sampler": 0, "target": {"node": 2, "path": "rotation"}}],
    "samplers": [{"input": 4, "output": 5}]}],
  "buffers": [{"uri": "t.bin", "byteLength": )" + std::to_string(full) + R"(}],
  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24},
    {"buffer": 0, "byteOffset": 60, "byteLength": 48}, {"buffer": 0, "byteOffset": 108, "byteLength": 128},
-   {"buffer": 0, "byteOffset": 236, "byteLength": 8}, {"buffer": 0, "byteOffset": 244, "byteLength": 32}],
+   {"buffer": 0, "byteOffset": 236, "byteLength": 8}, {"buffer": 0, "byteOffset": 244, "byteLength": 32},
+   {"buffer": 0, "byteOffset": 200, "byteLength": 100000}],
  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
    {"bufferView": 1, "componentType": 5123, "count": 3, "type": "VEC4"},
    {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"},
@@ -124,6 +130,16 @@ TEST(GltfSkin, MissingInverseBindMatricesAreIdentityAndCounted) {
   const SkinnedModel m = importSkinnedModel(t.write("skin_noibm"), &stats);
   EXPECT_TRUE(stats.identity_inverse_bind);
   EXPECT_EQ(m.skeleton.inverse_bind[1], Mat4(1.0f));
+}
+
+// An image whose buffer view runs past its buffer (what the fuzzer found: the image callback read past the buffer):
+// the model is read without its texture, with a warning, and nothing is read outside the buffer (make test-asan).
+TEST(GltfSkin, ImageViewPastItsBufferLeavesTheTextureOut) {
+  TinySkin t;
+  t.image_past_buffer = true;
+  const SkinnedModel m = importSkinnedModel(t.write("skin_image_view"));
+  EXPECT_EQ(m.mesh.triangleCount(), 1u);
+  EXPECT_FALSE(m.texture);
 }
 
 TEST(GltfSkin, TruncatedBufferIsAnError) {

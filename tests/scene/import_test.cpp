@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "farfield/core/error.h"
 #include "support/test_support.h"
@@ -169,6 +170,53 @@ TEST(Import, GltfWithExternalBufferAndTexture) {
   const auto dir3 = test::scratchDir("import_gltf_cycle");
   std::filesystem::copy_file(dir / "tex.png", dir3 / "tex.png");
   expectError([&] { importScene(writeGltf(dir3, "tex.png", R"(, "children": [0])")); }, {"tri.gltf", "reached twice"});
+}
+
+// A hand-written .gltf whose texture is a PNG in a buffer view of its external buffer; the view claims `extra` bytes
+// more than the image has (past the buffer's end when extra > 0).
+std::string writeGltfImageInView(const std::filesystem::path& dir, size_t extra) {
+  std::ifstream png(test::testDataDir() / "scene" / "textured_quad.png", std::ios::binary);
+  const std::vector<char> image((std::istreambuf_iterator<char>(png)), std::istreambuf_iterator<char>());
+  const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::ofstream bin(dir / "tri.bin", std::ios::binary);
+  bin.write(reinterpret_cast<const char*>(pos), sizeof(pos));
+  bin.write(image.data(), std::streamsize(image.size()));
+  bin.close();
+  const std::string path = (dir / "tri.gltf").string();
+  std::ofstream(path) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"name": "n", "mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+    "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+    "textures": [{"source": 0}], "images": [{"bufferView": 1, "mimeType": "image/png"}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                   "min": [0, 0, 0], "max": [1, 1, 0]}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36},
+                    {"buffer": 0, "byteOffset": 36, "byteLength": )" << image.size() + extra << R"(}],
+    "buffers": [{"uri": "tri.bin", "byteLength": )" << 36 + image.size() << R"(}]})";
+  return path;
+}
+
+// An image in a buffer view is read through the view, checked against its buffer: a view past the buffer's end (a
+// corrupt file; the fuzzer's glTF skin input made the image callback read past the buffer) is a counted missing
+// texture naming the image and the bytes, not a read outside the buffer.
+TEST(Import, GltfImageInABufferViewIsCheckedAgainstItsBuffer) {
+  const auto dir = test::scratchDir("import_gltf_view_image");
+  ImportStats st;
+  const Scene s = importScene(writeGltfImageInView(dir, 0), {}, &st);
+  const Material& m = s.materials[s.objects[0].parts[0].material];
+  ASSERT_TRUE(m.texture);
+  EXPECT_FALSE(TextureFiles::isPlaceholder(m.texture));
+  EXPECT_EQ(m.texture->width(), 4);
+  EXPECT_TRUE(st.missing_textures.empty());
+
+  const auto dir2 = test::scratchDir("import_gltf_view_past_buffer");
+  ImportStats st2;
+  const Scene past = importScene(writeGltfImageInView(dir2, 100000), {}, &st2);
+  EXPECT_EQ(past.triangleCount(), 1u);
+  ASSERT_EQ(st2.missing_textures.size(), 1u);
+  EXPECT_EQ(st2.missing_textures[0].name, "image 0");
+  EXPECT_NE(st2.missing_textures[0].reason.find("past the buffer"), std::string::npos) << st2.missing_textures[0].reason;
+  expectCheckerboard(past.materials[past.objects[0].parts[0].material].texture);
 }
 
 TEST(Import, ZUpFileKeepsCoordinates) {

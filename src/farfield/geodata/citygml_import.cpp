@@ -63,7 +63,7 @@ std::string narrow(const XMLCh* s) {
 }
 
 // libcitygml's log: errors and warnings counted, the first error kept for the message of a failed load.
-class Logger : public citygml::CityGMLLogger {
+class Logger final : public citygml::CityGMLLogger {
  public:
   Logger() : CityGMLLogger(LOGLEVEL::LL_WARNING) {}
   void log(LOGLEVEL level, const std::string& message, const char*, int) const override {

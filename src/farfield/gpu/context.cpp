@@ -354,7 +354,7 @@ class GlfwContext final : public Context {
   void framebufferSize(int& width, int& height) const override { glfwGetFramebufferSize(window_, &width, &height); }
 
  private:
-  IgnoreDriverLeaks ignore_driver_leaks_;  // first member: constructed first, destroyed after the window
+  [[maybe_unused]] IgnoreDriverLeaks ignore_driver_leaks_;  // first member: constructed first, destroyed after the window
   GLFWwindow* window_;
 };
 

@@ -47,6 +47,32 @@ GltfView gltfAccessor(const tinygltf::Model& model, int index, const std::string
   return v;
 }
 
+std::span<const unsigned char> gltfImageBytes(const tinygltf::Model& model, int index, std::string* why) {
+  if (index < 0 || size_t(index) >= model.images.size()) {
+    *why = "image " + std::to_string(index) + " out of range";
+    return {};
+  }
+  const tinygltf::Image& img = model.images[size_t(index)];
+  const std::string where = "image " + std::to_string(index);
+  if (img.bufferView < 0 || size_t(img.bufferView) >= model.bufferViews.size()) {
+    *why = where + ": buffer view " + std::to_string(img.bufferView) + " out of range";
+    return {};
+  }
+  const tinygltf::BufferView& bv = model.bufferViews[size_t(img.bufferView)];
+  if (bv.buffer < 0 || size_t(bv.buffer) >= model.buffers.size()) {
+    *why = where + ": buffer " + std::to_string(bv.buffer) + " out of range";
+    return {};
+  }
+  const tinygltf::Buffer& buf = model.buffers[size_t(bv.buffer)];
+  const uint64_t end = uint64_t(bv.byteOffset) + uint64_t(bv.byteLength);
+  if (end > buf.data.size() || end < uint64_t(bv.byteOffset)) {
+    *why = where + ": buffer view " + std::to_string(img.bufferView) + " ends at byte " + std::to_string(end) +
+           " past the buffer's " + std::to_string(buf.data.size()) + " bytes (truncated file?)";
+    return {};
+  }
+  return {buf.data.data() + bv.byteOffset, size_t(bv.byteLength)};
+}
+
 double gltfComponent(const GltfView& v, size_t i, int c) {
   const unsigned char* p = v.data + i * v.stride;
   switch (v.component_type) {

@@ -26,9 +26,11 @@ namespace {
 const Mat4 kYUpToZUp(Vec4(1, 0, 0, 0), Vec4(0, 0, 1, 0), Vec4(0, -1, 0, 0), Vec4(0, 0, 0, 1));
 
 // Image bytes kept raw; decoded by TextureFiles afterwards (one decoder for every importer).
+// Images in a buffer view are left alone here: tinygltf does not check the view against its buffer before calling
+// (gltfImageBytes reads them, checked, in readTexture).
 bool keepImageBytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
                     const unsigned char* bytes, int size, void*) {
-  image->image.assign(bytes, bytes + std::max(size, 0));
+  if (image->bufferView < 0) image->image.assign(bytes, bytes + std::max(size, 0));
   image->width = image->height = 0;
   image->component = 0;
   return true;
@@ -235,7 +237,14 @@ class SkinReader {
     ImportStats import_stats;
     TextureFiles files(import_stats);
     const std::string name = img.uri.empty() ? "embedded image " + std::to_string(source) : img.uri;
-    if (!img.image.empty())
+    if (img.bufferView >= 0) {
+      std::string why;
+      const std::span<const unsigned char> bytes = gltfImageBytes(model_, source, &why);
+      if (bytes.empty())
+        FF_WARN(path_ << ": " << name << " left out: " << (why.empty() ? "no bytes" : why));
+      else
+        out.texture = files.decode(name, bytes.data(), bytes.size());
+    } else if (!img.image.empty())
       out.texture = files.decode(name, img.image.data(), img.image.size());
     else if (!img.uri.empty())
       out.texture = files.load(name, std::filesystem::path(path_).parent_path() / img.uri);

@@ -124,6 +124,9 @@ void checkEmpty(const Scene& scene, const std::string& path) {
 // make tinygltf refuse the whole model.)
 bool loadGltfImage(tinygltf::Image* image, const int image_idx, std::string*, std::string*, int, int,
                    const unsigned char* bytes, int size, void* user) {
+  // An image in a buffer view is decoded by GltfReader::texture from gltfImageBytes: tinygltf does not check the
+  // view against its buffer before calling here.
+  if (image->bufferView >= 0) return true;
   std::string why;
   TexturePtr img = decodeImage(bytes, size_t(std::max(size, 0)), &why);
   if (!img) {
@@ -194,15 +197,23 @@ class GltfReader {
       if (TextureFiles::isPlaceholder(it->second)) ++stats_.placeholder_materials;
       return it->second;
     }
+    std::string view_why;  // why an image in a buffer view gives no texture
+    if (img.bufferView >= 0) {
+      const std::span<const unsigned char> bytes = gltfImageBytes(model_, source, &view_why);
+      if (!bytes.empty())
+        if (TexturePtr decoded = decodeImage(bytes.data(), bytes.size(), &view_why)) return images_[source] = decoded;
+      if (view_why.empty()) view_why = "no image data";
+    }
     if (img.image.empty() || img.width <= 0 || img.height <= 0) {
       // tinygltf leaves an external image it could not find empty, with only a warning; loadGltfImage leaves an
-      // undecodable one empty.
+      // undecodable one empty, and one in a buffer view to the lines above.
       texture_path->clear();
       const bool external = !img.uri.empty() && img.uri.rfind("data:", 0) != 0;
       const std::string label = external ? img.uri : !img.name.empty() ? img.name : "image " + std::to_string(source);
       auto why = undecodable_.find(source);
       const std::string reason =
-          why != undecodable_.end() ? why->second
+          !view_why.empty()        ? view_why
+          : why != undecodable_.end() ? why->second
           : external ? "no file " + (fs::path(path_).parent_path() / img.uri).string() + " (or not readable)"
                      : "no image data";
       stats_.missing_textures.push_back({label, reason});
