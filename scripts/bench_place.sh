@@ -5,7 +5,7 @@
 # frame budgets at the reference error bound, and the walkthrough benchmark of full, culled and placed along three
 # paths for each budget (a walk, a drive, and independent random views of the view space; every frame rendered 3
 # times, the fastest kept; full-geometry reference frames). Further
-# rows: other error bounds, halved and doubled CPVs, fewer candidates. tools/place_table.py makes the tables.
+# rows: other error bounds, halved and doubled CPVs, fewer candidates, rectangular view cells and per-cell placement. tools/place_table.py makes the tables.
 # Usage: scripts/bench_place.sh FARFIELD OUT [SEED] [BLOCKS] [FRAMES] [STRIDE]
 # Environment: TMAXES (default "18 20 22 25 28"), BOUND (px, default 2), REF_TMAX (default 20), BOUNDS (default
 # "1 4"), SIZE (default 512x512), ROWS=0 to skip the extra rows, FALLBACK (default "2,4": place --fallback-bounds;
@@ -83,5 +83,8 @@ if [ "${ROWS:-1}" != 0 ]; then
   place "place-cpv-half" --tmax "$REF_TMAX" --error-px "$BOUND" --cpv-size 23 --visibility-cache "$OUT/visibility-23.json"
   place "place-cpv-double" --tmax "$REF_TMAX" --error-px "$BOUND" --cpv-size 92 --visibility-cache "$OUT/visibility-92.json"
   place "place-fewer-candidates" --tmax "$REF_TMAX" --error-px "$BOUND" --cpv-size 46 --distance-steps 3
+  # Rectangular view cells (the paper's test 13) and per-cell placement (test 14: the smallest regions only).
+  place "place-boxes-t$REF_TMAX" --tmax "$REF_TMAX" --error-px "$BOUND" --cpv-size 46 --view-cells boxes
+  place "place-leaf-boxes-t$REF_TMAX" --tmax "$REF_TMAX" --error-px "$BOUND" --cpv-size 46 --view-cells leaf-boxes
 fi
 python3 "$here/../tools/place_table.py" "$OUT"

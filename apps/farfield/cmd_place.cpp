@@ -23,6 +23,7 @@ struct PlaceArgs {
   std::string view_min, view_max, around;
   float margin = 50.0f;
   int distance_steps = 11;
+  std::string view_cells = "shafts";
   double texel_px = 0.0;
   bake::PlaceOptions options;
 };
@@ -35,6 +36,12 @@ void runPlaceCommand(PlaceArgs& args) {
   o.view_space = parseViewSpace(args.view_min, args.view_max, args.around, args.margin);
   if (args.distance_steps < 1) throw Error("--distance-steps", "must be at least 1");
   o.candidates.distance_steps = args.distance_steps;
+  if (args.view_cells != "shafts" && args.view_cells != "boxes" && args.view_cells != "leaf-boxes" &&
+      args.view_cells != "both")
+    throw Error("--view-cells", "'" + args.view_cells + "' is not shafts, boxes, leaf-boxes or both");
+  o.candidates.shafts = args.view_cells == "shafts" || args.view_cells == "both";
+  o.candidates.rectangular_cells = args.view_cells != "shafts";
+  o.candidates.box_leaves_only = args.view_cells == "leaf-boxes";
   o.scene_label = args.scene;
   if (args.texel_px < 0.0) throw Error("--texel-px", "must be 0 (the error bound) or a positive number of pixels");
   o.layered.texel_pixels = args.texel_px > 0.0 ? args.texel_px : o.error_px;
@@ -112,6 +119,11 @@ const RegisterCommand reg("place", [](CLI::App& app) {
   cmd->add_option("--levels", o.hierarchy.max_levels, "Levels of the object hierarchy")->capture_default_str();
   cmd->add_option("--distance-steps", args->distance_steps, "Shaft minimum distances per axis (1, 2, 4, ... times "
                                                              "the cluster size)")->capture_default_str();
+  cmd->add_option("--view-cells", args->view_cells, "Candidate view cells: shafts (the paper's), boxes (the view "
+                                                     "space's regions, each planned through the shaft around it: the "
+                                                     "paper's test 13), leaf-boxes (the smallest regions only: "
+                                                     "per-cell placement, test 14) or both")
+      ->capture_default_str();
   cmd->add_option("--max-texture", o.layered.max_texture_size, "Largest layer texture side, texels")
       ->capture_default_str();
   cmd->add_option("--texel-px", args->texel_px, "Impostor texel size in pixels of the frames at the nearest "

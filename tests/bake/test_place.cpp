@@ -98,27 +98,37 @@ TEST(PlaceTest, ProblemViewsExistAndMostAreSolved) {
   EXPECT_THROW(placeOptionsFromJson(missing, "index"), Error);
 }
 
-TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
-  const Placed& s = placed();
-  const scene::Scene& scene = s.city.scene;
+struct ViewChecks {
+  size_t guarded = 0, with_impostors = 0;
+  size_t checked_images = 0, over_tolerance = 0;  // views compared with full geometry; p99 over bound + one texel
+  uint64_t hidden_triangles = 0;
+  double worst_parallax = 0.0;
+};
+
+// `views` random views of the database's view space planned by the runtime: where the CPV was solved (or no CPV holds
+// the view) the plan is predicted under t_max by the profile; where impostors are drawn (the first 40 such views) the
+// parallax against full geometry is measured (p99 of the object pixels, counted when over the bound plus one texel),
+// and the plan's geometry drawn through the occlusion culler with its impostors after it gives the same item buffer
+// as the plan drawn whole.
+ViewChecks checkViews(const scene::Scene& scene, const gpu::CostProfile& profile, const PlaceOptions& place_options,
+                      const std::string& dir, int views) {
   gpu::sharedHeadlessContext().makeCurrent();
   const gpu::GpuScene gpu_scene(scene);
   const scene::Bvh bvh(scene);
   gpu::Renderer renderer;
   runtime::WalkthroughOptions options;
-  options.database = s.dir;
+  options.database = dir;
   options.representation = runtime::Representation::Placed;
   runtime::Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
-  const store::PlacementIndex index = store::readPlacementIndex(s.dir);
+  const store::PlacementIndex index = store::readPlacementIndex(dir);
   const Box3 space = index.view_space;
   gpu::RenderTarget target(128, 128), reference_target(128, 128), culled_target(128, 128);
   gpu::OcclusionCuller culler;
-  uint64_t hidden_triangles = 0;
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  size_t guarded = 0, with_impostors = 0, checked_images = 0;
-  double worst_parallax = 0.0;
-  for (int k = 0; k < 300; ++k) {
+  ViewChecks out;
+  size_t checked_images = 0;
+  for (int k = 0; k < views; ++k) {
     Camera camera;
     camera.eye = space.lo + (space.hi - space.lo) * Vec3(u(rng), u(rng), u(rng));
     const float yaw = float(2.0 * kPi) * u(rng);
@@ -128,15 +138,14 @@ TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
     const runtime::FramePlan& plan = walkthrough.plan(camera);
     uint64_t triangles = 0;
     for (const gpu::DrawItem& item : plan.items) triangles += item.triangleCount();
-    const double predicted =
-        s.profile.boundMs(double(triangles), double(plan.items.size()), 128.0 * 128.0);
-    const bool solved = plan.report.cpv == urban::kNone || plan.report.cpv_t_after_ms <= s.options.t_max_ms;
+    const double predicted = profile.boundMs(double(triangles), double(plan.items.size()), 128.0 * 128.0);
+    const bool solved = plan.report.cpv == urban::kNone || plan.report.cpv_t_after_ms <= place_options.t_max_ms;
     if (solved) {
-      ++guarded;
-      EXPECT_LE(predicted, s.options.t_max_ms + 1e-9) << "view " << k << " cpv " << plan.report.cpv;
+      ++out.guarded;
+      EXPECT_LE(predicted, place_options.t_max_ms + 1e-9) << "view " << k << " cpv " << plan.report.cpv;
     }
     if (plan.report.cpv != urban::kNone && plan.report.impostor_triangles > 0) {
-      ++with_impostors;
+      ++out.with_impostors;
       if (checked_images < 40) {
         // Against full geometry: what the impostors show stays within the bound (item buffers; the ground, drawn
         // as geometry in both, left out; one texel of quantisation allowed beyond the bound).
@@ -159,27 +168,101 @@ TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
         eval::ParallaxOptions po;
         po.ignore_ids = {1};
         const eval::ParallaxError e = eval::parallaxError(reference_target.readIds(), target.readIds(), po);
-        worst_parallax = std::max(worst_parallax, e.object_percentile_px);
-        EXPECT_LE(e.object_percentile_px, s.options.error_px + s.options.layered.texel_pixels) << "view " << k;
+        out.worst_parallax = std::max(out.worst_parallax, e.object_percentile_px);
+        if (e.object_percentile_px > place_options.error_px + place_options.layered.texel_pixels) ++out.over_tolerance;
         ++checked_images;
+        ++out.checked_images;
         // The plan's geometry through the occlusion culler and its impostors after it: the same item buffer.
-        ASSERT_EQ(plan.geometry_bounds.size(), plan.geometry_items);
+        EXPECT_EQ(plan.geometry_bounds.size(), plan.geometry_items);
+        if (plan.geometry_bounds.size() != plan.geometry_items) continue;
         const std::span<const gpu::DrawItem> all(plan.items);
         culled_target.clear(Vec4(0.0f));
-        hidden_triangles += culler
-                                .draw(renderer, camera, all.first(plan.geometry_items), plan.geometry_bounds,
-                                      culled_target, all.subspan(plan.geometry_items))
-                                .hidden_triangles;
+        out.hidden_triangles += culler
+                                    .draw(renderer, camera, all.first(plan.geometry_items), plan.geometry_bounds,
+                                          culled_target, all.subspan(plan.geometry_items))
+                                    .hidden_triangles;
         const image::IdImage want = target.readIds(), got = culled_target.readIds();
         EXPECT_TRUE(std::equal(want.pixels().begin(), want.pixels().end(), got.pixels().begin())) << "view " << k;
       }
     }
   }
-  EXPECT_GT(guarded, 30u);
-  EXPECT_GT(with_impostors, 5u);
-  EXPECT_GT(hidden_triangles, 0u);  // the comparison above saw culled frames
-  std::printf("guarded views %zu, with impostors %zu, worst parallax p99 %.2f px\n", guarded, with_impostors,
-              worst_parallax);
+  return out;
+}
+
+TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
+  const Placed& s = placed();
+  const ViewChecks v = checkViews(s.city.scene, s.profile, s.options, s.dir, 300);
+  EXPECT_GT(v.guarded, 30u);
+  EXPECT_GT(v.with_impostors, 5u);
+  EXPECT_GT(v.hidden_triangles, 0u);  // the comparison saw culled frames
+  EXPECT_EQ(v.over_tolerance, 0u);
+  std::printf("guarded views %zu, with impostors %zu, worst parallax p99 %.2f px\n", v.guarded, v.with_impostors,
+              v.worst_parallax);
+}
+
+// Rectangular view cells (the paper's test 13): the view space's regions as box cells, each planned through the shaft
+// from the cluster's centre around it. Checked:
+//   - every CPV that shows an impostor lies in that impostor's shaft;
+//   - the promise of the layered plan, by brute force: from viewpoints sampled in those CPVs' regions, points of the
+//     cluster's box are seen within the plan's error angle (<= the bound) of where their layer draws them (the point
+//     where the capture eye's ray through them meets the layer's plane);
+//   - the views keep the frame budget as with shafts, and the item buffers against full geometry stay within the bound
+//     plus a texel in all but one view in twenty. (Seen here: 128x128 frames of clusters 200-350 m away, where a facade
+//     seen edge-on is a one-pixel sliver that a neighbour in the same slab covers from the capture eye; the sliver's
+//     pixels then measure the distance to the rest of its object, 5-8 px, though every point is drawn within the
+//     bound: a crack, which the bench counts as such.)
+TEST(PlaceTest, BoxViewCellsArePlannedThroughTheShaftAroundThem) {
+  const Placed& s = placed();
+  PlaceOptions options = s.options;
+  options.candidates.shafts = false;
+  options.candidates.rectangular_cells = true;
+  const std::string dir = test::scratchDir("place_boxes").string();
+  const PlaceReport r = placeImpostors(gpu::sharedHeadlessContext(), s.city.scene, s.profile, options, dir);
+  EXPECT_GT(r.candidate_counts.kept, 0u);
+  EXPECT_GT(r.impostors, 0u);
+  EXPECT_LT(r.unsolved_cpvs, r.cpvs);
+  const store::PlacementIndex index = store::readPlacementIndex(dir);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  size_t shown = 0, pairs = 0;
+  double worst_ratio = 0.0;
+  for (const store::StoredCpv& c : index.cpvs)
+    for (uint32_t id : c.impostors) {
+      const store::StoredPlacedImpostor& rec = *index.find(id);
+      EXPECT_TRUE(rec.shaft.containsBox(c.region));
+      ++shown;
+      const impostor::LayeredPlan lp = impostor::planLayered(rec.box, rec.shaft, rec.bound, rec.options);
+      const DVec3 e(lp.capture_eye), apex(lp.shaft.apex), axis(lp.shaft.axis);
+      const double d = lp.shaft.min_distance;
+      for (int k = 0; k < 20; ++k) {
+        const DVec3 eye(c.region.lo + (c.region.hi - c.region.lo) * Vec3(u(rng), u(rng), u(rng)));
+        const DVec3 p(rec.box.lo + (rec.box.hi - rec.box.lo) * Vec3(u(rng), u(rng), u(rng)));
+        const double zp = glm::dot(p - apex, axis);
+        const auto layer = std::find_if(lp.layers.begin(), lp.layers.end(), [&](const impostor::LayerPlan& l) {
+          return zp >= double(l.z_lo) - 1e-4 && zp <= double(l.z_hi) + 1e-4;
+        });
+        ASSERT_NE(layer, lp.layers.end());
+        const DVec3 q = e + (p - e) * ((d - double(layer->depth)) / (d - zp));
+        const DVec3 to_p = p - eye, to_q = q - eye;
+        const double angle = std::atan2(glm::length(glm::cross(to_p, to_q)), glm::dot(to_p, to_q));
+        EXPECT_LE(angle, lp.error_angle * (1.0 + 1e-6)) << "impostor " << id;
+        worst_ratio = std::max(worst_ratio, angle / lp.bound_angle);
+        ++pairs;
+      }
+    }
+  EXPECT_GT(shown, 0u);
+  EXPECT_LE(worst_ratio, 1.0 + 1e-6);
+  const ViewChecks v = checkViews(s.city.scene, s.profile, options, dir, 200);
+  EXPECT_GT(v.guarded, 30u);
+  EXPECT_GT(v.with_impostors, 3u);
+  EXPECT_GT(v.checked_images, 3u);
+  EXPECT_LE(v.over_tolerance * 20, v.checked_images);
+  std::printf("box cells: %zu candidates, %zu impostors (shafts: %zu), %zu of %zu CPVs unsolved (shafts: %zu), "
+              "%.2f MB (shafts: %.2f); %zu sampled pairs, worst parallax %.2f of the bound; item buffers: %zu of %zu "
+              "views over the bound plus a texel, worst p99 %.2f px\n",
+              r.candidate_counts.kept, r.impostors, s.report.impostors, r.unsolved_cpvs, r.cpvs,
+              s.report.unsolved_cpvs, r.memory_bytes / 1048576.0, s.report.memory_bytes / 1048576.0, pairs,
+              worst_ratio, v.over_tolerance, v.checked_images, v.worst_parallax);
 }
 
 // The layered impostors' fill in the cost model, and the fallback to coarser bounds: with a profile whose layered draw

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "farfield/core/error.h"
@@ -70,4 +72,42 @@ TEST(Shaft, SamplesLieInside) {
     EXPECT_TRUE(s.contains(p));
     EXPECT_LE(glm::length(p - s.apex), 100.0f + 1e-3f);
   }
+}
+
+// The shaft around a box view cell holds every point sampled in the box, and is the narrowest and nearest shaft with
+// its apex and axis: some corner lies on its rim and the box's nearest point at its minimum distance.
+TEST(Shaft, EnclosingShaftHoldsTheBoxAndIsTight) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  int made = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Vec3 apex(40.0f * uni(rng), 40.0f * uni(rng), 10.0f * uni(rng));
+    const Vec3 c = apex + Vec3(uni(rng) - 0.5f, uni(rng) - 0.5f, 0.2f * (uni(rng) - 0.5f)) * 200.0f;
+    const Vec3 half = Vec3(uni(rng) * 30.0f, uni(rng) * 30.0f, uni(rng) * 3.0f) + Vec3(0.1f);
+    const Box3 box = Box3::fromPoints(c - half, c + half);
+    const std::optional<Shaft> s = Shaft::enclosing(apex, box);
+    if (box.contains(apex)) {
+      EXPECT_FALSE(s.has_value()) << "trial " << trial;
+      continue;
+    }
+    if (!s) continue;  // a box wider than a half-space seen from the apex
+    ++made;
+    EXPECT_TRUE(s->containsBox(box)) << "trial " << trial;
+    float widest = 0.0f, nearest = 1e30f;
+    for (int i = 0; i <= 6; ++i)
+      for (int j = 0; j <= 6; ++j)
+        for (int k = 0; k <= 6; ++k) {
+          const Vec3 p = box.lo + (box.hi - box.lo) * Vec3(i / 6.0f, j / 6.0f, k / 6.0f);
+          EXPECT_TRUE(s->contains(p)) << "trial " << trial;
+          const Vec3 d = p - apex;
+          widest = std::max(widest, std::acos(std::clamp(glm::dot(d, s->axis) / glm::length(d), -1.0f, 1.0f)));
+          nearest = std::min(nearest, glm::length(d));
+        }
+    EXPECT_NEAR(2.0f * widest, s->apex_angle, 1e-3f) << "trial " << trial;  // the corners are among the samples
+    EXPECT_LE(s->min_distance, nearest);
+    EXPECT_GE(s->min_distance, nearest - 0.1f * glm::length(box.extent())) << "trial " << trial;
+  }
+  EXPECT_GT(made, 200);
+  EXPECT_FALSE(Shaft::enclosing(Vec3(0.0f), Box3::fromPoints(Vec3(-1.0f), Vec3(1.0f))).has_value());
+  EXPECT_FALSE(Shaft::enclosing(Vec3(0.0f), Box3{}).has_value());
 }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <random>
 #include <set>
@@ -136,6 +137,7 @@ TEST(Candidates, RectangularCellsServeTheCpvsInside) {
   o.rectangular_cells = true;
   const CandidateSet set = generateCandidates(h, vs, kLens, o);
   ASSERT_FALSE(set.candidates.empty());
+  size_t planned = 0;
   for (const Candidate& c : set.candidates) {
     const Box3& cell = std::get<Box3>(c.cell);
     const Box3& bounds = h.nodes()[size_t(c.node)].bounds;
@@ -148,10 +150,38 @@ TEST(Candidates, RectangularCellsServeTheCpvsInside) {
         expected.push_back(k);
     }
     EXPECT_EQ(c.cpvs, expected);
+    // The shaft an impostor of the box cell is planned for holds the cell, with its apex at the cluster's centre.
+    const std::optional<Shaft> shaft = planningShaft(c, h);
+    if (shaft) {
+      ++planned;
+      EXPECT_TRUE(shaft->containsBox(cell));
+      EXPECT_EQ(shaft->apex, bounds.center());
+    }
   }
+  EXPECT_GT(planned, set.candidates.size() / 2);
   // 7 regions hold CPVs: the root, its two halves and their four 30 x 30 m leaves.
   EXPECT_EQ(set.counts.considered, h.nodes().size() * 7);
   EXPECT_EQ(set.counts.considered, set.counts.kept + set.counts.intersecting + set.counts.no_cpv);
+}
+
+// Per-cell placement (the paper's test 14): box cells from the partition's leaves only, each serving the CPVs inside.
+TEST(Candidates, LeafBoxesAreTheSmallestRegionsOnly) {
+  const ObjectHierarchy h = randomHierarchy(3);
+  const ViewSpace vs = allProblems();
+  CandidateOptions o;
+  o.shafts = false;
+  o.rectangular_cells = true;
+  o.box_leaves_only = true;
+  const CandidateSet set = generateCandidates(h, vs, kLens, o);
+  ASSERT_FALSE(set.candidates.empty());
+  for (const Candidate& c : set.candidates) {
+    const Box3& cell = std::get<Box3>(c.cell);
+    const auto leaf = std::find_if(vs.nodes.begin(), vs.nodes.end(), [&](const ViewSpaceNode& n) {
+      return n.children[0] < 0 && n.box.lo == cell.lo && n.box.hi == cell.hi;
+    });
+    EXPECT_NE(leaf, vs.nodes.end());
+  }
+  EXPECT_EQ(set.counts.considered, h.nodes().size() * 4);  // the four 30 x 30 m leaves
 }
 
 TEST(Candidates, DefaultsFollowThePaper) {

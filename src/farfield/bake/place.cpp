@@ -356,9 +356,9 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     kept.counts = all.counts;
     std::vector<impostor::LayeredPlan> plans;
     for (const placement::Candidate& original : all.candidates) {
-      const Shaft* shaft = std::get_if<Shaft>(&original.cell);
+      const std::optional<Shaft> shaft = placement::planningShaft(original, hierarchy);
       if (!shaft) {
-        if (pass == 0) ++report.candidates_unplannable;  // box cells need a shaft around them: not planned yet
+        if (pass == 0) ++report.candidates_unplannable;  // a box cell no shaft from the cluster's centre holds
         continue;
       }
       placement::Candidate c = original;
@@ -422,7 +422,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
       const uint32_t id = next_id++;
       id_of[k] = id;
       written[id] = store::writePlacedImpostor(out_dir, generation, id, uint32_t(c.node), objects, imp,
-                                               hierarchy.nodes()[size_t(c.node)].bounds, std::get<Shaft>(c.cell),
+                                               hierarchy.nodes()[size_t(c.node)].bounds, plans[k].shaft,
                                                pass_bound, options.layered);
       id_bytes[id] = imp.plan.id_textures ? 0.5 * double(imp.plan.texture_bytes) : 0.0;
       chosen_plans[id] = plans[k];
@@ -546,7 +546,8 @@ nlohmann::json placeOptionsToJson(const PlaceOptions& o) {
                           {"first_distance_factor", c.first_distance_factor},
                           {"distance_steps", c.distance_steps},
                           {"drop_identical", c.drop_identical},
-                          {"rectangular_cells", c.rectangular_cells}}},
+                          {"rectangular_cells", c.rectangular_cells},
+                          {"box_leaves_only", c.box_leaves_only}}},
           {"layered", {{"texel_pixels", l.texel_pixels},
                        {"max_texture_size", l.max_texture_size},
                        {"max_layers", l.max_layers},
@@ -598,6 +599,8 @@ PlaceOptions placeOptionsFromJson(const nlohmann::json& j, const std::string& so
   c.number("distance_steps", o.candidates.distance_steps);
   o.candidates.drop_identical = c.boolean("drop_identical");
   o.candidates.rectangular_cells = c.boolean("rectangular_cells");
+  // Databases placed before per-cell boxes existed say nothing of them: boxes from every region then.
+  o.candidates.box_leaves_only = c.has("box_leaves_only") && c.boolean("box_leaves_only");
   c.rejectUnknown();
   StrictJson l = r.object("layered");
   l.number("texel_pixels", o.layered.texel_pixels);

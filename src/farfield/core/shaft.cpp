@@ -18,6 +18,24 @@ Shaft Shaft::make(const Vec3& apex, const Vec3& axis, float apex_angle, float mi
   return Shaft{apex, axis / length, apex_angle, min_distance};
 }
 
+std::optional<Shaft> Shaft::enclosing(const Vec3& apex, const Box3& box) {
+  if (box.empty() || !isFinite(apex) || box.contains(apex)) return std::nullopt;
+  const Vec3 to_centre = box.center() - apex;
+  if (!(glm::length(to_centre) > 0.0f)) return std::nullopt;
+  const Vec3 axis = glm::normalize(to_centre);
+  float cos_half = 1.0f;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner((i & 1) ? box.hi.x : box.lo.x, (i & 2) ? box.hi.y : box.lo.y, (i & 4) ? box.hi.z : box.lo.z);
+    const Vec3 d = corner - apex;
+    cos_half = std::min(cos_half, glm::dot(d, axis) / glm::length(d));
+  }
+  // A little wider than the widest corner, so that containsBox's float test holds at that corner too.
+  const float half = std::acos(std::clamp(cos_half, -1.0f, 1.0f)) + 1e-5f;
+  if (!(half < 0.5f * static_cast<float>(kPi))) return std::nullopt;
+  const float nearest = glm::length(glm::clamp(apex, box.lo, box.hi) - apex);
+  return Shaft{apex, axis, 2.0f * half, nearest * (1.0f - 1e-6f)};
+}
+
 bool Shaft::contains(const Vec3& p) const {
   const Vec3 d = p - apex;
   const float dist = glm::length(d);

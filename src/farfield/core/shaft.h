@@ -7,6 +7,8 @@
 // Apex angles up to 180 degrees keep the cone convex, which the box tests below rely on.
 #pragma once
 
+#include <optional>
+
 #include "farfield/core/bounds.h"
 #include "farfield/core/math.h"
 
@@ -22,6 +24,12 @@ struct Shaft {
   // (0, pi] or a negative minimum distance. The axis is normalised.
   static Shaft make(const Vec3& apex, const Vec3& axis, float apex_angle, float min_distance,
                     const char* what = "shaft");
+  // The shaft from `apex` around a box view cell (a rectangular cell planned as a shaft, Jeschke et al. 2005 test
+  // 13): the axis through the box's centre, the apex angle twice the largest angle of a corner to it, the minimum
+  // distance the box's nearest point. containsBox(box) holds for it, so whatever holds from every viewpoint of the
+  // shaft (a layered plan's error bound) holds from every viewpoint of the box. Empty when the box is empty, holds
+  // the apex, or is not within a cone of at most 180 degrees (no convex shaft holds it).
+  static std::optional<Shaft> enclosing(const Vec3& apex, const Box3& box);
 
   bool contains(const Vec3& p) const;
   // Every point of the box is in the shaft (the box's corners are in the cone, which is convex, and its nearest point

@@ -90,9 +90,9 @@ void shaftCandidates(const ObjectHierarchy& h, int node, const std::vector<uint3
 }
 
 void boxCandidates(int node, const Box3& bounds, const std::vector<Frustum>& frusta, const ViewSpace& vs,
-                   CandidateSet& out) {
+                   bool leaves_only, CandidateSet& out) {
   for (const ViewSpaceNode& region : vs.nodes) {
-    if (region.cpv_count == 0) continue;
+    if (region.cpv_count == 0 || (leaves_only && region.children[0] >= 0)) continue;
     ++out.counts.considered;
     if (region.box.overlaps(bounds)) {
       ++out.counts.intersecting;
@@ -107,6 +107,11 @@ void boxCandidates(int node, const Box3& bounds, const std::vector<Frustum>& fru
 }
 
 }  // namespace
+
+std::optional<Shaft> planningShaft(const Candidate& candidate, const ObjectHierarchy& hierarchy) {
+  if (const Shaft* shaft = std::get_if<Shaft>(&candidate.cell)) return *shaft;
+  return Shaft::enclosing(hierarchy.nodes()[size_t(candidate.node)].bounds.center(), std::get<Box3>(candidate.cell));
+}
 
 std::vector<Frustum> cpvFrusta(const ViewSpace& view_space, const Lens& lens) {
   std::vector<Frustum> frusta;
@@ -128,7 +133,7 @@ CandidateSet generateCandidates(const ObjectHierarchy& hierarchy, const ViewSpac
     for (uint32_t c = 0; c < frusta.size(); ++c)
       if (frusta[c].intersects(bounds)) visible.push_back(c);
     if (options.shafts) shaftCandidates(hierarchy, node, visible, view_space, options, axes, out);
-    if (options.rectangular_cells) boxCandidates(node, bounds, frusta, view_space, out);
+    if (options.rectangular_cells) boxCandidates(node, bounds, frusta, view_space, options.box_leaves_only, out);
   }
   out.counts.kept = out.candidates.size();
   return out;

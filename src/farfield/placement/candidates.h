@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <variant>
 #include <vector>
 
@@ -36,6 +37,7 @@ struct CandidateOptions {
   // angle, then the largest minimum distance (the smallest cell; it needs the least impostor memory).
   bool drop_identical = true;
   bool rectangular_cells = false;  // also the view-space partition's regions as box cells
+  bool box_leaves_only = false;    // box cells from the partition's leaves only (per-cell placement, test 14)
 };
 
 using ViewCell = std::variant<Shaft, Box3>;
@@ -61,6 +63,11 @@ struct CandidateSet {
 
 // The CPVs' enclosing frusta, in CPV order (candidates and cost estimates both need them).
 std::vector<Frustum> cpvFrusta(const ViewSpace& view_space, const Lens& lens);
+
+// The shaft an impostor of the candidate is planned for: its own shaft, or for a box cell the shaft from the node's
+// centre around the box (Shaft::enclosing: a layered plan that keeps the bound from it keeps it from the box). Empty
+// for a box no convex shaft from the node's centre holds.
+std::optional<Shaft> planningShaft(const Candidate& candidate, const ObjectHierarchy& hierarchy);
 
 // Throws farfield::Error naming the option for bad options (and for a bad lens).
 CandidateSet generateCandidates(const ObjectHierarchy& hierarchy, const ViewSpace& view_space, const Lens& lens,
