@@ -1,6 +1,6 @@
 // farfield crowd bench -o OUTDIR [--agents 1000,10000] [--paths pedestrian,elevated] [--frames N] [--step K]
 //                      [--size WxH] [--blocks N] [--detail D] [--models A.glb,B.glb] [--texel M] [--cycle-frames F]
-//                      [--azimuths A] [--elevations E] [--error-px PX] [--atlas-from-bound] [--bound-switch M]
+//                      [--azimuths A] [--elevations E] [--octahedral N] [--error-px PX] [--atlas-from-bound] [--bound-switch M]
 //                      [--blend-views] [--outfits N] [--no-shadows] [--shadow-map N] [--shadow-distance M]
 // Animated crowds with multi-view impostors on a generated city: eval::runCrowdBench (eval/crowd_bench.h).
 #include <cstdio>
@@ -16,6 +16,7 @@
 #include "farfield/core/error.h"
 #include "farfield/eval/crowd_bench.h"
 #include "farfield/gpu/context.h"
+#include "farfield/impostor/multi_view.h"
 
 namespace farfield::app {
 namespace {
@@ -34,6 +35,7 @@ struct CrowdArgs {
   std::string paths = "pedestrian,elevated";
   std::string size = "512x512";
   std::string models = "../shared/data/models/CesiumMan.glb,../shared/data/models/Fox.glb";
+  int octahedral = 0;
 };
 
 void run(CrowdArgs& a) {
@@ -59,6 +61,8 @@ void run(CrowdArgs& a) {
   a.o.models = splitList(a.models);
   if (a.o.runtime.grid.azimuths < 1 || a.o.runtime.grid.elevations < 1)
     throw Error("--azimuths/--elevations", "must be at least 1");
+  if (a.octahedral == 1 || a.octahedral < 0) throw Error("--octahedral", "must be 0 (off) or at least 2 views a side");
+  if (a.octahedral >= 2) a.o.runtime.grid = impostor::ViewGrid::octahedralGrid(a.octahedral);
   const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), a.o);
   std::printf("%s\nwrote %s/{crowd.json,crowd.md,frames/}\n", r.markdown.c_str(), a.o.out_dir.c_str());
 }
@@ -87,6 +91,10 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
   bench->add_option("--cycle-frames", o.runtime.frames, "Impostor frames per walk cycle")->capture_default_str();
   bench->add_option("--azimuths", o.runtime.grid.azimuths, "Impostor views around")->capture_default_str();
   bench->add_option("--elevations", o.runtime.grid.elevations, "Impostor view elevations")->capture_default_str();
+  bench->add_option("--octahedral", a->octahedral, "N > 1: views on an N x N octahedral map of the hemisphere "
+                                                    "instead of azimuths x elevations (with --atlas-from-bound: the "
+                                                    "octahedral grid the bound asks for)")
+      ->capture_default_str();
   bench->add_option("--error-px", o.runtime.error_px, "View error bound (pixels) of crowd-mixed")->capture_default_str();
   bench->add_option("--samples", o.samples, "Sample frames saved per run")->capture_default_str();
   bench->add_flag("--atlas-from-bound", o.runtime.atlas_from_bound,

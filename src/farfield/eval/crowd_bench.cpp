@@ -121,7 +121,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
        << (c.from_bound ? "chosen from the bound (" + fmt("%.2f", options.runtime.error_px) + " px from " +
                               fmt("%.1f", options.runtime.bound_switch_m) + " m on)"
                         : std::string("fixed"))
-       << ": " << l.azimuths << "x" << l.elevations << " views x " << l.frames << " frames (frame error "
+       << ": " << l.azimuths << "x" << l.elevations << (l.octahedral ? " octahedral" : "") << " views x " << l.frames
+       << " frames (frame error "
        << fmt("%.3f", c.frame_error_m) << " m), cells " << l.cell_width << "x" << l.cell_height << " texels ("
        << fmt("%.3f", c.texel_m) << " m), " << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0)
        << " MiB uncompressed (" << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames)
@@ -161,7 +162,8 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
     const gpu::AtlasLayout& l = result.layouts[m];
     const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
     j["models"].push_back({{"file", result.model_names[m]}, {"triangles", result.model_triangles[m]},
-                           {"azimuths", l.azimuths}, {"elevations", l.elevations}, {"frames", l.frames},
+                           {"azimuths", l.azimuths}, {"elevations", l.elevations},
+                           {"octahedral", l.octahedral}, {"frames", l.frames},
                            {"cell", {l.cell_width, l.cell_height}}, {"texel_m", c.texel_m},
                            {"frame_error_m", c.frame_error_m}, {"from_bound", c.from_bound},
                            {"atlas_bytes", result.atlas_bytes[m]},

@@ -253,6 +253,7 @@ FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtla
   p.set("u_fixed_dir", Vec3(0.0f));
   p.set("u_outfits", outfits_);
   p.set("u_max_elevation", l.max_elevation);
+  p.set("u_octahedral", l.octahedral ? 1 : 0);
   bindAtlas(p, atlas);
   setLight(p, light);
   glBindVertexArray(empty_vao_);

@@ -71,6 +71,7 @@ struct AtlasLayout {
   Vec3 centre{0.0f};     // agent space
   float radius = 1.0f;   // metres: depth normalisation
   float max_elevation = 1.5707964f;  // radians: ring j at j * max_elevation / elevations (view blending)
+  bool octahedral = false;  // the cells are an N x N octahedral map of the hemisphere (impostor::ViewGrid)
   int width() const { return azimuths * cell_width; }
   int height() const { return elevations * cell_height; }
 };

@@ -18,10 +18,43 @@ Vec3 directionOf(float az, float el) {
 
 }  // namespace
 
-Vec3 ViewGrid::direction(int cell) const { return directionOf(azimuth(cell % azimuths), elevation(cell / azimuths)); }
+Vec2 octahedralPoint(const Vec3& direction) {
+  const Vec3 d(direction.x, direction.y, std::max(direction.z, 0.0f));
+  const float l1 = std::abs(d.x) + std::abs(d.y) + d.z;
+  if (!(l1 > 0.0f)) return Vec2(0.0f);
+  const Vec2 p = Vec2(d.x, d.y) / l1;
+  return Vec2(p.x + p.y, p.x - p.y);
+}
+
+Vec3 octahedralDirection(const Vec2& point) {
+  const Vec2 q = glm::clamp(point, Vec2(-1.0f), Vec2(1.0f));
+  const Vec2 p(0.5f * (q.x + q.y), 0.5f * (q.x - q.y));
+  return glm::normalize(Vec3(p.x, p.y, std::max(0.0f, 1.0f - std::abs(p.x) - std::abs(p.y))));
+}
+
+Vec3 ViewGrid::direction(int cell) const {
+  if (octahedral) {
+    const float step = 2.0f / float(std::max(azimuths - 1, 1));
+    return octahedralDirection(Vec2(-1.0f + step * float(cell % azimuths), -1.0f + step * float(cell / azimuths)));
+  }
+  return directionOf(azimuth(cell % azimuths), elevation(cell / azimuths));
+}
 
 int nearestView(const ViewGrid& grid, const Vec3& to_camera) {
   const Vec3 d = glm::normalize(to_camera);
+  if (grid.octahedral) {
+    const int n = grid.azimuths;
+    const Vec2 f = (octahedralPoint(d) * 0.5f + 0.5f) * float(n - 1);
+    const int col = int(std::lround(f.x)), row = int(std::lround(f.y));
+    int best = -1;
+    float best_dot = -2.0f;
+    for (int r = std::max(row - 1, 0); r <= std::min(row + 1, n - 1); ++r)
+      for (int c = std::max(col - 1, 0); c <= std::min(col + 1, n - 1); ++c) {
+        const float dot = glm::dot(grid.direction(r * n + c), d);
+        if (dot > best_dot) best_dot = dot, best = r * n + c;
+      }
+    return best;
+  }
   float az = std::atan2(d.y, d.x);
   if (az < 0.0f) az += float(2.0 * kPi);
   const int ai = int(std::lround(az / float(2.0 * kPi) * float(grid.azimuths))) % grid.azimuths;
@@ -49,10 +82,13 @@ float worstViewAngle(const ViewGrid& grid) {
 
 gpu::AtlasLayout atlasLayout(const Box3& bounds, const ViewGrid& grid, int frames, float texel_m) {
   if (!(texel_m > 0.0f) || frames < 1) throw Error("multi-view atlas", "texel size and frame count must be positive");
+  if (grid.azimuths < 1 || grid.elevations < 1 || (grid.octahedral && (grid.azimuths < 2 || grid.azimuths != grid.elevations)))
+    throw Error("multi-view atlas", "a grid needs at least one view; an octahedral one N x N views, N >= 2");
   gpu::AtlasLayout l;
   l.azimuths = grid.azimuths;
   l.max_elevation = grid.max_elevation;
   l.elevations = grid.elevations;
+  l.octahedral = grid.octahedral;
   l.frames = frames;
   l.centre = bounds.center();
   const Vec3 half = bounds.hi - l.centre;
@@ -60,8 +96,8 @@ gpu::AtlasLayout atlasLayout(const Box3& bounds, const ViewGrid& grid, int frame
   // vertical extent is at most half.z cos e + r sin e.
   const float r = std::sqrt(half.x * half.x + half.y * half.y);
   float hh = 0.0f;
-  for (int j = 0; j < grid.elevations; ++j) {
-    const float e = grid.elevation(j);
+  for (int v = 0; v < grid.viewCount(); ++v) {
+    const float e = std::asin(std::clamp(grid.direction(v).z, 0.0f, 1.0f));
     hh = std::max(hh, half.z * std::cos(e) + r * std::sin(e));
   }
   l.half_size = Vec2(r, hh) * 1.02f;
@@ -125,12 +161,21 @@ int framesForBound(std::span<const std::vector<Vec3>> pose_positions, double max
 }
 
 BoundChoice chooseForBound(double error_px, double focal_px, double switch_m, double half_width_m,
-                           float max_elevation) {
+                           float max_elevation, bool octahedral) {
   if (!(error_px > 0.0) || !(focal_px > 0.0) || !(switch_m > 0.0) || !(half_width_m > 0.0) || !(max_elevation > 0.0f))
     throw Error("multi-view bound", "error, focal length, switch distance and half width must be positive");
   BoundChoice c;
   c.texel_m = float(switch_m / focal_px);
   const double allowed = error_px * switch_m / (focal_px * half_width_m);
+  if (octahedral) {
+    // Neighbouring map points are at most about pi / (N - 1) apart (the map's edge, a quarter circle per N / 2 - 1/2
+    // steps); start below and refine until the measured worst angle fits.
+    for (int n = std::max(2, int(std::floor(kPi / 2.0 / allowed))); n < 4096; ++n) {
+      c.grid = ViewGrid::octahedralGrid(n);
+      if (double(worstViewAngle(c.grid)) <= allowed) break;
+    }
+    return c;
+  }
   // Equal spacing s: the worst angle is s at the top ring's gap and s / sqrt(2) between four views; start from the
   // spacing equal to the allowed angle and refine until the measured worst angle fits.
   for (int n = std::max(1, int(std::ceil(double(max_elevation) / std::min(allowed, double(max_elevation))))); n < 4096;

@@ -2,7 +2,9 @@
 // part 3, "Crowd using impostors" (32 azimuths x 8 elevations per animation frame, the best view chosen per agent).
 //
 // Views lie on a grid of azimuths (full circle, azimuth 0 = the agent's +x, its facing) and elevations (0 up to
-// below max_elevation, evenly spaced). Each view is an orthographic image of the model, centred on its capture centre,
+// below max_elevation, evenly spaced), or, as an option, on an N x N grid of the upper hemisphere's octahedral map
+// (the layout of octahedral impostors: views spread evenly over the hemisphere, no crowding at the zenith; the
+// four around a direction are the corners of its map square). Each view is an orthographic image of the model, centred on its capture centre,
 // of a fixed world extent (half_size) for every view so that one quad size fits all; an atlas layer holds every view
 // of one animation frame. Pure functions here (views, selection, error and memory estimates); the bake renders with
 // gpu::CrowdRenderer.
@@ -23,7 +25,12 @@ struct ViewGrid {
   int azimuths = 32;
   int elevations = 8;
   float max_elevation = float(kPi / 2);  // radians: elevations j * max_elevation / elevations, j = 0..elevations-1
+  // Octahedral: azimuths = elevations = N (>= 2) are the map's columns and rows; view (row, column) looks from the
+  // hemisphere direction of map point (-1 + 2 column / (N - 1), -1 + 2 row / (N - 1)) (octahedralDirection), the
+  // map's edge being the horizon. max_elevation is then pi / 2.
+  bool octahedral = false;
 
+  static ViewGrid octahedralGrid(int n) { return ViewGrid{n, n, float(kPi / 2), true}; }
   int viewCount() const { return azimuths * elevations; }
   float azimuth(int i) const { return float(2.0 * kPi) * float(i) / float(azimuths); }
   float elevation(int j) const { return max_elevation * float(j) / float(elevations); }
@@ -31,8 +38,15 @@ struct ViewGrid {
   Vec3 direction(int cell) const;
 };
 
+// The upper hemisphere's octahedral map: a direction (z < 0 taken as its horizontal part) to its point in [-1, 1]^2
+// (p = (x, y) / (|x| + |y| + z), then (p.x + p.y, p.x - p.y): the horizon is the square's edge, the zenith its
+// centre), and back (unit length). multiview.vert.glsl computes the same map.
+Vec2 octahedralPoint(const Vec3& direction);
+Vec3 octahedralDirection(const Vec2& point);
+
 // The view whose direction is nearest (largest dot product) to the unit direction `to_camera` (agent space): the
-// nearest azimuth on the two elevation rings around the direction's elevation, compared exactly.
+// nearest azimuth on the two elevation rings around the direction's elevation, compared exactly; on an octahedral
+// grid the nearest of the 3 x 3 views around the direction's map point.
 int nearestView(const ViewGrid& grid, const Vec3& to_camera);
 
 // Largest angle (radians) between a direction with elevation in [0, max_elevation] and its nearest view, sampled
@@ -77,8 +91,9 @@ struct BoundChoice {
   ViewGrid grid;
   float texel_m = 0.0f;
 };
+// With `octahedral`, the coarsest N x N octahedral grid that keeps it.
 BoundChoice chooseForBound(double error_px, double focal_px, double switch_m, double half_width_m,
-                           float max_elevation = float(kPi / 2));
+                           float max_elevation = float(kPi / 2), bool octahedral = false);
 
 // A baked model: layout, grid and the atlas on the GPU.
 struct MultiViewImpostor {

@@ -64,7 +64,8 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
     if (options.atlas_from_bound) {
       const Vec3 half = agent_bounds.hi - model.centre;
       const impostor::BoundChoice bc = impostor::chooseForBound(options.error_px, options.bound_focal_px,
-                                                                options.bound_switch_m, std::hypot(half.x, half.y));
+                                                                options.bound_switch_m, std::hypot(half.x, half.y),
+                                                                float(kPi / 2), options.grid.octahedral);
       choice.grid = bc.grid;
       choice.texel_m = bc.texel_m;
       choice.frames = impostor::framesForBound(pose_positions,

@@ -5,7 +5,9 @@
 // Drawn as a 4-vertex triangle strip per instance, no vertex buffer. With u_fixed_dir non-zero (an orthographic
 // light: shadow casters) every quad faces that unit direction instead of the eye. FF_BLEND_VIEWS: the four views
 // around the direction to the eye (two azimuths on the two elevation rings around it) with bilinear weights in
-// azimuth and elevation, for the fragment shader to blend (the agent's own `view` is then unused).
+// azimuth and elevation, for the fragment shader to blend (the agent's own `view` is then unused); on an octahedral
+// grid (u_octahedral) the four corners of the map square holding the direction's octahedral point (impostor::
+// octahedralPoint), weighted bilinearly in the map.
 
 struct Agent {
   vec4 pos_heading;
@@ -30,6 +32,7 @@ flat out float v_heading;
 #ifdef FF_BLEND_VIEWS
 uniform ivec2 u_grid;  // azimuths, elevations
 uniform float u_max_elevation;
+uniform int u_octahedral;
 flat out uvec4 v_views;
 flat out vec4 v_weights;
 #endif
@@ -52,6 +55,18 @@ void main() {
   v_heading = a.pos_heading.w;
 #ifdef FF_BLEND_VIEWS
   const vec3 local = vec3(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);  // towards the eye, agent space
+  if (u_octahedral != 0) {
+    const vec3 h = vec3(local.xy, max(local.z, 0.0));
+    const vec2 p = h.xy / max(abs(h.x) + abs(h.y) + h.z, 1e-8);
+    const vec2 f = (vec2(p.x + p.y, p.x - p.y) * 0.5 + 0.5) * float(u_grid.x - 1);
+    const ivec2 i0 = clamp(ivec2(floor(f)), ivec2(0), ivec2(u_grid.x - 2));
+    const vec2 t = clamp(f - vec2(i0), 0.0, 1.0);
+    const int v00 = i0.y * u_grid.x + i0.x;
+    v_views = uvec4(v00, v00 + 1, v00 + u_grid.x, v00 + u_grid.x + 1);
+    v_weights = vec4((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * t.y);
+    gl_Position = u_view_proj * vec4(v_world, 1.0);
+    return;
+  }
   float az = atan(local.y, local.x);
   if (az < 0.0) az += 6.28318530718;
   const float fa = az / 6.28318530718 * float(u_grid.x);
