@@ -129,13 +129,21 @@ TEST(Candidates, DropIdenticalKeepsEachServedSetOnce) {
   }
 }
 
-TEST(Candidates, RectangularCellsServeTheCpvsInside) {
-  const ObjectHierarchy h = randomHierarchy(3);
-  const ViewSpace vs = allProblems();
+namespace {
+// Box cells only: every region of the partition, or its leaves.
+CandidateSet boxCellsOnly(const ObjectHierarchy& h, const ViewSpace& vs, bool leaves_only) {
   CandidateOptions o;
   o.shafts = false;
   o.rectangular_cells = true;
-  const CandidateSet set = generateCandidates(h, vs, kLens, o);
+  o.box_leaves_only = leaves_only;
+  return generateCandidates(h, vs, kLens, o);
+}
+}  // namespace
+
+TEST(Candidates, RectangularCellsServeTheCpvsInside) {
+  const ObjectHierarchy h = randomHierarchy(3);
+  const ViewSpace vs = allProblems();
+  const CandidateSet set = boxCellsOnly(h, vs, false);
   ASSERT_FALSE(set.candidates.empty());
   size_t planned = 0;
   for (const Candidate& c : set.candidates) {
@@ -168,11 +176,7 @@ TEST(Candidates, RectangularCellsServeTheCpvsInside) {
 TEST(Candidates, LeafBoxesAreTheSmallestRegionsOnly) {
   const ObjectHierarchy h = randomHierarchy(3);
   const ViewSpace vs = allProblems();
-  CandidateOptions o;
-  o.shafts = false;
-  o.rectangular_cells = true;
-  o.box_leaves_only = true;
-  const CandidateSet set = generateCandidates(h, vs, kLens, o);
+  const CandidateSet set = boxCellsOnly(h, vs, true);
   ASSERT_FALSE(set.candidates.empty());
   for (const Candidate& c : set.candidates) {
     const Box3& cell = std::get<Box3>(c.cell);
