@@ -9,7 +9,10 @@
 # Extra libFuzzer flags: FUZZ_FLAGS="-runs=1000000". FUZZ_NICE (default 10) is the nice level of each run.
 # FUZZ_CHUNK=S runs each target as a series of fresh processes of S seconds over the same corpus until SECONDS are
 # spent (for a library that leaks on damaged input, whose RSS would otherwise reach the limit): executions are
-# summed over the series, the rate is their mean, the coverage and corpus are the last run's.
+# summed over the series, the rate is their mean, the coverage and corpus are the last run's. FUZZ_CHUNK_RUNS=N ends
+# each process of the series after N executions instead (the leak grows per execution, so on a shared machine, where
+# the rate varies, a count keeps the RSS bounded where a time does not; a process that only replayed its corpus
+# before its seconds ran out explored nothing).
 set -uo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${1:?usage: run_fuzzers.sh BUILD_DIR SECONDS [TARGET...]}"
@@ -46,12 +49,16 @@ for t in "${targets[@]}"; do
   execs=0
   : > "$log"
   rc=0
+  runs=()
+  [ -n "${FUZZ_CHUNK_RUNS:-}" ] && runs=("-runs=$FUZZ_CHUNK_RUNS")
   while [ "$left" -gt 0 ] && [ "$rc" -eq 0 ]; do
     run=$(( left < chunk ? left : chunk ))
+    started=$(date +%s)
     # shellcheck disable=SC2086
     nice -n "${FUZZ_NICE:-10}" "$bin" -max_total_time="$run" -timeout=30 -rss_limit_mb=2560 -print_final_stats=1 \
-      -artifact_prefix="$crashes/" "${dict[@]}" "${flags[@]}" ${FUZZ_FLAGS:-} "$corpus" > "$log.part" 2>&1
+      -artifact_prefix="$crashes/" "${dict[@]}" "${flags[@]}" "${runs[@]}" ${FUZZ_FLAGS:-} "$corpus" > "$log.part" 2>&1
     rc=$?
+    [ ${#runs[@]} -gt 0 ] && run=$(( $(date +%s) - started > 0 ? $(date +%s) - started : 1 ))
     cat "$log.part" >> "$log"
     n=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log.part" | tail -1 | grep -o '[0-9]*$')
     execs=$((execs + ${n:-0}))
