@@ -38,29 +38,20 @@ void KeyframeVisibility::reset(const QuadtreeLod& lod, const Camera& keyframe, c
   depth_ = depth;
   camera_ = keyframe;
   options_ = options;
-  const size_t n = lod.positions().size();
-  if (stamp_.size() != n) {
-    stamp_.assign(n, 0);
-    visible_.assign(n, 0);
-    generation_ = 0;
-  }
-  if (++generation_ == 0) {  // wrapped: start over
-    std::fill(stamp_.begin(), stamp_.end(), 0);
-    generation_ = 1;
-  }
+  visible_.clear();
   classified_ = 0;
 }
 
 bool KeyframeVisibility::vertexVisible(uint32_t v) {
-  FF_CHECK(lod_ && v < stamp_.size());
-  if (stamp_[v] != generation_) {
-    stamp_[v] = generation_;
+  FF_CHECK(lod_ && v < lod_->positions().size());
+  const auto [it, fresh] = visible_.try_emplace(v, false);
+  if (fresh) {
     const Heightfield& hf = lod_->heightfield();
     const int i = int(v % uint32_t(hf.width)), j = int(v / uint32_t(hf.width));
-    visible_[v] = terrain::vertexVisible(camera_, *depth_, lod_->position(v), hf.normal(i, j), options_) ? 1 : 0;
+    it->second = terrain::vertexVisible(camera_, *depth_, lod_->position(v), hf.normal(i, j), options_);
     ++classified_;
   }
-  return visible_[v] != 0;
+  return it->second;
 }
 
 size_t KeyframeVisibility::partition(std::vector<uint32_t>& indices) {
