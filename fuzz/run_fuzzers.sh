@@ -58,7 +58,8 @@ for t in "${targets[@]}"; do
     nice -n "${FUZZ_NICE:-10}" "$bin" -max_total_time="$run" -timeout=30 -rss_limit_mb=2560 -print_final_stats=1 \
       -artifact_prefix="$crashes/" "${dict[@]}" "${flags[@]}" "${runs[@]}" ${FUZZ_FLAGS:-} "$corpus" > "$log.part" 2>&1
     rc=$?
-    [ ${#runs[@]} -gt 0 ] && run=$(( $(date +%s) - started > 0 ? $(date +%s) - started : 1 ))
+    elapsed=$(( $(date +%s) - started ))
+    [ ${#runs[@]} -gt 0 ] && run=$(( elapsed > 0 ? elapsed : 1 ))
     cat "$log.part" >> "$log"
     n=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log.part" | tail -1 | grep -o '[0-9]*$')
     execs=$((execs + ${n:-0}))

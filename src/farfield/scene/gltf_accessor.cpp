@@ -6,10 +6,37 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <span>
 
 #include "farfield/core/error.h"
 
 namespace farfield::scene {
+
+namespace {
+
+// The bytes of buffer view `index`, checked against its buffer; empty with *why set when the view or its buffer is
+// out of range or the view does not fit in the buffer (*why is left alone otherwise).
+std::span<const unsigned char> viewBytes(const tinygltf::Model& model, int index, std::string* why) {
+  if (index < 0 || size_t(index) >= model.bufferViews.size()) {
+    *why = "buffer view " + std::to_string(index) + " out of range";
+    return {};
+  }
+  const tinygltf::BufferView& bv = model.bufferViews[size_t(index)];
+  if (bv.buffer < 0 || size_t(bv.buffer) >= model.buffers.size()) {
+    *why = "buffer " + std::to_string(bv.buffer) + " out of range";
+    return {};
+  }
+  const tinygltf::Buffer& buf = model.buffers[size_t(bv.buffer)];
+  const uint64_t end = uint64_t(bv.byteOffset) + uint64_t(bv.byteLength);
+  if (end > buf.data.size() || end < uint64_t(bv.byteOffset)) {
+    *why = "buffer view " + std::to_string(index) + " ends at byte " + std::to_string(end) + " past the buffer's " +
+           std::to_string(buf.data.size()) + " bytes (truncated file?)";
+    return {};
+  }
+  return {buf.data.data() + bv.byteOffset, size_t(bv.byteLength)};
+}
+
+}  // namespace
 
 GltfView gltfAccessor(const tinygltf::Model& model, int index, const std::string& what, const std::string& path) {
   auto fail = [&](const std::string& message) { throw Error(path, message); };
@@ -18,27 +45,21 @@ GltfView gltfAccessor(const tinygltf::Model& model, int index, const std::string
   const tinygltf::Accessor& a = model.accessors[size_t(index)];
   const std::string where = what + " (accessor " + std::to_string(index) + ")";
   if (a.sparse.isSparse) fail(where + ": sparse accessors are not supported");
-  if (a.bufferView < 0 || size_t(a.bufferView) >= model.bufferViews.size())
-    fail(where + ": buffer view " + std::to_string(a.bufferView) + " out of range");
-  const tinygltf::BufferView& bv = model.bufferViews[size_t(a.bufferView)];
-  if (bv.buffer < 0 || size_t(bv.buffer) >= model.buffers.size())
-    fail(where + ": buffer " + std::to_string(bv.buffer) + " out of range");
-  const tinygltf::Buffer& buf = model.buffers[size_t(bv.buffer)];
+  std::string why;
+  const std::span<const unsigned char> view = viewBytes(model, a.bufferView, &why);
+  if (!why.empty()) fail(where + ": " + why);
   const int comp_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
   const int comps = tinygltf::GetNumComponentsInType(uint32_t(a.type));
   if (comp_size <= 0 || comps <= 0) fail(where + ": unknown component or element type");
   const uint64_t elem = uint64_t(comp_size) * uint64_t(comps);
-  const uint64_t stride = bv.byteStride > 0 ? uint64_t(bv.byteStride) : elem;
+  const int byte_stride = model.bufferViews[size_t(a.bufferView)].byteStride;  // the view is valid (viewBytes)
+  const uint64_t stride = byte_stride > 0 ? uint64_t(byte_stride) : elem;
   if (stride < elem) fail(where + ": byte stride smaller than one element");
-  const uint64_t view_end = uint64_t(bv.byteOffset) + uint64_t(bv.byteLength);
-  if (view_end > buf.data.size())
-    fail(where + ": buffer view ends at byte " + std::to_string(view_end) + " past the buffer's " +
-         std::to_string(buf.data.size()) + " bytes (truncated file?)");
-  const uint64_t start = uint64_t(bv.byteOffset) + uint64_t(a.byteOffset);
-  if (a.count > 0 && start + stride * (uint64_t(a.count) - 1) + elem > view_end)
+  const uint64_t start = uint64_t(a.byteOffset);
+  if (a.count > 0 && start + stride * (uint64_t(a.count) - 1) + elem > view.size())
     fail(where + ": " + std::to_string(a.count) + " elements do not fit in the buffer view (truncated file?)");
   GltfView v;
-  v.data = buf.data.data() + start;
+  v.data = view.data() + start;
   v.stride = size_t(stride);
   v.count = a.count;
   v.component_type = a.componentType;
@@ -52,25 +73,10 @@ std::span<const unsigned char> gltfImageBytes(const tinygltf::Model& model, int 
     *why = "image " + std::to_string(index) + " out of range";
     return {};
   }
-  const tinygltf::Image& img = model.images[size_t(index)];
-  const std::string where = "image " + std::to_string(index);
-  if (img.bufferView < 0 || size_t(img.bufferView) >= model.bufferViews.size()) {
-    *why = where + ": buffer view " + std::to_string(img.bufferView) + " out of range";
-    return {};
-  }
-  const tinygltf::BufferView& bv = model.bufferViews[size_t(img.bufferView)];
-  if (bv.buffer < 0 || size_t(bv.buffer) >= model.buffers.size()) {
-    *why = where + ": buffer " + std::to_string(bv.buffer) + " out of range";
-    return {};
-  }
-  const tinygltf::Buffer& buf = model.buffers[size_t(bv.buffer)];
-  const uint64_t end = uint64_t(bv.byteOffset) + uint64_t(bv.byteLength);
-  if (end > buf.data.size() || end < uint64_t(bv.byteOffset)) {
-    *why = where + ": buffer view " + std::to_string(img.bufferView) + " ends at byte " + std::to_string(end) +
-           " past the buffer's " + std::to_string(buf.data.size()) + " bytes (truncated file?)";
-    return {};
-  }
-  return {buf.data.data() + bv.byteOffset, size_t(bv.byteLength)};
+  std::string view_why;
+  const std::span<const unsigned char> bytes = viewBytes(model, model.images[size_t(index)].bufferView, &view_why);
+  if (!view_why.empty()) *why = "image " + std::to_string(index) + ": " + view_why;
+  return bytes;
 }
 
 double gltfComponent(const GltfView& v, size_t i, int c) {

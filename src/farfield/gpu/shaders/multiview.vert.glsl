@@ -55,29 +55,27 @@ void main() {
   v_heading = a.pos_heading.w;
 #ifdef FF_BLEND_VIEWS
   const vec3 local = vec3(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);  // towards the eye, agent space
+  // The four views: columns c0, c1 and rows r0, r1 of the grid around the direction, fractions tc and tr between them.
+  int c0, c1, r0, r1;
+  float tc, tr;
   if (u_octahedral != 0) {
     const vec3 h = vec3(local.xy, max(local.z, 0.0));
     const vec2 p = h.xy / max(abs(h.x) + abs(h.y) + h.z, 1e-8);
     const vec2 f = (vec2(p.x + p.y, p.x - p.y) * 0.5 + 0.5) * float(u_grid.x - 1);
     const ivec2 i0 = clamp(ivec2(floor(f)), ivec2(0), ivec2(u_grid.x - 2));
     const vec2 t = clamp(f - vec2(i0), 0.0, 1.0);
-    const int v00 = i0.y * u_grid.x + i0.x;
-    v_views = uvec4(v00, v00 + 1, v00 + u_grid.x, v00 + u_grid.x + 1);
-    v_weights = vec4((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * t.y);
-    gl_Position = u_view_proj * vec4(v_world, 1.0);
-    return;
+    c0 = i0.x, c1 = i0.x + 1, r0 = i0.y, r1 = i0.y + 1, tc = t.x, tr = t.y;
+  } else {
+    float az = atan(local.y, local.x);
+    if (az < 0.0) az += 6.28318530718;
+    const float fa = az / 6.28318530718 * float(u_grid.x);
+    c0 = int(floor(fa)) % u_grid.x, c1 = (c0 + 1) % u_grid.x, tc = fract(fa);
+    const float fe = clamp(asin(clamp(local.z, -1.0, 1.0)) / (u_max_elevation / float(u_grid.y)), 0.0,
+                           float(u_grid.y - 1));
+    r0 = min(int(floor(fe)), u_grid.y - 1), r1 = min(r0 + 1, u_grid.y - 1), tr = fe - float(r0);
   }
-  float az = atan(local.y, local.x);
-  if (az < 0.0) az += 6.28318530718;
-  const float fa = az / 6.28318530718 * float(u_grid.x);
-  const int a0 = int(floor(fa)) % u_grid.x, a1 = (a0 + 1) % u_grid.x;
-  const float ta = fract(fa);
-  const float fe = clamp(asin(clamp(local.z, -1.0, 1.0)) / (u_max_elevation / float(u_grid.y)), 0.0,
-                         float(u_grid.y - 1));
-  const int e0 = min(int(floor(fe)), u_grid.y - 1), e1 = min(e0 + 1, u_grid.y - 1);
-  const float te = fe - float(e0);
-  v_views = uvec4(e0 * u_grid.x + a0, e0 * u_grid.x + a1, e1 * u_grid.x + a0, e1 * u_grid.x + a1);
-  v_weights = vec4((1.0 - ta) * (1.0 - te), ta * (1.0 - te), (1.0 - ta) * te, ta * te);
+  v_views = uvec4(r0 * u_grid.x + c0, r0 * u_grid.x + c1, r1 * u_grid.x + c0, r1 * u_grid.x + c1);
+  v_weights = vec4((1.0 - tc) * (1.0 - tr), tc * (1.0 - tr), (1.0 - tc) * tr, tc * tr);
 #endif
   gl_Position = u_view_proj * vec4(v_world, 1.0);
 }
