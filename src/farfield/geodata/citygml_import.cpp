@@ -463,7 +463,7 @@ class Importer {
       st_.centre_line_segments = lines.size();
       if (cl.invalid_polygons > 0) st_.skipped["road surfaces not simple (no centre lines)"] += cl.invalid_polygons;
       if (cl.degenerate_areas > 0)
-        st_.skipped["united road areas whose borders touch (no centre lines)"] += cl.degenerate_areas;
+        st_.skipped["united road areas without area after cleaning (no centre lines)"] += cl.degenerate_areas;
       if (!lines.empty()) graph = planarizeStreets(lines, options_.planarize, &st_.streets, source_);
     }
     st_.streets_s = clock.seconds();
