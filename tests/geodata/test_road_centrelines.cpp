@@ -66,6 +66,10 @@ TEST(RoadCentreLines, StraightRoadAndL) {
       corner |= glm::distance(p, DVec2(5.0, 5.0)) < 1e-6;
     }
   EXPECT_TRUE(corner);
+  // A road too large for doubles (its perimeter overflows) is counted, not triangulated.
+  const auto huge = roadCentreLines({rect(-1e308, -1e308, 1e308, 1e308)}, &st);
+  EXPECT_TRUE(huge.empty());
+  EXPECT_EQ(st.degenerate_areas, 1u);
   // A self-intersecting (bow-tie) polygon is counted and left out.
   const auto none = roadCentreLines({{{{0, 0}, {10, 10}, {10, 0}, {0, 10}}}}, &st);
   EXPECT_TRUE(none.empty());

@@ -535,7 +535,11 @@ std::vector<StreetPolyline> roadCentreLines(const std::vector<std::vector<std::v
     for (auto h = ip.holes_begin(); h != ip.holes_end(); ++h) addPerimeter(*h);
     cleaned.push_back(std::move(ip));
   }
-  if (cleaned.empty() || !std::isfinite(perimeter)) return {};
+  if (!std::isfinite(perimeter)) {  // coordinates near the double range: no triangulation can hold them
+    st.degenerate_areas += cleaned.size();
+    return {};
+  }
+  if (cleaned.empty()) return {};
 
   // All corners at once, spatially sorted by CGAL, then the ring edges as constraints between them (inserting each
   // ring in order would walk the triangulation from afar for every corner); then the borders are refined.

@@ -25,7 +25,8 @@ struct RoadCentreLineStats {
   size_t invalid_polygons = 0;  // not simple (self-intersecting) or without area: left out of the union
   size_t united = 0;            // polygons (with holes) after the union
   size_t cleaned_vertices = 0;  // near-duplicate or near-collinear vertices (under 5 cm) dropped before triangulating
-  size_t degenerate_areas = 0;  // united areas with under three vertices left after that: no centre lines
+  size_t degenerate_areas = 0;  // united areas with under three vertices left after that, or too large for
+                                // doubles (perimeter overflows): no centre lines
   size_t triangles = 0;         // triangles inside the road areas
   size_t junctions = 0;         // junctions after merging the junction triangles
   size_t spurs = 0;             // dead-end branches dropped
