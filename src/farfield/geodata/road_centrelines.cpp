@@ -15,6 +15,9 @@
 #include <map>
 #include <memory>
 
+#include "farfield/core/douglas_peucker.h"
+#include "farfield/core/polygon2d.h"
+
 #include <CGAL/Boolean_set_operations_2.h>
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
@@ -61,11 +64,17 @@ IPolygon toInexact(const EPolygon& p) {
 // road marking is wide.
 constexpr double kCleanTolerance = 0.05;
 
+DVec2 toDVec2(const Ik::Point_2& p) { return DVec2(p.x(), p.y()); }
+
 double distanceToSegment(const Ik::Point_2& p, const Ik::Point_2& a, const Ik::Point_2& b) {
-  const DVec2 pa(p.x() - a.x(), p.y() - a.y()), ba(b.x() - a.x(), b.y() - a.y());
-  const double len2 = glm::dot(ba, ba);
-  const double t = len2 > 0.0 ? std::clamp(glm::dot(pa, ba) / len2, 0.0, 1.0) : 0.0;
-  return glm::length(pa - t * ba);
+  return distancePointSegmentD(toDVec2(p), toDVec2(a), toDVec2(b));
+}
+
+// Distance from p to the line through a and b (to a when they coincide).
+double pointLineDistance(const DVec2& p, const DVec2& a, const DVec2& b) {
+  const DVec2 d = b - a, q = p - a;
+  const double len = glm::length(d);
+  return len > 0.0 ? std::abs(d.x * q.y - d.y * q.x) / len : glm::length(q);
 }
 
 // Drops near-duplicate and near-collinear vertices until none is left; returns how many were dropped.
@@ -305,7 +314,7 @@ class AxisGraph {
       std::nth_element(widths.begin(), widths.begin() + std::ptrdiff_t(widths.size() / 2), widths.end());
       StreetPolyline line;
       for (uint32_t n : c.nodes) line.points.push_back(pos_[n]);
-      line.points = simplify(line.points, tolerance);
+      line.points = simplifyPolyline(line.points, tolerance);
       line.width = std::max(min_width, float(widths[widths.size() / 2]));
       out.push_back(std::move(line));
     };
@@ -319,55 +328,18 @@ class AxisGraph {
   }
 
  private:
-  // Douglas-Peucker.
-  static std::vector<DVec2> simplify(const std::vector<DVec2>& p, double tolerance) {
-    if (p.size() <= 2) return p;
-    std::vector<bool> keep(p.size(), false);
-    keep.front() = keep.back() = true;
-    std::vector<std::pair<size_t, size_t>> stack = {{0, p.size() - 1}};
-    while (!stack.empty()) {
-      const auto [i, j] = stack.back();
-      stack.pop_back();
-      double worst = -1.0;
-      size_t at = i;
-      for (size_t k = i + 1; k < j; ++k) {
-        const DVec2 d = p[j] - p[i], q = p[k] - p[i];
-        const double len = glm::length(d);
-        const double dist = len > 0.0 ? std::abs(d.x * q.y - d.y * q.x) / len : glm::length(q);
-        if (dist > worst) worst = dist, at = k;
-      }
-      if (worst > tolerance) {
-        keep[at] = true;
-        stack.push_back({i, at});
-        stack.push_back({at, j});
-      }
-    }
-    std::vector<DVec2> out;
-    for (size_t k = 0; k < p.size(); ++k)
-      if (keep[k]) out.push_back(p[k]);
-    return out;
-  }
-
   std::vector<DVec2> pos_;
   std::vector<bool> junction_;
   std::vector<std::vector<uint32_t>> incident_;
   std::vector<Edge> edges_;
 };
 
-double pointLineDistance(const DVec2& p, const DVec2& a, const DVec2& b) {
-  const DVec2 d = b - a, q = p - a;
-  const double len = glm::length(d);
-  return len > 0.0 ? std::abs(d.x * q.y - d.y * q.x) / len : glm::length(q);
-}
-
-DVec2 toDVec2(const Ik::Point_2& p) { return DVec2(p.x(), p.y()); }
+constexpr uint32_t kNoSample = std::numeric_limits<uint32_t>::max();
 
 // Splits every border edge longer than the road is wide across it (the distance from the edge to the opposite corner
 // of its triangle inside the road) into equal pieces that are not, nor shorter than `min_spacing`, until no edge
-// needs it (a few rounds: splitting changes the triangles) or kMaxSamples samples are in. A chord of a triangle then joins the two borders of the
-// road, and its midpoint lies between them.
-constexpr uint32_t kNoSample = std::numeric_limits<uint32_t>::max();
-
+// needs it (a few rounds: splitting changes the triangles) or kMaxSamples samples are in. A chord of a triangle then
+// joins the two borders of the road, and its midpoint lies between them.
 void refineBorders(Cdt& cdt, double min_spacing) {
   double budget = kMaxSamples;  // samples left to insert
   struct Split {
@@ -433,7 +405,7 @@ void refineBorders(Cdt& cdt, double min_spacing) {
 AxisGraph chordalAxis(const Cdt& cdt, size_t& triangles) {
   AxisGraph g;
   std::map<std::pair<uint32_t, uint32_t>, uint32_t> chord_node;  // chord (vertex ids) -> node at its midpoint
-  auto point = [](Cdt::Vertex_handle v) { return DVec2(v->point().x(), v->point().y()); };
+  auto point = [](Cdt::Vertex_handle v) { return toDVec2(v->point()); };
   auto chord = [&](Cdt::Face_handle f, int i) {
     const Cdt::Vertex_handle a = f->vertex(Cdt::cw(i)), b = f->vertex(Cdt::ccw(i));
     const auto key = std::minmax(a->info(), b->info());
@@ -454,11 +426,8 @@ AxisGraph chordalAxis(const Cdt& cdt, size_t& triangles) {
     }
     if (inner.size() == 2) {
       // A sleeve: the road's width is the distance from the apex to the border edge's line.
-      const DVec2 apex = point(f->vertex(border)), a = point(f->vertex(Cdt::cw(border))),
-                  b = point(f->vertex(Cdt::ccw(border)));
-      const DVec2 d = b - a, q = apex - a;
-      const double len = glm::length(d);
-      const double width = len > 0.0 ? std::abs(d.x * q.y - d.y * q.x) / len : glm::length(q);
+      const double width = pointLineDistance(point(f->vertex(border)), point(f->vertex(Cdt::cw(border))),
+                                             point(f->vertex(Cdt::ccw(border))));
       g.addEdge(chord(f, inner[0]), chord(f, inner[1]), width);
     } else if (inner.size() == 3) {
       const DVec2 centre = (point(f->vertex(0)) + point(f->vertex(1)) + point(f->vertex(2))) / 3.0;
@@ -529,7 +498,7 @@ std::vector<StreetPolyline> roadCentreLines(const std::vector<std::vector<std::v
       if (hole.size() >= 3) ip.add_hole(hole);
     }
     auto addPerimeter = [&](const IPolygon& ring) {
-      for (auto e = ring.edges_begin(); e != ring.edges_end(); ++e) perimeter += std::sqrt(CGAL::to_double(e->squared_length()));
+      for (auto e = ring.edges_begin(); e != ring.edges_end(); ++e) perimeter += std::sqrt(e->squared_length());
     };
     addPerimeter(ip.outer_boundary());
     for (auto h = ip.holes_begin(); h != ip.holes_end(); ++h) addPerimeter(*h);

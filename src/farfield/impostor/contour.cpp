@@ -7,7 +7,7 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
-#include "farfield/impostor/douglas_peucker.h"
+#include "farfield/core/douglas_peucker.h"
 
 namespace farfield::impostor {
 namespace {

@@ -19,7 +19,7 @@
 #include <string>
 
 #include "farfield/core/error.h"
-#include "farfield/impostor/douglas_peucker.h"
+#include "farfield/core/douglas_peucker.h"
 
 namespace farfield::impostor {
 namespace {

@@ -1,10 +1,10 @@
-#include "farfield/impostor/douglas_peucker.h"
+#include "farfield/core/douglas_peucker.h"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-namespace farfield::impostor {
+namespace farfield {
 namespace {
 
 double distanceToPolyline(const DVec2& p, const std::vector<DVec2>& line, bool closed) {
@@ -57,4 +57,4 @@ TEST(DouglasPeuckerTest, RandomWalksStayWithinTolerance) {
 }
 
 }  // namespace
-}  // namespace farfield::impostor
+}  // namespace farfield

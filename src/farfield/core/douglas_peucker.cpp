@@ -1,22 +1,13 @@
 // Douglas-Peucker simplification (Sillion et al. 1997, section 4.2: the contour and the discrepancy chains are
 // approximated by polylines within a tolerance in pixels).
-#include "farfield/impostor/douglas_peucker.h"
+#include "farfield/core/douglas_peucker.h"
 
 #include <algorithm>
 #include <utility>
 
-namespace farfield::impostor {
-namespace {
+#include "farfield/core/polygon2d.h"
 
-double pointSegmentDistance(const DVec2& p, const DVec2& a, const DVec2& b) {
-  const DVec2 ab = b - a;
-  const double len2 = glm::dot(ab, ab);
-  if (len2 <= 0.0) return glm::length(p - a);
-  const double t = std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0);
-  return glm::length(p - (a + t * ab));
-}
-
-}  // namespace
+namespace farfield {
 
 std::vector<size_t> douglasPeuckerIndices(const std::vector<DVec2>& points, double tolerance) {
   const size_t n = points.size();
@@ -36,7 +27,7 @@ std::vector<size_t> douglasPeuckerIndices(const std::vector<DVec2>& points, doub
     double worst = -1.0;
     size_t worst_index = first;
     for (size_t i = first + 1; i < last; ++i) {
-      const double d = pointSegmentDistance(points[i], points[first], points[last]);
+      const double d = distancePointSegmentD(points[i], points[first], points[last]);
       if (d > worst) {
         worst = d;
         worst_index = i;
@@ -87,7 +78,7 @@ std::vector<DVec2> simplifyClosed(const std::vector<DVec2>& polygon, double tole
     size_t best = 0;
     double best_d = -1.0;
     for (size_t i = 0; i < n; ++i) {
-      const double d = pointSegmentDistance(polygon[i], polygon[0], polygon[far_index]);
+      const double d = distancePointSegmentD(polygon[i], polygon[0], polygon[far_index]);
       if (d > best_d) {
         best_d = d;
         best = i;
@@ -106,4 +97,4 @@ std::vector<DVec2> simplifyClosed(const std::vector<DVec2>& polygon, double tole
   return out;
 }
 
-}  // namespace farfield::impostor
+}  // namespace farfield

@@ -1,12 +1,12 @@
-// Douglas-Peucker polyline simplification in image space (pixels), shared by the contour and the depth-discrepancy
-// lines of the depth-mesh impostor (Sillion et al. 1997, section 4.2).
+// Douglas-Peucker polyline simplification, shared by the contour and the depth-discrepancy lines of the depth-mesh
+// impostor (Sillion et al. 1997, section 4.2; pixels) and the road centre lines of real cities (metres).
 #pragma once
 
 #include <vector>
 
 #include "farfield/core/math.h"
 
-namespace farfield::impostor {
+namespace farfield {
 
 // Indices of the points kept from an open polyline: the first and the last point always, and every point whose
 // removal would move the polyline by more than `tolerance` (distance to the simplified segment that replaces it).
@@ -23,4 +23,4 @@ std::vector<DVec2> simplifyPolyline(const std::vector<DVec2>& points, double tol
 // result's boundary.
 std::vector<DVec2> simplifyClosed(const std::vector<DVec2>& polygon, double tolerance);
 
-}  // namespace farfield::impostor
+}  // namespace farfield
