@@ -70,18 +70,12 @@ TEST(LayeredCalibrationTest, FactorsBoundEveryValidationSample) {
   }
   EXPECT_LE(r.draw_ratio_p50, r.draw_ratio_max);
   EXPECT_EQ(c.validation["validation_samples"], o.validation_samples);
-  // Capturing renders the cluster once per layer: the samples with more layers x triangles cost more on the whole.
-  double small = 0, large = 0;
-  size_t n_small = 0, n_large = 0;
-  std::vector<uint64_t> work;
-  for (const LayeredSample& s : r.fit) work.push_back(s.triangles + s.texels);
-  std::vector<uint64_t> sorted = work;
-  std::sort(sorted.begin(), sorted.end());
-  const uint64_t median = sorted[sorted.size() / 2];
-  for (size_t i = 0; i < r.fit.size(); ++i)
-    (work[i] < median ? small : large) += r.fit[i].capture_ms, ++(work[i] < median ? n_small : n_large);
-  ASSERT_GT(n_small, 0u);
-  EXPECT_LT(small / double(n_small), large / double(n_large));
+  // The fits are non-negative least squares: no term makes more work cheaper. (Whether the measured capture times
+  // grow with the work is a timing question for `farfield calibrate`'s report, not for a unit test: under a loaded
+  // machine the halves of 12 samples came out in either order.)
+  for (const double k : {c.capture.base_ms, c.capture.ms_per_mtriangle, c.capture.ms_per_draw, c.capture.ms_per_mpixel,
+                         c.draw.base_ms, c.draw.ms_per_draw, c.draw.ms_per_mpixel})
+    EXPECT_GE(k, 0.0);
 }
 
 TEST(LayeredCalibrationTest, BadOptionsAreErrors) {
