@@ -197,5 +197,56 @@ TEST_F(OcclusionStreetTest, FramesAreIdenticalToFrustumCulledFramesAndHiddenItem
   EXPECT_GT(hidden_triangles, offered_triangles / 10);
 }
 
+// hidesWorldBox, used for things that are not draw items (an image cache's nodes): every object whose world box it
+// calls hidden shows no pixel in the full frame's ids (brute force), also when every item was an occluder and the
+// depth is read on first use.
+TEST_F(OcclusionStreetTest, WorldBoxesCalledHiddenShowNoPixelOfTheFrame) {
+  Renderer renderer;
+  RenderTarget target(96, 64);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  size_t hidden = 0, hidden_all_occluders = 0, visible = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    Camera camera;
+    camera.width = 96;
+    camera.height = 64;
+    camera.near_plane = 0.2f;
+    camera.far_plane = 500.0f;
+    camera.eye = Vec3(3.0f * u(rng), 50.0f * u(rng), 1.7f);
+    camera.at = camera.eye + Vec3(0.8f * u(rng), u(rng), 0.2f * u(rng));
+    std::vector<DrawItem> items;
+    std::vector<Box3> bounds;
+    gpu_scene_->appendDrawItems({}, items, camera, &bounds);
+    renderer.render(camera, items, target, RenderMode::ItemBuffer);
+    const image::IdImage ids = target.readIds();
+    std::vector<bool> seen(scene_.objects.size() + 1, false);
+    for (const uint32_t id : ids.pixels())
+      if (id < seen.size()) seen[id] = true;
+
+    const bool all_occluders = trial % 3 == 0;
+    target.bind();
+    target.clear(Vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    OcclusionCuller culler(all_occluders ? 1.0 : 0.2);
+    std::vector<DrawItem> rest;
+    culler.cull(
+        camera, items, bounds, target,
+        [&](std::span<const DrawItem> occluders) { renderer.draw(camera, occluders, target, RenderMode::ItemBuffer); },
+        rest);
+    for (const scene::Object& object : scene_.objects) {
+      if (!culler.hidesWorldBox(object.world_bounds)) {
+        visible += seen[object.id];
+        continue;
+      }
+      EXPECT_FALSE(seen[object.id]) << "object " << object.id << " called hidden in trial " << trial;
+      ++hidden;
+      hidden_all_occluders += all_occluders;
+    }
+  }
+  // Not vacuous: in the canyon most towers are behind the walls, on both paths.
+  EXPECT_GT(hidden, 300u);
+  EXPECT_GT(hidden_all_occluders, 100u);
+  EXPECT_GT(visible, 100u);
+}
+
 }  // namespace
 }  // namespace farfield::gpu

@@ -137,5 +137,76 @@ TEST(ImageCacheGl, LayeredRegenerationsKeepTheCalibratedBudget) {
   EXPECT_THROW(ImageCache(s, gs, o), Error);
 }
 
+// Occlusion culling inside the cache's frame: a long wall in front of the eye (larger than max_object_radius, so
+// always geometry, and the occluder; reaching below the frame, so that the depth pyramid's coarse texels over the
+// grid hold only the wall) hides about half of the grid. Nodes behind it are neither regenerated nor drawn,
+// the frame stays as close to the full-geometry frame as the frame without occlusion culling, and with the wall
+// removed from the view nothing is hidden.
+TEST(ImageCacheGl, OcclusionSkipsNodesHiddenBehindNearGeometry) {
+  gpu::sharedHeadlessContext();
+  scene::Scene s = grid();
+  {
+    scene::Material m;
+    m.base_color = Vec4(0.7f, 0.6f, 0.5f, 1.0f);
+    scene::Object wall;
+    wall.parts.push_back({s.addMesh(scene::makeBox(Vec3(-300, -81, -20), Vec3(24, -80, 12))), s.addMaterial(m)});
+    s.addObject(wall);
+    s.updateBounds();
+  }
+  const gpu::GpuScene gs(s);
+  gpu::Renderer renderer;
+  Camera cam;
+  cam.eye = Vec3(20, -100, 3);
+  cam.at = Vec3(30, 30, 3);
+  cam.width = 320;
+  cam.height = 180;
+  ImageCacheOptions o;
+  o.error_px = 1.0;
+  o.leaf_objects = 2;
+  o.min_distance_radii = 6.0;  // small nodes: some wholly behind the wall
+  gpu::RenderTarget target(cam.width, cam.height);
+  renderer.render(cam, gs.drawItems(), target);
+  const image::ColorImage reference = target.readColor();
+
+  auto run = [&](const Camera& camera, bool occlusion, ImageCacheFrameStats& st) {
+    ImageCache cache(s, gs, o);
+    std::vector<gpu::DrawItem> items;
+    renderer.render(camera, {}, target);  // clears
+    ImageCacheOcclusion occ;
+    occ.target = &target;
+    occ.occluder_share = 0.1;
+    occ.draw_occluders = [&](std::span<const gpu::DrawItem> occluders) { renderer.draw(camera, occluders, target); };
+    st = cache.frame(renderer, camera, 0, items, occlusion ? &occ : nullptr);
+    renderer.draw(camera, items, target);
+    return target.readColor();
+  };
+  ImageCacheFrameStats plain, culled;
+  const image::ColorImage without = run(cam, false, plain);
+  const image::ColorImage with = run(cam, true, culled);
+  EXPECT_EQ(plain.hidden_nodes, 0u);
+  EXPECT_GT(culled.occluders, 0u);
+  EXPECT_GT(culled.hidden_nodes, 0u);
+  EXPECT_GT(culled.hidden_node_triangles, 0u);
+  // What is hidden needs no image: fewer regenerations, and every node is either hidden, an image or geometry.
+  EXPECT_LT(culled.regenerations, plain.regenerations);
+  EXPECT_EQ(culled.regenerations + culled.geometry_nodes + culled.hidden_nodes,
+            plain.regenerations + plain.geometry_nodes);
+  const double psnr_without = image::psnr(without, reference), psnr_with = image::psnr(with, reference);
+  EXPECT_GT(psnr_with, 30.0);
+  EXPECT_GE(psnr_with, psnr_without - 0.5);
+  std::printf("image cache occlusion: %zu of %zu nodes hidden, %zu regenerations instead of %zu; PSNR %.1f dB "
+              "(%.1f without)\n",
+              culled.hidden_nodes, plain.regenerations + plain.geometry_nodes, culled.regenerations,
+              plain.regenerations, psnr_with, psnr_without);
+
+  // Seen from above the wall, nothing of the grid is behind it.
+  Camera above = cam;
+  above.eye = Vec3(20, -100, 90);
+  ImageCacheFrameStats open;
+  run(above, true, open);
+  EXPECT_EQ(open.hidden_nodes, 0u);
+  EXPECT_GT(open.regenerations, 0u);
+}
+
 }  // namespace
 }  // namespace farfield::runtime

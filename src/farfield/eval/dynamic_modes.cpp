@@ -9,6 +9,7 @@
 #include "farfield/core/timer.h"
 #include "farfield/eval/layered_calibration.h"
 #include "farfield/eval/mode_options.h"
+#include "farfield/eval/occlusion_pass.h"
 #include "farfield/gpu/cost_model.h"
 #include "farfield/gpu/cost_profile.h"
 #include "farfield/impostor/capture.h"
@@ -124,6 +125,10 @@ DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const 
   options_.audit_samples = intOption(context, "audit", 0, 0, 1000000);
   options_.impostor.plane_in_front = choiceOption(context, "plane", "best", {"best", "front"}) == "front";
   profile_path_ = context.option("profile");
+  if (switchOption(context, "occlusion", true)) {
+    occlusion_.emplace();
+    occlusion_->occluder_share = occluderShareOption(context, name());
+  }
 }
 
 std::string DynamicImpostorMode::name() const {
@@ -168,13 +173,19 @@ void DynamicImpostorMode::prepare(const ModeContext& context) {
 }
 
 void DynamicImpostorMode::frame(FrameContext& frame) {
-  frame.beginOwnPass();
-  per_frame_[frame.pathFrame()] = cache_->frame(frame.renderer(), frame.camera(), frame.pathFrame(), frame.items());
+  gpu::RenderTarget& target = frame.beginOwnPass();
+  if (occlusion_) {
+    occlusion_->target = &target;
+    occlusion_->draw_occluders = [&frame](std::span<const gpu::DrawItem> items) { frame.drawPass(items); };
+  }
+  per_frame_[frame.pathFrame()] =
+      cache_->frame(frame.renderer(), frame.camera(), frame.pathFrame(), frame.items(), occlusion_ ? &*occlusion_ : nullptr);
 }
 
 std::map<std::string, double> DynamicImpostorMode::info() const {
   double regen = 0, regen_max = 0, images = 0, geometry = 0, written = 0, uploaded = 0, tex_max = 0, audited = 0,
          unneeded = 0, missed = 0, frames_with_regen = 0, predicted = 0, deferred = 0, frames_with_deferred = 0;
+  double hidden_nodes = 0, hidden_node_tris = 0, hidden_items = 0, hidden_tris = 0, occluders = 0, occlusion_ms = 0;
   for (const auto& [k, s] : per_frame_) {
     regen += double(s.regenerations);
     regen_max = std::max(regen_max, double(s.regenerations));
@@ -190,6 +201,12 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
     predicted += s.predicted_ms;
     deferred += double(s.geometry_nodes);
     frames_with_deferred += s.geometry_nodes > 0;
+    hidden_nodes += double(s.hidden_nodes);
+    hidden_node_tris += double(s.hidden_node_triangles);
+    hidden_items += double(s.hidden_items);
+    hidden_tris += double(s.hidden_triangles);
+    occluders += double(s.occluders);
+    occlusion_ms += s.occlusion_ms;
   }
   const double f = double(std::max<size_t>(per_frame_.size(), 1));
   std::map<std::string, double> out;
@@ -217,7 +234,14 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
           {"cost_safety_factor", options_.cost_safety_factor},
           {"layered_cost_calibrated", options_.layered_cost.calibrated ? 1.0 : 0.0},
           {"deferred_regenerations_per_frame", deferred / f},
-          {"frames_with_deferred", frames_with_deferred}});
+          {"frames_with_deferred", frames_with_deferred},
+          {"occlusion", occlusion_ ? 1.0 : 0.0},
+          {"occlusion_hidden_nodes_per_frame", hidden_nodes / f},
+          {"occlusion_hidden_node_triangles_per_frame", hidden_node_tris / f},
+          {"occlusion_hidden_items_per_frame", hidden_items / f},
+          {"occlusion_hidden_triangles_per_frame", hidden_tris / f},
+          {"occlusion_occluder_items_per_frame", occluders / f},
+          {"occlusion_ms_per_frame", occlusion_ms / f}});
   return out;
 }
 

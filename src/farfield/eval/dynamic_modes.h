@@ -11,6 +11,9 @@
 //   plane=best|front  (dynamic-*) the best plane, or the best plane moved in front of the node's samples
 //   profile=FILE      (dynamic-*, layered) a cost profile of this machine (farfield calibrate over the path's view
 //                     space): its model, safety factor and layered terms predict the frame; default: a quick fit here
+//   occlusion=on|off  (dynamic-*, layered) the cache's near geometry occlusion-culled against the depth of its nearest
+//                     items, and nodes hidden behind that depth skipped: no image, no regeneration (default on)
+//   occluder_share=S  the share of the near geometry's triangles drawn first as occluders (default 0.1)
 //   warp_interval=N   (warp) a keyframe of culled geometry every N path frames (default 4)
 //   billboard_kind=cylindrical|spherical, billboard_views=N (default 8), billboard_texels=N (default 32)
 #pragma once
@@ -18,6 +21,7 @@
 #include <array>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -72,6 +76,7 @@ class DynamicImpostorMode final : public Mode {
   std::map<size_t, runtime::ImageCacheFrameStats> per_frame_;
   double calibrate_s_ = 0.0;
   std::string profile_path_;  // --mode-option profile=FILE: the cost profile to predict with ("" = calibrate here)
+  std::optional<runtime::ImageCacheOcclusion> occlusion_;  // --mode-option occlusion=on (target set per frame)
 };
 
 // Post-render warping (the lecture's "Post-render warping (Mark et al.)" and "3D warping using depth"): every

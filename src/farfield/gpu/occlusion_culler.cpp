@@ -124,6 +124,9 @@ OcclusionStats OcclusionCuller::cull(const Camera& camera, std::span<const DrawI
   stats.items = uint32_t(items.size());
   const int width = target.width(), height = target.height();
   const Mat4 view_proj = camera.viewProjection();
+  view_proj_ = view_proj;
+  target_ = &target;
+  pyramid_built_ = false;
   boxes_.resize(items.size());
   order_.resize(items.size());
   for (size_t i = 0; i < items.size(); ++i) {
@@ -138,11 +141,8 @@ OcclusionStats OcclusionCuller::cull(const Camera& camera, std::span<const DrawI
   draw_occluders(occluders_);
   if (split == order_.size()) return stats;
 
-  Stopwatch wait;
-  target.readDepthRows(depth_);
-  stats.readback_ms = wait.milliseconds();
+  buildPyramid(&stats);
   Stopwatch test;
-  pyramid_.build(depth_, width, height);
   for (size_t k = split; k < order_.size(); ++k) {
     const uint32_t i = order_[k];
     if (pyramid_.hides(boxes_[i])) {
@@ -152,8 +152,24 @@ OcclusionStats OcclusionCuller::cull(const Camera& camera, std::span<const DrawI
       rest.push_back(items[i]);
     }
   }
-  stats.pyramid_ms = test.milliseconds();
+  stats.pyramid_ms += test.milliseconds();
   return stats;
+}
+
+void OcclusionCuller::buildPyramid(OcclusionStats* stats) {
+  FF_CHECK(target_ != nullptr);
+  Stopwatch wait;
+  target_->readDepthRows(depth_);
+  if (stats) stats->readback_ms = wait.milliseconds();
+  Stopwatch build;
+  pyramid_.build(depth_, target_->width(), target_->height());
+  pyramid_built_ = true;
+  if (stats) stats->pyramid_ms = build.milliseconds();
+}
+
+bool OcclusionCuller::hidesWorldBox(const Box3& box) {
+  if (!pyramid_built_) buildPyramid(nullptr);
+  return pyramid_.hides(projectBox(box, view_proj_, pyramid_.width(), pyramid_.height()));
 }
 
 OcclusionStats OcclusionCuller::draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,

@@ -88,6 +88,11 @@ class OcclusionCuller {
                       const RenderTarget& target,
                       const std::function<void(std::span<const DrawItem>)>& draw_occluders,
                       std::vector<DrawItem>& rest);
+  // After cull(): whether a box given in world space lies behind the depth the occluders of the last cull left over
+  // the whole of its footprint in that cull's camera (the same test cull() applies to its items). Reads the depth
+  // back on first use when cull() did not need it (every item was an occluder). Things that are not draw items use
+  // it: the nodes of an image cache, whose images and regenerations a hidden node does not need.
+  bool hidesWorldBox(const Box3& box);
   // Both passes with `renderer` (Renderer::draw: no clear, no wait): the occluders, then the items not hidden, then
   // `also` (items drawn after them as they are, such as impostors), all in `mode`.
   OcclusionStats draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,
@@ -102,6 +107,11 @@ class OcclusionCuller {
   std::vector<DrawItem> rest_;  // draw()'s second pass
   std::vector<float> depth_;
   DepthPyramid pyramid_;
+  // The last cull's camera and target, and whether its pyramid has been built (hidesWorldBox).
+  Mat4 view_proj_{1.0f};
+  const RenderTarget* target_ = nullptr;
+  bool pyramid_built_ = false;
+  void buildPyramid(OcclusionStats* stats);
 };
 
 }  // namespace farfield::gpu

@@ -10,8 +10,10 @@
 #include <cmath>
 #include <limits>
 
+#include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/error_bound.h"
+#include "farfield/core/timer.h"
 #include "farfield/impostor/layered_fill.h"
 #include "farfield/runtime/regeneration_scheduler.h"
 
@@ -138,7 +140,7 @@ void ImageCache::evict(size_t frame_index) {
 }
 
 ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& camera, size_t frame_index,
-                                       std::vector<gpu::DrawItem>& out) {
+                                       std::vector<gpu::DrawItem>& out, const ImageCacheOcclusion* occlusion) {
   ImageCacheFrameStats st;
   const bool repeat = last_frame_ && *last_frame_ == frame_index;
   last_frame_ = frame_index;
@@ -170,6 +172,42 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
     }
   }
   st.near_objects = near_objects.size();
+
+  // The near geometry. With occlusion culling its nearest items are drawn now, and the depth they leave hides the
+  // rest of it and whole nodes of the cut.
+  scratch_.clear();
+  scratch_bounds_.clear();
+  gpu_scene_.appendDrawItems(near_objects, scratch_, camera, occlusion ? &scratch_bounds_ : nullptr);
+  uint64_t near_triangles = 0;
+  for (const gpu::DrawItem& it : scratch_) near_triangles += it.triangleCount();
+  size_t near_draws = scratch_.size();
+  if (occlusion) {
+    FF_CHECK(occlusion->target != nullptr && occlusion->draw_occluders);
+    if (!culler_ || culler_share_ != occlusion->occluder_share) {
+      culler_.emplace(occlusion->occluder_share);
+      culler_share_ = occlusion->occluder_share;
+    }
+    visible_.clear();
+    const gpu::OcclusionStats os =
+        culler_->cull(camera, scratch_, scratch_bounds_, *occlusion->target, occlusion->draw_occluders, visible_);
+    st.occluders = os.occluders;
+    st.hidden_items = os.hidden;
+    st.hidden_triangles = os.hidden_triangles;
+    near_triangles -= os.hidden_triangles;
+    near_draws -= os.hidden;
+    Stopwatch test;
+    std::erase_if(cut, [&](int i) {
+      const Node& n = nodes_[size_t(i)];
+      if (!culler_->hidesWorldBox(n.bounds)) return false;
+      ++st.hidden_nodes;
+      st.hidden_node_triangles += n.triangles;
+      return true;
+    });
+    st.occlusion_ms = os.readback_ms + os.pyramid_ms + test.milliseconds();
+    out.insert(out.end(), visible_.begin(), visible_.end());
+  } else {
+    out.insert(out.end(), scratch_.begin(), scratch_.end());
+  }
 
   // Requests: images missing or judged invalid by the metric (on a repeat, the nodes this frame regenerated).
   const gpu::CostModel& c = options_.cost;
@@ -243,18 +281,9 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
           renders * (r.geometry_ms + options_.regeneration_overhead_ms + k * c.ms_per_mpixel * side * side / 1e6);
     requests.push_back(r);
   }
-  double base = c.base_ms + c.ms_per_mpixel * pixels / 1e6;
-  {
-    uint64_t tris = 0, draws = 0;
-    scratch_.clear();
-    gpu_scene_.appendDrawItems(near_objects, scratch_, camera);
-    for (const gpu::DrawItem& it : scratch_) tris += it.triangleCount();
-    draws = scratch_.size();
-    base = k * (base + c.ms_per_mtriangle * double(tris) / 1e6 + c.ms_per_draw * double(draws) +
-                c.ms_per_draw * double(valid.size()));
-    for (const int i : valid) base += nodes_[size_t(i)].layered_draw_ms;  // the valid layered images' fill
-    out.insert(out.end(), scratch_.begin(), scratch_.end());
-  }
+  double base = k * (c.base_ms + c.ms_per_mpixel * pixels / 1e6 + c.ms_per_mtriangle * double(near_triangles) / 1e6 +
+                     c.ms_per_draw * double(near_draws) + c.ms_per_draw * double(valid.size()));
+  for (const int i : valid) base += nodes_[size_t(i)].layered_draw_ms;  // the valid layered images' fill
   const RegenerationSchedule schedule =
       scheduleRegenerations(requests, base, options_.t_max_ms, options_.max_regenerations);
   st.predicted_ms = schedule.predicted_ms;

@@ -7,9 +7,11 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@
 #include "farfield/core/camera.h"
 #include "farfield/gpu/cost_model.h"
 #include "farfield/gpu/cost_profile.h"
+#include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/core/shaft.h"
 #include "farfield/impostor/dynamic.h"
@@ -68,6 +71,27 @@ struct ImageCacheFrameStats {
   size_t audited = 0;
   size_t unneeded = 0;  // the metric said invalid, the measured error was within the bound
   size_t missed = 0;    // the metric said valid, the measured error was over the bound
+  // Occlusion culling (ImageCacheOcclusion): near items drawn first as occluders, near items hidden behind them,
+  // nodes of the cut hidden behind them (no image drawn, none regenerated, no geometry), and the time spent waiting
+  // for the occluders' depth and testing boxes against it.
+  size_t occluders = 0;
+  size_t hidden_items = 0;
+  uint64_t hidden_triangles = 0;  // of the hidden near items
+  size_t hidden_nodes = 0;
+  uint64_t hidden_node_triangles = 0;
+  double occlusion_ms = 0.0;
+};
+
+// Occlusion culling inside the cache's frame (gpu/occlusion_culler.h). The nearest of the near geometry's items (up
+// to occluder_share of its triangles, and every item reaching behind the eye) are drawn first by draw_occluders into
+// the frame's target; the depth they leave hides the other near items and whole nodes of the cut whose boxes lie
+// behind it. A hidden node needs no image, no regeneration and no geometry this frame, and the budget is planned
+// without it. Exact for geometry (nothing hidden could draw a pixel); a hidden node's image could only have drawn
+// pixels that its own geometry does not show.
+struct ImageCacheOcclusion {
+  const gpu::RenderTarget* target = nullptr;  // the frame's target, into which draw_occluders draws
+  std::function<void(std::span<const gpu::DrawItem>)> draw_occluders;
+  double occluder_share = 0.1;  // in [0, 1]
 };
 
 class ImageCache {
@@ -79,8 +103,10 @@ class ImageCache {
   // The frame for `camera`: regenerates images with Renderer::draw (call inside a frame after the frame's own-pass
   // start), appends the main pass (geometry and images) to `out`. A call with the same frame_index as the previous
   // call repeats that frame's work (the same regenerations), so repeated timings of one frame time the same work.
+  // With `occlusion`, the occluders are drawn through it before any regeneration, and `out` receives only what they
+  // do not hide.
   ImageCacheFrameStats frame(gpu::Renderer& renderer, const Camera& camera, size_t frame_index,
-                             std::vector<gpu::DrawItem>& out);
+                             std::vector<gpu::DrawItem>& out, const ImageCacheOcclusion* occlusion = nullptr);
 
   size_t nodeCount() const { return nodes_.size(); }
   size_t textureBytes() const { return texture_bytes_; }
@@ -117,6 +143,10 @@ class ImageCache {
   size_t texture_bytes_ = 0;
   std::optional<size_t> last_frame_;
   std::vector<gpu::DrawItem> scratch_;
+  std::vector<Box3> scratch_bounds_;
+  std::vector<gpu::DrawItem> visible_;
+  std::optional<gpu::OcclusionCuller> culler_;
+  double culler_share_ = -1.0;
 };
 
 }  // namespace farfield::runtime
