@@ -4,6 +4,9 @@
 # this machine calibrated over the path's district (frame model, safety factor, layered draw and capture terms), then
 # the modes that regenerate images inside t_max (dynamic-shade, dynamic-schaufler, layered) against culled, every
 # frame rendered 3 times and the fastest kept, against full-geometry reference frames.
+# OCCLUSION=off runs the dynamic modes without the image cache's occlusion culling (--mode-option occlusion=off; the
+# outputs get the suffix -occlusion-off), to compare with the default (on). INVEST=0 runs them with
+# --mode-option lost_frame_investment=0 (suffix -invest-0): a frame over t_max whatever it does regenerates nothing.
 # Usage: scripts/bench_dynamic_budget.sh FARFIELD OUT [TMAX_MS] [FRAMES] [STRIDE]
 set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
@@ -11,6 +14,11 @@ OUT=${2:-out/bench/dynamic-budget}
 TMAX=${3:-200}
 FRAMES=${4:-40}
 STRIDE=${5:-3}
+OCCLUSION=${OCCLUSION:-on}
+SUFFIX=""
+[ "$OCCLUSION" = on ] || SUFFIX="-occlusion-$OCCLUSION"
+INVEST=${INVEST:-1}
+[ "$INVEST" = 1 ] || SUFFIX="$SUFFIX-invest-$INVEST"
 mkdir -p "$OUT"
 [ -f "$OUT/city_trees.glb" ] || "$FARFIELD" gen city --trees -o "$OUT/city_trees.glb" > "$OUT/gen_city.txt"
 [ -f "$OUT/drive2.json" ] || "$FARFIELD" path street "$OUT/city_trees.streets.json" --car --frames 400 --seed 2 \
@@ -24,9 +32,11 @@ for run in "city city_trees.glb drive2.json" "forest forest5.glb fly5.json"; do
   [ -f "$OUT/profile-$name.json" ] || "$FARFIELD" calibrate "$scene" -o "$OUT/profile-$name.json" --size 640x360 \
     --fov 60 --around "$path" --margin 20 --views "${CAL_VIEWS:-100}" --fit-views 50 --layered-samples 30 \
     --layered-error-px 2 > "$OUT/calibrate-$name.txt" 2>&1
-  [ -f "$OUT/bench-$name-t$TMAX/bench.json" ] && continue
+  run_dir=$OUT/bench-$name-t$TMAX$SUFFIX
+  [ -f "$run_dir/bench.json" ] && continue
   "$FARFIELD" bench "$scene" --path "$path" --modes culled,dynamic-shade,dynamic-schaufler,layered --reference \
     --repeats 3 --tmax "$TMAX" --frames "$FRAMES" --stride "$STRIDE" --mode-option error_px=2 \
-    --mode-option t_max_ms="$TMAX" --mode-option profile="$OUT/profile-$name.json" -o "$OUT/bench-$name-t$TMAX" \
-    > "$OUT/bench-$name-t$TMAX.txt" 2>&1
+    --mode-option t_max_ms="$TMAX" --mode-option profile="$OUT/profile-$name.json" --mode-option occlusion="$OCCLUSION" \
+    --mode-option lost_frame_investment="$INVEST" \
+    -o "$run_dir" > "$run_dir.txt" 2>&1
 done

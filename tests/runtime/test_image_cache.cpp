@@ -76,11 +76,23 @@ TEST(ImageCacheGl, ReusesRegeneratesAndFallsBackUnderTheBudget) {
   tight.cost.base_ms = 10.0;
   tight.cost.ms_per_draw = 0.01;
   tight.t_max_ms = 5.0;  // less than the frame's base: no regeneration fits
+  tight.lost_frame_investment = 0.0;
   ImageCache starved(s, gs, tight);
   items.clear();
   const ImageCacheFrameStats none = starved.frame(renderer, cam, 0, items);
+  EXPECT_TRUE(none.lost);
   EXPECT_EQ(none.regenerations, 0u);
   EXPECT_GT(none.geometry_nodes, 0u);
+  // The same lost frame with an investment still makes the images that pay back in a frame (a node of 4 objects:
+  // 2 ms of geometry, against 0.3 ms of overhead to regenerate it and 0.5 ms to draw its image).
+  tight.cost.ms_per_draw = 0.5;
+  tight.cost.base_ms = 100.0;
+  tight.lost_frame_investment = 1.0;
+  ImageCache investing(s, gs, tight);
+  items.clear();
+  const ImageCacheFrameStats some = investing.frame(renderer, cam, 0, items);
+  EXPECT_TRUE(some.lost);
+  EXPECT_GT(some.regenerations, 0u);
   std::printf("image cache: %zu regenerations, PSNR %.1f dB at the capture eye; %zu after moving 18 m\n",
               first.regenerations, psnr, later.regenerations);
   o.error_px = 0.0;

@@ -65,5 +65,67 @@ TEST(RegenerationScheduler, NoBudgetRegeneratesUpToTheCount) {
   EXPECT_EQ(s.geometry, (std::vector<uint32_t>{1, 0}));
 }
 
+// A lost frame (all geometry already over t_max): without an investment it regenerates nothing; with one it takes,
+// most invalid first, exactly the requests that pay back over their expected reuse and fit the investment (replayed
+// here by brute force), and never more than the all-geometry prediction + the investment.
+TEST(RegenerationScheduler, ALostFrameInvestsInImagesThatPayBackOverTheirReuse) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  size_t invested = 0, refused_payback = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::vector<RegenerationRequest> req(1 + trial % 15);
+    for (size_t i = 0; i < req.size(); ++i) {
+      req[i].node = uint32_t(i);
+      req[i].error_ratio = 1.0 + 5 * u(rng);
+      req[i].geometry_ms = 4 * u(rng);
+      req[i].image_ms = 0.05;
+      req[i].regenerate_ms = req[i].geometry_ms + 3 * u(rng);  // some pay back, some do not
+      req[i].expected_reuse = i % 4 == 0 ? 0.0 : (i % 4 == 1 ? 1.0 : 2.5);
+    }
+    const double base = 10.0;
+    double all_geometry = base;
+    for (const auto& r : req) all_geometry += r.geometry_ms;
+    const double t_max = all_geometry * (0.3 + 0.6 * u(rng));  // lost
+    const RegenerationSchedule none = scheduleRegenerations(req, base, t_max, 100, 0.0);
+    EXPECT_TRUE(none.lost);
+    EXPECT_TRUE(none.regenerate.empty());
+    EXPECT_NEAR(none.predicted_ms, all_geometry, 1e-9);
+
+    const double invest = t_max * u(rng);
+    const RegenerationSchedule s = scheduleRegenerations(req, base, t_max, 100, invest);
+    EXPECT_TRUE(s.lost);
+    EXPECT_LE(s.predicted_ms, all_geometry + invest + 1e-9);
+    std::vector<size_t> order(req.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return req[a].error_ratio > req[b].error_ratio; });
+    std::vector<uint32_t> want;
+    double running = all_geometry;
+    for (const size_t i : order) {
+      const double delta = req[i].regenerate_ms + req[i].image_ms - req[i].geometry_ms;
+      const bool pays = delta <= req[i].expected_reuse * (req[i].geometry_ms - req[i].image_ms);
+      EXPECT_FALSE(req[i].expected_reuse == 0.0 && std::count(s.regenerate.begin(), s.regenerate.end(), req[i].node))
+          << "an image that was not reused is no investment";
+      refused_payback += !pays;
+      if (!pays || running + delta > all_geometry + invest) continue;
+      running += delta;
+      want.push_back(req[i].node);
+    }
+    EXPECT_EQ(s.regenerate, want) << "trial " << trial;
+    EXPECT_NEAR(s.predicted_ms, running, 1e-9);
+    invested += s.regenerate.size();
+  }
+  EXPECT_GT(invested, 100u);  // not vacuous: both kinds of request occur
+  EXPECT_GT(refused_payback, 100u);
+
+  // A frame that is not lost keeps the plain rule, investment or not.
+  std::vector<RegenerationRequest> req(3);
+  for (size_t i = 0; i < req.size(); ++i) req[i] = {uint32_t(i), double(i) + 2, 2.0, 0.1, 1.0, 1.0};
+  const RegenerationSchedule fits = scheduleRegenerations(req, 1.0, 6.0, 10, 100.0);
+  EXPECT_FALSE(fits.lost);
+  EXPECT_NEAR(fits.predicted_ms, 4.0 + 1.1, 1e-9);  // a second regeneration (+1.1) would pass 6
+  EXPECT_EQ(fits.regenerate, (std::vector<uint32_t>{2}));
+}
+
 }  // namespace
 }  // namespace farfield::runtime

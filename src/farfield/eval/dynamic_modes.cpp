@@ -122,6 +122,7 @@ DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const 
   options_.error_px = numberOption(context, "error_px", 2.0, 0.01);
   options_.t_max_ms = numberOption(context, "t_max_ms", 0.0, 0.0);
   options_.max_regenerations = intOption(context, "max_regenerations", 32, 0, 100000);
+  options_.lost_frame_investment = numberOption(context, "lost_frame_investment", 1.0, 0.0);
   options_.audit_samples = intOption(context, "audit", 0, 0, 1000000);
   options_.impostor.plane_in_front = choiceOption(context, "plane", "best", {"best", "front"}) == "front";
   profile_path_ = context.option("profile");
@@ -185,7 +186,7 @@ void DynamicImpostorMode::frame(FrameContext& frame) {
 std::map<std::string, double> DynamicImpostorMode::info() const {
   double regen = 0, regen_max = 0, images = 0, geometry = 0, written = 0, uploaded = 0, tex_max = 0, audited = 0,
          unneeded = 0, missed = 0, frames_with_regen = 0, predicted = 0, deferred = 0, frames_with_deferred = 0;
-  double hidden_nodes = 0, hidden_node_tris = 0, hidden_items = 0, hidden_tris = 0, occluders = 0, occlusion_ms = 0;
+  double lost = 0, lost_with_regen = 0, hidden_nodes = 0, hidden_node_tris = 0, hidden_items = 0, hidden_tris = 0, occluders = 0, occlusion_ms = 0;
   for (const auto& [k, s] : per_frame_) {
     regen += double(s.regenerations);
     regen_max = std::max(regen_max, double(s.regenerations));
@@ -201,6 +202,8 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
     predicted += s.predicted_ms;
     deferred += double(s.geometry_nodes);
     frames_with_deferred += s.geometry_nodes > 0;
+    lost += double(s.lost);
+    lost_with_regen += double(s.lost && s.regenerations > 0);
     hidden_nodes += double(s.hidden_nodes);
     hidden_node_tris += double(s.hidden_node_triangles);
     hidden_items += double(s.hidden_items);
@@ -235,6 +238,9 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
           {"layered_cost_calibrated", options_.layered_cost.calibrated ? 1.0 : 0.0},
           {"deferred_regenerations_per_frame", deferred / f},
           {"frames_with_deferred", frames_with_deferred},
+          {"lost_frame_investment", options_.lost_frame_investment},
+          {"frames_predicted_lost", lost},
+          {"frames_predicted_lost_with_regenerations", lost_with_regen},
           {"occlusion", occlusion_ ? 1.0 : 0.0},
           {"occlusion_hidden_nodes_per_frame", hidden_nodes / f},
           {"occlusion_hidden_node_triangles_per_frame", hidden_node_tris / f},

@@ -39,6 +39,8 @@ ImageCache::ImageCache(const scene::Scene& scene, const gpu::GpuScene& gpu_scene
   if (!(options.min_distance_radii > 1.0)) throw Error("image cache", "min_distance_radii must be > 1");
   if (options.shade_samples < 1) throw Error("image cache", "shade_samples must be >= 1");
   if (!(options.cost_safety_factor >= 1.0)) throw Error("image cache", "cost_safety_factor must be >= 1");
+  if (!(options.lost_frame_investment >= 0.0 && std::isfinite(options.lost_frame_investment)))
+    throw Error("image cache", "lost_frame_investment must be a finite number >= 0");
   std::vector<uint32_t> small;
   for (const scene::Object& o : scene.objects) {
     if (o.world_bounds.empty()) continue;
@@ -247,6 +249,7 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
     RegenerationRequest r;
     r.node = uint32_t(i);
     r.error_ratio = ratio;
+    r.expected_reuse = n.last_reuse;
     r.geometry_ms = geometryMs(n);
     const double side = std::min(double(options_.impostor.max_texels),
                                  2.0 * std::asin(std::min(1.0, 1.02 * objectRadius(n.bounds) /
@@ -285,11 +288,16 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
                      c.ms_per_draw * double(near_draws) + c.ms_per_draw * double(valid.size()));
   for (const int i : valid) base += nodes_[size_t(i)].layered_draw_ms;  // the valid layered images' fill
   const RegenerationSchedule schedule =
-      scheduleRegenerations(requests, base, options_.t_max_ms, options_.max_regenerations);
+      scheduleRegenerations(requests, base, options_.t_max_ms, options_.max_regenerations,
+                            options_.lost_frame_investment * options_.t_max_ms);
   st.predicted_ms = schedule.predicted_ms;
+  st.lost = schedule.lost;
 
   for (const uint32_t i : schedule.regenerate) {
     Node& n = nodes_[i];
+    // How long the image being replaced served (not on a repeat of the frame that made it).
+    if (hasImage(n) && n.regenerated_in != frame_index) n.last_reuse = double(n.uses > 0 ? n.uses - 1 : 0);
+    n.uses = 0;
     dropImage(n);
     if (options_.kind == CachedImageKind::Layered) {
       const DVec3 centre(n.bounds.center());
@@ -333,6 +341,7 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
   }
   for (const int i : valid) {
     Node& n = nodes_[size_t(i)];
+    if (n.uses == 0 || n.last_used != frame_index) ++n.uses;
     n.last_used = frame_index;
     if (n.layered) n.layered->appendDrawItems(out, 0);
     else n.image->appendDrawItems(out, 0);

@@ -55,12 +55,17 @@ struct ImageCacheOptions {
   // readback, crop, upload) bounds; not calibrated: a layered regeneration is estimated as renders of the geometry.
   gpu::LayeredCost layered_cost;
   double regeneration_overhead_ms = 0.3;  // per regeneration: target, clear, state
+  // A frame predicted over t_max even with every invalid node as geometry still regenerates the nodes whose images
+  // pay for themselves over the frames the node's previous image served, up to this share of t_max more
+  // (runtime/regeneration_scheduler.h, invest_ms); 0: such a frame draws every invalid node as geometry.
+  double lost_frame_investment = 1.0;
 };
 
 struct ImageCacheFrameStats {
   size_t images_drawn = 0;         // cached images drawn (valid or regenerated this frame)
   size_t regenerations = 0;
   size_t geometry_nodes = 0;       // invalid nodes drawn as geometry (no time to regenerate)
+  bool lost = false;               // predicted over t_max even with every invalid node as geometry
   size_t near_objects = 0;         // objects drawn as geometry because they are near (or large)
   double predicted_ms = 0.0;
   size_t texture_bytes = 0;        // all cached images (after this frame)
@@ -128,6 +133,8 @@ class ImageCache {
     double layered_draw_ms = 0.0;  // bound of drawing the layered image (its plan's layers and fill)
     size_t last_used = 0;
     std::optional<size_t> regenerated_in;
+    size_t uses = 0;          // frames the current image was drawn in
+    double last_reuse = 1.0;  // frames the previous image was drawn in after the one it was made in (1 at first)
   };
   int build(std::vector<uint32_t> objects, int depth);
   void evict(size_t frame_index);

@@ -9,10 +9,13 @@
 namespace farfield::runtime {
 
 RegenerationSchedule scheduleRegenerations(std::span<const RegenerationRequest> requests, double base_ms,
-                                           double t_max_ms, int max_regenerations) {
+                                           double t_max_ms, int max_regenerations, double invest_ms) {
   RegenerationSchedule s;
   s.predicted_ms = base_ms;
   for (const RegenerationRequest& r : requests) s.predicted_ms += r.geometry_ms;
+  s.lost = t_max_ms > 0.0 && s.predicted_ms > t_max_ms;
+  // A lost frame's limit: what it costs anyway plus the investment (none without one).
+  const double limit = s.lost ? s.predicted_ms + std::max(invest_ms, 0.0) : t_max_ms;
   std::vector<size_t> order(requests.size());
   std::iota(order.begin(), order.end(), size_t(0));
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
@@ -25,7 +28,8 @@ RegenerationSchedule scheduleRegenerations(std::span<const RegenerationRequest> 
     if (count >= max_regenerations) break;
     const RegenerationRequest& r = requests[i];
     const double delta = r.regenerate_ms + r.image_ms - r.geometry_ms;
-    if (t_max_ms > 0.0 && s.predicted_ms + delta > t_max_ms) continue;
+    if (s.lost && (invest_ms <= 0.0 || delta > r.expected_reuse * (r.geometry_ms - r.image_ms))) continue;
+    if (t_max_ms > 0.0 && s.predicted_ms + delta > limit) continue;
     s.predicted_ms += delta;
     chosen[i] = true;
     s.regenerate.push_back(r.node);

@@ -16,12 +16,16 @@ struct RegenerationRequest {
   double regenerate_ms = 0.0;  // predicted: rendering the image
   double image_ms = 0.0;       // predicted: drawing the image
   double geometry_ms = 0.0;    // predicted: drawing the node's geometry instead
+  // Frames the new image is expected to be drawn after the one it is made in (a lost frame's investment needs it):
+  // the node's previous image's count, 1 for a first image.
+  double expected_reuse = 1.0;
 };
 
 struct RegenerationSchedule {
   std::vector<uint32_t> regenerate;  // nodes, most invalid first
   std::vector<uint32_t> geometry;    // nodes drawn as geometry this frame
   double predicted_ms = 0.0;         // base + what the choices cost
+  bool lost = false;                 // the all-geometry prediction was over t_max (see invest_ms)
 };
 
 // Starts from every request drawn as geometry (base_ms + the geometry), then takes the requests in decreasing
@@ -29,7 +33,15 @@ struct RegenerationSchedule {
 // keeps the prediction at or under t_max_ms, at most max_regenerations of them. A request that does not fit is
 // skipped, and later (less invalid, cheaper) ones may still fit. t_max_ms <= 0: no budget (every request up to
 // the count is regenerated).
+//
+// A lost frame (the all-geometry prediction is already over t_max_ms: the frame breaks the budget whatever is
+// chosen) would otherwise regenerate nothing, and a cache that starts that way never gets its images: every later
+// frame draws the same geometry and is lost too. With invest_ms > 0 such a frame still regenerates, in the same
+// order, the requests that pay for themselves over their expected reuse (regenerate + image - geometry <=
+// expected_reuse x (geometry - image): what the frame pays beyond the geometry, the later frames save), as long as
+// the prediction stays within the all-geometry prediction + invest_ms. An image that was not reused last time
+// (expected_reuse 0) is never an investment. invest_ms = 0: a lost frame draws every request as geometry.
 RegenerationSchedule scheduleRegenerations(std::span<const RegenerationRequest> requests, double base_ms,
-                                           double t_max_ms, int max_regenerations);
+                                           double t_max_ms, int max_regenerations, double invest_ms = 0.0);
 
 }  // namespace farfield::runtime
