@@ -147,6 +147,19 @@ class OcclusionStreetTest : public GpuTest {
     gpu_scene_ = std::make_unique<GpuScene>(scene_, options);
   }
 
+  // A 96 x 64 camera in the street at eye height, or above the walls looking down a little.
+  static Camera streetCamera(std::mt19937& rng, bool above) {
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    Camera camera;
+    camera.width = 96;
+    camera.height = 64;
+    camera.near_plane = 0.2f;
+    camera.far_plane = 500.0f;
+    camera.eye = Vec3(3.0f * u(rng), 50.0f * u(rng), above ? 30.0f : 1.7f);
+    camera.at = camera.eye + Vec3(0.8f * u(rng), u(rng), 0.2f * u(rng) - (above ? 0.5f : 0.0f));
+    return camera;
+  }
+
   scene::Scene scene_;
   std::unique_ptr<GpuScene> gpu_scene_;
 };
@@ -155,17 +168,10 @@ TEST_F(OcclusionStreetTest, FramesAreIdenticalToFrustumCulledFramesAndHiddenItem
   Renderer renderer;
   RenderTarget target(96, 64);
   std::mt19937 rng(4);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   uint64_t hidden = 0, hidden_triangles = 0, offered_triangles = 0;
   for (int trial = 0; trial < 40; ++trial) {
-    Camera camera;
-    camera.width = 96;
-    camera.height = 64;
-    camera.near_plane = 0.2f;
-    camera.far_plane = 500.0f;
     // In the street at eye height, some frames higher up (above the walls: little is hidden there).
-    camera.eye = Vec3(3.0f * u(rng), 50.0f * u(rng), trial % 4 == 3 ? 30.0f : 1.7f);
-    camera.at = camera.eye + Vec3(0.8f * u(rng), u(rng), 0.2f * u(rng) - (trial % 4 == 3 ? 0.5f : 0.0f));
+    const Camera camera = streetCamera(rng, trial % 4 == 3);
     std::vector<DrawItem> items;
     std::vector<Box3> bounds;
     gpu_scene_->appendDrawItems({}, items, camera, &bounds);
@@ -204,16 +210,9 @@ TEST_F(OcclusionStreetTest, WorldBoxesCalledHiddenShowNoPixelOfTheFrame) {
   Renderer renderer;
   RenderTarget target(96, 64);
   std::mt19937 rng(9);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   size_t hidden = 0, hidden_all_occluders = 0, visible = 0;
   for (int trial = 0; trial < 30; ++trial) {
-    Camera camera;
-    camera.width = 96;
-    camera.height = 64;
-    camera.near_plane = 0.2f;
-    camera.far_plane = 500.0f;
-    camera.eye = Vec3(3.0f * u(rng), 50.0f * u(rng), 1.7f);
-    camera.at = camera.eye + Vec3(0.8f * u(rng), u(rng), 0.2f * u(rng));
+    const Camera camera = streetCamera(rng, false);
     std::vector<DrawItem> items;
     std::vector<Box3> bounds;
     gpu_scene_->appendDrawItems({}, items, camera, &bounds);
