@@ -77,9 +77,12 @@ TEST(ImageCacheGl, ReusesRegeneratesAndFallsBackUnderTheBudget) {
   tight.cost.ms_per_draw = 0.01;
   tight.t_max_ms = 5.0;  // less than the frame's base: no regeneration fits
   tight.lost_frame_investment = 0.0;
-  ImageCache starved(s, gs, tight);
-  items.clear();
-  const ImageCacheFrameStats none = starved.frame(renderer, cam, 0, items);
+  auto firstFrame = [&](const ImageCacheOptions& options) {
+    ImageCache cache(s, gs, options);
+    items.clear();
+    return cache.frame(renderer, cam, 0, items);
+  };
+  const ImageCacheFrameStats none = firstFrame(tight);
   EXPECT_TRUE(none.lost);
   EXPECT_EQ(none.regenerations, 0u);
   EXPECT_GT(none.geometry_nodes, 0u);
@@ -88,9 +91,7 @@ TEST(ImageCacheGl, ReusesRegeneratesAndFallsBackUnderTheBudget) {
   tight.cost.ms_per_draw = 0.5;
   tight.cost.base_ms = 100.0;
   tight.lost_frame_investment = 1.0;
-  ImageCache investing(s, gs, tight);
-  items.clear();
-  const ImageCacheFrameStats some = investing.frame(renderer, cam, 0, items);
+  const ImageCacheFrameStats some = firstFrame(tight);
   EXPECT_TRUE(some.lost);
   EXPECT_GT(some.regenerations, 0u);
   std::printf("image cache: %zu regenerations, PSNR %.1f dB at the capture eye; %zu after moving 18 m\n",

@@ -179,14 +179,15 @@ void DynamicImpostorMode::frame(FrameContext& frame) {
     occlusion_->target = &target;
     occlusion_->draw_occluders = [&frame](std::span<const gpu::DrawItem> items) { frame.drawPass(items); };
   }
-  per_frame_[frame.pathFrame()] =
-      cache_->frame(frame.renderer(), frame.camera(), frame.pathFrame(), frame.items(), occlusion_ ? &*occlusion_ : nullptr);
+  per_frame_[frame.pathFrame()] = cache_->frame(frame.renderer(), frame.camera(), frame.pathFrame(), frame.items(),
+                                                occlusion_ ? &*occlusion_ : nullptr);
 }
 
 std::map<std::string, double> DynamicImpostorMode::info() const {
   double regen = 0, regen_max = 0, images = 0, geometry = 0, written = 0, uploaded = 0, tex_max = 0, audited = 0,
          unneeded = 0, missed = 0, frames_with_regen = 0, predicted = 0, deferred = 0, frames_with_deferred = 0;
-  double lost = 0, lost_with_regen = 0, hidden_nodes = 0, hidden_node_tris = 0, hidden_items = 0, hidden_tris = 0, occluders = 0, occlusion_ms = 0;
+  double lost = 0, lost_with_regen = 0, hidden_nodes = 0, hidden_node_tris = 0, hidden_items = 0, hidden_tris = 0,
+         occluders = 0, occlusion_ms = 0;
   for (const auto& [k, s] : per_frame_) {
     regen += double(s.regenerations);
     regen_max = std::max(regen_max, double(s.regenerations));

@@ -7,7 +7,8 @@
 //   error_px=P        the bound in pixels of the frame (default 2)
 //   t_max_ms=T        frame budget for regenerations (dynamic-*, default 0 = none)
 //   lost_frame_investment=S (dynamic-*, layered) a frame predicted over t_max even with every invalid node as geometry
-//                     still regenerates the images that pay for themselves in one frame of reuse, up to S x t_max more
+//                     still regenerates the images that pay for themselves over their previous image's reuse, up to
+//                     S x t_max more
 //                     (default 1; 0: such a frame draws every invalid node as geometry)
 //   max_regenerations=N (dynamic-*, default 32), audit=N (dynamic-*: N mesh vertices per node measure the error
 //                     the metric is checked against, default 0 = off; costs frame time)

@@ -80,6 +80,7 @@ class OcclusionCuller {
  public:
   // occluder_share: the first pass draws the nearest items until they hold this share of the triangles.
   explicit OcclusionCuller(double occluder_share = 0.1);
+  double occluderShare() const { return occluder_share_; }
 
   // items and bounds (parallel: each item's bounds in its mesh's space, as GpuScene::appendDrawItems gives them) of a
   // frame seen by camera into target. Calls draw_occluders once with the first pass's items (which must draw them

@@ -185,10 +185,7 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
   size_t near_draws = scratch_.size();
   if (occlusion) {
     FF_CHECK(occlusion->target != nullptr && occlusion->draw_occluders);
-    if (!culler_ || culler_share_ != occlusion->occluder_share) {
-      culler_.emplace(occlusion->occluder_share);
-      culler_share_ = occlusion->occluder_share;
-    }
+    if (!culler_ || culler_->occluderShare() != occlusion->occluder_share) culler_.emplace(occlusion->occluder_share);
     visible_.clear();
     const gpu::OcclusionStats os =
         culler_->cull(camera, scratch_, scratch_bounds_, *occlusion->target, occlusion->draw_occluders, visible_);

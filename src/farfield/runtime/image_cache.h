@@ -153,7 +153,6 @@ class ImageCache {
   std::vector<Box3> scratch_bounds_;
   std::vector<gpu::DrawItem> visible_;
   std::optional<gpu::OcclusionCuller> culler_;
-  double culler_share_ = -1.0;
 };
 
 }  // namespace farfield::runtime
