@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -53,6 +54,51 @@ TEST(DepthPyramid, FarthestIsNeverNearerThanAPixelOfTheRectangleAndComesFromNear
     }
     EXPECT_GT(exact, 200) << "the pyramid should often be exact, not only conservative";
   }
+}
+
+// The occluders are the nearest boxes until they hold the share of all triangles, those that follow outside the
+// boxes (also_triangles) included, and every box reaching the eye: against a brute-force count over random sets.
+TEST(SplitNearestFirst, OccludersHoldTheirShareOfTheTrianglesThatFollowToo) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<float> depth(0.0f, 1.0f);
+  std::uniform_int_distribution<int> tris(1, 500);
+  size_t grew = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const size_t n = 1 + size_t(trial % 40);
+    std::vector<ScreenBox> boxes(n);
+    std::vector<uint64_t> triangles(n);
+    for (size_t i = 0; i < n; ++i) {
+      boxes[i].reaches_eye = trial % 5 == 0 && i == n / 2;  // as projectBox gives it: infinitely near
+      boxes[i].nearest = boxes[i].reaches_eye ? std::numeric_limits<float>::infinity() : depth(rng);
+      triangles[i] = uint64_t(tris(rng));
+    }
+    const double share = 0.05 * double(trial % 20);
+    const uint64_t also = trial % 2 ? uint64_t(tris(rng)) * 40 : 0;
+    std::vector<uint32_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
+    const size_t split = splitNearestFirst(
+        order, boxes, [&](uint32_t i) { return triangles[i]; }, share, also);
+    // Brute force: sort nearest first (eye-reaching boxes first), take until the share is held.
+    std::vector<uint32_t> expected(n);
+    for (size_t i = 0; i < n; ++i) expected[i] = uint32_t(i);
+    std::sort(expected.begin(), expected.end(), [&](uint32_t a, uint32_t b) {
+      return boxes[a].nearest != boxes[b].nearest ? boxes[a].nearest > boxes[b].nearest : a < b;
+    });
+    ASSERT_EQ(order, expected);
+    uint64_t total = also, held = 0;
+    for (const uint64_t t : triangles) total += t;
+    size_t want = 0;
+    while (want < n && double(held) < share * double(total)) held += triangles[expected[want++]];
+    for (size_t k = 0; k < n; ++k)
+      if (boxes[expected[k]].reaches_eye) want = std::max(want, k + 1);
+    EXPECT_EQ(split, want) << "trial " << trial;
+    if (also > 0) {
+      std::vector<uint32_t> again(n);
+      for (size_t i = 0; i < n; ++i) again[i] = uint32_t(i);
+      grew += split > splitNearestFirst(again, boxes, [&](uint32_t i) { return triangles[i]; }, share, 0);
+    }
+  }
+  EXPECT_GT(grew, 10u);  // the triangles that follow ask for more occluders
 }
 
 TEST(ProjectBox, FootprintHoldsEveryPointOfTheBoxAndNearestIsItsNearestDepth) {

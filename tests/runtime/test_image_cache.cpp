@@ -30,6 +30,29 @@ scene::Scene grid() {
   return s;
 }
 
+// The grid behind a long wall (larger than max_object_radius, so always geometry, and the occluder; reaching below
+// the frame, so that the depth pyramid's coarse texels over the grid hold only the wall), and an eye behind the wall
+// from which it hides about half of the grid.
+scene::Scene gridBehindWall() {
+  scene::Scene s = grid();
+  scene::Material m;
+  m.base_color = Vec4(0.7f, 0.6f, 0.5f, 1.0f);
+  scene::Object wall;
+  wall.parts.push_back({s.addMesh(scene::makeBox(Vec3(-300, -81, -20), Vec3(24, -80, 12))), s.addMaterial(m)});
+  s.addObject(wall);
+  s.updateBounds();
+  return s;
+}
+
+Camera behindWallCamera() {
+  Camera cam;
+  cam.eye = Vec3(20, -100, 3);
+  cam.at = Vec3(30, 30, 3);
+  cam.width = 320;
+  cam.height = 180;
+  return cam;
+}
+
 TEST(ImageCacheGl, ReusesRegeneratesAndFallsBackUnderTheBudget) {
   gpu::sharedHeadlessContext();
   const scene::Scene s = grid();
@@ -77,27 +100,73 @@ TEST(ImageCacheGl, ReusesRegeneratesAndFallsBackUnderTheBudget) {
   tight.cost.ms_per_draw = 0.01;
   tight.t_max_ms = 5.0;  // less than the frame's base: no regeneration fits
   tight.lost_frame_investment = 0.0;
-  auto firstFrame = [&](const ImageCacheOptions& options) {
+  // The second frame from the same eye: the first (no speed known yet) expects no reuse of any image.
+  auto secondFrame = [&](const ImageCacheOptions& options) {
     ImageCache cache(s, gs, options);
     items.clear();
-    return cache.frame(renderer, cam, 0, items);
+    cache.frame(renderer, cam, 0, items);
+    items.clear();
+    return cache.frame(renderer, cam, 1, items);
   };
-  const ImageCacheFrameStats none = firstFrame(tight);
+  const ImageCacheFrameStats none = secondFrame(tight);
   EXPECT_TRUE(none.lost);
   EXPECT_EQ(none.regenerations, 0u);
   EXPECT_GT(none.geometry_nodes, 0u);
-  // The same lost frame with an investment still makes the images that pay back in a frame (a node of 4 objects:
-  // 2 ms of geometry, against 0.3 ms of overhead to regenerate it and 0.5 ms to draw its image).
+  // The same lost frame with an investment still makes the images that pay back over their reuse (a node of 4
+  // objects: 2 ms of geometry, against 2.3 ms to regenerate it and 0.5 ms to draw its image; the eye at rest).
   tight.cost.ms_per_draw = 0.5;
   tight.cost.base_ms = 100.0;
   tight.lost_frame_investment = 1.0;
-  const ImageCacheFrameStats some = firstFrame(tight);
+  const ImageCacheFrameStats some = secondFrame(tight);
   EXPECT_TRUE(some.lost);
   EXPECT_GT(some.regenerations, 0u);
   std::printf("image cache: %zu regenerations, PSNR %.1f dB at the capture eye; %zu after moving 18 m\n",
               first.regenerations, psnr, later.regenerations);
   o.error_px = 0.0;
   EXPECT_THROW(ImageCache(s, gs, o), Error);
+}
+
+// Pay-back: a regeneration is taken only when the frames the new image is expected to serve (the eye's
+// displacement its images stay valid over, divided by the eye's speed) save more than it costs. With a dear capture
+// (50 ms of overhead against 0.5 ms of geometry per box), the first frame (no speed known: no reuse) draws
+// geometry; a next frame from a still eye makes the images; a next frame 85 m away makes none, which a
+// cache without the rule does.
+TEST(ImageCacheGl, ImagesAreMadeWhenTheyPayOverTheFramesTheEyeLeavesThemValid) {
+  gpu::sharedHeadlessContext();
+  const scene::Scene s = grid();
+  const gpu::GpuScene gs(s);
+  gpu::Renderer renderer;
+  Camera a;
+  a.eye = Vec3(-120, -140, 40);
+  a.at = Vec3(35, 35, 0);
+  a.width = 320;
+  a.height = 180;
+  Camera still = a, far = a;
+  still.eye += Vec3(0.01f, 0.0f, 0.0f);
+  far.eye += Vec3(60.0f, -60.0f, 0.0f);
+  ImageCacheOptions o;
+  o.error_px = 1.0;
+  o.leaf_objects = 4;
+  o.cost.ms_per_draw = 0.5;
+  o.regeneration_overhead_ms = 50.0;
+  std::vector<gpu::DrawItem> items;
+  auto secondFrame = [&](const ImageCacheOptions& options, const Camera& next, ImageCacheFrameStats& first) {
+    ImageCache cache(s, gs, options);
+    items.clear();
+    first = cache.frame(renderer, a, 0, items);
+    items.clear();
+    return cache.frame(renderer, next, 1, items);
+  };
+  ImageCacheFrameStats first;
+  const ImageCacheFrameStats after_still = secondFrame(o, still, first);
+  EXPECT_EQ(first.regenerations, 0u);
+  EXPECT_GT(first.geometry_nodes, 0u);
+  EXPECT_GT(after_still.regenerations, 0u);
+  const ImageCacheFrameStats after_far = secondFrame(o, far, first);
+  EXPECT_EQ(after_far.regenerations, 0u);
+  EXPECT_GT(after_far.geometry_nodes, 0u);
+  o.pay_back = false;
+  EXPECT_GT(secondFrame(o, far, first).regenerations, 0u);
 }
 
 // The layered kind's regenerations are scheduled with the calibrated capture and draw bounds: a capture that costs
@@ -121,6 +190,7 @@ TEST(ImageCacheGl, LayeredRegenerationsKeepTheCalibratedBudget) {
   o.cost.ms_per_draw = 0.01;
   o.layered_cost.calibrated = true;
   o.layered_cost.capture.ms_per_draw = 1000.0;  // per layer: no capture fits 100 ms
+  o.pay_back = false;  // the budget alone decides here (pay-back: ImagesAreMadeWhenTheyPay...)
   std::vector<gpu::DrawItem> items;
   ImageCache dear(s, gs, o);
   const ImageCacheFrameStats none = dear.frame(renderer, cam, 0, items);
@@ -150,29 +220,15 @@ TEST(ImageCacheGl, LayeredRegenerationsKeepTheCalibratedBudget) {
   EXPECT_THROW(ImageCache(s, gs, o), Error);
 }
 
-// Occlusion culling inside the cache's frame: a long wall in front of the eye (larger than max_object_radius, so
-// always geometry, and the occluder; reaching below the frame, so that the depth pyramid's coarse texels over the
-// grid hold only the wall) hides about half of the grid. Nodes behind it are neither regenerated nor drawn,
-// the frame stays as close to the full-geometry frame as the frame without occlusion culling, and with the wall
-// removed from the view nothing is hidden.
+// Occlusion culling inside the cache's frame: the wall of gridBehindWall hides about half of the grid. Nodes behind
+// it are neither regenerated nor drawn, the frame stays as close to the full-geometry frame as the frame without
+// occlusion culling, and with the wall removed from the view nothing is hidden.
 TEST(ImageCacheGl, OcclusionSkipsNodesHiddenBehindNearGeometry) {
   gpu::sharedHeadlessContext();
-  scene::Scene s = grid();
-  {
-    scene::Material m;
-    m.base_color = Vec4(0.7f, 0.6f, 0.5f, 1.0f);
-    scene::Object wall;
-    wall.parts.push_back({s.addMesh(scene::makeBox(Vec3(-300, -81, -20), Vec3(24, -80, 12))), s.addMaterial(m)});
-    s.addObject(wall);
-    s.updateBounds();
-  }
+  const scene::Scene s = gridBehindWall();
   const gpu::GpuScene gs(s);
   gpu::Renderer renderer;
-  Camera cam;
-  cam.eye = Vec3(20, -100, 3);
-  cam.at = Vec3(30, 30, 3);
-  cam.width = 320;
-  cam.height = 180;
+  const Camera cam = behindWallCamera();
   ImageCacheOptions o;
   o.error_px = 1.0;
   o.leaf_objects = 2;
@@ -219,6 +275,55 @@ TEST(ImageCacheGl, OcclusionSkipsNodesHiddenBehindNearGeometry) {
   run(above, true, open);
   EXPECT_EQ(open.hidden_nodes, 0u);
   EXPECT_GT(open.regenerations, 0u);
+}
+
+// Nodes drawn as geometry (no regeneration allowed) behind the wall, large nodes that reach out beside it: occlusion culling drops its items behind the wall, the frame is pixel-identical to the one
+// drawn without it (an exact cull), it draws fewer triangles, and the prediction counts only what is drawn.
+TEST(ImageCacheGl, NodesDrawnAsGeometryCostOnlyWhatTheOccludersLeave) {
+  gpu::sharedHeadlessContext();
+  const scene::Scene s = gridBehindWall();
+  const gpu::GpuScene gs(s);
+  gpu::Renderer renderer;
+  const Camera cam = behindWallCamera();
+  ImageCacheOptions o;
+  o.error_px = 1.0;
+  o.leaf_objects = 1;
+  o.min_distance_radii = 1.2;     // large nodes, partly behind the wall
+  o.max_regenerations = 0;        // every node of the cut is drawn as geometry
+  o.cost.ms_per_mtriangle = 1000.0;
+  gpu::RenderTarget target(cam.width, cam.height);
+  auto run = [&](bool occlusion, ImageCacheFrameStats& st, uint64_t& triangles) {
+    ImageCache cache(s, gs, o);
+    std::vector<gpu::DrawItem> items;
+    renderer.render(cam, {}, target, gpu::RenderMode::ItemBuffer);  // clears
+    ImageCacheOcclusion occ;
+    occ.target = &target;
+    occ.occluder_share = 0.1;
+    occ.draw_occluders = [&](std::span<const gpu::DrawItem> occluders) {
+      renderer.draw(cam, occluders, target, gpu::RenderMode::ItemBuffer);
+      for (const gpu::DrawItem& it : occluders) triangles += it.triangleCount();
+    };
+    st = cache.frame(renderer, cam, 0, items, occlusion ? &occ : nullptr);
+    renderer.draw(cam, items, target, gpu::RenderMode::ItemBuffer);
+    for (const gpu::DrawItem& it : items) triangles += it.triangleCount();
+    return target.readIds().pixels();
+  };
+  ImageCacheFrameStats plain, culled;
+  uint64_t plain_triangles = 0, culled_triangles = 0;
+  const std::vector<uint32_t> without = run(false, plain, plain_triangles);
+  const std::vector<uint32_t> with = run(true, culled, culled_triangles);
+  ASSERT_EQ(plain.regenerations, 0u);
+  ASSERT_GT(culled.geometry_nodes, 0u);
+  EXPECT_GT(culled.hidden_fallback_items, 0u);
+  EXPECT_GT(culled.hidden_fallback_triangles, 0u);
+  EXPECT_EQ(with, without);
+  EXPECT_LT(culled_triangles, plain_triangles);
+  // The prediction is what is drawn (1000 ms per million triangles, nothing else: 1 ms per 1000).
+  EXPECT_NEAR(plain.predicted_ms, 1e-3 * double(plain_triangles), 1e-9 * plain.predicted_ms);
+  EXPECT_NEAR(culled.predicted_ms, 1e-3 * double(culled_triangles), 1e-9 * plain.predicted_ms);
+  std::printf("nodes as geometry: %zu of their items hidden (%llu triangles); %llu triangles drawn instead of %llu\n",
+              culled.hidden_fallback_items, (unsigned long long)culled.hidden_fallback_triangles,
+              (unsigned long long)culled_triangles, (unsigned long long)plain_triangles);
 }
 
 }  // namespace

@@ -127,5 +127,55 @@ TEST(RegenerationScheduler, ALostFrameInvestsInImagesThatPayBackOverTheirReuse) 
   EXPECT_EQ(fits.regenerate, (std::vector<uint32_t>{2}));
 }
 
+// With pay_back every frame takes, most invalid first, exactly the requests that pay for themselves over their
+// expected reuse and fit t_max (a brute-force replay); without it the same frames take more, some of them images
+// that cost more than the geometry they replace.
+TEST(RegenerationScheduler, PayBackTakesOnlyImagesThatPayForThemselves) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  size_t taken = 0, refused = 0, taken_without = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::vector<RegenerationRequest> req(1 + trial % 12);
+    for (size_t i = 0; i < req.size(); ++i) {
+      req[i].node = uint32_t(i);
+      req[i].error_ratio = 1.0 + 5 * u(rng);
+      req[i].geometry_ms = 4 * u(rng);
+      req[i].image_ms = 0.05;
+      req[i].regenerate_ms = req[i].geometry_ms + 3 * u(rng);
+      req[i].expected_reuse = 3 * u(rng);
+    }
+    const double base = 2.0;
+    double all_geometry = base;
+    for (const auto& r : req) all_geometry += r.geometry_ms;
+    const double t_max = all_geometry * (1.0 + 2 * u(rng));  // not lost
+    const RegenerationSchedule s = scheduleRegenerations(req, base, t_max, 100, 1.0, true);
+    EXPECT_FALSE(s.lost);
+    std::vector<size_t> order(req.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return req[a].error_ratio > req[b].error_ratio; });
+    std::vector<uint32_t> want;
+    double running = all_geometry;
+    for (const size_t i : order) {
+      const double delta = req[i].regenerate_ms + req[i].image_ms - req[i].geometry_ms;
+      if (delta > req[i].expected_reuse * (req[i].geometry_ms - req[i].image_ms)) {
+        ++refused;
+        continue;
+      }
+      if (running + delta > t_max) continue;
+      running += delta;
+      want.push_back(req[i].node);
+    }
+    EXPECT_EQ(s.regenerate, want) << "trial " << trial;
+    EXPECT_NEAR(s.predicted_ms, running, 1e-9);
+    EXPECT_LE(s.predicted_ms, t_max + 1e-9);
+    taken += s.regenerate.size();
+    taken_without += scheduleRegenerations(req, base, t_max, 100, 1.0, false).regenerate.size();
+  }
+  EXPECT_GT(taken, 100u);  // not vacuous
+  EXPECT_GT(refused, 100u);
+  EXPECT_GT(taken_without, taken);
+}
+
 }  // namespace
 }  // namespace farfield::runtime

@@ -124,6 +124,7 @@ DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const 
   options_.max_regenerations = intOption(context, "max_regenerations", 32, 0, 100000);
   options_.lost_frame_investment = numberOption(context, "lost_frame_investment", 1.0, 0.0);
   options_.audit_samples = intOption(context, "audit", 0, 0, 1000000);
+  options_.pay_back = switchOption(context, "pay_back", true);
   options_.impostor.plane_in_front = choiceOption(context, "plane", "best", {"best", "front"}) == "front";
   profile_path_ = context.option("profile");
   if (switchOption(context, "occlusion", true)) {
@@ -187,7 +188,7 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
   double regen = 0, regen_max = 0, images = 0, geometry = 0, written = 0, uploaded = 0, tex_max = 0, audited = 0,
          unneeded = 0, missed = 0, frames_with_regen = 0, predicted = 0, deferred = 0, frames_with_deferred = 0;
   double lost = 0, lost_with_regen = 0, hidden_nodes = 0, hidden_node_tris = 0, hidden_items = 0, hidden_tris = 0,
-         occluders = 0, occlusion_ms = 0;
+         occluders = 0, occlusion_ms = 0, hidden_fallback_tris = 0;
   for (const auto& [k, s] : per_frame_) {
     regen += double(s.regenerations);
     regen_max = std::max(regen_max, double(s.regenerations));
@@ -211,6 +212,7 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
     hidden_tris += double(s.hidden_triangles);
     occluders += double(s.occluders);
     occlusion_ms += s.occlusion_ms;
+    hidden_fallback_tris += double(s.hidden_fallback_triangles);
   }
   const double f = double(std::max<size_t>(per_frame_.size(), 1));
   std::map<std::string, double> out;
@@ -248,6 +250,7 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
           {"occlusion_hidden_items_per_frame", hidden_items / f},
           {"occlusion_hidden_triangles_per_frame", hidden_tris / f},
           {"occlusion_occluder_items_per_frame", occluders / f},
+          {"occlusion_hidden_fallback_triangles_per_frame", hidden_fallback_tris / f},
           {"occlusion_ms_per_frame", occlusion_ms / f}});
   return out;
 }

@@ -10,6 +10,9 @@
 //                     still regenerates the images that pay for themselves over their previous image's reuse, up to
 //                     S x t_max more
 //                     (default 1; 0: such a frame draws every invalid node as geometry)
+//   pay_back=on|off   (dynamic-*, layered) regenerate only images that pay for themselves over the frames they are
+//                     expected to serve (the eye's speed against how far the node's images stay valid; default on);
+//                     off: every invalid image that fits t_max is regenerated
 //   max_regenerations=N (dynamic-*, default 32), audit=N (dynamic-*: N mesh vertices per node measure the error
 //                     the metric is checked against, default 0 = off; costs frame time)
 //   plane=best|front  (dynamic-*) the best plane, or the best plane moved in front of the node's samples
@@ -17,7 +20,8 @@
 //                     space): its model, safety factor and layered terms predict the frame; default: a quick fit here
 //   occlusion=on|off  (dynamic-*, layered) the cache's near geometry occlusion-culled against the depth of its nearest
 //                     items, and nodes hidden behind that depth skipped: no image, no regeneration (default on)
-//   occluder_share=S  the share of the near geometry's triangles drawn first as occluders (default 0.1)
+//   occluder_share=S  the nearest near items drawn first as occluders hold this share of the triangles of the near
+//                     geometry and the cut's nodes (default 0.1)
 //   warp_interval=N   (warp) a keyframe of culled geometry every N path frames (default 4)
 //   billboard_kind=cylindrical|spherical, billboard_views=N (default 8), billboard_texels=N (default 32)
 #pragma once

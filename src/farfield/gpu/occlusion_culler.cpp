@@ -95,11 +95,12 @@ bool DepthPyramid::hides(const ScreenBox& box) const {
 // ---------------------------------------------------------------------------------------------------------------
 
 size_t splitNearestFirst(std::vector<uint32_t>& order, std::span<const ScreenBox> boxes,
-                         const std::function<uint64_t(uint32_t)>& triangles, double share) {
+                         const std::function<uint64_t(uint32_t)>& triangles, double share,
+                         uint64_t also_triangles) {
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
     return boxes[a].nearest != boxes[b].nearest ? boxes[a].nearest > boxes[b].nearest : a < b;
   });
-  uint64_t total = 0;
+  uint64_t total = also_triangles;
   for (uint32_t i : order) total += triangles(i);
   const double wanted = share * double(total);
   uint64_t drawn = 0;
@@ -118,7 +119,7 @@ OcclusionCuller::OcclusionCuller(double occluder_share) : occluder_share_(occlud
 OcclusionStats OcclusionCuller::cull(const Camera& camera, std::span<const DrawItem> items,
                                      std::span<const Box3> bounds, const RenderTarget& target,
                                      const std::function<void(std::span<const DrawItem>)>& draw_occluders,
-                                     std::vector<DrawItem>& rest) {
+                                     std::vector<DrawItem>& rest, uint64_t also_triangles) {
   FF_CHECK(items.size() == bounds.size());
   OcclusionStats stats;
   stats.items = uint32_t(items.size());
@@ -134,7 +135,7 @@ OcclusionStats OcclusionCuller::cull(const Camera& camera, std::span<const DrawI
     order_[i] = uint32_t(i);
   }
   const size_t split = splitNearestFirst(
-      order_, boxes_, [&](uint32_t i) { return items[i].triangleCount(); }, occluder_share_);
+      order_, boxes_, [&](uint32_t i) { return items[i].triangleCount(); }, occluder_share_, also_triangles);
   occluders_.clear();
   for (size_t k = 0; k < split; ++k) occluders_.push_back(items[order_[k]]);
   stats.occluders = uint32_t(occluders_.size());
@@ -167,9 +168,9 @@ void OcclusionCuller::buildPyramid(OcclusionStats* stats) {
   if (stats) stats->pyramid_ms = build.milliseconds();
 }
 
-bool OcclusionCuller::hidesWorldBox(const Box3& box) {
+bool OcclusionCuller::hidesBox(const Box3& box, const Mat4& model) {
   if (!pyramid_built_) buildPyramid(nullptr);
-  return pyramid_.hides(projectBox(box, view_proj_, pyramid_.width(), pyramid_.height()));
+  return pyramid_.hides(projectBox(box, view_proj_ * model, pyramid_.width(), pyramid_.height()));
 }
 
 OcclusionStats OcclusionCuller::draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,

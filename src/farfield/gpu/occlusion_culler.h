@@ -62,10 +62,12 @@ class DepthPyramid {
 
 // The split of occlusion culling's first pass: sorts `order` (indices into `boxes`) nearest first (boxes reaching
 // the eye are infinitely near; ties by index, for a deterministic split) and returns how many of its first entries
-// are occluders: the nearest until they hold `share` of the triangles of all (triangles(i) for index i), and every
-// box that reaches the eye.
+// are occluders: the nearest until they hold `share` of the triangles of all (triangles(i) for index i, plus
+// also_triangles: geometry that may follow them in the frame but is not among the boxes), and every box that reaches
+// the eye.
 size_t splitNearestFirst(std::vector<uint32_t>& order, std::span<const ScreenBox> boxes,
-                         const std::function<uint64_t(uint32_t)>& triangles, double share);
+                         const std::function<uint64_t(uint32_t)>& triangles, double share,
+                         uint64_t also_triangles = 0);
 
 struct OcclusionStats {
   uint32_t items = 0;      // items offered
@@ -84,16 +86,21 @@ class OcclusionCuller {
 
   // items and bounds (parallel: each item's bounds in its mesh's space, as GpuScene::appendDrawItems gives them) of a
   // frame seen by camera into target. Calls draw_occluders once with the first pass's items (which must draw them
-  // into target), then appends to `rest` the other items that are not hidden, nearest first.
+  // into target), then appends to `rest` the other items that are not hidden, nearest first. also_triangles: other
+  // geometry the frame may draw behind these items (tested later with hidesBox), counted in the total whose share
+  // the occluders hold, so that a frame whose items are a small near part of it gets the occluders a cull of all of
+  // it would.
   OcclusionStats cull(const Camera& camera, std::span<const DrawItem> items, std::span<const Box3> bounds,
                       const RenderTarget& target,
                       const std::function<void(std::span<const DrawItem>)>& draw_occluders,
-                      std::vector<DrawItem>& rest);
+                      std::vector<DrawItem>& rest, uint64_t also_triangles = 0);
   // After cull(): whether a box given in world space lies behind the depth the occluders of the last cull left over
   // the whole of its footprint in that cull's camera (the same test cull() applies to its items). Reads the depth
   // back on first use when cull() did not need it (every item was an occluder). Things that are not draw items use
   // it: the nodes of an image cache, whose images and regenerations a hidden node does not need.
-  bool hidesWorldBox(const Box3& box);
+  bool hidesWorldBox(const Box3& box) { return hidesBox(box, Mat4(1.0f)); }
+  // The same for a box in the space that `model` takes to the world (a draw item's bounds and transform).
+  bool hidesBox(const Box3& box, const Mat4& model);
   // Both passes with `renderer` (Renderer::draw: no clear, no wait): the occluders, then the items not hidden, then
   // `also` (items drawn after them as they are, such as impostors), all in `mode`.
   OcclusionStats draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,

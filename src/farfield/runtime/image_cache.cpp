@@ -141,10 +141,28 @@ void ImageCache::evict(size_t frame_index) {
   }
 }
 
+// Frames a new image of n made now would serve after this one: the eye's displacement its images stay valid over,
+// divided by the eye's speed. The displacement is the previous image's, measured; for a node none of whose images has
+// become invalid yet, the parallax estimate theta d^2 / (2 r) (points across the node's depth 2 r, at distance d,
+// shift against each other by about 2 r x / d^2 when the eye moves x sideways). At the first frame, with no speed
+// known, none: only an image cheaper than its geometry is made, and the others wait one frame for the speed; with the
+// eye at rest, a thousand.
+double ImageCache::expectedReuse(const Node& n, const DVec3& eye, double theta) const {
+  if (eye_speed_ < 0.0) return 0.0;
+  const double r = std::max(objectRadius(n.bounds), 1e-6);
+  const double d = glm::length(eye - DVec3(n.bounds.center()));
+  const double life = n.life >= 0.0 ? n.life : theta * d * d / (2.0 * r);
+  return eye_speed_ > 1e-9 ? std::min(life / eye_speed_, 1000.0) : 1000.0;
+}
+
 ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& camera, size_t frame_index,
                                        std::vector<gpu::DrawItem>& out, const ImageCacheOcclusion* occlusion) {
   ImageCacheFrameStats st;
   const bool repeat = last_frame_ && *last_frame_ == frame_index;
+  if (!repeat) {
+    if (last_frame_) eye_speed_ = glm::length(DVec3(camera.eye) - last_eye_);  // per frame of the cache
+    last_eye_ = DVec3(camera.eye);
+  }
   last_frame_ = frame_index;
   const ErrorBound bound = ErrorBound::forCamera(options_.error_px, camera);
   const double theta = bound.angle();
@@ -187,8 +205,12 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
     FF_CHECK(occlusion->target != nullptr && occlusion->draw_occluders);
     if (!culler_ || culler_->occluderShare() != occlusion->occluder_share) culler_.emplace(occlusion->occluder_share);
     visible_.clear();
-    const gpu::OcclusionStats os =
-        culler_->cull(camera, scratch_, scratch_bounds_, *occlusion->target, occlusion->draw_occluders, visible_);
+    // The occluders hold their share of everything the frame could draw as geometry, the cut's nodes included (as
+    // culled geometry's occluders would), not only of the near geometry.
+    uint64_t cut_triangles = 0;
+    for (const int i : cut) cut_triangles += nodes_[size_t(i)].triangles;
+    const gpu::OcclusionStats os = culler_->cull(camera, scratch_, scratch_bounds_, *occlusion->target,
+                                                 occlusion->draw_occluders, visible_, cut_triangles);
     st.occluders = os.occluders;
     st.hidden_items = os.hidden;
     st.hidden_triangles = os.hidden_triangles;
@@ -212,8 +234,39 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
   const gpu::CostModel& c = options_.cost;
   const double k = options_.cost_safety_factor;
   const gpu::LayeredCost& lc = options_.layered_cost;
-  auto geometryMs = [&](const Node& n) {
-    return k * (c.ms_per_mtriangle * double(n.triangles) / 1e6 + c.ms_per_draw * double(n.draws));
+  auto geometryMs = [&](uint64_t triangles, size_t draws) {
+    return k * (c.ms_per_mtriangle * double(triangles) / 1e6 + c.ms_per_draw * double(draws));
+  };
+  // The geometry an invalid node would be drawn with, and its predicted cost: only what is in view and, with
+  // occlusion culling, not behind the occluders (a node drawn as geometry behind a street's first row of buildings
+  // costs what culled geometry costs, not its whole triangle count).
+  fallback_items_.clear();
+  auto fallbackMs = [&](Node& n) {
+    n.fallback_begin = fallback_items_.size();
+    fallback_bounds_.clear();
+    gpu_scene_.appendDrawItems(n.objects, fallback_items_, camera, occlusion ? &fallback_bounds_ : nullptr);
+    uint64_t triangles = 0;
+    if (occlusion) {
+      size_t kept = n.fallback_begin;
+      for (size_t j = n.fallback_begin; j < fallback_items_.size(); ++j) {
+        const gpu::DrawItem& it = fallback_items_[j];
+        if (culler_->hidesBox(fallback_bounds_[j - n.fallback_begin], it.transform)) {
+          ++st.hidden_fallback_items;
+          st.hidden_fallback_triangles += it.triangleCount();
+          continue;
+        }
+        fallback_items_[kept++] = it;
+      }
+      fallback_items_.resize(kept);
+    }
+    n.fallback_end = fallback_items_.size();
+    for (size_t j = n.fallback_begin; j < n.fallback_end; ++j) triangles += fallback_items_[j].triangleCount();
+    return geometryMs(triangles, n.fallback_end - n.fallback_begin);
+  };
+  auto appendFallback = [&](const Node& n) {
+    out.insert(out.end(), fallback_items_.begin() + std::ptrdiff_t(n.fallback_begin),
+               fallback_items_.begin() + std::ptrdiff_t(n.fallback_end));
+    ++st.geometry_nodes;
   };
   std::vector<RegenerationRequest> requests;
   std::vector<int> valid;
@@ -246,8 +299,9 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
     RegenerationRequest r;
     r.node = uint32_t(i);
     r.error_ratio = ratio;
-    r.expected_reuse = n.last_reuse;
-    r.geometry_ms = geometryMs(n);
+    r.expected_reuse = expectedReuse(n, eye, theta);
+    r.geometry_ms = fallbackMs(n);
+    const double capture_geometry_ms = geometryMs(n.triangles, n.draws);  // an image is rendered from all of it
     const double side = std::min(double(options_.impostor.max_texels),
                                  2.0 * std::asin(std::min(1.0, 1.02 * objectRadius(n.bounds) /
                                                                    glm::length(eye - DVec3(n.bounds.center())))) /
@@ -278,7 +332,7 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
     }
     if (r.regenerate_ms < 0.0)
       r.regenerate_ms =
-          renders * (r.geometry_ms + options_.regeneration_overhead_ms + k * c.ms_per_mpixel * side * side / 1e6);
+          renders * (capture_geometry_ms + options_.regeneration_overhead_ms + k * c.ms_per_mpixel * side * side / 1e6);
     requests.push_back(r);
   }
   double base = k * (c.base_ms + c.ms_per_mpixel * pixels / 1e6 + c.ms_per_mtriangle * double(near_triangles) / 1e6 +
@@ -286,15 +340,17 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
   for (const int i : valid) base += nodes_[size_t(i)].layered_draw_ms;  // the valid layered images' fill
   const RegenerationSchedule schedule =
       scheduleRegenerations(requests, base, options_.t_max_ms, options_.max_regenerations,
-                            options_.lost_frame_investment * options_.t_max_ms);
+                            options_.lost_frame_investment * options_.t_max_ms,
+                            options_.pay_back && (c.ms_per_mtriangle > 0.0 || c.ms_per_draw > 0.0));
   st.predicted_ms = schedule.predicted_ms;
   st.lost = schedule.lost;
 
   for (const uint32_t i : schedule.regenerate) {
     Node& n = nodes_[i];
-    // How long the image being replaced served (not on a repeat of the frame that made it).
-    if (hasImage(n) && n.regenerated_in != frame_index) n.last_reuse = double(n.uses > 0 ? n.uses - 1 : 0);
-    n.uses = 0;
+    // How far the image being replaced stayed valid (not on a repeat of the frame that made it).
+    if (hasImage(n) && n.regenerated_in != frame_index) n.life = n.reach;
+    n.capture_eye = eye;
+    n.reach = 0.0;
     dropImage(n);
     if (options_.kind == CachedImageKind::Layered) {
       const DVec3 centre(n.bounds.center());
@@ -310,8 +366,7 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
       } catch (const Error&) {
         // The shaft's minimum distance does not clear the cluster (its layers' quads reach out further than its
         // box): too near for a layered image; its geometry is drawn.
-        gpu_scene_.appendDrawItems(n.objects, out, camera);
-        ++st.geometry_nodes;
+        appendFallback(n);
         continue;
       }
       const impostor::LayeredImpostor captured =
@@ -338,16 +393,13 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
   }
   for (const int i : valid) {
     Node& n = nodes_[size_t(i)];
-    if (n.uses == 0 || n.last_used != frame_index) ++n.uses;
+    n.reach = std::max(n.reach, glm::length(eye - n.capture_eye));
     n.last_used = frame_index;
     if (n.layered) n.layered->appendDrawItems(out, 0);
     else n.image->appendDrawItems(out, 0);
     ++st.images_drawn;
   }
-  for (const uint32_t i : schedule.geometry) {
-    gpu_scene_.appendDrawItems(nodes_[i].objects, out, camera);
-    ++st.geometry_nodes;
-  }
+  for (const uint32_t i : schedule.geometry) appendFallback(nodes_[i]);
   evict(frame_index);
   st.texture_bytes = texture_bytes_;
   return st;

@@ -59,6 +59,11 @@ struct ImageCacheOptions {
   // pay for themselves over the frames the node's previous image served, up to this share of t_max more
   // (runtime/regeneration_scheduler.h, invest_ms); 0: such a frame draws every invalid node as geometry.
   double lost_frame_investment = 1.0;
+  // A regeneration is taken only when it pays for itself over the frames the new image is expected to serve
+  // (regeneration + image - geometry <= expected reuse x (geometry - image)), in every frame and not only in a lost
+  // one: where images do not live long enough, the node is drawn as geometry, which is exact and cheaper. Only with
+  // a cost model that prices geometry (without one no image can pay, and every image is made as before).
+  bool pay_back = true;
 };
 
 struct ImageCacheFrameStats {
@@ -84,14 +89,18 @@ struct ImageCacheFrameStats {
   uint64_t hidden_triangles = 0;  // of the hidden near items
   size_t hidden_nodes = 0;
   uint64_t hidden_node_triangles = 0;
+  // Items of the nodes drawn as geometry (their invalid images not regenerated) hidden behind the occluders: such a
+  // node costs only what it shows, as in frustum- and occlusion-culled geometry.
+  size_t hidden_fallback_items = 0;
+  uint64_t hidden_fallback_triangles = 0;
   double occlusion_ms = 0.0;
 };
 
-// Occlusion culling inside the cache's frame (gpu/occlusion_culler.h). The nearest of the near geometry's items (up
-// to occluder_share of its triangles, and every item reaching behind the eye) are drawn first by draw_occluders into
-// the frame's target; the depth they leave hides the other near items and whole nodes of the cut whose boxes lie
-// behind it. A hidden node needs no image, no regeneration and no geometry this frame, and the budget is planned
-// without it. Exact for geometry (nothing hidden could draw a pixel); a hidden node's image could only have drawn
+// Occlusion culling inside the cache's frame (gpu/occlusion_culler.h). The nearest of the near geometry's items (until
+// they hold occluder_share of the triangles of the near geometry and the cut's nodes, and every item reaching behind
+// the eye) are drawn first by draw_occluders into the frame's target; the depth they leave hides the other near
+// items, whole nodes of the cut whose boxes lie behind it, and the items of nodes drawn as geometry. A hidden node
+// needs no image, no regeneration and no geometry this frame, and the budget is planned without it. Exact for geometry (nothing hidden could draw a pixel); a hidden node's image could only have drawn
 // pixels that its own geometry does not show.
 struct ImageCacheOcclusion {
   const gpu::RenderTarget* target = nullptr;  // the frame's target, into which draw_occluders draws
@@ -133,14 +142,22 @@ class ImageCache {
     double layered_draw_ms = 0.0;  // bound of drawing the layered image (its plan's layers and fill)
     size_t last_used = 0;
     std::optional<size_t> regenerated_in;
-    size_t uses = 0;          // frames the current image was drawn in
-    double last_reuse = 1.0;  // frames the previous image was drawn in after the one it was made in (1 at first)
+    // This frame's items of the node's geometry in fallback_items_ (invalid nodes only): what drawing it as geometry
+    // draws, frustum-culled and, with occlusion culling, without the items behind the occluders.
+    size_t fallback_begin = 0, fallback_end = 0;
+    // How far the eye moved from the capture eye while the current image was still valid, and the same for the
+    // previous image, measured when it became invalid (< 0: no image has become invalid yet). With the eye's speed
+    // it predicts how many frames a new image would serve (ImageCache::expectedReuse).
+    DVec3 capture_eye{0.0};
+    double reach = 0.0;
+    double life = -1.0;
   };
   int build(std::vector<uint32_t> objects, int depth);
   void evict(size_t frame_index);
   bool hasImage(const Node& n) const { return n.image || n.layered; }
   size_t imageBytes(const Node& n) const;
   void dropImage(Node& n);
+  double expectedReuse(const Node& n, const DVec3& eye, double theta) const;
 
   const scene::Scene& scene_;
   const gpu::GpuScene& gpu_scene_;
@@ -149,9 +166,14 @@ class ImageCache {
   std::vector<uint32_t> always_geometry_;
   size_t texture_bytes_ = 0;
   std::optional<size_t> last_frame_;
+  // The eye of the last frame and how far it moved from the frame before (< 0: unknown, at the first frame).
+  DVec3 last_eye_{0.0};
+  double eye_speed_ = -1.0;
   std::vector<gpu::DrawItem> scratch_;
   std::vector<Box3> scratch_bounds_;
   std::vector<gpu::DrawItem> visible_;
+  std::vector<gpu::DrawItem> fallback_items_;
+  std::vector<Box3> fallback_bounds_;
   std::optional<gpu::OcclusionCuller> culler_;
 };
 

@@ -9,7 +9,8 @@
 namespace farfield::runtime {
 
 RegenerationSchedule scheduleRegenerations(std::span<const RegenerationRequest> requests, double base_ms,
-                                           double t_max_ms, int max_regenerations, double invest_ms) {
+                                           double t_max_ms, int max_regenerations, double invest_ms,
+                                           bool pay_back) {
   RegenerationSchedule s;
   s.predicted_ms = base_ms;
   for (const RegenerationRequest& r : requests) s.predicted_ms += r.geometry_ms;
@@ -28,7 +29,9 @@ RegenerationSchedule scheduleRegenerations(std::span<const RegenerationRequest> 
     if (count >= max_regenerations) break;
     const RegenerationRequest& r = requests[i];
     const double delta = r.regenerate_ms + r.image_ms - r.geometry_ms;
-    if (s.lost && (invest_ms <= 0.0 || delta > r.expected_reuse * (r.geometry_ms - r.image_ms))) continue;
+    const bool pays = delta <= r.expected_reuse * (r.geometry_ms - r.image_ms);
+    if (s.lost && (invest_ms <= 0.0 || !pays)) continue;
+    if (pay_back && !pays) continue;
     if (t_max_ms > 0.0 && s.predicted_ms + delta > limit) continue;
     s.predicted_ms += delta;
     chosen[i] = true;

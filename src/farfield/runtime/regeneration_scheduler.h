@@ -16,8 +16,8 @@ struct RegenerationRequest {
   double regenerate_ms = 0.0;  // predicted: rendering the image
   double image_ms = 0.0;       // predicted: drawing the image
   double geometry_ms = 0.0;    // predicted: drawing the node's geometry instead
-  // Frames the new image is expected to be drawn after the one it is made in (a lost frame's investment needs it):
-  // the node's previous image's count, 1 for a first image.
+  // Frames the new image is expected to be drawn after the one it is made in (the pay-back rule below needs it;
+  // runtime/image_cache.h estimates it from the eye's speed).
   double expected_reuse = 1.0;
 };
 
@@ -39,9 +39,14 @@ struct RegenerationSchedule {
 // frame draws the same geometry and is lost too. With invest_ms > 0 such a frame still regenerates, in the same
 // order, the requests that pay for themselves over their expected reuse (regenerate + image - geometry <=
 // expected_reuse x (geometry - image): what the frame pays beyond the geometry, the later frames save), as long as
-// the prediction stays within the all-geometry prediction + invest_ms. An image that was not reused last time
+// the prediction stays within the all-geometry prediction + invest_ms. An image expected to serve no later frame
 // (expected_reuse 0) is never an investment. invest_ms = 0: a lost frame draws every request as geometry.
+//
+// pay_back: every frame, lost or not, takes only the requests that pay for themselves that way; the others are
+// drawn as geometry even where the budget would have room for their regeneration (an image that does not live long
+// enough costs more than the exact geometry it replaces).
 RegenerationSchedule scheduleRegenerations(std::span<const RegenerationRequest> requests, double base_ms,
-                                           double t_max_ms, int max_regenerations, double invest_ms = 0.0);
+                                           double t_max_ms, int max_regenerations, double invest_ms = 0.0,
+                                           bool pay_back = false);
 
 }  // namespace farfield::runtime
