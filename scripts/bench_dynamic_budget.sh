@@ -7,6 +7,8 @@
 # OCCLUSION=off runs the dynamic modes without the image cache's occlusion culling (--mode-option occlusion=off; the
 # outputs get the suffix -occlusion-off), to compare with the default (on). INVEST=0 runs them with
 # --mode-option lost_frame_investment=0 (suffix -invest-0): a frame over t_max whatever it does regenerates nothing.
+# PAY_BACK=off (suffix -pay-back-off): every invalid image that fits t_max is regenerated, paying or not.
+# MODES=all (suffix -all) adds billboard and warp, for the table of every mode against full and culled.
 # Usage: scripts/bench_dynamic_budget.sh FARFIELD OUT [TMAX_MS] [FRAMES] [STRIDE]
 set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
@@ -19,6 +21,13 @@ SUFFIX=""
 [ "$OCCLUSION" = on ] || SUFFIX="-occlusion-$OCCLUSION"
 INVEST=${INVEST:-1}
 [ "$INVEST" = 1 ] || SUFFIX="$SUFFIX-invest-$INVEST"
+PAY_BACK=${PAY_BACK:-on}
+[ "$PAY_BACK" = on ] || SUFFIX="$SUFFIX-pay-back-$PAY_BACK"
+MODES_LIST=culled,dynamic-shade,dynamic-schaufler,layered
+if [ "${MODES:-}" = all ]; then
+  MODES_LIST=culled,billboard,dynamic-shade,dynamic-schaufler,layered,warp
+  SUFFIX="$SUFFIX-all"
+fi
 mkdir -p "$OUT"
 [ -f "$OUT/city_trees.glb" ] || "$FARFIELD" gen city --trees -o "$OUT/city_trees.glb" > "$OUT/gen_city.txt"
 [ -f "$OUT/drive2.json" ] || "$FARFIELD" path street "$OUT/city_trees.streets.json" --car --frames 400 --seed 2 \
@@ -34,9 +43,9 @@ for run in "city city_trees.glb drive2.json" "forest forest5.glb fly5.json"; do
     --layered-error-px 2 > "$OUT/calibrate-$name.txt" 2>&1
   run_dir=$OUT/bench-$name-t$TMAX$SUFFIX
   [ -f "$run_dir/bench.json" ] && continue
-  "$FARFIELD" bench "$scene" --path "$path" --modes culled,dynamic-shade,dynamic-schaufler,layered --reference \
+  "$FARFIELD" bench "$scene" --path "$path" --modes "$MODES_LIST" --reference \
     --repeats 3 --tmax "$TMAX" --frames "$FRAMES" --stride "$STRIDE" --mode-option error_px=2 \
     --mode-option t_max_ms="$TMAX" --mode-option profile="$OUT/profile-$name.json" --mode-option occlusion="$OCCLUSION" \
-    --mode-option lost_frame_investment="$INVEST" \
+    --mode-option lost_frame_investment="$INVEST" --mode-option pay_back="$PAY_BACK" \
     -o "$run_dir" > "$run_dir.txt" 2>&1
 done
