@@ -56,6 +56,7 @@ BillboardMode::BillboardMode(const ModeContext& context) {
   options_.views = intOption(context, "billboard_views", 8, 1, 64);
   options_.texels = intOption(context, "billboard_texels", 32, 4, 2048);
   options_.elevation = options_.kind == impostor::BillboardKind::Spherical ? 0.15 : 0.0;
+  if (switchOption(context, "occlusion", true)) occlusion_.emplace(occluderShareOption(context, name()));
 }
 
 void BillboardMode::prepare(const ModeContext& context) {
@@ -91,7 +92,14 @@ void BillboardMode::frame(FrameContext& frame) {
     if (b && batch_->shape(b - 1).errorAngle(cam.eye) <= theta) boards_.push_back(b - 1);
     else geometry_.push_back(id);
   }
-  if (!geometry_.empty()) gpu_scene_->appendDrawItems(geometry_, frame.items(), cam);
+  if (!geometry_.empty() && occlusion_) {
+    candidates_.clear();
+    bounds_.clear();
+    gpu_scene_->appendDrawItems(geometry_, candidates_, cam, &bounds_);
+    occlusion_->run(frame, candidates_, bounds_);
+  } else if (!geometry_.empty()) {
+    gpu_scene_->appendDrawItems(geometry_, frame.items(), cam);
+  }
   const size_t bytes = boards_.empty() ? 0 : batch_->build(boards_, cam.eye, frame.items());
   ++frames_;
   billboards_drawn_ += boards_.size();
@@ -101,7 +109,8 @@ void BillboardMode::frame(FrameContext& frame) {
 
 std::map<std::string, double> BillboardMode::info() const {
   const double f = double(std::max<size_t>(frames_, 1));
-  return {{"error_bound_px", error_px_},
+  std::map<std::string, double> out = occlusion_ ? occlusion_->info() : std::map<std::string, double>{};
+  out.merge(std::map<std::string, double>{{"error_bound_px", error_px_},
           {"billboards", double(tree_ids_.size())},
           {"views", double(options_.views)},
           {"texels", double(options_.texels)},
@@ -110,7 +119,8 @@ std::map<std::string, double> BillboardMode::info() const {
           {"geometry_objects_per_frame", double(trees_as_geometry_) / f},
           {"uploaded_bytes_per_frame", double(uploaded_bytes_) / f},
           {"regenerations_per_frame", 0.0},
-          {"prepare_s", prepare_s_}};
+          {"prepare_s", prepare_s_}});
+  return out;
 }
 
 // ---- dynamic-shade / dynamic-schaufler ----

@@ -19,7 +19,8 @@
 //   profile=FILE      (dynamic-*, layered) a cost profile of this machine (farfield calibrate over the path's view
 //                     space): its model, safety factor and layered terms predict the frame; default: a quick fit here
 //   occlusion=on|off  (dynamic-*, layered) the cache's near geometry occlusion-culled against the depth of its nearest
-//                     items, and nodes hidden behind that depth skipped: no image, no regeneration (default on)
+//                     items, and nodes hidden behind that depth skipped: no image, no regeneration (default on);
+//                     billboard: its geometry (what is not a billboard) occlusion-culled as the culled mode's
 //   occluder_share=S  the nearest near items drawn first as occluders hold this share of the triangles of the near
 //                     geometry and the cut's nodes (default 0.1)
 //   warp_interval=N   (warp) a keyframe of culled geometry every N path frames (default 4)
@@ -37,6 +38,7 @@
 #include "farfield/impostor/billboard.h"
 #include "farfield/impostor/dynamic.h"
 #include "farfield/impostor/warp.h"
+#include "farfield/eval/occlusion_pass.h"
 #include "farfield/runtime/image_cache.h"
 
 namespace farfield::eval {
@@ -61,6 +63,9 @@ class BillboardMode final : public Mode {
   std::vector<uint32_t> tree_ids_;
   std::unique_ptr<impostor::BillboardBatch> batch_;
   std::vector<uint32_t> visible_, geometry_, boards_;
+  std::optional<OcclusionPass> occlusion_;  // the geometry occlusion-culled (--mode-option occlusion=on)
+  std::vector<gpu::DrawItem> candidates_;
+  std::vector<Box3> bounds_;
   double prepare_s_ = 0.0;
   size_t frames_ = 0, billboards_drawn_ = 0, trees_as_geometry_ = 0, uploaded_bytes_ = 0;
 };
