@@ -1,4 +1,5 @@
-// farfield gen city --blocks N --seed S [--detail D] [--hill] [--objects blocks|buildings] [--trees] -o city.glb
+// farfield gen city --blocks N --seed S [--detail D] [--hill | --terrain DEM|fractal:... [--terrain-scale S]]
+//                   [--objects blocks|buildings] [--trees] -o city.glb
 // farfield gen forest [--size M] [--trees N] [--leaves L] [--seed S] -o forest.glb
 // Generates a procedural city (farfield/gen/city.h), writes it as binary glTF and its street graph as
 // city.streets.json next to it, and prints what was made and what it cost.
@@ -8,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "city_terrain.h"
 #include "cli_util.h"
 #include "command.h"
 #include "farfield/core/error.h"
@@ -24,6 +26,8 @@ struct CityArgs {
   uint64_t seed = 1;
   int detail = 1;
   bool hill = false;
+  std::string terrain;
+  float terrain_scale = 1.0f;
   std::string objects = "blocks";
   bool trees = false;
   float park_share = 0.1f;
@@ -52,6 +56,7 @@ void runCity(const CityArgs& args) {
   options.trees = args.trees;
   options.park_share = args.park_share;
   options.tree_leaves = args.tree_leaves;
+  if (!args.terrain.empty()) std::printf("terrain:    %s\n", setCityTerrain(options, args.terrain, args.terrain_scale).c_str());
 
   Stopwatch clock;
   const gen::City city = gen::generateCity(options);
@@ -113,6 +118,11 @@ const RegisterCommand reg("gen", [](CLI::App& app) {
   c->add_option("--detail", city->detail, "Facade detail 0..4 (0 plain, 1 ledges, 2 windows, 3 balconies, 4 dense)")
       ->check(CLI::Range(0, 4));
   c->add_flag("--hill", city->hill, "A hill in the middle of the city");
+  c->add_option("--terrain", city->terrain,
+                "The city on a terrain: a DEM file or fractal:SIZE[:SEED][:relief=M][:roughness=R][:cell=M], "
+                "its centre under the city's")
+      ->excludes("--hill");
+  c->add_option("--terrain-scale", city->terrain_scale, "With --terrain: vertical scale of its heights (default 1)");
   c->add_option("--objects", city->objects, "One object per block (blocks) or per building (buildings)")
       ->check(CLI::IsMember({"blocks", "buildings"}));
   c->add_option("-o,--output", city->output, "Output scene (.glb); the street graph goes next to it")->required();

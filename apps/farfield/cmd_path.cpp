@@ -1,4 +1,5 @@
-// farfield path street STREETS.json [--frames N] [--seed S] [--car] [--fps F] [--fov DEG] [--turn-radius M] -o FILE
+// farfield path street STREETS.json [--frames N] [--seed S] [--car] [--fps F] [--fov DEG] [--turn-radius M]
+//                     [--hill | --terrain SPEC [--terrain-scale S]] -o FILE
 // farfield path flyover SCENE [--frames N] [--fps F] [--altitude M] [--fov DEG] -o FILE
 // farfield path views SCENE [--frames N] [--seed S] [--view-min X,Y,Z --view-max X,Y,Z] [--fov DEG] -o FILE
 // farfield path orbit SCENE [--frames N] [--fps F] [--radius-scale K] [--elevation DEG] [--fov DEG] -o FILE
@@ -7,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "city_terrain.h"
 #include "cli_util.h"
 #include "command.h"
 #include "farfield/bake/place.h"
@@ -27,6 +29,8 @@ struct PathArgs {
   uint64_t seed = 1;
   bool car = false;
   bool hill = false;
+  std::string terrain;
+  float terrain_scale = 1.0f;
   float fps = 30.0f;
   float fov_deg = 0.0f;  // 0: the default of each kind
   float turn_radius = 6.0f;
@@ -59,6 +63,11 @@ void runStreet(const PathArgs& args) {
     // The streets file keeps only the plan; the ground of a `gen city --hill` city is a function of its bounds.
     gen::CityOptions city;
     city.hill = true;
+    const Box2 bounds = graph.bounds();
+    options.ground_height = [city, bounds](float x, float y) { return gen::cityGroundHeight(city, bounds, {x, y}); };
+  } else if (!args.terrain.empty()) {
+    gen::CityOptions city;  // the ground of `gen city --terrain` with the same spec and scale
+    setCityTerrain(city, args.terrain, args.terrain_scale);
     const Box2 bounds = graph.bounds();
     options.ground_height = [city, bounds](float x, float y) { return gen::cityGroundHeight(city, bounds, {x, y}); };
   }
@@ -127,6 +136,9 @@ const RegisterCommand reg("path", [](CLI::App& app) {
   addCommon(s, *street);
   s->add_option("--seed", street->seed, "Random seed for the walk");
   s->add_flag("--hill", street->hill, "The city was made with `gen city --hill`: follow its ground");
+  s->add_option("--terrain", street->terrain, "The city was made with `gen city --terrain SPEC`: follow its ground")
+      ->excludes("--hill");
+  s->add_option("--terrain-scale", street->terrain_scale, "With --terrain: the city's --terrain-scale");
   s->add_flag("--car", street->car, "Drive (1.2 m eye height, 10 m/s) instead of walking (1.7 m, 1.4 m/s)");
   s->add_option("--turn-radius", street->turn_radius, "Turn radius at junctions, metres")
       ->check(CLI::NonNegativeNumber);

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <map>
 
@@ -200,6 +201,26 @@ TEST(City, OptionsOutOfRangeThrow) {
   }
 }
 
+// The ground mesh stays within 0.3 m of the ground's function between its vertices (triangle centroids), and every
+// building reaches below the ground under each footprint corner and rises above it.
+void expectStandingOnTheGround(const City& city, const CityOptions& options) {
+  const scene::Mesh& ground = city.scene.meshes[city.scene.objects[0].parts[0].mesh];
+  for (size_t t = 0; t < ground.triangleCount(); ++t) {
+    const Vec3 c = (ground.positions[ground.indices[3 * t]] + ground.positions[ground.indices[3 * t + 1]] +
+                    ground.positions[ground.indices[3 * t + 2]]) /
+                   3.0f;
+    EXPECT_NEAR(c.z, cityGroundHeight(options, city.bounds, Vec2(c)), 0.3f);
+  }
+  for (size_t i = 1; i < city.scene.objects.size(); ++i) {
+    const scene::Object& o = city.scene.objects[i];
+    for (const Vec2& v : o.footprint) {
+      const float g = cityGroundHeight(options, city.bounds, v);
+      EXPECT_LE(o.world_bounds.lo.z, g) << o.name;
+      EXPECT_GT(o.world_bounds.hi.z, g + 2.0f) << o.name;
+    }
+  }
+}
+
 TEST(City, HillRaisesGroundAndBuildingsStandInIt) {
   const City& city = hillCity();
   CityOptions options = small(30, 2, 0, true);
@@ -216,22 +237,28 @@ TEST(City, HillRaisesGroundAndBuildingsStandInIt) {
     zmax = std::max(zmax, p.z);
   }
   EXPECT_GT(zmax, 0.95f * top);
-  // Between the ground's vertices the mesh stays within 0.3 m of the function: sample triangle centroids.
-  for (size_t t = 0; t < ground.triangleCount(); ++t) {
-    const Vec3 c = (ground.positions[ground.indices[3 * t]] + ground.positions[ground.indices[3 * t + 1]] +
-                    ground.positions[ground.indices[3 * t + 2]]) /
-                   3.0f;
-    EXPECT_NEAR(c.z, cityGroundHeight(options, city.bounds, Vec2(c)), 0.3f);
-  }
-  // Every building reaches below the ground under each footprint corner and rises above it.
-  for (size_t i = 1; i < city.scene.objects.size(); ++i) {
-    const scene::Object& o = city.scene.objects[i];
-    for (const Vec2& v : o.footprint) {
-      const float g = cityGroundHeight(options, city.bounds, v);
-      EXPECT_LE(o.world_bounds.lo.z, g) << o.name;
-      EXPECT_GT(o.world_bounds.hi.z, g + 2.0f) << o.name;
-    }
-  }
+  expectStandingOnTheGround(city, options);
+}
+
+// Any ground (a terrain, gen city --terrain): the same promises for a tilted, rolling function, given relative to
+// the centre of the city's bounds; a hill and a ground together, or a bad cell, are errors.
+TEST(City, BuildingsStandOnAGivenGround) {
+  CityOptions options = small(30, 2, 0, false, ObjectGrouping::Buildings);
+  options.ground = [](Vec2 p) { return 0.04f * p.x + 6.0f * std::sin(p.y / 50.0f); };
+  options.ground_cell = 5.0f;
+  const City city = generateCity(options);
+  EXPECT_EQ(cityGroundHeight(options, city.bounds, city.bounds.center()), 0.0f);
+  EXPECT_NEAR(cityGroundHeight(options, city.bounds, city.bounds.center() + Vec2(100.0f, 0.0f)), 4.0f, 1e-4f);
+  const scene::Mesh& ground = city.scene.meshes[city.scene.objects[0].parts[0].mesh];
+  for (const Vec3& p : ground.positions) EXPECT_NEAR(p.z, cityGroundHeight(options, city.bounds, Vec2(p)), 1e-3f);
+  EXPECT_GT(ground.positions.size(), 1000u);  // cells of about 5 m, not the flat ground's two triangles
+  expectStandingOnTheGround(city, options);
+
+  CityOptions both = options;
+  both.hill = true;
+  EXPECT_THROW(generateCity(both), Error);
+  options.ground_cell = 0.0f;
+  EXPECT_THROW(generateCity(options), Error);
 }
 
 TEST(City, StreetsPathNextToTheGlb) {

@@ -64,7 +64,37 @@ Vec3 hillNormal(const Hill& h, const Vec2& p) {
   return glm::normalize(Vec3(-g.x, -g.y, 1.0f));
 }
 
+// The ground under the city: flat, the hill, or CityOptions::ground.
+class Ground {
+ public:
+  Ground(const CityOptions& o, const Box2& bounds)
+      : hill_(hillFor(bounds)), with_hill_(o.hill), fn_(o.ground ? &o.ground : nullptr), centre_(bounds.center()) {}
+  bool flat() const { return !with_hill_ && !fn_; }
+  bool custom() const { return fn_ != nullptr; }
+  const Hill& hill() const { return hill_; }
+  float height(Vec2 p) const {
+    if (fn_) return (*fn_)(p - centre_);
+    return with_hill_ ? hillHeight(hill_, p) : 0.0f;
+  }
+  Vec3 normal(Vec2 p) const {
+    if (!fn_) return with_hill_ ? hillNormal(hill_, p) : Vec3(0.0f, 0.0f, 1.0f);
+    const float h = 0.5f;  // central differences over a metre
+    const float dx = (height(p + Vec2(h, 0.0f)) - height(p - Vec2(h, 0.0f))) / (2.0f * h);
+    const float dy = (height(p + Vec2(0.0f, h)) - height(p - Vec2(0.0f, h))) / (2.0f * h);
+    return glm::normalize(Vec3(-dx, -dy, 1.0f));
+  }
+
+ private:
+  Hill hill_;
+  bool with_hill_;
+  const std::function<float(Vec2)>* fn_;
+  Vec2 centre_;
+};
+
 void validate(const CityOptions& o) {
+  if (o.hill && o.ground) throw Error("city options", "a hill and a ground (terrain) exclude each other");
+  if (o.ground && !(o.ground_cell >= 0.5f && std::isfinite(o.ground_cell)))
+    throw Error("city options", "ground cell must be a finite number >= 0.5 m");
   if (o.blocks < kMinBlocks || o.blocks > kMaxBlocks)
     throw Error("city options", "blocks must be in [" + std::to_string(kMinBlocks) + ", " + std::to_string(kMaxBlocks) +
                                     "], got " + std::to_string(o.blocks));
@@ -80,11 +110,18 @@ void validate(const CityOptions& o) {
 }
 
 // The ground: one grid over the ground rectangle whose lines are the rectangle's edges plus, with a hill, a
-// regular grid over the hill's square (cells about radius / 24). One tensor grid keeps every vertex shared, so
-// the flat part and the hill meet without T-junctions.
-scene::Mesh groundMesh(const Box2& ground, const Hill& hill, bool with_hill) {
+// regular grid over the hill's square (cells about radius / 24), or with a ground function a regular grid over the
+// whole rectangle (cells of ground_cell, at most 1024 a side). One tensor grid keeps every vertex shared, so the
+// flat part and the hill meet without T-junctions.
+scene::Mesh groundMesh(const Box2& ground, const Ground& g, float cell) {
   std::vector<float> xs{ground.lo.x}, ys{ground.lo.y};
-  if (with_hill && hill.radius > 0.0f) {
+  const Hill& hill = g.hill();
+  if (g.custom()) {
+    const Vec2 e = ground.extent();
+    const int nx = std::clamp(int(std::ceil(e.x / cell)), 1, 1024), ny = std::clamp(int(std::ceil(e.y / cell)), 1, 1024);
+    for (int i = 1; i < nx; ++i) xs.push_back(ground.lo.x + e.x * float(i) / float(nx));
+    for (int j = 1; j < ny; ++j) ys.push_back(ground.lo.y + e.y * float(j) / float(ny));
+  } else if (!g.flat() && hill.radius > 0.0f) {
     const int cells = 48;
     for (int i = 0; i <= cells; ++i) {
       const float t = -1.0f + 2.0f * float(i) / float(cells);
@@ -103,9 +140,8 @@ scene::Mesh groundMesh(const Box2& ground, const Hill& hill, bool with_hill) {
   for (size_t j = 0; j < ny; ++j)
     for (size_t i = 0; i < nx; ++i) {
       const Vec2 p(xs[i], ys[j]);
-      const float z = with_hill ? hillHeight(hill, p) : 0.0f;
-      m.positions.push_back(Vec3(p, z));
-      m.normals.push_back(with_hill ? hillNormal(hill, p) : Vec3(0.0f, 0.0f, 1.0f));
+      m.positions.push_back(Vec3(p, g.height(p)));
+      m.normals.push_back(g.normal(p));
       // Relative to the ground's corner: uvs stay small numbers (precise) across a city of 20 km.
       m.uvs.push_back(Vec2((p.x - ground.lo.x) / kGroundTile, -(p.y - ground.lo.y) / kGroundTile));
     }
@@ -150,7 +186,7 @@ struct BlockJob {
   bool park = false;                 // trees instead of buildings (CityOptions::trees)
 };
 
-void buildBlock(const CityOptions& options, const Hill& hill, const BlockJob& job, BlockResult& result,
+void buildBlock(const CityOptions& options, const Ground& ground, const BlockJob& job, BlockResult& result,
                 BuildingMeshes& scratch) {
   const uint64_t seed = mixSeed(options.seed, job.face);
   Rng rng(mixSeed(seed, 0xb10c));
@@ -168,13 +204,13 @@ void buildBlock(const CityOptions& options, const Hill& hill, const BlockJob& jo
     buildings = std::move(layout.buildings);
   }
   for (Building& b : buildings) {
-    if (!options.hill) continue;
+    if (ground.flat()) continue;
     // Stand on the lowest ground under the footprint (corners and edge midpoints), reaching a little below it,
     // and keep the building's height above the highest ground: on a slope it gains the floors it sinks by.
-    float lowest = hillHeight(hill, b.footprint[0]), highest = lowest;
+    float lowest = ground.height(b.footprint[0]), highest = lowest;
     for (size_t i = 0; i < b.footprint.size(); ++i) {
       const Vec2 a = b.footprint[i], c = b.footprint[(i + 1) % b.footprint.size()];
-      for (float h : {hillHeight(hill, a), hillHeight(hill, 0.5f * (a + c))}) {
+      for (float h : {ground.height(a), ground.height(0.5f * (a + c))}) {
         lowest = std::min(lowest, h);
         highest = std::max(highest, h);
       }
@@ -265,6 +301,7 @@ std::vector<std::pair<size_t, Building>> chooseLandmarks(const std::vector<Block
 }  // namespace
 
 float cityGroundHeight(const CityOptions& options, const Box2& city_bounds, Vec2 p) {
+  if (options.ground) return options.ground(p - city_bounds.center());
   if (!options.hill) return 0.0f;
   return hillHeight(hillFor(city_bounds), p);
 }
@@ -280,12 +317,12 @@ std::string streetsPathFor(const std::string& glb_path) {
 }
 
 // Street trees along every buildable block and scattered trees in the park blocks, after the blocks' objects.
-static void addCityTrees(const CityOptions& options, const Hill& hill, const std::vector<BlockFootprint>& blocks,
+static void addCityTrees(const CityOptions& options, const Ground& g, const std::vector<BlockFootprint>& blocks,
                   const std::vector<BlockJob>& jobs, City& city) {
   const VegetationMaterials materials = addVegetationMaterials(city.scene);
   TreeOptions tree;
   tree.leaves = options.tree_leaves;
-  auto ground = [&](Vec2 p) { return options.hill ? hillHeight(hill, p) : 0.0f; };
+  auto ground = [&](Vec2 p) { return g.height(p); };
   for (size_t i = 0; i < blocks.size(); ++i) {
     std::vector<Vec2> sites = streetTreeSites(std::span(&blocks[i].footprint, 1), options.tree_spacing, 2.0f);
     if (jobs[i].park) {
@@ -310,7 +347,7 @@ City generateCity(const CityOptions& options) {
   net.seed = options.seed;
   city.streets = generateStreetNetwork(net);
   city.bounds = city.streets.bounds();
-  const Hill hill = hillFor(city.bounds);
+  const Ground terrain(options, city.bounds);
 
   const std::vector<BlockFootprint> blocks = buildableBlocks(city.streets);
   city.skipped_blocks = city.streets.blockCount() - std::min(city.streets.blockCount(), blocks.size());
@@ -342,7 +379,7 @@ City generateCity(const CityOptions& options) {
   auto work = [&]() {
     BuildingMeshes scratch;
     for (size_t i = next.fetch_add(1); i < jobs.size(); i = next.fetch_add(1)) {
-      buildBlock(options, hill, jobs[i], results[i], scratch);
+      buildBlock(options, terrain, jobs[i], results[i], scratch);
       if (progress) progress->advance();
     }
   };
@@ -371,7 +408,7 @@ City generateCity(const CityOptions& options) {
   {
     scene::Object o;
     o.name = "ground";
-    o.parts.push_back({scene.addMesh(groundMesh(ground, hill, options.hill)), ground_material});
+    o.parts.push_back({scene.addMesh(groundMesh(ground, terrain, options.ground_cell)), ground_material});
     o.footprint = {ground.lo, Vec2(ground.hi.x, ground.lo.y), ground.hi, Vec2(ground.lo.x, ground.hi.y)};
     scene.addObject(std::move(o));
     city.object_block.push_back(-1);
@@ -405,7 +442,7 @@ City generateCity(const CityOptions& options) {
     r.objects.clear();
     r.objects.shrink_to_fit();
   }
-  if (options.trees) addCityTrees(options, hill, blocks, jobs, city);
+  if (options.trees) addCityTrees(options, terrain, blocks, jobs, city);
   return city;
 }
 

@@ -1,8 +1,10 @@
 // Procedural city: a planar street graph whose faces are blocks, buildings filling each block from its footprint
-// inward (extruded footprints with facade detail as real geometry), a few landmarks, an optional hill.
+// inward (extruded footprints with facade detail as real geometry), a few landmarks, an optional hill or any ground
+// (a terrain) under it all.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "farfield/scene/scene.h"
@@ -17,6 +19,11 @@ struct CityOptions {
   uint64_t seed = 1;
   int detail = 1;            // facade detail level 0..4: 0 = plain boxes, higher = windows, ledges, balconies
   bool hill = false;         // a hill in the middle of the city (as Montmartre), so panoramic views open up
+  // Any ground instead (a terrain: a DEM or a fractal, apps' `gen city --terrain`): the height (metres) at a point
+  // given relative to the centre of the street graph's bounds. Called from several threads at once (it must only
+  // read). Not with `hill`. The ground mesh samples it every ground_cell metres (at most 1024 cells a side).
+  std::function<float(Vec2)> ground;
+  float ground_cell = 10.0f;
   ObjectGrouping objects = ObjectGrouping::Blocks;
   // Vegetation (gen/vegetation.h), off by default so the figures of cities without it stay valid: street trees
   // every tree_spacing metres along the blocks (on the street's margin) and park_share of the blocks (not landmarks)
@@ -49,8 +56,8 @@ struct City {
 City generateCity(const CityOptions& options);
 
 // Height of the ground (z, metres) at p for a city generated with `options`, whose street graph has the 2D bounds
-// `city_bounds` (StreetGraph::bounds()). 0 everywhere without a hill; with one, a smooth bump (raised cosine)
-// centred on the bounds. Camera paths use it to follow the ground; the ground mesh is a tessellation of it (within
+// `city_bounds` (StreetGraph::bounds()). 0 everywhere without a hill or a ground; with a hill, a smooth bump (raised
+// cosine) centred on the bounds; with a ground, that function at p - the bounds' centre. Camera paths use it to follow the ground; the ground mesh is a tessellation of it (within
 // about 0.2 m) and buildings stand on it (their walls reach 1 m below the lowest ground under their footprint).
 float cityGroundHeight(const CityOptions& options, const Box2& city_bounds, Vec2 p);
 
