@@ -15,14 +15,19 @@
 namespace farfield::eval {
 namespace {
 
-TEST(DynamicModesGl, RunOnAForestCloseToTheFullFrames) {
-  registerImpostorModes();
+// An 80 m forest of small trees (60 leaf triangles each).
+scene::Scene smallForest(int trees, uint64_t seed) {
   gen::ForestOptions fo;
   fo.size = 80.0f;
-  fo.trees = 30;
+  fo.trees = trees;
   fo.tree.leaves = 60;
-  fo.seed = 4;
-  const scene::Scene forest = gen::generateForest(fo);
+  fo.seed = seed;
+  return gen::generateForest(fo);
+}
+
+TEST(DynamicModesGl, RunOnAForestCloseToTheFullFrames) {
+  registerImpostorModes();
+  const scene::Scene forest = smallForest(30, 4);
   gpu::sharedHeadlessContext().makeCurrent();
   ModeRunResources run(forest, 160, 96, {{"error_px", "4"}, {"warp_interval", "3"}, {"audit", "50"}});
   FrameRunner runner(run.renderer, run.target);
@@ -61,12 +66,7 @@ TEST(DynamicModesGl, RunOnAForestCloseToTheFullFrames) {
 // drawn without it, from eyes among the trees where near trunks and crowns hide others.
 TEST(DynamicModesGl, BillboardOcclusionCullingLeavesTheFrameAsItWas) {
   registerImpostorModes();
-  gen::ForestOptions fo;
-  fo.size = 80.0f;
-  fo.trees = 60;
-  fo.tree.leaves = 60;
-  fo.seed = 6;
-  const scene::Scene forest = gen::generateForest(fo);
+  const scene::Scene forest = smallForest(60, 6);
   gpu::sharedHeadlessContext().makeCurrent();
   ModeRunResources on(forest, 160, 96, {{"error_px", "2"}});
   ModeRunResources off(forest, 160, 96, {{"error_px", "2"}, {"occlusion", "off"}});

@@ -53,16 +53,22 @@ Camera behindWallCamera() {
   return cam;
 }
 
+// An eye outside the grid's corner, looking at its middle.
+Camera gridCamera(int width, int height) {
+  Camera cam;
+  cam.eye = Vec3(-120, -140, 40);
+  cam.at = Vec3(35, 35, 0);
+  cam.width = width;
+  cam.height = height;
+  return cam;
+}
+
 TEST(ImageCacheGl, ReusesRegeneratesAndFallsBackUnderTheBudget) {
   gpu::sharedHeadlessContext();
   const scene::Scene s = grid();
   const gpu::GpuScene gs(s);
   gpu::Renderer renderer;
-  Camera cam;
-  cam.eye = Vec3(-120, -140, 40);
-  cam.at = Vec3(35, 35, 0);
-  cam.width = 320;
-  cam.height = 180;
+  const Camera cam = gridCamera(320, 180);
   ImageCacheOptions o;
   o.metric = impostor::ValidityMetric::Shade;
   o.error_px = 1.0;
@@ -136,11 +142,7 @@ TEST(ImageCacheGl, ImagesAreMadeWhenTheyPayOverTheFramesTheEyeLeavesThemValid) {
   const scene::Scene s = grid();
   const gpu::GpuScene gs(s);
   gpu::Renderer renderer;
-  Camera a;
-  a.eye = Vec3(-120, -140, 40);
-  a.at = Vec3(35, 35, 0);
-  a.width = 320;
-  a.height = 180;
+  const Camera a = gridCamera(320, 180);
   Camera still = a, far = a;
   still.eye += Vec3(0.01f, 0.0f, 0.0f);
   far.eye += Vec3(60.0f, -60.0f, 0.0f);
@@ -177,11 +179,7 @@ TEST(ImageCacheGl, LayeredRegenerationsKeepTheCalibratedBudget) {
   const scene::Scene s = grid();
   const gpu::GpuScene gs(s);
   gpu::Renderer renderer;
-  Camera cam;
-  cam.eye = Vec3(-120, -140, 40);
-  cam.at = Vec3(35, 35, 0);
-  cam.width = 160;
-  cam.height = 90;
+  const Camera cam = gridCamera(160, 90);
   ImageCacheOptions o;
   o.kind = CachedImageKind::Layered;
   o.error_px = 2.0;

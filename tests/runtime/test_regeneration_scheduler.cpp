@@ -12,6 +12,19 @@
 namespace farfield::runtime {
 namespace {
 
+// Brute-force replay helpers: requests in decreasing error ratio (stable), and the pay-back rule written out.
+std::vector<size_t> mostInvalidFirst(const std::vector<RegenerationRequest>& req) {
+  std::vector<size_t> order(req.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return req[a].error_ratio > req[b].error_ratio; });
+  return order;
+}
+
+bool paysBack(const RegenerationRequest& r) {
+  return r.regenerate_ms + r.image_ms - r.geometry_ms <= r.expected_reuse * (r.geometry_ms - r.image_ms);
+}
+
 TEST(RegenerationScheduler, MostInvalidFirstUnderTheBudget) {
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -37,10 +50,7 @@ TEST(RegenerationScheduler, MostInvalidFirstUnderTheBudget) {
     EXPECT_NEAR(s.predicted_ms, predicted, 1e-9);
     EXPECT_LE(s.predicted_ms, t_max + 1e-9);
     // Replay in priority order: a skipped request did not fit at its turn (or the cap was reached).
-    std::vector<size_t> order(req.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](size_t a, size_t b) { return req[a].error_ratio > req[b].error_ratio; });
+    const std::vector<size_t> order = mostInvalidFirst(req);
     double running = all_geometry;
     size_t next = 0;
     for (const size_t i : order) {
@@ -95,15 +105,12 @@ TEST(RegenerationScheduler, ALostFrameInvestsInImagesThatPayBackOverTheirReuse) 
     const RegenerationSchedule s = scheduleRegenerations(req, base, t_max, 100, invest);
     EXPECT_TRUE(s.lost);
     EXPECT_LE(s.predicted_ms, all_geometry + invest + 1e-9);
-    std::vector<size_t> order(req.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](size_t a, size_t b) { return req[a].error_ratio > req[b].error_ratio; });
+    const std::vector<size_t> order = mostInvalidFirst(req);
     std::vector<uint32_t> want;
     double running = all_geometry;
     for (const size_t i : order) {
       const double delta = req[i].regenerate_ms + req[i].image_ms - req[i].geometry_ms;
-      const bool pays = delta <= req[i].expected_reuse * (req[i].geometry_ms - req[i].image_ms);
+      const bool pays = paysBack(req[i]);
       EXPECT_FALSE(req[i].expected_reuse == 0.0 && std::count(s.regenerate.begin(), s.regenerate.end(), req[i].node))
           << "an image that was not reused is no investment";
       refused_payback += !pays;
@@ -150,15 +157,12 @@ TEST(RegenerationScheduler, PayBackTakesOnlyImagesThatPayForThemselves) {
     const double t_max = all_geometry * (1.0 + 2 * u(rng));  // not lost
     const RegenerationSchedule s = scheduleRegenerations(req, base, t_max, 100, 1.0, true);
     EXPECT_FALSE(s.lost);
-    std::vector<size_t> order(req.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](size_t a, size_t b) { return req[a].error_ratio > req[b].error_ratio; });
+    const std::vector<size_t> order = mostInvalidFirst(req);
     std::vector<uint32_t> want;
     double running = all_geometry;
     for (const size_t i : order) {
       const double delta = req[i].regenerate_ms + req[i].image_ms - req[i].geometry_ms;
-      if (delta > req[i].expected_reuse * (req[i].geometry_ms - req[i].image_ms)) {
+      if (!paysBack(req[i])) {
         ++refused;
         continue;
       }
