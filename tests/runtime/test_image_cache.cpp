@@ -275,8 +275,9 @@ TEST(ImageCacheGl, OcclusionSkipsNodesHiddenBehindNearGeometry) {
   EXPECT_GT(open.regenerations, 0u);
 }
 
-// Nodes drawn as geometry (no regeneration allowed) behind the wall, large nodes that reach out beside it: occlusion culling drops its items behind the wall, the frame is pixel-identical to the one
-// drawn without it (an exact cull), it draws fewer triangles, and the prediction counts only what is drawn.
+// Nodes drawn as geometry (no regeneration allowed) behind the wall, large nodes that reach out beside it:
+// occlusion culling drops their items behind the wall, the frame is pixel-identical to the one drawn without it (an
+// exact cull), it draws fewer triangles, and the prediction counts only what is drawn.
 TEST(ImageCacheGl, NodesDrawnAsGeometryCostOnlyWhatTheOccludersLeave) {
   gpu::sharedHeadlessContext();
   const scene::Scene s = gridBehindWall();
