@@ -9,8 +9,8 @@
 
 namespace farfield::app {
 
-// Sets options.ground and options.ground_cell (the terrain's cell size) from the terrain `spec`, and returns a line
-// describing the terrain. Throws farfield::Error for a bad spec or file, or a scale that is not a finite number > 0.
+// Sets options.ground and options.ground_cell (half the terrain's cell size) from the terrain `spec`, and returns a
+// line describing the terrain. Throws farfield::Error for a bad spec or file, or a scale that is not a finite number > 0.
 std::string setCityTerrain(gen::CityOptions& options, const std::string& spec, float vertical_scale);
 
 }  // namespace farfield::app

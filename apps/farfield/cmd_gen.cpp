@@ -56,7 +56,8 @@ void runCity(const CityArgs& args) {
   options.trees = args.trees;
   options.park_share = args.park_share;
   options.tree_leaves = args.tree_leaves;
-  if (!args.terrain.empty()) std::printf("terrain:    %s\n", setCityTerrain(options, args.terrain, args.terrain_scale).c_str());
+  if (!args.terrain.empty())
+    std::printf("terrain:    %s\n", setCityTerrain(options, args.terrain, args.terrain_scale).c_str());
 
   Stopwatch clock;
   const gen::City city = gen::generateCity(options);

@@ -118,7 +118,8 @@ scene::Mesh groundMesh(const Box2& ground, const Ground& g, float cell) {
   const Hill& hill = g.hill();
   if (g.custom()) {
     const Vec2 e = ground.extent();
-    const int nx = std::clamp(int(std::ceil(e.x / cell)), 1, 1024), ny = std::clamp(int(std::ceil(e.y / cell)), 1, 1024);
+    const int nx = std::clamp(int(std::ceil(e.x / cell)), 1, 1024);
+    const int ny = std::clamp(int(std::ceil(e.y / cell)), 1, 1024);
     for (int i = 1; i < nx; ++i) xs.push_back(ground.lo.x + e.x * float(i) / float(nx));
     for (int j = 1; j < ny; ++j) ys.push_back(ground.lo.y + e.y * float(j) / float(ny));
   } else if (!g.flat() && hill.radius > 0.0f) {

@@ -57,8 +57,9 @@ City generateCity(const CityOptions& options);
 
 // Height of the ground (z, metres) at p for a city generated with `options`, whose street graph has the 2D bounds
 // `city_bounds` (StreetGraph::bounds()). 0 everywhere without a hill or a ground; with a hill, a smooth bump (raised
-// cosine) centred on the bounds; with a ground, that function at p - the bounds' centre. Camera paths use it to follow the ground; the ground mesh is a tessellation of it (within
-// about 0.2 m) and buildings stand on it (their walls reach 1 m below the lowest ground under their footprint).
+// cosine) centred on the bounds; with a ground, that function at p - the bounds' centre. Camera paths use it to
+// follow the ground; the ground mesh is a tessellation of it (within about 0.2 m for the hill) and buildings stand on
+// it (their walls reach 1 m below the lowest ground under their footprint).
 float cityGroundHeight(const CityOptions& options, const Box2& city_bounds, Vec2 p);
 
 // Writes scene to `glb_path` and the street graph to the `.streets.json` next to it

@@ -100,8 +100,9 @@ struct ImageCacheFrameStats {
 // they hold occluder_share of the triangles of the near geometry and the cut's nodes, and every item reaching behind
 // the eye) are drawn first by draw_occluders into the frame's target; the depth they leave hides the other near
 // items, whole nodes of the cut whose boxes lie behind it, and the items of nodes drawn as geometry. A hidden node
-// needs no image, no regeneration and no geometry this frame, and the budget is planned without it. Exact for geometry (nothing hidden could draw a pixel); a hidden node's image could only have drawn
-// pixels that its own geometry does not show.
+// needs no image, no regeneration and no geometry this frame, and the budget is planned without it. Exact for
+// geometry (nothing hidden could draw a pixel); a hidden node's image could only have drawn pixels that its own
+// geometry does not show.
 struct ImageCacheOcclusion {
   const gpu::RenderTarget* target = nullptr;  // the frame's target, into which draw_occluders draws
   std::function<void(std::span<const gpu::DrawItem>)> draw_occluders;
