@@ -143,15 +143,19 @@ void ImageCache::evict(size_t frame_index) {
 
 // Frames a new image of n made now would serve after this one: the eye's displacement its images stay valid over,
 // divided by the eye's speed. The displacement is the previous image's, measured; for a node none of whose images has
-// become invalid yet, the parallax estimate theta d^2 / (2 r) (points across the node's depth 2 r, at distance d,
-// shift against each other by about 2 r x / d^2 when the eye moves x sideways). At the first frame, with no speed
+// become invalid yet, the parallax estimate theta d^2 / (2 r) of a planar image (points across the node's depth 2 r,
+// at distance d, shift against each other by about 2 r x / d^2 when the eye moves x sideways), or for a layered
+// image the way out of its shaft: d sin(apex / 2) sideways, (1 - approach) d towards. At the first frame, with no speed
 // known, none: only an image cheaper than its geometry is made, and the others wait one frame for the speed; with the
 // eye at rest, a thousand.
 double ImageCache::expectedReuse(const Node& n, const DVec3& eye, double theta) const {
   if (eye_speed_ < 0.0) return 0.0;
   const double r = std::max(objectRadius(n.bounds), 1e-6);
   const double d = glm::length(eye - DVec3(n.bounds.center()));
-  const double life = n.life >= 0.0 ? n.life : theta * d * d / (2.0 * r);
+  const double guess = options_.kind == CachedImageKind::Layered
+                           ? d * std::min(std::sin(0.5 * options_.layered_apex_angle), 1.0 - options_.layered_approach)
+                           : theta * d * d / (2.0 * r);
+  const double life = n.life >= 0.0 ? n.life : guess;
   return eye_speed_ > 1e-9 ? std::min(life / eye_speed_, 1000.0) : 1000.0;
 }
 
