@@ -59,15 +59,12 @@ void runStreet(const PathArgs& args) {
   options.fps = args.fps;
   if (args.fov_deg > 0.0f) options.fov_deg = args.fov_deg;
   options.turn_radius = args.turn_radius;
-  if (args.hill) {
-    // The streets file keeps only the plan; the ground of a `gen city --hill` city is a function of its bounds.
+  if (args.hill || !args.terrain.empty()) {
+    // The streets file keeps only the plan; the ground of a `gen city --hill` or `--terrain` city is a function of
+    // its bounds (and of the same terrain spec and scale).
     gen::CityOptions city;
-    city.hill = true;
-    const Box2 bounds = graph.bounds();
-    options.ground_height = [city, bounds](float x, float y) { return gen::cityGroundHeight(city, bounds, {x, y}); };
-  } else if (!args.terrain.empty()) {
-    gen::CityOptions city;  // the ground of `gen city --terrain` with the same spec and scale
-    setCityTerrain(city, args.terrain, args.terrain_scale);
+    city.hill = args.hill;
+    if (!args.terrain.empty()) setCityTerrain(city, args.terrain, args.terrain_scale);
     const Box2 bounds = graph.bounds();
     options.ground_height = [city, bounds](float x, float y) { return gen::cityGroundHeight(city, bounds, {x, y}); };
   }

@@ -92,13 +92,13 @@ void BillboardMode::frame(FrameContext& frame) {
     if (b && batch_->shape(b - 1).errorAngle(cam.eye) <= theta) boards_.push_back(b - 1);
     else geometry_.push_back(id);
   }
-  if (!geometry_.empty() && occlusion_) {
+  if (!geometry_.empty() && !occlusion_) {
+    gpu_scene_->appendDrawItems(geometry_, frame.items(), cam);
+  } else if (!geometry_.empty()) {  // the culled mode's occlusion pass
     candidates_.clear();
     bounds_.clear();
     gpu_scene_->appendDrawItems(geometry_, candidates_, cam, &bounds_);
     occlusion_->run(frame, candidates_, bounds_);
-  } else if (!geometry_.empty()) {
-    gpu_scene_->appendDrawItems(geometry_, frame.items(), cam);
   }
   const size_t bytes = boards_.empty() ? 0 : batch_->build(boards_, cam.eye, frame.items());
   ++frames_;

@@ -173,6 +173,22 @@ bool OcclusionCuller::hidesBox(const Box3& box, const Mat4& model) {
   return pyramid_.hides(projectBox(box, view_proj_ * model, pyramid_.width(), pyramid_.height()));
 }
 
+OcclusionStats OcclusionCuller::appendNotHidden(std::span<const DrawItem> items, std::span<const Box3> bounds,
+                                                std::vector<DrawItem>& out) {
+  FF_CHECK(items.size() == bounds.size());
+  OcclusionStats stats;
+  stats.items = uint32_t(items.size());
+  for (size_t i = 0; i < items.size(); ++i) {
+    if (hidesBox(bounds[i], items[i].transform)) {
+      ++stats.hidden;
+      stats.hidden_triangles += items[i].triangleCount();
+    } else {
+      out.push_back(items[i]);
+    }
+  }
+  return stats;
+}
+
 OcclusionStats OcclusionCuller::draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,
                                      std::span<const Box3> bounds, RenderTarget& target,
                                      std::span<const DrawItem> also, RenderMode mode) {

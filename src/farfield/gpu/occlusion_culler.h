@@ -101,6 +101,10 @@ class OcclusionCuller {
   bool hidesWorldBox(const Box3& box) { return hidesBox(box, Mat4(1.0f)); }
   // The same for a box in the space that `model` takes to the world (a draw item's bounds and transform).
   bool hidesBox(const Box3& box, const Mat4& model);
+  // After cull(): appends to `out` the items (bounds parallel, as cull() takes them) that hidesBox does not hide, in
+  // their order; the stats count the items offered and those hidden.
+  OcclusionStats appendNotHidden(std::span<const DrawItem> items, std::span<const Box3> bounds,
+                                 std::vector<DrawItem>& out);
   // Both passes with `renderer` (Renderer::draw: no clear, no wait): the occluders, then the items not hidden, then
   // `also` (items drawn after them as they are, such as impostors), all in `mode`.
   OcclusionStats draw(Renderer& renderer, const Camera& camera, std::span<const DrawItem> items,

@@ -247,23 +247,18 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
   fallback_items_.clear();
   auto fallbackMs = [&](Node& n) {
     n.fallback_begin = fallback_items_.size();
-    fallback_bounds_.clear();
-    gpu_scene_.appendDrawItems(n.objects, fallback_items_, camera, occlusion ? &fallback_bounds_ : nullptr);
-    uint64_t triangles = 0;
     if (occlusion) {
-      size_t kept = n.fallback_begin;
-      for (size_t j = n.fallback_begin; j < fallback_items_.size(); ++j) {
-        const gpu::DrawItem& it = fallback_items_[j];
-        if (culler_->hidesBox(fallback_bounds_[j - n.fallback_begin], it.transform)) {
-          ++st.hidden_fallback_items;
-          st.hidden_fallback_triangles += it.triangleCount();
-          continue;
-        }
-        fallback_items_[kept++] = it;
-      }
-      fallback_items_.resize(kept);
+      fallback_candidates_.clear();
+      fallback_bounds_.clear();
+      gpu_scene_.appendDrawItems(n.objects, fallback_candidates_, camera, &fallback_bounds_);
+      const gpu::OcclusionStats os = culler_->appendNotHidden(fallback_candidates_, fallback_bounds_, fallback_items_);
+      st.hidden_fallback_items += os.hidden;
+      st.hidden_fallback_triangles += os.hidden_triangles;
+    } else {
+      gpu_scene_.appendDrawItems(n.objects, fallback_items_, camera);
     }
     n.fallback_end = fallback_items_.size();
+    uint64_t triangles = 0;
     for (size_t j = n.fallback_begin; j < n.fallback_end; ++j) triangles += fallback_items_[j].triangleCount();
     return geometryMs(triangles, n.fallback_end - n.fallback_begin);
   };

@@ -56,8 +56,8 @@ struct ImageCacheOptions {
   gpu::LayeredCost layered_cost;
   double regeneration_overhead_ms = 0.3;  // per regeneration: target, clear, state
   // A frame predicted over t_max even with every invalid node as geometry still regenerates the nodes whose images
-  // pay for themselves over the frames the node's previous image served, up to this share of t_max more
-  // (runtime/regeneration_scheduler.h, invest_ms); 0: such a frame draws every invalid node as geometry.
+  // pay for themselves over the frames they are expected to serve (ImageCache::expectedReuse), up to this share of
+  // t_max more (runtime/regeneration_scheduler.h, invest_ms); 0: such a frame draws every invalid node as geometry.
   double lost_frame_investment = 1.0;
   // A regeneration is taken only when it pays for itself over the frames the new image is expected to serve
   // (regeneration + image - geometry <= expected reuse x (geometry - image)), in every frame and not only in a lost
@@ -174,6 +174,7 @@ class ImageCache {
   std::vector<Box3> scratch_bounds_;
   std::vector<gpu::DrawItem> visible_;
   std::vector<gpu::DrawItem> fallback_items_;
+  std::vector<gpu::DrawItem> fallback_candidates_;  // one node's items before occlusion culling
   std::vector<Box3> fallback_bounds_;
   std::optional<gpu::OcclusionCuller> culler_;
 };
