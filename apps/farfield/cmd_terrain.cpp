@@ -3,7 +3,7 @@
 // farfield terrain bench DEM [--path FILE | --frames N] [--epsilon PX] -o OUTDIR [--size WxH] [--high-error PX]
 //                        [--low-error PX] [--reference] [--quality-stride K] [--sweep-epsilons LIST]
 //                        [--sweep-frames LIST] [--no-sweeps] [--no-section5] [--no-plots] [--no-choice]
-//                        [--clearance M] [--full-max-triangles N]
+//                        [--clearance M] [--full-max-triangles N] [--sprite-tile-cells N]
 // farfield terrain tiles DEM -o OUTDIR [--budget-mb MB] [--block N] [--tile-blocks N] [--frames N] [--cache FILE]
 //                        [--reuse-cache] [--pixel-error PX] [--check-stride K] [--clearance M] [--size WxH]
 //                        [--sprite-tiles CELLS] [--epsilon PX] [--low-error PX]
@@ -176,6 +176,8 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
                   "No cost calibration: lod-sprite takes the sprite path on every frame (as lod-sprite-always)");
   bench->add_option("--python", o.python, "Python interpreter for the plots");
   bench->add_option("--block", o.block, "LOD block size in cells")->capture_default_str();
+  bench->add_option("--sprite-tile-cells", o.sprite_tile_cells, "Tile side of the lod-sprite-tiles mode, cells")
+      ->capture_default_str();
   bench->add_option("--full-max-triangles", o.full_max_triangles,
                     "Above this many full-resolution triangles the harness's full baseline draws nothing")
       ->capture_default_str();

@@ -18,45 +18,15 @@
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_texture.h"
 #include "support/test_support.h"
+#include "terrain_gl_scene.h"
 
 namespace farfield::terrain {
 namespace {
 
-const Vec4 kSky(0.62f, 0.74f, 0.88f, 1.0f);
-
-struct Scene {
-  Heightfield hf;
-  std::unique_ptr<QuadtreeLod> lod;
-  image::ColorImage texture;
-  std::unique_ptr<gpu::TerrainRenderer> renderer;
-
-  explicit Scene(Heightfield h) : hf(std::move(h)) {
-    gpu::sharedHeadlessContext().makeCurrent();
-    lod = std::make_unique<QuadtreeLod>(hf);
-    texture = terrainTexture(hf);
-    Vec2 scale, offset;
-    texCoordTransform(hf, scale, offset);
-    renderer = std::make_unique<gpu::TerrainRenderer>(lod->positions(), texture, scale, offset);
-  }
-  image::ColorImage renderLod(const Camera& camera, float pixel_error) {
-    gpu::RenderTarget target(camera.width, camera.height);
-    target.clear(kSky);
-    LodMesh mesh;
-    renderLodFrame(*lod, *renderer, camera, LodSettings{pixel_error, true, false}, target, mesh);
-    return target.readColor();
-  }
-};
-
-Camera makeCamera(Vec3 eye, Vec3 at, int size = 128) {
-  Camera c;
-  c.eye = eye;
-  c.at = at;
-  c.width = c.height = size;
-  c.fov_y = float(degToRad(60.0));
-  c.near_plane = 1.0f;
-  c.far_plane = 50000.0f;
-  return c;
-}
+using test::kSky;
+using test::makeCamera;
+using test::Scene;
+using test::testFractal;
 
 // Flat ground at 0 with a 200 m ridge along row 32 (y = 320 m) of a 65x65 grid of 10 m cells.
 Heightfield ridgeTerrain() {
@@ -125,15 +95,6 @@ TEST(LodSprite, TriangleBehindRidgeIsNotVisibleAndInFrontIs) {
   // The renderer's own classification of this frame agrees: some triangles were drawn with the original texture.
   EXPECT_LT(info.visible_triangles, info.low_triangles);
   EXPECT_GT(info.visible_triangles, 0u);
-}
-
-Heightfield testFractal() {
-  FractalOptions o;
-  o.size = 129;
-  o.seed = 9;
-  o.cell_size = 20.0;
-  o.relief = 500.0;
-  return fractalTerrain(o);
 }
 
 TEST(LodSprite, AtTheKeyframeViewpointMatchesHighResolution) {

@@ -128,6 +128,7 @@ void checkOptions(const TerrainBenchOptions& o) {
   for (double e : o.sweep_epsilons)
     if (!(e > 0.0)) throw Error("--sweep-epsilons", "expected positive numbers, got " + num(e, 3));
   if (o.block < 1) throw Error("--block", "must be at least 1 cell");
+  if (o.sprite_tile_cells < 1) throw Error("--sprite-tile-cells", "must be at least 1 cell");
   if (!(o.clearance >= 0.0f)) throw Error("--clearance", "must be 0 (default) or a positive number of metres");
 }
 
@@ -298,6 +299,10 @@ void runQuality(Experiment& x) {
     sprites.emplace_back(name, std::make_unique<terrain::LodSpriteRenderer>(
                                    *data.lod, renderer, o.width, o.height, spriteOptions(*x.run, variant, o.epsilon)));
   }
+  std::unique_ptr<terrain::TileSpriteRenderer> tiles;
+  if (std::find(o.modes.begin(), o.modes.end(), "lod-sprite-tiles") != o.modes.end())
+    tiles = std::make_unique<terrain::TileSpriteRenderer>(*data.lod, renderer, o.width, o.height,
+                                                          tileSpriteOptions(*x.run));
   // Figure 6 and 7's views: over the plain (40% of the path) and over the mountains (70%).
   const std::set<size_t> views{bench.frame_indices[bench.frame_indices.size() * 2 / 5],
                                bench.frame_indices[bench.frame_indices.size() * 7 / 10]};
@@ -347,6 +352,11 @@ void runQuality(Experiment& x) {
                   << num(row.psnr[name], 3) << "," << num(image::meanAbsoluteError(high_image, low_image), 3) << ","
                   << num(image::meanAbsoluteError(high_image, img), 3) << "\n";
       }
+    }
+    if (tiles) {
+      target.clear(x.run->sky);
+      tiles->render(camera, target);
+      if (measure) row.psnr["lod-sprite-tiles"] = std::min(image::psnr(high_image, target.readColor()), kPsnrCapDb);
     }
     if (measure) x.result.quality.push_back(std::move(row));
     progress.advance();
@@ -759,6 +769,7 @@ TerrainBenchResult runTerrainBench(const TerrainBenchOptions& options) {
   run->high_error = options.high_error;
   run->low_error = options.low_error;
   run->epsilon = options.epsilon;
+  run->sprite_tile_cells = options.sprite_tile_cells;
   const ScopedTerrainRun scoped(run);  // the harness's terrain modes draw this terrain
   result.terrain = run->data->describe();
   say(options, "terrain: %s\n", result.terrain.c_str());

@@ -67,6 +67,7 @@ struct TerrainBenchOptions {
   std::string bench_plot_script;    // tools/plot_bench.py ("" = findToolScript)
   std::string terrain_plot_script;  // tools/plot_terrain.py ("" = findToolScript)
   int block = 128;          // LOD block size, cells
+  int sprite_tile_cells = 128;  // tile side of the lod-sprite-tiles mode, cells (>= 1)
   std::FILE* log = stdout;  // what each stage does, one line each; null = quiet
 };
 

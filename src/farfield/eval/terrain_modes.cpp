@@ -28,6 +28,7 @@ std::shared_ptr<TerrainRun> runFor(const ModeContext& context, const std::string
     loaded->low_error =
         checkedCast<float>(positiveOption(context, "low_error", loaded->low_error), "--mode-option low_error", "value");
     loaded->epsilon = positiveOption(context, "epsilon", loaded->epsilon);
+    loaded->sprite_tile_cells = intOption(context, "tile_cells", loaded->sprite_tile_cells, 1, 1 << 20);
     if (context.renderer) loaded->sky = context.renderer->light().sky_color;
     run = std::move(loaded);
   }
@@ -168,6 +169,48 @@ std::map<std::string, double> SpriteMode::info() const {
           {"keyframe_decisions", double(c.fresh_keyframes - c.switches + c.virtual_keyframes)}};
 }
 
+terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run) {
+  terrain::TileSpriteRenderOptions o;
+  o.tile_cells = run.sprite_tile_cells;
+  o.epsilon = run.epsilon;
+  o.high_error = run.high_error;
+  o.low_error = run.low_error;
+  o.sky_color = run.sky;
+  return o;
+}
+
+void TileSpriteMode::prepare(const ModeContext& context) {
+  run_ = runFor(context, name());
+  sprite_ = std::make_unique<terrain::TileSpriteRenderer>(*run_->data->lod, run_->gpuRenderer(), context.width,
+                                                          context.height, tileSpriteOptions(*run_));
+}
+
+void TileSpriteMode::frame(FrameContext& frame) {
+  // A path frame at or before the last one starts a new pass (the harness's warm-up frame was the first pass).
+  if (started_ && frame.pathFrame() <= last_frame_) sprite_->reset();
+  started_ = true;
+  last_frame_ = frame.pathFrame();
+  frame.addStats(sprite_->render(frame.camera(), frame.beginOwnPass()));
+}
+
+std::map<std::string, double> TileSpriteMode::info() const {
+  const terrain::TileSpriteCounters& c = sprite_->counters();
+  const double frames = double(std::max<size_t>(c.frames, 1));
+  return {{"epsilon_px", sprite_->options().epsilon},
+          {"tile_cells", double(sprite_->options().tile_cells)},
+          {"frames", double(c.frames)},
+          {"tile_keyframes", double(c.tile_keyframes)},
+          {"frames_with_keyframes", double(c.frames_with_keyframes)},
+          {"keyframe_fraction", double(c.frames_with_keyframes) / frames},
+          {"tile_frames_in_view", double(c.tile_frames_in_view)},
+          {"tile_keyframe_fraction", double(c.tile_keyframes) / double(std::max<size_t>(c.tile_frames_in_view, 1))},
+          {"unframed_tile_frames", double(c.unframed_tile_frames)},
+          {"keyframe_triangles_per_frame", double(c.keyframe_triangles) / frames},
+          {"sprite_triangle_share", double(c.sprite_triangles) / double(std::max<uint64_t>(c.low_triangles, 1))},
+          {"peak_sprites", double(c.peak_sprites)},
+          {"peak_sprite_bytes", double(c.peak_sprite_bytes)}};
+}
+
 void registerTerrainModes() {
   registerMode("high", "terrain: high-resolution quadtree LOD (--mode-option terrain=DEM)",
                [](const ModeContext&) { return std::make_unique<LodMode>("high", true); });
@@ -193,6 +236,8 @@ void registerTerrainModes() {
                [](const ModeContext&) {
                  return std::make_unique<SpriteMode>("lod-sprite-cache", SpriteVariant::Cache);
                });
+  registerMode("lod-sprite-tiles", "terrain: LOD-sprite with a sprite per terrain tile (--mode-option tile_cells=N)",
+               [](const ModeContext&) { return std::make_unique<TileSpriteMode>(); });
 }
 
 }  // namespace farfield::eval

@@ -26,6 +26,7 @@
 #include "farfield/terrain/terrain_data.h"
 #include "farfield/terrain/tile_cache.h"
 #include "farfield/terrain/tile_pager.h"
+#include "farfield/terrain/tile_sprite_renderer.h"
 
 namespace farfield::eval {
 
@@ -42,6 +43,7 @@ struct TerrainRun {
   float high_error = 1.0f;  // LOD thresholds, pixels
   float low_error = 4.0f;
   double epsilon = 1.0;     // LOD-sprite error threshold, pixels
+  int sprite_tile_cells = 128;  // tile side of lod-sprite-tiles, grid cells
   Vec4 sky{0.62f, 0.74f, 0.88f, 1.0f};
   std::optional<terrain::TerrainCost> cost;  // calibrated on this machine; "lod-sprite" chooses per frame with it
   std::map<std::string, std::vector<SpriteLog>> logs;  // sprite mode name -> frames of its last pass
@@ -133,7 +135,29 @@ class SpriteMode : public Mode {
   size_t last_frame_ = 0;
 };
 
-// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict and lod-sprite-cache to the mode registry (mode.h). Idempotent.
+// The options of lod-sprite-tiles with the run's thresholds (the mode's and the quality pass's).
+terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run);
+
+// `lod-sprite-tiles`: a sprite per terrain tile (terrain/tile_sprite_renderer.h), every frame the sprite path. Each
+// pass over the path starts from scratch, as SpriteMode's. Under `farfield bench`: --mode-option tile_cells=N.
+class TileSpriteMode : public Mode {
+ public:
+  std::string name() const override { return "lod-sprite-tiles"; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  // epsilon_px, tile_cells, frames, tile_keyframes, frames_with_keyframes (share too), tile_frames_in_view,
+  // tile_keyframe_fraction (of tile-frames in view), unframed_tile_frames, keyframe_triangles_per_frame,
+  // sprite_triangle_share (of the low mesh's triangles), peak_sprites, peak_sprite_bytes (of the last pass).
+  std::map<std::string, double> info() const override;
+
+ private:
+  std::shared_ptr<TerrainRun> run_;
+  std::unique_ptr<terrain::TileSpriteRenderer> sprite_;
+  bool started_ = false;
+  size_t last_frame_ = 0;
+};
+
+// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict, lod-sprite-cache and lod-sprite-tiles to the mode registry (mode.h). Idempotent.
 // Called by runTerrainBench and by the executable at start-up (the eval library is static: a static registration
 // object in it would be dropped by the linker).
 void registerTerrainModes();

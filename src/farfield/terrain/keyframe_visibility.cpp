@@ -32,12 +32,14 @@ bool vertexVisible(const Camera& keyframe, const image::DepthImage& depth, const
 }
 
 void KeyframeVisibility::reset(const QuadtreeLod& lod, const Camera& keyframe, const image::DepthImage* depth,
-                               const VisibilityOptions& options) {
+                               const VisibilityOptions& options, const GridRect* region) {
   FF_CHECK(depth && depth->width() == keyframe.width && depth->height() == keyframe.height);
   lod_ = &lod;
   depth_ = depth;
   camera_ = keyframe;
   options_ = options;
+  has_region_ = region != nullptr;
+  if (region) region_ = *region;
   visible_.clear();
   classified_ = 0;
 }
@@ -48,7 +50,8 @@ bool KeyframeVisibility::vertexVisible(uint32_t v) {
   if (fresh) {
     const Heightfield& hf = lod_->heightfield();
     const int i = int(v % uint32_t(hf.width)), j = int(v / uint32_t(hf.width));
-    it->second = terrain::vertexVisible(camera_, *depth_, lod_->position(v), hf.normal(i, j), options_);
+    it->second = (!has_region_ || region_.contains(i, j)) &&
+                 terrain::vertexVisible(camera_, *depth_, lod_->position(v), hf.normal(i, j), options_);
     ++classified_;
   }
   return it->second;

@@ -38,6 +38,12 @@ struct VisibilityOptions {
 bool vertexVisible(const Camera& keyframe, const image::DepthImage& depth, const Vec3& p, const Vec3& n,
                    const VisibilityOptions& options = {});
 
+// A rectangle of grid points, [x0, x1] x [y0, y1] inclusive.
+struct GridRect {
+  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+  bool contains(int x, int y) const { return x >= x0 && x <= x1 && y >= y0 && y <= y1; }
+};
+
 // Per-vertex visibility against one keyframe, computed once per grid vertex on first use (the LOD mesh changes
 // from frame to frame, so vertices that were not in the keyframe-time mesh are classified when they first appear,
 // by the same test against the stored z-buffer; the paper classifies the keyframe-time mesh in one pass). The
@@ -48,9 +54,10 @@ class KeyframeVisibility {
  public:
   KeyframeVisibility() = default;
   // Starts a new keyframe; `depth` must have the camera's size. Keeps references to lod and depth, which must
-  // outlive their use here.
+  // outlive their use here. region: a keyframe that drew only part of the terrain (a tile's sprite,
+  // tile_sprite_renderer.h); vertices outside it are never visible, so a triangle textured with it lies inside it.
   void reset(const QuadtreeLod& lod, const Camera& keyframe, const image::DepthImage* depth,
-             const VisibilityOptions& options);
+             const VisibilityOptions& options, const GridRect* region = nullptr);
   bool vertexVisible(uint32_t v);
   bool triangleVisible(uint32_t a, uint32_t b, uint32_t c) { return vertexVisible(a) && vertexVisible(b) && vertexVisible(c); }
   // Reorders a triangle list so that the visible triangles come first; returns how many are visible.
@@ -64,6 +71,8 @@ class KeyframeVisibility {
   const image::DepthImage* depth_ = nullptr;
   Camera camera_;
   VisibilityOptions options_;
+  bool has_region_ = false;
+  GridRect region_;
   std::unordered_map<uint32_t, bool> visible_;  // grid vertex -> visible, for the vertices classified so far
   size_t classified_ = 0;
   std::vector<uint32_t> scratch_;

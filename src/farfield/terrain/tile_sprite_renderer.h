@@ -1,0 +1,132 @@
+// LOD-sprite terrain with a sprite per tile (issue 18): the rendering of the decisions of tile_sprites.h.
+//
+// Chen et al. 1999 (section 3) render the whole frame as one sprite and re-render it whole when equation 2's mean
+// over the frame's quadrants trips, near ground dominating that mean. Here the terrain is cut into square tiles of
+// tile_cells cells and each tile keeps its own sprite:
+// - Each frame builds the low-resolution LOD mesh (as the paper), and sorts its triangles and quadrants into tiles
+//   (a triangle by its centroid's cell, a quadrant by its central vertex).
+// - A tile's error is equation 2 over its own quadrants, from its sprite's viewpoint to the eye; a tile with no
+//   sprite, or whose error reaches epsilon, is re-rendered alone.
+// - A tile's keyframe frames its region: the grid rectangle of the tile and of the tile's low-resolution triangles
+//   in that frame (far triangles reach past a small tile), grown by region_margin, with the heights of the tiles it
+//   touches. The whole tile, not only its part in view: a turning or advancing view brings the rest into view. The camera sits at the eye and looks at the
+//   region's box, its frustum just enclosing the box, at the frame's pixel density (so the sprite is as sharp as a
+//   whole-frame keyframe would be there). Since it frames the whole region, the sprite stays valid whatever the
+//   view direction later: its validity depends on the eye's position only, which is what equation 2 measures.
+//   Only the high-resolution triangles that meet the region are drawn into it (the LOD built over the region's
+//   blocks), and its z-buffer is kept.
+// - Drawing: a low-resolution triangle whose three vertices lie inside its tile's region and are visible in the
+//   tile's keyframe (equation 3, keyframe_visibility.h) is textured with the tile's sprite; the others with the
+//   original texture, as the paper does with triangles the keyframe did not see. Occlusion between tiles is the
+//   frame's own z-buffer's business: a sprite holds its region's terrain unoccluded by other tiles.
+// - A tile whose region cannot be framed (it reaches behind or beside the eye by more than max_half_angle_deg,
+//   e.g. the ground right under a low eye) gets no sprite in that frame: its triangles take the original texture.
+//
+// Far tiles subtend small parallax angles, so their sprites last longer than near ones; a refresh re-renders one
+// tile's high LOD, not the frame's. Sprites of tiles out of view for keep_frames frames are released.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/gpu/terrain_renderer.h"
+#include "farfield/image/image.h"
+#include "farfield/terrain/keyframe_visibility.h"
+#include "farfield/terrain/quadtree_lod.h"
+
+namespace farfield::terrain {
+
+struct TileSpriteRenderOptions {
+  int tile_cells = 128;      // tile side, grid cells
+  double epsilon = 1.0;      // error threshold, pixels (equation 2, per tile)
+  float high_error = 1.0f;   // LOD threshold of keyframes, pixels
+  float low_error = 4.0f;    // LOD threshold of novel frames, pixels
+  VisibilityOptions visibility;
+  Vec4 sky_color{0.62f, 0.74f, 0.88f, 1.0f};
+  float region_margin = 0.1f;      // share of the region's side added on each side (at least one cell)
+  float max_half_angle_deg = 60.0f;  // widest half-angle of a tile keyframe's frustum
+  int max_sprite_size = 2048;      // pixels per side; larger regions are drawn at a lower density
+  int keep_frames = 30;            // frames a sprite is kept out of view
+};
+
+struct TileSpriteRenderFrame {
+  size_t tiles_in_view = 0;       // tiles holding a triangle of the frame's low mesh
+  size_t tiles_refreshed = 0;     // keyframes rendered in this frame
+  size_t tiles_unframed = 0;      // tiles in view that could not be framed (no sprite this frame)
+  uint64_t keyframe_triangles = 0;  // high-resolution triangles drawn into this frame's keyframes
+  uint64_t keyframe_pixels = 0;     // their pixels
+  uint64_t low_triangles = 0;
+  uint64_t sprite_triangles = 0;  // low-resolution triangles textured with a sprite
+  double max_tile_error_px = 0.0; // largest error of a sprite kept (below epsilon)
+};
+
+struct TileSpriteCounters {
+  size_t frames = 0;
+  size_t frames_with_keyframes = 0;
+  size_t tile_keyframes = 0;
+  size_t tile_frames_in_view = 0;
+  size_t unframed_tile_frames = 0;
+  uint64_t keyframe_triangles = 0;
+  uint64_t low_triangles = 0;
+  uint64_t sprite_triangles = 0;
+  size_t peak_sprites = 0;
+  uint64_t peak_sprite_bytes = 0;  // GPU bytes of the sprites held (colour, ids, depth) and their z-buffer copies
+};
+
+class TileSpriteRenderer {
+ public:
+  // Needs a current context. lod and renderer must outlive this object; frames are width x height. Throws
+  // farfield::Error for bad options.
+  TileSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, int width, int height,
+                     const TileSpriteRenderOptions& options);
+  ~TileSpriteRenderer();
+
+  // Draws one frame into target (bound here; not cleared: the caller clears it to the sky colour).
+  gpu::FrameStats render(const Camera& camera, gpu::RenderTarget& target, TileSpriteRenderFrame* info = nullptr);
+  // Forgets every sprite and counter (a new pass over a path); keeps the GPU allocations for reuse.
+  void reset();
+
+  IVec2 tileOf(int x, int y) const;
+  int tilesX() const { return tiles_x_; }
+  int tilesY() const { return tiles_y_; }
+  const TileSpriteCounters& counters() const { return counters_; }
+  const TileSpriteRenderOptions& options() const { return options_; }
+  // The sprite of a tile (tests): its camera, region and z-buffer; null when the tile has none.
+  struct SpriteView {
+    const Camera* camera;
+    GridRect region;
+    const image::DepthImage* depth;
+  };
+  bool sprite(IVec2 tile, SpriteView& out) const;
+
+ private:
+  struct Sprite;
+  using TileKey = std::pair<int, int>;
+  bool frame(const Camera& camera, GridRect region, Camera& out) const;
+  void renderKeyframe(Sprite& sprite, TileSpriteRenderFrame& info, gpu::FrameStats& stats);
+  gpu::RenderTarget takeTarget(int width, int height);
+  void release(Sprite& sprite);
+  uint64_t spriteBytes() const;
+
+  const QuadtreeLod& lod_;
+  gpu::TerrainRenderer& renderer_;
+  int width_, height_;
+  TileSpriteRenderOptions options_;
+  int tiles_x_ = 0, tiles_y_ = 0;
+  std::vector<float> tile_min_z_, tile_max_z_;
+  std::map<TileKey, std::unique_ptr<Sprite>> sprites_;
+  std::map<TileKey, std::vector<gpu::RenderTarget>> spare_;  // released targets by size
+  TileSpriteCounters counters_;
+  uint64_t frame_ = 0;
+  LodMesh low_, high_;
+  std::vector<uint32_t> keyframe_indices_, frame_indices_;
+};
+
+}  // namespace farfield::terrain

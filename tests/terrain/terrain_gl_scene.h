@@ -1,0 +1,64 @@
+// A small terrain on the GPU for the LOD-sprite tests: its LOD, texture and renderer, and cameras over it.
+#pragma once
+
+#include <memory>
+#include <utility>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/terrain_renderer.h"
+#include "farfield/terrain/fractal.h"
+#include "farfield/terrain/lod_sprite.h"
+#include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_texture.h"
+
+namespace farfield::terrain::test {
+
+inline const Vec4 kSky(0.62f, 0.74f, 0.88f, 1.0f);
+
+struct Scene {
+  Heightfield hf;
+  std::unique_ptr<QuadtreeLod> lod;
+  image::ColorImage texture;
+  std::unique_ptr<gpu::TerrainRenderer> renderer;
+
+  explicit Scene(Heightfield h) : hf(std::move(h)) {
+    gpu::sharedHeadlessContext().makeCurrent();
+    lod = std::make_unique<QuadtreeLod>(hf);
+    texture = terrainTexture(hf);
+    Vec2 scale, offset;
+    texCoordTransform(hf, scale, offset);
+    renderer = std::make_unique<gpu::TerrainRenderer>(lod->positions(), texture, scale, offset);
+  }
+  image::ColorImage renderLod(const Camera& camera, float pixel_error) {
+    gpu::RenderTarget target(camera.width, camera.height);
+    target.clear(kSky);
+    LodMesh mesh;
+    renderLodFrame(*lod, *renderer, camera, LodSettings{pixel_error, true, false}, target, mesh);
+    return target.readColor();
+  }
+};
+
+inline Camera makeCamera(Vec3 eye, Vec3 at, int size = 128) {
+  Camera c;
+  c.eye = eye;
+  c.at = at;
+  c.width = c.height = size;
+  c.fov_y = float(degToRad(60.0));
+  c.near_plane = 1.0f;
+  c.far_plane = 50000.0f;
+  return c;
+}
+
+// 129 x 129 points, 20 m cells, 500 m of relief.
+inline Heightfield testFractal() {
+  FractalOptions o;
+  o.size = 129;
+  o.seed = 9;
+  o.cell_size = 20.0;
+  o.relief = 500.0;
+  return fractalTerrain(o);
+}
+
+}  // namespace farfield::terrain::test
