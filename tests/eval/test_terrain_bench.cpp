@@ -207,6 +207,25 @@ TEST(TerrainBenchGL, WithoutSweepsOnlyTheirFilesAreMissing) {
 }
 
 // Bad options: farfield::Error naming the option, before the terrain is loaded or a file written.
+// lod-sprite-tiles runs through the harness and the quality pass like the other modes.
+TEST(TerrainBenchGL, TileSpritesAreTimedAndMeasured) {
+  const fs::path out = test::scratchDir("terrain_bench_tiles");
+  TerrainBenchOptions o = smallOptions(out);
+  o.modes = {"high", "low", "lod-sprite", "lod-sprite-tiles"};
+  o.sweeps = false;
+  o.sprite_tile_cells = 32;
+  const TerrainBenchResult result = runTerrainBench(o);
+  const nlohmann::json bench = nlohmann::json::parse(readText(out / "bench.json"));
+  const nlohmann::json& info = bench["modes"]["lod-sprite-tiles"]["info"];
+  EXPECT_EQ(info["tile_cells"].get<double>(), 32.0);
+  EXPECT_EQ(info["frames"].get<double>(), double(kFrames));
+  EXPECT_GT(info["tile_keyframes"].get<double>(), 0.0);
+  EXPECT_LE(info["tile_keyframes"].get<double>(), info["tile_frames_in_view"].get<double>());
+  EXPECT_GT(info["sprite_triangle_share"].get<double>(), 0.0);
+  ASSERT_TRUE(result.psnr_mean.count("lod-sprite-tiles"));
+  EXPECT_GT(result.psnr_mean.at("lod-sprite-tiles"), result.psnr_mean.at("low"));
+}
+
 TEST(TerrainBench, BadOptionsNameTheOption) {
   const fs::path out = test::scratchDir("terrain_bench_bad") / "out";
   const std::vector<std::pair<std::string, std::function<void(TerrainBenchOptions&)>>> cases{
@@ -225,6 +244,7 @@ TEST(TerrainBench, BadOptionsNameTheOption) {
       {"mode 'no-such-mode'", [](TerrainBenchOptions& o) { o.modes.push_back("no-such-mode"); }},
       {"--sweep-epsilons", [](TerrainBenchOptions& o) { o.sweep_epsilons = {1.0, -2.0}; }},
       {"--block", [](TerrainBenchOptions& o) { o.block = 0; }},
+      {"--sprite-tile-cells", [](TerrainBenchOptions& o) { o.sprite_tile_cells = 0; }},
   };
   for (const auto& [name, spoil] : cases) {
     TerrainBenchOptions o = smallOptions(out);

@@ -204,7 +204,7 @@ std::map<std::string, double> TileSpriteMode::info() const {
           {"keyframe_fraction", double(c.frames_with_keyframes) / frames},
           {"tile_frames_in_view", double(c.tile_frames_in_view)},
           {"tile_keyframe_fraction", double(c.tile_keyframes) / double(std::max<size_t>(c.tile_frames_in_view, 1))},
-          {"unframed_tile_frames", double(c.unframed_tile_frames)},
+          {"view_framed_keyframes", double(c.view_framed_keyframes)},
           {"keyframe_triangles_per_frame", double(c.keyframe_triangles) / frames},
           {"sprite_triangle_share", double(c.sprite_triangles) / double(std::max<uint64_t>(c.low_triangles, 1))},
           {"peak_sprites", double(c.peak_sprites)},

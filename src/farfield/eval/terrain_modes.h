@@ -146,7 +146,7 @@ class TileSpriteMode : public Mode {
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
   // epsilon_px, tile_cells, frames, tile_keyframes, frames_with_keyframes (share too), tile_frames_in_view,
-  // tile_keyframe_fraction (of tile-frames in view), unframed_tile_frames, keyframe_triangles_per_frame,
+  // tile_keyframe_fraction (of tile-frames in view), view_framed_keyframes, keyframe_triangles_per_frame,
   // sprite_triangle_share (of the low mesh's triangles), peak_sprites, peak_sprite_bytes (of the last pass).
   std::map<std::string, double> info() const override;
 
@@ -157,7 +157,8 @@ class TileSpriteMode : public Mode {
   size_t last_frame_ = 0;
 };
 
-// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict, lod-sprite-cache and lod-sprite-tiles to the mode registry (mode.h). Idempotent.
+// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict, lod-sprite-cache and
+// lod-sprite-tiles to the mode registry (mode.h). Idempotent.
 // Called by runTerrainBench and by the executable at start-up (the eval library is static: a static registration
 // object in it would be dropped by the linker).
 void registerTerrainModes();

@@ -7,6 +7,7 @@
 // colour to attachment 0, object id (1 for the terrain) to attachment 1. Draw calls do not clear and do not wait.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 
@@ -18,6 +19,13 @@
 #include "farfield/image/image.h"
 
 namespace farfield::gpu {
+
+// Adds one draw's counts to a frame's (objects: the larger, the terrain being one object).
+inline void addDraw(FrameStats& sum, const FrameStats& draw) {
+  sum.triangles += draw.triangles;
+  sum.draw_calls += draw.draw_calls;
+  sum.objects = std::max(sum.objects, draw.objects);
+}
 
 class TerrainRenderer {
  public:

@@ -68,16 +68,6 @@ struct LodSpriteRenderer::Keyframe {
   bool ready = false;
 };
 
-namespace {
-
-void add(gpu::FrameStats& sum, const gpu::FrameStats& s) {
-  sum.triangles += s.triangles;
-  sum.draw_calls += s.draw_calls;
-  sum.objects = std::max(sum.objects, s.objects);
-}
-
-}  // namespace
-
 LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, int width, int height,
                                      const LodSpriteOptions& options)
     : lod_(lod), renderer_(renderer), width_(width), height_(height), options_(options) {
@@ -167,7 +157,7 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
   lod_.build(k->camera, LodSettings{options_.high_error, true, false}, high_);
   renderer_.setIndices(high_.indices, 0);
   k->target.clear(options_.sky_color);
-  add(stats, renderer_.drawTextured(k->camera, k->target, 0, high_.triangleCount(), 0));
+  gpu::addDraw(stats, renderer_.drawTextured(k->camera, k->target, 0, high_.triangleCount(), 0));
   info.keyframe_triangles += high_.triangleCount();
   high_triangles_key_ = high_.triangleCount();
   high_latest_is_key_ = true;
@@ -237,7 +227,7 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
   const size_t per_chunk = (total + chunks - 1) / chunks;
   const size_t first = std::min(total, (pending_chunk_ - 1) * per_chunk);
   const size_t count = std::min(total - first, per_chunk);
-  add(stats, renderer_.drawTextured(k.camera, k.target, first, count, 1));
+  gpu::addDraw(stats, renderer_.drawTextured(k.camera, k.target, first, count, 1));
   info.ahead_triangles += count;
   if (++pending_chunk_ <= chunks) return;
   k.depth = k.target.readDepth();
@@ -402,8 +392,9 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   const size_t visible = visibility_.partition(low_.indices);
   if (info.source == SpriteSource::Fresh) current_->coverage_at_creation = n ? double(visible) / double(n) : 1.0;
   renderer_.setIndices(low_.indices, 0);
-  add(stats, renderer_.drawSprite(camera, target, current_->target.colorTexture(), current_->view_proj, 0, visible, 0));
-  add(stats, renderer_.drawTextured(camera, target, visible, n - visible, 0));
+  gpu::addDraw(stats,
+               renderer_.drawSprite(camera, target, current_->target.colorTexture(), current_->view_proj, 0, visible, 0));
+  gpu::addDraw(stats, renderer_.drawTextured(camera, target, visible, n - visible, 0));
   info.low_triangles = n;
   info.visible_triangles = visible;
   if (out) *out = info;

@@ -18,6 +18,8 @@ struct TileSpriteRenderer::Sprite {
   image::DepthImage depth;
   KeyframeVisibility visibility;
   uint64_t last_seen = 0;
+  bool view_bound = false;  // took the frame's view: valid while the view has not turned past its margin
+  Vec3 key_forward{0.0f};
   // This frame's low-resolution triangles and quadrants of the tile.
   std::vector<uint32_t> triangles;
   std::vector<LodQuadrant> quadrants;
@@ -26,11 +28,6 @@ struct TileSpriteRenderer::Sprite {
 
 namespace {
 
-void add(gpu::FrameStats& sum, const gpu::FrameStats& s) {
-  sum.triangles += s.triangles;
-  sum.draw_calls += s.draw_calls;
-  sum.objects = std::max(sum.objects, s.objects);
-}
 
 int roundUp(int v, int m) { return (v + m - 1) / m * m; }
 
@@ -49,6 +46,8 @@ TileSpriteRenderer::TileSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRende
   if (!(options.max_half_angle_deg > 1.0f && options.max_half_angle_deg < 89.0f))
     throw Error("lod-sprite-tiles", "the widest half-angle must be between 1 and 89 degrees");
   if (options.max_sprite_size < 16) throw Error("lod-sprite-tiles", "sprites need at least 16 pixels per side");
+  if (!(options.view_margin >= 0.0f && options.view_margin <= 1.0f))
+    throw Error("lod-sprite-tiles", "view margin must be 0..1 (share of the frame size per side)");
   if (options.keep_frames < 0) throw Error("lod-sprite-tiles", "keep_frames must not be negative");
   tiles_x_ = (lod.width() - 2) / options.tile_cells + 1;
   tiles_y_ = (lod.height() - 2) / options.tile_cells + 1;
@@ -60,9 +59,10 @@ TileSpriteRenderer::TileSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRende
     for (int x = 0; x < lod.width(); ++x) {
       const float z = positions[size_t(x) + size_t(y) * size_t(lod.width())].z;
       // A border point belongs to the tiles on both sides.
-      for (int ty = std::max(0, (y - 1) / options.tile_cells); ty <= std::min(tiles_y_ - 1, y / options.tile_cells); ++ty)
-        for (int tx = std::max(0, (x - 1) / options.tile_cells); tx <= std::min(tiles_x_ - 1, x / options.tile_cells);
-             ++tx) {
+      const int ty0 = std::max(0, (y - 1) / options.tile_cells), ty1 = std::min(tiles_y_ - 1, y / options.tile_cells);
+      const int tx0 = std::max(0, (x - 1) / options.tile_cells), tx1 = std::min(tiles_x_ - 1, x / options.tile_cells);
+      for (int ty = ty0; ty <= ty1; ++ty)
+        for (int tx = tx0; tx <= tx1; ++tx) {
           const size_t t = size_t(tx) + size_t(ty) * size_t(tiles_x_);
           tile_min_z_[t] = std::min(tile_min_z_[t], z);
           tile_max_z_[t] = std::max(tile_max_z_[t], z);
@@ -131,7 +131,8 @@ bool TileSpriteRenderer::frame(const Camera& camera, GridRect r, Camera& out) co
     }
   const Vec3 lo = lod_.position(uint32_t(r.x0) + uint32_t(r.y0) * uint32_t(lod_.width()));
   const Vec3 hi = lod_.position(uint32_t(r.x1) + uint32_t(r.y1) * uint32_t(lod_.width()));
-  const Vec3 box_lo(std::min(lo.x, hi.x), std::min(lo.y, hi.y), z0), box_hi(std::max(lo.x, hi.x), std::max(lo.y, hi.y), z1);
+  const Vec3 box_lo(std::min(lo.x, hi.x), std::min(lo.y, hi.y), z0);
+  const Vec3 box_hi(std::max(lo.x, hi.x), std::max(lo.y, hi.y), z1);
   const Vec3 centre = 0.5f * (box_lo + box_hi);
   const Vec3 f = glm::normalize(centre - camera.eye);
   if (!(glm::length(centre - camera.eye) > 0.0f)) return false;
@@ -163,6 +164,15 @@ bool TileSpriteRenderer::frame(const Camera& camera, GridRect r, Camera& out) co
   return true;
 }
 
+Camera TileSpriteRenderer::viewKeyframe(const Camera& camera) const {
+  // Same eye, direction and pixel density, a whole number of pixels wider and taller on each side.
+  Camera k = camera;
+  k.width = width_ + 2 * int(std::lround(options_.view_margin * float(width_)));
+  k.height = height_ + 2 * int(std::lround(options_.view_margin * float(height_)));
+  k.fov_y = 2.0f * std::atan(std::tan(camera.fov_y * 0.5f) * float(k.height) / float(height_));
+  return k;
+}
+
 void TileSpriteRenderer::renderKeyframe(Sprite& s, TileSpriteRenderFrame& info, gpu::FrameStats& stats) {
   // The high-resolution LOD of the region's blocks, seen from the keyframe camera; the triangles meeting the region.
   const int block = lod_.block();
@@ -190,7 +200,7 @@ void TileSpriteRenderer::renderKeyframe(Sprite& s, TileSpriteRenderFrame& info, 
   renderer_.setIndices(keyframe_indices_, 1);
   s.target.clear(options_.sky_color);
   const size_t n = keyframe_indices_.size() / 3;
-  add(stats, renderer_.drawTextured(s.camera, s.target, 0, n, 1));
+  gpu::addDraw(stats, renderer_.drawTextured(s.camera, s.target, 0, n, 1));
   s.depth = s.target.readDepth();
   s.visibility.reset(lod_, s.camera, &s.depth, options_.visibility, &s.region);
   s.has_keyframe = true;
@@ -256,6 +266,9 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
     ++info.tiles_in_view;
     s.last_seen = frame_;
     bool due = !s.has_keyframe;
+    // A sprite of the frame's view: refreshed once the view has turned past its margin.
+    if (!due && s.view_bound)
+      due = glm::dot(camera.forward(), s.key_forward) < std::cos(options_.view_margin * camera.fov_y);
     if (!due) {
       const SpriteError e = spriteError(lod_, s.quadrants, s.camera.eye, camera.eye);
       due = keyframeDue(e, beta, options_.epsilon);
@@ -275,15 +288,14 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
       const int gy = std::max(1, int(std::lround(options_.region_margin * float(r.y1 - r.y0))));
       r = GridRect{std::max(0, r.x0 - gx), std::max(0, r.y0 - gy), std::min(lod_.width() - 1, r.x1 + gx),
                    std::min(lod_.height() - 1, r.y1 + gy)};
-      Camera key;
-      if (frame(camera, r, key)) {
-        s.camera = key;
-        s.region = r;
-        renderKeyframe(s, info, stats);
-      } else {
-        release(s);
-        ++info.tiles_unframed;
+      s.view_bound = !frame(camera, r, s.camera);
+      if (s.view_bound) {
+        s.camera = viewKeyframe(camera);
+        ++info.tiles_view_framed;
       }
+      s.key_forward = camera.forward();
+      s.region = r;
+      renderKeyframe(s, info, stats);
     }
     if (s.has_keyframe) {
       // Visible triangles with the sprite, the others with the original texture.
@@ -305,15 +317,16 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
   frame_indices_.insert(frame_indices_.end(), textured.begin(), textured.end());
   renderer_.setIndices(frame_indices_, 0);
   for (const Range& r : ranges)
-    add(stats, renderer_.drawSprite(camera, target, r.sprite->target.colorTexture(), r.sprite->view_proj, r.first,
-                                    r.count, 0));
-  if (!textured.empty()) add(stats, renderer_.drawTextured(camera, target, rest_first, textured.size() / 3, 0));
+    gpu::addDraw(stats, renderer_.drawSprite(camera, target, r.sprite->target.colorTexture(), r.sprite->view_proj,
+                                             r.first, r.count, 0));
+  if (!textured.empty())
+    gpu::addDraw(stats, renderer_.drawTextured(camera, target, rest_first, textured.size() / 3, 0));
 
   ++counters_.frames;
   counters_.frames_with_keyframes += info.tiles_refreshed ? 1 : 0;
   counters_.tile_keyframes += info.tiles_refreshed;
   counters_.tile_frames_in_view += info.tiles_in_view;
-  counters_.unframed_tile_frames += info.tiles_unframed;
+  counters_.view_framed_keyframes += info.tiles_view_framed;
   counters_.keyframe_triangles += info.keyframe_triangles;
   counters_.low_triangles += info.low_triangles;
   counters_.sprite_triangles += info.sprite_triangles;

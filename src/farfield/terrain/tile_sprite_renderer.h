@@ -9,10 +9,11 @@
 //   sprite, or whose error reaches epsilon, is re-rendered alone.
 // - A tile's keyframe frames its region: the grid rectangle of the tile and of the tile's low-resolution triangles
 //   in that frame (far triangles reach past a small tile), grown by region_margin, with the heights of the tiles it
-//   touches. The whole tile, not only its part in view: a turning or advancing view brings the rest into view. The camera sits at the eye and looks at the
-//   region's box, its frustum just enclosing the box, at the frame's pixel density (so the sprite is as sharp as a
-//   whole-frame keyframe would be there). Since it frames the whole region, the sprite stays valid whatever the
-//   view direction later: its validity depends on the eye's position only, which is what equation 2 measures.
+//   touches. The whole tile, not only its part in view: a turning or advancing view brings the rest into view. The
+//   camera sits at the eye and looks at the region's box, its frustum just enclosing the box, at the frame's pixel
+//   density (so the sprite is as sharp as a whole-frame keyframe would be there). Since it frames the whole region,
+//   the sprite stays valid whatever the view direction later: its validity depends on the eye's position only,
+//   which is what equation 2 measures.
 //   Only the high-resolution triangles that meet the region are drawn into it (the LOD built over the region's
 //   blocks), and its z-buffer is kept.
 // - Drawing: a low-resolution triangle whose three vertices lie inside its tile's region and are visible in the
@@ -20,7 +21,9 @@
 //   original texture, as the paper does with triangles the keyframe did not see. Occlusion between tiles is the
 //   frame's own z-buffer's business: a sprite holds its region's terrain unoccluded by other tiles.
 // - A tile whose region cannot be framed (it reaches behind or beside the eye by more than max_half_angle_deg,
-//   e.g. the ground right under a low eye) gets no sprite in that frame: its triangles take the original texture.
+//   e.g. the ground right under a low eye) takes the frame's own view instead, widened by view_margin on each side
+//   as the whole-frame keyframe is; such a sprite is also refreshed when the view has turned by more than that
+//   margin's angle (triangles out of its image would otherwise fall back to the original texture).
 //
 // Far tiles subtend small parallax angles, so their sprites last longer than near ones; a refresh re-renders one
 // tile's high LOD, not the frame's. Sprites of tiles out of view for keep_frames frames are released.
@@ -53,13 +56,14 @@ struct TileSpriteRenderOptions {
   float region_margin = 0.1f;      // share of the region's side added on each side (at least one cell)
   float max_half_angle_deg = 60.0f;  // widest half-angle of a tile keyframe's frustum
   int max_sprite_size = 2048;      // pixels per side; larger regions are drawn at a lower density
+  float view_margin = 0.1f;        // share of the frame added on each side of a keyframe taking the frame's view
   int keep_frames = 30;            // frames a sprite is kept out of view
 };
 
 struct TileSpriteRenderFrame {
   size_t tiles_in_view = 0;       // tiles holding a triangle of the frame's low mesh
   size_t tiles_refreshed = 0;     // keyframes rendered in this frame
-  size_t tiles_unframed = 0;      // tiles in view that could not be framed (no sprite this frame)
+  size_t tiles_view_framed = 0;   // keyframes of this frame that took the frame's view (the region could not be framed)
   uint64_t keyframe_triangles = 0;  // high-resolution triangles drawn into this frame's keyframes
   uint64_t keyframe_pixels = 0;     // their pixels
   uint64_t low_triangles = 0;
@@ -72,7 +76,7 @@ struct TileSpriteCounters {
   size_t frames_with_keyframes = 0;
   size_t tile_keyframes = 0;
   size_t tile_frames_in_view = 0;
-  size_t unframed_tile_frames = 0;
+  size_t view_framed_keyframes = 0;
   uint64_t keyframe_triangles = 0;
   uint64_t low_triangles = 0;
   uint64_t sprite_triangles = 0;
@@ -110,6 +114,7 @@ class TileSpriteRenderer {
   struct Sprite;
   using TileKey = std::pair<int, int>;
   bool frame(const Camera& camera, GridRect region, Camera& out) const;
+  Camera viewKeyframe(const Camera& camera) const;
   void renderKeyframe(Sprite& sprite, TileSpriteRenderFrame& info, gpu::FrameStats& stats);
   gpu::RenderTarget takeTarget(int width, int height);
   void release(Sprite& sprite);
