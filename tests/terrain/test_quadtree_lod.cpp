@@ -166,6 +166,31 @@ void expectCrackFree(const Heightfield& hf, int block) {
     }
 }
 
+TEST(QuadtreeLod, RemovingTrianglesInsideARectKeepsEveryOtherInOrder) {
+  const Heightfield hf = smallFractal(65, 4);
+  const QuadtreeLod lod(hf, 16);
+  const Camera camera = viewOver(hf, Vec3(320, -200, 900), Vec3(320, 400, 0));
+  const LodMesh full = lod.build(camera, LodSettings{2.0f, true, true});
+  const GridRect rect{10, 20, 40, 50};
+  LodMesh cut = full;
+  removeTrianglesInside(cut, rect, uint32_t(hf.width));
+  std::vector<uint32_t> expected;
+  for (size_t t = 0; t < full.indices.size(); t += 3) {
+    int inside = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      const int x = int(full.indices[t + k]) % hf.width, y = int(full.indices[t + k]) / hf.width;
+      inside += (x >= 10 && x <= 40 && y >= 20 && y <= 50) ? 1 : 0;
+    }
+    if (inside < 3) expected.insert(expected.end(), full.indices.begin() + long(t), full.indices.begin() + long(t + 3));
+  }
+  EXPECT_EQ(cut.indices, expected);
+  EXPECT_LT(cut.indices.size(), full.indices.size());
+  EXPECT_EQ(cut.quadrants.size(), full.quadrants.size());
+  LodMesh same = full;
+  removeTrianglesInside(same, GridRect{}, uint32_t(hf.width));  // empty: nothing removed
+  EXPECT_EQ(same.indices, full.indices);
+}
+
 TEST(QuadtreeLod, CrackFreeOneBlock) { expectCrackFree(smallFractal(65, 11), 64); }
 
 TEST(QuadtreeLod, CrackFreeAcrossSeveralBlocks) {

@@ -11,18 +11,21 @@
 
 #include "farfield/core/checked_cast.h"
 #include "farfield/core/error.h"
+#include "farfield/eval/city_on_terrain_mode.h"
 #include "farfield/eval/mode_options.h"
 #include "farfield/terrain/tiled_lod.h"
 
 namespace farfield::eval {
-namespace {
 
-// `terrain bench` sets the run; under `farfield bench` the first terrain mode loads it from the mode options.
-std::shared_ptr<TerrainRun> runFor(const ModeContext& context, const std::string& mode) {
+std::shared_ptr<TerrainRun> terrainRunFor(const ModeContext& context, const std::string& mode) {
   std::shared_ptr<TerrainRun>& run = currentTerrainRun();
   if (!run) {
     auto loaded = std::make_shared<TerrainRun>();
-    loaded->data = terrain::TerrainData::load(context.requireOption("terrain", mode));
+    terrain::TerrainLoadOptions load;
+    if (!context.option("terrain_scale").empty())
+      load.centred_scale =
+          checkedCast<float>(positiveOption(context, "terrain_scale", 1.0), "--mode-option terrain_scale", "value");
+    loaded->data = terrain::TerrainData::load(context.requireOption("terrain", mode), load);
     loaded->high_error =
         checkedCast<float>(positiveOption(context, "high_error", loaded->high_error), "--mode-option high_error", "value");
     loaded->low_error =
@@ -35,7 +38,6 @@ std::shared_ptr<TerrainRun> runFor(const ModeContext& context, const std::string
   return run;
 }
 
-}  // namespace
 
 gpu::TerrainRenderer& TerrainRun::gpuRenderer() {
   if (!renderer) {
@@ -52,7 +54,7 @@ std::shared_ptr<TerrainRun>& currentTerrainRun() {
 }
 
 void LodMode::prepare(const ModeContext& context) {
-  run_ = runFor(context, name_);
+  run_ = terrainRunFor(context, name_);
   run_->gpuRenderer();
 }
 
@@ -77,7 +79,7 @@ TiledLodMode::~TiledLodMode() {
 }
 
 void TiledLodMode::prepare(const ModeContext& context) {
-  run_ = runFor(context, name());
+  run_ = terrainRunFor(context, name());
   run_->gpuRenderer();
   const int tile_blocks = intOption(context, "tile_blocks", 4, 1, 1 << 16);
   const uint64_t budget = mebibytesOption(context, "tile_budget_mb", uint64_t(256) << 20);
@@ -129,7 +131,7 @@ bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant) {
 }
 
 void SpriteMode::prepare(const ModeContext& context) {
-  run_ = runFor(context, name_);
+  run_ = terrainRunFor(context, name_);
   const terrain::LodSpriteOptions o = spriteOptions(*run_, variant_, epsilon_ > 0.0 ? epsilon_ : run_->epsilon);
   sprite_ = std::make_unique<terrain::LodSpriteRenderer>(*run_->data->lod, run_->gpuRenderer(), context.width,
                                                          context.height, o);
@@ -180,7 +182,7 @@ terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run) {
 }
 
 void TileSpriteMode::prepare(const ModeContext& context) {
-  run_ = runFor(context, name());
+  run_ = terrainRunFor(context, name());
   sprite_ = std::make_unique<terrain::TileSpriteRenderer>(*run_->data->lod, run_->gpuRenderer(), context.width,
                                                           context.height, tileSpriteOptions(*run_));
 }
@@ -236,6 +238,7 @@ void registerTerrainModes() {
                [](const ModeContext&) {
                  return std::make_unique<SpriteMode>("lod-sprite-cache", SpriteVariant::Cache);
                });
+  registerCityOnTerrainModes();
   registerMode("lod-sprite-tiles", "terrain: LOD-sprite with a sprite per terrain tile (--mode-option tile_cells=N)",
                [](const ModeContext&) { return std::make_unique<TileSpriteMode>(); });
 }

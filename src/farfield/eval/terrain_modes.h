@@ -53,6 +53,10 @@ struct TerrainRun {
 
 // The run the terrain modes use; null when none is set (the first terrain mode then loads one from its options).
 std::shared_ptr<TerrainRun>& currentTerrainRun();
+// The current run, or one loaded from the mode options when none is set: terrain=SPEC (required), high_error=,
+// low_error=, epsilon= (pixels), tile_cells=N, terrain_scale=S (heights relative to the terrain's centre times S,
+// terrain_data.h: the ground of a city made with `gen city --terrain SPEC --terrain-scale S`).
+std::shared_ptr<TerrainRun> terrainRunFor(const ModeContext& context, const std::string& mode);
 
 // Sets the current run for its lifetime and clears it afterwards (also when an exception leaves the scope).
 class ScopedTerrainRun {

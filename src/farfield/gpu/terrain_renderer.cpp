@@ -57,10 +57,17 @@ void TerrainRenderer::setState(const Camera& camera, RenderTarget& target, int s
 }
 
 void TerrainRenderer::drawRange(size_t first, size_t count) {
+  const bool bias = bias_factor_ != 0.0f || bias_units_ != 0.0f;
+  if (bias) {
+    // Reversed Z: farther is smaller.
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(-bias_factor_, -bias_units_);
+  }
   glBindVertexArray(vao_);
   glDrawElements(GL_TRIANGLES, GLsizei(count * 3), GL_UNSIGNED_INT,
                  reinterpret_cast<const void*>(first * 3 * sizeof(uint32_t)));
   glBindVertexArray(0);
+  if (bias) glDisable(GL_POLYGON_OFFSET_FILL);
 }
 
 void TerrainRenderer::finish() { glFinish(); }

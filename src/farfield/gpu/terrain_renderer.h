@@ -51,6 +51,14 @@ class TerrainRenderer {
   FrameStats drawSprite(const Camera& camera, RenderTarget& target, const Texture& sprite,
                         const Mat4& sprite_view_proj, size_t first, size_t count, int slot = 0);
 
+  // Pushes the terrain's depth away from the eye by slope_factor times each triangle's depth change per pixel plus
+  // `units` steps of the depth buffer (glPolygonOffset), so that ground drawn by someone else on the same surface
+  // (a city's streets) wins the depth test; 0, 0 (the default) = no bias. Applies to the draws that follow.
+  void setDepthBias(float slope_factor, float units) {
+    bias_factor_ = slope_factor;
+    bias_units_ = units;
+  }
+
   // Waits until every command issued so far has completed (glFinish): the end of a timed terrain frame.
   void finish();
 
@@ -70,6 +78,7 @@ class TerrainRenderer {
   Program textured_;
   Program sprite_;
   Vec2 uv_scale_{1.0f}, uv_offset_{0.0f};
+  float bias_factor_ = 0.0f, bias_units_ = 0.0f;
 };
 
 }  // namespace farfield::gpu

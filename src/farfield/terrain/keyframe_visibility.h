@@ -38,12 +38,6 @@ struct VisibilityOptions {
 bool vertexVisible(const Camera& keyframe, const image::DepthImage& depth, const Vec3& p, const Vec3& n,
                    const VisibilityOptions& options = {});
 
-// A rectangle of grid points, [x0, x1] x [y0, y1] inclusive.
-struct GridRect {
-  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
-  bool contains(int x, int y) const { return x >= x0 && x <= x1 && y >= y0 && y <= y1; }
-};
-
 // Per-vertex visibility against one keyframe, computed once per grid vertex on first use (the LOD mesh changes
 // from frame to frame, so vertices that were not in the keyframe-time mesh are classified when they first appear,
 // by the same test against the stored z-buffer; the paper classifies the keyframe-time mesh in one pass). The

@@ -11,8 +11,10 @@
 namespace farfield::terrain {
 
 gpu::FrameStats renderLodFrame(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, const Camera& camera,
-                               const LodSettings& settings, gpu::RenderTarget& target, LodMesh& scratch) {
+                               const LodSettings& settings, gpu::RenderTarget& target, LodMesh& scratch,
+                               const GridRect& hole) {
   lod.build(camera, settings, scratch);
+  removeTrianglesInside(scratch, hole, uint32_t(lod.width()));
   renderer.setIndices(scratch.indices, 0);
   return renderer.drawTextured(camera, target, 0, scratch.triangleCount(), 0);
 }
@@ -155,6 +157,7 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
   k->view_proj = k->camera.viewProjection();
   // Figure 3, lines 1 and 5: the high-resolution mesh rendered into the sprite; then the z-buffer is kept.
   lod_.build(k->camera, LodSettings{options_.high_error, true, false}, high_);
+  removeTrianglesInside(high_, options_.hole, uint32_t(lod_.width()));
   renderer_.setIndices(high_.indices, 0);
   k->target.clear(options_.sky_color);
   gpu::addDraw(stats, renderer_.drawTextured(k->camera, k->target, 0, high_.triangleCount(), 0));
@@ -218,6 +221,7 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
   const size_t chunks = pending_chunks_;
   if (pending_chunk_ == 0) {
     lod_.build(k.camera, LodSettings{options_.high_error, true, false}, pending_mesh_);
+    removeTrianglesInside(pending_mesh_, options_.hole, uint32_t(lod_.width()));
     renderer_.setIndices(pending_mesh_.indices, 1);
     k.target.clear(options_.sky_color);
     ++pending_chunk_;
@@ -259,8 +263,8 @@ gpu::FrameStats LodSpriteRenderer::renderHigh(const Camera& camera, gpu::RenderT
                                               LodSpriteFrameInfo& info) {
   info.path = TerrainPath::High;
   ++counters_.high_frames;
-  const gpu::FrameStats stats =
-      renderLodFrame(lod_, renderer_, camera, LodSettings{options_.high_error, true, false}, target, high_);
+  const gpu::FrameStats stats = renderLodFrame(lod_, renderer_, camera, LodSettings{options_.high_error, true, false},
+                                               target, high_, options_.hole);
   info.high_triangles = high_.triangleCount();
   high_triangles_frame_ = high_.triangleCount();
   high_latest_is_key_ = false;
@@ -279,6 +283,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
 
   // Figure 3, line 6 (done first: the error metric of line 3 runs over this mesh's quadrants).
   lod_.build(camera, LodSettings{options_.low_error, true, true}, low_);
+  removeTrianglesInside(low_, options_.hole, uint32_t(lod_.width()));
   info.quadrants = low_.quadrants.size();
   const double beta = pixelAngle(camera);
   auto errorOf = [&](const Keyframe& k) { return spriteError(lod_, low_.quadrants, k.camera.eye, camera.eye); };

@@ -55,9 +55,11 @@ std::vector<uint8_t> simulateKeyframes(const QuadtreeLod& lod, const std::vector
                                        double epsilon, std::vector<double>* error_px = nullptr);
 
 // Renders one frame of a LOD mesh with the original texture (the "high" and "low" runs). Binds the target; does not
-// clear it and does not wait. `scratch` keeps its allocation between frames.
+// clear it and does not wait. `scratch` keeps its allocation between frames. hole: grid points whose triangles are
+// left out (removeTrianglesInside).
 gpu::FrameStats renderLodFrame(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, const Camera& camera,
-                               const LodSettings& settings, gpu::RenderTarget& target, LodMesh& scratch);
+                               const LodSettings& settings, gpu::RenderTarget& target, LodMesh& scratch,
+                               const GridRect& hole = {});
 
 struct LodSpriteOptions {
   double epsilon = 1.0;     // error threshold, pixels (equation 2)
@@ -84,6 +86,9 @@ struct LodSpriteOptions {
   // Must outlive the renderer.
   const TerrainCost* cost = nullptr;
   int lifetime_history = 5;  // recent sprite lifetimes (real or virtual) the expected lifetime is the median of
+  // Grid points whose triangles are not drawn (removeTrianglesInside; every mesh the renderer draws): ground that
+  // something else draws, e.g. a city's. The error metric still counts the quadrants there.
+  GridRect hole;
 };
 
 enum class SpriteSource : uint8_t {

@@ -354,4 +354,16 @@ std::vector<uint32_t> QuadtreeLod::fullResolutionIndices() const {
   return indices;
 }
 
+void removeTrianglesInside(LodMesh& mesh, const GridRect& rect, uint32_t grid_width) {
+  if (rect.empty()) return;
+  auto inside = [&](uint32_t v) { return rect.contains(int(v % grid_width), int(v / grid_width)); };
+  size_t kept = 0;
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
+    if (inside(a) && inside(b) && inside(c)) continue;
+    mesh.indices[kept++] = a, mesh.indices[kept++] = b, mesh.indices[kept++] = c;
+  }
+  mesh.indices.resize(kept);
+}
+
 }  // namespace farfield::terrain

@@ -58,6 +58,17 @@ struct LodMesh {
   }
 };
 
+// A rectangle of grid points, [x0, x1] x [y0, y1] inclusive (empty by default).
+struct GridRect {
+  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+  bool empty() const { return x1 < x0 || y1 < y0; }
+  bool contains(int x, int y) const { return x >= x0 && x <= x1 && y >= y0 && y <= y1; }
+};
+
+// Removes the triangles whose three vertices lie in `rect` (grid indices of a grid `grid_width` points wide); the
+// quadrants stay. A hole cut for ground drawn by something else (a city on the terrain).
+void removeTrianglesInside(LodMesh& mesh, const GridRect& rect, uint32_t grid_width);
+
 // Part of a LOD to build, for a LOD over one tile of a larger grid (tiled_lod.h): only the blocks
 // [block_x0, block_x1) x [block_y0, block_y1) are refined, and the mesh's indices (and quadrants) are grid indices
 // of the larger grid, (x * step + origin.x) + (y * step + origin.y) * global_width for the LOD's grid point (x, y).

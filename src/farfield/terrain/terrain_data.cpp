@@ -69,6 +69,14 @@ std::unique_ptr<TerrainData> TerrainData::load(const std::string& spec, const Te
   } else {
     data->source = loadDem(spec, options.dem);
   }
+  if (!(options.centred_scale >= 0.0f && std::isfinite(options.centred_scale)))
+    throw Error(spec, "the terrain's vertical scale must be a finite number >= 0");
+  const double cx = 0.5 * data->source.extentX(), cy = 0.5 * data->source.extentY();
+  if (options.centred_scale > 0.0f) {
+    // As the city's ground function samples it (apps/farfield/city_terrain.cpp).
+    const float base = data->source.sample(cx, cy);
+    for (float& h : data->source.heights) h = options.centred_scale * (h - base);
+  }
   if (options.block < 2 || (options.block & (options.block - 1)) != 0)
     throw Error("LOD block size", "must be a power of two >= 2");
   // Blocks as large as the grid allows, up to the option: bigger blocks let the low-resolution LOD get coarser.
@@ -77,6 +85,7 @@ std::unique_ptr<TerrainData> TerrainData::load(const std::string& spec, const Te
   data->hf = cropForBlocks(data->source, block);
   data->crop_i0 = (data->source.width - data->hf.width) / 2;
   data->crop_j0 = (data->source.height - data->hf.height) / 2;
+  data->source_centre = DVec2(cx - data->crop_i0 * data->source.cell_x, cy - data->crop_j0 * data->source.cell_y);
   data->lod = std::make_unique<QuadtreeLod>(data->hf, block);
   if (options.texture.empty()) {
     TextureOptions t;

@@ -20,6 +20,9 @@ struct TerrainLoadOptions {
   int texture_scale = 1;  // texels per cell
   std::string texture;    // a PNG to use as the original texture instead of the generated one ("" = generate)
   DemLoadOptions dem;     // how a DEM file is read (band, cell size, height scale, size limit)
+  // > 0: heights relative to the terrain's height at its centre, times this scale: the ground a city made with
+  // `farfield gen city --terrain SPEC --terrain-scale S` stands on (its z = 0 at the centre). 0 = heights as loaded.
+  float centred_scale = 0.0f;
 };
 
 // "fractal:SIZE[:SEED][:relief=M][:roughness=R][:cell=M]" -> the fractal's options (the others at their defaults;
@@ -32,6 +35,7 @@ struct TerrainData {
   Heightfield source;  // as loaded (before cropping)
   Heightfield hf;      // cropped to whole LOD blocks; the terrain everything renders
   int crop_i0 = 0, crop_j0 = 0;  // position of hf's grid point (0, 0) in `source`
+  DVec2 source_centre{0.0};     // the centre of `source` in hf's local frame (metres): where a city's origin lies
   std::unique_ptr<QuadtreeLod> lod;
   image::ColorImage texture;
 

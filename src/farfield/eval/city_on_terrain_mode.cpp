@@ -1,0 +1,108 @@
+// A city and a terrain in one frame (see city_on_terrain_mode.h).
+#include "farfield/eval/city_on_terrain_mode.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "farfield/core/error.h"
+
+namespace farfield::eval {
+namespace {
+
+// The terrain's depth bias under a city, in depth slopes per pixel: its LOD error is at most high_error (1 px).
+constexpr float kDepthBiasSlopes = 2.0f;
+
+}  // namespace
+
+CityOnTerrainMode::CityOnTerrainMode(std::string terrain, std::string city)
+    : terrain_(std::move(terrain)), city_(std::move(city)) {
+  if (terrain_ != "high" && terrain_ != "lod-sprite")
+    throw Error("mode " + name(), "the terrain technique must be high or lod-sprite");
+}
+
+void CityOnTerrainMode::prepare(const ModeContext& context) {
+  if (!context.scene) throw Error("mode " + name(), "needs the city's scene");
+  run_ = terrainRunFor(context, name());
+  const terrain::TerrainData& data = *run_->data;
+  offset_ = Vec3(float(data.source_centre.x), float(data.source_centre.y), 0.0f);
+  // The hole: grid points strictly inside the city's ground rectangle, one cell in from its edge.
+  hole_ = {};
+  for (const scene::Object& o : context.scene->objects) {
+    if (o.name != "ground") continue;
+    const Box3& b = o.world_bounds;
+    const double cx = data.hf.cell_x, cy = data.hf.cell_y;
+    hole_.x0 = std::max(0, int(std::ceil((double(b.lo.x) + data.source_centre.x) / cx)) + 1);
+    hole_.y0 = std::max(0, int(std::ceil((double(b.lo.y) + data.source_centre.y) / cy)) + 1);
+    hole_.x1 = std::min(data.hf.width - 1, int(std::floor((double(b.hi.x) + data.source_centre.x) / cx)) - 1);
+    hole_.y1 = std::min(data.hf.height - 1, int(std::floor((double(b.hi.y) + data.source_centre.y) / cy)) - 1);
+    break;
+  }
+  gpu::TerrainRenderer& renderer = run_->gpuRenderer();
+  if (terrain_ == "lod-sprite") {
+    terrain::LodSpriteOptions o = spriteOptions(*run_, SpriteVariant::Always, run_->epsilon);
+    o.hole = hole_;
+    sprite_ = std::make_unique<terrain::LodSpriteRenderer>(*data.lod, renderer, context.width, context.height, o);
+  }
+  city_mode_ = createMode(city_, context);
+  city_mode_->prepare(context);
+}
+
+Camera CityOnTerrainMode::terrainCamera(const Camera& city_camera) const {
+  Camera c = city_camera;
+  c.eye += offset_;
+  c.at += offset_;
+  return c;
+}
+
+void CityOnTerrainMode::frame(FrameContext& frame) {
+  // A path frame at or before the last one starts a new pass (as the sprite modes do).
+  if (sprite_ && started_ && frame.pathFrame() <= last_frame_) sprite_->reset();
+  started_ = true;
+  last_frame_ = frame.pathFrame();
+  gpu::RenderTarget& target = frame.beginOwnPass();
+  const Camera camera = terrainCamera(frame.camera());
+  gpu::FrameStats stats;
+  gpu::TerrainRenderer& renderer = run_->gpuRenderer();
+  // Where the terrain's LOD triangles reach over the city's ground near the hole's edge, the ground wins.
+  renderer.setDepthBias(kDepthBiasSlopes, kDepthBiasSlopes);
+  if (sprite_) {
+    stats = sprite_->render(camera, target);
+  } else {
+    stats = terrain::renderLodFrame(*run_->data->lod, renderer, camera,
+                                    terrain::LodSettings{run_->high_error, true, false}, target, mesh_, hole_);
+  }
+  renderer.setDepthBias(0.0f, 0.0f);
+  terrain_triangles_ += stats.triangles;
+  ++frames_;
+  frame.addStats(stats);
+  city_mode_->frame(frame);
+}
+
+std::map<std::string, double> CityOnTerrainMode::info() const {
+  std::map<std::string, double> out;
+  for (const auto& [key, value] : city_mode_->info()) out["city_" + key] = value;
+  out["terrain_triangles_per_frame"] = frames_ ? double(terrain_triangles_) / double(frames_) : 0.0;
+  out["terrain_hole_grid_points"] =
+      hole_.empty() ? 0.0 : double(hole_.x1 - hole_.x0 + 1) * double(hole_.y1 - hole_.y0 + 1);
+  if (sprite_) {
+    const terrain::LodSpriteCounters& c = sprite_->counters();
+    out["terrain_keyframes"] = double(c.fresh_keyframes);
+    out["terrain_keyframe_fraction"] = double(c.fresh_keyframes) / double(std::max<size_t>(c.frames, 1));
+    out["terrain_epsilon_px"] = sprite_->options().epsilon;
+  }
+  return out;
+}
+
+void registerCityOnTerrainModes() {
+  for (const char* terrain : {"high", "lod-sprite"})
+    for (const char* city : {"culled", "dynamic-shade"}) {
+      const std::string t = terrain, c = city;
+      registerMode("terrain-" + t + "+" + c,
+                   "a city (" + c + ") on a terrain (" + t +
+                       ") in one frame (--mode-option terrain=SPEC terrain_scale=S, as gen city --terrain)",
+                   [t, c](const ModeContext&) { return std::make_unique<CityOnTerrainMode>(t, c); });
+    }
+}
+
+}  // namespace farfield::eval

@@ -1,0 +1,60 @@
+// A city and a terrain in one frame (issue 18): the city's scene drawn by a walkthrough mode ("culled",
+// "dynamic-shade", ...) over a terrain drawn by a terrain technique ("high": the 1 px quadtree LOD, or "lod-sprite":
+// Chen et al. 1999 on every frame), both into the frame's target, the z-buffer deciding between them.
+//
+// The city must have been made on the same terrain: `farfield gen city --terrain SPEC --terrain-scale S`, then
+// `farfield bench city.glb path.json --modes terrain-lod-sprite+culled --mode-option terrain=SPEC --mode-option
+// terrain_scale=S`. Its origin lies over the terrain's centre and its heights are the terrain's relative to the
+// centre's, times S (terrain_data.h, centred_scale): the terrain is drawn with the camera moved by the centre's
+// position, which is the same frame up to a translation. The city's own ground (object "ground": its streets, over
+// the terrain's surface) covers the city; the terrain's triangles under it are left out (a hole of whole grid
+// cells inside the ground's rectangle), so the two do not fight for the same pixels.
+//
+// Names: "terrain-high+MODE" and "terrain-lod-sprite+MODE" for MODE culled and dynamic-shade (registered by
+// registerTerrainModes); the mode's own options apply. info(): the city mode's, prefixed "city_", and the terrain's.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "farfield/eval/mode.h"
+#include "farfield/eval/terrain_modes.h"
+#include "farfield/terrain/lod_sprite.h"
+#include "farfield/terrain/quadtree_lod.h"
+
+namespace farfield::eval {
+
+class CityOnTerrainMode : public Mode {
+ public:
+  // terrain: "high" or "lod-sprite"; city: a registered walkthrough mode's name.
+  CityOnTerrainMode(std::string terrain, std::string city);
+  std::string name() const override { return "terrain-" + terrain_ + "+" + city_; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::map<std::string, double> info() const override;
+
+  // The terrain's camera for a city camera (moved by the city origin's position in the terrain's frame), and the
+  // grid points left out under the city's ground (tests).
+  Camera terrainCamera(const Camera& city_camera) const;
+  const terrain::GridRect& hole() const { return hole_; }
+
+ private:
+  std::string terrain_, city_;
+  std::unique_ptr<Mode> city_mode_;
+  std::shared_ptr<TerrainRun> run_;
+  std::unique_ptr<terrain::LodSpriteRenderer> sprite_;
+  terrain::GridRect hole_;
+  Vec3 offset_{0.0f};
+  terrain::LodMesh mesh_;
+  bool started_ = false;
+  size_t last_frame_ = 0;
+  uint64_t terrain_triangles_ = 0;
+  size_t frames_ = 0;
+};
+
+// Registers "terrain-high+culled", "terrain-lod-sprite+culled", "terrain-high+dynamic-shade" and
+// "terrain-lod-sprite+dynamic-shade" (called by registerTerrainModes).
+void registerCityOnTerrainModes();
+
+}  // namespace farfield::eval

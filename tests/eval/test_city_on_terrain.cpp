@@ -1,0 +1,152 @@
+// A city and a terrain in one frame (eval/city_on_terrain_mode.h): the terrain's heights are the city's ground, and
+// the frame is the depth composite of the city drawn alone and the terrain drawn alone (GL: headless llvmpipe).
+#include "farfield/eval/city_on_terrain_mode.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "farfield/core/error.h"
+#include "farfield/eval/frame_runner.h"
+#include "farfield/eval/terrain_modes.h"
+#include "farfield/gen/city.h"
+#include "farfield/gpu/context.h"
+#include "farfield/terrain/fractal.h"
+#include "farfield/terrain/terrain_data.h"
+#include "support/test_support.h"
+
+namespace farfield::eval {
+namespace {
+
+const char* const kSpec = "fractal:129:6:relief=300";
+constexpr float kScale = 0.5f;
+
+// The city's ground as `farfield gen city --terrain kSpec --terrain-scale kScale` makes it (apps/farfield/
+// city_terrain.cpp), computed here from the raw fractal.
+struct Ground {
+  terrain::Heightfield raw = terrain::fractalTerrain(terrain::parseFractalSpec(kSpec));
+  double cx = 0.5 * raw.extentX(), cy = 0.5 * raw.extentY();
+  float base = raw.sample(cx, cy);
+  float at(Vec2 p) const { return kScale * (raw.sample(cx + double(p.x), cy + double(p.y)) - base); }
+};
+
+TEST(CityOnTerrain, TheTerrainsHeightsAreTheCitysGround) {
+  terrain::TerrainLoadOptions load;
+  load.block = 32;
+  load.centred_scale = kScale;
+  const auto data = terrain::TerrainData::load(kSpec, load);
+  const Ground ground;
+  size_t checked = 0;
+  for (int j = 0; j < data->hf.height; j += 7)
+    for (int i = 0; i < data->hf.width; i += 5) {
+      const Vec3 p = data->lod->position(uint32_t(i) + uint32_t(j) * uint32_t(data->hf.width));
+      const Vec2 city(float(double(p.x) - data->source_centre.x), float(double(p.y) - data->source_centre.y));
+      ASSERT_NEAR(p.z, ground.at(city), 1e-3f) << i << ", " << j;
+      ++checked;
+    }
+  EXPECT_GT(checked, 300u);
+  terrain::TerrainLoadOptions bad;
+  bad.centred_scale = -1.0f;
+  EXPECT_THROW(terrain::TerrainData::load(kSpec, bad), Error);
+}
+
+TEST(CityOnTerrainGL, TheFrameIsTheNearerOfTheCityAndTheTerrain) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  registerTerrainModes();
+  currentTerrainRun().reset();
+  const Ground ground;
+  gen::CityOptions co;
+  co.blocks = 12;
+  co.seed = 4;
+  co.detail = 0;
+  co.ground = [&ground](Vec2 p) { return ground.at(p); };
+  co.ground_cell = 15.0f;
+  const gen::City city = gen::generateCity(co);
+  ModeRunResources res(city.scene, 160, 96, {{"terrain", kSpec}, {"terrain_scale", "0.5"}});
+  FrameRunner runner(res.renderer, res.target);
+  // From above the city's edge, looking across it to the terrain beyond.
+  const Box3 b = city.scene.bounds();
+  Camera camera;
+  camera.eye = Vec3(b.lo.x - 60.0f, b.lo.y - 60.0f, b.hi.z + 120.0f);
+  camera.at = Vec3(b.hi.x + 400.0f, b.hi.y + 400.0f, 0.0f);
+  camera.width = 160;
+  camera.height = 96;
+  camera.near_plane = 1.0f;
+  camera.far_plane = 20000.0f;
+
+  auto composite = std::make_unique<CityOnTerrainMode>("high", "culled");
+  composite->prepare(res.context);
+  EXPECT_FALSE(composite->hole().empty());
+  runner.run(*composite, camera, 0);
+  const image::ColorImage both = res.target.readColor();
+  const image::DepthImage both_depth = res.target.readDepth();
+
+  auto culled = createMode("culled", res.context);
+  culled->prepare(res.context);
+  runner.run(*culled, camera, 0);
+  const image::ColorImage city_only = res.target.readColor();
+  const image::DepthImage city_depth = res.target.readDepth();
+
+  gpu::RenderTarget alone(camera.width, camera.height);
+  alone.clear(res.renderer.light().sky_color);
+  terrain::LodMesh mesh;
+  const TerrainRun& run = *currentTerrainRun();
+  terrain::renderLodFrame(*run.data->lod, *run.renderer, composite->terrainCamera(camera),
+                          terrain::LodSettings{run.high_error, true, false}, alone, mesh, composite->hole());
+  const image::ColorImage terrain_only = alone.readColor();
+  const image::DepthImage terrain_depth = alone.readDepth();
+
+  size_t compared = 0, differ = 0, terrain_wins = 0, city_wins = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const float dc = city_depth.at(x, y), dt = terrain_depth.at(x, y);
+      // Reversed Z: the larger depth is nearer. Near-ties (the city's ground over the terrain at the hole's edge,
+      // where the composite biases the terrain away) are left out.
+      if (dc > 0.0f && dt > 0.0f &&
+          std::abs(camera.linearDepth(dc) - camera.linearDepth(dt)) < 0.02f * camera.linearDepth(dc))
+        continue;
+      const bool terrain_nearer = dt > dc;
+      (terrain_nearer ? terrain_wins : city_wins) += 1;
+      const image::Rgba8 expected = terrain_nearer ? terrain_only.at(x, y) : city_only.at(x, y);
+      differ += both.at(x, y) == expected ? 0 : 1;
+      ++compared;
+    }
+  EXPECT_GT(compared, size_t(camera.width * camera.height) * 9 / 10);
+  EXPECT_GT(terrain_wins, compared / 20) << "the terrain beyond the city should show";
+  EXPECT_GT(city_wins, compared / 20);
+  EXPECT_LE(differ, compared / 100) << differ << " of " << compared;
+  (void)both_depth;
+  std::printf("composite: %zu pixels compared, terrain nearer on %zu, city on %zu, %zu differ\n", compared,
+              terrain_wins, city_wins, differ);
+
+  // The terrain's camera sees a terrain point where the city's camera sees the same point in the city's frame.
+  const terrain::TerrainData& data = *run.data;
+  const Camera moved = composite->terrainCamera(camera);
+  for (int j = 0; j < data.hf.height; j += 16)
+    for (int i = 0; i < data.hf.width; i += 16) {
+      const Vec3 p = data.lod->position(uint32_t(i) + uint32_t(j) * uint32_t(data.hf.width));
+      const Vec3 in_city(float(double(p.x) - data.source_centre.x), float(double(p.y) - data.source_centre.y), p.z);
+      const Vec3 a = moved.project(p), c = camera.project(in_city);
+      // Points far off screen project to thousands of pixels: float precision scales with them.
+      EXPECT_NEAR(a.x, c.x, 0.05f + 1e-4f * std::abs(c.x));
+      EXPECT_NEAR(a.y, c.y, 0.05f + 1e-4f * std::abs(c.y));
+    }
+  // The hole lies inside the city's ground.
+  const Box3 g = city.scene.object(1).world_bounds;
+  ASSERT_EQ(city.scene.object(1).name, "ground");
+  const terrain::GridRect& h = composite->hole();
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 p = data.lod->position(uint32_t((k & 1) ? h.x1 : h.x0) +
+                                      uint32_t((k & 2) ? h.y1 : h.y0) * uint32_t(data.hf.width));
+    EXPECT_GT(double(p.x) - data.source_centre.x, double(g.lo.x));
+    EXPECT_LT(double(p.x) - data.source_centre.x, double(g.hi.x));
+    EXPECT_GT(double(p.y) - data.source_centre.y, double(g.lo.y));
+    EXPECT_LT(double(p.y) - data.source_centre.y, double(g.hi.y));
+  }
+  currentTerrainRun().reset();
+}
+
+}  // namespace
+}  // namespace farfield::eval
