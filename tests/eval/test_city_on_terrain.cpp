@@ -148,5 +148,25 @@ TEST(CityOnTerrainGL, TheFrameIsTheNearerOfTheCityAndTheTerrain) {
   currentTerrainRun().reset();
 }
 
+TEST(CityOnTerrainGL, ACityMadeOnAnotherTerrainIsRefused) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  registerTerrainModes();
+  currentTerrainRun().reset();
+  gen::CityOptions co;  // flat: no terrain under it
+  co.blocks = 10;
+  co.seed = 2;
+  co.detail = 0;
+  const gen::City city = gen::generateCity(co);
+  ModeRunResources res(city.scene, 64, 48, {{"terrain", kSpec}, {"terrain_scale", "0.5"}});
+  CityOnTerrainMode mode("lod-sprite", "culled");
+  try {
+    mode.prepare(res.context);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("gen city --terrain"), std::string::npos) << e.what();
+  }
+  currentTerrainRun().reset();
+}
+
 }  // namespace
 }  // namespace farfield::eval

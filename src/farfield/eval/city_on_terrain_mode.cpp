@@ -3,6 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <string>
+#include <vector>
 #include <utility>
 
 #include "farfield/core/error.h"
@@ -12,6 +16,35 @@ namespace {
 
 // The terrain's depth bias under a city, in depth slopes per pixel: its LOD error is at most high_error (1 px).
 constexpr float kDepthBiasSlopes = 2.0f;
+
+// A city made on another terrain (or another scale, or none) would float above or sink into this one with nothing
+// to show for it but wrong frames: the ground mesh's vertices (every k-th, up to about 1,000) must lie on the
+// terrain, within a metre or 1 % of its relief at the median.
+void checkGroundLiesOnTerrain(const scene::Scene& scene, const scene::Object& ground, const terrain::TerrainData& data,
+                              const std::string& mode) {
+  std::vector<float> offsets;
+  for (const scene::Part& part : ground.parts) {
+    const std::vector<Vec3>& positions = scene.meshes[part.mesh].positions;
+    const size_t step = std::max<size_t>(1, positions.size() / 1000);
+    for (size_t k = 0; k < positions.size(); k += step) {
+      const Vec3 p = Vec3(ground.transform * Vec4(positions[k], 1.0f));
+      const double x = double(p.x) + data.source_centre.x, y = double(p.y) + data.source_centre.y;
+      if (x < 0.0 || y < 0.0 || x > data.hf.extentX() || y > data.hf.extentY()) continue;
+      offsets.push_back(std::abs(p.z - data.hf.sample(x, y)));
+    }
+  }
+  if (offsets.empty()) throw Error("mode " + mode, "the city's ground lies outside the terrain");
+  std::nth_element(offsets.begin(), offsets.begin() + std::ptrdiff_t(offsets.size() / 2), offsets.end());
+  const float median = offsets[offsets.size() / 2];
+  const float tolerance = std::max(1.0f, 0.01f * (data.hf.maxHeight() - data.hf.minHeight()));
+  if (median > tolerance) {
+    char line[160];
+    std::snprintf(line, sizeof line, "the city's ground is %.1f m from the terrain at the median (over %.1f m)",
+                  double(median), double(tolerance));
+    throw Error("mode " + mode, std::string(line) + ": make the city with gen city --terrain SPEC --terrain-scale S "
+                                                    "and give the same terrain= and terrain_scale= here");
+  }
+}
 
 }  // namespace
 
@@ -30,6 +63,7 @@ void CityOnTerrainMode::prepare(const ModeContext& context) {
   hole_ = {};
   for (const scene::Object& o : context.scene->objects) {
     if (o.name != "ground") continue;
+    checkGroundLiesOnTerrain(*context.scene, o, data, name());
     const Box3& b = o.world_bounds;
     const double cx = data.hf.cell_x, cy = data.hf.cell_y;
     hole_.x0 = std::max(0, int(std::ceil((double(b.lo.x) + data.source_centre.x) / cx)) + 1);
