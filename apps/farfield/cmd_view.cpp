@@ -1,5 +1,6 @@
 // farfield view SCENE [--impostors DB] [--mode M] [--path P | --replay P] [--screenshot-at N,M -o DIR] [--exit]
 //               [--record OUT.json] [--size WxH] [--tmax MS] [--error-px PX] [--streets FILE] [--walk] [--tint]
+//               [--terrain DEM|fractal:... [--terrain-scale S]]
 // The interactive viewer (farfield/view/viewer.h): a window with panels over the runtime; keys in docs/VIEWER.md.
 // The allocator is set up for timing first (farfield/core/allocator.h).
 #include <memory>
@@ -78,6 +79,11 @@ const RegisterCommand reg("view", [](CLI::App& app) {
   cmd->add_flag("--walk", args->walk, "Start walking (eye 1.7 m above the ground) instead of flying");
   cmd->add_flag("--tint", o.tint, "Tint impostors by kind");
   cmd->add_flag("--check-every-frame", o.check_every_frame, "Compare every frame with full geometry (slow)");
+  cmd->add_option("--terrain", o.terrain,
+                  "Terrain under the city in full and culled, drawn by LOD-sprite: the DEM or fractal:... the city was "
+                  "made on (gen city --terrain)");
+  cmd->add_option("--terrain-scale", o.terrain_scale, "Vertical scale the city was made with (gen city --terrain-scale)")
+      ->capture_default_str();
   cmd->callback([args] { runViewCommand(*args); });
 });
 

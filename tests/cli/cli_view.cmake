@@ -20,6 +20,7 @@ expect_error("--exit" view builtin:cubes --exit)
 expect_error("--path/--replay" view builtin:cubes --path ${WORK}/orbit.json --replay ${WORK}/orbit.json)
 expect_error("no-such-scene.glb" view ${WORK}/no-such-scene.glb ${script})
 expect_error("nopath.json" view builtin:cubes --replay ${WORK}/nopath.json --exit)
+expect_error("--terrain-scale" view builtin:cubes --terrain fractal:129:5 --terrain-scale 0 ${script})
 
 if(NOT DEFINED ENV{DISPLAY})
   message(STATUS "skipped: no DISPLAY for the window checks (run under xvfb-run)")
@@ -52,3 +53,19 @@ endforeach()
 if(EXISTS ${WORK}/shots/frame_1.png)
   message(FATAL_ERROR "farfield view wrote frame_1.png, which --screenshot-at did not ask for")
 endif()
+
+# A city on a terrain, the terrain drawn under it (LOD-sprite) in culled: the frame differs from the city alone; a
+# wrong vertical scale is refused (the city's ground would not lie on the terrain).
+set(terrain fractal:129:5:relief=300)
+run_ok(${FARFIELD} gen city --blocks 12 --seed 3 --detail 0 --terrain ${terrain} --terrain-scale 0.5
+       -o ${WORK}/tc.glb)
+run_ok(${FARFIELD} path flyover ${WORK}/tc.glb --frames 3 --altitude 150 -o ${WORK}/tc_fly.json)
+set(tc_script --mode culled --replay ${WORK}/tc_fly.json --screenshot-at 0 --exit --size 160x120)
+run_ok(${FARFIELD} view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_alone)
+run_ok(${FARFIELD} view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_terrain --terrain ${terrain} --terrain-scale 0.5)
+run_ok(${FARFIELD} diff ${WORK}/tc_alone/frame_0.png ${WORK}/tc_terrain/frame_0.png)
+if(LAST_OUT MATCHES "identical")
+  message(FATAL_ERROR "farfield view --terrain drew the same frame as without the terrain:\n${LAST_OUT}")
+endif()
+expect_error("gen city --terrain" view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_bad --terrain ${terrain}
+             --terrain-scale 2)

@@ -3,6 +3,9 @@
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
+#include "farfield/core/log.h"
+#include "farfield/eval/city_on_terrain_mode.h"
+#include "farfield/eval/terrain_modes.h"
 
 namespace farfield::view {
 
@@ -21,9 +24,17 @@ ModeRenderer::ModeRenderer(const scene::Scene& scene, const gpu::GpuScene& gpu_s
   context_.renderer = &renderer;
   context_.width = target.width();
   context_.height = target.height();
+  if (!settings_.terrain.empty()) {
+    context_.options["terrain"] = settings_.terrain;
+    context_.options["terrain_scale"] = std::to_string(settings_.terrain_scale);
+  }
 }
 
-ModeRenderer::~ModeRenderer() = default;
+ModeRenderer::~ModeRenderer() {
+  // The terrain's GPU buffers go while the context is current (the run outlives the modes otherwise).
+  eval_mode_.reset();
+  if (!settings_.terrain.empty()) eval::currentTerrainRun().reset();
+}
 
 void ModeRenderer::select(const std::string& mode) {
   if (const auto representation = runtime::representationFromName(mode)) {
@@ -34,6 +45,8 @@ void ModeRenderer::select(const std::string& mode) {
     options.gpu_budget_bytes = settings_.gpu_budget_bytes;
     options.width = target_.width();
     options.height = target_.height();
+    if (!settings_.terrain.empty())
+      FF_WARN("mode " << mode << " draws the city without the terrain (full and culled draw it under the city)");
     auto walkthrough = std::make_unique<runtime::Walkthrough>(scene_, gpu_scene_, bvh_, renderer_, options);
     walkthrough_ = std::move(walkthrough);
     eval_mode_.reset();
@@ -41,7 +54,9 @@ void ModeRenderer::select(const std::string& mode) {
     if (mode != "full" && mode != "culled")
       throw Error("mode '" + mode + "'", "unknown; the viewer draws full, culled and the database's representations "
                                          "(local, visible, smi, mmi, mmi-dynamic, placed)");
-    auto created = eval::createMode(mode, context_);
+    std::unique_ptr<eval::Mode> created;
+    if (settings_.terrain.empty()) created = eval::createMode(mode, context_);
+    else created = std::make_unique<eval::CityOnTerrainMode>("lod-sprite", mode);
     created->prepare(context_);
     eval_mode_ = std::move(created);
     walkthrough_.reset();

@@ -26,6 +26,10 @@ struct ModeSettings {
   std::string database;        // impostor database directory ("" = none)
   double error_px = 0.0;       // the walkthrough's bound; 0 = the database's
   uint64_t gpu_budget_bytes = uint64_t(512) << 20;
+  // A terrain under the city (eval/city_on_terrain_mode.h), drawn by LOD-sprite in full and culled: a DEM file or
+  // fractal:... spec and the vertical scale the city was made with (gen city --terrain SPEC --terrain-scale S).
+  std::string terrain;
+  float terrain_scale = 1.0f;
 };
 
 // One displayed frame.
@@ -46,7 +50,9 @@ class ModeRenderer {
   ~ModeRenderer();
 
   // Switches to a mode ("full", "culled" or a runtime representation name). Throws farfield::Error (an unknown name,
-  // a database that cannot draw it, a damaged database); the previous mode stays in use then.
+  // a database that cannot draw it, a damaged database, a city that does not lie on the terrain); the previous mode
+  // stays in use then. With a terrain, full and culled draw it under the city; the representations do not (a
+  // warning says so).
   void select(const std::string& mode);
   const std::string& mode() const { return mode_; }
   // The walkthrough of the current mode, null for full and culled.

@@ -99,6 +99,8 @@ class Viewer {
     ModeSettings settings;
     settings.database = options_.impostors;
     settings.error_px = options_.error_px;
+    settings.terrain = options_.terrain;
+    settings.terrain_scale = options_.terrain_scale;
     panel_.gpu_budget_bytes = settings.gpu_budget_bytes;
     modes_ = std::make_unique<ModeRenderer>(scene_, gpu_scene_, bvh_, renderer_, target_, settings);
     selectMode(options_.mode.empty() ? defaultMode(database_) : options_.mode);
@@ -388,6 +390,8 @@ void checkViewerOptions(const ViewerOptions& o) {
   if (!(o.t_max_ms >= 0.0)) throw Error("--tmax", "must be a number of ms >= 0");
   if (!(o.error_px >= 0.0) || !std::isfinite(o.error_px)) throw Error("--error-px", "must be a number of pixels >= 0");
   if (!o.path.empty() && !o.replay.empty()) throw Error("--path/--replay", "give one camera path, not both");
+  if (!(o.terrain_scale > 0.0f) || !std::isfinite(o.terrain_scale))
+    throw Error("--terrain-scale", "must be a finite number > 0");
   if (!o.screenshot_at.empty() && o.out_dir.empty()) throw Error("--screenshot-at", "needs -o DIR");
   if (o.exit_at_end && o.replay.empty() && o.screenshot_at.empty())
     throw Error("--exit", "needs --replay or --screenshot-at (otherwise nothing would be shown)");

@@ -38,6 +38,8 @@ struct ViewerOptions {
   bool show_map = true;
   bool check_every_frame = false;  // reference check of every frame (slow)
   Navigation navigation = Navigation::Fly;
+  std::string terrain;             // a terrain under the city in full and culled (DEM file or fractal:...; "" = none)
+  float terrain_scale = 1.0f;      // the vertical scale the city was made with (gen city --terrain-scale)
 };
 
 // Checks the options that need no window (sizes, files to read); throws farfield::Error naming the option.
