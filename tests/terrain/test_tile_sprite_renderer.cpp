@@ -32,16 +32,25 @@ TileSpriteRenderOptions tileOptions(int tile_cells) {
   return o;
 }
 
-TEST(TileSpriteRenderer, AtTheKeyframeViewpointMatchesHighResolution) {
-  Scene scene(testFractal());
-  const float top = scene.hf.maxHeight();
-  const Camera camera = makeCamera(Vec3(1280, 700, top + 1200), Vec3(1280, 1300, 0));
-  TileSpriteRenderer tiles(*scene.lod, *scene.renderer, camera.width, camera.height, tileOptions(32));
-  gpu::RenderTarget frame(camera.width, camera.height);
-  frame.clear(kSky);
+// The fractal seen from high above, looking down across it, and the first frame of 32-cell tiles there.
+struct FirstFrame {
+  Scene scene{testFractal()};
+  Camera camera = makeCamera(Vec3(1280, 700, scene.hf.maxHeight() + 1200), Vec3(1280, 1300, 0));
+  TileSpriteRenderer tiles{*scene.lod, *scene.renderer, camera.width, camera.height, tileOptions(32)};
+  gpu::RenderTarget frame{camera.width, camera.height};
   TileSpriteRenderFrame info;
-  tiles.render(camera, frame, &info);
-  const image::ColorImage image = frame.readColor();
+  FirstFrame() {
+    frame.clear(kSky);
+    tiles.render(camera, frame, &info);
+  }
+};
+
+TEST(TileSpriteRenderer, AtTheKeyframeViewpointMatchesHighResolution) {
+  FirstFrame first;
+  Scene& scene = first.scene;
+  const Camera& camera = first.camera;
+  const TileSpriteRenderFrame& info = first.info;
+  const image::ColorImage image = first.frame.readColor();
   const image::ColorImage high = scene.renderLod(camera, 1.0f), low = scene.renderLod(camera, 4.0f);
   if (std::getenv("FF_TERRAIN_DUMP")) {
     const auto dir = farfield::test::scratchDir("terrain_tile_keyframe_view");
@@ -92,13 +101,10 @@ TEST(TileSpriteRenderer, KeptTileSpritesStayCloserToHighResolutionThanLowResolut
 }
 
 TEST(TileSpriteRenderer, ATileSpriteTexturesOnlyTrianglesInsideItsRegion) {
-  Scene scene(testFractal());
-  const float top = scene.hf.maxHeight();
-  const Camera camera = makeCamera(Vec3(1280, 700, top + 1200), Vec3(1280, 1300, 0));
-  TileSpriteRenderer tiles(*scene.lod, *scene.renderer, camera.width, camera.height, tileOptions(32));
-  gpu::RenderTarget frame(camera.width, camera.height);
-  frame.clear(kSky);
-  tiles.render(camera, frame);
+  FirstFrame first;
+  Scene& scene = first.scene;
+  const Camera& camera = first.camera;
+  const TileSpriteRenderer& tiles = first.tiles;
   const LodMesh low = scene.lod->build(camera, LodSettings{4.0f, true, false});
   const uint32_t w = uint32_t(scene.hf.width);
   size_t checked = 0, outside = 0;
