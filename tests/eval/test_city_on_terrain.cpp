@@ -148,6 +148,40 @@ TEST(CityOnTerrainGL, TheFrameIsTheNearerOfTheCityAndTheTerrain) {
   currentTerrainRun().reset();
 }
 
+TEST(CityOnTerrainGL, TheLodSpriteTerrainChoosesPerFrameByCostsMeasuredAtPrepare) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  registerTerrainModes();
+  currentTerrainRun().reset();
+  const Ground ground;
+  gen::CityOptions co;
+  co.blocks = 10;
+  co.seed = 5;
+  co.detail = 0;
+  co.ground = [&ground](Vec2 p) { return ground.at(p); };
+  co.ground_cell = 15.0f;
+  const gen::City city = gen::generateCity(co);
+  ModeRunResources res(city.scene, 96, 64, {{"terrain", kSpec}, {"terrain_scale", "0.5"}});
+  CityOnTerrainMode mode("lod-sprite", "culled");
+  mode.prepare(res.context);
+  ASSERT_TRUE(currentTerrainRun()->cost.has_value());
+  EXPECT_GT(currentTerrainRun()->cost->frame.r2, 0.0);
+  FrameRunner runner(res.renderer, res.target);
+  const Box3 b = city.scene.bounds();
+  for (size_t f = 0; f < 4; ++f) {
+    Camera camera;
+    camera.eye = Vec3(b.lo.x + 5.0f * float(f), b.lo.y - 50.0f, b.hi.z + 100.0f);
+    camera.at = Vec3(b.hi.x + 300.0f, b.hi.y + 300.0f, 0.0f);
+    camera.width = 96;
+    camera.height = 64;
+    camera.near_plane = 1.0f;
+    camera.far_plane = 20000.0f;
+    runner.run(mode, camera, f);
+  }
+  // With the choice, the run starts on the high LOD (no sprite lifetime is known yet); always-sprite would not.
+  EXPECT_GE(mode.info().at("terrain_high_frames"), 1.0);
+  currentTerrainRun().reset();
+}
+
 TEST(CityOnTerrainGL, ACityMadeOnAnotherTerrainIsRefused) {
   gpu::sharedHeadlessContext().makeCurrent();
   registerTerrainModes();

@@ -74,12 +74,47 @@ void CityOnTerrainMode::prepare(const ModeContext& context) {
   }
   gpu::TerrainRenderer& renderer = run_->gpuRenderer();
   if (terrain_ == "lod-sprite") {
-    terrain::LodSpriteOptions o = spriteOptions(*run_, SpriteVariant::Always, run_->epsilon);
+    // LOD-sprite's per-frame choice needs this machine's terrain costs (terrain bench calibrates them on its path).
+    if (!run_->cost) run_->cost = terrain::calibrateTerrainCost(*data.lod, renderer, calibrationViews(context));
+    terrain::LodSpriteOptions o = spriteOptions(*run_, SpriteVariant::Paper, run_->epsilon);
     o.hole = hole_;
     sprite_ = std::make_unique<terrain::LodSpriteRenderer>(*data.lod, renderer, context.width, context.height, o);
   }
   city_mode_ = createMode(city_, context);
   city_mode_->prepare(context);
+}
+
+terrain::TerrainCostOptions CityOnTerrainMode::calibrationViews(const ModeContext& context) const {
+  // Five views of the terrain around the city: from above each corner of the city's ground, looking out across the
+  // terrain beyond it, and one from high above the centre.
+  const terrain::TerrainData& data = *run_->data;
+  const scene::Scene& scene = *context.scene;
+  const Box3 b = scene.bounds();
+  const Vec3 lo = b.lo + offset_, hi = b.hi + offset_;
+  const Vec3 centre = 0.5f * (lo + hi);
+  const float reach = std::max(hi.x - lo.x, hi.y - lo.y);
+  terrain::TerrainCostOptions c;
+  auto view = [&](Vec3 eye, Vec3 at) {
+    Camera v;
+    v.eye = eye;
+    v.at = at;
+    v.width = context.width;
+    v.height = context.height;
+    v.near_plane = 1.0f;
+    v.far_plane = float(std::max(20000.0, 2.0 * std::max(data.hf.extentX(), data.hf.extentY())));
+    c.views.push_back(v);
+  };
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, hi.z + 0.1f * reach);
+    const Vec3 outward = glm::normalize(Vec3(corner.x - centre.x, corner.y - centre.y, 0.0f));
+    view(corner, corner + outward * reach + Vec3(0.0f, 0.0f, -0.3f * reach));
+  }
+  view(Vec3(centre.x, centre.y - 0.01f * reach, hi.z + reach), Vec3(centre.x, centre.y, lo.z));
+  const terrain::LodSpriteOptions sprite = spriteOptions(*run_, SpriteVariant::Paper, run_->epsilon);
+  c.keyframe_width = context.width + 2 * int(std::lround(sprite.keyframe_margin * float(context.width)));
+  c.keyframe_height = context.height + 2 * int(std::lround(sprite.keyframe_margin * float(context.height)));
+  c.pixel_errors = {run_->high_error, 2.0f * run_->high_error, run_->low_error, 4.0f * run_->low_error};
+  return c;
 }
 
 Camera CityOnTerrainMode::terrainCamera(const Camera& city_camera) const {
@@ -124,6 +159,9 @@ std::map<std::string, double> CityOnTerrainMode::info() const {
     out["terrain_keyframes"] = double(c.fresh_keyframes);
     out["terrain_keyframe_fraction"] = double(c.fresh_keyframes) / double(std::max<size_t>(c.frames, 1));
     out["terrain_epsilon_px"] = sprite_->options().epsilon;
+    out["terrain_high_frames"] = double(c.high_frames);
+    out["terrain_virtual_keyframes"] = double(c.virtual_keyframes);
+    out["terrain_switches"] = double(c.switches);
   }
   return out;
 }

@@ -1,6 +1,8 @@
 // A city and a terrain in one frame (issue 18): the city's scene drawn by a walkthrough mode ("culled",
 // "dynamic-shade", ...) over a terrain drawn by a terrain technique ("high": the 1 px quadtree LOD, or "lod-sprite":
-// Chen et al. 1999 on every frame), both into the frame's target, the z-buffer deciding between them.
+// Chen et al. 1999, choosing per frame between the sprite and the high LOD by this machine's terrain costs, measured
+// at prepare() from five views around the city unless the run has them), both into the frame's target, the z-buffer
+// deciding between them.
 //
 // The city must have been made on the same terrain: `farfield gen city --terrain SPEC --terrain-scale S`, then
 // `farfield bench city.glb path.json --modes terrain-lod-sprite+culled --mode-option terrain=SPEC --mode-option
@@ -22,6 +24,7 @@
 #include "farfield/eval/terrain_modes.h"
 #include "farfield/terrain/lod_sprite.h"
 #include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_cost.h"
 
 namespace farfield::eval {
 
@@ -40,6 +43,8 @@ class CityOnTerrainMode : public Mode {
   const terrain::GridRect& hole() const { return hole_; }
 
  private:
+  terrain::TerrainCostOptions calibrationViews(const ModeContext& context) const;
+
   std::string terrain_, city_;
   std::unique_ptr<Mode> city_mode_;
   std::shared_ptr<TerrainRun> run_;
