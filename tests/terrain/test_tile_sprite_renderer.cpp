@@ -2,6 +2,8 @@
 // frames against the high- and low-resolution LOD, keyframes taken per tile, and the region a sprite covers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -153,6 +155,26 @@ TEST(TileSpriteRenderer, ATileUnderALowEyeTakesTheFramesView) {
   TileSpriteRenderFrame after;
   tiles.render(turned, frame, &after);
   EXPECT_GT(after.tiles_view_framed, 0u);
+}
+
+TEST(TileSpriteRenderer, ReleasedTargetsKeptForReuseStayFew) {
+  // Every pass over new viewpoints releases its sprites, of sizes that vary with the view: only a few are kept.
+  Scene scene(testFractal());
+  const float top = scene.hf.maxHeight();
+  TileSpriteRenderer tiles(*scene.lod, *scene.renderer, 128, 128, tileOptions(32));
+  gpu::RenderTarget frame(128, 128);
+  size_t most = 0;
+  for (int pass = 0; pass < 12; ++pass) {
+    const float a = 0.5f * float(pass);
+    const Camera camera = makeCamera(Vec3(1280 + 900 * std::cos(a), 1280 + 900 * std::sin(a), top + 300 + 80 * pass),
+                                     Vec3(1280, 1280, 0));
+    frame.clear(kSky);
+    tiles.render(camera, frame);
+    tiles.reset();
+    most = std::max(most, tiles.spareTargets());
+  }
+  EXPECT_GT(most, 0u);
+  EXPECT_LE(most, 16u);
 }
 
 TEST(TileSpriteRenderer, BadOptionsAreRefused) {

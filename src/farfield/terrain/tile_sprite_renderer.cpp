@@ -95,9 +95,11 @@ bool TileSpriteRenderer::sprite(IVec2 tile, SpriteView& out) const {
 
 gpu::RenderTarget TileSpriteRenderer::takeTarget(int width, int height) {
   auto it = spare_.find({width, height});
-  if (it != spare_.end() && !it->second.empty()) {
+  if (it != spare_.end()) {
     gpu::RenderTarget t = std::move(it->second.back());
     it->second.pop_back();
+    if (it->second.empty()) spare_.erase(it);
+    --spare_count_;
     return t;
   }
   return gpu::RenderTarget(width, height);
@@ -105,8 +107,12 @@ gpu::RenderTarget TileSpriteRenderer::takeTarget(int width, int height) {
 
 void TileSpriteRenderer::release(Sprite& s) {
   if (s.target.width() > 0) {
-    std::vector<gpu::RenderTarget>& pool = spare_[{s.target.width(), s.target.height()}];
-    if (pool.size() < 4) pool.push_back(std::move(s.target));
+    // Sizes vary from sprite to sprite (multiples of 16 pixels), so only a few released targets are kept for reuse:
+    // a long flight would otherwise hold one of every size it met.
+    if (spare_count_ < kMaxSpareTargets) {
+      spare_[{s.target.width(), s.target.height()}].push_back(std::move(s.target));
+      ++spare_count_;
+    }
     s.target = gpu::RenderTarget();
   }
   s.has_keyframe = false;

@@ -101,6 +101,8 @@ class TileSpriteRenderer {
   int tilesX() const { return tiles_x_; }
   int tilesY() const { return tiles_y_; }
   const TileSpriteCounters& counters() const { return counters_; }
+  // Released render targets kept for reuse (at most kMaxSpareTargets).
+  size_t spareTargets() const { return spare_count_; }
   const TileSpriteRenderOptions& options() const { return options_; }
   // The sprite of a tile (tests): its camera, region and z-buffer; null when the tile has none.
   struct SpriteView {
@@ -127,7 +129,9 @@ class TileSpriteRenderer {
   int tiles_x_ = 0, tiles_y_ = 0;
   std::vector<float> tile_min_z_, tile_max_z_;
   std::map<TileKey, std::unique_ptr<Sprite>> sprites_;
-  std::map<TileKey, std::vector<gpu::RenderTarget>> spare_;  // released targets by size
+  static constexpr size_t kMaxSpareTargets = 16;
+  std::map<TileKey, std::vector<gpu::RenderTarget>> spare_;  // released targets by size (never an empty list)
+  size_t spare_count_ = 0;
   TileSpriteCounters counters_;
   uint64_t frame_ = 0;
   LodMesh low_, high_;
