@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -91,7 +92,10 @@ void runCity(const CityArgs& args) {
                 s.bounds.hi.x, s.bounds.hi.y, s.bounds.hi.z);
   std::printf("time:       %.2f s generation, %.2f s writing\n", generate_s, write_s);
   std::printf("memory:     %.0f MiB peak resident (%.0f MiB after generation)\n", peakMemoryMiB(), generate_peak_mib);
-  std::printf("wrote:      %s\n            %s\n", args.output.c_str(), streets.c_str());
+  std::printf("wrote:      %s\n", args.output.c_str());
+  if (std::filesystem::path(args.output).extension() == ".gltf")
+    std::printf("            %s\n", scene::gltfBufferPath(args.output).c_str());
+  std::printf("            %s\n", streets.c_str());
 }
 
 void runForest(const ForestArgs& args) {
@@ -126,7 +130,10 @@ const RegisterCommand reg("gen", [](CLI::App& app) {
   c->add_option("--terrain-scale", city->terrain_scale, "With --terrain: vertical scale of its heights (default 1)");
   c->add_option("--objects", city->objects, "One object per block (blocks) or per building (buildings)")
       ->check(CLI::IsMember({"blocks", "buildings"}));
-  c->add_option("-o,--output", city->output, "Output scene (.glb); the street graph goes next to it")->required();
+  c->add_option("-o,--output", city->output,
+                "Output scene (.glb, or .gltf + .bin for scenes over the 4 GiB of a .glb); the street graph goes next to "
+                "it")
+      ->required();
   c->add_flag("--trees", city->trees, "Street trees along the blocks and parks (gen/vegetation.h)");
   c->add_option("--park-share", city->park_share, "With --trees: share of blocks turned into parks, 0..1")
       ->check(CLI::Range(0.0f, 1.0f));
@@ -141,7 +148,7 @@ const RegisterCommand reg("gen", [](CLI::App& app) {
   f->add_option("--leaves", forest->options.tree.leaves, "Leaf triangles per tree (about)")
       ->check(CLI::Range(1, 100000));
   f->add_option("--seed", forest->options.seed, "Random seed");
-  f->add_option("-o,--output", forest->output, "Output scene (.glb)")->required();
+  f->add_option("-o,--output", forest->output, "Output scene (.glb, or .gltf + .bin)")->required();
   f->callback([forest] { runForest(*forest); });
 });
 

@@ -46,10 +46,10 @@ Scene testScene() {
   return s;
 }
 
-TEST(ExportGlb, RoundTripKeepsGeometryTexturesAndExtras) {
+// A .glb, or a .gltf with its buffer in a .bin beside it (scenes over a .glb's 4 GiB).
+void expectRoundTrip(const std::string& path) {
+  SCOPED_TRACE(path);
   const Scene src = testScene();
-  const auto dir = test::scratchDir("export_glb");
-  const std::string path = (dir / "cubes.glb").string();
   exportGlb(src, path);
   const Scene back = importScene(path);
   EXPECT_NO_THROW(back.validate(path));
@@ -92,6 +92,21 @@ TEST(ExportGlb, RoundTripKeepsGeometryTexturesAndExtras) {
   EXPECT_EQ(ground.texture->height(), ta.height());
   EXPECT_EQ(ground.texture->pixels(), ta.pixels());
   EXPECT_EQ(back.stats().textures, 1u);
+}
+
+TEST(ExportGlb, RoundTripKeepsGeometryTexturesAndExtras) {
+  expectRoundTrip((test::scratchDir("export_glb") / "cubes.glb").string());
+}
+
+TEST(ExportGltf, RoundTripThroughAJsonFileAndItsBuffer) {
+  const auto dir = test::scratchDir("export_gltf");
+  expectRoundTrip((dir / "cubes.gltf").string());
+  EXPECT_EQ(gltfBufferPath((dir / "cubes.gltf").string()), (dir / "cubes.bin").string());
+  EXPECT_GT(std::filesystem::file_size(dir / "cubes.bin"), 0u);
+  std::ifstream json(dir / "cubes.gltf");
+  const nlohmann::json j = nlohmann::json::parse(json);
+  EXPECT_EQ(j["buffers"][0]["uri"].get<std::string>(), "cubes.bin");
+  EXPECT_LE(j["buffers"][0]["byteLength"].get<uint64_t>(), std::filesystem::file_size(dir / "cubes.bin"));
 }
 
 // The builder under exportGlb, as the store's exporters use it: a subset of objects carries only what it draws; a free

@@ -308,8 +308,8 @@ float cityGroundHeight(const CityOptions& options, const Box2& city_bounds, Vec2
 }
 
 std::string streetsPathFor(const std::string& glb_path) {
-  const std::string ext = ".glb";
-  if (glb_path.size() > ext.size()) {
+  for (const std::string ext : {".glb", ".gltf"}) {
+    if (glb_path.size() <= ext.size()) continue;
     std::string tail = glb_path.substr(glb_path.size() - ext.size());
     std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     if (tail == ext) return glb_path.substr(0, glb_path.size() - ext.size()) + ".streets.json";

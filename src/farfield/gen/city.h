@@ -63,7 +63,7 @@ City generateCity(const CityOptions& options);
 float cityGroundHeight(const CityOptions& options, const Box2& city_bounds, Vec2 p);
 
 // Writes scene to `glb_path` and the street graph to the `.streets.json` next to it
-// (city.glb -> city.streets.json).
+// (city.glb or city.gltf -> city.streets.json).
 std::string streetsPathFor(const std::string& glb_path);
 
 }  // namespace farfield::gen

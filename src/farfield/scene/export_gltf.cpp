@@ -14,8 +14,10 @@
 #include <stb_image_write.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -314,8 +316,9 @@ struct GltfBuilder::Impl {
     node(o.name, objectMesh(scene, o), -1, worldToGltf() * o.transform, dump({{"farfield", std::move(ff)}}));
   }
 
-  // The glTF JSON of everything added, with one buffer of buffer_bytes (none when there are no data).
-  std::string json() const {
+  // The glTF JSON of everything added, with one buffer of buffer_bytes (none when there are no data), in the .glb's
+  // BIN chunk or, with a uri, in that file.
+  std::string json(const std::string& buffer_uri = {}) const {
     std::string out = R"({"asset":{"generator":"Farfield","version":"2.0"})";
     if (unlit_used) out += R"(,"extensionsUsed":["KHR_materials_unlit"])";
     auto list = [&out](const char* name, size_t count, const auto& element) {
@@ -330,7 +333,11 @@ struct GltfBuilder::Impl {
       out += ']';
     };
     auto number = [&out](size_t v) { out += std::to_string(v); };
-    if (buffer_bytes > 0) out += R"(,"buffers":[{"byteLength":)" + std::to_string(buffer_bytes) + "}]";
+    if (buffer_bytes > 0) {
+      out += R"(,"buffers":[{)";
+      if (!buffer_uri.empty()) out += R"("uri":)" + dump(nlohmann::json(buffer_uri)) + ",";
+      out += R"("byteLength":)" + std::to_string(buffer_bytes) + "}]";
+    }
     list("bufferViews", views.size(), [&](size_t i) {
       const View& v = views[i];
       out += R"({"buffer":0,"byteOffset":)";
@@ -453,8 +460,43 @@ int GltfBuilder::addNode(const std::string& name, int mesh, int parent, const Ma
   return impl_->node(name, mesh, parent, matrix, extras.is_null() ? std::string() : dump(extras));
 }
 
+namespace {
+
+namespace fs = std::filesystem;
+
+bool endsWithGltf(const std::string& path) {
+  const std::string ext = ".gltf";
+  if (path.size() <= ext.size()) return false;
+  std::string tail = path.substr(path.size() - ext.size());
+  std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return tail == ext;
+}
+
+}  // namespace
+
+std::string gltfBufferPath(const std::string& gltf_path) {
+  return gltf_path.substr(0, gltf_path.size() - 5) + ".bin";
+}
+
 size_t GltfBuilder::write() {
   const std::string& path = impl_->path;
+  if (endsWithGltf(path)) {
+    // JSON and a separate buffer file: no 32-bit sizes, so scenes over the .glb's 4 GiB can be written.
+    const std::string bin_path = gltfBufferPath(path);
+    const std::string json = impl_->json(impl_->buffer_bytes > 0 ? fs::path(bin_path).filename().string() : "");
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(path, "cannot open for writing");
+    out.write(json.data(), std::streamsize(json.size()));
+    out.close();
+    if (!out) throw Error(path, "write failed");
+    if (impl_->buffer_bytes == 0) return json.size();
+    std::ofstream bin(bin_path, std::ios::binary | std::ios::trunc);
+    if (!bin) throw Error(bin_path, "cannot open for writing");
+    impl_->writeBuffer(bin);
+    bin.close();
+    if (!bin) throw Error(bin_path, "write failed");
+    return json.size() + impl_->buffer_bytes;
+  }
   const size_t bin_bytes = (impl_->buffer_bytes + 3) / 4 * 4;
   std::string json = impl_->json();
   while (json.size() % 4 != 0) json.push_back(' ');

@@ -19,8 +19,11 @@
 
 namespace farfield::scene {
 
-// Throws farfield::Error naming the file when it cannot be written.
+// Throws farfield::Error naming the file when it cannot be written. A path ending in .gltf writes the JSON there and
+// the buffer next to it (gltfBufferPath), with no 4 GiB limit; any other path writes one .glb.
 void exportGlb(const Scene& scene, const std::string& path);
+// The buffer file of a .gltf written by GltfBuilder: the same path with .bin for .gltf.
+std::string gltfBufferPath(const std::string& gltf_path);
 
 // The rotation from Farfield's world (x east, y north, z up) to glTF's frame (y up): world (x, y, z) is written
 // as glTF (x, z, -y). Its inverse is the y-up to z-up turn that importers and 3D Tiles apply to glTF content.
@@ -74,7 +77,9 @@ class GltfBuilder {
 
   // Serialises the model as .glb to the path given at construction, replacing the file: the JSON chunk, then the
   // buffer streamed piece by piece (memory: the JSON and one mesh's normals). Throws farfield::Error
-  // naming it when it cannot be written or the data exceed the 4 GiB limit of a .glb. Returns the bytes written.
+  // naming it when it cannot be written or the data exceed the 4 GiB limit of a .glb. A path ending in .gltf gets
+  // the JSON, and the buffer goes to gltfBufferPath(path), streamed the same way, with no size limit. Returns the
+  // bytes written.
   size_t write();
 
  private:
