@@ -137,6 +137,36 @@ TEST(TriangulationTest, RefinementSplitsUntilThePredicateHolds) {
     }
 }
 
+// Many constraints crossing at shallow angles, at coordinates as contour simplification leaves them (fractions of
+// a pixel): the intersection points CGAL computes in doubles fall off the crossed edges, which crashed the
+// triangulation with the tag for exact number types (docs/DESIGN-NOTES.md). Every run must finish with the square's
+// area inside, whatever the snapping did to the crossings inside it.
+TEST(TriangulationTest, ManyShallowCrossingsTriangulateWithoutCrashing) {
+  uint64_t state = 12345;
+  auto uniform = [&state](double lo, double hi) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * double(state >> 11) / double(uint64_t(1) << 53);
+  };
+  size_t steiner = 0;
+  for (int run = 0; run < 300; ++run) {
+    TriangulationInput input;
+    input.loops.push_back(square(0, 64));
+    const double slope = uniform(-0.2, 0.2);
+    for (int k = 0; k < 30; ++k) {
+      // Nearly parallel chains, a fraction of a pixel apart, each bending a little.
+      std::vector<DVec2> line;
+      const double y0 = uniform(1.0, 63.0), s = slope + uniform(-0.01, 0.01);
+      for (double x = uniform(0.5, 8.0); x < 63.5; x += uniform(4.0, 20.0))
+        line.push_back({x, std::clamp(y0 + s * x + uniform(-0.3, 0.3), 0.25, 63.75)});
+      input.polylines.push_back(std::move(line));
+    }
+    const Triangulation t = triangulate(input);
+    EXPECT_NEAR(insideArea(t), 64.0 * 64.0, 1e-6) << "run " << run;
+    steiner += t.steiner_vertices;
+  }
+  EXPECT_GT(steiner, 300u);  // the chains did cross
+}
+
 TEST(TriangulationTest, EmptyAndBadInput) {
   const Triangulation empty = triangulate({});
   EXPECT_TRUE(empty.triangles.empty());

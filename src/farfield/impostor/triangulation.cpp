@@ -2,10 +2,15 @@
 // reprojection") with CGAL. This is the only translation unit that includes CGAL: it compiles slowly, so its
 // interface (triangulation.h) is plain Farfield types.
 //
-// Why Exact_intersections_tag: the simplified contour and the discrepancy polylines are built independently and
+// Why Exact_predicates_tag: the simplified contour and the discrepancy polylines are built independently and
 // may cross (a discrepancy line running to the contour, two parallel chains one pixel apart after simplification).
-// With this tag CGAL splits crossing constraints at their intersection points, computed exactly and rounded, instead
-// of refusing them.
+// With this tag CGAL splits crossing constraints at their intersection points instead of refusing them, and it is
+// the tag for a kernel with exact predicates and inexact constructions (CGAL's Itag documentation): an intersection
+// point computed in doubles that falls outside the two triangles beside the crossed edge is recomputed almost
+// exactly and otherwise snapped to an end of that edge. Exact_intersections_tag, used before, is for exact number
+// types; with this kernel it has no such check, and a rounded intersection point outside those triangles corrupted
+// the triangulation: a SIGSEGV in CGAL's find_intersected_faces while baking a depth mesh of the 100,000-block city
+// at detail 1 (`farfield bake ... --pipeline pvs,near-far,single --layer-mesh depth-mesh`, its 21st cell).
 //
 // Why inside is decided by even-odd over the loops and not by flood-filling across constrained edges: discrepancy
 // constraints are constrained edges too but do not bound the inside. Every loop segment is a union of triangulation
@@ -33,7 +38,7 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Vb = CGAL::Triangulation_vertex_base_with_info_2<uint32_t, K>;
 using Fb = CGAL::Constrained_triangulation_face_base_2<K>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_intersections_tag>;
+using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
 using Point = Cdt::Point;
 
 Point toPoint(const DVec2& p, const char* what) {

@@ -45,8 +45,9 @@ struct Triangulation {
   size_t insideCount() const;
 };
 
-// Triangulates the input; constraints may cross (intersection points are computed exactly and rounded, CGAL's
-// Exact_intersections_tag) and may overlap. Degenerate pieces (zero-length segments) are skipped. Non-finite
+// Triangulates the input; constraints may cross (intersection points computed in doubles, recomputed or snapped to
+// an edge's end when rounding puts them outside the triangles beside the crossed edge: CGAL's Exact_predicates_tag)
+// and may overlap. Degenerate pieces (zero-length segments) are skipped. Non-finite
 // coordinates throw farfield::Error.
 Triangulation triangulate(const TriangulationInput& input, const Refinement* refinement = nullptr);
 
