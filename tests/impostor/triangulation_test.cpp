@@ -4,11 +4,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include "farfield/core/error.h"
 #include "farfield/impostor/contour.h"
+#include "support/test_support.h"
 
 namespace farfield::impostor {
 namespace {
@@ -165,6 +170,50 @@ TEST(TriangulationTest, ManyShallowCrossingsTriangulateWithoutCrashing) {
     steiner += t.steiner_vertices;
   }
   EXPECT_GT(steiner, 300u);  // the chains did cross
+}
+
+// The input (contour loop, discrepancy polylines, grid points) whose triangulation crashed CGAL inside
+// find_intersected_faces while baking a depth mesh of the 100,000-block city at detail 1, with the intersection tag
+// for exact number types. Its polylines double back on themselves along a line and cross the contour and each other.
+TriangulationInput readTriangulationInput(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  TriangulationInput input;
+  auto readLines = [&in](const char* what, std::vector<std::vector<DVec2>>& out) {
+    std::string word;
+    size_t count = 0;
+    in >> word >> count;
+    if (word != what) throw std::runtime_error("expected " + std::string(what));
+    out.resize(count);
+    for (auto& line : out) {
+      size_t n = 0;
+      in >> n;
+      line.resize(n);
+      for (DVec2& p : line) in >> p.x >> p.y;
+    }
+  };
+  readLines("loops", input.loops);
+  readLines("polylines", input.polylines);
+  std::string word;
+  size_t count = 0;
+  in >> word >> count;
+  input.points.resize(count);
+  for (DVec2& p : input.points) in >> p.x >> p.y;
+  if (!in) throw std::runtime_error("cannot read " + file.string());
+  return input;
+}
+
+TEST(TriangulationTest, TheInputThatCrashedABigCityBakeTriangulates) {
+  const TriangulationInput input =
+      readTriangulationInput(test::testDataDir() / "impostor" / "triangulation_bigcity_crash.txt");
+  ASSERT_EQ(input.loops.size(), 1u);
+  ASSERT_EQ(input.polylines.size(), 14u);
+  const Triangulation t = triangulate(input);
+  // The inside is the loop's area (shoelace formula, independent of the triangulation).
+  double area = 0.0;
+  const auto& loop = input.loops[0];
+  for (size_t i = 0; i < loop.size(); ++i) area += cross2(loop[i], loop[(i + 1) % loop.size()]);
+  EXPECT_NEAR(insideArea(t), std::abs(0.5 * area), 1e-6 * std::abs(area));
+  EXPECT_GT(t.steiner_vertices, 0u);
 }
 
 TEST(TriangulationTest, EmptyAndBadInput) {
