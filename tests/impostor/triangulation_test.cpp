@@ -142,10 +142,9 @@ TEST(TriangulationTest, RefinementSplitsUntilThePredicateHolds) {
     }
 }
 
-// Many constraints crossing at shallow angles, at coordinates as contour simplification leaves them (fractions of
-// a pixel): the intersection points CGAL computes in doubles fall off the crossed edges, which crashed the
-// triangulation with the tag for exact number types (docs/DESIGN-NOTES.md). Every run must finish with the square's
-// area inside, whatever the snapping did to the crossings inside it.
+// Many constraints crossing at shallow angles, at coordinates off the pixel grid: every run finishes with the
+// square's area inside, whatever CGAL did with the crossings inside it (the recorded input below is the one that
+// actually crashed the old intersection tag; these random ones did not).
 TEST(TriangulationTest, ManyShallowCrossingsTriangulateWithoutCrashing) {
   uint64_t state = 12345;
   auto uniform = [&state](double lo, double hi) {
