@@ -52,18 +52,24 @@ TEST(CityOnTerrain, TheTerrainsHeightsAreTheCitysGround) {
   EXPECT_THROW(terrain::TerrainData::load(kSpec, bad), Error);
 }
 
-TEST(CityOnTerrainGL, TheFrameIsTheNearerOfTheCityAndTheTerrain) {
+// A small plain city laid on the fractal as `gen city --terrain kSpec --terrain-scale kScale` lays it, with a fresh
+// terrain run (the GL context current).
+gen::City cityOnTheFractal(int blocks, uint64_t seed) {
   gpu::sharedHeadlessContext().makeCurrent();
   registerTerrainModes();
   currentTerrainRun().reset();
-  const Ground ground;
+  const auto ground = std::make_shared<Ground>();
   gen::CityOptions co;
-  co.blocks = 12;
-  co.seed = 4;
+  co.blocks = blocks;
+  co.seed = seed;
   co.detail = 0;
-  co.ground = [&ground](Vec2 p) { return ground.at(p); };
+  co.ground = [ground](Vec2 p) { return ground->at(p); };
   co.ground_cell = 15.0f;
-  const gen::City city = gen::generateCity(co);
+  return gen::generateCity(co);
+}
+
+TEST(CityOnTerrainGL, TheFrameIsTheNearerOfTheCityAndTheTerrain) {
+  const gen::City city = cityOnTheFractal(12, 4);
   ModeRunResources res(city.scene, 160, 96, {{"terrain", kSpec}, {"terrain_scale", "0.5"}});
   FrameRunner runner(res.renderer, res.target);
   // From above the city's edge, looking across it to the terrain beyond.
@@ -149,17 +155,7 @@ TEST(CityOnTerrainGL, TheFrameIsTheNearerOfTheCityAndTheTerrain) {
 }
 
 TEST(CityOnTerrainGL, TheLodSpriteTerrainChoosesPerFrameByCostsMeasuredAtPrepare) {
-  gpu::sharedHeadlessContext().makeCurrent();
-  registerTerrainModes();
-  currentTerrainRun().reset();
-  const Ground ground;
-  gen::CityOptions co;
-  co.blocks = 10;
-  co.seed = 5;
-  co.detail = 0;
-  co.ground = [&ground](Vec2 p) { return ground.at(p); };
-  co.ground_cell = 15.0f;
-  const gen::City city = gen::generateCity(co);
+  const gen::City city = cityOnTheFractal(10, 5);
   ModeRunResources res(city.scene, 96, 64, {{"terrain", kSpec}, {"terrain_scale", "0.5"}});
   CityOnTerrainMode mode("lod-sprite", "culled");
   mode.prepare(res.context);
