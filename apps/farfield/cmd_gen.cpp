@@ -6,7 +6,6 @@
 #include <sys/resource.h>
 
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -93,7 +92,7 @@ void runCity(const CityArgs& args) {
   std::printf("time:       %.2f s generation, %.2f s writing\n", generate_s, write_s);
   std::printf("memory:     %.0f MiB peak resident (%.0f MiB after generation)\n", peakMemoryMiB(), generate_peak_mib);
   std::printf("wrote:      %s\n", args.output.c_str());
-  if (std::filesystem::path(args.output).extension() == ".gltf")
+  if (scene::isGltfPath(args.output))
     std::printf("            %s\n", scene::gltfBufferPath(args.output).c_str());
   std::printf("            %s\n", streets.c_str());
 }

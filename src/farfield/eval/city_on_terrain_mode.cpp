@@ -93,7 +93,7 @@ terrain::TerrainCostOptions CityOnTerrainMode::calibrationViews(const ModeContex
   const Vec3 lo = b.lo + offset_, hi = b.hi + offset_;
   const Vec3 centre = 0.5f * (lo + hi);
   const float reach = std::max(hi.x - lo.x, hi.y - lo.y);
-  terrain::TerrainCostOptions c;
+  std::vector<Camera> views;
   auto view = [&](Vec3 eye, Vec3 at) {
     Camera v;
     v.eye = eye;
@@ -102,7 +102,7 @@ terrain::TerrainCostOptions CityOnTerrainMode::calibrationViews(const ModeContex
     v.height = context.height;
     v.near_plane = 1.0f;
     v.far_plane = float(std::max(20000.0, 2.0 * std::max(data.hf.extentX(), data.hf.extentY())));
-    c.views.push_back(v);
+    views.push_back(v);
   };
   for (int k = 0; k < 4; ++k) {
     const Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, hi.z + 0.1f * reach);
@@ -110,11 +110,7 @@ terrain::TerrainCostOptions CityOnTerrainMode::calibrationViews(const ModeContex
     view(corner, corner + outward * reach + Vec3(0.0f, 0.0f, -0.3f * reach));
   }
   view(Vec3(centre.x, centre.y - 0.01f * reach, hi.z + reach), Vec3(centre.x, centre.y, lo.z));
-  const terrain::LodSpriteOptions sprite = spriteOptions(*run_, SpriteVariant::Paper, run_->epsilon);
-  c.keyframe_width = context.width + 2 * int(std::lround(sprite.keyframe_margin * float(context.width)));
-  c.keyframe_height = context.height + 2 * int(std::lround(sprite.keyframe_margin * float(context.height)));
-  c.pixel_errors = {run_->high_error, 2.0f * run_->high_error, run_->low_error, 4.0f * run_->low_error};
-  return c;
+  return spriteCostOptions(*run_, std::move(views), context.width, context.height);
 }
 
 Camera CityOnTerrainMode::terrainCamera(const Camera& city_camera) const {

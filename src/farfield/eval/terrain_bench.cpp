@@ -228,15 +228,10 @@ double meanWithoutStalls(const std::vector<double>& times, double median) {
 void calibrate(Experiment& x) {
   const TerrainBenchOptions& o = x.options;
   gpu::sharedHeadlessContext().makeCurrent();
-  terrain::TerrainCostOptions c;
+  std::vector<Camera> views;
   const size_t n = x.path.frames.size();
-  for (size_t k = 0; k < 5; ++k) c.views.push_back(x.cameraAt(x.path, std::min(n - 1, (2 * k + 1) * n / 10)));
-  const terrain::LodSpriteOptions sprite = spriteOptions(*x.run, SpriteVariant::Paper, o.epsilon);
-  const int mx = int(std::lround(sprite.keyframe_margin * float(o.width)));
-  const int my = int(std::lround(sprite.keyframe_margin * float(o.height)));
-  c.keyframe_width = o.width + 2 * mx;
-  c.keyframe_height = o.height + 2 * my;
-  c.pixel_errors = {o.high_error, 2.0f * o.high_error, o.low_error, 4.0f * o.low_error};
+  for (size_t k = 0; k < 5; ++k) views.push_back(x.cameraAt(x.path, std::min(n - 1, (2 * k + 1) * n / 10)));
+  const terrain::TerrainCostOptions c = spriteCostOptions(*x.run, std::move(views), o.width, o.height);
   x.run->cost = terrain::calibrateTerrainCost(*x.data().lod, x.run->gpuRenderer(), c);
   x.result.cost = x.run->cost;
   const gpu::CostModel& m = x.run->cost->frame;

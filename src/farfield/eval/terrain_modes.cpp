@@ -121,6 +121,16 @@ terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant var
   return o;
 }
 
+terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector<Camera> views, int width, int height) {
+  terrain::TerrainCostOptions c;
+  c.views = std::move(views);
+  const Camera key = terrain::guardBandCamera(Camera{}, width, height, terrain::LodSpriteOptions{}.keyframe_margin);
+  c.keyframe_width = key.width;
+  c.keyframe_height = key.height;
+  c.pixel_errors = {run.high_error, 2.0f * run.high_error, run.low_error, 4.0f * run.low_error};
+  return c;
+}
+
 bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant) {
   if (mode_name == "lod-sprite") variant = SpriteVariant::Paper;
   else if (mode_name == "lod-sprite-always") variant = SpriteVariant::Always;

@@ -111,6 +111,9 @@ enum class SpriteVariant { Paper, Always, Predict, Cache };
 // The LOD-sprite options of a variant with the run's thresholds (epsilon, pixels, > 0); the one place the
 // variants are defined, shared by the modes and the terrain bench's quality pass.
 terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon);
+// What calibrateTerrainCost times for lod-sprite's choice on `views` (frames of width x height): the keyframe target
+// with the guard band, and LOD thresholds spread around the run's high and low ones.
+terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector<Camera> views, int width, int height);
 // "lod-sprite" -> Paper, "lod-sprite-always" -> Always, "lod-sprite-predict" -> Predict, "lod-sprite-cache" -> Cache; false for other names.
 bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant);
 

@@ -460,11 +460,7 @@ int GltfBuilder::addNode(const std::string& name, int mesh, int parent, const Ma
   return impl_->node(name, mesh, parent, matrix, extras.is_null() ? std::string() : dump(extras));
 }
 
-namespace {
-
-namespace fs = std::filesystem;
-
-bool endsWithGltf(const std::string& path) {
+bool isGltfPath(const std::string& path) {
   const std::string ext = ".gltf";
   if (path.size() <= ext.size()) return false;
   std::string tail = path.substr(path.size() - ext.size());
@@ -472,18 +468,16 @@ bool endsWithGltf(const std::string& path) {
   return tail == ext;
 }
 
-}  // namespace
-
 std::string gltfBufferPath(const std::string& gltf_path) {
-  return gltf_path.substr(0, gltf_path.size() - 5) + ".bin";
+  return (isGltfPath(gltf_path) ? gltf_path.substr(0, gltf_path.size() - 5) : gltf_path) + ".bin";
 }
 
 size_t GltfBuilder::write() {
   const std::string& path = impl_->path;
-  if (endsWithGltf(path)) {
+  if (isGltfPath(path)) {
     // JSON and a separate buffer file: no 32-bit sizes, so scenes over the .glb's 4 GiB can be written.
     const std::string bin_path = gltfBufferPath(path);
-    const std::string json = impl_->json(impl_->buffer_bytes > 0 ? fs::path(bin_path).filename().string() : "");
+    const std::string json = impl_->json(impl_->buffer_bytes > 0 ? std::filesystem::path(bin_path).filename().string() : "");
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     if (!out) throw Error(path, "cannot open for writing");
     out.write(json.data(), std::streamsize(json.size()));

@@ -22,6 +22,8 @@ namespace farfield::scene {
 // Throws farfield::Error naming the file when it cannot be written. A path ending in .gltf writes the JSON there and
 // the buffer next to it (gltfBufferPath), with no 4 GiB limit; any other path writes one .glb.
 void exportGlb(const Scene& scene, const std::string& path);
+// Whether a path names a .gltf (JSON with a separate buffer) rather than a .glb: it ends in .gltf, any case.
+bool isGltfPath(const std::string& path);
 // The buffer file of a .gltf written by GltfBuilder: the same path with .bin for .gltf.
 std::string gltfBufferPath(const std::string& gltf_path);
 

@@ -124,16 +124,16 @@ std::unique_ptr<LodSpriteRenderer::Keyframe> LodSpriteRenderer::takeKeyframe() {
   return k;
 }
 
-Camera LodSpriteRenderer::keyframeCamera(const Camera& camera) const {
-  // Same eye, direction and pixel density; the image grows by a whole number of pixels on each side, so at the
-  // keyframe's own viewpoint every frame pixel centre falls on a sprite texel centre.
-  const int mx = int(std::lround(options_.keyframe_margin * width_));
-  const int my = int(std::lround(options_.keyframe_margin * height_));
+Camera guardBandCamera(const Camera& camera, int width, int height, float margin) {
   Camera k = camera;
-  k.width = width_ + 2 * mx;
-  k.height = height_ + 2 * my;
-  k.fov_y = 2.0f * std::atan(std::tan(camera.fov_y * 0.5f) * float(k.height) / float(height_));
+  k.width = width + 2 * int(std::lround(margin * float(width)));
+  k.height = height + 2 * int(std::lround(margin * float(height)));
+  k.fov_y = 2.0f * std::atan(std::tan(camera.fov_y * 0.5f) * float(k.height) / float(height));
   return k;
+}
+
+Camera LodSpriteRenderer::keyframeCamera(const Camera& camera) const {
+  return guardBandCamera(camera, width_, height_, options_.keyframe_margin);
 }
 
 void LodSpriteRenderer::keep(std::unique_ptr<Keyframe> keyframe) {

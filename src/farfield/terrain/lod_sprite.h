@@ -61,6 +61,11 @@ gpu::FrameStats renderLodFrame(const QuadtreeLod& lod, gpu::TerrainRenderer& ren
                                const LodSettings& settings, gpu::RenderTarget& target, LodMesh& scratch,
                                const GridRect& hole = {});
 
+// A keyframe camera with a guard band: the same eye, direction and pixel density as `camera` drawing a frame of
+// width x height, its image grown by round(margin * size) whole pixels on each side (so at its own viewpoint every
+// frame pixel centre falls on a keyframe texel centre). The camera's own width and height are not used.
+Camera guardBandCamera(const Camera& camera, int width, int height, float margin);
+
 struct LodSpriteOptions {
   double epsilon = 1.0;     // error threshold, pixels (equation 2)
   float high_error = 1.0f;  // LOD threshold of keyframes, pixels

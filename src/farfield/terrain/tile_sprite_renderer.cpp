@@ -6,6 +6,8 @@
 #include <limits>
 
 #include "farfield/core/error.h"
+#include "farfield/terrain/lod_sprite.h"
+#include "farfield/terrain/tile_sprites.h"
 #include "farfield/terrain/sprite_error.h"
 
 namespace farfield::terrain {
@@ -73,10 +75,7 @@ TileSpriteRenderer::TileSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRende
 TileSpriteRenderer::~TileSpriteRenderer() = default;
 
 IVec2 TileSpriteRenderer::tileOf(int x, int y) const {
-  // The last row / column of grid points belongs to the tile before it.
-  x = std::clamp(x, 0, lod_.width() - 2);
-  y = std::clamp(y, 0, lod_.height() - 2);
-  return IVec2(x / options_.tile_cells, y / options_.tile_cells);
+  return gridPointTile(x, y, lod_.width(), lod_.height(), options_.tile_cells);
 }
 
 void TileSpriteRenderer::reset() {
@@ -170,15 +169,6 @@ bool TileSpriteRenderer::frame(const Camera& camera, GridRect r, Camera& out) co
   return true;
 }
 
-Camera TileSpriteRenderer::viewKeyframe(const Camera& camera) const {
-  // Same eye, direction and pixel density, a whole number of pixels wider and taller on each side.
-  Camera k = camera;
-  k.width = width_ + 2 * int(std::lround(options_.view_margin * float(width_)));
-  k.height = height_ + 2 * int(std::lround(options_.view_margin * float(height_)));
-  k.fov_y = 2.0f * std::atan(std::tan(camera.fov_y * 0.5f) * float(k.height) / float(height_));
-  return k;
-}
-
 void TileSpriteRenderer::renderKeyframe(Sprite& s, TileSpriteRenderFrame& info, gpu::FrameStats& stats) {
   // The high-resolution LOD of the region's blocks, seen from the keyframe camera; the triangles meeting the region.
   const int block = lod_.block();
@@ -237,9 +227,8 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
     return *s;
   };
   for (size_t t = 0; t < low_.indices.size(); t += 3) {
-    int x = 0, y = 0;
-    for (size_t k = 0; k < 3; ++k) x += int(low_.indices[t + k] % w), y += int(low_.indices[t + k] / w);
-    Sprite& s = spriteOf(tileOf(x / 3, y / 3));
+    const IVec2 c = centroidPoint(&low_.indices[t], w);
+    Sprite& s = spriteOf(tileOf(c.x, c.y));
     s.triangles.insert(s.triangles.end(), low_.indices.begin() + std::ptrdiff_t(t),
                        low_.indices.begin() + std::ptrdiff_t(t + 3));
   }
@@ -296,7 +285,7 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
                    std::min(lod_.height() - 1, r.y1 + gy)};
       s.view_bound = !frame(camera, r, s.camera);
       if (s.view_bound) {
-        s.camera = viewKeyframe(camera);
+        s.camera = guardBandCamera(camera, width_, height_, options_.view_margin);
         ++info.tiles_view_framed;
       }
       s.key_forward = camera.forward();

@@ -116,7 +116,6 @@ class TileSpriteRenderer {
   struct Sprite;
   using TileKey = std::pair<int, int>;
   bool frame(const Camera& camera, GridRect region, Camera& out) const;
-  Camera viewKeyframe(const Camera& camera) const;
   void renderKeyframe(Sprite& sprite, TileSpriteRenderFrame& info, gpu::FrameStats& stats);
   gpu::RenderTarget takeTarget(int width, int height);
   void release(Sprite& sprite);

@@ -12,11 +12,24 @@ TileSprites::TileSprites(const QuadtreeLod& lod, const TileSpriteOptions& option
   if (!(options.epsilon > 0.0)) throw Error("tile sprites", "epsilon must be positive");
 }
 
+IVec2 gridPointTile(int x, int y, int width, int height, int tile_cells) {
+  x = std::clamp(x, 0, width - 2);
+  y = std::clamp(y, 0, height - 2);
+  return IVec2(x / tile_cells, y / tile_cells);
+}
+
+IVec2 centroidPoint(const uint32_t* triangle, uint32_t width) {
+  int x = 0, y = 0;
+  for (int k = 0; k < 3; ++k) {
+    x += int(triangle[k] % width);
+    y += int(triangle[k] / width);
+  }
+  return IVec2(x / 3, y / 3);
+}
+
 IVec2 TileSprites::tileOf(uint32_t v) const {
-  const int w = lod_.width();
-  // The last row / column of grid points belongs to the tile before it.
-  const int x = std::min(int(v % uint32_t(w)), w - 2), y = std::min(int(v / uint32_t(w)), lod_.height() - 2);
-  return IVec2(x / options_.tile_cells, y / options_.tile_cells);
+  const uint32_t w = uint32_t(lod_.width());
+  return gridPointTile(int(v % w), int(v / w), lod_.width(), lod_.height(), options_.tile_cells);
 }
 
 TileSpriteFrame TileSprites::advance(const Camera& camera) {
@@ -48,14 +61,8 @@ TileSpriteFrame TileSprites::advance(const Camera& camera) {
     lod_.build(camera, LodSettings{options_.high_error, false, false}, high_);
     std::map<std::pair<int, int>, uint64_t> triangles;
     for (size_t t = 0; t < high_.indices.size(); t += 3) {
-      // The triangle's tile: that of its centroid's grid cell.
-      const int w = lod_.width();
-      int x = 0, y = 0;
-      for (int k = 0; k < 3; ++k) {
-        x += int(high_.indices[t + size_t(k)] % uint32_t(w));
-        y += int(high_.indices[t + size_t(k)] / uint32_t(w));
-      }
-      const IVec2 tile = tileOf(uint32_t(x / 3) + uint32_t(y / 3) * uint32_t(w));
+      const IVec2 c = centroidPoint(&high_.indices[t], uint32_t(lod_.width()));
+      const IVec2 tile = gridPointTile(c.x, c.y, lod_.width(), lod_.height(), options_.tile_cells);
       ++triangles[{tile.x, tile.y}];
     }
     for (const auto& tile : refresh) {

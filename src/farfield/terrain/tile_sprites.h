@@ -27,6 +27,13 @@
 
 namespace farfield::terrain {
 
+// The tile of grid point (x, y) of a width x height grid cut into tiles of tile_cells cells (coordinates clamped into
+// the grid); the last row and column of points belong to the tiles before them.
+IVec2 gridPointTile(int x, int y, int width, int height, int tile_cells);
+// The grid point at the (truncated) centroid of a triangle of grid indices (a grid `width` points wide): a triangle
+// belongs to that point's tile.
+IVec2 centroidPoint(const uint32_t* triangle, uint32_t width);
+
 struct TileSpriteOptions {
   int tile_cells = 256;     // tile side, grid cells
   double epsilon = 1.0;     // error threshold, pixels (equation 2, per tile)
