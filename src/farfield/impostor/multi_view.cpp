@@ -127,12 +127,12 @@ gpu::CaptureView captureView(const gpu::AtlasLayout& layout, const ViewGrid& gri
   return v;
 }
 
-SwitchDistances switchDistances(const gpu::AtlasLayout& layout, const ViewGrid& grid, double focal_px,
+SwitchDistances switchDistances(const gpu::AtlasLayout& layout, float worst_view_angle, double focal_px,
                                 double error_px, double frame_error_m) {
   SwitchDistances s;
   const double texel = 2.0 * double(layout.half_size.y) / double(layout.cell_height);
   s.texel_m = texel * focal_px;
-  s.view_m = double(layout.half_size.x) * double(worstViewAngle(grid)) * focal_px / std::max(error_px, 1e-6);
+  s.view_m = double(layout.half_size.x) * double(worst_view_angle) * focal_px / std::max(error_px, 1e-6);
   s.frame_m = frame_error_m * focal_px / std::max(error_px, 1e-6);
   return s;
 }
@@ -196,6 +196,7 @@ MultiViewImpostor bakeMultiView(gpu::CrowdRenderer& renderer, const gpu::Skinned
   Stopwatch clock;
   MultiViewImpostor out;
   out.grid = grid;
+  out.worst_view_angle = worstViewAngle(grid);
   out.layout = layout;
   out.atlas = std::make_unique<gpu::ImpostorAtlasGpu>(layout);
   std::vector<gpu::CaptureView> views;

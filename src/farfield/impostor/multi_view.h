@@ -50,7 +50,8 @@ Vec3 octahedralDirection(const Vec2& point);
 int nearestView(const ViewGrid& grid, const Vec3& to_camera);
 
 // Largest angle (radians) between a direction with elevation in [0, max_elevation] and its nearest view, sampled
-// densely (a bound on the view quantisation the impostor shows).
+// densely (a bound on the view quantisation the impostor shows). About 16,000 samples: a few milliseconds, so
+// callers keep it (MultiViewImpostor::worst_view_angle) rather than call it per frame.
 float worstViewAngle(const ViewGrid& grid);
 
 // The atlas for a model whose animated bounds (agent space: feet on z = 0, facing +x) are `bounds`: cells tall
@@ -62,16 +63,16 @@ gpu::CaptureView captureView(const gpu::AtlasLayout& layout, const ViewGrid& gri
 
 // Distances (metres) beyond which an impostor keeps a promise, for a camera of `focal_px` (pixels per unit of
 // tangent, height / (2 tan(fov_y / 2))): Dobbyn et al.'s rule, a texel covers at most one pixel (texel_m *
-// focal_px); the view error stays under `error_px` (the model's half width moves by at most radius * angle); and the
-// animation frame's error (frame_error_m, frameError below: a vertex's distance to where the geometry shows it)
-// stays under `error_px`.
+// focal_px); the view error stays under `error_px` (the model's half width moves by at most radius *
+// worst_view_angle, the grid's worstViewAngle); and the animation frame's error (frame_error_m, frameError below: a
+// vertex's distance to where the geometry shows it) stays under `error_px`.
 struct SwitchDistances {
   double texel_m = 0.0;
   double view_m = 0.0;
   double frame_m = 0.0;
   double both() const { return std::max({texel_m, view_m, frame_m}); }
 };
-SwitchDistances switchDistances(const gpu::AtlasLayout& layout, const ViewGrid& grid, double focal_px,
+SwitchDistances switchDistances(const gpu::AtlasLayout& layout, float worst_view_angle, double focal_px,
                                 double error_px, double frame_error_m = 0.0);
 
 // Animation frames from the error bound. pose_positions[p]: the model's vertices (agent space, metres) in palette
@@ -98,6 +99,7 @@ BoundChoice chooseForBound(double error_px, double focal_px, double switch_m, do
 // A baked model: layout, grid and the atlas on the GPU.
 struct MultiViewImpostor {
   ViewGrid grid;
+  float worst_view_angle = 0.0f;  // worstViewAngle(grid), radians
   gpu::AtlasLayout layout;
   std::unique_ptr<gpu::ImpostorAtlasGpu> atlas;
   double bake_seconds = 0.0;

@@ -92,8 +92,8 @@ CrowdRuntime::~CrowdRuntime() = default;
 
 impostor::SwitchDistances CrowdRuntime::switchDistances(size_t m, const Camera& camera) const {
   const Model& model = models_[m];
-  return impostor::switchDistances(model.impostor->layout, model.choice.grid, focalOf(camera), options_.error_px,
-                                   model.choice.frame_error_m);
+  return impostor::switchDistances(model.impostor->layout, model.impostor->worst_view_angle, focalOf(camera),
+                                   options_.error_px, model.choice.frame_error_m);
 }
 
 double CrowdRuntime::bakeSeconds() const {
