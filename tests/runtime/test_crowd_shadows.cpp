@@ -82,6 +82,39 @@ TEST(CrowdShadows, FitKeepsExactlyTheSpheresThatCanShadowWhatIsSeen) {
   }
   EXPECT_EQ(kept, fit.casters.size());
   EXPECT_GT(fit.projection.texel_m, 0.0f);
+  // Where the shadows can fall on screen, for the spheres well in front of the camera (nearer ones make the fit
+  // take the whole frame): points of each kept sphere swept along the light down to a metre below its lowest point
+  // (sampled on the sphere's surface at both ends and between) project inside some caster's rectangle.
+  std::vector<CasterSphere> ahead;
+  for (const CasterSphere& s : spheres)
+    if (s.centre.x > 8.0f) ahead.push_back(s);
+  const ShadowFit near_fit = fitShadow(camera, light, ahead, distance, 1024);
+  ASSERT_GT(near_fit.screen_rects.size(), 3u);
+  const Mat4 vp = camera.viewProjection();
+  size_t tested = 0;
+  for (uint32_t i : near_fit.casters) {
+    const CasterSphere& s = ahead[i];
+    const float drop = (2.0f * s.radius + 1.0f) / -f.z;
+    for (int k = 0; k <= 8; ++k)
+      for (int a = 0; a < 12; ++a)
+        for (int b = 0; b < 6; ++b) {
+          const float th = float(a) * float(kPi) / 6.0f, ph = -float(kPi) / 2.0f + float(b) * float(kPi) / 5.0f;
+          const Vec3 p = s.centre + f * (drop * float(k) / 8.0f) +
+                         s.radius * Vec3(std::cos(ph) * std::cos(th), std::cos(ph) * std::sin(th), std::sin(ph));
+          const Vec4 clip = vp * Vec4(p, 1.0f);
+          ASSERT_GT(clip.w, camera.near_plane);
+          const Vec2 px = (Vec2(clip) / clip.w * 0.5f + 0.5f) * Vec2(float(camera.width), float(camera.height));
+          if (px.x < 0.0f || px.y < 0.0f || px.x >= float(camera.width) || px.y >= float(camera.height)) continue;
+          ++tested;
+          bool inside = false;
+          for (const glm::ivec4& r : near_fit.screen_rects)
+            inside = inside || (px.x >= float(r.x) && px.x < float(r.z) && px.y >= float(r.y) && px.y < float(r.w));
+          EXPECT_TRUE(inside) << "sphere " << i << " point at pixel " << px.x << ", " << px.y;
+          const glm::ivec4& u = near_fit.screen;
+          EXPECT_TRUE(px.x >= float(u.x) && px.x < float(u.z) && px.y >= float(u.y) && px.y < float(u.w));
+        }
+  }
+  EXPECT_GT(tested, 100u);
   EXPECT_THROW(fitShadow(camera, Vec3(0.0f), spheres, distance, 1024), Error);
 }
 

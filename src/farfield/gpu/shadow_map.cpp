@@ -3,9 +3,11 @@
 #include <epoxy/gl.h>
 
 #include <string>
+#include <vector>
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/core/screen_tiles.h"
 
 namespace farfield::gpu {
 
@@ -53,18 +55,32 @@ void ShadowMap::bindForCasters() const {
 ShadowReceiver::ShadowReceiver()
     : program_(Program::fromEmbedded("shadow_receive.vert.glsl", "shadow_receive.frag.glsl")) {
   glCreateFramebuffers(1, &fbo_);
+  glCreateBuffers(1, &vbo_);
   glCreateVertexArrays(1, &vao_);
+  glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(glm::ivec2));
+  glEnableVertexArrayAttrib(vao_, 0);
+  glVertexArrayAttribIFormat(vao_, 0, 2, GL_INT, 0);
+  glVertexArrayAttribBinding(vao_, 0, 0);
 }
 
 ShadowReceiver::~ShadowReceiver() {
   if (fbo_) glDeleteFramebuffers(1, &fbo_);
   if (vao_) glDeleteVertexArrays(1, &vao_);
+  if (vbo_) glDeleteBuffers(1, &vbo_);
 }
 
 void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const ShadowProjection& projection,
                            const RenderTarget& target, const LightSettings& light, uint32_t agent_id_mask,
-                           float bias_m, float max_distance_m, const glm::ivec4* scissor) {
-  if (scissor && (scissor->z <= scissor->x || scissor->w <= scissor->y)) return;  // nothing to shade
+                           float bias_m, float max_distance_m, std::span<const glm::ivec4> regions) {
+  const std::vector<glm::ivec4> tiles = tileCover(regions, target.width(), target.height(), kTile);
+  if (tiles.empty()) return;  // nothing to shade
+  std::vector<glm::ivec2> corners;  // two triangles per rectangle, pixel corners
+  corners.reserve(tiles.size() * 6);
+  for (const glm::ivec4& t : tiles)
+    for (const glm::ivec2& c : {glm::ivec2(t.x, t.y), glm::ivec2(t.z, t.y), glm::ivec2(t.z, t.w), glm::ivec2(t.x, t.y),
+                                glm::ivec2(t.z, t.w), glm::ivec2(t.x, t.w)})
+      corners.push_back(c);
+  glNamedBufferData(vbo_, GLsizeiptr(corners.size() * sizeof(glm::ivec2)), corners.data(), GL_STREAM_DRAW);
   // The target's colour alone (its depth and ids are read as textures: no feedback loop).
   glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, target.colorTexture().handle(), 0);
   glNamedFramebufferDrawBuffer(fbo_, GL_COLOR_ATTACHMENT0);
@@ -74,12 +90,7 @@ void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const Sha
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_FALSE);
   glDisable(GL_CULL_FACE);
-  if (scissor) {
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(scissor->x, scissor->y, scissor->z - scissor->x, scissor->w - scissor->y);
-  } else {
-    glDisable(GL_SCISSOR_TEST);
-  }
+  glDisable(GL_SCISSOR_TEST);
   glEnable(GL_BLEND);
   glBlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_ONE);  // colour *= factor, alpha kept
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -96,14 +107,14 @@ void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const Sha
   program_.set("u_eye", camera.eye);
   program_.set("u_forward", camera.forward());
   program_.set("u_max_distance", max_distance_m);
+  glUniform2f(program_.uniformLocation("u_size"), float(target.width()), float(target.height()));
   glBindTextureUnit(0, target.depthTexture().handle());
   glBindTextureUnit(1, target.idTexture().handle());
   glBindTextureUnit(2, map.depthTexture());
   glBindVertexArray(vao_);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(corners.size()));
   glBindVertexArray(0);
   glDisable(GL_BLEND);
-  glDisable(GL_SCISSOR_TEST);
   glDepthMask(GL_TRUE);
   glEnable(GL_DEPTH_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
 #include "farfield/core/camera.h"
 #include "farfield/gpu/program.h"
@@ -53,15 +54,17 @@ class ShadowReceiver {
   // texel holding less than z - bias_m (metres, over the projection's depth range); the share s of the 4x4 texels
   // around it that leave it lit weighs the colour's factor mix(ambient / (ambient + light_color * max(n . -l, 0)),
   // 1, s) per channel: what the renderer's lighting (mesh.frag.glsl) gives without the direct term, n being the
-  // surface normal rebuilt from the depth buffer. Only within `scissor` (x0, y0, x1, y1 from the bottom left,
-  // exclusive ends) when given. Leaves the target unbound.
+  // surface normal rebuilt from the depth buffer. Only within `regions` (x0, y0, x1, y1 from the bottom left,
+  // exclusive ends; they may overlap): the pass shades the kTile-pixel tiles they touch, each pixel once
+  // (tileCover). Leaves the target unbound.
   void apply(const Camera& camera, const ShadowMap& map, const ShadowProjection& projection,
-             const RenderTarget& target, const LightSettings& light, uint32_t agent_id_mask, float bias_m = 0.03f,
-             float max_distance_m = 1e30f, const glm::ivec4* scissor = nullptr);
+             const RenderTarget& target, const LightSettings& light, uint32_t agent_id_mask, float bias_m,
+             float max_distance_m, std::span<const glm::ivec4> regions);
+  static constexpr int kTile = 16;
 
  private:
   Program program_;
-  uint32_t fbo_ = 0, vao_ = 0;
+  uint32_t fbo_ = 0, vao_ = 0, vbo_ = 0;
 };
 
 }  // namespace farfield::gpu

@@ -194,7 +194,7 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
     shadow_map_ = std::make_unique<gpu::ShadowMap>(shadows.map_size);
   shadow_map_->bindForCasters();  // cleared: no caster
   shadow_projection_ = fit.projection;
-  shadow_screen_ = fit.screen;
+  shadow_screen_ = fit.screen_rects;
   stats.shadow_texel_m = fit.projection.texel_m;
   if (fit.casters.empty()) return;
   const Vec3 to_light = -glm::normalize(light.direction);
@@ -241,7 +241,7 @@ CrowdFrameStats CrowdRuntime::drawShadowed(const Camera& camera, std::span<const
   if (stats.shadow_casters > 0) {
     if (!receiver_) receiver_ = std::make_unique<gpu::ShadowReceiver>();
     receiver_->apply(camera, *shadow_map_, shadow_projection_, target, light, shadows.agent_id_mask, shadows.bias_m,
-                     shadows.distance_m, &shadow_screen_);
+                     shadows.distance_m, shadow_screen_);
   }
   target.bindForOpaquePass();
   return stats;

@@ -153,7 +153,7 @@ class CrowdRuntime {
   std::unique_ptr<gpu::ShadowMap> shadow_map_;
   std::unique_ptr<gpu::ShadowReceiver> receiver_;
   gpu::ShadowProjection shadow_projection_;
-  glm::ivec4 shadow_screen_{0};
+  std::vector<glm::ivec4> shadow_screen_;  // where the casters' shadows can fall (ShadowFit::screen_rects)
 };
 
 }  // namespace farfield::runtime

@@ -73,11 +73,19 @@ ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const
   // below its lowest point (the sphere's bounds in between follow: the swept sphere is their convex hull).
   const Mat4 vp = camera.viewProjection();
   const float focal = float(camera.height) / (2.0f * ty);
+  auto clipped = [&](const Vec2& lo_px, const Vec2& hi_px) {
+    return glm::ivec4(std::clamp(int(std::floor(lo_px.x)), 0, camera.width),
+                      std::clamp(int(std::floor(lo_px.y)), 0, camera.height),
+                      std::clamp(int(std::ceil(hi_px.x)) + 1, 0, camera.width),
+                      std::clamp(int(std::ceil(hi_px.y)) + 1, 0, camera.height));
+  };
   Vec2 slo(1e30f), shi(-1e30f);
-  bool whole = false;
+  bool whole = f.z >= -1e-3f;
   for (uint32_t i : fit.casters) {
+    if (whole) break;
     const CasterSphere& s = spheres[i];
-    const float t = f.z < -1e-3f ? (2.0f * s.radius + drop_m) / -f.z : 0.0f;
+    const float t = (2.0f * s.radius + drop_m) / -f.z;
+    Vec2 clo(1e30f), chi(-1e30f);
     for (const Vec3& c : {s.centre, s.centre + f * t}) {
       const Vec4 clip = vp * Vec4(c, 1.0f);
       if (clip.w < camera.near_plane + s.radius) {
@@ -86,18 +94,20 @@ ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const
       }
       const Vec2 p = (Vec2(clip) / clip.w * 0.5f + 0.5f) * Vec2(float(camera.width), float(camera.height));
       const float r = s.radius * focal / clip.w * 1.5f;  // off-axis spheres project a little wider: margin
-      slo = glm::min(slo, p - r);
-      shi = glm::max(shi, p + r);
+      clo = glm::min(clo, p - r);
+      chi = glm::max(chi, p + r);
     }
     if (whole) break;
+    const glm::ivec4 rect = clipped(clo, chi);
+    if (rect.z > rect.x && rect.w > rect.y) fit.screen_rects.push_back(rect);
+    slo = glm::min(slo, clo);
+    shi = glm::max(shi, chi);
   }
-  if (whole || f.z >= -1e-3f) {
+  if (whole) {
     fit.screen = glm::ivec4(0, 0, camera.width, camera.height);
+    fit.screen_rects.assign(1, fit.screen);
   } else {
-    fit.screen = glm::ivec4(std::clamp(int(std::floor(slo.x)), 0, camera.width),
-                            std::clamp(int(std::floor(slo.y)), 0, camera.height),
-                            std::clamp(int(std::ceil(shi.x)) + 1, 0, camera.width),
-                            std::clamp(int(std::ceil(shi.y)) + 1, 0, camera.height));
+    fit.screen = clipped(slo, shi);
   }
   return fit;
 }

@@ -24,6 +24,9 @@ struct ShadowFit {
   // receiver no lower than `drop_m` below the caster's sphere: each caster's sphere swept along the light down to
   // there, projected; the whole frame when a swept sphere reaches behind the near plane.
   glm::ivec4 screen{0, 0, 0, 0};
+  // The same per caster (its swept sphere alone; empty ones left out): screen is their bounds. The whole frame alone
+  // where screen is the whole frame because a swept sphere reaches behind the near plane or the light is not downwards.
+  std::vector<glm::ivec4> screen_rects;
 };
 
 // Receivers: what `camera` sees up to `distance_m` along its view (the frustum cut there). Light space: x, y across
