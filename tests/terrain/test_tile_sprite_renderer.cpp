@@ -177,6 +177,59 @@ TEST(TileSpriteRenderer, ReleasedTargetsKeptForReuseStayFew) {
   EXPECT_LE(most, 16u);
 }
 
+// The per-frame choice on constructed cost profiles, over a moving view: where the high LOD is cheapest every frame
+// draws it (pixel for pixel the high LOD, no keyframe); where it is expensive, the first frame draws it (its size is
+// learnt from one frame) and every later one takes the tiles; where keyframes never pay (an enormous read back) no
+// tile is ever rendered, however cheap a sprite frame would be.
+TEST(TileSpriteRenderer, ChoicePicksTheCheaperPathOnConstructedCostProfiles) {
+  Scene scene(testFractal());
+  const float top = scene.hf.maxHeight();
+  auto camera = [&](int f) {
+    return makeCamera(Vec3(1280 + 6.0f * f, 700 + 12.0f * f, top + 1200), Vec3(1280 + 6.0f * f, 1300 + 12.0f * f, 0));
+  };
+  TerrainCost cheap_high, expensive_high, no_keyframes;
+  cheap_high.frame.base_ms = 1.0;
+  cheap_high.frame.ms_per_draw = 100.0;  // a draw per tile sprite costs more than the one draw of the high LOD
+  expensive_high.frame.base_ms = 1.0;
+  expensive_high.frame.ms_per_mtriangle = 1e6;
+  no_keyframes = expensive_high;
+  no_keyframes.readback_ms_per_mpixel = 1e12;
+  for (const TerrainCost* cost : {&cheap_high, &expensive_high, &no_keyframes}) {
+    TileSpriteRenderOptions o = tileOptions(32);
+    o.cost = cost;
+    TileSpriteRenderer tiles(*scene.lod, *scene.renderer, 128, 128, o);
+    gpu::RenderTarget frame(128, 128);
+    size_t high_frames = 0;
+    for (int f = 0; f < 8; ++f) {
+      frame.clear(kSky);
+      TileSpriteRenderFrame info;
+      tiles.render(camera(f), frame, &info);
+      const bool high_expected = f == 0 || cost != &expensive_high;
+      EXPECT_EQ(info.path, high_expected ? TerrainPath::High : TerrainPath::Sprite) << "frame " << f;
+      if (info.path == TerrainPath::High) {
+        ++high_frames;
+        EXPECT_EQ(info.tiles_refreshed, 0u);
+        const image::ColorImage high = scene.renderLod(camera(f), 1.0f), image = frame.readColor();
+        EXPECT_TRUE(std::equal(image.pixels().begin(), image.pixels().end(), high.pixels().begin(),
+                               [](const image::Rgba8& a, const image::Rgba8& b) {
+                                 return a.r == b.r && a.g == b.g && a.b == b.b;
+                               }))
+            << "frame " << f;
+      }
+      if (f > 0) {  // the frames' alternatives: the keyframes add to the sprite frame where tiles are due
+        EXPECT_GT(info.predicted_high_ms, 0.0);
+        if (info.tiles_due > 0) {
+          EXPECT_GT(info.predicted_keyframe_ms, info.predicted_sprite_ms);
+        } else {
+          EXPECT_EQ(info.predicted_keyframe_ms, info.predicted_sprite_ms);
+        }
+      }
+    }
+    EXPECT_EQ(tiles.counters().high_frames, high_frames);
+    EXPECT_EQ(tiles.counters().tile_keyframes > 0, cost == &expensive_high);
+  }
+}
+
 TEST(TileSpriteRenderer, BadOptionsAreRefused) {
   Scene scene(testFractal());
   TileSpriteRenderOptions o = tileOptions(0);

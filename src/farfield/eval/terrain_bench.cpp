@@ -294,10 +294,13 @@ void runQuality(Experiment& x) {
     sprites.emplace_back(name, std::make_unique<terrain::LodSpriteRenderer>(
                                    *data.lod, renderer, o.width, o.height, spriteOptions(*x.run, variant, o.epsilon)));
   }
-  std::unique_ptr<terrain::TileSpriteRenderer> tiles;
-  if (std::find(o.modes.begin(), o.modes.end(), "lod-sprite-tiles") != o.modes.end())
-    tiles = std::make_unique<terrain::TileSpriteRenderer>(*data.lod, renderer, o.width, o.height,
-                                                          tileSpriteOptions(*x.run));
+  std::vector<std::pair<std::string, std::unique_ptr<terrain::TileSpriteRenderer>>> tiles;
+  for (const std::string& name : o.modes) {
+    bool choose = false;
+    if (isTileSpriteMode(name, &choose))
+      tiles.emplace_back(name, std::make_unique<terrain::TileSpriteRenderer>(*data.lod, renderer, o.width, o.height,
+                                                                             tileSpriteOptions(*x.run, choose)));
+  }
   // Figure 6 and 7's views: over the plain (40% of the path) and over the mountains (70%).
   const std::set<size_t> views{bench.frame_indices[bench.frame_indices.size() * 2 / 5],
                                bench.frame_indices[bench.frame_indices.size() * 7 / 10]};
@@ -348,10 +351,10 @@ void runQuality(Experiment& x) {
                   << num(image::meanAbsoluteError(high_image, img), 3) << "\n";
       }
     }
-    if (tiles) {
+    for (auto& [name, t] : tiles) {
       target.clear(x.run->sky);
-      tiles->render(camera, target);
-      if (measure) row.psnr["lod-sprite-tiles"] = std::min(image::psnr(high_image, target.readColor()), kPsnrCapDb);
+      t->render(camera, target);
+      if (measure) row.psnr[name] = std::min(image::psnr(high_image, target.readColor()), kPsnrCapDb);
     }
     if (measure) x.result.quality.push_back(std::move(row));
     progress.advance();

@@ -181,8 +181,15 @@ std::map<std::string, double> SpriteMode::info() const {
           {"keyframe_decisions", double(c.fresh_keyframes - c.switches + c.virtual_keyframes)}};
 }
 
-terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run) {
+bool isTileSpriteMode(const std::string& mode_name, bool* choose) {
+  if (mode_name != "lod-sprite-tiles" && mode_name != "lod-sprite-tiles-always") return false;
+  if (choose) *choose = mode_name == "lod-sprite-tiles";
+  return true;
+}
+
+terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run, bool choose) {
   terrain::TileSpriteRenderOptions o;
+  if (choose && run.cost) o.cost = &*run.cost;
   o.tile_cells = run.sprite_tile_cells;
   o.epsilon = run.epsilon;
   o.high_error = run.high_error;
@@ -194,7 +201,8 @@ terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run) {
 void TileSpriteMode::prepare(const ModeContext& context) {
   run_ = terrainRunFor(context, name());
   sprite_ = std::make_unique<terrain::TileSpriteRenderer>(*run_->data->lod, run_->gpuRenderer(), context.width,
-                                                          context.height, tileSpriteOptions(*run_));
+                                                          context.height,
+                                                          tileSpriteOptions(*run_, name_ == "lod-sprite-tiles"));
 }
 
 void TileSpriteMode::frame(FrameContext& frame) {
@@ -220,7 +228,9 @@ std::map<std::string, double> TileSpriteMode::info() const {
           {"keyframe_triangles_per_frame", double(c.keyframe_triangles) / frames},
           {"sprite_triangle_share", double(c.sprite_triangles) / double(std::max<uint64_t>(c.low_triangles, 1))},
           {"peak_sprites", double(c.peak_sprites)},
-          {"peak_sprite_bytes", double(c.peak_sprite_bytes)}};
+          {"peak_sprite_bytes", double(c.peak_sprite_bytes)},
+          {"high_frames", double(c.high_frames)},
+          {"high_frame_fraction", double(c.high_frames) / frames}};
 }
 
 void registerTerrainModes() {
@@ -249,8 +259,12 @@ void registerTerrainModes() {
                  return std::make_unique<SpriteMode>("lod-sprite-cache", SpriteVariant::Cache);
                });
   registerCityOnTerrainModes();
-  registerMode("lod-sprite-tiles", "terrain: LOD-sprite with a sprite per terrain tile (--mode-option tile_cells=N)",
-               [](const ModeContext&) { return std::make_unique<TileSpriteMode>(); });
+  registerMode("lod-sprite-tiles",
+               "terrain: LOD-sprite with a sprite per terrain tile, choosing per frame between it and the high LOD "
+               "by the calibrated cost (--mode-option tile_cells=N)",
+               [](const ModeContext&) { return std::make_unique<TileSpriteMode>("lod-sprite-tiles"); });
+  registerMode("lod-sprite-tiles-always", "terrain: LOD-sprite with a sprite per terrain tile on every frame",
+               [](const ModeContext&) { return std::make_unique<TileSpriteMode>("lod-sprite-tiles-always"); });
 }
 
 }  // namespace farfield::eval

@@ -142,30 +142,37 @@ class SpriteMode : public Mode {
   size_t last_frame_ = 0;
 };
 
-// The options of lod-sprite-tiles with the run's thresholds (the mode's and the quality pass's).
-terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run);
+// The options of the tile modes with the run's thresholds (the mode's and the quality pass's), with the run's cost
+// model (the per-frame choice) when `choose` and the run has one.
+terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run, bool choose);
+// "lod-sprite-tiles" (with the per-frame choice) and "lod-sprite-tiles-always" (the tile path on every frame).
+bool isTileSpriteMode(const std::string& mode_name, bool* choose = nullptr);
 
-// `lod-sprite-tiles`: a sprite per terrain tile (terrain/tile_sprite_renderer.h), every frame the sprite path. Each
-// pass over the path starts from scratch, as SpriteMode's. Under `farfield bench`: --mode-option tile_cells=N.
+// `lod-sprite-tiles`: a sprite per terrain tile (terrain/tile_sprite_renderer.h), choosing per frame between the tiles
+// and the high LOD by the run's calibrated cost; `lod-sprite-tiles-always`: the tile path on every frame. Each pass
+// over the path starts from scratch, as SpriteMode's. Under `farfield bench`: --mode-option tile_cells=N.
 class TileSpriteMode : public Mode {
  public:
-  std::string name() const override { return "lod-sprite-tiles"; }
+  explicit TileSpriteMode(std::string name) : name_(std::move(name)) {}
+  std::string name() const override { return name_; }
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
   // epsilon_px, tile_cells, frames, tile_keyframes, frames_with_keyframes (share too), tile_frames_in_view,
   // tile_keyframe_fraction (of tile-frames in view), view_framed_keyframes, keyframe_triangles_per_frame,
-  // sprite_triangle_share (of the low mesh's triangles), peak_sprites, peak_sprite_bytes (of the last pass).
+  // sprite_triangle_share (of the low mesh's triangles), peak_sprites, peak_sprite_bytes (of the last pass),
+  // high_frames and high_frame_fraction (frames drawn as the high LOD by the choice).
   std::map<std::string, double> info() const override;
 
  private:
+  std::string name_;
   std::shared_ptr<TerrainRun> run_;
   std::unique_ptr<terrain::TileSpriteRenderer> sprite_;
   bool started_ = false;
   size_t last_frame_ = 0;
 };
 
-// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict, lod-sprite-cache and
-// lod-sprite-tiles to the mode registry (mode.h). Idempotent.
+// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict, lod-sprite-cache, lod-sprite-tiles
+// and lod-sprite-tiles-always to the mode registry (mode.h). Idempotent.
 // Called by runTerrainBench and by the executable at start-up (the eval library is static: a static registration
 // object in it would be dropped by the linker).
 void registerTerrainModes();

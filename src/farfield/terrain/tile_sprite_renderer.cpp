@@ -26,6 +26,9 @@ struct TileSpriteRenderer::Sprite {
   std::vector<uint32_t> triangles;
   std::vector<LodQuadrant> quadrants;
   bool has_keyframe = false;
+  bool due = false;             // this frame: no sprite, or its error reached epsilon (or its view turned away)
+  uint64_t served = 0;          // frames drawn with the current sprite (its lifetime so far)
+  uint64_t keyframe_triangles = 0;  // the current sprite's keyframe
 };
 
 namespace {
@@ -83,6 +86,8 @@ void TileSpriteRenderer::reset() {
   sprites_.clear();
   counters_ = {};
   frame_ = 0;
+  high_triangles_ = low_at_high_ = 0;
+  lifetimes_.clear();
 }
 
 bool TileSpriteRenderer::sprite(IVec2 tile, SpriteView& out) const {
@@ -115,6 +120,47 @@ void TileSpriteRenderer::release(Sprite& s) {
     s.target = gpu::RenderTarget();
   }
   s.has_keyframe = false;
+}
+
+void TileSpriteRenderer::countFrame(const TileSpriteRenderFrame& info) {
+  ++counters_.frames;
+  counters_.frames_with_keyframes += info.tiles_refreshed ? 1 : 0;
+  counters_.tile_keyframes += info.tiles_refreshed;
+  counters_.tile_frames_in_view += info.tiles_in_view;
+  counters_.view_framed_keyframes += info.tiles_view_framed;
+  counters_.keyframe_triangles += info.keyframe_triangles;
+  counters_.low_triangles += info.low_triangles;
+  counters_.sprite_triangles += info.sprite_triangles;
+  size_t held = 0;
+  for (const auto& [key, s] : sprites_) held += s->has_keyframe ? 1 : 0;
+  counters_.peak_sprites = std::max(counters_.peak_sprites, held);
+  counters_.peak_sprite_bytes = std::max(counters_.peak_sprite_bytes, spriteBytes());
+}
+
+bool TileSpriteRenderer::chooseHigh(size_t due, TileSpriteRenderFrame& info) const {
+  if (!options_.cost) return false;
+  if (low_at_high_ == 0) return true;  // the high LOD's size is learnt from one high frame first
+  const TerrainCost& c = *options_.cost;
+  const double high_tris = double(high_triangles_) * double(low_.triangleCount()) / double(low_at_high_);
+  size_t draws = 1;  // the triangles without a sprite
+  for (const auto& [key, s] : sprites_) draws += !s->triangles.empty() && (s->has_keyframe || s->due);
+  PathCosts p;
+  p.high_ms = c.frameMs(high_tris, 1.0, width_, height_);
+  p.sprite_ms = c.frameMs(double(low_.triangleCount()), double(draws), width_, height_);
+  p.keyframe_ms = p.sprite_ms;
+  for (const auto& [key, s] : sprites_) {
+    if (s->triangles.empty() || !s->due) continue;
+    // The tile's last keyframe stands for its next; a tile without one, its share of the high LOD at frame size.
+    const int kw = s->has_keyframe ? s->camera.width : width_, kh = s->has_keyframe ? s->camera.height : height_;
+    const double tris = s->has_keyframe ? double(s->keyframe_triangles)
+                                        : high_tris * double(s->triangles.size() / 3) /
+                                              double(std::max<size_t>(low_.triangleCount(), 1));
+    p.keyframe_ms += c.frameMs(tris, 1.0, kw, kh) + c.readbackMs(kw, kh);
+  }
+  info.predicted_high_ms = p.high_ms;
+  info.predicted_sprite_ms = p.sprite_ms;
+  info.predicted_keyframe_ms = p.keyframe_ms;
+  return choosePath(p, due == 0, spriteLifetimeEstimate(lifetimes_, 10.0)) == TerrainPath::High;
 }
 
 uint64_t TileSpriteRenderer::spriteBytes() const {
@@ -199,7 +245,13 @@ void TileSpriteRenderer::renderKeyframe(Sprite& s, TileSpriteRenderFrame& info, 
   gpu::addDraw(stats, renderer_.drawTextured(s.camera, s.target, 0, n, 1));
   s.depth = s.target.readDepth();
   s.visibility.reset(lod_, s.camera, &s.depth, options_.visibility, &s.region);
+  if (s.has_keyframe) {
+    lifetimes_.push_back(std::max<uint64_t>(s.served, 1));
+    while (lifetimes_.size() > 32) lifetimes_.pop_front();
+  }
   s.has_keyframe = true;
+  s.served = 0;
+  s.keyframe_triangles = n;
   info.keyframe_triangles += n;
   info.keyframe_pixels += uint64_t(s.camera.width) * uint64_t(s.camera.height);
   ++info.tiles_refreshed;
@@ -238,15 +290,9 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
     if (it != sprites_.end()) it->second->quadrants.push_back(q);
   }
 
-  // Per tile: keep its sprite, refresh it, or go without.
+  // Per tile: which sprites are due (missing, over epsilon, or of a view the frame has turned away from).
   const double beta = pixelAngle(camera);
-  frame_indices_.clear();
-  struct Range {
-    const Sprite* sprite;
-    size_t first, count;
-  };
-  std::vector<Range> ranges;
-  std::vector<uint32_t> textured;
+  size_t due_count = 0;
   for (auto it = sprites_.begin(); it != sprites_.end();) {
     Sprite& s = *it->second;
     if (s.triangles.empty()) {
@@ -260,18 +306,48 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
     }
     ++info.tiles_in_view;
     s.last_seen = frame_;
-    bool due = !s.has_keyframe;
-    // A sprite of the frame's view: refreshed once the view has turned past its margin.
-    if (!due && s.view_bound)
-      due = glm::dot(camera.forward(), s.key_forward) < std::cos(options_.view_margin * camera.fov_y);
-    if (!due) {
+    s.due = !s.has_keyframe;
+    if (!s.due && s.view_bound)
+      s.due = glm::dot(camera.forward(), s.key_forward) < std::cos(options_.view_margin * camera.fov_y);
+    if (!s.due) {
       const SpriteError e = spriteError(lod_, s.quadrants, s.camera.eye, camera.eye);
-      due = keyframeDue(e, beta, options_.epsilon);
-      if (!due) info.max_tile_error_px = std::max(info.max_tile_error_px, e.pixels(beta));
+      s.due = keyframeDue(e, beta, options_.epsilon);
+      if (!s.due) info.max_tile_error_px = std::max(info.max_tile_error_px, e.pixels(beta));
     }
-    if (due) {
+    due_count += s.due;
+    ++it;
+  }
+  info.tiles_due = due_count;
+
+  // The per-frame choice: the high LOD when the tiles do not pay.
+  if (chooseHigh(due_count, info)) {
+    info.path = TerrainPath::High;
+    gpu::addDraw(stats, renderLodFrame(lod_, renderer_, camera, LodSettings{options_.high_error, true, false}, target,
+                                       high_));
+    info.high_triangles = high_.triangleCount();
+    high_triangles_ = high_.triangleCount();
+    low_at_high_ = low_.triangleCount();
+    ++counters_.high_frames;
+    info.max_tile_error_px = 0.0;
+    countFrame(info);
+    if (out) *out = info;
+    return stats;
+  }
+
+  // The tile path: refresh the tiles due, then draw every tile with its sprite or without.
+  frame_indices_.clear();
+  struct Range {
+    const Sprite* sprite;
+    size_t first, count;
+  };
+  std::vector<Range> ranges;
+  std::vector<uint32_t> textured;
+  for (auto& [key, sp] : sprites_) {
+    Sprite& s = *sp;
+    if (s.triangles.empty()) continue;
+    if (s.due) {
       // The whole tile (parts out of view now may come into view later) and the triangles reaching past it.
-      const IVec2 tile(it->first.first, it->first.second);
+      const IVec2 tile(key.first, key.second);
       GridRect r{tile.x * options_.tile_cells, tile.y * options_.tile_cells,
                  std::min(lod_.width() - 1, (tile.x + 1) * options_.tile_cells),
                  std::min(lod_.height() - 1, (tile.y + 1) * options_.tile_cells)};
@@ -293,6 +369,7 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
       renderKeyframe(s, info, stats);
     }
     if (s.has_keyframe) {
+      ++s.served;
       // Visible triangles with the sprite, the others with the original texture.
       const size_t first = frame_indices_.size() / 3;
       for (size_t t = 0; t < s.triangles.size(); t += 3) {
@@ -305,7 +382,6 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
     } else {
       textured.insert(textured.end(), s.triangles.begin(), s.triangles.end());
     }
-    ++it;
   }
   info.sprite_triangles = frame_indices_.size() / 3;
   const size_t rest_first = frame_indices_.size() / 3;
@@ -317,18 +393,7 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
   if (!textured.empty())
     gpu::addDraw(stats, renderer_.drawTextured(camera, target, rest_first, textured.size() / 3, 0));
 
-  ++counters_.frames;
-  counters_.frames_with_keyframes += info.tiles_refreshed ? 1 : 0;
-  counters_.tile_keyframes += info.tiles_refreshed;
-  counters_.tile_frames_in_view += info.tiles_in_view;
-  counters_.view_framed_keyframes += info.tiles_view_framed;
-  counters_.keyframe_triangles += info.keyframe_triangles;
-  counters_.low_triangles += info.low_triangles;
-  counters_.sprite_triangles += info.sprite_triangles;
-  size_t held = 0;
-  for (const auto& [key, s] : sprites_) held += s->has_keyframe ? 1 : 0;
-  counters_.peak_sprites = std::max(counters_.peak_sprites, held);
-  counters_.peak_sprite_bytes = std::max(counters_.peak_sprite_bytes, spriteBytes());
+  countFrame(info);
   if (out) *out = info;
   return stats;
 }

@@ -27,10 +27,19 @@
 //
 // Far tiles subtend small parallax angles, so their sprites last longer than near ones; a refresh re-renders one
 // tile's high LOD, not the frame's. Sprites of tiles out of view for keep_frames frames are released.
+//
+// Never slower (path_choice.h), with a cost model (TileSpriteRenderOptions::cost): each frame predicts the high LOD's
+// frame and the tile path's (the low mesh in a draw per sprite, plus the keyframes of the tiles due, each from its
+// last keyframe's triangles and size) and draws the high LOD when the tiles do not pay: a frame whose sprites are all
+// valid is drawn from them when that is cheaper than the high LOD; a frame with tiles due pays their keyframes only
+// when they are cheaper over the tiles' expected lifetime (the median of the frames recent sprites served). A frame
+// drawn as the high LOD renders no keyframe; the tiles due stay due. The high LOD's size is the latest one drawn,
+// scaled by the low mesh's size since (their ratio changes slowly along a path).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <utility>
@@ -42,7 +51,9 @@
 #include "farfield/gpu/terrain_renderer.h"
 #include "farfield/image/image.h"
 #include "farfield/terrain/keyframe_visibility.h"
+#include "farfield/terrain/path_choice.h"
 #include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_cost.h"
 
 namespace farfield::terrain {
 
@@ -58,9 +69,17 @@ struct TileSpriteRenderOptions {
   int max_sprite_size = 2048;      // pixels per side; larger regions are drawn at a lower density
   float view_margin = 0.1f;        // share of the frame added on each side of a keyframe taking the frame's view
   int keep_frames = 30;            // frames a sprite is kept out of view
+  // The per-frame choice between the high LOD and the tile path (see above); null = always the tile path.
+  const TerrainCost* cost = nullptr;
 };
 
 struct TileSpriteRenderFrame {
+  TerrainPath path = TerrainPath::Sprite;  // High: the frame drew the high-resolution LOD (the per-frame choice)
+  size_t tiles_due = 0;           // tiles in view whose sprite was missing or over epsilon
+  double predicted_high_ms = 0.0;   // with a cost model: this frame's alternatives (path_choice.h's PathCosts)
+  double predicted_sprite_ms = 0.0;
+  double predicted_keyframe_ms = 0.0;
+  uint64_t high_triangles = 0;    // path High: the high LOD drawn
   size_t tiles_in_view = 0;       // tiles holding a triangle of the frame's low mesh
   size_t tiles_refreshed = 0;     // keyframes rendered in this frame
   size_t tiles_view_framed = 0;   // keyframes of this frame that took the frame's view (the region could not be framed)
@@ -73,6 +92,7 @@ struct TileSpriteRenderFrame {
 
 struct TileSpriteCounters {
   size_t frames = 0;
+  size_t high_frames = 0;  // frames drawn as the high-resolution LOD (the per-frame choice)
   size_t frames_with_keyframes = 0;
   size_t tile_keyframes = 0;
   size_t tile_frames_in_view = 0;
@@ -116,6 +136,9 @@ class TileSpriteRenderer {
   struct Sprite;
   using TileKey = std::pair<int, int>;
   bool frame(const Camera& camera, GridRect region, Camera& out) const;
+  // Whether this frame draws the high LOD instead of the tiles (options_.cost), with its predictions in `info`.
+  bool chooseHigh(size_t due, TileSpriteRenderFrame& info) const;
+  void countFrame(const TileSpriteRenderFrame& info);
   void renderKeyframe(Sprite& sprite, TileSpriteRenderFrame& info, gpu::FrameStats& stats);
   gpu::RenderTarget takeTarget(int width, int height);
   void release(Sprite& sprite);
@@ -134,6 +157,9 @@ class TileSpriteRenderer {
   TileSpriteCounters counters_;
   uint64_t frame_ = 0;
   LodMesh low_, high_;
+  // The per-frame choice: the latest high LOD drawn (its triangles and the low mesh's then) and recent lifetimes.
+  uint64_t high_triangles_ = 0, low_at_high_ = 0;
+  std::deque<uint64_t> lifetimes_;
   std::vector<uint32_t> keyframe_indices_, frame_indices_;
 };
 
