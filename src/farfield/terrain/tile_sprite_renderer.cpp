@@ -147,20 +147,31 @@ bool TileSpriteRenderer::chooseHigh(size_t due, TileSpriteRenderFrame& info) con
   PathCosts p;
   p.high_ms = c.frameMs(high_tris, 1.0, width_, height_);
   p.sprite_ms = c.frameMs(double(low_.triangleCount()), double(draws), width_, height_);
-  p.keyframe_ms = p.sprite_ms;
+  // Each due tile's keyframe, predicted from the tile's last one (triangles and size; a tile without one: its share
+  // of the high LOD at frame size) and amortised over the frames its last sprite served (a tile without one: the
+  // median of recent lifetimes): near tiles trip often and far ones seldom, so one lifetime for all would misprice
+  // both. The keyframes share the frame's fixed cost (the model's base, paid once).
+  const double base_ms = c.frame.base_ms * c.safety_factor;
+  const double fallback_life = spriteLifetimeEstimate(lifetimes_, 10.0);
+  double keyframes_ms = due > 0 ? base_ms : 0.0, amortised_ms = 0.0;
   for (const auto& [key, s] : sprites_) {
     if (s->triangles.empty() || !s->due) continue;
-    // The tile's last keyframe stands for its next; a tile without one, its share of the high LOD at frame size.
     const int kw = s->has_keyframe ? s->camera.width : width_, kh = s->has_keyframe ? s->camera.height : height_;
     const double tris = s->has_keyframe ? double(s->keyframe_triangles)
                                         : high_tris * double(s->triangles.size() / 3) /
                                               double(std::max<size_t>(low_.triangleCount(), 1));
-    p.keyframe_ms += c.frameMs(tris, 1.0, kw, kh) + c.readbackMs(kw, kh);
+    const double k = c.frameMs(tris, 1.0, kw, kh) - base_ms + c.readbackMs(kw, kh);
+    keyframes_ms += k;
+    amortised_ms += k / (s->has_keyframe ? double(std::max<uint64_t>(s->served, 1)) : fallback_life);
   }
+  if (due > 0) amortised_ms += base_ms / fallback_life;
+  p.keyframe_ms = p.sprite_ms + keyframes_ms;
   info.predicted_high_ms = p.high_ms;
   info.predicted_sprite_ms = p.sprite_ms;
   info.predicted_keyframe_ms = p.keyframe_ms;
-  return choosePath(p, due == 0, spriteLifetimeEstimate(lifetimes_, 10.0)) == TerrainPath::High;
+  // path_choice.h's rule, each keyframe over its own expected lifetime: the tiles when their frame plus the
+  // keyframes' share per frame of their lives costs less than the high LOD.
+  return p.sprite_ms + amortised_ms >= p.high_ms;
 }
 
 uint64_t TileSpriteRenderer::spriteBytes() const {

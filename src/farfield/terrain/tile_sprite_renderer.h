@@ -31,10 +31,11 @@
 // Never slower (path_choice.h), with a cost model (TileSpriteRenderOptions::cost): each frame predicts the high LOD's
 // frame and the tile path's (the low mesh in a draw per sprite, plus the keyframes of the tiles due, each from its
 // last keyframe's triangles and size) and draws the high LOD when the tiles do not pay: a frame whose sprites are all
-// valid is drawn from them when that is cheaper than the high LOD; a frame with tiles due pays their keyframes only
-// when they are cheaper over the tiles' expected lifetime (the median of the frames recent sprites served). A frame
-// drawn as the high LOD renders no keyframe; the tiles due stay due. The high LOD's size is the latest one drawn,
-// scaled by the low mesh's size since (their ratio changes slowly along a path).
+// valid is drawn from them when that is cheaper than the high LOD; a frame with tiles due takes the tiles when their
+// frame plus each keyframe's share per frame of its expected life costs less (a tile's expected life: the frames its
+// last sprite served; a tile without one: the median of recent lifetimes). A frame drawn as the high LOD renders no
+// keyframe; the tiles due stay due. The high LOD's size is the latest one drawn, scaled by the low mesh's size since
+// (their ratio changes slowly along a path).
 #pragma once
 
 #include <cstddef>
