@@ -354,7 +354,15 @@ void runQuality(Experiment& x) {
     for (auto& [name, t] : tiles) {
       target.clear(x.run->sky);
       t->render(camera, target);
-      if (measure) row.psnr[name] = std::min(image::psnr(high_image, target.readColor()), kPsnrCapDb);
+      if (!measure) continue;
+      const image::ColorImage img = target.readColor();
+      row.psnr[name] = std::min(image::psnr(high_image, img), kPsnrCapDb);
+      if (views.count(pf)) {  // Figure 6's views for the tile modes too, next to lod-sprite's
+        const std::string tag = "view" + std::to_string(1 + std::distance(views.begin(), views.find(pf)));
+        const fs::path dir = x.figures / "fig06";
+        image::writePng((dir / (tag + "_f_" + name + ".png")).string(), img);
+        image::writePng((dir / (tag + "_g_diff_high_" + name + ".png")).string(), absDifference(high_image, img));
+      }
     }
     if (measure) x.result.quality.push_back(std::move(row));
     progress.advance();
