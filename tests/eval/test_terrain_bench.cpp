@@ -206,26 +206,37 @@ TEST(TerrainBenchGL, WithoutSweepsOnlyTheirFilesAreMissing) {
   EXPECT_EQ(summary["modes"].size(), 4u);  // full, high, low, lod-sprite
 }
 
-// Bad options: farfield::Error naming the option, before the terrain is loaded or a file written.
-// lod-sprite-tiles runs through the harness and the quality pass like the other modes.
+// lod-sprite-tiles (with the per-frame choice) and lod-sprite-tiles-always run through the harness and the quality
+// pass like the other modes, with Figure 6's views written for both.
 TEST(TerrainBenchGL, TileSpritesAreTimedAndMeasured) {
   const fs::path out = test::scratchDir("terrain_bench_tiles");
   TerrainBenchOptions o = smallOptions(out);
-  o.modes = {"high", "low", "lod-sprite", "lod-sprite-tiles"};
+  o.modes = {"high", "low", "lod-sprite", "lod-sprite-tiles", "lod-sprite-tiles-always"};
   o.sweeps = false;
   o.sprite_tile_cells = 32;
   const TerrainBenchResult result = runTerrainBench(o);
   const nlohmann::json bench = nlohmann::json::parse(readText(out / "bench.json"));
-  const nlohmann::json& info = bench["modes"]["lod-sprite-tiles"]["info"];
-  EXPECT_EQ(info["tile_cells"].get<double>(), 32.0);
-  EXPECT_EQ(info["frames"].get<double>(), double(kFrames));
-  EXPECT_GT(info["tile_keyframes"].get<double>(), 0.0);
-  EXPECT_LE(info["tile_keyframes"].get<double>(), info["tile_frames_in_view"].get<double>());
-  EXPECT_GT(info["sprite_triangle_share"].get<double>(), 0.0);
-  ASSERT_TRUE(result.psnr_mean.count("lod-sprite-tiles"));
-  EXPECT_GT(result.psnr_mean.at("lod-sprite-tiles"), result.psnr_mean.at("low"));
+  for (const char* mode : {"lod-sprite-tiles", "lod-sprite-tiles-always"}) {
+    const nlohmann::json& info = bench["modes"][mode]["info"];
+    EXPECT_EQ(info["tile_cells"].get<double>(), 32.0) << mode;
+    EXPECT_EQ(info["frames"].get<double>(), double(kFrames)) << mode;
+    EXPECT_LE(info["tile_keyframes"].get<double>(), info["tile_frames_in_view"].get<double>()) << mode;
+    ASSERT_TRUE(result.psnr_mean.count(mode));
+    EXPECT_GT(result.psnr_mean.at(mode), result.psnr_mean.at("low")) << mode;
+    for (const char* view : {"view1", "view2"}) {
+      EXPECT_TRUE(fs::exists(out / "figures" / "fig06" / (std::string(view) + "_f_" + mode + ".png"))) << mode;
+    }
+  }
+  // The tiles on every frame render keyframes and never the high LOD; with the choice the first frame is the high
+  // LOD (its size is learnt from one frame).
+  const nlohmann::json& always = bench["modes"]["lod-sprite-tiles-always"]["info"];
+  EXPECT_GT(always["tile_keyframes"].get<double>(), 0.0);
+  EXPECT_GT(always["sprite_triangle_share"].get<double>(), 0.0);
+  EXPECT_EQ(always["high_frames"].get<double>(), 0.0);
+  EXPECT_GE(bench["modes"]["lod-sprite-tiles"]["info"]["high_frames"].get<double>(), 1.0);
 }
 
+// Bad options: farfield::Error naming the option, before the terrain is loaded or a file written.
 TEST(TerrainBench, BadOptionsNameTheOption) {
   const fs::path out = test::scratchDir("terrain_bench_bad") / "out";
   const std::vector<std::pair<std::string, std::function<void(TerrainBenchOptions&)>>> cases{
