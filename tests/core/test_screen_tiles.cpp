@@ -36,7 +36,8 @@ TEST(ScreenTiles, CoverHoldsEveryRegionPixelOnceAndOnlyTilesNearRegions) {
         for (int tx = c.x; tx < c.z; tx += tile) {
           bool any = false;
           for (int y = ty; y < std::min(ty + tile, h) && !any; ++y)
-            for (int x = tx; x < std::min(tx + tile, w) && !any; ++x) any = inside[size_t(y) * size_t(w) + size_t(x)] != 0;
+            for (int x = tx; x < std::min(tx + tile, w) && !any; ++x)
+              any = inside[size_t(y) * size_t(w) + size_t(x)] != 0;
           EXPECT_TRUE(any) << "tile at " << tx << "," << ty << " touches no region";
         }
     }

@@ -25,7 +25,8 @@ std::vector<glm::ivec4> tileCover(std::span<const glm::ivec4> regions, int width
       }
       const int start = tx;
       while (tx < cols && covered[size_t(ty) * size_t(cols) + size_t(tx)]) ++tx;
-      out.emplace_back(start * tile_px, ty * tile_px, std::min(tx * tile_px, width), std::min((ty + 1) * tile_px, height));
+      out.emplace_back(start * tile_px, ty * tile_px, std::min(tx * tile_px, width),
+                       std::min((ty + 1) * tile_px, height));
     }
   return out;
 }

@@ -87,6 +87,7 @@ void TileSpriteRenderer::reset() {
   counters_ = {};
   frame_ = 0;
   high_triangles_ = low_at_high_ = 0;
+  high_known_ = false;
   lifetimes_.clear();
 }
 
@@ -139,9 +140,11 @@ void TileSpriteRenderer::countFrame(const TileSpriteRenderFrame& info) {
 
 bool TileSpriteRenderer::chooseHigh(size_t due, TileSpriteRenderFrame& info) const {
   if (!options_.cost) return false;
-  if (low_at_high_ == 0) return true;  // the high LOD's size is learnt from one high frame first
+  if (!high_known_) return true;  // the high LOD's size is learnt from one high frame first
   const TerrainCost& c = *options_.cost;
-  const double high_tris = double(high_triangles_) * double(low_.triangleCount()) / double(low_at_high_);
+  const double high_tris =
+      low_at_high_ > 0 ? double(high_triangles_) * double(low_.triangleCount()) / double(low_at_high_)
+                       : double(high_triangles_);
   size_t draws = 1;  // the triangles without a sprite
   for (const auto& [key, s] : sprites_) draws += !s->triangles.empty() && (s->has_keyframe || s->due);
   PathCosts p;
@@ -338,6 +341,7 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
     info.high_triangles = high_.triangleCount();
     high_triangles_ = high_.triangleCount();
     low_at_high_ = low_.triangleCount();
+    high_known_ = true;
     ++counters_.high_frames;
     info.max_tile_error_px = 0.0;
     countFrame(info);

@@ -160,6 +160,7 @@ class TileSpriteRenderer {
   LodMesh low_, high_;
   // The per-frame choice: the latest high LOD drawn (its triangles and the low mesh's then) and recent lifetimes.
   uint64_t high_triangles_ = 0, low_at_high_ = 0;
+  bool high_known_ = false;
   std::deque<uint64_t> lifetimes_;
   std::vector<uint32_t> keyframe_indices_, frame_indices_;
 };
