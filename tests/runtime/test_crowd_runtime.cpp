@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/gpu_mesh.h"
 #include "farfield/gpu/render_target.h"
+#include "farfield/gpu/renderer.h"
 #include "farfield/scene/gltf_skin.h"
 #include "support/test_support.h"
 
@@ -77,6 +79,81 @@ TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
   EXPECT_EQ(all_impostors.draw.triangles, 4u);
 }
 
+
+// cullBehind: agents behind a wall drawn first are left out and the frame is unchanged, pixel for pixel and id for id;
+// agents in front of it, or beside it, are drawn; the culling holds for one call only. Brute force: each agent is
+// hidden if, drawn alone over the wall, it leaves the wall's frame unchanged.
+TEST_F(CrowdRuntimeGl, AgentsBehindTheCityAreLeftOutAndTheFrameIsUnchanged) {
+  const scene::SkinnedModel fox = loadFox();
+  CrowdRuntimeOptions o;
+  o.palette_poses = 4;
+  o.frames = 4;
+  o.grid = impostor::ViewGrid{8, 3, float(kPi / 4)};
+  o.texel_m = 0.02f;
+  CrowdModelOptions mo;
+  mo.height_m = 0.8f;
+  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), o);
+  // A wall 10 m ahead, 4 m wide, from 2 m below the agents' feet (no ground here: the agents' bounding boxes reach
+  // below it) to 3 m above, facing the camera.
+  scene::Mesh wall_mesh;
+  wall_mesh.positions = {{10, -2, -2}, {10, 2, -2}, {10, 2, 3}, {10, -2, 3}};
+  wall_mesh.normals.assign(4, Vec3(-1, 0, 0));
+  wall_mesh.indices = {0, 2, 1, 0, 3, 2};
+  gpu::GpuMesh wall_gpu(wall_mesh);
+  gpu::GpuMaterial grey;
+  grey.base_color = Vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  const gpu::DrawItem item{&wall_gpu, &grey, Mat4(1.0f), 1u};
+  gpu::Renderer renderer;
+  const gpu::LightSettings light = renderer.light();
+  Camera camera;
+  camera.eye = Vec3(0, 0, 1.2f);
+  camera.at = Vec3(10, 0, 1.0f);
+  camera.width = camera.height = 128;
+  std::vector<CrowdAgentState> agents;
+  for (float x : {6.0f, 14.0f, 20.0f})  // in front of the wall, behind it, far behind it
+    for (float y : {-1.0f, 0.5f, 4.5f}) {  // behind the wall's middle, near its edge, beside it
+      CrowdAgentState a;
+      a.position = Vec3(x, y * x / 10.0f, 0.0f);
+      a.heading = 0.3f * float(agents.size());
+      a.object_id = uint32_t(agents.size() + 2);
+      agents.push_back(a);
+    }
+  gpu::RenderTarget target(128, 128);
+  for (CrowdPolicy policy : {CrowdPolicy::Geometry, CrowdPolicy::Mixed}) {
+    auto frame = [&](std::span<const CrowdAgentState> drawn, bool cull, CrowdFrameStats* st) {
+      renderer.render(camera, std::span(&item, 1), target);
+      target.bindForOpaquePass();
+      if (cull) rt.cullBehind(target);
+      const CrowdFrameStats s = rt.draw(camera, drawn, policy, light);
+      if (st) *st = s;
+      rt.finish();
+      return std::make_pair(target.readColor(), target.readIds());
+    };
+    CrowdFrameStats culled, plain;
+    const auto with = frame(agents, true, &culled);
+    const auto without = frame(agents, false, &plain);
+    EXPECT_TRUE(std::equal(with.first.pixels().begin(), with.first.pixels().end(), without.first.pixels().begin(),
+                           [](const image::Rgba8& a, const image::Rgba8& b) {
+                             return a.r == b.r && a.g == b.g && a.b == b.b;
+                           }));
+    EXPECT_EQ(with.second.pixels(), without.second.pixels());
+    EXPECT_EQ(plain.occluded, 0u);
+    EXPECT_EQ(culled.in_view, plain.in_view);
+    EXPECT_EQ(culled.geometry + culled.impostors + culled.occluded, plain.geometry + plain.impostors);
+    // Brute force: how many agents change the wall's frame when drawn alone.
+    const auto wall_only = frame(std::span<const CrowdAgentState>(), false, nullptr);
+    size_t showing = 0;
+    for (const CrowdAgentState& a : agents) {
+      const auto alone = frame(std::span(&a, 1), false, nullptr);
+      showing += alone.second.pixels() != wall_only.second.pixels();
+    }
+    EXPECT_GE(culled.occluded, 2u);                            // the agents behind the wall's middle
+    EXPECT_LE(culled.occluded, plain.in_view - showing);       // never one that shows
+    // The culling was for that call only.
+    target.bindForOpaquePass();
+    EXPECT_EQ(rt.draw(camera, agents, policy, light).occluded, 0u);
+  }
+}
 
 // Agents at any heading and between capture views: the impostor covers nearly the pixels the geometry covers
 // (a telephoto camera, so that the agent is large on screen).

@@ -130,6 +130,14 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
        << fmt("%.1f", result.switch_m[m]) << " m\n";
   }
   if (options.runtime.blend_views) md << "- impostors blend the four views around the direction to the eye\n";
+  if (options.agent_occlusion) {
+    md << "- agents hidden behind the city left out in every mode (not in the reference), per frame:";
+    for (const CrowdRun& run : result.runs)
+      md << " " << thousands(run.agents) << " " << run.path << " "
+         << fmt("%.0f", run.modes.empty() ? 0.0 : run.modes[0].occluded) << " of "
+         << fmt("%.0f", run.modes.empty() ? 0.0 : run.modes[0].in_view) << " in view;";
+    md << "\n";
+  }
   if (options.shadows)
     md << "- shadows: one " << options.shadow.map_size << "x" << options.shadow.map_size << " map, receivers within "
        << fmt("%.0f", options.shadow.distance_m) << " m, in the reference and every mode\n";
@@ -179,7 +187,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
                            {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
                            {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
-                           {"in_view", r.in_view}, {"triangles", r.triangles},
+                           {"in_view", r.in_view}, {"occluded", r.occluded}, {"triangles", r.triangles},
                            {"shadow_casters", r.shadow_casters}, {"shadow_texel_m", r.shadow_texel_m},
                            {"receiver_bad_pixels", r.receiver_bad_pixels}});
   std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
@@ -268,7 +276,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), psnr(specs.size()),
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
           in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
-          receiver_bad(specs.size());
+          receiver_bad(specs.size()), occluded(specs.size());
       std::vector<image::ColorImage> prev(specs.size());
       std::vector<image::IdImage> prev_ids(specs.size());
       image::ColorImage prev_ref;
@@ -312,6 +320,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           city_culler.draw(renderer, camera, items, item_bounds, target);
           rt.finish();
           const double city_ms = clock.milliseconds();
+          if (options.agent_occlusion) rt.cullBehind(target);
           const runtime::CrowdFrameStats st = drawCrowd(rt, camera, states, specs[m].policy, light, target, options);
           rt.finish();
           const double total = clock.milliseconds();
@@ -321,6 +330,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           geo[m].push_back(double(st.geometry));
           imp[m].push_back(double(st.impostors));
           in_view[m].push_back(double(st.in_view));
+          occluded[m].push_back(double(st.occluded));
           tris[m].push_back(double(st.draw.triangles));
           casters[m].push_back(double(st.shadow_casters));
           shadow_texel[m].push_back(double(st.shadow_texel_m));
@@ -369,6 +379,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.geometry_agents = mean(geo[m]);
         r.impostor_agents = mean(imp[m]);
         r.in_view = mean(in_view[m]);
+        r.occluded = mean(occluded[m]);
         r.triangles = mean(tris[m]);
         r.shadow_casters = mean(casters[m]);
         r.shadow_texel_m = mean(shadow_texel[m]);

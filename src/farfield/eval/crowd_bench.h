@@ -37,6 +37,9 @@ struct CrowdBenchOptions {
   runtime::CrowdRuntimeOptions runtime;  // its bound_focal_px is set from the frame size (60 degrees)
   size_t outfits = 32;                   // colour-region outfits drawn from
   bool shadows = true;                   // agents cast shadows (reference and every mode)
+  // Every mode leaves out the agents hidden behind the city (CrowdRuntime::cullBehind; its depth read back and
+  // reduced inside the crowd pass's time). The reference never culls.
+  bool agent_occlusion = false;
   runtime::CrowdShadowOptions shadow;
   std::string out_dir;
   int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)
@@ -51,6 +54,7 @@ struct CrowdModeResult {
   double psnr_mean = 0.0, psnr_min = 0.0, bad_share_mean = 0.0, crowd_pixels_mean = 0.0;
   double popping_mean = 0.0, popping_max = 0.0;
   double geometry_agents = 0.0, impostor_agents = 0.0, in_view = 0.0, triangles = 0.0;  // means per frame
+  double occluded = 0.0;  // mean per frame: agents in view left out behind the city (agent_occlusion)
   double shadow_casters = 0.0, shadow_texel_m = 0.0;  // means per frame
   double receiver_bad_pixels = 0.0;  // mean per frame: non-agent pixels off by > 8/255 (shadow differences)
 };

@@ -122,8 +122,23 @@ gpu::CrowdAgentGpu CrowdRuntime::record(const CrowdAgentState& a) const {
   return g;
 }
 
+void CrowdRuntime::cullBehind(const gpu::RenderTarget& target) {
+  target.readDepthRows(depth_rows_);
+  occluders_.build(depth_rows_, target.width(), target.height());
+  cull_next_ = true;
+}
+
+bool CrowdRuntime::hidden(const Camera& camera, const Vec3& centre, float radius) const {
+  if (occluders_.width() != camera.width || occluders_.height() != camera.height)
+    throw Error("crowd runtime", "cullBehind's target is not the camera's size");
+  const Box3 box = Box3::fromPoints(centre - Vec3(radius), centre + Vec3(radius));
+  return occluders_.hides(gpu::projectBox(box, camera.viewProjection(), camera.width, camera.height));
+}
+
 void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                             CrowdFrameStats& stats) {
+  const bool cull = cull_next_;
+  cull_next_ = false;
   Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
   for (Vec4& p : frustum.planes) p /= std::max(glm::length(Vec3(p)), 1e-20f);
   std::vector<double> switch_m(models_.size());
@@ -144,6 +159,10 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
       }
     if (!visible) continue;
     ++stats.in_view;
+    if (cull && hidden(camera, centre, model.radius)) {
+      ++stats.occluded;
+      continue;
+    }
     const float phase = a.phase - std::floor(a.phase);
     gpu::CrowdAgentGpu g = record(a);
     const Vec3 to_eye = camera.eye - centre;

@@ -13,6 +13,7 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/gpu/crowd_renderer.h"
+#include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/shadow_map.h"
 #include "farfield/impostor/multi_view.h"
@@ -85,6 +86,7 @@ struct CrowdAtlasChoice {
 // Agents drawn in a frame, by representation.
 struct CrowdFrameStats {
   size_t in_view = 0;
+  size_t occluded = 0;  // of in_view: left out behind the depth given to cullBehind
   size_t geometry = 0;
   size_t impostors = 0;
   size_t shadow_casters = 0;  // drawShadowed: agents drawn into the shadow map
@@ -112,6 +114,11 @@ class CrowdRuntime {
                                const gpu::LightSettings& light, const gpu::RenderTarget& target,
                                const CrowdShadowOptions& shadows = {});
 
+  // Occlusion culling of the next draw or drawShadowed call (that call only): agents whose bounding box lies behind
+  // `target`'s current depth (the city, drawn first) over the box's whole footprint are left out (gpu::DepthPyramid;
+  // exact: such an agent would draw no pixel). Reads the depth back (a wait for the GPU). Shadow casters are chosen
+  // without it: a hidden agent may shadow what is seen. The target must be the camera's size.
+  void cullBehind(const gpu::RenderTarget& target);
   // Waits for the GPU (frame timings).
   void finish() const { renderer_.finish(); }
   // The switch distance of model m for a camera (metres; Dobbyn's texel rule and the view error bound).
@@ -140,6 +147,7 @@ class CrowdRuntime {
   };
   void classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                 CrowdFrameStats& stats);
+  bool hidden(const Camera& camera, const Vec3& centre, float radius) const;
   CrowdFrameStats drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats);
   void castShadows(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                    const gpu::LightSettings& light, const CrowdShadowOptions& shadows, CrowdFrameStats& stats);
@@ -150,6 +158,9 @@ class CrowdRuntime {
   gpu::CrowdRenderer renderer_;
   std::vector<Model> models_;
   Lists lists_, caster_lists_;  // reused per frame
+  gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
+  std::vector<float> depth_rows_;
+  bool cull_next_ = false;
   std::unique_ptr<gpu::ShadowMap> shadow_map_;
   std::unique_ptr<gpu::ShadowReceiver> receiver_;
   gpu::ShadowProjection shadow_projection_;
