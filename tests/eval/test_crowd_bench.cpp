@@ -59,6 +59,23 @@ TEST(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgains
   EXPECT_NE(r.markdown.find("crowd-mixed"), std::string::npos);
 }
 
+// With the agents hidden behind the city left out, every mode's agents are those in view less the hidden ones, and
+// crowd-geometry still draws exactly what the (unculled) reference draws.
+TEST(CrowdBench, AgentsCulledBehindTheCityLeaveTheGeometryFrameExact) {
+  eval::CrowdBenchOptions o = tinyOptions();
+  o.agent_occlusion = true;
+  o.out_dir = test::scratchDir("crowd_bench_occlusion").string();
+  const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), o);
+  ASSERT_EQ(r.runs.size(), 1u);
+  for (const eval::CrowdModeResult& m : r.runs[0].modes) {
+    EXPECT_NEAR(m.geometry_agents + m.impostor_agents + m.occluded, m.in_view, 1e-9) << m.name;
+    EXPECT_EQ(m.occluded, r.runs[0].modes[0].occluded) << m.name << ": the same agents hide in every mode";
+  }
+  EXPECT_GE(r.runs[0].modes[0].psnr_min, 99.0);
+  EXPECT_EQ(r.runs[0].modes[0].bad_share_mean, 0.0);
+  EXPECT_NE(r.markdown.find("hidden behind the city"), std::string::npos);
+}
+
 TEST(CrowdBench, BadOptionsAreErrors) {
   eval::CrowdBenchOptions o = tinyOptions();
   o.frames = 1;
