@@ -24,16 +24,26 @@ scene::SkinnedModel loadFox() {
   return scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
 }
 
-TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
-  const scene::SkinnedModel fox = loadFox();
+// A small atlas (8 x 3 views up to 45 degrees, 4 frames, 2 cm texels) over a palette of `poses`.
+CrowdRuntimeOptions smallAtlas(int poses) {
   CrowdRuntimeOptions o;
-  o.palette_poses = 8;
+  o.palette_poses = poses;
   o.frames = 4;
   o.grid = impostor::ViewGrid{8, 3, float(kPi / 4)};
   o.texel_m = 0.02f;
+  return o;
+}
+
+CrowdModelOptions foxOptions() {
   CrowdModelOptions mo;
   mo.height_m = 0.8f;
-  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), o);
+  return mo;
+}
+
+TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
+  const scene::SkinnedModel fox = loadFox();
+  const CrowdModelOptions mo = foxOptions();
+  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), smallAtlas(8));
   EXPECT_GT(rt.atlasBytes(), 0u);
 
   Camera camera;
@@ -85,14 +95,8 @@ TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
 // hidden if, drawn alone over the wall, it leaves the wall's frame unchanged.
 TEST_F(CrowdRuntimeGl, AgentsBehindTheCityAreLeftOutAndTheFrameIsUnchanged) {
   const scene::SkinnedModel fox = loadFox();
-  CrowdRuntimeOptions o;
-  o.palette_poses = 4;
-  o.frames = 4;
-  o.grid = impostor::ViewGrid{8, 3, float(kPi / 4)};
-  o.texel_m = 0.02f;
-  CrowdModelOptions mo;
-  mo.height_m = 0.8f;
-  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), o);
+  const CrowdModelOptions mo = foxOptions();
+  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), smallAtlas(4));
   // A wall 10 m ahead, 4 m wide, from 2 m below the agents' feet (no ground here: the agents' bounding boxes reach
   // below it) to 3 m above, facing the camera.
   scene::Mesh wall_mesh;
