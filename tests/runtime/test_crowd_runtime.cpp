@@ -6,10 +6,10 @@
 #include <cmath>
 
 #include "farfield/gpu/context.h"
-#include "farfield/gpu/gpu_mesh.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/scene/gltf_skin.h"
+#include "grey_quad.h"
 #include "support/test_support.h"
 
 namespace farfield::runtime {
@@ -99,14 +99,8 @@ TEST_F(CrowdRuntimeGl, AgentsBehindTheCityAreLeftOutAndTheFrameIsUnchanged) {
   CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), smallAtlas(4));
   // A wall 10 m ahead, 4 m wide, from 2 m below the agents' feet (no ground here: the agents' bounding boxes reach
   // below it) to 3 m above, facing the camera.
-  scene::Mesh wall_mesh;
-  wall_mesh.positions = {{10, -2, -2}, {10, 2, -2}, {10, 2, 3}, {10, -2, 3}};
-  wall_mesh.normals.assign(4, Vec3(-1, 0, 0));
-  wall_mesh.indices = {0, 2, 1, 0, 3, 2};
-  gpu::GpuMesh wall_gpu(wall_mesh);
-  gpu::GpuMaterial grey;
-  grey.base_color = Vec4(0.5f, 0.5f, 0.5f, 1.0f);
-  const gpu::DrawItem item{&wall_gpu, &grey, Mat4(1.0f), 1u};
+  const test::GreyQuad wall({Vec3(10, -2, -2), Vec3(10, -2, 3), Vec3(10, 2, 3), Vec3(10, 2, -2)}, Vec3(-1, 0, 0), 0.5f);
+  const gpu::DrawItem& item = wall.item;
   gpu::Renderer renderer;
   const gpu::LightSettings light = renderer.light();
   Camera camera;

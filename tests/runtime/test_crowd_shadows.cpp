@@ -10,11 +10,11 @@
 
 #include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
-#include "farfield/gpu/gpu_mesh.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/image/png_io.h"
 #include "farfield/runtime/crowd_runtime.h"
 #include "farfield/scene/gltf_skin.h"
+#include "grey_quad.h"
 #include "support/test_support.h"
 
 namespace farfield::runtime {
@@ -151,14 +151,10 @@ TEST_F(CrowdShadowsGl, AnAgentDarkensTheGroundWhereItsSilhouetteFallsAlongTheLig
   CrowdRuntime rt(std::span(&man, 1), std::span(&mo, 1), o);
 
   // The ground: a 20 m quad at z = 0, grey, drawn by the city's renderer.
-  scene::Mesh ground_mesh;
-  ground_mesh.positions = {{-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0}};
-  ground_mesh.normals.assign(4, Vec3(0, 0, 1));
-  ground_mesh.indices = {0, 1, 2, 0, 2, 3};
-  gpu::GpuMesh ground_gpu(ground_mesh);
-  gpu::GpuMaterial grey;
-  grey.base_color = Vec4(0.6f, 0.6f, 0.6f, 1.0f);
-  const gpu::DrawItem item{&ground_gpu, &grey, Mat4(1.0f), 1u};
+  const test::GreyQuad ground_quad({Vec3(-10, -10, 0), Vec3(10, -10, 0), Vec3(10, 10, 0), Vec3(-10, 10, 0)}, Vec3(0, 0, 1),
+                                   0.6f);
+  const gpu::DrawItem& item = ground_quad.item;
+  const gpu::GpuMaterial& grey = ground_quad.material;
   gpu::Renderer renderer;
   const gpu::LightSettings light = renderer.light();
 
