@@ -99,7 +99,8 @@ TEST_F(CrowdRuntimeGl, AgentsBehindTheCityAreLeftOutAndTheFrameIsUnchanged) {
   CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), smallAtlas(4));
   // A wall 10 m ahead, 4 m wide, from 2 m below the agents' feet (no ground here: the agents' bounding boxes reach
   // below it) to 3 m above, facing the camera.
-  const test::GreyQuad wall({Vec3(10, -2, -2), Vec3(10, -2, 3), Vec3(10, 2, 3), Vec3(10, 2, -2)}, Vec3(-1, 0, 0), 0.5f);
+  const test::GreyQuad wall({Vec3(10, -2, -2), Vec3(10, -2, 3), Vec3(10, 2, 3), Vec3(10, 2, -2)}, Vec3(-1, 0, 0),
+                            0.5f);
   const gpu::DrawItem& item = wall.item;
   gpu::Renderer renderer;
   const gpu::LightSettings light = renderer.light();

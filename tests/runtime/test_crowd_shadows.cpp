@@ -151,8 +151,8 @@ TEST_F(CrowdShadowsGl, AnAgentDarkensTheGroundWhereItsSilhouetteFallsAlongTheLig
   CrowdRuntime rt(std::span(&man, 1), std::span(&mo, 1), o);
 
   // The ground: a 20 m quad at z = 0, grey, drawn by the city's renderer.
-  const test::GreyQuad ground_quad({Vec3(-10, -10, 0), Vec3(10, -10, 0), Vec3(10, 10, 0), Vec3(-10, 10, 0)}, Vec3(0, 0, 1),
-                                   0.6f);
+  const test::GreyQuad ground_quad({Vec3(-10, -10, 0), Vec3(10, -10, 0), Vec3(10, 10, 0), Vec3(-10, 10, 0)},
+                                   Vec3(0, 0, 1), 0.6f);
   const gpu::DrawItem& item = ground_quad.item;
   const gpu::GpuMaterial& grey = ground_quad.material;
   gpu::Renderer renderer;
