@@ -2,7 +2,7 @@
 //                      [--size WxH] [--blocks N] [--detail D] [--models A.glb,B.glb] [--texel M] [--cycle-frames F]
 //                      [--azimuths A] [--elevations E] [--octahedral N] [--error-px PX] [--atlas-from-bound] [--bound-switch M]
 //                      [--blend-views] [--outfits N] [--no-shadows] [--shadow-map N] [--shadow-distance M]
-//                      [--agent-occlusion]
+//                      [--agent-occlusion] [--impostor-shadows]
 // Animated crowds with multi-view impostors on a generated city: eval::runCrowdBench (eval/crowd_bench.h).
 #include <cstdio>
 #include <memory>
@@ -107,6 +107,8 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
   bench->add_flag("!--no-shadows", o.shadows, "No agent shadows");
   bench->add_flag("--agent-occlusion", o.agent_occlusion,
                   "Every mode leaves out the agents hidden behind the city (exact; the reference never culls)");
+  bench->add_flag("--impostor-shadows", o.impostor_shadows,
+                  "crowd-mixed's geometry agents cast their shadows as impostors (the reference's cast geometry)");
   bench->add_option("--shadow-map", o.shadow.map_size, "Shadow map texels per side")->capture_default_str();
   bench->add_option("--shadow-distance", o.shadow.distance_m, "Shadow receivers up to this distance (m)")
       ->capture_default_str();

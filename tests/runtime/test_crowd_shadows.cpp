@@ -253,6 +253,41 @@ TEST_F(CrowdShadowsGl, AnAgentDarkensTheGroundWhereItsSilhouetteFallsAlongTheLig
   EXPECT_LT(double(value_off), 0.02 * double(inner)) << "shadowed ground keeps the ambient term alone";
   // The impostor, seen from the light's nearest view, casts nearly the geometry's shadow.
   EXPECT_GT(double(imp_both), 0.8 * double(imp_either)) << imp_both << " of " << imp_either;
+
+  // Mixed with impostor casters: the near agent is drawn as geometry (the geometry frame's ids) and casts the
+  // impostor's shadow (the impostor frame's ground, pixel for pixel, but next to the agent, where the receivers'
+  // normals come from depths the two frames do not share); without the option, the geometry's shadow.
+  auto groundInBoth = [&](int x, int y) {
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const size_t j = size_t(std::clamp(y + dy, 0, h - 1)) * size_t(w) + size_t(std::clamp(x + dx, 0, w - 1));
+        if (ig.pixels()[j] != 1u || ii.pixels()[j] != 1u) return false;
+      }
+    return true;
+  };
+  for (bool impostor_casters : {true, false}) {
+    gpu::RenderTarget mixed(200, 200);
+    renderer.render(camera, std::span(&item, 1), mixed);
+    CrowdShadowOptions so;
+    so.map_size = 1024;
+    so.impostor_casters = impostor_casters;
+    const CrowdFrameStats st = rt.drawShadowed(camera, agents, CrowdPolicy::Mixed, light, mixed, so);
+    rt.finish();
+    EXPECT_EQ(st.geometry, 1u);
+    const image::ColorImage mc = mixed.readColor();
+    EXPECT_EQ(mixed.readIds().pixels(), ig.pixels());
+    const image::ColorImage& shadow_of = impostor_casters ? im : g;
+    size_t compared = 0, differ = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (!groundInBoth(x, y)) continue;
+        const size_t i = size_t(y) * size_t(w) + size_t(x);
+        ++compared;
+        differ += mc.pixels()[i].r != shadow_of.pixels()[i].r || mc.pixels()[i].g != shadow_of.pixels()[i].g;
+      }
+    EXPECT_GT(compared, 20000u);
+    EXPECT_EQ(differ, 0u) << (impostor_casters ? "impostor" : "geometry") << " casters";
+  }
 }
 
 }  // namespace

@@ -40,6 +40,9 @@ struct CrowdBenchOptions {
   // Every mode leaves out the agents hidden behind the city (CrowdRuntime::cullBehind; its depth read back and
   // reduced inside the crowd pass's time). The reference never culls.
   bool agent_occlusion = false;
+  // crowd-mixed's geometry agents cast their shadows as impostors (CrowdShadowOptions::impostor_casters); the
+  // reference and crowd-geometry always cast geometry.
+  bool impostor_shadows = false;
   runtime::CrowdShadowOptions shadow;
   std::string out_dir;
   int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)

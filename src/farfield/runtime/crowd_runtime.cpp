@@ -231,7 +231,8 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
     gpu::CrowdAgentGpu g = record(a);
     const bool impostor =
         policy == CrowdPolicy::Impostor ||
-        (policy == CrowdPolicy::Mixed && double(glm::length(camera.eye - spheres[i].centre)) >= switch_m[a.model]);
+        (policy == CrowdPolicy::Mixed &&
+         (shadows.impostor_casters || double(glm::length(camera.eye - spheres[i].centre)) >= switch_m[a.model]));
     if (!impostor) {
       g.index = uint32_t(std::lround(phase * float(options_.palette_poses))) % uint32_t(options_.palette_poses);
       caster_lists_.geometry[a.model].push_back(g);

@@ -72,6 +72,10 @@ struct CrowdShadowOptions {
   float distance_m = 60.0f;    // receivers up to this far along the view
   float bias_m = 0.03f;        // depth bias, metres along the light
   uint32_t agent_id_mask = kAgentIdBit;  // pixels whose id has these bits receive no shadow
+  // Under the Mixed policy, the agents drawn as geometry cast as impostors too (their view towards the light): a quad
+  // instead of a skinned mesh in the shadow map, for shadows that differ from the geometry's by the impostor's view
+  // and frame quantisation. The Geometry policy always casts geometry.
+  bool impostor_casters = false;
 };
 
 // What the atlas of a model holds and why (CrowdRuntimeOptions).
