@@ -128,18 +128,19 @@ void CrowdRuntime::cullBehind(const gpu::RenderTarget& target) {
   cull_next_ = true;
 }
 
-bool CrowdRuntime::hidden(const Camera& camera, const Vec3& centre, float radius) const {
-  if (occluders_.width() != camera.width || occluders_.height() != camera.height)
-    throw Error("crowd runtime", "cullBehind's target is not the camera's size");
+bool CrowdRuntime::hidden(const Mat4& view_proj, const Vec3& centre, float radius) const {
   const Box3 box = Box3::fromPoints(centre - Vec3(radius), centre + Vec3(radius));
-  return occluders_.hides(gpu::projectBox(box, camera.viewProjection(), camera.width, camera.height));
+  return occluders_.hides(gpu::projectBox(box, view_proj, occluders_.width(), occluders_.height()));
 }
 
 void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                             CrowdFrameStats& stats) {
   const bool cull = cull_next_;
   cull_next_ = false;
-  Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  if (cull && (occluders_.width() != camera.width || occluders_.height() != camera.height))
+    throw Error("crowd runtime", "cullBehind's target is not the camera's size");
+  const Mat4 view_proj = camera.viewProjection();
+  Frustum frustum = Frustum::fromMatrix(view_proj);
   for (Vec4& p : frustum.planes) p /= std::max(glm::length(Vec3(p)), 1e-20f);
   std::vector<double> switch_m(models_.size());
   for (size_t m = 0; m < models_.size(); ++m) {
@@ -159,7 +160,7 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
       }
     if (!visible) continue;
     ++stats.in_view;
-    if (cull && hidden(camera, centre, model.radius)) {
+    if (cull && hidden(view_proj, centre, model.radius)) {
       ++stats.occluded;
       continue;
     }

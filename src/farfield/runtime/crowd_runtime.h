@@ -151,7 +151,8 @@ class CrowdRuntime {
   };
   void classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                 CrowdFrameStats& stats);
-  bool hidden(const Camera& camera, const Vec3& centre, float radius) const;
+  // Whether the box around the sphere lies behind cullBehind's depth over its whole footprint.
+  bool hidden(const Mat4& view_proj, const Vec3& centre, float radius) const;
   CrowdFrameStats drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats);
   void castShadows(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                    const gpu::LightSettings& light, const CrowdShadowOptions& shadows, CrowdFrameStats& stats);

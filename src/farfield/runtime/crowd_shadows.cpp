@@ -73,13 +73,6 @@ ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const
   // below its lowest point (the sphere's bounds in between follow: the swept sphere is their convex hull).
   const Mat4 vp = camera.viewProjection();
   const float focal = float(camera.height) / (2.0f * ty);
-  auto clipped = [&](const Vec2& lo_px, const Vec2& hi_px) {
-    return glm::ivec4(std::clamp(int(std::floor(lo_px.x)), 0, camera.width),
-                      std::clamp(int(std::floor(lo_px.y)), 0, camera.height),
-                      std::clamp(int(std::ceil(hi_px.x)) + 1, 0, camera.width),
-                      std::clamp(int(std::ceil(hi_px.y)) + 1, 0, camera.height));
-  };
-  Vec2 slo(1e30f), shi(-1e30f);
   bool whole = f.z >= -1e-3f;
   for (uint32_t i : fit.casters) {
     if (whole) break;
@@ -98,17 +91,13 @@ ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const
       chi = glm::max(chi, p + r);
     }
     if (whole) break;
-    const glm::ivec4 rect = clipped(clo, chi);
+    const glm::ivec4 rect(std::clamp(int(std::floor(clo.x)), 0, camera.width),
+                          std::clamp(int(std::floor(clo.y)), 0, camera.height),
+                          std::clamp(int(std::ceil(chi.x)) + 1, 0, camera.width),
+                          std::clamp(int(std::ceil(chi.y)) + 1, 0, camera.height));
     if (rect.z > rect.x && rect.w > rect.y) fit.screen_rects.push_back(rect);
-    slo = glm::min(slo, clo);
-    shi = glm::max(shi, chi);
   }
-  if (whole) {
-    fit.screen = glm::ivec4(0, 0, camera.width, camera.height);
-    fit.screen_rects.assign(1, fit.screen);
-  } else {
-    fit.screen = clipped(slo, shi);
-  }
+  if (whole) fit.screen_rects.assign(1, glm::ivec4(0, 0, camera.width, camera.height));
   return fit;
 }
 

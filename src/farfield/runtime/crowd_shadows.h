@@ -20,12 +20,10 @@ struct CasterSphere {
 struct ShadowFit {
   gpu::ShadowProjection projection;
   std::vector<uint32_t> casters;  // indices of the spheres inside the box, increasing
-  // Pixels (x0, y0, x1, y1; row 0 at the bottom, as GL scissors; exclusive ends) that can hold a caster's shadow on a
-  // receiver no lower than `drop_m` below the caster's sphere: each caster's sphere swept along the light down to
-  // there, projected; the whole frame when a swept sphere reaches behind the near plane.
-  glm::ivec4 screen{0, 0, 0, 0};
-  // The same per caster (its swept sphere alone; empty ones left out): screen is their bounds. The whole frame alone
-  // where screen is the whole frame because a swept sphere reaches behind the near plane or the light is not downwards.
+  // Per caster, the pixels (x0, y0, x1, y1; row 0 at the bottom, as GL scissors; exclusive ends) that can hold its
+  // shadow on a receiver no lower than `drop_m` below its sphere: the sphere swept along the light down to there,
+  // projected (empty ones left out). The whole frame alone when a swept sphere reaches behind the near plane or the
+  // light is not downwards.
   std::vector<glm::ivec4> screen_rects;
 };
 
