@@ -45,8 +45,9 @@ void runCalibrateCommand(CalibrateArgs& args) {
   std::printf("scene:              %s\n", args.scene.c_str());
   std::printf("renderer:           %s\n", r.profile.renderer.c_str());
   std::printf("malloc:             %s\n", allocator.description.c_str());
-  std::printf("model:              %.3f ms + %.3f ms/Mtri + %.4f ms/draw + %.3f ms/Mpixel (fit r2 %.3f, %zu samples)\n",
-              m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.r2, m.samples);
+  std::printf("model:              %.3f ms + %.3f ms/Mtri + %.4f ms/draw + %.3f ms/Mpixel + %.3f ms/Mpixel of "
+              "estimated fill (fit r2 %.3f, %zu samples)\n",
+              m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.ms_per_mfill, m.r2, m.samples);
   std::printf("validation:         %zu views at %dx%d, %.0f deg, min of %d renders each\n", r.checks.size(), o.width,
               o.height, double(o.fov_deg), o.repeats);
   std::printf("measured/predicted: p50 %.3f  p95 %.3f  p99 %.3f  max %.3f\n", r.ratio_p50, r.ratio_p95, r.ratio_p99,
@@ -95,6 +96,9 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
   cmd->add_option("--margin-quantile", args->options.margin_quantile,
                   "Safety factor = this quantile of measured/predicted (1 = the maximum)")->capture_default_str();
   cmd->add_option("--csv", args->csv, "Per-view predicted and measured times");
+  cmd->add_flag("--fill-term", args->options.fill_term,
+                "Fit the estimated-fill term too (better per-view predictions; placement then bounds each region's "
+                "fill from its nearest point, which is far more conservative: see docs/BENCHMARKS.md)");
   cmd->add_option("--layered-samples", args->options.layered_samples,
                   "Layered impostors the draw and capture terms are fitted on (as many validate them; 0: none)")
       ->capture_default_str();

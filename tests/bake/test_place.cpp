@@ -138,7 +138,8 @@ ViewChecks checkViews(const scene::Scene& scene, const gpu::CostProfile& profile
     const runtime::FramePlan& plan = walkthrough.plan(camera);
     uint64_t triangles = 0;
     for (const gpu::DrawItem& item : plan.items) triangles += item.triangleCount();
-    const double predicted = profile.boundMs(double(triangles), double(plan.items.size()), 128.0 * 128.0);
+    const double predicted = profile.boundMs(double(triangles), double(plan.items.size()), 128.0 * 128.0,
+                                             test::itemsFill(plan.items, scene, camera));
     const bool solved = plan.report.cpv == urban::kNone || plan.report.cpv_t_after_ms <= place_options.t_max_ms;
     if (solved) {
       ++out.guarded;
@@ -265,9 +266,10 @@ TEST(PlaceTest, BoxViewCellsArePlannedThroughTheShaftAroundThem) {
               worst_ratio, v.over_tolerance, v.checked_images, v.worst_parallax);
 }
 
-// The layered impostors' fill in the cost model, and the fallback to coarser bounds: with a profile whose layered draw
-// term is dear, every view the runtime plans where its CPV was solved is predicted under t_max from what it draws,
-// the impostors' fill included (recomputed here from each drawn impostor's plan at the eye's distance); the fallback
+// The fill in the cost model, and the fallback to coarser bounds: with a profile whose layered draw term and geometry
+// fill term are dear, every view the runtime plans where its CPV was solved is predicted under t_max from what it
+// draws, the impostors' fill and the geometry's fill included (recomputed here from each drawn impostor's plan and
+// each drawn object's bounds at the eye's distance: placement charges them from the CPV region's nearest point); the fallback
 // passes leave no more CPVs over t_max than the bound alone, and the database's impostors placed under a coarser
 // bound are the ones the report counts.
 TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
@@ -277,6 +279,7 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
   profile.layered.draw.ms_per_draw = 0.05;      // per layer
   profile.layered.draw.ms_per_mpixel = 40.0;    // per million pixels of quads
   profile.layered.draw_safety_factor = 1.5;
+  profile.model.ms_per_mfill = 8.0;  // per million pixels the drawn objects may cover: a full 128 x 128 frame 0.13 ms
   PlaceOptions options = test::smallPlaceOptions(city.scene);
   options.fallback_bound_factors = {2.0, 4.0};
   const std::string dir = test::scratchDir("place_fill_fallback").string();
@@ -302,7 +305,7 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   size_t guarded = 0, drawn = 0;
-  for (int k = 0; k < 200; ++k) {
+  for (int k = 0; k < 400; ++k) {
     Camera camera;
     camera.eye = index.view_space.lo + (index.view_space.hi - index.view_space.lo) * Vec3(u(rng), u(rng), u(rng));
     const float yaw = float(2.0 * kPi) * u(rng);
@@ -312,7 +315,8 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
     const runtime::FramePlan& plan = walkthrough.plan(camera);
     uint64_t triangles = 0;
     for (const gpu::DrawItem& item : plan.items) triangles += item.triangleCount();
-    double predicted = profile.boundMs(double(triangles), double(plan.items.size()), 128.0 * 128.0);
+    double predicted = profile.boundMs(double(triangles), double(plan.items.size()), 128.0 * 128.0,
+                                       test::itemsFill(plan.items, city.scene, camera));
     for (const runtime::LayerDecision& d : plan.layers)
       if (const auto* i = std::get_if<runtime::ClusterAsImpostor>(&d)) {
         const store::StoredPlacedImpostor& rec = *index.find(i->impostor);

@@ -77,6 +77,35 @@ TEST(CalibrationTest, TheSafetyFactorBoundsTheViewsItCameFrom) {
   EXPECT_LE(above, 12u);
 }
 
+// The fill term (core/object_fill.h) is fitted only when asked; either way each view's estimated fill is reported,
+// and with it every prediction is the model's four workload terms and the fill, recomputed here from the coefficients.
+TEST(CalibrationTest, TheFillTermIsFittedOnlyWhenAsked) {
+  CalibrateOptions o;
+  o.width = o.height = 64;
+  o.views = 16;
+  o.fit_views = 12;
+  o.repeats = 1;
+  o.progress = false;
+  o.layered_samples = 0;
+  const CalibrateResult off = calibrate(gpu::sharedHeadlessContext(), smallCity(), o);
+  EXPECT_EQ(off.profile.model.ms_per_mfill, 0.0);
+  EXPECT_EQ(off.profile.validation["fill_term"], false);
+  o.fill_term = true;
+  const CalibrateResult on = calibrate(gpu::sharedHeadlessContext(), smallCity(), o);
+  EXPECT_EQ(on.profile.validation["fill_term"], true);
+  const gpu::CostModel& m = on.profile.model;
+  size_t with_fill = 0;
+  for (const ViewCheck& c : on.checks) {
+    with_fill += c.fill > 0.0;
+    EXPECT_NEAR(c.predicted_ms,
+                m.base_ms + m.ms_per_mtriangle * double(c.triangles) * 1e-6 + m.ms_per_draw * double(c.draw_calls) +
+                    m.ms_per_mpixel * 64.0 * 64.0 * 1e-6 + m.ms_per_mfill * c.fill * 1e-6,
+                1e-9 * (1.0 + c.predicted_ms));
+    EXPECT_LE(c.measured_ms, c.predicted_ms * on.profile.safety_factor * (1 + 1e-9));
+  }
+  EXPECT_GT(with_fill, 8u);
+}
+
 TEST(CalibrationTest, BadOptionsAreErrors) {
   CalibrateOptions o;
   o.progress = false;

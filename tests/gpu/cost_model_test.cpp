@@ -20,19 +20,23 @@
 namespace farfield::gpu {
 namespace {
 
-// Workloads spread over the three terms independently (a small factorial design).
+// Workloads spread over the four terms independently (a small factorial design).
 std::vector<CostSample> workloads() {
   std::vector<CostSample> out;
   for (double tri : {1e4, 2e5, 8e5})
     for (double draws : {10.0, 300.0, 1200.0})
-      for (double px : {128.0 * 128.0, 512.0 * 512.0}) out.push_back({tri, draws, px, 0.0});
+      for (double px : {128.0 * 128.0, 512.0 * 512.0})
+        for (double fill : {0.3e6, 2.5e6}) out.push_back({tri, draws, px, 0.0, fill});
   return out;
 }
 
-double sumSquaredResiduals(const std::vector<CostSample>& samples, const std::array<double, 4>& c) {
+constexpr size_t kTerms = 5;  // base, triangles, draw calls, pixels, fill
+
+double sumSquaredResiduals(const std::vector<CostSample>& samples, const std::array<double, kTerms>& c) {
   double ssr = 0.0;
   for (const CostSample& s : samples) {
-    const double pred = c[0] + c[1] * s.triangles * 1e-6 + c[2] * s.draw_calls + c[3] * s.pixels * 1e-6;
+    const double pred =
+        c[0] + c[1] * s.triangles * 1e-6 + c[2] * s.draw_calls + c[3] * s.pixels * 1e-6 + c[4] * s.fill * 1e-6;
     ssr += (s.ms - pred) * (s.ms - pred);
   }
   return ssr;
@@ -40,42 +44,46 @@ double sumSquaredResiduals(const std::vector<CostSample>& samples, const std::ar
 
 // Independent NNLS: cyclic coordinate descent with clamping at 0 (each step minimises the objective exactly along one
 // coordinate), many sweeps. Converges to the constrained optimum for a convex quadratic.
-std::array<double, 4> coordinateDescentNnls(const std::vector<CostSample>& samples) {
-  std::vector<std::array<double, 4>> x;
-  for (const CostSample& s : samples) x.push_back({1.0, s.triangles * 1e-6, s.draw_calls, s.pixels * 1e-6});
-  std::array<double, 4> c{};
+std::array<double, kTerms> coordinateDescentNnls(const std::vector<CostSample>& samples) {
+  std::vector<std::array<double, kTerms>> x;
+  for (const CostSample& s : samples)
+    x.push_back({1.0, s.triangles * 1e-6, s.draw_calls, s.pixels * 1e-6, s.fill * 1e-6});
+  std::array<double, kTerms> c{};
   for (int sweep = 0; sweep < 200000; ++sweep)
-    for (int j = 0; j < 4; ++j) {
+    for (size_t j = 0; j < kTerms; ++j) {
       double num = 0.0, den = 0.0;
       for (size_t i = 0; i < samples.size(); ++i) {
         double others = 0.0;
-        for (int k = 0; k < 4; ++k)
-          if (k != j) others += c[size_t(k)] * x[i][size_t(k)];
-        num += x[i][size_t(j)] * (samples[i].ms - others);
-        den += x[i][size_t(j)] * x[i][size_t(j)];
+        for (size_t k = 0; k < kTerms; ++k)
+          if (k != j) others += c[k] * x[i][k];
+        num += x[i][j] * (samples[i].ms - others);
+        den += x[i][j] * x[i][j];
       }
-      c[size_t(j)] = den > 0.0 ? std::max(0.0, num / den) : 0.0;
+      c[j] = den > 0.0 ? std::max(0.0, num / den) : 0.0;
     }
   return c;
 }
 
 TEST(CostModelTest, FitRecoversKnownCoefficientsFromNoisySamples) {
-  const double base = 0.8, per_mtri = 25.0, per_draw = 0.004, per_mpx = 6.0;
+  const double base = 0.8, per_mtri = 25.0, per_draw = 0.004, per_mpx = 6.0, per_mfill = 1.5;
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 0.05);  // ms
   std::vector<CostSample> samples = workloads();
   for (CostSample& s : samples)
-    s.ms = base + per_mtri * s.triangles * 1e-6 + per_draw * s.draw_calls + per_mpx * s.pixels * 1e-6 + noise(rng);
+    s.ms = base + per_mtri * s.triangles * 1e-6 + per_draw * s.draw_calls + per_mpx * s.pixels * 1e-6 +
+           per_mfill * s.fill * 1e-6 + noise(rng);
   const CostModel m = CostModel::fit(samples);
   EXPECT_NEAR(m.base_ms, base, 0.1);
   EXPECT_NEAR(m.ms_per_mtriangle, per_mtri, 0.05 * per_mtri);
   EXPECT_NEAR(m.ms_per_draw, per_draw, 0.1 * per_draw);
   EXPECT_NEAR(m.ms_per_mpixel, per_mpx, 0.1 * per_mpx);
+  EXPECT_NEAR(m.ms_per_mfill, per_mfill, 0.1 * per_mfill);
   EXPECT_EQ(m.samples, samples.size());
   EXPECT_GT(m.r2, 0.999);
   EXPECT_LT(m.rms_error_ms, 0.1);
   // Prediction of a workload not among the samples, against the true model.
-  EXPECT_NEAR(m.predict(5e5, 700, 300.0 * 300.0), base + per_mtri * 0.5 + per_draw * 700 + per_mpx * 0.09, 0.1);
+  EXPECT_NEAR(m.predict(5e5, 700, 300.0 * 300.0, 1e6),
+              base + per_mtri * 0.5 + per_draw * 700 + per_mpx * 0.09 + per_mfill * 1.0, 0.1);
   const nlohmann::json j = m.toJson();
   EXPECT_DOUBLE_EQ(j.at("ms_per_draw").get<double>(), m.ms_per_draw);
   EXPECT_EQ(j.at("samples").get<size_t>(), samples.size());
@@ -89,23 +97,26 @@ TEST(CostModelTest, NegativeTermsAreClampedAndTheFitMatchesAnIndependentSolver) 
   std::normal_distribution<double> noise(0.0, 0.02);
   std::vector<CostSample> samples = workloads();
   for (CostSample& s : samples)
-    s.ms = 3.0 + 10.0 * s.triangles * 1e-6 - 0.0005 * s.draw_calls - 1.0 * s.pixels * 1e-6 + noise(rng);
+    s.ms = 3.0 + 10.0 * s.triangles * 1e-6 - 0.0005 * s.draw_calls - 1.0 * s.pixels * 1e-6 + 0.5 * s.fill * 1e-6 +
+           noise(rng);
   const CostModel m = CostModel::fit(samples);
-  for (double c : {m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel}) EXPECT_GE(c, 0.0);
+  for (double c : {m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.ms_per_mfill}) EXPECT_GE(c, 0.0);
   EXPECT_EQ(m.ms_per_draw, 0.0);
   EXPECT_EQ(m.ms_per_mpixel, 0.0);
+  EXPECT_GT(m.ms_per_mfill, 0.0);
 
-  const std::array<double, 4> fitted{m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel};
-  const std::array<double, 4> reference = coordinateDescentNnls(samples);
+  const std::array<double, kTerms> fitted{m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel,
+                                          m.ms_per_mfill};
+  const std::array<double, kTerms> reference = coordinateDescentNnls(samples);
   const double ssr_fit = sumSquaredResiduals(samples, fitted), ssr_ref = sumSquaredResiduals(samples, reference);
   EXPECT_LE(ssr_fit, ssr_ref * (1.0 + 1e-6) + 1e-12);
-  for (size_t k = 0; k < 4; ++k) EXPECT_NEAR(fitted[k], reference[k], 1e-3 * (1.0 + std::abs(reference[k])));
+  for (size_t k = 0; k < kTerms; ++k) EXPECT_NEAR(fitted[k], reference[k], 1e-3 * (1.0 + std::abs(reference[k])));
   EXPECT_NEAR(m.rms_error_ms, std::sqrt(ssr_fit / double(samples.size())), 1e-9);
 
   double mean_ms = 0.0, mean_pred = 0.0;
   for (const CostSample& s : samples) {
     mean_ms += s.ms / double(samples.size());
-    mean_pred += m.predict(s.triangles, s.draw_calls, s.pixels) / double(samples.size());
+    mean_pred += m.predict(s.triangles, s.draw_calls, s.pixels, s.fill) / double(samples.size());
   }
   EXPECT_NEAR(mean_pred, mean_ms, 0.01 * mean_ms);
 }
@@ -113,7 +124,7 @@ TEST(CostModelTest, NegativeTermsAreClampedAndTheFitMatchesAnIndependentSolver) 
 TEST(CostModelTest, CollinearTermsStayFiniteAndPredictTheSamples) {
   // Every sample at one size: pixels and the base are the same column. Either may take the cost, not both wildly.
   std::vector<CostSample> samples;
-  for (double tri : {1e4, 1e5, 4e5, 9e5}) samples.push_back({tri, 20.0, 65536.0, 1.0 + 20.0 * tri * 1e-6});
+  for (double tri : {1e4, 1e5, 4e5, 6e5, 9e5}) samples.push_back({tri, 20.0, 65536.0, 1.0 + 20.0 * tri * 1e-6});
   const CostModel m = CostModel::fit(samples);
   for (double c : {m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel}) {
     EXPECT_TRUE(std::isfinite(c));
@@ -125,8 +136,8 @@ TEST(CostModelTest, CollinearTermsStayFiniteAndPredictTheSamples) {
 }
 
 TEST(CostModelTest, BadSamplesThrow) {
-  std::vector<CostSample> three(3, CostSample{1e5, 10, 65536, 2.0});
-  EXPECT_THROW(CostModel::fit(three), Error);
+  std::vector<CostSample> four(4, CostSample{1e5, 10, 65536, 2.0});
+  EXPECT_THROW(CostModel::fit(four), Error);
   EXPECT_THROW(CostModel::fit({}), Error);
   std::vector<CostSample> samples = workloads();
   for (CostSample& s : samples) s.ms = 1.0;
@@ -136,6 +147,9 @@ TEST(CostModelTest, BadSamplesThrow) {
   samples[3].triangles = std::numeric_limits<double>::infinity();
   EXPECT_THROW(CostModel::fit(samples), Error);
   samples[3].triangles = -5.0;
+  EXPECT_THROW(CostModel::fit(samples), Error);
+  samples[3].triangles = 1e5;
+  samples[4].fill = std::nan("");
   EXPECT_THROW(CostModel::fit(samples), Error);
 }
 

@@ -18,6 +18,7 @@ CostProfile oddProfile() {
   p.model.ms_per_mtriangle = 3.5;
   p.model.ms_per_draw = 0.0625;
   p.model.ms_per_mpixel = 0.75;
+  p.model.ms_per_mfill = 2.5;
   p.model.samples = 17;
   p.model.rms_error_ms = 0.5;
   p.model.r2 = 0.875;
@@ -46,8 +47,8 @@ TEST(CostProfileTest, RoundTripAndBound) {
   saveCostProfile(p, file);
   const CostProfile q = loadCostProfile(file);
   EXPECT_EQ(q.toJson(), p.toJson());
-  // By hand: (1.25 + 3.5 * 2 + 0.0625 * 100 + 0.75 * 1) * 1.5.
-  EXPECT_DOUBLE_EQ(q.boundMs(2e6, 100, 1e6), (1.25 + 7.0 + 6.25 + 0.75) * 1.5);
+  // By hand: (1.25 + 3.5 * 2 + 0.0625 * 100 + 0.75 * 1 + 2.5 * 4) * 1.5.
+  EXPECT_DOUBLE_EQ(q.boundMs(2e6, 100, 1e6, 4e6), (1.25 + 7.0 + 6.25 + 0.75 + 10.0) * 1.5);
   // The layered terms by hand: draw (0.125 + 0.25 * 10 + 4 * 0.5) * 2; capture (8 * 1 + 0.5 * 10 + 16 * 0.25) * 1.25.
   EXPECT_DOUBLE_EQ(q.layered.drawBoundMs(10, 5e5), (0.125 + 2.5 + 2.0) * 2.0);
   EXPECT_DOUBLE_EQ(q.layered.captureBoundMs(1e6, 10, 2.5e5), (8.0 + 5.0 + 4.0) * 1.25);
@@ -65,11 +66,24 @@ TEST(CostProfileTest, VersionOneHasNoLayeredTerms) {
   nlohmann::json j = oddProfile().toJson();
   j["version"] = 1;
   j.erase("layered");
+  j["model"].erase("ms_per_mfill");
   const CostProfile p = CostProfile::fromJson(j, "old.json");
   EXPECT_FALSE(p.layered.calibrated);
   EXPECT_DOUBLE_EQ(p.model.ms_per_draw, 0.0625);
   j["layered"] = nullptr;  // a key version 1 did not have
   EXPECT_THROW(CostProfile::fromJson(j, "old.json"), Error);
+}
+
+TEST(CostProfileTest, VersionTwoHasNoFillTerm) {
+  nlohmann::json j = oddProfile().toJson();
+  j["version"] = 2;
+  for (nlohmann::json* m : {&j["model"], &j["layered"]["draw"], &j["layered"]["capture"]}) m->erase("ms_per_mfill");
+  const CostProfile p = CostProfile::fromJson(j, "v2.json");
+  EXPECT_EQ(p.model.ms_per_mfill, 0.0);
+  EXPECT_DOUBLE_EQ(p.boundMs(2e6, 100, 1e6, 4e6), (1.25 + 7.0 + 6.25 + 0.75) * 1.5);  // the fill predicts nothing
+  EXPECT_TRUE(p.layered.calibrated);
+  j["model"]["ms_per_mfill"] = 1.0;  // a key version 2 did not have
+  EXPECT_THROW(CostProfile::fromJson(j, "v2.json"), Error);
 }
 
 TEST(CostProfileTest, StrictReadNamesTheKey) {
@@ -99,8 +113,11 @@ TEST(CostProfileTest, StrictReadNamesTheKey) {
   j["model"]["colour"] = 1;
   expectError(j, "colour");
   j = good;
-  j["version"] = 3;
+  j["version"] = 4;
   expectError(j, "version");
+  j = good;
+  j["model"].erase("ms_per_mfill");
+  expectError(j, "ms_per_mfill");
   j = good;
   j.erase("layered");
   expectError(j, "layered");

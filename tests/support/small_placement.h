@@ -4,10 +4,14 @@
 #pragma once
 
 #include <algorithm>
+#include <span>
+#include <vector>
 
 #include "farfield/bake/place.h"
 #include "farfield/gen/city.h"
 #include "farfield/gpu/cost_profile.h"
+#include "farfield/core/object_fill.h"
+#include "farfield/gpu/renderer.h"
 
 namespace farfield::test {
 
@@ -49,6 +53,20 @@ inline bake::PlaceOptions smallPlaceOptions(const scene::Scene& scene) {
   p.progress = false;
   p.t_max_ms = 9.0;
   return p;
+}
+
+// The fill term's workload of drawn items (gpu/cost_model.h): each scene object among them counted once, from the
+// eye (core/object_fill.h). Impostor quads (ids past the scene's objects) have their own fill term.
+inline double itemsFill(std::span<const gpu::DrawItem> items, const scene::Scene& scene, const Camera& camera) {
+  const FillLens lens = FillLens::of(camera.width, camera.height, double(camera.fov_y));
+  std::vector<uint32_t> ids;
+  for (const gpu::DrawItem& item : items)
+    if (item.object_id >= 1 && item.object_id <= scene.objects.size()) ids.push_back(item.object_id);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  double fill = 0.0;
+  for (uint32_t id : ids) fill += lens.objectPixels(scene.objects[id - 1].world_bounds, camera.eye);
+  return fill;
 }
 
 }  // namespace farfield::test

@@ -12,6 +12,7 @@
 
 #include "farfield/core/enclosing_frustum.h"
 #include "farfield/core/error.h"
+#include "farfield/core/object_fill.h"
 #include "farfield/core/log.h"
 #include "farfield/core/strict_json.h"
 #include "farfield/core/progress.h"
@@ -144,11 +145,14 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   lens.near_plane = options.near_plane;
   lens.far_plane = options.far_plane;
   const double pixels = double(options.width) * double(options.height);
+  // The objects' fill (core/object_fill.h), from the nearest point of a region: at least what any view in it covers.
+  const FillLens fill_lens = FillLens::of(options.width, options.height, degToRad(double(options.fov_deg)));
 
   // Per object: its triangles and draw calls (the GPU scene's clusters: what a frame draws for it, uncut).
   const std::vector<gpu::ObjectDrawCost> cost = gpu_scene.objectDrawCosts();
-  const auto geometryMs = [&](uint64_t triangles, uint64_t draws) {
-    return (profile.model.ms_per_mtriangle * double(triangles) * 1e-6 + profile.model.ms_per_draw * double(draws)) *
+  const auto geometryMs = [&](uint64_t triangles, uint64_t draws, double fill) {
+    return (profile.model.ms_per_mtriangle * double(triangles) * 1e-6 + profile.model.ms_per_draw * double(draws) +
+            profile.model.ms_per_mfill * fill * 1e-6) *
            profile.safety_factor;
   };
 
@@ -259,12 +263,14 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     bvh.queryFrustum(enclosingFrustum(region, vdi, lens), ids);
     const bool culled = visible && !visible->empty();
     uint64_t triangles = 0, draws = 0;
+    double fill = 0.0;
     for (uint32_t id : ids) {
       if (culled && !std::binary_search(visible->begin(), visible->end(), id)) continue;
       triangles += cost[id].triangles;
       draws += cost[id].draws;
+      if (profile.model.ms_per_mfill > 0.0) fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
     }
-    return profile.boundMs(double(triangles), double(draws), pixels);
+    return profile.boundMs(double(triangles), double(draws), pixels, fill);
   };
   const placement::ViewSpace view_space = placement::approximateProblemViewSpace(vs_options, callbacks);
   report.regions = view_space.counts.regions;
@@ -308,15 +314,18 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     const uint64_t key = (uint64_t(uint32_t(node)) << 32) | cpv;
     const auto it = t_object_memo.find(key);
     if (it != t_object_memo.end()) return it->second;
-    const std::vector<uint32_t>* visible = visibleFrom(view_space.cpvs[cpv].region);
+    const Box3& region = view_space.cpvs[cpv].region;
+    const std::vector<uint32_t>* visible = visibleFrom(region);
     uint64_t triangles = 0, draws = 0;
+    double fill = 0.0;
     for (uint32_t id : hierarchy.objects(node))
       if ((!visible || std::binary_search(visible->begin(), visible->end(), id)) &&
           frusta[cpv].intersects(scene.objects[id - 1].world_bounds)) {
         triangles += cost[id].triangles;
         draws += cost[id].draws;
+        if (profile.model.ms_per_mfill > 0.0) fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
       }
-    return t_object_memo[key] = geometryMs(triangles, draws);
+    return t_object_memo[key] = geometryMs(triangles, draws, fill);
   };
   // An impostor's time: its quads and draw calls as geometry, plus what its alpha-tested layers fill (the profile's
   // layered draw term over the plan's quads seen from the nearest viewpoint on the axis; 0 for a profile without it).
@@ -325,7 +334,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     const Box3& region = view_space.cpvs[cpv].region;
     const Vec3 nearest = glm::clamp(plan.shaft.apex, region.lo, region.hi);
     const double fill = impostor::layeredFillPixels(plan, double(glm::length(nearest - plan.shaft.apex)), bound);
-    return geometryMs(2 * uint64_t(plan.quads()), plan.draws()) +
+    return geometryMs(2 * uint64_t(plan.quads()), plan.draws(), 0.0) +
            profile.layered.drawBoundMs(double(plan.quads()), fill);
   };
 

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "farfield/core/error.h"
+#include "farfield/core/object_fill.h"
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
 #include "farfield/eval/frame_stats.h"
@@ -76,6 +77,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   profile.fov_y_deg = options.fov_deg;
   profile.renderer = context.description();
   const double pixels = double(options.width) * double(options.height);
+  const FillLens fill_lens = FillLens::of(options.width, options.height, degToRad(double(options.fov_deg)));
   std::vector<uint32_t> ids;
   std::vector<gpu::DrawItem> items;
   const auto measure = [&](const Camera& camera) {
@@ -88,6 +90,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     check.camera = camera;
     for (const gpu::DrawItem& item : items) check.triangles += item.triangleCount();
     check.draw_calls = items.size();
+    for (uint32_t id : ids) check.fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, camera.eye);
     check.measured_ms = std::numeric_limits<double>::infinity();
     for (int r = 0; r < options.repeats; ++r)
       check.measured_ms = std::min(check.measured_ms, renderer.render(camera, items, target).wall_ms);
@@ -101,7 +104,8 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     Progress progress("calibrate: fitting views", fit_views.size());
     for (const Camera& camera : fit_views) {
       const ViewCheck c = measure(camera);
-      samples.push_back({double(c.triangles), double(c.draw_calls), pixels, c.measured_ms});
+      const double fill = options.fill_term ? c.fill : 0.0;
+      samples.push_back({double(c.triangles), double(c.draw_calls), pixels, c.measured_ms, fill});
       if (options.progress) progress.advance();
     }
     progress.finish();
@@ -113,7 +117,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   Progress progress("calibrate: validation views", views.size());
   for (const Camera& camera : views) {
     ViewCheck check = measure(camera);
-    check.predicted_ms = profile.model.predict(double(check.triangles), double(check.draw_calls), pixels);
+    check.predicted_ms = profile.model.predict(double(check.triangles), double(check.draw_calls), pixels, check.fill);
     result.checks.push_back(check);
     if (options.progress) progress.advance();
   }
@@ -152,6 +156,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   }
   result.wall_s = wall.seconds();
   profile.validation = {{"views", result.checks.size()},
+                        {"fill_term", options.fill_term},
                         {"repeats", options.repeats},
                         {"seed", options.seed},
                         {"view_space", {{"lo", {space.lo.x, space.lo.y, space.lo.z}}, {"hi", {space.hi.x, space.hi.y, space.hi.z}}}},
@@ -171,12 +176,12 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
 void writeCalibrationCsv(const CalibrateResult& result, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw Error(path, "cannot write");
-  out << "view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,predicted_ms,measured_ms\n";
+  out << "view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,fill_pixels,predicted_ms,measured_ms\n";
   for (size_t i = 0; i < result.checks.size(); ++i) {
     const ViewCheck& c = result.checks[i];
     const Vec3 d = c.camera.forward();
     out << i << ',' << c.camera.eye.x << ',' << c.camera.eye.y << ',' << c.camera.eye.z << ',' << d.x << ',' << d.y
-        << ',' << d.z << ',' << c.triangles << ',' << c.draw_calls << ',' << c.predicted_ms << ',' << c.measured_ms
+        << ',' << d.z << ',' << c.triangles << ',' << c.draw_calls << ',' << c.fill << ',' << c.predicted_ms << ',' << c.measured_ms
         << '\n';
   }
   if (!out) throw Error(path, "write failed");

@@ -11,6 +11,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
+#include "farfield/core/object_fill.h"
 #include "farfield/core/progress.h"
 #include "farfield/core/timer.h"
 #include "farfield/gpu/renderer.h"
@@ -153,6 +154,7 @@ EnvMapBaselineReport runEnvMapBaseline(gpu::Context& context, const scene::Scene
   std::vector<double> distances = options.far_distances;
   std::sort(distances.begin(), distances.end(), std::greater<>());
   const double pixels = double(bound.width) * double(bound.height);
+  const FillLens fill_lens = FillLens::of(bound.width, bound.height, bound.fov_y);
 
   std::unique_ptr<Progress> progress;
   if (options.progress) progress = std::make_unique<Progress>("envmap baseline", cells.size());
@@ -178,12 +180,14 @@ EnvMapBaselineReport runEnvMapBaseline(gpu::Context& context, const scene::Scene
         bvh.queryFrustum(enclosingFrustum(node.box, index.cpvs[k].vdi, lens), in_frustum);
         std::sort(in_frustum.begin(), in_frustum.end());
         uint64_t triangles = 2 * candidate.layers(), draws = candidate.draws();
+        double fill = 0.0;  // of the near geometry, as placement charges it (the layers' own fill is not charged)
         for (uint32_t id : candidate.near_objects)
           if (std::binary_search(in_frustum.begin(), in_frustum.end(), id)) {
             triangles += cost[id].triangles;
             draws += cost[id].draws;
+            fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, node.box);
           }
-        worst = std::max(worst, profile.boundMs(double(triangles), double(draws), pixels));
+        worst = std::max(worst, profile.boundMs(double(triangles), double(draws), pixels, fill));
       }
       const bool fits = worst <= t_max_ms;
       if (fits || !have || d < plan.far_distance) {

@@ -24,11 +24,11 @@
 namespace farfield::gpu {
 namespace {
 
-constexpr int kTerms = 4;  // base, triangles, draw calls, pixels
+constexpr int kTerms = 5;  // base, triangles, draw calls, pixels, fill
 
 // The design row of a sample, in the units of the coefficients.
 std::array<double, kTerms> designRow(const CostSample& s) {
-  return {1.0, s.triangles * 1e-6, s.draw_calls, s.pixels * 1e-6};
+  return {1.0, s.triangles * 1e-6, s.draw_calls, s.pixels * 1e-6, s.fill * 1e-6};
 }
 
 // Unconstrained least squares restricted to the terms in `mask`, by modified Gram-Schmidt QR on the columns
@@ -95,19 +95,20 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-double CostModel::predict(double triangles, double draw_calls, double pixels) const {
-  return base_ms + ms_per_mtriangle * triangles * 1e-6 + ms_per_draw * draw_calls + ms_per_mpixel * pixels * 1e-6;
+double CostModel::predict(double triangles, double draw_calls, double pixels, double fill) const {
+  return base_ms + ms_per_mtriangle * triangles * 1e-6 + ms_per_draw * draw_calls + ms_per_mpixel * pixels * 1e-6 +
+         ms_per_mfill * fill * 1e-6;
 }
 
 CostModel CostModel::fit(std::span<const CostSample> samples) {
   if (samples.size() < size_t(kTerms))
-    throw Error("cost model", "fitting 4 coefficients needs at least 4 samples, got " +
+    throw Error("cost model", "fitting 5 coefficients needs at least 5 samples, got " +
                                   std::to_string(samples.size()));
   std::vector<std::array<double, kTerms>> rows;
   std::vector<double> y;
   for (size_t i = 0; i < samples.size(); ++i) {
     const CostSample& s = samples[i];
-    for (double v : {s.triangles, s.draw_calls, s.pixels, s.ms})
+    for (double v : {s.triangles, s.draw_calls, s.pixels, s.fill, s.ms})
       if (!std::isfinite(v) || v < 0.0)
         throw Error("cost model", "sample " + std::to_string(i) + ": value " + std::to_string(v) +
                                       " is not a finite non-negative number");
@@ -115,12 +116,12 @@ CostModel CostModel::fit(std::span<const CostSample> samples) {
     y.push_back(s.ms);
   }
 
-  // Non-negative least squares on 4 unknowns by enumerating the 16 subsets of active terms: the constrained
+  // Non-negative least squares on 5 unknowns by enumerating the 32 subsets of active terms: the constrained
   // optimum is the unconstrained least-squares solution on its own support (whose coefficients are then all >= 0),
   // and every feasible subset solution is a feasible point, so the feasible subset solution with the smallest
   // residual is the optimum. Exact, with no iteration to tune. Subsets are visited by increasing size and a larger
   // one must do strictly better, so terms the data cannot tell apart stay at 0.
-  std::array<unsigned, 16> order;
+  std::array<unsigned, 1u << kTerms> order;
   std::iota(order.begin(), order.end(), 0u);
   std::stable_sort(order.begin(), order.end(),
                    [](unsigned a, unsigned b) { return std::popcount(a) < std::popcount(b); });
@@ -148,6 +149,7 @@ CostModel CostModel::fit(std::span<const CostSample> samples) {
   model.ms_per_mtriangle = best[1];
   model.ms_per_draw = best[2];
   model.ms_per_mpixel = best[3];
+  model.ms_per_mfill = best[4];
   model.samples = samples.size();
   model.rms_error_ms = std::sqrt(best_ssr / double(samples.size()));
   if (sst > 1e-12 * std::max(yy, 1e-300))
@@ -159,7 +161,7 @@ CostModel CostModel::fit(std::span<const CostSample> samples) {
 
 nlohmann::json CostModel::toJson() const {
   return {{"base_ms", base_ms},   {"ms_per_mtriangle", ms_per_mtriangle}, {"ms_per_draw", ms_per_draw},
-          {"ms_per_mpixel", ms_per_mpixel}, {"samples", samples}, {"rms_error_ms", rms_error_ms},
+          {"ms_per_mpixel", ms_per_mpixel}, {"ms_per_mfill", ms_per_mfill}, {"samples", samples}, {"rms_error_ms", rms_error_ms},
           {"r2", r2}};
 }
 

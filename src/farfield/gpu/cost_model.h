@@ -5,12 +5,17 @@
 // (the paper's platforms differed by an order of magnitude, and so do a GPU and llvmpipe here):
 //
 //   ms = base_ms + ms_per_mtriangle * triangles / 1e6 + ms_per_draw * draw_calls + ms_per_mpixel * pixels / 1e6
+//        + ms_per_mfill * fill / 1e6
 //
 // - triangles: triangles submitted (FrameStats::triangles), visible or not;
 // - draw_calls: draw calls issued (FrameStats::draw_calls);
 // - pixels: pixels of the render target that the frame clears and draws into, i.e. width * height. Not the
 //   fragments shaded: those depend on coverage and overdraw, which are unknown before drawing. The calibration
 //   draws views that fill much of the target, so the term stands for "a frame of that size";
+// - fill: the frame pixels the drawn objects may cover, estimated before drawing from their bounds and distances
+//   (core/object_fill.h), summed over the objects, so overdraw counts. 0 where the caller does not estimate it (the
+//   term then fits to 0 and predicts nothing). `farfield calibrate` fits it on street views, where it is what
+//   separates a view past a near facade from one down an open street;
 // - ms: wall time of the frame from the first command to glFinish (FrameStats::wall_ms of Renderer::render).
 //
 // A scheduler (section 5.5: "From the desired and the predicted frame times we can determine how much time we have
@@ -33,6 +38,7 @@ struct CostSample {
   double draw_calls = 0;
   double pixels = 0;  // target width * height
   double ms = 0;      // measured wall time
+  double fill = 0;    // estimated pixels covered by the drawn objects (core/object_fill.h), 0: not estimated
 };
 
 struct CostModel {
@@ -41,6 +47,7 @@ struct CostModel {
   double ms_per_mtriangle = 0;  // per million triangles
   double ms_per_draw = 0;       // per draw call
   double ms_per_mpixel = 0;     // per million target pixels
+  double ms_per_mfill = 0;      // per million estimated pixels covered (CostSample::fill)
   // Fit quality, over the samples the model was fitted to.
   size_t samples = 0;
   double rms_error_ms = 0;  // root mean square of the residuals
@@ -48,15 +55,15 @@ struct CostModel {
                             // and the fit reproduces it)
 
   // Predicted frame time (ms) of a workload; the arguments are in the units of CostSample.
-  double predict(double triangles, double draw_calls, double pixels) const;
+  double predict(double triangles, double draw_calls, double pixels, double fill = 0.0) const;
 
-  // Least squares on the four terms with every coefficient constrained to be >= 0 (non-negative least squares).
+  // Least squares on the five terms with every coefficient constrained to be >= 0 (non-negative least squares).
   // Terms the samples cannot tell apart (e.g. every sample at the same size: pixels and base are collinear) are
-  // resolved towards the fewest non-zero terms. Throws farfield::Error with fewer than 4 samples, or for a sample with
+  // resolved towards the fewest non-zero terms. Throws farfield::Error with fewer than 5 samples, or for a sample with
   // a non-finite or negative value.
   static CostModel fit(std::span<const CostSample> samples);
 
-  // {"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "samples", "rms_error_ms", "r2"}.
+  // {"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "ms_per_mfill", "samples", "rms_error_ms", "r2"}.
   nlohmann::json toJson() const;
 };
 

@@ -30,13 +30,18 @@ void onlyKeys(const nlohmann::json& j, const std::set<std::string>& keys, const 
     if (!j.contains(key)) throw Error(source, "missing key \"" + key + "\"");
 }
 
-CostModel modelFromJson(const nlohmann::json& m, const std::string& ms) {
-  onlyKeys(m, {"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "samples", "rms_error_ms", "r2"}, ms);
+// `with_fill`: version 3 and later have the fill term; earlier profiles are read with it at 0.
+CostModel modelFromJson(const nlohmann::json& m, const std::string& ms, bool with_fill) {
+  std::set<std::string> keys{"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "samples", "rms_error_ms",
+                             "r2"};
+  if (with_fill) keys.insert("ms_per_mfill");
+  onlyKeys(m, keys, ms);
   CostModel model;
   model.base_ms = number(m, "base_ms", ms, 0.0);
   model.ms_per_mtriangle = number(m, "ms_per_mtriangle", ms, 0.0);
   model.ms_per_draw = number(m, "ms_per_draw", ms, 0.0);
   model.ms_per_mpixel = number(m, "ms_per_mpixel", ms, 0.0);
+  if (with_fill) model.ms_per_mfill = number(m, "ms_per_mfill", ms, 0.0);
   model.samples = wholeNumber<size_t>(number(m, "samples", ms, 0.0), ms, "\"samples\"");
   model.rms_error_ms = number(m, "rms_error_ms", ms, 0.0);
   model.r2 = number(m, "r2", ms, -1e300);
@@ -51,13 +56,13 @@ nlohmann::json LayeredCost::toJson() const {
           {"capture_safety_factor", capture_safety_factor}, {"validation", validation}};
 }
 
-LayeredCost LayeredCost::fromJson(const nlohmann::json& j, const std::string& source) {
+LayeredCost LayeredCost::fromJson(const nlohmann::json& j, const std::string& source, int version) {
   LayeredCost c;
   if (j.is_null()) return c;
   onlyKeys(j, {"draw", "capture", "draw_safety_factor", "capture_safety_factor", "validation"}, source);
   c.calibrated = true;
-  c.draw = modelFromJson(j.at("draw"), source + ".draw");
-  c.capture = modelFromJson(j.at("capture"), source + ".capture");
+  c.draw = modelFromJson(j.at("draw"), source + ".draw", version >= 3);
+  c.capture = modelFromJson(j.at("capture"), source + ".capture", version >= 3);
   c.draw_safety_factor = number(j, "draw_safety_factor", source, 1.0);
   c.capture_safety_factor = number(j, "capture_safety_factor", source, 1.0);
   c.validation = j.at("validation");
@@ -71,20 +76,22 @@ nlohmann::json CostProfile::toJson() const {
 }
 
 CostProfile CostProfile::fromJson(const nlohmann::json& j, const std::string& source) {
-  // Version 1 has no "layered" key; later versions must have it.
+  // Version 1 has no "layered" key; later versions must have it. Versions 1 and 2 have no fill term.
   const bool v1 = j.is_object() && j.contains("version") && j.at("version") == 1;
+  const bool v2 = j.is_object() && j.contains("version") && j.at("version") == 2;
   std::set<std::string> keys{"format", "version", "model", "safety_factor", "width", "height", "fov_y_deg",
                              "renderer", "validation"};
   if (!v1) keys.insert("layered");
   onlyKeys(j, keys, source);
   if (j.at("format") != kCostProfileFormat)
     throw Error(source, std::string("\"format\" is not \"") + kCostProfileFormat + "\"");
-  if (!v1 && j.at("version") != kCostProfileVersion)
-    throw Error(source, "version " + j.at("version").dump() + " (this build reads versions 1 and " +
+  if (!v1 && !v2 && j.at("version") != kCostProfileVersion)
+    throw Error(source, "version " + j.at("version").dump() + " (this build reads versions 1 to " +
                             std::to_string(kCostProfileVersion) + ")");
+  const int version = v1 ? 1 : v2 ? 2 : kCostProfileVersion;
   CostProfile p;
-  p.model = modelFromJson(j.at("model"), source + ": model");
-  if (!v1) p.layered = LayeredCost::fromJson(j.at("layered"), source + ": layered");
+  p.model = modelFromJson(j.at("model"), source + ": model", version >= 3);
+  if (!v1) p.layered = LayeredCost::fromJson(j.at("layered"), source + ": layered", version);
   p.safety_factor = number(j, "safety_factor", source, 1.0);
   // The frame size: whole pixels of an int (a conversion of 1e300 to int is undefined behaviour).
   p.width = wholeNumber<int>(number(j, "width", source, 1.0), source, "\"width\"");

@@ -10,7 +10,8 @@
 //
 // Saved whole and read back strictly: a missing or unknown key, or a value of the wrong type or out of range, is a
 // farfield::Error naming the file and the key. Version 1 profiles (before the layered terms) are read with
-// LayeredCost::calibrated false; version 2 has the key "layered" (null when not calibrated).
+// LayeredCost::calibrated false; version 2 has the key "layered" (null when not calibrated); version 3 has the fill
+// term (CostModel::ms_per_mfill) in every model, read as 0 from earlier versions.
 #pragma once
 
 #include <string>
@@ -22,7 +23,7 @@
 namespace farfield::gpu {
 
 inline constexpr char kCostProfileFormat[] = "farfield-cost-profile";
-inline constexpr int kCostProfileVersion = 2;
+inline constexpr int kCostProfileVersion = 3;
 
 // The layered impostor's two costs. The models reuse CostModel's four columns with these meanings:
 // - draw: ms added to a frame by drawing one layered impostor = base + ms_per_draw * layers + ms_per_mpixel * the
@@ -45,7 +46,7 @@ struct LayeredCost {
     return calibrated ? capture.predict(triangles, layers, texels) * capture_safety_factor : 0.0;
   }
   nlohmann::json toJson() const;  // null when not calibrated
-  static LayeredCost fromJson(const nlohmann::json& json, const std::string& source);
+  static LayeredCost fromJson(const nlohmann::json& json, const std::string& source, int version);
 };
 
 struct CostProfile {
@@ -59,9 +60,9 @@ struct CostProfile {
   nlohmann::json validation = nlohmann::json::object();
   LayeredCost layered;
 
-  // An upper bound of the frame time (ms) of a workload, in the units of CostSample.
-  double boundMs(double triangles, double draw_calls, double pixels) const {
-    return model.predict(triangles, draw_calls, pixels) * safety_factor;
+  // An upper bound of the frame time (ms) of a workload, in the units of CostSample (fill: core/object_fill.h).
+  double boundMs(double triangles, double draw_calls, double pixels, double fill) const {
+    return model.predict(triangles, draw_calls, pixels, fill) * safety_factor;
   }
   nlohmann::json toJson() const;
   static CostProfile fromJson(const nlohmann::json& json, const std::string& source);
