@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "farfield/core/error.h"
-#include "farfield/runtime/crowd_shadows.h"
 
 namespace farfield::runtime {
 
@@ -108,10 +107,24 @@ size_t CrowdRuntime::atlasBytes() const {
   return b;
 }
 
-Vec3 CrowdRuntime::agentCentre(const CrowdAgentState& a) const {
-  if (a.model >= models_.size()) throw Error("crowd runtime", "agent of model " + std::to_string(a.model) + " out of range");
-  return a.position + turn(a.heading, models_[a.model].centre);
+void CrowdRuntime::placeAgents(std::span<const CrowdAgentState> agents) {
+  spheres_.resize(agents.size());
+  for (size_t i = 0; i < agents.size(); ++i) {
+    const CrowdAgentState& a = agents[i];
+    if (a.model >= models_.size())
+      throw Error("crowd runtime", "agent of model " + std::to_string(a.model) + " out of range");
+    spheres_[i] = {a.position + turn(a.heading, models_[a.model].centre), models_[a.model].radius};
+  }
 }
+
+namespace {
+
+// The index of `count` poses or frames spread over one cycle that a phase (cycles, any real) shows.
+uint32_t cycleIndex(float phase, int count) {
+  return uint32_t(std::lround((phase - std::floor(phase)) * float(count))) % uint32_t(count);
+}
+
+}  // namespace
 
 gpu::CrowdAgentGpu CrowdRuntime::record(const CrowdAgentState& a) const {
   gpu::CrowdAgentGpu g;
@@ -148,9 +161,9 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
     lists_.impostors[m].clear();
     switch_m[m] = switchDistances(m, camera).both();
   }
-  const int poses = options_.palette_poses;
-  for (const CrowdAgentState& a : agents) {
-    const Vec3 centre = agentCentre(a);
+  for (size_t i = 0; i < agents.size(); ++i) {
+    const CrowdAgentState& a = agents[i];
+    const Vec3 centre = spheres_[i].centre;
     const Model& model = models_[a.model];
     bool visible = true;
     for (const Vec4& p : frustum.planes)
@@ -164,18 +177,16 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
       ++stats.occluded;
       continue;
     }
-    const float phase = a.phase - std::floor(a.phase);
     gpu::CrowdAgentGpu g = record(a);
     const Vec3 to_eye = camera.eye - centre;
     const bool impostor = policy == CrowdPolicy::Impostor ||
                           (policy == CrowdPolicy::Mixed && double(glm::length(to_eye)) >= switch_m[a.model]);
     if (!impostor) {
-      g.index = uint32_t(std::lround(phase * float(poses))) % uint32_t(poses);
+      g.index = cycleIndex(a.phase, options_.palette_poses);
       lists_.geometry[a.model].push_back(g);
       continue;
     }
-    const int frames = model.choice.frames;
-    g.index = uint32_t(std::lround(phase * float(frames))) % uint32_t(frames);
+    g.index = cycleIndex(a.phase, model.choice.frames);
     const Vec3 local = turn(-a.heading, to_eye);  // the eye in agent space
     g.view = uint32_t(impostor::nearestView(model.impostor->grid, glm::length(local) > 0.0f ? local : Vec3(1, 0, 0)));
     lists_.impostors[a.model].push_back(g);
@@ -200,6 +211,7 @@ CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSe
 CrowdFrameStats CrowdRuntime::draw(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                                    const gpu::LightSettings& light) {
   CrowdFrameStats stats;
+  placeAgents(agents);
   classify(camera, agents, policy, stats);
   return drawLists(camera, light, stats);
 }
@@ -207,9 +219,7 @@ CrowdFrameStats CrowdRuntime::draw(const Camera& camera, std::span<const CrowdAg
 void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                                const gpu::LightSettings& light, const CrowdShadowOptions& shadows,
                                CrowdFrameStats& stats) {
-  std::vector<CasterSphere> spheres(agents.size());
-  for (size_t i = 0; i < agents.size(); ++i) spheres[i] = {agentCentre(agents[i]), models_[agents[i].model].radius};
-  const ShadowFit fit = fitShadow(camera, light.direction, spheres, shadows.distance_m, shadows.map_size);
+  const ShadowFit fit = fitShadow(camera, light.direction, spheres_, shadows.distance_m, shadows.map_size);
   if (!shadow_map_ || shadow_map_->size() != shadows.map_size)
     shadow_map_ = std::make_unique<gpu::ShadowMap>(shadows.map_size);
   shadow_map_->bindForCasters();  // cleared: no caster
@@ -228,17 +238,16 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
   for (uint32_t i : fit.casters) {
     const CrowdAgentState& a = agents[i];
     const Model& model = models_[a.model];
-    const float phase = a.phase - std::floor(a.phase);
     gpu::CrowdAgentGpu g = record(a);
     const bool impostor =
         policy == CrowdPolicy::Impostor ||
         (policy == CrowdPolicy::Mixed &&
-         (shadows.impostor_casters || double(glm::length(camera.eye - spheres[i].centre)) >= switch_m[a.model]));
+         (shadows.impostor_casters || double(glm::length(camera.eye - spheres_[i].centre)) >= switch_m[a.model]));
     if (!impostor) {
-      g.index = uint32_t(std::lround(phase * float(options_.palette_poses))) % uint32_t(options_.palette_poses);
+      g.index = cycleIndex(a.phase, options_.palette_poses);
       caster_lists_.geometry[a.model].push_back(g);
     } else {
-      g.index = uint32_t(std::lround(phase * float(model.choice.frames))) % uint32_t(model.choice.frames);
+      g.index = cycleIndex(a.phase, model.choice.frames);
       g.view = uint32_t(impostor::nearestView(model.impostor->grid, turn(-a.heading, to_light)));
       caster_lists_.impostors[a.model].push_back(g);
     }
@@ -255,6 +264,7 @@ CrowdFrameStats CrowdRuntime::drawShadowed(const Camera& camera, std::span<const
                                            CrowdPolicy policy, const gpu::LightSettings& light,
                                            const gpu::RenderTarget& target, const CrowdShadowOptions& shadows) {
   CrowdFrameStats stats;
+  placeAgents(agents);
   castShadows(camera, agents, policy, light, shadows, stats);
   classify(camera, agents, policy, stats);
   target.bindForOpaquePass();

@@ -17,6 +17,7 @@
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/shadow_map.h"
 #include "farfield/impostor/multi_view.h"
+#include "farfield/runtime/crowd_shadows.h"
 #include "farfield/scene/skin.h"
 
 namespace farfield::runtime {
@@ -157,12 +158,15 @@ class CrowdRuntime {
   void castShadows(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                    const gpu::LightSettings& light, const CrowdShadowOptions& shadows, CrowdFrameStats& stats);
   gpu::CrowdAgentGpu record(const CrowdAgentState& a) const;
-  Vec3 agentCentre(const CrowdAgentState& a) const;
+  // Each agent's bounding sphere in the world, once a frame (spheres_), for the casters and the classification.
+  // Throws farfield::Error for an agent of a model out of range.
+  void placeAgents(std::span<const CrowdAgentState> agents);
 
   CrowdRuntimeOptions options_;
   gpu::CrowdRenderer renderer_;
   std::vector<Model> models_;
   Lists lists_, caster_lists_;  // reused per frame
+  std::vector<CasterSphere> spheres_;  // placeAgents: per agent, this frame
   gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
   std::vector<float> depth_rows_;
   bool cull_next_ = false;
