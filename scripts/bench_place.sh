@@ -38,6 +38,7 @@ import json, sys
 fresh, quiet = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
 for key in ("model", "safety_factor", "validation"):
     fresh[key] = quiet[key]
+fresh["model"].setdefault("ms_per_mfill", 0.0)  # a model from a profile before version 3 has no fill term
 fresh["validation"]["model_from"] = sys.argv[2]
 json.dump(fresh, open(sys.argv[3], "w"), indent=2)
 PY

@@ -1,5 +1,6 @@
 // farfield calibrate SCENE -o profile.json [--size WxH] [--fov DEG] [--views N] [--repeats N]
 //                    [--view-min X,Y,Z --view-max X,Y,Z] [--seed S] [--margin-quantile Q] [--csv FILE]
+//                    [--fill-term] [--visibility-cache FILE]
 // Fits the frame-time cost model on this machine and validates it on random views of the view space
 // (eval/calibration.h); writes the cost profile that placement bounds frame times with.
 #include <cstdio>
@@ -11,6 +12,7 @@
 #include "farfield/core/error.h"
 #include "farfield/eval/calibration.h"
 #include "farfield/gpu/context.h"
+#include "farfield/placement/visibility_cache.h"
 #include "farfield/scene/import.h"
 
 namespace farfield::app {
@@ -23,6 +25,7 @@ struct CalibrateArgs {
   std::string view_min, view_max, around;
   float margin = 50.0f;
   std::string csv;
+  std::string visibility_cache;
   eval::CalibrateOptions options;
 };
 
@@ -34,6 +37,16 @@ void runCalibrateCommand(CalibrateArgs& args) {
   o.height = size.y;
   o.view_space = parseViewSpace(args.view_min, args.view_max, args.around, args.margin);
   const scene::Scene scene = scene::loadScene(args.scene);
+  placement::VisibilityCache cache;
+  if (!args.visibility_cache.empty()) {
+    cache = placement::readVisibilityCache(args.visibility_cache);
+    const size_t objects = cache.key.value("scene_objects", size_t(0));
+    if (objects != scene.objects.size())
+      throw Error(args.visibility_cache, "made for a scene of " + std::to_string(objects) + " objects, not " +
+                                             std::to_string(scene.objects.size()));
+    if (o.view_space.empty()) o.view_space = cache.viewSpace();  // its regions' views
+    o.visible_set = [&cache](const Vec3& eye) { return cache.visibleFrom(eye); };
+  }
   const eval::CalibrateResult r = eval::calibrate(gpu::sharedHeadlessContext(), scene, o);
   ensureParentDirectory(args.out);
   gpu::saveCostProfile(r.profile, args.out);
@@ -45,6 +58,7 @@ void runCalibrateCommand(CalibrateArgs& args) {
   std::printf("scene:              %s\n", args.scene.c_str());
   std::printf("renderer:           %s\n", r.profile.renderer.c_str());
   std::printf("malloc:             %s\n", allocator.description.c_str());
+  std::printf("frames:             %s\n", r.profile.validation.value("frames", std::string()).c_str());
   std::printf("model:              %.3f ms + %.3f ms/Mtri + %.4f ms/draw + %.3f ms/Mpixel + %.3f ms/Mpixel of "
               "estimated fill (fit r2 %.3f, %zu samples)\n",
               m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.ms_per_mfill, m.r2, m.samples);
@@ -96,6 +110,9 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
   cmd->add_option("--margin-quantile", args->options.margin_quantile,
                   "Safety factor = this quantile of measured/predicted (1 = the maximum)")->capture_default_str();
   cmd->add_option("--csv", args->csv, "Per-view predicted and measured times");
+  cmd->add_option("--visibility-cache", args->visibility_cache,
+                  "Time placed frames: the visible sets `farfield place --visibility-cache` saved, occlusion-culled, "
+                  "counted over whole objects as placement counts them (the view space defaults to the cache's)");
   cmd->add_flag("--fill-term", args->options.fill_term,
                 "Fit the estimated-fill term too (better per-view predictions; placement then bounds each region's "
                 "fill from its nearest point, which is far more conservative: see docs/BENCHMARKS.md)");

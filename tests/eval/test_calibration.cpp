@@ -10,6 +10,8 @@
 #include "farfield/core/error.h"
 #include "farfield/gen/city.h"
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/scene/bvh.h"
 
 namespace farfield::eval {
 namespace {
@@ -104,6 +106,49 @@ TEST(CalibrationTest, TheFillTermIsFittedOnlyWhenAsked) {
     EXPECT_LE(c.measured_ms, c.predicted_ms * on.profile.safety_factor * (1 + 1e-9));
   }
   EXPECT_GT(with_fill, 8u);
+}
+
+// Placed frames: each view's workload is the whole objects of the given visible set that its frustum meets (recounted
+// here from the BVH and the scene's per-object costs), and the safety factor still bounds every view.
+TEST(CalibrationTest, PlacedFramesCountTheVisibleSetAsPlacementDoes) {
+  const scene::Scene& scene = smallCity();
+  std::vector<uint32_t> visible;  // every other object
+  for (uint32_t id = 1; id <= scene.objects.size(); id += 2) visible.push_back(id);
+  CalibrateOptions o;
+  o.width = o.height = 64;
+  o.views = 16;
+  o.fit_views = 12;
+  o.repeats = 1;
+  o.progress = false;
+  o.layered_samples = 0;
+  size_t asked = 0;
+  o.visible_set = [&](const Vec3&) -> const std::vector<uint32_t>* {
+    ++asked;
+    return &visible;
+  };
+  const CalibrateResult r = calibrate(gpu::sharedHeadlessContext(), scene, o);
+  EXPECT_EQ(asked, 28u);
+  EXPECT_NE(r.profile.validation["frames"].get<std::string>().find("placed"), std::string::npos);
+  gpu::sharedHeadlessContext().makeCurrent();
+  const gpu::GpuScene gpu_scene(scene);
+  const std::vector<gpu::ObjectDrawCost> cost = gpu_scene.objectDrawCosts();
+  const scene::Bvh bvh(scene);
+  size_t seen = 0;
+  for (const ViewCheck& c : r.checks) {
+    std::vector<uint32_t> ids;
+    bvh.queryFrustum(Frustum::fromMatrix(c.camera.viewProjection()), ids);
+    uint64_t triangles = 0, draws = 0;
+    for (uint32_t id : ids)
+      if (id % 2 == 1) {
+        triangles += cost[id].triangles;
+        draws += cost[id].draws;
+      }
+    EXPECT_EQ(c.triangles, triangles);
+    EXPECT_EQ(c.draw_calls, draws);
+    seen += draws > 0;
+    EXPECT_LE(c.measured_ms, c.predicted_ms * r.profile.safety_factor * (1 + 1e-9));
+  }
+  EXPECT_GT(seen, 8u);
 }
 
 TEST(CalibrationTest, BadOptionsAreErrors) {

@@ -22,6 +22,7 @@
 #include "farfield/placement/greedy.h"
 #include "farfield/placement/placement_problem.h"
 #include "farfield/placement/view_space.h"
+#include "farfield/placement/visibility_cache.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/store/placement_store.h"
 #include "farfield/urban/pvs.h"
@@ -190,28 +191,18 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     return std::max({e.x, e.y, e.z}) <= options.min_region_size;
   };
   // The cache's identity: what the visible sets depend on.
-  const nlohmann::json cache_key = {{"scene_objects", scene.objects.size()},
-                                    {"view_space", {{"lo", {space.lo.x, space.lo.y, space.lo.z}},
-                                                    {"hi", {space.hi.x, space.hi.y, space.hi.z}}}},
-                                    {"min_region_size", options.min_region_size},
-                                    {"visibility_face", options.visibility_face},
-                                    {"far_plane", options.far_plane}};
+  const nlohmann::json cache_key = placement::visibilityCacheKey(scene.objects.size(), space, options.min_region_size,
+                                                                 options.visibility_face, options.far_plane);
   std::map<std::array<float, 3>, std::vector<uint32_t>> cached;
   if (options.visibility && !options.visibility_cache.empty() && fs::exists(options.visibility_cache)) {
     try {
-      std::ifstream in(options.visibility_cache);
-      nlohmann::json j;
-      in >> j;
-      if (j.at("key") == cache_key) {
-        for (const nlohmann::json& r : j.at("regions"))
-          cached[{r.at("lo")[0].get<float>(), r.at("lo")[1].get<float>(), r.at("lo")[2].get<float>()}] =
-              r.at("visible").get<std::vector<uint32_t>>();
-      } else {
+      placement::VisibilityCache read = placement::readVisibilityCache(options.visibility_cache);
+      if (read.key == cache_key)
+        cached = std::move(read.regions);
+      else
         FF_WARN(options.visibility_cache << ": made for another scene or view space; sampling again");
-      }
-    } catch (const std::exception& e) {
-      FF_WARN(options.visibility_cache << ": unreadable (" << e.what() << "); sampling again");
-      cached.clear();
+    } catch (const Error& e) {
+      FF_WARN(e.what() << "; sampling again");
     }
   }
   if (options.visibility) {
@@ -281,10 +272,10 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   report.view_space_s = step.seconds();
   if (report.visibility_regions) report.mean_visible_objects /= double(report.visibility_regions);
   if (options.visibility && !options.visibility_cache.empty() && report.visibility_cached < report.visibility_regions) {
-    nlohmann::json regions = nlohmann::json::array();
-    for (const auto& [lo, visible] : region_visible) regions.push_back({{"lo", {lo[0], lo[1], lo[2]}}, {"visible", visible}});
-    const std::string text = nlohmann::json{{"key", cache_key}, {"regions", regions}}.dump() + "\n";
-    store::writeFileAtomic(options.visibility_cache, text);
+    placement::VisibilityCache cache;
+    cache.key = cache_key;
+    cache.regions = region_visible;
+    store::writeFileAtomic(options.visibility_cache, cache.toJson().dump() + "\n");
   }
   const auto visibleFrom = [&](const Box3& region) -> const std::vector<uint32_t>* {
     const auto it = region_visible.find({region.lo.x, region.lo.y, region.lo.z});

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,12 @@ struct CalibrateOptions {
   // every adjacent building as the whole frame, so placement's problem view space grows several times (measured in
   // docs/BENCHMARKS.md): off by default.
   bool fill_term = false;
+  // Placed frames (`farfield calibrate --visibility-cache`): when set, a view draws the objects this returns for its
+  // eye (the visible set of the region holding it; nullptr: every object) that its frustum meets, through the
+  // occlusion culler, as the placed walkthrough draws its geometry; and its workload is counted as placement counts
+  // it, over whole objects (gpu::GpuScene::objectDrawCosts). So the model and its safety factor are of the frames
+  // placement must bound. Unset: frustum-culled full geometry, counted by the clusters drawn.
+  std::function<const std::vector<uint32_t>*(const Vec3& eye)> visible_set;
   uint32_t seed = 1;
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
