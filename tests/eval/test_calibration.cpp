@@ -28,6 +28,18 @@ const scene::Scene& smallCity() {
   return *s;
 }
 
+// Quick runs: 64 x 64 frames, one render per view, no layered terms unless asked.
+CalibrateOptions quickOptions(size_t views, size_t layered_samples = 0) {
+  CalibrateOptions o;
+  o.width = o.height = 64;
+  o.views = views;
+  o.fit_views = 12;
+  o.repeats = 1;
+  o.progress = false;
+  o.layered_samples = layered_samples;
+  return o;
+}
+
 TEST(CalibrationTest, RandomViewsLieInTheViewSpaceAndRepeat) {
   const Box3 space = Box3::fromPoints(Vec3(-10, -20, 1), Vec3(30, 5, 2));
   const std::vector<Camera> a = randomViews(space, 200, 4, 64, 48, 45.0f, 0.5f, 1000.0f);
@@ -44,12 +56,7 @@ TEST(CalibrationTest, RandomViewsLieInTheViewSpaceAndRepeat) {
 }
 
 TEST(CalibrationTest, TheSafetyFactorBoundsTheViewsItCameFrom) {
-  CalibrateOptions o;
-  o.width = o.height = 64;
-  o.views = 24;
-  o.fit_views = 12;
-  o.repeats = 1;
-  o.progress = false;
+  CalibrateOptions o = quickOptions(24, CalibrateOptions{}.layered_samples);
   const CalibrateResult r = calibrate(gpu::sharedHeadlessContext(), smallCity(), o);
   ASSERT_EQ(r.checks.size(), 24u);
   EXPECT_GE(r.profile.safety_factor, 1.0);
@@ -82,13 +89,7 @@ TEST(CalibrationTest, TheSafetyFactorBoundsTheViewsItCameFrom) {
 // The fill term (core/object_fill.h) is fitted only when asked; either way each view's estimated fill is reported,
 // and with it every prediction is the model's four workload terms and the fill, recomputed here from the coefficients.
 TEST(CalibrationTest, TheFillTermIsFittedOnlyWhenAsked) {
-  CalibrateOptions o;
-  o.width = o.height = 64;
-  o.views = 16;
-  o.fit_views = 12;
-  o.repeats = 1;
-  o.progress = false;
-  o.layered_samples = 0;
+  CalibrateOptions o = quickOptions(16);
   const CalibrateResult off = calibrate(gpu::sharedHeadlessContext(), smallCity(), o);
   EXPECT_EQ(off.profile.model.ms_per_mfill, 0.0);
   EXPECT_EQ(off.profile.validation["fill_term"], false);
@@ -114,13 +115,7 @@ TEST(CalibrationTest, PlacedFramesCountTheVisibleSetAsPlacementDoes) {
   const scene::Scene& scene = smallCity();
   std::vector<uint32_t> visible;  // every other object
   for (uint32_t id = 1; id <= scene.objects.size(); id += 2) visible.push_back(id);
-  CalibrateOptions o;
-  o.width = o.height = 64;
-  o.views = 16;
-  o.fit_views = 12;
-  o.repeats = 1;
-  o.progress = false;
-  o.layered_samples = 0;
+  CalibrateOptions o = quickOptions(16);
   size_t asked = 0;
   o.visible_set = [&](const Vec3&) -> const std::vector<uint32_t>* {
     ++asked;
