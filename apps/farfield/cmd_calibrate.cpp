@@ -62,6 +62,11 @@ void runCalibrateCommand(CalibrateArgs& args) {
   std::printf("model:              %.3f ms + %.3f ms/Mtri + %.4f ms/draw + %.3f ms/Mpixel + %.3f ms/Mpixel of "
               "estimated fill (fit r2 %.3f, %zu samples)\n",
               m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.ms_per_mfill, m.r2, m.samples);
+  if (m.ms_per_mfill > 0.0)
+    std::printf("fill counted up to: %s\n", m.fill_cap_pixels > 0.0
+                                                 ? (std::to_string(m.fill_cap_pixels / (double(o.width) * o.height)) +
+                                                    " frames (chosen on the fitting views)").c_str()
+                                                 : "no cap (the best fit on the fitting views)");
   std::printf("validation:         %zu views at %dx%d, %.0f deg, min of %d renders each\n", r.checks.size(), o.width,
               o.height, double(o.fov_deg), o.repeats);
   std::printf("measured/predicted: p50 %.3f  p95 %.3f  p99 %.3f  max %.3f\n", r.ratio_p50, r.ratio_p95, r.ratio_p99,

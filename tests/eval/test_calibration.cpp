@@ -102,11 +102,17 @@ TEST(CalibrationTest, TheFillTermIsFittedOnlyWhenAsked) {
     with_fill += c.fill > 0.0;
     EXPECT_NEAR(c.predicted_ms,
                 m.base_ms + m.ms_per_mtriangle * double(c.triangles) * 1e-6 + m.ms_per_draw * double(c.draw_calls) +
-                    m.ms_per_mpixel * 64.0 * 64.0 * 1e-6 + m.ms_per_mfill * c.fill * 1e-6,
+                    m.ms_per_mpixel * 64.0 * 64.0 * 1e-6 +
+                    m.ms_per_mfill * (m.fill_cap_pixels > 0.0 ? std::min(c.fill, m.fill_cap_pixels) : c.fill) * 1e-6,
                 1e-9 * (1.0 + c.predicted_ms));
     EXPECT_LE(c.measured_ms, c.predicted_ms * on.profile.safety_factor * (1 + 1e-9));
   }
   EXPECT_GT(with_fill, 8u);
+  // The cap is one of the candidates (2 to 8 frames) or none.
+  const double frames = m.fill_cap_pixels / (64.0 * 64.0);
+  EXPECT_TRUE(m.fill_cap_pixels == 0.0 || frames == 2.0 || frames == 3.0 || frames == 4.0 || frames == 6.0 ||
+              frames == 8.0)
+      << frames;
 }
 
 // Placed frames: each view's workload is the whole objects of the given visible set that its frustum meets (recounted

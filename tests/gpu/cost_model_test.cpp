@@ -84,6 +84,11 @@ TEST(CostModelTest, FitRecoversKnownCoefficientsFromNoisySamples) {
   // Prediction of a workload not among the samples, against the true model.
   EXPECT_NEAR(m.predict(5e5, 700, 300.0 * 300.0, 1e6),
               base + per_mtri * 0.5 + per_draw * 700 + per_mpx * 0.09 + per_mfill * 1.0, 0.1);
+  // A capped fill counts up to the cap.
+  CostModel capped = m;
+  capped.fill_cap_pixels = 2e6;
+  EXPECT_DOUBLE_EQ(capped.predict(5e5, 700, 9e4, 5e6), m.predict(5e5, 700, 9e4, 2e6));
+  EXPECT_DOUBLE_EQ(capped.predict(5e5, 700, 9e4, 1e6), m.predict(5e5, 700, 9e4, 1e6));
   const nlohmann::json j = m.toJson();
   EXPECT_DOUBLE_EQ(j.at("ms_per_draw").get<double>(), m.ms_per_draw);
   EXPECT_EQ(j.at("samples").get<size_t>(), samples.size());

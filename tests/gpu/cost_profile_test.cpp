@@ -19,6 +19,7 @@ CostProfile oddProfile() {
   p.model.ms_per_draw = 0.0625;
   p.model.ms_per_mpixel = 0.75;
   p.model.ms_per_mfill = 2.5;
+  p.model.fill_cap_pixels = 3e6;
   p.model.samples = 17;
   p.model.rms_error_ms = 0.5;
   p.model.r2 = 0.875;
@@ -47,8 +48,9 @@ TEST(CostProfileTest, RoundTripAndBound) {
   saveCostProfile(p, file);
   const CostProfile q = loadCostProfile(file);
   EXPECT_EQ(q.toJson(), p.toJson());
-  // By hand: (1.25 + 3.5 * 2 + 0.0625 * 100 + 0.75 * 1 + 2.5 * 4) * 1.5.
-  EXPECT_DOUBLE_EQ(q.boundMs(2e6, 100, 1e6, 4e6), (1.25 + 7.0 + 6.25 + 0.75 + 10.0) * 1.5);
+  // By hand: (1.25 + 3.5 * 2 + 0.0625 * 100 + 0.75 * 1 + 2.5 * 2) * 1.5, and the fill counted up to its cap of 3.
+  EXPECT_DOUBLE_EQ(q.boundMs(2e6, 100, 1e6, 2e6), (1.25 + 7.0 + 6.25 + 0.75 + 5.0) * 1.5);
+  EXPECT_DOUBLE_EQ(q.boundMs(2e6, 100, 1e6, 4e6), (1.25 + 7.0 + 6.25 + 0.75 + 7.5) * 1.5);
   // The layered terms by hand: draw (0.125 + 0.25 * 10 + 4 * 0.5) * 2; capture (8 * 1 + 0.5 * 10 + 16 * 0.25) * 1.25.
   EXPECT_DOUBLE_EQ(q.layered.drawBoundMs(10, 5e5), (0.125 + 2.5 + 2.0) * 2.0);
   EXPECT_DOUBLE_EQ(q.layered.captureBoundMs(1e6, 10, 2.5e5), (8.0 + 5.0 + 4.0) * 1.25);
@@ -67,6 +69,7 @@ TEST(CostProfileTest, VersionOneHasNoLayeredTerms) {
   j["version"] = 1;
   j.erase("layered");
   j["model"].erase("ms_per_mfill");
+  j["model"].erase("fill_cap_pixels");
   const CostProfile p = CostProfile::fromJson(j, "old.json");
   EXPECT_FALSE(p.layered.calibrated);
   EXPECT_DOUBLE_EQ(p.model.ms_per_draw, 0.0625);
@@ -77,7 +80,10 @@ TEST(CostProfileTest, VersionOneHasNoLayeredTerms) {
 TEST(CostProfileTest, VersionTwoHasNoFillTerm) {
   nlohmann::json j = oddProfile().toJson();
   j["version"] = 2;
-  for (nlohmann::json* m : {&j["model"], &j["layered"]["draw"], &j["layered"]["capture"]}) m->erase("ms_per_mfill");
+  for (nlohmann::json* m : {&j["model"], &j["layered"]["draw"], &j["layered"]["capture"]}) {
+    m->erase("ms_per_mfill");
+    m->erase("fill_cap_pixels");
+  }
   const CostProfile p = CostProfile::fromJson(j, "v2.json");
   EXPECT_EQ(p.model.ms_per_mfill, 0.0);
   EXPECT_DOUBLE_EQ(p.boundMs(2e6, 100, 1e6, 4e6), (1.25 + 7.0 + 6.25 + 0.75) * 1.5);  // the fill predicts nothing
@@ -118,6 +124,9 @@ TEST(CostProfileTest, StrictReadNamesTheKey) {
   j = good;
   j["model"].erase("ms_per_mfill");
   expectError(j, "ms_per_mfill");
+  j = good;
+  j["model"]["fill_cap_pixels"] = -1.0;
+  expectError(j, "fill_cap_pixels");
   j = good;
   j.erase("layered");
   expectError(j, "layered");

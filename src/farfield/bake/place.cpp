@@ -300,6 +300,10 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
       if (at == a) return true;
     return false;
   };
+  // What a cluster's fill saves when an impostor replaces it: its own fill where the fill term is linear; nothing
+  // where the term is capped (a CPV whose fill is over the cap may stay there without the cluster), which keeps t_after
+  // an upper bound.
+  const bool fill_saves = profile.model.ms_per_mfill > 0.0 && !(profile.model.fill_cap_pixels > 0.0);
   std::unordered_map<uint64_t, double> t_object_memo;
   const auto tObject = [&](int node, uint32_t cpv) {
     const uint64_t key = (uint64_t(uint32_t(node)) << 32) | cpv;
@@ -314,7 +318,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
           frusta[cpv].intersects(scene.objects[id - 1].world_bounds)) {
         triangles += cost[id].triangles;
         draws += cost[id].draws;
-        if (profile.model.ms_per_mfill > 0.0) fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
+        if (fill_saves) fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
       }
     return t_object_memo[key] = geometryMs(triangles, draws, fill);
   };

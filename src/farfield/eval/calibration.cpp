@@ -6,6 +6,7 @@
 #include <iterator>
 #include <limits>
 #include <random>
+#include <span>
 
 #include "farfield/core/error.h"
 #include "farfield/core/object_fill.h"
@@ -44,6 +45,21 @@ class PlacedGeometry final : public Mode {
   std::vector<gpu::DrawItem> items_;
   std::vector<Box3> bounds_;
 };
+
+// The fill term's cap (gpu::CostModel::fill_cap_pixels), chosen on the fitting views: the model fitted with the fill
+// counted up to 2, 3, 4, 6 or 8 frames, or without a cap, whichever leaves the least squared error.
+gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double frame_pixels) {
+  gpu::CostModel best = gpu::CostModel::fit(samples);
+  std::vector<gpu::CostSample> capped(samples.begin(), samples.end());
+  for (double frames : {2.0, 3.0, 4.0, 6.0, 8.0}) {
+    const double cap = frames * frame_pixels;
+    for (size_t i = 0; i < samples.size(); ++i) capped[i].fill = std::min(samples[i].fill, cap);
+    gpu::CostModel m = gpu::CostModel::fit(capped);
+    m.fill_cap_pixels = cap;
+    if (m.rms_error_ms < best.rms_error_ms * (1.0 - 1e-9)) best = m;
+  }
+  return best;
+}
 
 }  // namespace
 
@@ -159,7 +175,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
       if (options.progress) progress.advance();
     }
     progress.finish();
-    profile.model = gpu::CostModel::fit(samples);
+    profile.model = options.fill_term ? fitWithFillCap(samples, pixels) : gpu::CostModel::fit(samples);
   }
 
   const std::vector<Camera> views = randomViews(space, options.views, options.seed, options.width, options.height,

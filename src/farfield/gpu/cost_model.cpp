@@ -96,8 +96,9 @@ double median(std::vector<double> v) {
 }  // namespace
 
 double CostModel::predict(double triangles, double draw_calls, double pixels, double fill) const {
+  const double counted = fill_cap_pixels > 0.0 ? std::min(fill, fill_cap_pixels) : fill;
   return base_ms + ms_per_mtriangle * triangles * 1e-6 + ms_per_draw * draw_calls + ms_per_mpixel * pixels * 1e-6 +
-         ms_per_mfill * fill * 1e-6;
+         ms_per_mfill * counted * 1e-6;
 }
 
 CostModel CostModel::fit(std::span<const CostSample> samples) {
@@ -161,7 +162,8 @@ CostModel CostModel::fit(std::span<const CostSample> samples) {
 
 nlohmann::json CostModel::toJson() const {
   return {{"base_ms", base_ms},   {"ms_per_mtriangle", ms_per_mtriangle}, {"ms_per_draw", ms_per_draw},
-          {"ms_per_mpixel", ms_per_mpixel}, {"ms_per_mfill", ms_per_mfill}, {"samples", samples}, {"rms_error_ms", rms_error_ms},
+          {"ms_per_mpixel", ms_per_mpixel}, {"ms_per_mfill", ms_per_mfill},
+          {"fill_cap_pixels", fill_cap_pixels}, {"samples", samples}, {"rms_error_ms", rms_error_ms},
           {"r2", r2}};
 }
 

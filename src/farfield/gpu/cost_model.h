@@ -48,6 +48,10 @@ struct CostModel {
   double ms_per_draw = 0;       // per draw call
   double ms_per_mpixel = 0;     // per million target pixels
   double ms_per_mfill = 0;      // per million estimated pixels covered (CostSample::fill)
+  // > 0: the fill counts up to this many pixels (min(fill, cap)); 0: no cap. A frame drawn through an occlusion
+  // culler shades a few layers of the frame however many objects its estimate sums, so the fill saturates; the cap
+  // also keeps a bound over a region (which sums every object near it) within what a view of it can cost.
+  double fill_cap_pixels = 0;
   // Fit quality, over the samples the model was fitted to.
   size_t samples = 0;
   double rms_error_ms = 0;  // root mean square of the residuals
@@ -63,7 +67,8 @@ struct CostModel {
   // a non-finite or negative value.
   static CostModel fit(std::span<const CostSample> samples);
 
-  // {"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "ms_per_mfill", "samples", "rms_error_ms", "r2"}.
+  // {"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "ms_per_mfill", "fill_cap_pixels", "samples",
+  //  "rms_error_ms", "r2"}.
   nlohmann::json toJson() const;
 };
 

@@ -34,14 +34,17 @@ void onlyKeys(const nlohmann::json& j, const std::set<std::string>& keys, const 
 CostModel modelFromJson(const nlohmann::json& m, const std::string& ms, bool with_fill) {
   std::set<std::string> keys{"base_ms", "ms_per_mtriangle", "ms_per_draw", "ms_per_mpixel", "samples", "rms_error_ms",
                              "r2"};
-  if (with_fill) keys.insert("ms_per_mfill");
+  if (with_fill) keys.insert({"ms_per_mfill", "fill_cap_pixels"});
   onlyKeys(m, keys, ms);
   CostModel model;
   model.base_ms = number(m, "base_ms", ms, 0.0);
   model.ms_per_mtriangle = number(m, "ms_per_mtriangle", ms, 0.0);
   model.ms_per_draw = number(m, "ms_per_draw", ms, 0.0);
   model.ms_per_mpixel = number(m, "ms_per_mpixel", ms, 0.0);
-  if (with_fill) model.ms_per_mfill = number(m, "ms_per_mfill", ms, 0.0);
+  if (with_fill) {
+    model.ms_per_mfill = number(m, "ms_per_mfill", ms, 0.0);
+    model.fill_cap_pixels = number(m, "fill_cap_pixels", ms, 0.0);
+  }
   model.samples = wholeNumber<size_t>(number(m, "samples", ms, 0.0), ms, "\"samples\"");
   model.rms_error_ms = number(m, "rms_error_ms", ms, 0.0);
   model.r2 = number(m, "r2", ms, -1e300);

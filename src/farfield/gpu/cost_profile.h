@@ -11,7 +11,7 @@
 // Saved whole and read back strictly: a missing or unknown key, or a value of the wrong type or out of range, is a
 // farfield::Error naming the file and the key. Version 1 profiles (before the layered terms) are read with
 // LayeredCost::calibrated false; version 2 has the key "layered" (null when not calibrated); version 3 has the fill
-// term (CostModel::ms_per_mfill) in every model, read as 0 from earlier versions.
+// term (CostModel::ms_per_mfill, fill_cap_pixels) in every model, read as 0 from earlier versions.
 #pragma once
 
 #include <string>
