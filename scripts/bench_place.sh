@@ -10,7 +10,9 @@
 # Environment: TMAXES (default "18 20 22 25 28"), BOUND (px, default 2), REF_TMAX (default 20), BOUNDS (default
 # "1 4"), SIZE (default 512x512), ROWS=0 to skip the extra rows, FALLBACK (default "2,4": place --fallback-bounds;
 # "" for none), MODEL_PROFILE (a profile whose frame model and safety factor replace the fresh calibration's, its
-# layered terms kept: for a machine loaded by other jobs while calibrating, with an earlier quiet calibration).
+# layered terms kept: for a machine loaded by other jobs while calibrating, with an earlier quiet calibration),
+# PLACED_CAL=1 (the profile fitted on placed frames with the capped fill: place --visibility-only samples every
+# region's visible set into the cache, then calibrate --fill-term --visibility-cache).
 set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
 OUT=${2:-out/bench/place}
@@ -32,7 +34,12 @@ PLACE_COMMON=(--profile "$OUT/profile.json" --max-pitch 20 --size "$SIZE" --fov 
 # CAL_VIEWS (default 500): validation views of the frame model (8 is enough when MODEL_PROFILE replaces it).
 [ -f "$OUT/calibrated.json" ] || "$FARFIELD" calibrate "$OUT/city.glb" -o "$OUT/calibrated.json" --views "${CAL_VIEWS:-500}" \
   --size "$SIZE" --fov 45 --csv "$OUT/calibration.csv" > "$OUT/calibrate.txt"
-if [ -n "${MODEL_PROFILE:-}" ]; then
+if [ "${PLACED_CAL:-0}" = 1 ]; then
+  [ -f "$OUT/visibility.json" ] || "$FARFIELD" place "$OUT/city.glb" --visibility-only --cpv-size 46 \
+    --visibility-cache "$OUT/visibility.json" > "$OUT/visibility-run.txt" 2>&1
+  "$FARFIELD" calibrate "$OUT/city.glb" -o "$OUT/profile.json" --fill-term --visibility-cache "$OUT/visibility.json" \
+    --views "${CAL_VIEWS:-500}" --size "$SIZE" --fov 45 --csv "$OUT/calibration-placed.csv" > "$OUT/calibrate-placed.txt"
+elif [ -n "${MODEL_PROFILE:-}" ]; then
   python3 - "$OUT/calibrated.json" "$MODEL_PROFILE" "$OUT/profile.json" <<'PY'
 import json, sys
 fresh, quiet = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))

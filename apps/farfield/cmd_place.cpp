@@ -1,5 +1,6 @@
 // farfield place SCENE --profile profile.json -o DIR [--tmax MS] [--error-px PX] [--size WxH] [--fov DEG]
 //                [--view-min X,Y,Z --view-max X,Y,Z] [--cpv-size M] [--vdi-deg DEG] [--levels N] ...
+// farfield place SCENE --visibility-only --visibility-cache vis.json [--cpv-size M] [view space options]
 // Automatic impostor placement (Jeschke et al. 2005; bake/place.h): which object clusters become layered impostors
 // for which view cells, so every view of the view space renders under t_max with an error under the bound.
 #include <cstdio>
@@ -45,9 +46,19 @@ void runPlaceCommand(PlaceArgs& args) {
   o.scene_label = args.scene;
   if (args.texel_px < 0.0) throw Error("--texel-px", "must be 0 (the error bound) or a positive number of pixels");
   o.layered.texel_pixels = args.texel_px > 0.0 ? args.texel_px : o.error_px;
-  const gpu::CostProfile profile = gpu::loadCostProfile(args.profile);
+  if (!o.visibility_only && args.profile.empty()) throw Error("--profile", "is required (unless --visibility-only)");
+  if (!o.visibility_only && args.out.empty()) throw Error("-o", "is required (unless --visibility-only)");
+  const gpu::CostProfile profile = o.visibility_only ? gpu::CostProfile{} : gpu::loadCostProfile(args.profile);
   const scene::Scene scene = scene::loadScene(args.scene);
   const bake::PlaceReport r = bake::placeImpostors(gpu::sharedHeadlessContext(), scene, profile, o, args.out);
+  if (o.visibility_only) {
+    std::printf("visibility:       %zu regions (%zu from the cache) sampled from %zu points, %.1f objects seen per "
+                "region, %.1f s\n",
+                r.visibility_regions, r.visibility_cached, r.visibility_points, r.mean_visible_objects,
+                r.visibility_s);
+    std::printf("cache:            %s\n", o.visibility_cache.c_str());
+    return;
+  }
   std::printf("scene:            %s (%zu objects: %zu clustered, %zu always geometry)\n", args.scene.c_str(),
               scene.objects.size(), r.clustered_objects, r.geometry_objects);
   std::printf("promises:         t_max %.2f ms, error %.2f px at %dx%d, %.1f deg (profile %s, safety factor %.3f)\n",
@@ -94,8 +105,8 @@ const RegisterCommand reg("place", [](CLI::App& app) {
   auto* cmd = app.add_subcommand("place", "Automatic impostor placement (Jeschke 2005): layered impostors of object "
                                           "clusters per view cell, keeping every view under t_max and the error bound");
   cmd->add_option("scene", args->scene, "Scene file (glTF, OBJ, ...) or builtin:NAME")->required();
-  cmd->add_option("--profile", args->profile, "Cost profile of this machine (farfield calibrate -o FILE)")->required();
-  cmd->add_option("-o,--out", args->out, "Placement database directory to write")->required();
+  cmd->add_option("--profile", args->profile, "Cost profile of this machine (farfield calibrate -o FILE)");
+  cmd->add_option("-o,--out", args->out, "Placement database directory to write");
   cmd->add_option("--tmax", o.t_max_ms, "Frame budget, ms")->capture_default_str();
   cmd->add_option("--error-px", o.error_px, "Error bound, pixels of the frames")->capture_default_str();
   cmd->add_option("--size", args->size, "Frame size WxH")->capture_default_str();
@@ -114,7 +125,12 @@ const RegisterCommand reg("place", [](CLI::App& app) {
                                                  "visibility)");
   cmd->add_option("--visibility-cache", o.visibility_cache, "Keep the sampled visible sets in this file between runs "
                                                             "(a t_max sweep samples them once)");
+  cmd->add_flag("--visibility-only", o.visibility_only, "Sample every region's visible set into --visibility-cache "
+                                                        "and stop (for calibrate --visibility-cache)");
   cmd->add_option("--visibility-face", o.visibility_face, "Item-buffer face size of the visibility samples, pixels")
+      ->capture_default_str();
+  cmd->add_option("--visibility-grid", o.visibility_grid, "Visibility sample points per side of a region (N x N at "
+                                                          "mid height; 2: the corners and the centre)")
       ->capture_default_str();
   cmd->add_option("--levels", o.hierarchy.max_levels, "Levels of the object hierarchy")->capture_default_str();
   cmd->add_option("--distance-steps", args->distance_steps, "Shaft minimum distances per axis (1, 2, 4, ... times "

@@ -6,6 +6,7 @@
 //   - the impostors drawn keep the error bound against full geometry (parallax of item buffers);
 //   - the database reads back with the options that made it, strictly.
 #include "farfield/bake/place.h"
+#include "farfield/placement/visibility_cache.h"
 
 #include <gtest/gtest.h>
 
@@ -96,6 +97,11 @@ TEST(PlaceTest, ProblemViewsExistAndMostAreSolved) {
   nlohmann::json missing = index.options;
   missing.erase("t_max_ms");
   EXPECT_THROW(placeOptionsFromJson(missing, "index"), Error);
+  // A database placed before the visibility grid was an option sampled the corners and the centre.
+  EXPECT_EQ(index.options.at("visibility_grid"), 3);
+  nlohmann::json before = index.options;
+  before.erase("visibility_grid");
+  EXPECT_EQ(placeOptionsFromJson(before, "index").visibility_grid, 2);
 }
 
 struct ViewChecks {
@@ -335,6 +341,40 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
   std::printf("fill charged: %zu CPVs over t_max at the bound, %zu after the fallback (%zu coarser impostors); %zu "
               "guarded views, %zu impostors drawn\n",
               r.unsolved_at_bound, r.unsolved_cpvs, r.fallback_impostors, guarded, drawn);
+}
+
+// --visibility-only: every minimum-size region of the view space's partition is sampled into the cache (the regions
+// a full placement visits at a budget every view exceeds), each found again from its centre; no database is written.
+TEST(PlaceTest, VisibilityOnlySamplesEveryRegionIntoTheCache) {
+  const gen::City city = test::smallPlacementCity();
+  PlaceOptions options = test::smallPlaceOptions(city.scene);
+  const std::string dir = test::scratchDir("place_visibility_only").string();
+  options.visibility_cache = dir + "/vis.json";
+  options.visibility_only = true;
+  const PlaceReport r =
+      placeImpostors(gpu::sharedHeadlessContext(), city.scene, gpu::CostProfile{}, options, dir + "/db");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/db"));
+  const placement::VisibilityCache cache = placement::readVisibilityCache(options.visibility_cache);
+  EXPECT_EQ(cache.regions.size(), r.visibility_regions);
+  // The same partition from a placement that visits every region (a budget below any view's time).
+  PlaceOptions all = test::smallPlaceOptions(city.scene);
+  all.t_max_ms = 1e-3;
+  all.visibility_cache = dir + "/vis_all.json";
+  all.candidates.distance_steps = 1;
+  placeImpostors(gpu::sharedHeadlessContext(), city.scene, test::handProfile(), all, dir + "/db_all");
+  const placement::VisibilityCache visited = placement::readVisibilityCache(all.visibility_cache);
+  EXPECT_EQ(cache.key, visited.key);
+  EXPECT_EQ(cache.regions, visited.regions);
+  EXPECT_GE(cache.regions.size(), 8u);
+  for (const auto& [lo, ids] : cache.regions) {
+    const std::optional<Box3> region = cache.regionOf(Vec3(lo[0], lo[1], lo[2]) + Vec3(0.01f));
+    ASSERT_TRUE(region.has_value());
+    EXPECT_EQ(region->lo, Vec3(lo[0], lo[1], lo[2]));
+    EXPECT_FALSE(ids.empty());
+  }
+  options.visibility_cache.clear();
+  EXPECT_THROW(placeImpostors(gpu::sharedHeadlessContext(), city.scene, gpu::CostProfile{}, options, dir + "/db"),
+               Error);
 }
 
 TEST(PlaceTest, BadOptionsAreErrors) {

@@ -33,6 +33,18 @@ namespace farfield::bake {
 
 namespace {
 
+// A region's visibility sample points at mid height: an n x n grid over its floor plan, and for n = 2 its centre too.
+std::vector<Vec3> visibilityPoints(const Box3& region, int n) {
+  const float z = 0.5f * (region.lo.z + region.hi.z);
+  std::vector<Vec3> points;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      points.emplace_back(region.lo.x + float(i) / float(n - 1) * (region.hi.x - region.lo.x),
+                          region.lo.y + float(j) / float(n - 1) * (region.hi.y - region.lo.y), z);
+  if (n == 2) points.emplace_back(region.center().x, region.center().y, z);
+  return points;
+}
+
 void validate(const PlaceOptions& o) {
   if (!(o.t_max_ms > 0.0) || !std::isfinite(o.t_max_ms)) throw Error("--tmax", "must be a positive number of ms");
   if (!(o.error_px > 0.0) || !std::isfinite(o.error_px)) throw Error("--error-px", "must be a positive number");
@@ -44,6 +56,8 @@ void validate(const PlaceOptions& o) {
   if (!(o.max_pitch_deg > 0.0f && o.max_pitch_deg <= 90.0f)) throw Error("--max-pitch", "must be in (0, 90] degrees");
   if (!(o.max_object_share > 0.0f)) throw Error("place options", "max_object_share must be positive");
   if (!(o.near_plane > 0.0f && o.far_plane > o.near_plane)) throw Error("--near/--far", "need 0 < near < far");
+  if (o.visibility_grid < 2 || o.visibility_grid > 16)
+    throw Error("--visibility-grid", "must be 2..16 sample points per side, got " + std::to_string(o.visibility_grid));
   for (double f : o.fallback_bound_factors)
     if (!(f > 1.0) || !std::isfinite(f)) throw Error("--fallback-bounds", "each factor must be a number > 1");
 }
@@ -131,7 +145,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   context.makeCurrent();
   const Box3 space = options.view_space.empty() ? defaultPlaceViewSpace(scene) : options.view_space;
   if (space.empty() || !isFinite(space.lo) || !isFinite(space.hi)) throw Error("--view-min/--view-max", "empty view space");
-  if (!profile.layered.calibrated)
+  if (!profile.layered.calibrated && !options.visibility_only)
     FF_WARN("place: the cost profile has no layered impostor terms (a version-1 profile): the layers' fill is not in "
             "the estimates, so the frame-time guarantee does not cover it; run farfield calibrate again");
   report.layered_fill_in_model = profile.layered.calibrated;
@@ -191,8 +205,9 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     return std::max({e.x, e.y, e.z}) <= options.min_region_size;
   };
   // The cache's identity: what the visible sets depend on.
-  const nlohmann::json cache_key = placement::visibilityCacheKey(scene.objects.size(), space, options.min_region_size,
-                                                                 options.visibility_face, options.far_plane);
+  nlohmann::json cache_key = placement::visibilityCacheKey(scene.objects.size(), space, options.min_region_size,
+                                                           options.visibility_face, options.far_plane);
+  if (options.visibility_grid != 2) cache_key["visibility_grid"] = options.visibility_grid;  // 2: caches of before
   std::map<std::array<float, 3>, std::vector<uint32_t>> cached;
   if (options.visibility && !options.visibility_cache.empty() && fs::exists(options.visibility_cache)) {
     try {
@@ -219,11 +234,8 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
         return region_visible[hit->first] = hit->second;
       }
       Stopwatch timer;
-      const float z = 0.5f * (region.lo.z + region.hi.z);
       std::vector<uint8_t> seen;
-      for (const Vec3& p : {Vec3(region.lo.x, region.lo.y, z), Vec3(region.hi.x, region.lo.y, z),
-                            Vec3(region.lo.x, region.hi.y, z), Vec3(region.hi.x, region.hi.y, z),
-                            Vec3(region.center().x, region.center().y, z)}) {
+      for (const Vec3& p : visibilityPoints(region, options.visibility_grid)) {
         auto [it, fresh] = point_visible.try_emplace({p.x, p.y, p.z});
         if (fresh) {
           std::vector<uint8_t> here;
@@ -246,6 +258,34 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
       region_visible[{region.lo.x, region.lo.y, region.lo.z}] = out;
       return out;
     };
+  }
+  if (options.visibility_only) {
+    if (!options.visibility || options.visibility_cache.empty())
+      throw Error("--visibility-only", "needs the visibility on and a --visibility-cache file to write");
+    // Every minimum-size region of the view space's partition (view_space.h's split), sampled or read once.
+    std::vector<Box3> stack{space};
+    while (!stack.empty()) {
+      const Box3 box = stack.back();
+      stack.pop_back();
+      const int axis = box.longestAxis();
+      if (box.extent()[axis] <= options.min_region_size) {
+        callbacks.visible_set(box);
+        continue;
+      }
+      const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
+      Box3 lower = box, upper = box;
+      lower.hi[axis] = mid;
+      upper.lo[axis] = mid;
+      stack.push_back(upper);
+      stack.push_back(lower);
+    }
+    if (report.visibility_regions) report.mean_visible_objects /= double(report.visibility_regions);
+    placement::VisibilityCache cache;
+    cache.key = cache_key;
+    cache.regions = region_visible;
+    store::writeFileAtomic(options.visibility_cache, cache.toJson().dump() + "\n");
+    report.wall_s = wall.seconds();
+    return report;
   }
   const double max_pitch = degToRad(double(options.max_pitch_deg));
   callbacks.estimate = [&](const Box3& region, const Vdi& vdi, const std::vector<uint32_t>* visible) {
@@ -539,6 +579,7 @@ nlohmann::json placeOptionsToJson(const PlaceOptions& o) {
           {"max_object_share", o.max_object_share},
           {"visibility", o.visibility},
           {"visibility_face", o.visibility_face},
+          {"visibility_grid", o.visibility_grid},
           {"seed", o.seed},
           {"fallback_bound_factors", o.fallback_bound_factors},
           {"hierarchy", {{"max_levels", o.hierarchy.max_levels},
@@ -588,6 +629,9 @@ PlaceOptions placeOptionsFromJson(const nlohmann::json& j, const std::string& so
   r.number("max_object_share", o.max_object_share);
   o.visibility = r.boolean("visibility");
   r.number("visibility_face", o.visibility_face);
+  // Databases placed before the grid was an option sampled the corners and the centre.
+  o.visibility_grid = 2;
+  if (r.has("visibility_grid")) r.number("visibility_grid", o.visibility_grid);
   r.number("seed", o.seed);
   r.numbers("fallback_bound_factors", o.fallback_bound_factors);
   StrictJson h = r.object("hierarchy");
