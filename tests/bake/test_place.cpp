@@ -98,7 +98,7 @@ TEST(PlaceTest, ProblemViewsExistAndMostAreSolved) {
   missing.erase("t_max_ms");
   EXPECT_THROW(placeOptionsFromJson(missing, "index"), Error);
   // A database placed before the visibility grid was an option sampled the corners and the centre.
-  EXPECT_EQ(index.options.at("visibility_grid"), 3);
+  EXPECT_EQ(index.options.at("visibility_grid"), 4);
   nlohmann::json before = index.options;
   before.erase("visibility_grid");
   EXPECT_EQ(placeOptionsFromJson(before, "index").visibility_grid, 2);

@@ -54,8 +54,9 @@ struct PlaceOptions {
   bool visibility = true;
   int visibility_face = 64;
   // Sample points per side of a region: a grid of n x n at mid height (2: the corners and the centre, as before
-  // 2026-12-03). 3 (corners, edge midpoints, centre) halved the cracks of an untuned city for 2.2x the sampling time.
-  int visibility_grid = 3;
+  // 2026-12-03). On an untuned city the drive's cracks were 0.31 % with 2, 0.16 % with 3 and 0.05 % with 4 (the
+  // issue's limit is 0.1 %), for 2.2x and 4.4x the sampling time (docs/BENCHMARKS.md).
+  int visibility_grid = 4;
   // A file that keeps the sampled visible sets between runs over the same scene and view space (a t_max sweep samples
   // them once): read when it matches (scene object count, view space, region size, face size), written otherwise.
   // Not part of the saved options. "" = none.
