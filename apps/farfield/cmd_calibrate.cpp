@@ -62,11 +62,11 @@ void runCalibrateCommand(CalibrateArgs& args) {
   std::printf("model:              %.3f ms + %.3f ms/Mtri + %.4f ms/draw + %.3f ms/Mpixel + %.3f ms/Mpixel of "
               "estimated fill (fit r2 %.3f, %zu samples)\n",
               m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.ms_per_mfill, m.r2, m.samples);
-  if (m.ms_per_mfill > 0.0)
-    std::printf("fill counted up to: %s\n", m.fill_cap_pixels > 0.0
-                                                 ? (std::to_string(m.fill_cap_pixels / (double(o.width) * o.height)) +
-                                                    " frames (chosen on the fitting views)").c_str()
-                                                 : "no cap (the best fit on the fitting views)");
+  if (m.ms_per_mfill > 0.0 && m.fill_cap_pixels > 0.0)
+    std::printf("fill counted up to: %.0f frames (chosen on the fitting views)\n",
+                m.fill_cap_pixels / (double(o.width) * double(o.height)));
+  else if (m.ms_per_mfill > 0.0)
+    std::printf("fill counted up to: no cap (the best fit on the fitting views)\n");
   std::printf("validation:         %zu views at %dx%d, %.0f deg, min of %d renders each\n", r.checks.size(), o.width,
               o.height, double(o.fov_deg), o.repeats);
   std::printf("measured/predicted: p50 %.3f  p95 %.3f  p99 %.3f  max %.3f\n", r.ratio_p50, r.ratio_p95, r.ratio_p99,
@@ -119,8 +119,8 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
                   "Time placed frames: the visible sets `farfield place --visibility-cache` saved, occlusion-culled, "
                   "counted over whole objects as placement counts them (the view space defaults to the cache's)");
   cmd->add_flag("--fill-term", args->options.fill_term,
-                "Fit the estimated-fill term too (better per-view predictions; placement then bounds each region's "
-                "fill from its nearest point, which is far more conservative: see docs/BENCHMARKS.md)");
+                "Fit the estimated-fill term too, counted up to a cap chosen on the fitting views (with "
+                "--visibility-cache: the tightest model placement can bound; see docs/BENCHMARKS.md)");
   cmd->add_option("--layered-samples", args->options.layered_samples,
                   "Layered impostors the draw and capture terms are fitted on (as many validate them; 0: none)")
       ->capture_default_str();

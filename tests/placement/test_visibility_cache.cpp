@@ -26,7 +26,9 @@ TEST(VisibilityCache, AnEyesRegionIsTheViewSpacesAndReadsBack) {
     o.min_region_size = 17.0f + 20.0f * u(rng);
     o.t_max = 1.0;
     VisibilityCache cache;
-    cache.key = visibilityCacheKey(99, o.box, o.min_region_size, 32, 1000.0f);
+    cache.key = visibilityCacheKey(99, o.box, o.min_region_size, 32, 1000.0f, 4);
+    EXPECT_EQ(cache.key.at("visibility_grid"), 4);
+    EXPECT_FALSE(visibilityCacheKey(99, o.box, o.min_region_size, 32, 1000.0f, 2).contains("visibility_grid"));
     uint32_t next = 1;
     ViewSpaceCallbacks cb;
     cb.visible_set = [&](const Box3& region) {

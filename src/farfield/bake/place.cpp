@@ -201,13 +201,22 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   std::map<std::array<float, 3>, std::vector<uint32_t>> region_visible;
   std::map<std::array<float, 3>, std::vector<uint32_t>> point_visible;
   const auto isLeafSized = [&](const Box3& region) {
-    const Vec3 e = region.extent();
-    return std::max({e.x, e.y, e.z}) <= options.min_region_size;
+    return placement::isPartitionLeaf(region, options.min_region_size);
   };
   // The cache's identity: what the visible sets depend on.
-  nlohmann::json cache_key = placement::visibilityCacheKey(scene.objects.size(), space, options.min_region_size,
-                                                           options.visibility_face, options.far_plane);
-  if (options.visibility_grid != 2) cache_key["visibility_grid"] = options.visibility_grid;  // 2: caches of before
+  const nlohmann::json cache_key =
+      placement::visibilityCacheKey(scene.objects.size(), space, options.min_region_size, options.visibility_face,
+                                    options.far_plane, options.visibility_grid);
+  // Once the visible sets are known: their mean size, and the cache written when some were sampled anew.
+  const auto finishVisibility = [&] {
+    if (report.visibility_regions) report.mean_visible_objects /= double(report.visibility_regions);
+    if (!options.visibility || options.visibility_cache.empty() || report.visibility_cached >= report.visibility_regions)
+      return;
+    placement::VisibilityCache cache;
+    cache.key = cache_key;
+    cache.regions = region_visible;
+    store::writeFileAtomic(options.visibility_cache, cache.toJson().dump() + "\n");
+  };
   std::map<std::array<float, 3>, std::vector<uint32_t>> cached;
   if (options.visibility && !options.visibility_cache.empty() && fs::exists(options.visibility_cache)) {
     try {
@@ -262,28 +271,8 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   if (options.visibility_only) {
     if (!options.visibility || options.visibility_cache.empty())
       throw Error("--visibility-only", "needs the visibility on and a --visibility-cache file to write");
-    // Every minimum-size region of the view space's partition (view_space.h's split), sampled or read once.
-    std::vector<Box3> stack{space};
-    while (!stack.empty()) {
-      const Box3 box = stack.back();
-      stack.pop_back();
-      const int axis = box.longestAxis();
-      if (box.extent()[axis] <= options.min_region_size) {
-        callbacks.visible_set(box);
-        continue;
-      }
-      const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
-      Box3 lower = box, upper = box;
-      lower.hi[axis] = mid;
-      upper.lo[axis] = mid;
-      stack.push_back(upper);
-      stack.push_back(lower);
-    }
-    if (report.visibility_regions) report.mean_visible_objects /= double(report.visibility_regions);
-    placement::VisibilityCache cache;
-    cache.key = cache_key;
-    cache.regions = region_visible;
-    store::writeFileAtomic(options.visibility_cache, cache.toJson().dump() + "\n");
+    for (const Box3& region : placement::partitionLeaves(space, options.min_region_size)) callbacks.visible_set(region);
+    finishVisibility();
     report.wall_s = wall.seconds();
     return report;
   }
@@ -310,13 +299,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   report.estimates = view_space.counts.estimates;
   for (const placement::Cpv& c : view_space.cpvs) report.t_enc_max_ms = std::max(report.t_enc_max_ms, c.t_enc);
   report.view_space_s = step.seconds();
-  if (report.visibility_regions) report.mean_visible_objects /= double(report.visibility_regions);
-  if (options.visibility && !options.visibility_cache.empty() && report.visibility_cached < report.visibility_regions) {
-    placement::VisibilityCache cache;
-    cache.key = cache_key;
-    cache.regions = region_visible;
-    store::writeFileAtomic(options.visibility_cache, cache.toJson().dump() + "\n");
-  }
+  finishVisibility();
   const auto visibleFrom = [&](const Box3& region) -> const std::vector<uint32_t>* {
     const auto it = region_visible.find({region.lo.x, region.lo.y, region.lo.z});
     return it == region_visible.end() || it->second.empty() ? nullptr : &it->second;

@@ -30,11 +30,11 @@ struct CalibrateOptions {
   size_t fit_views = 100;      // random views of the view space the model is fitted on (other than the validation's)
   int repeats = 3;             // renders per validation view, the minimum kept
   double margin_quantile = 1.0;  // safety factor = this quantile of measured / predicted (1 = the maximum)
-  // Fit the model's fill term (gpu/cost_model.h, core/object_fill.h) too. Off: the views' estimated fill is still
-  // written to the CSV, and the term fits to 0. On street views of llvmpipe it explains much of what triangles and
-  // draw calls leave (r2 0.72 -> 0.87 on the default city), but a region's fill bounded from its nearest point counts
-  // every adjacent building as the whole frame, so placement's problem view space grows several times (measured in
-  // docs/BENCHMARKS.md): off by default.
+  // Fit the model's fill term (gpu/cost_model.h, core/object_fill.h) too, counted up to a cap chosen on the fitting
+  // views (2 to 8 frames, or none). Off: the views' estimated fill is still written to the CSV, and the term is 0.
+  // Uncapped, a region's fill bounded from its nearest point counts every adjacent building as a whole frame, and
+  // placement's problem view space grew several times; capped and fitted on placed frames (visible_set) it gives the
+  // tightest bound measured (docs/BENCHMARKS.md).
   bool fill_term = false;
   // Placed frames (`farfield calibrate --visibility-cache`): when set, a view draws the objects this returns for its
   // eye (the visible set of the region holding it; nullptr: every object) that its frustum meets, through the

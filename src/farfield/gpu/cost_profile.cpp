@@ -80,21 +80,20 @@ nlohmann::json CostProfile::toJson() const {
 
 CostProfile CostProfile::fromJson(const nlohmann::json& j, const std::string& source) {
   // Version 1 has no "layered" key; later versions must have it. Versions 1 and 2 have no fill term.
-  const bool v1 = j.is_object() && j.contains("version") && j.at("version") == 1;
-  const bool v2 = j.is_object() && j.contains("version") && j.at("version") == 2;
+  const nlohmann::json* v = j.is_object() && j.contains("version") ? &j.at("version") : nullptr;
+  const int version = v && v->is_number_integer() ? v->get<int>() : 0;  // 0: none this build reads
   std::set<std::string> keys{"format", "version", "model", "safety_factor", "width", "height", "fov_y_deg",
                              "renderer", "validation"};
-  if (!v1) keys.insert("layered");
+  if (version != 1) keys.insert("layered");
   onlyKeys(j, keys, source);
   if (j.at("format") != kCostProfileFormat)
     throw Error(source, std::string("\"format\" is not \"") + kCostProfileFormat + "\"");
-  if (!v1 && !v2 && j.at("version") != kCostProfileVersion)
+  if (version < 1 || version > kCostProfileVersion)
     throw Error(source, "version " + j.at("version").dump() + " (this build reads versions 1 to " +
                             std::to_string(kCostProfileVersion) + ")");
-  const int version = v1 ? 1 : v2 ? 2 : kCostProfileVersion;
   CostProfile p;
   p.model = modelFromJson(j.at("model"), source + ": model", version >= 3);
-  if (!v1) p.layered = LayeredCost::fromJson(j.at("layered"), source + ": layered", version);
+  if (version != 1) p.layered = LayeredCost::fromJson(j.at("layered"), source + ": layered", version);
   p.safety_factor = number(j, "safety_factor", source, 1.0);
   // The frame size: whole pixels of an int (a conversion of 1e300 to int is undefined behaviour).
   p.width = wholeNumber<int>(number(j, "width", source, 1.0), source, "\"width\"");

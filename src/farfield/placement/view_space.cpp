@@ -88,18 +88,14 @@ class Approximation {
     const std::vector<uint32_t>* visible_ptr = cb_.visible_set ? &visible : nullptr;
     const uint32_t first = uint32_t(vs_.cpvs.size());
     vs_.nodes[size_t(node)].cpv_first = first;
-    const int axis = box.longestAxis();
-    if (box.extent()[axis] <= vs_.options.min_region_size) {
+    if (isPartitionLeaf(box, vs_.options.min_region_size)) {
       if (directions(node, box, visible_ptr, true)) ++vs_.counts.problem_regions;
     } else if (directions(node, box, visible_ptr, false)) {
-      const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
-      Box3 lower = box, upper = box;
-      lower.hi[axis] = mid;
-      upper.lo[axis] = mid;
+      const std::array<Box3, 2> halves = splitRegion(box);
       const int depth = vs_.nodes[size_t(node)].depth + 1;
       for (int k = 0; k < 2; ++k) {
         const int child = int(vs_.nodes.size());
-        vs_.nodes.push_back({k == 0 ? lower : upper, node, {-1, -1}, depth});
+        vs_.nodes.push_back({halves[size_t(k)], node, {-1, -1}, depth});
         vs_.nodes[size_t(node)].children[k] = child;
       }
       visit(vs_.nodes[size_t(node)].children[0]);
@@ -132,6 +128,45 @@ void ViewSpaceOptions::validate() const {
   if (depth > 40)
     throw Error(kWhat, "min_region_size " + std::to_string(min_region_size) + " gives 2^" + std::to_string(depth) +
                            " regions for this box (at most 2^40)");
+}
+
+bool isPartitionLeaf(const Box3& region, float min_size) {
+  return region.extent()[region.longestAxis()] <= min_size;
+}
+
+std::array<Box3, 2> splitRegion(const Box3& region) {
+  const int axis = region.longestAxis();
+  const float mid = 0.5f * (region.lo[axis] + region.hi[axis]);
+  std::array<Box3, 2> halves{region, region};
+  halves[0].hi[axis] = mid;
+  halves[1].lo[axis] = mid;
+  return halves;
+}
+
+std::vector<Box3> partitionLeaves(const Box3& box, float min_size) {
+  std::vector<Box3> leaves, stack{box};
+  while (!stack.empty()) {
+    const Box3 region = stack.back();
+    stack.pop_back();
+    if (isPartitionLeaf(region, min_size)) {
+      leaves.push_back(region);
+      continue;
+    }
+    const std::array<Box3, 2> halves = splitRegion(region);
+    stack.push_back(halves[1]);
+    stack.push_back(halves[0]);
+  }
+  return leaves;
+}
+
+std::optional<Box3> partitionLeafOf(const Box3& box, float min_size, const Vec3& eye) {
+  if (!box.contains(eye) || !(min_size > 0.0f)) return std::nullopt;
+  Box3 region = box;
+  while (!isPartitionLeaf(region, min_size)) {
+    const std::array<Box3, 2> halves = splitRegion(region);
+    region = halves[0].contains(eye) ? halves[0] : halves[1];
+  }
+  return region;
 }
 
 ViewSpace approximateProblemViewSpace(const ViewSpaceOptions& options, const ViewSpaceCallbacks& callbacks) {

@@ -12,6 +12,7 @@
 // this file needs no GPU. Units: metres, radians; times in the unit of t_max.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -82,5 +83,15 @@ struct ViewSpace {
 
 // Throws farfield::Error for bad options, a missing estimate, or an estimate that is negative or not finite.
 ViewSpace approximateProblemViewSpace(const ViewSpaceOptions& options, const ViewSpaceCallbacks& callbacks);
+
+// The regular partition the view space is split by, for callers that need its regions without a ViewSpace (the
+// visibility cache, `place --visibility-only`). A region is a leaf when its longest side is <= min_size; otherwise
+// it splits at the midpoint of its longest axis into {lower, upper}.
+bool isPartitionLeaf(const Box3& region, float min_size);
+std::array<Box3, 2> splitRegion(const Box3& region);
+// Every leaf under `box`, lower halves first.
+std::vector<Box3> partitionLeaves(const Box3& box, float min_size);
+// The leaf under `box` holding `eye` (on a split plane: the lower half, as ViewSpace::lookup); none outside `box`.
+std::optional<Box3> partitionLeafOf(const Box3& box, float min_size, const Vec3& eye);
 
 }  // namespace farfield::placement

@@ -3,18 +3,21 @@
 #include <fstream>
 
 #include "farfield/core/error.h"
+#include "farfield/placement/view_space.h"
 
 namespace farfield::placement {
 
 nlohmann::json visibilityCacheKey(size_t scene_objects, const Box3& view_space, float min_region_size,
-                                  int visibility_face, float far_plane) {
-  return {{"scene_objects", scene_objects},
-          {"view_space",
-           {{"lo", {view_space.lo.x, view_space.lo.y, view_space.lo.z}},
-            {"hi", {view_space.hi.x, view_space.hi.y, view_space.hi.z}}}},
-          {"min_region_size", min_region_size},
-          {"visibility_face", visibility_face},
-          {"far_plane", far_plane}};
+                                  int visibility_face, float far_plane, int visibility_grid) {
+  nlohmann::json key = {{"scene_objects", scene_objects},
+                        {"view_space",
+                         {{"lo", {view_space.lo.x, view_space.lo.y, view_space.lo.z}},
+                          {"hi", {view_space.hi.x, view_space.hi.y, view_space.hi.z}}}},
+                        {"min_region_size", min_region_size},
+                        {"visibility_face", visibility_face},
+                        {"far_plane", far_plane}};
+  if (visibility_grid != 2) key["visibility_grid"] = visibility_grid;  // caches of before the grid have none
+  return key;
 }
 
 Box3 VisibilityCache::viewSpace() const {
@@ -36,22 +39,7 @@ float VisibilityCache::minRegionSize() const {
 }
 
 std::optional<Box3> VisibilityCache::regionOf(const Vec3& eye) const {
-  Box3 box = viewSpace();
-  const float min_size = minRegionSize();
-  if (!box.contains(eye) || !(min_size > 0.0f)) return std::nullopt;
-  // The split of view_space.cpp: the midpoint of the longest axis, the same float arithmetic, down to the size.
-  for (int depth = 0; depth < 64; ++depth) {
-    const int axis = box.longestAxis();
-    if (box.extent()[axis] <= min_size) return box;
-    const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
-    Box3 lower = box;
-    lower.hi[axis] = mid;
-    if (lower.contains(eye))  // on the plane: the lower half, as ViewSpace::lookup
-      box = lower;
-    else
-      box.lo[axis] = mid;
-  }
-  return box;
+  return partitionLeafOf(viewSpace(), minRegionSize(), eye);
 }
 
 const std::vector<uint32_t>* VisibilityCache::visibleFrom(const Vec3& eye) const {

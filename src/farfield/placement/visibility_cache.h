@@ -27,16 +27,18 @@ struct VisibilityCache {
   // The key's view space and minimum region size. Throws farfield::Error when the key lacks them.
   Box3 viewSpace() const;
   float minRegionSize() const;
-  // The minimum-size region of the view space's partition that holds `eye`; none outside the view space.
+  // The minimum-size region of the view space's partition that holds `eye` (placement::partitionLeafOf); none outside
+  // the view space.
   std::optional<Box3> regionOf(const Vec3& eye) const;
   // Its visible set; nullptr outside the view space or for a region the cache does not hold.
   const std::vector<uint32_t>* visibleFrom(const Vec3& eye) const;
   nlohmann::json toJson() const;  // the file's content
 };
 
-// The key placement writes for these inputs.
+// The key placement writes for these inputs (visibility_grid: sample points per side of a region; 2, the corners and
+// the centre, is left out, as in caches written before it was an option).
 nlohmann::json visibilityCacheKey(size_t scene_objects, const Box3& view_space, float min_region_size,
-                                  int visibility_face, float far_plane);
+                                  int visibility_face, float far_plane, int visibility_grid);
 
 // Throws farfield::Error naming the file for a missing, unreadable or malformed cache.
 VisibilityCache readVisibilityCache(const std::string& path);

@@ -107,7 +107,9 @@ size_t CrowdRuntime::atlasBytes() const {
   return b;
 }
 
-void CrowdRuntime::placeAgents(std::span<const CrowdAgentState> agents) {
+void CrowdRuntime::prepareFrame(const Camera& camera, std::span<const CrowdAgentState> agents) {
+  switch_m_.resize(models_.size());
+  for (size_t m = 0; m < models_.size(); ++m) switch_m_[m] = switchDistances(m, camera).both();
   spheres_.resize(agents.size());
   for (size_t i = 0; i < agents.size(); ++i) {
     const CrowdAgentState& a = agents[i];
@@ -155,11 +157,9 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
   const Mat4 view_proj = camera.viewProjection();
   Frustum frustum = Frustum::fromMatrix(view_proj);
   for (Vec4& p : frustum.planes) p /= std::max(glm::length(Vec3(p)), 1e-20f);
-  std::vector<double> switch_m(models_.size());
   for (size_t m = 0; m < models_.size(); ++m) {
     lists_.geometry[m].clear();
     lists_.impostors[m].clear();
-    switch_m[m] = switchDistances(m, camera).both();
   }
   for (size_t i = 0; i < agents.size(); ++i) {
     const CrowdAgentState& a = agents[i];
@@ -180,7 +180,7 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
     gpu::CrowdAgentGpu g = record(a);
     const Vec3 to_eye = camera.eye - centre;
     const bool impostor = policy == CrowdPolicy::Impostor ||
-                          (policy == CrowdPolicy::Mixed && double(glm::length(to_eye)) >= switch_m[a.model]);
+                          (policy == CrowdPolicy::Mixed && double(glm::length(to_eye)) >= switch_m_[a.model]);
     if (!impostor) {
       g.index = cycleIndex(a.phase, options_.palette_poses);
       lists_.geometry[a.model].push_back(g);
@@ -211,7 +211,7 @@ CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSe
 CrowdFrameStats CrowdRuntime::draw(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                                    const gpu::LightSettings& light) {
   CrowdFrameStats stats;
-  placeAgents(agents);
+  prepareFrame(camera, agents);
   classify(camera, agents, policy, stats);
   return drawLists(camera, light, stats);
 }
@@ -228,11 +228,9 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
   stats.shadow_texel_m = fit.projection.texel_m;
   if (fit.casters.empty()) return;
   const Vec3 to_light = -glm::normalize(light.direction);
-  std::vector<double> switch_m(models_.size());
   for (size_t m = 0; m < models_.size(); ++m) {
     caster_lists_.geometry[m].clear();
     caster_lists_.impostors[m].clear();
-    switch_m[m] = switchDistances(m, camera).both();
   }
   // Each caster in the representation the camera's policy gives it; impostors show their view towards the light.
   for (uint32_t i : fit.casters) {
@@ -242,7 +240,7 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
     const bool impostor =
         policy == CrowdPolicy::Impostor ||
         (policy == CrowdPolicy::Mixed &&
-         (shadows.impostor_casters || double(glm::length(camera.eye - spheres_[i].centre)) >= switch_m[a.model]));
+         (shadows.impostor_casters || double(glm::length(camera.eye - spheres_[i].centre)) >= switch_m_[a.model]));
     if (!impostor) {
       g.index = cycleIndex(a.phase, options_.palette_poses);
       caster_lists_.geometry[a.model].push_back(g);
@@ -264,7 +262,7 @@ CrowdFrameStats CrowdRuntime::drawShadowed(const Camera& camera, std::span<const
                                            CrowdPolicy policy, const gpu::LightSettings& light,
                                            const gpu::RenderTarget& target, const CrowdShadowOptions& shadows) {
   CrowdFrameStats stats;
-  placeAgents(agents);
+  prepareFrame(camera, agents);
   castShadows(camera, agents, policy, light, shadows, stats);
   classify(camera, agents, policy, stats);
   target.bindForOpaquePass();

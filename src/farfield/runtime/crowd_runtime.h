@@ -158,15 +158,17 @@ class CrowdRuntime {
   void castShadows(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                    const gpu::LightSettings& light, const CrowdShadowOptions& shadows, CrowdFrameStats& stats);
   gpu::CrowdAgentGpu record(const CrowdAgentState& a) const;
-  // Each agent's bounding sphere in the world, once a frame (spheres_), for the casters and the classification.
-  // Throws farfield::Error for an agent of a model out of range.
-  void placeAgents(std::span<const CrowdAgentState> agents);
+  // Once a frame, for the casters and the classification: each model's switch distance for the camera (switch_m_)
+  // and each agent's bounding sphere in the world (spheres_). Throws farfield::Error for an agent of a model out of
+  // range.
+  void prepareFrame(const Camera& camera, std::span<const CrowdAgentState> agents);
 
   CrowdRuntimeOptions options_;
   gpu::CrowdRenderer renderer_;
   std::vector<Model> models_;
   Lists lists_, caster_lists_;  // reused per frame
-  std::vector<CasterSphere> spheres_;  // placeAgents: per agent, this frame
+  std::vector<CasterSphere> spheres_;  // prepareFrame: per agent, this frame
+  std::vector<double> switch_m_;       // prepareFrame: per model, this frame's camera
   gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
   std::vector<float> depth_rows_;
   bool cull_next_ = false;
