@@ -32,7 +32,7 @@ PLACE_COMMON=(--profile "$OUT/profile.json" --max-pitch 20 --size "$SIZE" --fov 
 [ -f "$OUT/city.glb" ] || "$FARFIELD" gen city --blocks "$BLOCKS" --seed "$SEED" --objects buildings -o "$OUT/city.glb" \
   > "$OUT/gen.txt"
 # CAL_VIEWS (default 500): validation views of the frame model (8 is enough when MODEL_PROFILE replaces it).
-[ -f "$OUT/calibrated.json" ] || "$FARFIELD" calibrate "$OUT/city.glb" -o "$OUT/calibrated.json" --views "${CAL_VIEWS:-500}" \
+[ "${PLACED_CAL:-0}" = 1 ] || [ -f "$OUT/calibrated.json" ] || "$FARFIELD" calibrate "$OUT/city.glb" -o "$OUT/calibrated.json" --views "${CAL_VIEWS:-500}" \
   --size "$SIZE" --fov 45 --csv "$OUT/calibration.csv" > "$OUT/calibrate.txt"
 if [ "${PLACED_CAL:-0}" = 1 ]; then
   [ -f "$OUT/visibility.json" ] || "$FARFIELD" place "$OUT/city.glb" --visibility-only --cpv-size 46 \

@@ -74,7 +74,12 @@ void runCalibrateCommand(CalibrateArgs& args) {
   std::printf("|error| ms:         p50 %.3f  p95 %.3f  max %.3f\n", r.abs_error_p50_ms, r.abs_error_p95_ms,
               r.abs_error_max_ms);
   std::printf("safety factor:      %.3f (quantile %.3f of measured/predicted); views over prediction x factor: %zu of %zu\n",
-              r.profile.safety_factor, o.margin_quantile, r.over_bound, r.checks.size());
+              r.profile.safety_factor, o.margin_quantile, r.over_factor, r.checks.size());
+  std::printf("safety margin:      %.3f ms (quantile %.3f of measured - predicted); the bound is the smaller: "
+              "prediction x %.3f up to %.2f ms predicted, + %.3f ms above\n",
+              r.margin_ms, o.margin_quantile, r.profile.safety_factor,
+              r.profile.safety_factor > 1.0 ? r.margin_ms / (r.profile.safety_factor - 1.0) : 0.0, r.margin_ms);
+  std::printf("views over the bound: %zu of %zu\n", r.over_bound, r.checks.size());
   std::printf("views slower than predicted (before the factor): %zu\n", r.under_predicted);
   if (r.profile.layered.calibrated) {
     const gpu::LayeredCost& l = r.profile.layered;
@@ -113,7 +118,7 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
   cmd->add_option("--margin", args->margin, "Margin of --around on the ground, metres")->capture_default_str();
   cmd->add_option("--seed", args->options.seed, "Seed of the random views")->capture_default_str();
   cmd->add_option("--margin-quantile", args->options.margin_quantile,
-                  "Safety factor = this quantile of measured/predicted (1 = the maximum)")->capture_default_str();
+                  "Safety factor and margin = this quantile of measured/predicted and measured - predicted (1 = the maximum)")->capture_default_str();
   cmd->add_option("--csv", args->csv, "Per-view predicted and measured times");
   cmd->add_option("--visibility-cache", args->visibility_cache,
                   "Time placed frames: the visible sets `farfield place --visibility-cache` saved, occlusion-culled, "

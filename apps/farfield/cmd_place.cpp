@@ -3,6 +3,7 @@
 // farfield place SCENE --visibility-only --visibility-cache vis.json [--cpv-size M] [view space options]
 // Automatic impostor placement (Jeschke et al. 2005; bake/place.h): which object clusters become layered impostors
 // for which view cells, so every view of the view space renders under t_max with an error under the bound.
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -61,9 +62,13 @@ void runPlaceCommand(PlaceArgs& args) {
   }
   std::printf("scene:            %s (%zu objects: %zu clustered, %zu always geometry)\n", args.scene.c_str(),
               scene.objects.size(), r.clustered_objects, r.geometry_objects);
-  std::printf("promises:         t_max %.2f ms, error %.2f px at %dx%d, %.1f deg (profile %s, safety factor %.3f)\n",
+  const std::string margin = std::isfinite(profile.safety_margin_ms)
+                                 ? ", or + " + std::to_string(profile.safety_margin_ms).substr(0, 5) + " ms where smaller"
+                                 : std::string();
+  std::printf("promises:         t_max %.2f ms, error %.2f px at %dx%d, %.1f deg (profile %s: bound prediction x "
+              "%.3f%s; at t_max a factor of %.3f)\n",
               o.t_max_ms, o.error_px, o.width, o.height, double(o.fov_deg), args.profile.c_str(),
-              profile.safety_factor);
+              profile.safety_factor, margin.c_str(), r.safety_factor);
   if (o.visibility)
     std::printf("visibility:       %zu regions (%zu from the cache) sampled from %zu points, %.1f objects seen per "
                 "region, %.1f s\n",

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -298,6 +300,50 @@ TEST(Bench, FramesAreInterleavedWithRotatingOrder) {
     // The first mode of frame k is mode k mod 2: the order rotates by one each frame.
     EXPECT_EQ(run.result.modes[k % 2].order[k], 0);
   }
+}
+
+// A mode that logs its renders in a shared log and is slow on its first render of every frame.
+class LoggingMode : public Mode {
+ public:
+  LoggingMode(std::string name, std::vector<std::pair<std::string, size_t>>& log) : name_(std::move(name)), log_(log) {}
+  std::string name() const override { return name_; }
+  void frame(FrameContext& frame) override {
+    size_t before = 0;
+    for (const auto& entry : log_) before += entry == std::make_pair(name_, frame.pathFrame());
+    log_.emplace_back(name_, frame.pathFrame());
+    if (before == 0) std::this_thread::sleep_for(std::chrono::milliseconds(40));
+  }
+
+ private:
+  std::string name_;
+  std::vector<std::pair<std::string, size_t>>& log_;
+};
+
+// With repeats, a frame's renders are made in rounds over the modes: no mode renders a frame twice in a row (so a
+// burst of the machine's noise cannot slow all of a mode's renders), and the fastest of them is kept.
+TEST(Bench, RepeatsAreRoundsOverTheModesAndTheFastestIsKept) {
+  static std::vector<std::pair<std::string, size_t>> log;
+  log.clear();
+  for (const char* name : {"test-log-a", "test-log-b"})
+    registerMode(name, "a test mode", [name](const ModeContext&) { return std::make_unique<LoggingMode>(name, log); });
+  const scene::Scene scene = scene::builtinScene("cubes");
+  BenchOptions options;
+  options.modes = {"test-log-a", "test-log-b"};
+  options.width = 32;
+  options.height = 32;
+  options.frames = 3;
+  options.repeats = 3;
+  options.out_dir = test::scratchDir("eval_bench_repeats").string();
+  const BenchResult result = runBench(gpu::sharedHeadlessContext(), scene, test::sideWalkPath(3), options);
+  ASSERT_EQ(result.modes.size(), 3u);  // full, a, b
+  // Per logging mode: the warm-up frame once, then 3 renders of each of the 3 frames.
+  EXPECT_EQ(log.size(), 2u * (1 + 3 * 3));
+  for (size_t i = 1; i < log.size(); ++i)
+    EXPECT_FALSE(log[i] == log[i - 1]) << "render " << i << ": " << log[i].first << " frame " << log[i].second
+                                       << " twice in a row";
+  for (size_t m = 1; m < 3; ++m)
+    for (const FrameRecord& f : result.modes[m].frames)
+      EXPECT_LT(f.wall_ms, 40.0) << result.modes[m].name << " frame " << f.path_frame << ": not the fastest render";
 }
 
 TEST(Bench, CsvMarkdownAndSampleFrames) {

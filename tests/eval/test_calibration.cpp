@@ -60,14 +60,25 @@ TEST(CalibrationTest, TheSafetyFactorBoundsTheViewsItCameFrom) {
   const CalibrateResult r = calibrate(gpu::sharedHeadlessContext(), smallCity(), o);
   ASSERT_EQ(r.checks.size(), 24u);
   EXPECT_GE(r.profile.safety_factor, 1.0);
-  EXPECT_EQ(r.over_bound, 0u);  // quantile 1: the largest ratio
-  size_t over = 0;
+  EXPECT_EQ(r.over_factor, 0u);  // quantile 1: the largest ratio
+  EXPECT_EQ(r.over_bound, 0u);
+  size_t over = 0, margin_tight = 0;
+  double largest_excess = 0.0;
   for (const ViewCheck& c : r.checks) {
     EXPECT_GT(c.predicted_ms, 0.0);
     EXPECT_GT(c.measured_ms, 0.0);
     over += c.measured_ms > c.predicted_ms * r.profile.safety_factor * (1 + 1e-9) ? 1 : 0;
+    // The additive margin bounds every view too, so the profile's bound (the smaller) does.
+    EXPECT_LE(c.measured_ms, c.predicted_ms + r.profile.safety_margin_ms + 1e-9);
+    EXPECT_LE(c.measured_ms, r.profile.boundOfPrediction(c.predicted_ms) + 1e-9);
+    largest_excess = std::max(largest_excess, c.measured_ms - c.predicted_ms);
+    margin_tight += c.predicted_ms + r.profile.safety_margin_ms < c.predicted_ms * r.profile.safety_factor;
   }
   EXPECT_EQ(over, 0u);
+  EXPECT_NEAR(r.profile.safety_margin_ms, largest_excess, 1e-12);  // the largest, recomputed
+  EXPECT_EQ(r.profile.validation["margin_ms"].get<double>(), r.profile.safety_margin_ms);
+  std::printf("margin %.3f ms, factor %.3f: the margin is the smaller bound for %zu of 24 views\n",
+              r.profile.safety_margin_ms, r.profile.safety_factor, margin_tight);
   EXPECT_LE(r.ratio_p50, r.ratio_max);
   EXPECT_EQ(r.profile.width, 64);
   EXPECT_EQ(r.profile.validation["views"], 24);
@@ -80,9 +91,18 @@ TEST(CalibrationTest, TheSafetyFactorBoundsTheViewsItCameFrom) {
   std::sort(ratios.begin(), ratios.end());
   const double median = 0.5 * (ratios[11] + ratios[12]);  // 24 views: between the 12th and 13th
   EXPECT_NEAR(half.profile.safety_factor, std::max(1.0, median), 1e-9);
-  size_t above = 0;
-  for (const ViewCheck& c : half.checks) above += c.measured_ms / c.predicted_ms > half.profile.safety_factor ? 1 : 0;
-  EXPECT_EQ(half.over_bound, above);
+  std::vector<double> excess;
+  for (const ViewCheck& c : half.checks) excess.push_back(c.measured_ms - c.predicted_ms);
+  std::sort(excess.begin(), excess.end());
+  EXPECT_NEAR(half.profile.safety_margin_ms, std::max(0.0, 0.5 * (excess[11] + excess[12])), 1e-9);
+  size_t above = 0, above_both = 0;
+  for (const ViewCheck& c : half.checks) {
+    const bool over_factor = c.measured_ms / c.predicted_ms > half.profile.safety_factor;
+    above += over_factor ? 1 : 0;
+    above_both += over_factor && c.measured_ms - c.predicted_ms > half.profile.safety_margin_ms ? 1 : 0;
+  }
+  EXPECT_EQ(half.over_factor, above);
+  EXPECT_EQ(half.over_bound, above_both);
   EXPECT_LE(above, 12u);
 }
 

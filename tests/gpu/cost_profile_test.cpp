@@ -1,10 +1,12 @@
 // The cost profile (gpu/cost_profile.h): saved whole and read back strictly; the bound is the prediction times the
-// safety factor.
+// safety factor, or plus the margin where that is smaller, and one factor at a budget decides as that bound does.
 #include "farfield/gpu/cost_profile.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <limits>
 
 #include "farfield/core/error.h"
 #include "support/test_support.h"
@@ -24,6 +26,7 @@ CostProfile oddProfile() {
   p.model.rms_error_ms = 0.5;
   p.model.r2 = 0.875;
   p.safety_factor = 1.5;
+  p.safety_margin_ms = 12.0;  // the factor's bound is the smaller up to predictions of 24 ms
   p.width = 640;
   p.height = 360;
   p.fov_y_deg = 52.5;
@@ -64,10 +67,62 @@ TEST(CostProfileTest, RoundTripAndBound) {
   EXPECT_TRUE(r.toJson()["layered"].is_null());
 }
 
+TEST(CostProfileTest, TheBoundIsTheSmallerOfTheFactorAndTheMargin) {
+  CostProfile p = oddProfile();
+  EXPECT_DOUBLE_EQ(p.boundOfPrediction(10.0), 15.0);   // x 1.5 (22 with the margin)
+  EXPECT_DOUBLE_EQ(p.boundOfPrediction(24.0), 36.0);   // both
+  EXPECT_DOUBLE_EQ(p.boundOfPrediction(40.0), 52.0);   // + 12 (60 with the factor)
+  EXPECT_DOUBLE_EQ(p.boundMs(2e7, 100, 1e6, 4e7), 1.25 + 70.0 + 6.25 + 0.75 + 7.5 + 12.0);  // 85.75 predicted
+  p.safety_margin_ms = std::numeric_limits<double>::infinity();  // none: the factor alone
+  EXPECT_DOUBLE_EQ(p.boundOfPrediction(40.0), 60.0);
+}
+
+// At a budget t the profile folded to one factor gives the bound's verdict for every prediction: brute force over
+// predictions and budgets, with and without a margin, and with a margin above the budget.
+TEST(CostProfileTest, OneFactorAtABudgetDecidesAsTheBound) {
+  for (double margin : {0.0, 0.8, 3.0, 12.0, std::numeric_limits<double>::infinity()}) {
+    CostProfile p = oddProfile();
+    p.safety_margin_ms = margin;
+    for (double t : {1.0, 2.5, 8.0, 10.0, 24.0, 100.0}) {
+      const CostProfile at = p.atBudget(t);
+      EXPECT_GE(at.safety_factor, 1.0);
+      EXPECT_LE(at.safety_factor, p.safety_factor);
+      EXPECT_FALSE(std::isfinite(at.safety_margin_ms));
+      for (int k = 1; k <= 4000; ++k) {
+        const double predicted = 0.01 * k;
+        const double exact = p.boundOfPrediction(predicted), folded = at.boundOfPrediction(predicted);
+        // The same verdict away from the edge (a hair's rounding at it).
+        if (std::abs(exact - t) > 1e-9 && std::abs(folded - t) > 1e-9)
+          EXPECT_EQ(exact <= t, folded <= t) << "margin " << margin << " t " << t << " prediction " << predicted;
+        if (folded < t) EXPECT_LE(folded, exact + 1e-12);  // scaled: at most the bound under t
+        if (folded > t) EXPECT_GE(folded, exact - 1e-12);  // and at least over it
+      }
+    }
+  }
+}
+
+TEST(CostProfileTest, VersionThreeHasNoMargin) {
+  nlohmann::json j = oddProfile().toJson();
+  j["version"] = 3;
+  j.erase("safety_margin_ms");
+  const CostProfile p = CostProfile::fromJson(j, "v3.json");
+  EXPECT_FALSE(std::isfinite(p.safety_margin_ms));
+  EXPECT_DOUBLE_EQ(p.boundOfPrediction(40.0), 60.0);
+  j["safety_margin_ms"] = 1.0;  // a key version 3 did not have
+  EXPECT_THROW(CostProfile::fromJson(j, "v3.json"), Error);
+  // Version 4 without a margin: null, read back as none.
+  CostProfile none = oddProfile();
+  none.safety_margin_ms = std::numeric_limits<double>::infinity();
+  const nlohmann::json k = none.toJson();
+  EXPECT_TRUE(k["safety_margin_ms"].is_null());
+  EXPECT_FALSE(std::isfinite(CostProfile::fromJson(k, "v4.json").safety_margin_ms));
+}
+
 TEST(CostProfileTest, VersionOneHasNoLayeredTerms) {
   nlohmann::json j = oddProfile().toJson();
   j["version"] = 1;
   j.erase("layered");
+  j.erase("safety_margin_ms");
   j["model"].erase("ms_per_mfill");
   j["model"].erase("fill_cap_pixels");
   const CostProfile p = CostProfile::fromJson(j, "old.json");
@@ -80,6 +135,7 @@ TEST(CostProfileTest, VersionOneHasNoLayeredTerms) {
 TEST(CostProfileTest, VersionTwoHasNoFillTerm) {
   nlohmann::json j = oddProfile().toJson();
   j["version"] = 2;
+  j.erase("safety_margin_ms");
   for (nlohmann::json* m : {&j["model"], &j["layered"]["draw"], &j["layered"]["capture"]}) {
     m->erase("ms_per_mfill");
     m->erase("fill_cap_pixels");
@@ -119,8 +175,14 @@ TEST(CostProfileTest, StrictReadNamesTheKey) {
   j["model"]["colour"] = 1;
   expectError(j, "colour");
   j = good;
-  j["version"] = 4;
+  j["version"] = 5;
   expectError(j, "version");
+  j = good;
+  j["safety_margin_ms"] = -0.5;
+  expectError(j, "safety_margin_ms");
+  j = good;
+  j.erase("safety_margin_ms");
+  expectError(j, "safety_margin_ms");
   j = good;
   j["model"].erase("ms_per_mfill");
   expectError(j, "ms_per_mfill");

@@ -117,6 +117,7 @@ nlohmann::json PlaceReport::toJson() const {
           {"fallback_impostors", fallback_impostors},
           {"fallback_cpv_impostors", fallback_cpv_impostors},
           {"layered_fill_in_model", layered_fill_in_model},
+          {"safety_factor", safety_factor},
           {"memory_bytes", memory_bytes},
           {"id_texture_bytes", id_texture_bytes},
           {"layer_texels", layer_texels},
@@ -135,9 +136,12 @@ nlohmann::json PlaceReport::toJson() const {
           {"wall_s", wall_s}};
 }
 
-PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, const gpu::CostProfile& profile,
+PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, const gpu::CostProfile& given_profile,
                            const PlaceOptions& options, const std::string& out_dir) {
   validate(options);
+  // The profile's bound, min(prediction x factor, prediction + margin), as one factor at t_max: linear, so the objects'
+  // and impostors' times below add up, with the bound's own verdict on every CPV.
+  const gpu::CostProfile profile = given_profile.atBudget(options.t_max_ms);
   if (scene.objects.empty()) throw Error("place", "the scene has no objects");
   Stopwatch wall;
   PlaceReport report;
@@ -149,6 +153,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     FF_WARN("place: the cost profile has no layered impostor terms (a version-1 profile): the layers' fill is not in "
             "the estimates, so the frame-time guarantee does not cover it; run farfield calibrate again");
   report.layered_fill_in_model = profile.layered.calibrated;
+  report.safety_factor = profile.safety_factor;
   const gpu::GpuScene gpu_scene(scene);
   const scene::Bvh bvh(scene);
   gpu::Renderer renderer;

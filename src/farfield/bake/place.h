@@ -97,6 +97,7 @@ struct PlaceReport {
   // the coarser passes and (CPV, impostor) pairs they are shown in. unsolved_cpvs counts what is left after all passes.
   size_t unsolved_at_bound = 0, fallback_impostors = 0, fallback_cpv_impostors = 0;
   bool layered_fill_in_model = false;  // the profile's layered draw term was part of the impostors' times
+  double safety_factor = 1.0;  // the profile's bound at t_max as one factor (gpu::CostProfile::safetyFactorAt)
   double memory_bytes = 0.0;        // kept impostors, GPU bytes (each layer cropped to its data: cropLayered)
   double estimated_bytes = 0.0;     // the same impostors as the optimiser estimated them (uncropped plans)
   // What that memory holds (kept impostors): per-texel object ids (for measurement; half of the texture bytes when

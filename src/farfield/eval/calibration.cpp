@@ -202,9 +202,20 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   result.abs_error_p50_ms = percentile(errors, 50.0);
   result.abs_error_p95_ms = percentile(errors, 95.0);
   result.abs_error_max_ms = percentile(errors, 100.0);
+  // Two bounds from the same views, each the quantile of what it must cover: a factor (measured / predicted) and an
+  // additive margin (measured - predicted); the profile bounds by the smaller (gpu::CostProfile::boundOfPrediction).
+  std::vector<double> excess;
+  for (const ViewCheck& c : result.checks) excess.push_back(c.measured_ms - c.predicted_ms);
   profile.safety_factor = std::max(1.0, percentile(ratios, 100.0 * options.margin_quantile));
-  for (const ViewCheck& c : result.checks)
-    if (c.measured_ms / std::max(c.predicted_ms, 1e-6) > profile.safety_factor) ++result.over_bound;  // as ratios
+  profile.safety_margin_ms = std::max(0.0, percentile(excess, 100.0 * options.margin_quantile));
+  result.margin_ms = profile.safety_margin_ms;
+  for (const ViewCheck& c : result.checks) {
+    // As ratios and differences, as the bounds were taken (prediction x factor may round a hair below the view).
+    const bool over_factor = c.measured_ms / std::max(c.predicted_ms, 1e-6) > profile.safety_factor;
+    const bool over_margin = c.measured_ms - c.predicted_ms > profile.safety_margin_ms;
+    if (over_factor) ++result.over_factor;
+    if (over_factor && over_margin) ++result.over_bound;
+  }
   if (options.layered_samples > 0) {
     LayeredCalibrateOptions lo;
     lo.width = options.width;
@@ -237,6 +248,8 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
                         {"abs_error_p95_ms", result.abs_error_p95_ms},
                         {"abs_error_max_ms", result.abs_error_max_ms},
                         {"under_predicted", result.under_predicted},
+                        {"margin_ms", result.margin_ms},
+                        {"over_factor", result.over_factor},
                         {"over_bound", result.over_bound}};
   return result;
 }

@@ -2,8 +2,9 @@
 // 2003) fitted on the running machine and validated. The cost model (gpu/cost_model.h) is fitted on `fit_views`
 // random views of the view space, then checked on `views` other ones: each view's frustum-culled geometry is drawn
 // and timed (minimum of `repeats` renders, to remove the machine's noise) and compared with the prediction from its
-// triangles, draw calls, pixels and estimated fill (core/object_fill.h). The distribution of measured / predicted gives the profile's safety factor
-// (the quantile `margin_quantile` of the ratios, 1 = the largest seen), so that prediction * factor bounds the
+// triangles, draw calls, pixels and estimated fill (core/object_fill.h). The distribution of measured / predicted
+// gives the profile's safety factor and that of measured - predicted its additive margin (the quantile
+// `margin_quantile` of each, 1 = the largest seen), so that min(prediction x factor, prediction + margin) bounds the
 // measured time of (that share of) the validation views.
 #pragma once
 
@@ -29,7 +30,7 @@ struct CalibrateOptions {
   size_t views = 500;          // validation views (the issue asks for at least 500)
   size_t fit_views = 100;      // random views of the view space the model is fitted on (other than the validation's)
   int repeats = 3;             // renders per validation view, the minimum kept
-  double margin_quantile = 1.0;  // safety factor = this quantile of measured / predicted (1 = the maximum)
+  double margin_quantile = 1.0;  // safety factor and margin: this quantile of measured / predicted and - (1 = max)
   // Fit the model's fill term (gpu/cost_model.h, core/object_fill.h) too, counted up to a cap chosen on the fitting
   // views (2 to 8 frames, or none). Off: the views' estimated fill is still written to the CSV, and the term is 0.
   // Uncapped, a region's fill bounded from its nearest point counts every adjacent building as a whole frame, and
@@ -68,7 +69,9 @@ struct CalibrateResult {
   double ratio_p50 = 0.0, ratio_p95 = 0.0, ratio_p99 = 0.0, ratio_max = 0.0;
   double abs_error_p50_ms = 0.0, abs_error_p95_ms = 0.0, abs_error_max_ms = 0.0;
   size_t under_predicted = 0;  // views slower than predicted (before the safety factor)
-  size_t over_bound = 0;       // views slower than predicted * safety factor
+  double margin_ms = 0.0;      // the quantile of measured - predicted (the profile's safety_margin_ms)
+  size_t over_factor = 0;      // views slower than predicted * safety factor
+  size_t over_bound = 0;       // views slower than the profile's bound (the factor's and the margin's smaller)
   double wall_s = 0.0;
   LayeredCalibrateResult layered;  // empty when CalibrateOptions::layered_samples is 0
 };

@@ -74,7 +74,9 @@ LayeredCost LayeredCost::fromJson(const nlohmann::json& j, const std::string& so
 
 nlohmann::json CostProfile::toJson() const {
   return {{"format", kCostProfileFormat}, {"version", kCostProfileVersion}, {"model", model.toJson()},
-          {"safety_factor", safety_factor}, {"width", width}, {"height", height}, {"fov_y_deg", fov_y_deg},
+          {"safety_factor", safety_factor},
+          {"safety_margin_ms", std::isfinite(safety_margin_ms) ? nlohmann::json(safety_margin_ms) : nlohmann::json()},
+          {"width", width}, {"height", height}, {"fov_y_deg", fov_y_deg},
           {"renderer", renderer}, {"validation", validation}, {"layered", layered.toJson()}};
 }
 
@@ -85,6 +87,7 @@ CostProfile CostProfile::fromJson(const nlohmann::json& j, const std::string& so
   std::set<std::string> keys{"format", "version", "model", "safety_factor", "width", "height", "fov_y_deg",
                              "renderer", "validation"};
   if (version != 1) keys.insert("layered");
+  if (version >= 4) keys.insert("safety_margin_ms");
   onlyKeys(j, keys, source);
   if (j.at("format") != kCostProfileFormat)
     throw Error(source, std::string("\"format\" is not \"") + kCostProfileFormat + "\"");
@@ -95,6 +98,8 @@ CostProfile CostProfile::fromJson(const nlohmann::json& j, const std::string& so
   p.model = modelFromJson(j.at("model"), source + ": model", version >= 3);
   if (version != 1) p.layered = LayeredCost::fromJson(j.at("layered"), source + ": layered", version);
   p.safety_factor = number(j, "safety_factor", source, 1.0);
+  if (version >= 4 && !j.at("safety_margin_ms").is_null())
+    p.safety_margin_ms = number(j, "safety_margin_ms", source, 0.0);
   // The frame size: whole pixels of an int (a conversion of 1e300 to int is undefined behaviour).
   p.width = wholeNumber<int>(number(j, "width", source, 1.0), source, "\"width\"");
   p.height = wholeNumber<int>(number(j, "height", source, 1.0), source, "\"height\"");

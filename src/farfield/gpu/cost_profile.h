@@ -2,6 +2,11 @@
 // for, and the safety factor measured when it was validated against frames of the view space (eval/calibration.h,
 // `farfield calibrate`). Placement (Jeschke et al. 2005, section 3) bounds a view's time by
 // predict(...) * safety_factor, so the frame-time guarantee rests on a measured distribution, stated in the profile.
+// Since version 4 the profile also holds an additive margin, the largest measured - predicted of the same views, and
+// the bound is the smaller of the two: min(prediction * safety_factor, prediction + safety_margin_ms). Both hold for
+// every validation view, so their minimum does too; the factor is the tighter one for light frames, the margin for
+// the heavy frames near a budget (a multiplicative factor set by a 2 ms view that measured 4 ms charges a 9 ms
+// prediction 18 ms).
 //
 // Layered impostors (impostor/layered.h) cost what the linear frame model does not see: every alpha-tested layer is
 // filled over its whole quad, transparent texels included, and regenerating one renders, reads back, crops and
@@ -11,9 +16,12 @@
 // Saved whole and read back strictly: a missing or unknown key, or a value of the wrong type or out of range, is a
 // farfield::Error naming the file and the key. Version 1 profiles (before the layered terms) are read with
 // LayeredCost::calibrated false; version 2 has the key "layered" (null when not calibrated); version 3 has the fill
-// term (CostModel::ms_per_mfill, fill_cap_pixels) in every model, read as 0 from earlier versions.
+// term (CostModel::ms_per_mfill, fill_cap_pixels) in every model, read as 0 from earlier versions; version 4 has
+// "safety_margin_ms" (a number, or null for none), read as none from earlier versions.
 #pragma once
 
+#include <algorithm>
+#include <limits>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -23,7 +31,7 @@
 namespace farfield::gpu {
 
 inline constexpr char kCostProfileFormat[] = "farfield-cost-profile";
-inline constexpr int kCostProfileVersion = 3;
+inline constexpr int kCostProfileVersion = 4;
 
 // The layered impostor's two costs. The models reuse CostModel's four columns with these meanings:
 // - draw: ms added to a frame by drawing one layered impostor = base + ms_per_draw * layers + ms_per_mpixel * the
@@ -51,7 +59,9 @@ struct LayeredCost {
 
 struct CostProfile {
   CostModel model;
-  double safety_factor = 1.0;  // >= 1: bound = prediction * safety_factor
+  double safety_factor = 1.0;  // >= 1: bound = prediction * safety_factor ...
+  // ... or prediction + safety_margin_ms where that is smaller (>= 0; infinity: no additive margin).
+  double safety_margin_ms = std::numeric_limits<double>::infinity();
   int width = 512;             // the frames it was fitted and validated on
   int height = 512;
   double fov_y_deg = 45.0;
@@ -62,7 +72,25 @@ struct CostProfile {
 
   // An upper bound of the frame time (ms) of a workload, in the units of CostSample (fill: core/object_fill.h).
   double boundMs(double triangles, double draw_calls, double pixels, double fill) const {
-    return model.predict(triangles, draw_calls, pixels, fill) * safety_factor;
+    return boundOfPrediction(model.predict(triangles, draw_calls, pixels, fill));
+  }
+  double boundOfPrediction(double predicted_ms) const {
+    return std::min(predicted_ms * safety_factor, predicted_ms + safety_margin_ms);
+  }
+  // The one factor that decides a budget as the bound does: prediction * safetyFactorAt(t) <= t exactly when
+  // boundOfPrediction(prediction) <= t (t > 0). It is safety_factor, or t / (t - margin) where that is smaller.
+  double safetyFactorAt(double t_max_ms) const {
+    if (!(t_max_ms > safety_margin_ms)) return safety_factor;
+    return std::min(safety_factor, t_max_ms / (t_max_ms - safety_margin_ms));
+  }
+  // This profile at one frame budget: the margin folded into the factor (safetyFactorAt), so the bound is linear again
+  // and per-object costs add up as placement sums them, with the same verdict at t_max for every workload. Bounds away
+  // from t_max are scaled: under t_max they are at most the true bound, over it at least.
+  CostProfile atBudget(double t_max_ms) const {
+    CostProfile p = *this;
+    p.safety_factor = safetyFactorAt(t_max_ms);
+    p.safety_margin_ms = std::numeric_limits<double>::infinity();
+    return p;
   }
   nlohmann::json toJson() const;
   static CostProfile fromJson(const nlohmann::json& json, const std::string& source);
