@@ -67,8 +67,8 @@ struct BenchOptions {
   std::optional<double> error_px;
   // Renders per mode and frame; the frame's times are those of the fastest render (the machine's noise removed; a
   // mode's first render of a frame also carries its loads, which later renders then skip: see the mode's info for
-  // load times). The repeats of a frame are made in rounds over the modes (every mode once, then again), so a mode's
-  // renders of a frame are apart by the other modes' renders and the image measures. >= 1.
+  // load times). The repeats are whole passes over the path after the first (timing only), so a frame's renders are
+  // seconds apart and a slow spell of the machine does not slow all of them. >= 1.
   int repeats = 1;
   // The frame budget (ms, > 0): frames whose wall time exceeds it are counted per mode; unset = not checked.
   std::optional<double> t_max_ms;

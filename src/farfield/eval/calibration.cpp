@@ -138,7 +138,6 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     std::sort(ids.begin(), ids.end());
     ViewCheck check;
     check.camera = camera;
-    check.measured_ms = std::numeric_limits<double>::infinity();
     if (placed) {
       if (const std::vector<uint32_t>* visible = options.visible_set(camera.eye)) {
         std::vector<uint32_t> kept;
@@ -150,44 +149,51 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
         check.draw_calls += object_cost[id].draws;
       }
       placed_geometry.ids = ids;
-      for (int r = 0; r < options.repeats; ++r)
-        check.measured_ms = std::min(check.measured_ms, runner.run(placed_geometry, camera, 0).wall_ms);
+      check.measured_ms = runner.run(placed_geometry, camera, 0).wall_ms;
     } else {
       if (!ids.empty()) gpu_scene.appendDrawItems(ids, items, camera);
       for (const gpu::DrawItem& item : items) check.triangles += item.triangleCount();
       check.draw_calls = items.size();
-      for (int r = 0; r < options.repeats; ++r)
-        check.measured_ms = std::min(check.measured_ms, renderer.render(camera, items, target).wall_ms);
+      check.measured_ms = renderer.render(camera, items, target).wall_ms;
     }
     for (uint32_t id : ids) check.fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, camera.eye);
     return check;
+  };
+  // Every view measured once, then again in further passes over all of them, the fastest render kept: a view's
+  // renders are a pass apart (seconds), so a slow spell of the machine does not slow all of them.
+  const auto measureAll = [&](const std::vector<Camera>& cameras, const std::string& what) {
+    std::vector<ViewCheck> checks;
+    for (int r = 0; r < options.repeats; ++r) {
+      Progress progress("calibrate: " + what + ", pass " + std::to_string(r + 1) + " of " +
+                            std::to_string(options.repeats),
+                        cameras.size());
+      for (size_t i = 0; i < cameras.size(); ++i) {
+        ViewCheck c = measure(cameras[i]);
+        if (r == 0) checks.push_back(c);
+        else checks[i].measured_ms = std::min(checks[i].measured_ms, c.measured_ms);
+        if (options.progress) progress.advance();
+      }
+      progress.finish();
+    }
+    return checks;
   };
   {
     const std::vector<Camera> fit_views = randomViews(space, options.fit_views, options.seed ^ 0x9e3779b9u, options.width,
                                                       options.height, options.fov_deg, options.near_plane,
                                                       options.far_plane);
     std::vector<gpu::CostSample> samples;
-    Progress progress("calibrate: fitting views", fit_views.size());
-    for (const Camera& camera : fit_views) {
-      const ViewCheck c = measure(camera);
+    for (const ViewCheck& c : measureAll(fit_views, "fitting views")) {
       const double fill = options.fill_term ? c.fill : 0.0;
       samples.push_back({double(c.triangles), double(c.draw_calls), pixels, c.measured_ms, fill});
-      if (options.progress) progress.advance();
     }
-    progress.finish();
     profile.model = options.fill_term ? fitWithFillCap(samples, pixels) : gpu::CostModel::fit(samples);
   }
 
   const std::vector<Camera> views = randomViews(space, options.views, options.seed, options.width, options.height,
                                                 options.fov_deg, options.near_plane, options.far_plane);
-  Progress progress("calibrate: validation views", views.size());
-  for (const Camera& camera : views) {
-    ViewCheck check = measure(camera);
+  result.checks = measureAll(views, "validation views");
+  for (ViewCheck& check : result.checks)
     check.predicted_ms = profile.model.predict(double(check.triangles), double(check.draw_calls), pixels, check.fill);
-    result.checks.push_back(check);
-    if (options.progress) progress.advance();
-  }
-  progress.finish();
 
   std::vector<double> ratios, errors;
   for (const ViewCheck& c : result.checks) {

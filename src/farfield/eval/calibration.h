@@ -1,7 +1,7 @@
 // `farfield calibrate`: the rendering-time estimation of Jeschke et al. 2005 (section 3.2, after Wimmer and Wonka
 // 2003) fitted on the running machine and validated. The cost model (gpu/cost_model.h) is fitted on `fit_views`
 // random views of the view space, then checked on `views` other ones: each view's frustum-culled geometry is drawn
-// and timed (minimum of `repeats` renders, to remove the machine's noise) and compared with the prediction from its
+// and timed (minimum of `repeats` renders, each in its own pass over the views, to remove the machine's noise) and compared with the prediction from its
 // triangles, draw calls, pixels and estimated fill (core/object_fill.h). The distribution of measured / predicted
 // gives the profile's safety factor and that of measured - predicted its additive margin (the quantile
 // `margin_quantile` of each, 1 = the largest seen), so that min(prediction x factor, prediction + margin) bounds the
@@ -29,7 +29,7 @@ struct CalibrateOptions {
   Box3 view_space;             // eyes are drawn uniformly from it; empty: the scene's bounds at 1.7 m above its floor
   size_t views = 500;          // validation views (the issue asks for at least 500)
   size_t fit_views = 100;      // random views of the view space the model is fitted on (other than the validation's)
-  int repeats = 3;             // renders per validation view, the minimum kept
+  int repeats = 3;             // renders per view (passes over the views), the minimum kept
   double margin_quantile = 1.0;  // safety factor and margin: this quantile of measured / predicted and - (1 = max)
   // Fit the model's fill term (gpu/cost_model.h, core/object_fill.h) too, counted up to a cap chosen on the fitting
   // views (2 to 8 frames, or none). Off: the views' estimated fill is still written to the CSV, and the term is 0.
