@@ -9,7 +9,7 @@
 # Usage: scripts/bench_place.sh FARFIELD OUT [SEED] [BLOCKS] [FRAMES] [STRIDE]
 # Environment: TMAXES (default "18 20 22 25 28"), BOUND (px, default 2), REF_TMAX (default 20), BOUNDS (default
 # "1 4"), SIZE (default 512x512), ROWS=0 to skip the extra rows, FALLBACK (default "2,4": place --fallback-bounds;
-# "" for none), MODEL_PROFILE (a profile whose frame model and safety factor replace the fresh calibration's, its
+# "" for none), MODEL_PROFILE (a profile whose frame model, safety factor and margin replace the fresh calibration's, its
 # layered terms kept: for a machine loaded by other jobs while calibrating, with an earlier quiet calibration),
 # PLACED_CAL=1 (the profile fitted on placed frames with the capped fill: place --visibility-only samples every
 # region's visible set into the cache, then calibrate --fill-term --visibility-cache).
@@ -46,6 +46,7 @@ fresh, quiet = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
 for key in ("model", "safety_factor", "validation"):
     fresh[key] = quiet[key]
 fresh["model"].setdefault("ms_per_mfill", 0.0)  # a model from a profile before version 3 has no fill term
+fresh["safety_margin_ms"] = quiet.get("safety_margin_ms")  # none before version 4
 fresh["validation"]["model_from"] = sys.argv[2]
 json.dump(fresh, open(sys.argv[3], "w"), indent=2)
 PY
