@@ -80,6 +80,12 @@ void runCalibrateCommand(CalibrateArgs& args) {
               r.margin_ms, o.margin_quantile, r.profile.safety_factor,
               r.profile.safety_factor > 1.0 ? r.margin_ms / (r.profile.safety_factor - 1.0) : 0.0, r.margin_ms);
   std::printf("views over the bound: %zu of %zu\n", r.over_bound, r.checks.size());
+  if (o.margin_quantile >= 1.0)
+    // Each bound is the largest of n exchangeable views, so a further view of the same view space exceeds it with
+    // probability at most 1 / (n + 1); the profile's bound (the smaller) is exceeded when either is.
+    std::printf("a further random view of the view space is over the bound with probability at most 2 / (n + 1) = "
+                "%.2f %% (n = %zu; more --views lower it)\n",
+                200.0 / double(r.checks.size() + 1), r.checks.size());
   std::printf("views slower than predicted (before the factor): %zu\n", r.under_predicted);
   if (r.profile.layered.calibrated) {
     const gpu::LayeredCost& l = r.profile.layered;
