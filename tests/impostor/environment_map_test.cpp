@@ -109,6 +109,61 @@ TEST(EnvironmentMapPlanTest, LayersFollowTheBoundAndTheDistance) {
   }
 }
 
+// The layers a view draws: looking along +x from the cell's centre every quad of the +x face is in view and none of
+// the -x face; the fill is each counted quad's area over the square of its distance less the cell's half-diagonal,
+// recomputed here from the quads' corners, each capped at the frame; a wider cell (nearer viewpoints) fills more.
+TEST(EnvironmentMapPlanTest, TheLayersInViewAreTheQuadsTheFrustumMeets) {
+  std::mt19937 rng(11);
+  const std::vector<EnvMapObject> objects = scatter(rng, 300);
+  const Box3 cell = Box3::fromPoints(Vec3(-10.0f, -10.0f, 1.0f), Vec3(10.0f, 10.0f, 2.0f));
+  const ErrorBound bound = testBound();
+  const EnvMapPlan plan = planEnvironmentMap(cell, 100.0, objects, bound);
+  const EnvMapFace* px = findFace(plan, 0);
+  const EnvMapFace* nx = findFace(plan, 1);
+  ASSERT_NE(px, nullptr);
+  ASSERT_NE(nx, nullptr);
+  const Vec3 c = cell.center();
+  const auto lookAlong = [&](const Vec3& dir) {
+    Camera camera;
+    camera.eye = c;
+    camera.at = c + dir;
+    camera.up = Vec3(0.0f, 0.0f, 1.0f);
+    camera.width = 512;
+    camera.height = 512;
+    camera.fov_y = float(degToRad(45.0));
+    camera.near_plane = 0.5f;
+    camera.far_plane = 20000.0f;
+    return Frustum::fromMatrix(camera.viewProjection());
+  };
+  const Frustum ahead = lookAlong(Vec3(1.0f, 0.0f, 0.0f));
+  const EnvMapLayersInView seen = envMapLayersInView(plan, ahead, bound);
+  EXPECT_GE(seen.quads, px->plan.layers.size());
+  EXPECT_LE(seen.quads, plan.layers() - nx->plan.layers.size());
+  // Brute force over the quads' corners: a quad is counted exactly when the frustum meets its corners' box.
+  size_t expected_quads = 0;
+  double expected_fill = 0.0;
+  const double frame = 512.0 * 512.0;
+  for (const EnvMapFace& face : plan.faces)
+    for (const LayerPlan& layer : face.plan.layers) {
+      const Vec3 centre = c + (face.plan.shaft.apex - c) * (1.0f - layer.depth / face.plan.shaft.min_distance);
+      Box3 box;
+      for (float su : {-1.0f, 1.0f})
+        for (float sv : {-1.0f, 1.0f})
+          box.expand(centre + face.plan.right * (su * layer.half_u) + face.plan.up * (sv * layer.half_v));
+      if (!ahead.intersects(box)) continue;
+      ++expected_quads;
+      const double t = double(glm::length(centre - c)) - plan.radius;
+      expected_fill += std::min(4.0 * layer.half_u * layer.half_v * std::pow(bound.focalPixels() / t, 2.0), frame);
+    }
+  EXPECT_EQ(seen.quads, expected_quads);
+  EXPECT_NEAR(seen.fill_pixels, expected_fill, 1e-3 * expected_fill);
+  EXPECT_GT(seen.fill_pixels, 0.0);
+  EXPECT_LE(seen.fill_pixels, double(seen.quads) * frame);
+  const EnvMapLayersInView behind = envMapLayersInView(plan, lookAlong(Vec3(-1.0f, 0.0f, 0.0f)), bound);
+  EXPECT_GE(behind.quads, nx->plan.layers.size());
+  EXPECT_LE(behind.quads, plan.layers() - px->plan.layers.size());
+}
+
 TEST(EnvironmentMapPlanTest, BadInputIsAnErrorNamingIt) {
   const Box3 cell = Box3::fromPoints(Vec3(-10.0f, -10.0f, 1.2f), Vec3(10.0f, 10.0f, 1.7f));
   const std::vector<EnvMapObject> one = {{1, Box3::fromPoints(Vec3(100.0f), Vec3(110.0f))}};

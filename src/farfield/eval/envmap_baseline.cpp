@@ -177,17 +177,22 @@ EnvMapBaselineReport runEnvMapBaseline(gpu::Context& context, const scene::Scene
       double worst = 0.0;
       for (uint32_t k = node.cpv_first; k < node.cpv_first + node.cpv_count; ++k) {
         in_frustum.clear();
-        bvh.queryFrustum(enclosingFrustum(node.box, index.cpvs[k].vdi, lens), in_frustum);
+        const Frustum frustum = enclosingFrustum(node.box, index.cpvs[k].vdi, lens);
+        bvh.queryFrustum(frustum, in_frustum);
         std::sort(in_frustum.begin(), in_frustum.end());
         uint64_t triangles = 2 * candidate.layers(), draws = candidate.draws();
-        double fill = 0.0;  // of the near geometry, as placement charges it (the layers' own fill is not charged)
+        double fill = 0.0;  // of the near geometry, as placement charges it
         for (uint32_t id : candidate.near_objects)
           if (std::binary_search(in_frustum.begin(), in_frustum.end(), id)) {
             triangles += cost[id].triangles;
             draws += cost[id].draws;
             fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, node.box);
           }
-        worst = std::max(worst, profile.boundMs(double(triangles), double(draws), pixels, fill));
+        // The layers the CPV's frustum meets fill the frame through the alpha test, charged as placement charges its
+        // impostors' layers (the profile's layered draw term; 0 for a profile without it).
+        const impostor::EnvMapLayersInView layers = impostor::envMapLayersInView(candidate, frustum, bound);
+        worst = std::max(worst, profile.boundMs(double(triangles), double(draws), pixels, fill) +
+                                    profile.layered.drawBoundMs(double(layers.quads), layers.fill_pixels));
       }
       const bool fits = worst <= t_max_ms;
       if (fits || !have || d < plan.far_distance) {

@@ -6,7 +6,9 @@
 //
 // The far-field distance of a cell is the largest of `far_distances` for which every CPV of the cell is estimated at
 // or under t_max: the cost profile's bound over the near-field objects of the cell's visible set that meet the CPV's
-// enclosing frustum, plus the environment map's draw calls and quads. That is the placement's own guarantee rule
+// enclosing frustum, plus the environment map's draw calls and quads, plus the fill of the layer quads that frustum
+// meets through the profile's layered draw term, as placement charges its impostors' layers (before 2026-12-03 the
+// layers' fill was not charged, and the baseline "solved" cells that way). That is the placement's own guarantee rule
 // (bake/place.h), so both methods are compared at the same t_max; the largest such distance needs the fewest layers.
 // A cell no distance solves takes the smallest and is counted as unsolved (the paper's environment maps carry no
 // frame-time guarantee at all).

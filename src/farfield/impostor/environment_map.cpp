@@ -190,6 +190,30 @@ EnvMapPlan planEnvironmentMap(const Box3& cell, double far_distance, std::span<c
   return plan;
 }
 
+EnvMapLayersInView envMapLayersInView(const EnvMapPlan& plan, const Frustum& view, const ErrorBound& frame) {
+  EnvMapLayersInView in_view;
+  const double focal = frame.focalPixels();
+  const double cap = double(frame.width) * double(frame.height);
+  for (const EnvMapFace& face : plan.faces) {
+    const LayeredPlan& p = face.plan;
+    for (const LayerPlan& layer : p.layers) {
+      // The quad's plane lies `depth` from the apex along the axis, t_m = L - depth from the cell's centre.
+      const Vec3 centre = p.shaft.apex + p.shaft.axis * layer.depth + p.right * layer.offset_u + p.up * layer.offset_v;
+      const Vec3 du = p.right * layer.half_u, dv = p.up * layer.half_v;
+      Box3 quad = Box3::fromPoints(centre - du - dv, centre + du + dv);
+      quad.expand(centre + du - dv);
+      quad.expand(centre - du + dv);
+      if (!view.intersects(quad)) continue;
+      const double t_m = double(p.shaft.min_distance) - double(layer.depth);
+      const double gap = std::max(t_m - plan.radius, 1e-2 * t_m);
+      ++in_view.quads;
+      in_view.fill_pixels +=
+          std::min(4.0 * double(layer.half_u) * double(layer.half_v) * focal * focal / (gap * gap), cap);
+    }
+  }
+  return in_view;
+}
+
 double envMapPointError(const LayeredPlan& face_plan, const Vec3& eye, const Vec3& p) {
   const DVec3 c(face_plan.capture_eye), a(-face_plan.shaft.axis), P(p);
   const double L = face_plan.shaft.min_distance;

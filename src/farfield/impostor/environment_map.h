@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "farfield/core/bounds.h"
+#include "farfield/core/camera.h"
 #include "farfield/core/error_bound.h"
 #include "farfield/impostor/layered.h"
 
@@ -76,6 +77,16 @@ struct EnvMapPlan {
 // bounds or id 0, a bound without pixels, and options out of range.
 EnvMapPlan planEnvironmentMap(const Box3& cell, double far_distance, std::span<const EnvMapObject> objects,
                               const ErrorBound& bound, const EnvMapOptions& options = {});
+
+// What a view of the cell draws of its environment map: the layer quads whose bounds meet `view` (a frustum from
+// inside the cell, e.g. a CPV's enclosing frustum), and the frame pixels they cover, transparent texels included,
+// seen from the cell's nearest viewpoint to each quad (distance t_m - r, each quad capped at the frame) in frames of
+// `frame`'s focal length: the fill the alpha test pays, as impostor::layeredFillPixels estimates a placed impostor's.
+struct EnvMapLayersInView {
+  size_t quads = 0;
+  double fill_pixels = 0.0;
+};
+EnvMapLayersInView envMapLayersInView(const EnvMapPlan& plan, const Frustum& view, const ErrorBound& frame);
 
 // The angle (radians) at viewpoint `eye` between a point P and where face `face_plan` of an environment map draws it
 // (P projected from the capture eye onto the plane of P's layer); P must lie in one of the plan's slabs and in the
