@@ -75,10 +75,11 @@ void runCalibrateCommand(CalibrateArgs& args) {
               r.abs_error_max_ms);
   std::printf("safety factor:      %.3f (quantile %.3f of measured/predicted); views over prediction x factor: %zu of %zu\n",
               r.profile.safety_factor, o.margin_quantile, r.over_factor, r.checks.size());
+  const double margin = r.profile.safety_margin_ms;
   std::printf("safety margin:      %.3f ms (quantile %.3f of measured - predicted); the bound is the smaller: "
               "prediction x %.3f up to %.2f ms predicted, + %.3f ms above\n",
-              r.margin_ms, o.margin_quantile, r.profile.safety_factor,
-              r.profile.safety_factor > 1.0 ? r.margin_ms / (r.profile.safety_factor - 1.0) : 0.0, r.margin_ms);
+              margin, o.margin_quantile, r.profile.safety_factor,
+              r.profile.safety_factor > 1.0 ? margin / (r.profile.safety_factor - 1.0) : 0.0, margin);
   std::printf("views over the bound: %zu of %zu\n", r.over_bound, r.checks.size());
   if (o.margin_quantile >= 1.0)
     // Each bound is the largest of n exchangeable views, so a further view of the same view space exceeds it with

@@ -62,13 +62,13 @@ void runPlaceCommand(PlaceArgs& args) {
   }
   std::printf("scene:            %s (%zu objects: %zu clustered, %zu always geometry)\n", args.scene.c_str(),
               scene.objects.size(), r.clustered_objects, r.geometry_objects);
-  const std::string margin = std::isfinite(profile.safety_margin_ms)
-                                 ? ", or + " + std::to_string(profile.safety_margin_ms).substr(0, 5) + " ms where smaller"
-                                 : std::string();
+  char margin[64] = "";
+  if (std::isfinite(profile.safety_margin_ms))
+    std::snprintf(margin, sizeof margin, ", or + %.2f ms where smaller", profile.safety_margin_ms);
   std::printf("promises:         t_max %.2f ms, error %.2f px at %dx%d, %.1f deg (profile %s: bound prediction x "
               "%.3f%s; at t_max a factor of %.3f)\n",
               o.t_max_ms, o.error_px, o.width, o.height, double(o.fov_deg), args.profile.c_str(),
-              profile.safety_factor, margin.c_str(), r.safety_factor);
+              profile.safety_factor, margin, r.safety_factor);
   if (o.visibility)
     std::printf("visibility:       %zu regions (%zu from the cache) sampled from %zu points, %.1f objects seen per "
                 "region, %.1f s\n",

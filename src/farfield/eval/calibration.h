@@ -1,8 +1,8 @@
 // `farfield calibrate`: the rendering-time estimation of Jeschke et al. 2005 (section 3.2, after Wimmer and Wonka
 // 2003) fitted on the running machine and validated. The cost model (gpu/cost_model.h) is fitted on `fit_views`
 // random views of the view space, then checked on `views` other ones: each view's frustum-culled geometry is drawn
-// and timed (minimum of `repeats` renders, each in its own pass over the views, to remove the machine's noise) and compared with the prediction from its
-// triangles, draw calls, pixels and estimated fill (core/object_fill.h). The distribution of measured / predicted
+// and timed (minimum of `repeats` renders, each in its own pass over the views, to remove the machine's noise) and
+// compared with the prediction from its triangles, draw calls, pixels and estimated fill (core/object_fill.h). The distribution of measured / predicted
 // gives the profile's safety factor and that of measured - predicted its additive margin (the quantile
 // `margin_quantile` of each, 1 = the largest seen), so that min(prediction x factor, prediction + margin) bounds the
 // measured time of (that share of) the validation views.
@@ -69,7 +69,6 @@ struct CalibrateResult {
   double ratio_p50 = 0.0, ratio_p95 = 0.0, ratio_p99 = 0.0, ratio_max = 0.0;
   double abs_error_p50_ms = 0.0, abs_error_p95_ms = 0.0, abs_error_max_ms = 0.0;
   size_t under_predicted = 0;  // views slower than predicted (before the safety factor)
-  double margin_ms = 0.0;      // the quantile of measured - predicted (the profile's safety_margin_ms)
   size_t over_factor = 0;      // views slower than predicted * safety factor
   size_t over_bound = 0;       // views slower than the profile's bound (the factor's and the margin's smaller)
   double wall_s = 0.0;
