@@ -140,6 +140,40 @@ TEST(CostModelTest, CollinearTermsStayFiniteAndPredictTheSamples) {
   EXPECT_GT(m.r2, 0.999999);
 }
 
+// The fill credit against the prediction itself: predict(total) - predict(total - removed) over the fill term, with
+// and without a cap; and parts of a workload credited one by one against the same total never add up to more than
+// their union's credit (what lets placement sum per-cluster savings and keep an upper bound).
+TEST(CostModelTest, TheFillCreditIsWhatThePredictionStopsCountingAndPartsNeverOvercount) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (double cap : {0.0, 1e6}) {
+    CostModel m;
+    m.base_ms = 0.7;
+    m.ms_per_mfill = 4.0;
+    m.fill_cap_pixels = cap;
+    for (int trial = 0; trial < 2000; ++trial) {
+      const double total = 3e6 * u(rng);
+      std::vector<double> parts(1 + size_t(u(rng) * 4));
+      double left = total;
+      for (double& p : parts) left -= (p = left * u(rng));
+      double summed = 0.0, joined = 0.0;
+      for (double p : parts) {
+        const double credit = m.fillCredit(total, p);
+        const double by_prediction =
+            (m.predict(0, 0, 0, total) - m.predict(0, 0, 0, total - p)) / (m.ms_per_mfill * 1e-6);
+        ASSERT_NEAR(credit, by_prediction, 1e-3) << "cap " << cap << " total " << total << " part " << p;
+        summed += credit;
+        joined += p;
+      }
+      EXPECT_LE(summed, m.fillCredit(total, joined) + 1e-6) << "cap " << cap << " total " << total;
+      if (cap == 0.0) {
+        EXPECT_NEAR(summed, joined, 1e-6);
+      }
+    }
+    EXPECT_DOUBLE_EQ(m.fillCredit(5e5, 7e5), 5e5);  // more than the total removes the total
+  }
+}
+
 TEST(CostModelTest, BadSamplesThrow) {
   std::vector<CostSample> four(4, CostSample{1e5, 10, 65536, 2.0});
   EXPECT_THROW(CostModel::fit(four), Error);

@@ -92,10 +92,15 @@ TEST(CostProfileTest, OneFactorAtABudgetDecidesAsTheBound) {
         const double predicted = 0.01 * k;
         const double exact = p.boundOfPrediction(predicted), folded = at.boundOfPrediction(predicted);
         // The same verdict away from the edge (a hair's rounding at it).
-        if (std::abs(exact - t) > 1e-9 && std::abs(folded - t) > 1e-9)
+        if (std::abs(exact - t) > 1e-9 && std::abs(folded - t) > 1e-9) {
           EXPECT_EQ(exact <= t, folded <= t) << "margin " << margin << " t " << t << " prediction " << predicted;
-        if (folded < t) EXPECT_LE(folded, exact + 1e-12);  // scaled: at most the bound under t
-        if (folded > t) EXPECT_GE(folded, exact - 1e-12);  // and at least over it
+        }
+        if (folded < t) {
+          EXPECT_LE(folded, exact + 1e-12);  // scaled: at most the bound under t
+        }
+        if (folded > t) {
+          EXPECT_GE(folded, exact - 1e-12);  // and at least over it
+        }
       }
     }
   }

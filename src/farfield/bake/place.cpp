@@ -328,10 +328,23 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
       if (at == a) return true;
     return false;
   };
-  // What a cluster's fill saves when an impostor replaces it: its own fill where the fill term is linear; nothing
-  // where the term is capped (a CPV whose fill is over the cap may stay there without the cluster), which keeps t_after
-  // an upper bound.
-  const bool fill_saves = profile.model.ms_per_mfill > 0.0 && !(profile.model.fill_cap_pixels > 0.0);
+  // What a cluster's fill saves when an impostor replaces it: what the CPV's estimate stops counting without it
+  // (CostModel::fillCredit against the CPV's whole fill, summed over the objects its enclosing frustum meets as the
+  // estimate sums them): all of it where the term is linear or the CPV is under the cap, only what takes the CPV back
+  // under the cap above it. Credits of several clusters in one CPV, each against the CPV's fill without any impostor,
+  // add up to at most their joint credit, so t_after stays an upper bound.
+  const bool fill_saves = profile.model.ms_per_mfill > 0.0;
+  std::vector<double> cpv_fill(view_space.cpvs.size(), 0.0);
+  if (fill_saves)
+    for (size_t c = 0; c < view_space.cpvs.size(); ++c) {
+      const Box3& region = view_space.cpvs[c].region;
+      const std::vector<uint32_t>* visible = visibleFrom(region);
+      ids.clear();
+      bvh.queryFrustum(frusta[c], ids);
+      for (uint32_t id : ids)
+        if (!visible || std::binary_search(visible->begin(), visible->end(), id))
+          cpv_fill[c] += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
+    }
   std::unordered_map<uint64_t, double> t_object_memo;
   const auto tObject = [&](int node, uint32_t cpv) {
     const uint64_t key = (uint64_t(uint32_t(node)) << 32) | cpv;
@@ -348,7 +361,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
         draws += cost[id].draws;
         if (fill_saves) fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
       }
-    return t_object_memo[key] = geometryMs(triangles, draws, fill);
+    return t_object_memo[key] = geometryMs(triangles, draws, profile.model.fillCredit(cpv_fill[cpv], fill));
   };
   // An impostor's time: its quads and draw calls as geometry, plus what its alpha-tested layers fill (the profile's
   // layered draw term over the plan's quads seen from the nearest viewpoint on the axis; 0 for a profile without it).

@@ -101,6 +101,12 @@ double CostModel::predict(double triangles, double draw_calls, double pixels, do
          ms_per_mfill * counted * 1e-6;
 }
 
+double CostModel::fillCredit(double total, double removed) const {
+  removed = std::clamp(removed, 0.0, std::max(total, 0.0));
+  if (!(fill_cap_pixels > 0.0)) return removed;
+  return std::max(0.0, removed - std::max(0.0, total - fill_cap_pixels));
+}
+
 CostModel CostModel::fit(std::span<const CostSample> samples) {
   if (samples.size() < size_t(kTerms))
     throw Error("cost model", "fitting 5 coefficients needs at least 5 samples, got " +

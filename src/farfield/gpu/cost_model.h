@@ -60,6 +60,12 @@ struct CostModel {
 
   // Predicted frame time (ms) of a workload; the arguments are in the units of CostSample.
   double predict(double triangles, double draw_calls, double pixels, double fill = 0.0) const;
+  // The fill pixels (in the units of CostSample::fill) that the prediction stops counting when `removed` of a
+  // workload's `total` fill is taken away: counted(total) - counted(total - removed), with counted the capped fill.
+  // It is `removed` under the cap and what takes the total back under it above. As a function of `removed` it is
+  // convex and 0 at 0, so it is superadditive: credits of disjoint parts computed one by one against the same total
+  // add up to at most the credit of their union (placement sums them and stays an upper bound of the time).
+  double fillCredit(double total, double removed) const;
 
   // Least squares on the five terms with every coefficient constrained to be >= 0 (non-negative least squares).
   // Terms the samples cannot tell apart (e.g. every sample at the same size: pixels and base are collinear) are
