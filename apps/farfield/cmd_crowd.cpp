@@ -97,6 +97,10 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
                                                     "octahedral grid the bound asks for)")
       ->capture_default_str();
   bench->add_option("--error-px", o.runtime.error_px, "View error bound (pixels) of crowd-mixed")->capture_default_str();
+  bench->add_option("--geometry-triangles", o.runtime.max_geometry_triangles,
+                    "crowd-mixed's geometry budget: skinned triangles a frame for the nearest agents inside their "
+                    "switch distance, the others as impostors (0: none)")
+      ->capture_default_str();
   bench->add_option("--samples", o.samples, "Sample frames saved per run")->capture_default_str();
   bench->add_flag("--atlas-from-bound", o.runtime.atlas_from_bound,
                   "Choose views, frames and texel per model from --error-px for impostors from --bound-switch on");

@@ -89,6 +89,72 @@ TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
   EXPECT_EQ(all_impostors.draw.triangles, 4u);
 }
 
+// Mixed under a geometry budget: of the agents inside their switch distance, the nearest are drawn as geometry while
+// their triangles fit and the rest as impostors, whatever the agents' order. Brute force: the frame equals the one
+// drawn by Geometry for the nearest agents and Impostor for the others, and differs from the opposite assignment.
+TEST_F(CrowdRuntimeGl, AGeometryBudgetDrawsTheNearestAgentsAsGeometry) {
+  const scene::SkinnedModel fox = loadFox();
+  const CrowdModelOptions mo = foxOptions();
+  CrowdRuntimeOptions options = smallAtlas(8);
+  const uint64_t fox_triangles = fox.mesh.triangleCount();
+  options.max_geometry_triangles = 2 * fox_triangles + fox_triangles / 2;  // two foxes fit, not three
+  CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), options);
+  CrowdRuntimeOptions unbudgeted_options = smallAtlas(8);
+  CrowdRuntime unbudgeted(std::span(&fox, 1), std::span(&mo, 1), unbudgeted_options);
+
+  Camera camera;
+  camera.eye = Vec3(0, 0, 1.2f);
+  camera.at = Vec3(10, 0, 0.4f);
+  camera.width = camera.height = 128;
+  const double d = rt.switchDistances(0, camera).both();
+  ASSERT_GT(d, 3.0);
+  // Four agents inside the switch, listed far to near, spread across the view.
+  std::vector<CrowdAgentState> agents(4);
+  for (size_t i = 0; i < agents.size(); ++i) {
+    const double x = d * (0.85 - 0.15 * double(i));
+    agents[i].position = Vec3(float(x), float(x * (double(i) - 1.5) * 0.15), 0.0f);
+    agents[i].heading = 0.7f * float(i);
+    agents[i].object_id = uint32_t(i + 1);
+  }
+  gpu::RenderTarget target(128, 128);
+  gpu::LightSettings light;
+  const auto frame = [&](const std::vector<std::pair<CrowdRuntime*, CrowdPolicy>>& passes,
+                         const std::vector<std::vector<CrowdAgentState>>& lists, CrowdFrameStats* stats) {
+    target.bindForOpaquePass();
+    target.clear(light.sky_color);
+    for (size_t k = 0; k < passes.size(); ++k) {
+      const CrowdFrameStats s = passes[k].first->draw(camera, lists[k], passes[k].second, light);
+      if (stats) *stats = s;
+    }
+    rt.finish();
+    return target.readColor();
+  };
+  CrowdFrameStats st;
+  const image::ColorImage budgeted = frame({{&rt, CrowdPolicy::Mixed}}, {agents}, &st);
+  EXPECT_EQ(st.in_view, 4u);
+  EXPECT_EQ(st.geometry, 2u);
+  EXPECT_EQ(st.impostors, 2u);
+  EXPECT_EQ(st.over_budget, 2u);
+  EXPECT_EQ(st.draw.triangles, 2 * fox_triangles + 4);
+  const std::vector<CrowdAgentState> near(agents.begin() + 2, agents.end()), far(agents.begin(), agents.begin() + 2);
+  const image::ColorImage expected =
+      frame({{&unbudgeted, CrowdPolicy::Geometry}, {&unbudgeted, CrowdPolicy::Impostor}}, {near, far}, nullptr);
+  const image::ColorImage opposite =
+      frame({{&unbudgeted, CrowdPolicy::Impostor}, {&unbudgeted, CrowdPolicy::Geometry}}, {near, far}, nullptr);
+  const auto same = [](const image::ColorImage& a, const image::ColorImage& b) {
+    return std::equal(a.pixels().begin(), a.pixels().end(), b.pixels().begin(),
+                      [](const image::Rgba8& x, const image::Rgba8& y) {
+                        return x.r == y.r && x.g == y.g && x.b == y.b;
+                      });
+  };
+  EXPECT_TRUE(same(budgeted, expected));
+  EXPECT_FALSE(same(budgeted, opposite));
+  // Without the budget every agent inside the switch is geometry.
+  const image::ColorImage all = frame({{&unbudgeted, CrowdPolicy::Mixed}}, {agents}, &st);
+  EXPECT_EQ(st.geometry, 4u);
+  EXPECT_EQ(st.over_budget, 0u);
+  EXPECT_TRUE(same(all, frame({{&unbudgeted, CrowdPolicy::Geometry}}, {agents}, nullptr)));
+}
 
 // cullBehind: agents behind a wall drawn first are left out and the frame is unchanged, pixel for pixel and id for id;
 // agents in front of it, or beside it, are drawn; the culling holds for one call only. Brute force: each agent is

@@ -45,22 +45,29 @@ class PlacedGeometry final : public Mode {
   std::vector<Box3> bounds_;
 };
 
-// The fill term's cap (gpu::CostModel::fill_cap_pixels), chosen on the fitting views: the model fitted with the fill
-// counted up to 2, 3, 4, 6 or 8 frames, or without a cap, whichever leaves the least squared error.
+}  // namespace
+
 gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double frame_pixels) {
-  gpu::CostModel best = gpu::CostModel::fit(samples);
   std::vector<gpu::CostSample> capped(samples.begin(), samples.end());
+  const auto largestUnder = [&](const gpu::CostModel& m) {
+    double worst = -std::numeric_limits<double>::infinity();
+    for (const gpu::CostSample& s : samples)
+      worst = std::max(worst, s.ms - m.predict(s.triangles, s.draw_calls, s.pixels, s.fill));
+    return worst;
+  };
+  gpu::CostModel best = gpu::CostModel::fit(samples);
+  double best_under = largestUnder(best);
   for (double frames : {2.0, 3.0, 4.0, 6.0, 8.0}) {
     const double cap = frames * frame_pixels;
     for (size_t i = 0; i < samples.size(); ++i) capped[i].fill = std::min(samples[i].fill, cap);
     gpu::CostModel m = gpu::CostModel::fit(capped);
     m.fill_cap_pixels = cap;
-    if (m.rms_error_ms < best.rms_error_ms * (1.0 - 1e-9)) best = m;
+    const double under = largestUnder(m);
+    if (under < best_under - 1e-9 || (under <= best_under + 1e-9 && m.rms_error_ms < best.rms_error_ms * (1.0 - 1e-9)))
+      best = m, best_under = under;
   }
   return best;
 }
-
-}  // namespace
 
 std::vector<Camera> randomViews(const Box3& view_space, size_t count, uint32_t seed, int width, int height,
                                 float fov_deg, float near_plane, float far_plane) {

@@ -32,7 +32,7 @@ struct CalibrateOptions {
   int repeats = 3;             // renders per view (passes over the views), the minimum kept
   double margin_quantile = 1.0;  // safety factor and margin: this quantile of measured / predicted and - (1 = max)
   // Fit the model's fill term (gpu/cost_model.h, core/object_fill.h) too, counted up to a cap chosen on the fitting
-  // views (2 to 8 frames, or none). Off: the views' estimated fill is still written to the CSV, and the term is 0.
+  // views (2 to 8 frames, or none: fitWithFillCap). Off: the views' estimated fill is still written to the CSV, and the term is 0.
   // Uncapped, a region's fill bounded from its nearest point counts every adjacent building as a whole frame, and
   // placement's problem view space grew several times; capped and fitted on placed frames (visible_set) it gives the
   // tightest bound measured (docs/BENCHMARKS.md).
@@ -83,6 +83,13 @@ std::vector<Camera> randomViews(const Box3& view_space, size_t count, uint32_t s
 // The scene's default view space: its bounds in x and y, at 1.7 m above the lowest point of its bounds (a
 // pedestrian over flat ground), 0.01 m thick.
 Box3 defaultViewSpace(const scene::Scene& scene);
+
+// The model with the fill term counted up to a cap (gpu::CostModel::fill_cap_pixels) of 2, 3, 4, 6 or 8 frames of
+// `frame_pixels`, or uncapped: each fitted by least squares, the one kept whose largest under-prediction
+// (measured - predicted) over the samples is smallest, the statistic the profile's margin is made of (least squared
+// error, a tie-break, fits the many light views and leaves the few heavy ones, which set the bound, furthest under).
+// Throws farfield::Error as gpu::CostModel::fit.
+gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double frame_pixels);
 
 // Fits and validates. Makes `context` current. Throws farfield::Error for bad options (fewer than 8 views, repeats
 // < 1, quantile outside (0, 1], an empty scene, a view space that is not finite).

@@ -146,6 +146,10 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
     md << "- shadows: one " << options.shadow.map_size << "x" << options.shadow.map_size << " map, receivers within "
        << fmt("%.0f", options.shadow.distance_m) << " m, in the reference and every mode"
        << (options.impostor_shadows ? " (crowd-mixed's geometry agents cast as impostors)" : "") << "\n";
+  if (options.runtime.max_geometry_triangles > 0)
+    md << "- crowd-mixed's geometry budget: " << thousands(size_t(options.runtime.max_geometry_triangles))
+       << " skinned triangles a frame, the nearest agents first; the others inside their switch distance drawn as "
+          "impostors (\"over the budget\")\n";
   md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
   md << "| agents | path | mode | median ms | crowd ms | speedup | crowd speedup | geometry / impostor agents | "
         "triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) | shadow casters / receiver px off |\n";
@@ -155,7 +159,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
       md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << fmt("%.1f", r.wall.median)
          << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.2fx", r.speedup) << " | "
          << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
-         << fmt("%.0f", r.impostor_agents) << " | " << thousands(size_t(r.triangles)) << " | "
+         << fmt("%.0f", r.impostor_agents)
+         << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string()) << " | " << thousands(size_t(r.triangles)) << " | "
          << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
          << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
          << fmt("%.2f", run.reference_popping_mean) << ") | " << fmt("%.0f", r.shadow_casters) << " / "
@@ -171,6 +176,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                {"triangles", result.city_triangles}, {"gen_seconds", result.city_seconds}};
   j["size"] = {options.width, options.height};
   j["bake_seconds"] = result.bake_seconds;
+  j["max_geometry_triangles"] = options.runtime.max_geometry_triangles;
   for (size_t m = 0; m < result.layouts.size(); ++m) {
     const gpu::AtlasLayout& l = result.layouts[m];
     const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
@@ -192,7 +198,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
                            {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
                            {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
-                           {"in_view", r.in_view}, {"occluded", r.occluded}, {"triangles", r.triangles},
+                           {"in_view", r.in_view}, {"occluded", r.occluded}, {"over_budget_agents", r.over_budget}, {"triangles", r.triangles},
                            {"shadow_casters", r.shadow_casters}, {"shadow_texel_m", r.shadow_texel_m},
                            {"receiver_bad_pixels", r.receiver_bad_pixels}});
   std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
@@ -281,7 +287,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), psnr(specs.size()),
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
           in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
-          receiver_bad(specs.size()), occluded(specs.size());
+          receiver_bad(specs.size()), occluded(specs.size()), over_budget(specs.size());
       std::vector<image::ColorImage> prev(specs.size());
       std::vector<image::IdImage> prev_ids(specs.size());
       image::ColorImage prev_ref;
@@ -336,6 +342,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           imp[m].push_back(double(st.impostors));
           in_view[m].push_back(double(st.in_view));
           occluded[m].push_back(double(st.occluded));
+          over_budget[m].push_back(double(st.over_budget));
           tris[m].push_back(double(st.draw.triangles));
           casters[m].push_back(double(st.shadow_casters));
           shadow_texel[m].push_back(double(st.shadow_texel_m));
@@ -385,6 +392,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.impostor_agents = mean(imp[m]);
         r.in_view = mean(in_view[m]);
         r.occluded = mean(occluded[m]);
+        r.over_budget = mean(over_budget[m]);
         r.triangles = mean(tris[m]);
         r.shadow_casters = mean(casters[m]);
         r.shadow_texel_m = mean(shadow_texel[m]);

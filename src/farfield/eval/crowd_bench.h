@@ -58,6 +58,7 @@ struct CrowdModeResult {
   double popping_mean = 0.0, popping_max = 0.0;
   double geometry_agents = 0.0, impostor_agents = 0.0, in_view = 0.0, triangles = 0.0;  // means per frame
   double occluded = 0.0;  // mean per frame: agents in view left out behind the city (agent_occlusion)
+  double over_budget = 0.0;  // mean per frame: impostors inside their switch distance (runtime.max_geometry_triangles)
   double shadow_casters = 0.0, shadow_texel_m = 0.0;  // means per frame
   double receiver_bad_pixels = 0.0;  // mean per frame: non-agent pixels off by > 8/255 (shadow differences)
 };

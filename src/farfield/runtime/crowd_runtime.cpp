@@ -161,6 +161,9 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
     lists_.geometry[m].clear();
     lists_.impostors[m].clear();
   }
+  drawn_.assign(agents.size(), Drawn::NotDrawn);
+  near_.clear();
+  const bool budgeted = policy == CrowdPolicy::Mixed && options_.max_geometry_triangles > 0;
   for (size_t i = 0; i < agents.size(); ++i) {
     const CrowdAgentState& a = agents[i];
     const Vec3 centre = spheres_[i].centre;
@@ -177,20 +180,42 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
       ++stats.occluded;
       continue;
     }
-    gpu::CrowdAgentGpu g = record(a);
-    const Vec3 to_eye = camera.eye - centre;
+    const float distance = glm::length(camera.eye - centre);
     const bool impostor = policy == CrowdPolicy::Impostor ||
-                          (policy == CrowdPolicy::Mixed && double(glm::length(to_eye)) >= switch_m_[a.model]);
-    if (!impostor) {
-      g.index = cycleIndex(a.phase, options_.palette_poses);
-      lists_.geometry[a.model].push_back(g);
+                          (policy == CrowdPolicy::Mixed && double(distance) >= switch_m_[a.model]);
+    if (!impostor && budgeted) {
+      near_.push_back({distance, uint32_t(i)});  // decided below, nearest first
       continue;
     }
-    g.index = cycleIndex(a.phase, model.choice.frames);
-    const Vec3 local = turn(-a.heading, to_eye);  // the eye in agent space
-    g.view = uint32_t(impostor::nearestView(model.impostor->grid, glm::length(local) > 0.0f ? local : Vec3(1, 0, 0)));
-    lists_.impostors[a.model].push_back(g);
+    addToLists(camera, a, uint32_t(i), impostor);
   }
+  if (near_.empty()) return;
+  std::sort(near_.begin(), near_.end());
+  uint64_t triangles = 0;
+  bool full = false;
+  for (const auto& [distance, i] : near_) {
+    const CrowdAgentState& a = agents[i];
+    const uint64_t t = models_[a.model].gpu->triangleCount();
+    full = full || triangles + t > options_.max_geometry_triangles;
+    if (!full) triangles += t;
+    stats.over_budget += full ? 1 : 0;
+    addToLists(camera, a, i, full);
+  }
+}
+
+void CrowdRuntime::addToLists(const Camera& camera, const CrowdAgentState& a, uint32_t i, bool impostor) {
+  const Model& model = models_[a.model];
+  gpu::CrowdAgentGpu g = record(a);
+  drawn_[i] = impostor ? Drawn::Impostor : Drawn::Geometry;
+  if (!impostor) {
+    g.index = cycleIndex(a.phase, options_.palette_poses);
+    lists_.geometry[a.model].push_back(g);
+    return;
+  }
+  g.index = cycleIndex(a.phase, model.choice.frames);
+  const Vec3 local = turn(-a.heading, camera.eye - spheres_[i].centre);  // the eye in agent space
+  g.view = uint32_t(impostor::nearestView(model.impostor->grid, glm::length(local) > 0.0f ? local : Vec3(1, 0, 0)));
+  lists_.impostors[a.model].push_back(g);
 }
 
 CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats) {
@@ -237,10 +262,15 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
     const CrowdAgentState& a = agents[i];
     const Model& model = models_[a.model];
     gpu::CrowdAgentGpu g = record(a);
+    // Mixed: as the agent is drawn; an agent out of view (or hidden) by its distance, or as an impostor under a
+    // geometry budget (which only the drawn agents share).
     const bool impostor =
         policy == CrowdPolicy::Impostor ||
         (policy == CrowdPolicy::Mixed &&
-         (shadows.impostor_casters || double(glm::length(camera.eye - spheres_[i].centre)) >= switch_m_[a.model]));
+         (shadows.impostor_casters || drawn_[i] == Drawn::Impostor ||
+          (drawn_[i] == Drawn::NotDrawn &&
+           (options_.max_geometry_triangles > 0 ||
+            double(glm::length(camera.eye - spheres_[i].centre)) >= switch_m_[a.model]))));
     if (!impostor) {
       g.index = cycleIndex(a.phase, options_.palette_poses);
       caster_lists_.geometry[a.model].push_back(g);
@@ -263,8 +293,8 @@ CrowdFrameStats CrowdRuntime::drawShadowed(const Camera& camera, std::span<const
                                            const gpu::RenderTarget& target, const CrowdShadowOptions& shadows) {
   CrowdFrameStats stats;
   prepareFrame(camera, agents);
+  classify(camera, agents, policy, stats);  // first: the casters are cast as they are drawn
   castShadows(camera, agents, policy, light, shadows, stats);
-  classify(camera, agents, policy, stats);
   target.bindForOpaquePass();
   stats = drawLists(camera, light, stats);
   if (stats.shadow_casters > 0) {

@@ -63,6 +63,12 @@ struct CrowdRuntimeOptions {
   bool blend_views = false;
   // Colour-region tints: outfit o, region r at o * scene::kColorRegions + r; empty = one outfit of white.
   std::vector<Vec4> region_tints;
+  // Mixed's geometry budget (skinned triangles a frame; 0: none): of the agents in view nearer than their switch
+  // distance, the nearest are drawn as geometry while their triangles stay within it, the others as impostors inside
+  // their switch distance (CrowdFrameStats::over_budget: where the error bound gives way to the frame's cost). Agents
+  // outside the view then cast their shadows as impostors. A crowd as dense near the camera as far from it costs
+  // geometry in proportion to its density without it (100,000 agents on the default city: 59 skinned agents a frame).
+  uint64_t max_geometry_triangles = 0;
 };
 
 // The crowd's shadows (drawShadowed).
@@ -94,6 +100,7 @@ struct CrowdFrameStats {
   size_t occluded = 0;  // of in_view: left out behind the depth given to cullBehind
   size_t geometry = 0;
   size_t impostors = 0;
+  size_t over_budget = 0;  // of impostors: inside their switch distance, left out of Mixed's geometry budget
   size_t shadow_casters = 0;  // drawShadowed: agents drawn into the shadow map
   float shadow_texel_m = 0.0f;
   gpu::FrameStats draw;
@@ -152,6 +159,8 @@ class CrowdRuntime {
   };
   void classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                 CrowdFrameStats& stats);
+  // Agent i into this frame's lists, as an impostor (its nearest view to the eye) or as geometry.
+  void addToLists(const Camera& camera, const CrowdAgentState& a, uint32_t i, bool impostor);
   // Whether the box around the sphere lies behind cullBehind's depth over its whole footprint.
   bool hidden(const Mat4& view_proj, const Vec3& centre, float radius) const;
   CrowdFrameStats drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats);
@@ -168,6 +177,10 @@ class CrowdRuntime {
   std::vector<Model> models_;
   Lists lists_, caster_lists_;  // reused per frame
   std::vector<CasterSphere> spheres_;  // prepareFrame: per agent, this frame
+  // classify: per agent, how this frame draws it (castShadows casts it alike).
+  enum class Drawn : uint8_t { NotDrawn, Geometry, Impostor };
+  std::vector<Drawn> drawn_;
+  std::vector<std::pair<float, uint32_t>> near_;  // classify: (distance, agent) inside the switch, under a budget
   std::vector<double> switch_m_;       // prepareFrame: per model, this frame's camera
   gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
   std::vector<float> depth_rows_;
