@@ -282,20 +282,30 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     return report;
   }
   const double max_pitch = degToRad(double(options.max_pitch_deg));
-  callbacks.estimate = [&](const Box3& region, const Vdi& vdi, const std::vector<uint32_t>* visible) {
-    if (options.max_pitch_deg < 90.0f && minAbsPitch(vdi) > max_pitch) return 0.0;  // no view of the walkthrough
-    ids.clear();
-    bvh.queryFrustum(enclosingFrustum(region, vdi, lens), ids);
-    const bool culled = visible && !visible->empty();
+  // What the objects an enclosing frustum meets (of the visible set, when there is one) cost as geometry, and their
+  // fill from the region's nearest point: the view space's estimates and the CPVs' fill sums count the same objects.
+  struct Workload {
     uint64_t triangles = 0, draws = 0;
     double fill = 0.0;
+  };
+  const auto workloadIn = [&](const Frustum& frustum, const Box3& region, const std::vector<uint32_t>* visible) {
+    Workload w;
+    ids.clear();
+    bvh.queryFrustum(frustum, ids);
+    const bool culled = visible && !visible->empty();
     for (uint32_t id : ids) {
       if (culled && !std::binary_search(visible->begin(), visible->end(), id)) continue;
-      triangles += cost[id].triangles;
-      draws += cost[id].draws;
-      if (profile.model.ms_per_mfill > 0.0) fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
+      w.triangles += cost[id].triangles;
+      w.draws += cost[id].draws;
+      if (profile.model.ms_per_mfill > 0.0)
+        w.fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
     }
-    return profile.boundMs(double(triangles), double(draws), pixels, fill);
+    return w;
+  };
+  callbacks.estimate = [&](const Box3& region, const Vdi& vdi, const std::vector<uint32_t>* visible) {
+    if (options.max_pitch_deg < 90.0f && minAbsPitch(vdi) > max_pitch) return 0.0;  // no view of the walkthrough
+    const Workload w = workloadIn(enclosingFrustum(region, vdi, lens), region, visible);
+    return profile.boundMs(double(w.triangles), double(w.draws), pixels, w.fill);
   };
   const placement::ViewSpace view_space = placement::approximateProblemViewSpace(vs_options, callbacks);
   report.regions = view_space.counts.regions;
@@ -338,12 +348,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
   if (fill_saves)
     for (size_t c = 0; c < view_space.cpvs.size(); ++c) {
       const Box3& region = view_space.cpvs[c].region;
-      const std::vector<uint32_t>* visible = visibleFrom(region);
-      ids.clear();
-      bvh.queryFrustum(frusta[c], ids);
-      for (uint32_t id : ids)
-        if (!visible || std::binary_search(visible->begin(), visible->end(), id))
-          cpv_fill[c] += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
+      cpv_fill[c] = workloadIn(frusta[c], region, visibleFrom(region)).fill;
     }
   std::unordered_map<uint64_t, double> t_object_memo;
   const auto tObject = [&](int node, uint32_t cpv) {

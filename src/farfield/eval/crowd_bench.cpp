@@ -160,7 +160,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
          << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.2fx", r.speedup) << " | "
          << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
          << fmt("%.0f", r.impostor_agents)
-         << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string()) << " | " << thousands(size_t(r.triangles)) << " | "
+         << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string()) << " | "
+         << thousands(size_t(r.triangles)) << " | "
          << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
          << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
          << fmt("%.2f", run.reference_popping_mean) << ") | " << fmt("%.0f", r.shadow_casters) << " / "
@@ -198,7 +199,8 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
                            {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
                            {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
-                           {"in_view", r.in_view}, {"occluded", r.occluded}, {"over_budget_agents", r.over_budget}, {"triangles", r.triangles},
+                           {"in_view", r.in_view}, {"occluded", r.occluded}, {"over_budget_agents", r.over_budget},
+                           {"triangles", r.triangles},
                            {"shadow_casters", r.shadow_casters}, {"shadow_texel_m", r.shadow_texel_m},
                            {"receiver_bad_pixels", r.receiver_bad_pixels}});
   std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";

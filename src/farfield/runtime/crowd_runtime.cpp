@@ -262,16 +262,7 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
     const CrowdAgentState& a = agents[i];
     const Model& model = models_[a.model];
     gpu::CrowdAgentGpu g = record(a);
-    // Mixed: as the agent is drawn; an agent out of view (or hidden) by its distance, or as an impostor under a
-    // geometry budget (which only the drawn agents share).
-    const bool impostor =
-        policy == CrowdPolicy::Impostor ||
-        (policy == CrowdPolicy::Mixed &&
-         (shadows.impostor_casters || drawn_[i] == Drawn::Impostor ||
-          (drawn_[i] == Drawn::NotDrawn &&
-           (options_.max_geometry_triangles > 0 ||
-            double(glm::length(camera.eye - spheres_[i].centre)) >= switch_m_[a.model]))));
-    if (!impostor) {
+    if (!castsAsImpostor(camera, a, i, policy, shadows)) {
       g.index = cycleIndex(a.phase, options_.palette_poses);
       caster_lists_.geometry[a.model].push_back(g);
     } else {
@@ -286,6 +277,17 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
                                 caster_lists_.impostors[m]);
   }
   stats.shadow_casters = fit.casters.size();
+}
+
+bool CrowdRuntime::castsAsImpostor(const Camera& camera, const CrowdAgentState& a, uint32_t i, CrowdPolicy policy,
+                                   const CrowdShadowOptions& shadows) const {
+  if (policy != CrowdPolicy::Mixed) return policy == CrowdPolicy::Impostor;
+  if (shadows.impostor_casters || drawn_[i] == Drawn::Impostor) return true;
+  if (drawn_[i] == Drawn::Geometry) return false;
+  // Not drawn (out of view or hidden): by its distance, or as an impostor under a geometry budget, which only the
+  // drawn agents share.
+  return options_.max_geometry_triangles > 0 ||
+         double(glm::length(camera.eye - spheres_[i].centre)) >= switch_m_[a.model];
 }
 
 CrowdFrameStats CrowdRuntime::drawShadowed(const Camera& camera, std::span<const CrowdAgentState> agents,

@@ -159,6 +159,9 @@ class CrowdRuntime {
   };
   void classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                 CrowdFrameStats& stats);
+  // Whether agent i casts its shadow as an impostor: under Mixed as classify drew it (after classify).
+  bool castsAsImpostor(const Camera& camera, const CrowdAgentState& a, uint32_t i, CrowdPolicy policy,
+                       const CrowdShadowOptions& shadows) const;
   // Agent i into this frame's lists, as an impostor (its nearest view to the eye) or as geometry.
   void addToLists(const Camera& camera, const CrowdAgentState& a, uint32_t i, bool impostor);
   // Whether the box around the sphere lies behind cullBehind's depth over its whole footprint.
