@@ -46,6 +46,7 @@ void runCalibrateCommand(CalibrateArgs& args) {
                                              std::to_string(scene.objects.size()));
     if (o.view_space.empty()) o.view_space = cache.viewSpace();  // its regions' views
     o.visible_set = [&cache](const Vec3& eye) { return cache.visibleFrom(eye); };
+    o.region_of = [&cache](const Vec3& eye) { return cache.regionOf(eye); };
   }
   const eval::CalibrateResult r = eval::calibrate(gpu::sharedHeadlessContext(), scene, o);
   ensureParentDirectory(args.out);
@@ -62,11 +63,13 @@ void runCalibrateCommand(CalibrateArgs& args) {
   std::printf("model:              %.3f ms + %.3f ms/Mtri + %.4f ms/draw + %.3f ms/Mpixel + %.3f ms/Mpixel of "
               "estimated fill (fit r2 %.3f, %zu samples)\n",
               m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.ms_per_mfill, m.r2, m.samples);
+  const char* const counted_as = o.region_of ? "fitting views' objects counted from their regions, as placement counts them"
+                                             : "fitting views";
   if (m.ms_per_mfill > 0.0 && m.fill_cap_pixels > 0.0)
-    std::printf("fill counted up to: %.0f frames (chosen on the fitting views)\n",
-                m.fill_cap_pixels / (double(o.width) * double(o.height)));
+    std::printf("fill counted up to: %.0f frames (the smallest bound summed over the %s)\n",
+                m.fill_cap_pixels / (double(o.width) * double(o.height)), counted_as);
   else if (m.ms_per_mfill > 0.0)
-    std::printf("fill counted up to: no cap (the best fit on the fitting views)\n");
+    std::printf("fill counted up to: no cap (the smallest bound summed over the %s)\n", counted_as);
   std::printf("validation:         %zu views at %dx%d, %.0f deg, min of %d renders each\n", r.checks.size(), o.width,
               o.height, double(o.fov_deg), o.repeats);
   std::printf("measured/predicted: p50 %.3f  p95 %.3f  p99 %.3f  max %.3f\n", r.ratio_p50, r.ratio_p95, r.ratio_p99,

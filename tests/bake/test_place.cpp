@@ -326,7 +326,7 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
     for (const runtime::LayerDecision& d : plan.layers)
       if (const auto* i = std::get_if<runtime::ClusterAsImpostor>(&d)) {
         const store::StoredPlacedImpostor& rec = *index.find(i->impostor);
-        const impostor::LayeredPlan lp = impostor::planLayered(rec.box, rec.shaft, rec.bound, rec.options);
+        const impostor::LayeredPlan lp = store::storedLayeredPlan(rec);  // the quads as drawn: cropped
         const ErrorBound frame{options.error_px, 128, 128, degToRad(45.0)};
         predicted += profile.layered.drawBoundMs(
             double(lp.quads()), impostor::layeredFillPixels(lp, double(glm::length(camera.eye - rec.shaft.apex)), frame));

@@ -480,7 +480,13 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
       ++report.impostors_generated;
       if (options.progress && report.impostors_generated % 25 == 0)
         FF_INFO("place: " << report.impostors_generated << " impostors generated");
-      return placement::GeneratedImpostor{double(imp.plan.bytes()), {}};
+      // Measured after generation (section 5.3): the memory of the cropped layers, and in each served CPV the time of
+      // the quads as cropped (smaller than the plan's: fill falls with them), so a CPV's t_after is what the runtime
+      // will draw, still bounded from the region's nearest point.
+      placement::GeneratedImpostor made{double(imp.plan.bytes()), {}};
+      made.t_impostor.reserve(c.cpvs.size());
+      for (uint32_t cpv : c.cpvs) made.t_impostor.push_back(tImpostor(imp.plan, cpv));
+      return made;
     });
     greedy_total_s += greedy_clock.seconds() - (capture_s - capture_before);
     for (size_t c = 0; c < cpv_t.size(); ++c) {

@@ -47,24 +47,39 @@ class PlacedGeometry final : public Mode {
 
 }  // namespace
 
-gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double frame_pixels) {
+gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double frame_pixels,
+                              std::span<const double> bounded_fill) {
+  if (!bounded_fill.empty() && bounded_fill.size() != samples.size())
+    throw Error("cost model", std::to_string(bounded_fill.size()) + " bounded fills for " +
+                                  std::to_string(samples.size()) + " samples");
   std::vector<gpu::CostSample> capped(samples.begin(), samples.end());
-  const auto largestUnder = [&](const gpu::CostModel& m) {
-    double worst = -std::numeric_limits<double>::infinity();
-    for (const gpu::CostSample& s : samples)
-      worst = std::max(worst, s.ms - m.predict(s.triangles, s.draw_calls, s.pixels, s.fill));
-    return worst;
+  // The profile's bound of a fit (its factor and margin from the samples), summed over the bounded workloads.
+  const auto boundSum = [&](const gpu::CostModel& m) {
+    double factor = 1.0, margin = 0.0;
+    for (const gpu::CostSample& s : samples) {
+      const double predicted = m.predict(s.triangles, s.draw_calls, s.pixels, s.fill);
+      factor = std::max(factor, s.ms / std::max(predicted, 1e-6));
+      margin = std::max(margin, s.ms - predicted);
+    }
+    double sum = 0.0;
+    for (size_t i = 0; i < samples.size(); ++i) {
+      const gpu::CostSample& s = samples[i];
+      const double predicted =
+          m.predict(s.triangles, s.draw_calls, s.pixels, bounded_fill.empty() ? s.fill : bounded_fill[i]);
+      sum += std::min(predicted * factor, predicted + margin);
+    }
+    return sum;
   };
   gpu::CostModel best = gpu::CostModel::fit(samples);
-  double best_under = largestUnder(best);
+  double best_sum = boundSum(best);
   for (double frames : {2.0, 3.0, 4.0, 6.0, 8.0}) {
     const double cap = frames * frame_pixels;
     for (size_t i = 0; i < samples.size(); ++i) capped[i].fill = std::min(samples[i].fill, cap);
     gpu::CostModel m = gpu::CostModel::fit(capped);
     m.fill_cap_pixels = cap;
-    const double under = largestUnder(m);
-    if (under < best_under - 1e-9 || (under <= best_under + 1e-9 && m.rms_error_ms < best.rms_error_ms * (1.0 - 1e-9)))
-      best = m, best_under = under;
+    const double sum = boundSum(m);
+    if (sum < best_sum * (1.0 - 1e-12) || (sum <= best_sum * (1.0 + 1e-12) && m.rms_error_ms < best.rms_error_ms))
+      best = m, best_sum = sum;
   }
   return best;
 }
@@ -162,7 +177,12 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
       for (const gpu::DrawItem& item : items) check.triangles += item.triangleCount();
       check.draw_calls = items.size();
     }
-    for (uint32_t id : view_ids) check.fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, camera.eye);
+    const std::optional<Box3> region = options.region_of ? options.region_of(camera.eye) : std::nullopt;
+    for (uint32_t id : view_ids) {
+      const Box3& bounds = scene.objects[id - 1].world_bounds;
+      check.fill += fill_lens.objectPixels(bounds, camera.eye);
+      check.region_fill += region ? fill_lens.objectPixels(bounds, *region) : fill_lens.objectPixels(bounds, camera.eye);
+    }
     return check;
   };
   // One timed render of a view's objects: placed frames through the occlusion culler, else frustum-culled clusters.
@@ -199,11 +219,13 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
                                                       options.height, options.fov_deg, options.near_plane,
                                                       options.far_plane);
     std::vector<gpu::CostSample> samples;
+    std::vector<double> region_fills;
     for (const ViewCheck& c : measureAll(fit_views, "fitting views")) {
       const double fill = options.fill_term ? c.fill : 0.0;
       samples.push_back({double(c.triangles), double(c.draw_calls), pixels, c.measured_ms, fill});
+      region_fills.push_back(c.region_fill);
     }
-    profile.model = options.fill_term ? fitWithFillCap(samples, pixels) : gpu::CostModel::fit(samples);
+    profile.model = options.fill_term ? fitWithFillCap(samples, pixels, region_fills) : gpu::CostModel::fit(samples);
   }
 
   const std::vector<Camera> views = randomViews(space, options.views, options.seed, options.width, options.height,
@@ -279,12 +301,13 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
 void writeCalibrationCsv(const CalibrateResult& result, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw Error(path, "cannot write");
-  out << "view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,fill_pixels,predicted_ms,measured_ms\n";
+  out << "view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,fill_pixels,region_fill_pixels,predicted_ms,"
+         "measured_ms\n";
   for (size_t i = 0; i < result.checks.size(); ++i) {
     const ViewCheck& c = result.checks[i];
     const Vec3 d = c.camera.forward();
     out << i << ',' << c.camera.eye.x << ',' << c.camera.eye.y << ',' << c.camera.eye.z << ',' << d.x << ',' << d.y
-        << ',' << d.z << ',' << c.triangles << ',' << c.draw_calls << ',' << c.fill << ',' << c.predicted_ms << ',' << c.measured_ms
+        << ',' << d.z << ',' << c.triangles << ',' << c.draw_calls << ',' << c.fill << ',' << c.region_fill << ',' << c.predicted_ms << ',' << c.measured_ms
         << '\n';
   }
   if (!out) throw Error(path, "write failed");

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,10 @@ struct CalibrateOptions {
   // it, over whole objects (gpu::GpuScene::objectDrawCosts). So the model and its safety factor are of the frames
   // placement must bound. Unset: frustum-culled full geometry, counted by the clusters drawn.
   std::function<const std::vector<uint32_t>*(const Vec3& eye)> visible_set;
+  // With visible_set: the region holding an eye (placement's minimum-size region; none outside the view space).
+  // Placement bounds a region's fill from its nearest point, so the fill cap is chosen for those sums
+  // (fitWithFillCap's bounded fills): each fitting view's objects counted from its region.
+  std::function<std::optional<Box3>(const Vec3& eye)> region_of;
   uint32_t seed = 1;
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
@@ -58,6 +63,9 @@ struct ViewCheck {
   uint64_t triangles = 0;
   size_t draw_calls = 0;
   double fill = 0.0;  // estimated pixels covered by the drawn objects (core/object_fill.h)
+  // The same objects' fill from the nearest point of the eye's region (CalibrateOptions::region_of), as placement
+  // bounds it; the view's own fill without a region.
+  double region_fill = 0.0;
   double predicted_ms = 0.0;
   double measured_ms = 0.0;  // minimum of the repeats
 };
@@ -85,17 +93,21 @@ std::vector<Camera> randomViews(const Box3& view_space, size_t count, uint32_t s
 Box3 defaultViewSpace(const scene::Scene& scene);
 
 // The model with the fill term counted up to a cap (gpu::CostModel::fill_cap_pixels) of 2, 3, 4, 6 or 8 frames of
-// `frame_pixels`, or uncapped: each fitted by least squares, the one kept whose largest under-prediction
-// (measured - predicted) over the samples is smallest, the statistic the profile's margin is made of (least squared
-// error, a tie-break, fits the many light views and leaves the few heavy ones, which set the bound, furthest under).
-// Throws farfield::Error as gpu::CostModel::fit.
-gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double frame_pixels);
+// `frame_pixels`, or uncapped: each fitted by least squares, the one kept whose bound is smallest summed over the
+// workloads placement will bound. The bound of a fit is the profile's: prediction x the largest measured / predicted
+// over the samples, or + the largest measured - predicted where smaller (so a fit that leaves heavy views far under
+// pays for it everywhere); the workloads are the samples with their fill replaced by `bounded_fill[i]` (the fill of
+// sample i's objects from its region's nearest point, which counts near buildings as whole frames: there a cap
+// decides the bound), or the samples themselves when `bounded_fill` is empty. Ties go to the smaller squared error.
+// Throws farfield::Error as gpu::CostModel::fit, or for a bounded_fill of another size than the samples.
+gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double frame_pixels,
+                              std::span<const double> bounded_fill = {});
 
 // Fits and validates. Makes `context` current. Throws farfield::Error for bad options (fewer than 8 views, repeats
 // < 1, quantile outside (0, 1], an empty scene, a view space that is not finite).
 CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, const CalibrateOptions& options);
 
-// view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,fill_pixels,predicted_ms,measured_ms
+// view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,fill_pixels,region_fill_pixels,predicted_ms,measured_ms
 void writeCalibrationCsv(const CalibrateResult& result, const std::string& path);
 
 }  // namespace farfield::eval

@@ -663,25 +663,41 @@ PlacementIndex readPlacementIndex(const std::string& dir) {
   return placementFromJson(j, file);
 }
 
+namespace {
+
+// storedLayeredPlan, its errors naming `source` (the index file, when known) and the record.
+impostor::LayeredPlan storedPlanIn(const StoredPlacedImpostor& imp, const std::string& source) {
+  const std::string record = imp.record.empty() ? recordName(imp.id) : imp.record;
+  impostor::LayeredPlan plan;
+  try {
+    plan = impostor::planLayered(imp.box, imp.shaft, imp.bound, imp.options);
+  } catch (const Error& e) {
+    throw Error(source, record + ": its box, shaft, bound and options give no layered plan: " + e.what());
+  }
+  if (plan.layers.size() != imp.layers.size())
+    throw Error(source, record + ": lists " + std::to_string(imp.layers.size()) + " layers, its plan has " +
+                            std::to_string(plan.layers.size()));
+  std::vector<impostor::LayerCrop> crops;
+  for (const StoredImpostorLayer& s : imp.layers) crops.push_back(s.crop);
+  try {
+    impostor::cropLayers(plan, crops);
+  } catch (const Error& e) {
+    throw Error(source, record + ": " + e.what());
+  }
+  return plan;
+}
+
+}  // namespace
+
+impostor::LayeredPlan storedLayeredPlan(const StoredPlacedImpostor& imp) {
+  return storedPlanIn(imp, "placement database");
+}
+
 impostor::LayeredImpostor loadPlacedImpostor(const std::string& dir, const StoredPlacedImpostor& imp) {
   const std::string record = imp.record.empty() ? recordName(imp.id) : imp.record;
   const std::string index_file = joinPath(dir, kPlacementIndexFile);
   impostor::LayeredImpostor out;
-  try {
-    out.plan = impostor::planLayered(imp.box, imp.shaft, imp.bound, imp.options);
-  } catch (const Error& e) {
-    throw Error(index_file, record + ": its box, shaft, bound and options give no layered plan: " + e.what());
-  }
-  if (out.plan.layers.size() != imp.layers.size())
-    throw Error(index_file, record + ": lists " + std::to_string(imp.layers.size()) + " layers, its plan has " +
-                                std::to_string(out.plan.layers.size()));
-  std::vector<impostor::LayerCrop> crops;
-  for (const StoredImpostorLayer& s : imp.layers) crops.push_back(s.crop);
-  try {
-    impostor::cropLayers(out.plan, crops);
-  } catch (const Error& e) {
-    throw Error(index_file, record + ": " + e.what());
-  }
+  out.plan = storedPlanIn(imp, index_file);
   out.capture_ms = imp.capture_ms;
   for (size_t l = 0; l < imp.layers.size(); ++l) {
     const StoredImpostorLayer& s = imp.layers[l];

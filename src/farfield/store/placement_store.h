@@ -184,6 +184,10 @@ PlacementIndex readPlacementIndex(const std::string& dir);
 // layer 3 texture: truncated: 100 of 812 bytes").
 impostor::LayeredImpostor loadPlacedImpostor(const std::string& dir, const StoredPlacedImpostor& impostor);
 
+// The impostor's layered plan as the runtime draws it: re-derived from (box, shaft, bound, options) and cut to its
+// layers' crops. Throws farfield::Error naming the record when these disagree (readPlacementIndex checked them).
+impostor::LayeredPlan storedLayeredPlan(const StoredPlacedImpostor& impostor);
+
 // The leaf of the BSP holding the eye (the lower child when on both), or none outside the view space.
 std::optional<uint32_t> lookupLeaf(const PlacementIndex& index, const Vec3& eye);
 
