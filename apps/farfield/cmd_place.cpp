@@ -39,10 +39,10 @@ void runPlaceCommand(PlaceArgs& args) {
   if (args.distance_steps < 1) throw Error("--distance-steps", "must be at least 1");
   o.candidates.distance_steps = args.distance_steps;
   if (args.view_cells != "shafts" && args.view_cells != "boxes" && args.view_cells != "leaf-boxes" &&
-      args.view_cells != "both")
-    throw Error("--view-cells", "'" + args.view_cells + "' is not shafts, boxes, leaf-boxes or both");
+      args.view_cells != "both" && args.view_cells != "none")
+    throw Error("--view-cells", "'" + args.view_cells + "' is not shafts, boxes, leaf-boxes, both or none");
   o.candidates.shafts = args.view_cells == "shafts" || args.view_cells == "both";
-  o.candidates.rectangular_cells = args.view_cells != "shafts";
+  o.candidates.rectangular_cells = args.view_cells != "shafts" && args.view_cells != "none";
   o.candidates.box_leaves_only = args.view_cells == "leaf-boxes";
   o.scene_label = args.scene;
   if (args.texel_px < 0.0) throw Error("--texel-px", "must be 0 (the error bound) or a positive number of pixels");
@@ -143,7 +143,9 @@ const RegisterCommand reg("place", [](CLI::App& app) {
   cmd->add_option("--view-cells", args->view_cells, "Candidate view cells: shafts (the paper's), boxes (the view "
                                                      "space's regions, each planned through the shaft around it: the "
                                                      "paper's test 13), leaf-boxes (the smallest regions only: "
-                                                     "per-cell placement, test 14) or both")
+                                                     "per-cell placement, test 14), both, or none (no "
+                                                     "impostor: the problem view space and its regions' visible sets "
+                                                     "alone, a control for what the impostors add)")
       ->capture_default_str();
   cmd->add_option("--max-texture", o.layered.max_texture_size, "Largest layer texture side, texels")
       ->capture_default_str();

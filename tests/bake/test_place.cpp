@@ -218,6 +218,30 @@ TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
 //     seen edge-on is a one-pixel sliver that a neighbour in the same slab covers from the capture eye; the sliver's
 //     pixels then measure the distance to the rest of its object, 5-8 px, though every point is drawn within the
 //     bound: a crack, which the bench counts as such.)
+// No view cells (`place --view-cells none`, the control of what impostors add): the same problem view space and
+// visible sets as the placement with candidates, no impostor, every CPV's time as estimated.
+TEST(PlaceTest, WithoutViewCellsTheViewSpaceIsTheSameAndNothingIsPlaced) {
+  const Placed& s = placed();
+  PlaceOptions options = s.options;
+  options.candidates.shafts = false;
+  options.candidates.rectangular_cells = false;
+  const std::string dir = test::scratchDir("place_none").string();
+  const PlaceReport r = placeImpostors(gpu::sharedHeadlessContext(), s.city.scene, s.profile, options, dir);
+  EXPECT_EQ(r.candidate_counts.considered, 0u);
+  EXPECT_EQ(r.impostors, 0u);
+  EXPECT_EQ(r.unsolved_cpvs, r.cpvs);
+  const store::PlacementIndex none = store::readPlacementIndex(dir);
+  const store::PlacementIndex with = store::readPlacementIndex(s.dir);
+  ASSERT_EQ(none.cpvs.size(), with.cpvs.size());
+  for (size_t c = 0; c < none.cpvs.size(); ++c) {
+    EXPECT_EQ(none.cpvs[c].t_enc, with.cpvs[c].t_enc) << c;
+    EXPECT_EQ(none.cpvs[c].t_after, none.cpvs[c].t_enc) << c;
+    EXPECT_TRUE(none.cpvs[c].impostors.empty()) << c;
+  }
+  ASSERT_EQ(none.nodes.size(), with.nodes.size());
+  for (size_t n = 0; n < none.nodes.size(); ++n) EXPECT_EQ(none.nodes[n].visible, with.nodes[n].visible) << n;
+}
+
 TEST(PlaceTest, BoxViewCellsArePlannedThroughTheShaftAroundThem) {
   const Placed& s = placed();
   PlaceOptions options = s.options;
