@@ -52,36 +52,47 @@ gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double f
   if (!bounded_fill.empty() && bounded_fill.size() != samples.size())
     throw Error("cost model", std::to_string(bounded_fill.size()) + " bounded fills for " +
                                   std::to_string(samples.size()) + " samples");
-  std::vector<gpu::CostSample> capped(samples.begin(), samples.end());
-  // The profile's bound of a fit (its factor and margin from the samples), summed over the bounded workloads.
-  const auto boundSum = [&](const gpu::CostModel& m) {
-    double factor = 1.0, margin = 0.0;
-    for (const gpu::CostSample& s : samples) {
-      const double predicted = m.predict(s.triangles, s.draw_calls, s.pixels, s.fill);
-      factor = std::max(factor, s.ms / std::max(predicted, 1e-6));
-      margin = std::max(margin, s.ms - predicted);
-    }
-    double sum = 0.0;
+  // The model at a cap (0: none), fitted on every sample but those of fold `skip` (sample i is in fold i % kFolds;
+  // -1: all of them).
+  const auto fitAt = [&](double cap, int skip) {
+    std::vector<gpu::CostSample> kept;
     for (size_t i = 0; i < samples.size(); ++i) {
-      const gpu::CostSample& s = samples[i];
-      const double predicted =
-          m.predict(s.triangles, s.draw_calls, s.pixels, bounded_fill.empty() ? s.fill : bounded_fill[i]);
-      sum += std::min(predicted * factor, predicted + margin);
+      if (int(i % kFillCapFolds) == skip) continue;
+      kept.push_back(samples[i]);
+      if (cap > 0.0) kept.back().fill = std::min(kept.back().fill, cap);
+    }
+    gpu::CostModel m = gpu::CostModel::fit(kept);
+    m.fill_cap_pixels = cap;
+    return m;
+  };
+  // A cap's score, out of sample: each fold bounded by the model fitted on the others, with the factor and margin
+  // that model leaves on the fold, summed over the fold's bounded workloads.
+  const auto heldOutBound = [&](double cap) {
+    double sum = 0.0;
+    for (int fold = 0; fold < int(kFillCapFolds); ++fold) {
+      const gpu::CostModel m = fitAt(cap, fold);
+      double factor = 1.0, margin = 0.0;
+      for (size_t i = size_t(fold); i < samples.size(); i += kFillCapFolds) {
+        const gpu::CostSample& s = samples[i];
+        const double predicted = m.predict(s.triangles, s.draw_calls, s.pixels, s.fill);
+        factor = std::max(factor, s.ms / std::max(predicted, 1e-6));
+        margin = std::max(margin, s.ms - predicted);
+      }
+      for (size_t i = size_t(fold); i < samples.size(); i += kFillCapFolds) {
+        const gpu::CostSample& s = samples[i];
+        const double predicted =
+            m.predict(s.triangles, s.draw_calls, s.pixels, bounded_fill.empty() ? s.fill : bounded_fill[i]);
+        sum += std::min(predicted * factor, predicted + margin);
+      }
     }
     return sum;
   };
-  gpu::CostModel best = gpu::CostModel::fit(samples);
-  double best_sum = boundSum(best);
+  double best_cap = 0.0, best_score = heldOutBound(0.0);
   for (double frames : {2.0, 3.0, 4.0, 6.0, 8.0}) {
-    const double cap = frames * frame_pixels;
-    for (size_t i = 0; i < samples.size(); ++i) capped[i].fill = std::min(samples[i].fill, cap);
-    gpu::CostModel m = gpu::CostModel::fit(capped);
-    m.fill_cap_pixels = cap;
-    const double sum = boundSum(m);
-    if (sum < best_sum * (1.0 - 1e-12) || (sum <= best_sum * (1.0 + 1e-12) && m.rms_error_ms < best.rms_error_ms))
-      best = m, best_sum = sum;
+    const double score = heldOutBound(frames * frame_pixels);
+    if (score < best_score * (1.0 - 1e-12)) best_cap = frames * frame_pixels, best_score = score;
   }
-  return best;
+  return fitAt(best_cap, -1);
 }
 
 std::vector<Camera> randomViews(const Box3& view_space, size_t count, uint32_t seed, int width, int height,

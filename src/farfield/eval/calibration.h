@@ -93,13 +93,16 @@ std::vector<Camera> randomViews(const Box3& view_space, size_t count, uint32_t s
 Box3 defaultViewSpace(const scene::Scene& scene);
 
 // The model with the fill term counted up to a cap (gpu::CostModel::fill_cap_pixels) of 2, 3, 4, 6 or 8 frames of
-// `frame_pixels`, or uncapped: each fitted by least squares, the one kept whose bound is smallest summed over the
-// workloads placement will bound. The bound of a fit is the profile's: prediction x the largest measured / predicted
-// over the samples, or + the largest measured - predicted where smaller (so a fit that leaves heavy views far under
-// pays for it everywhere); the workloads are the samples with their fill replaced by `bounded_fill[i]` (the fill of
-// sample i's objects from its region's nearest point, which counts near buildings as whole frames: there a cap
-// decides the bound), or the samples themselves when `bounded_fill` is empty. Ties go to the smaller squared error.
-// Throws farfield::Error as gpu::CostModel::fit, or for a bounded_fill of another size than the samples.
+// `frame_pixels`, or uncapped, fitted by least squares on every sample; the cap kept is the one whose bound is
+// smallest out of sample, summed over the workloads placement will bound. Each of kFillCapFolds folds (sample i in
+// fold i % kFillCapFolds) is predicted by the model fitted on the others and bounded as the profile bounds
+// (prediction x the largest measured / predicted over the fold, or + the largest measured - predicted where smaller;
+// so a fit that leaves heavy views far under pays for it everywhere), its workloads being the samples with their fill
+// replaced by `bounded_fill[i]` (the fill of sample i's objects from its region's nearest point, which counts near
+// buildings as whole frames: there a cap decides the bound), or the samples themselves when `bounded_fill` is empty.
+// Ties go to no cap, then to the smaller cap. Throws farfield::Error as gpu::CostModel::fit (each fold's fit needs 5
+// samples), or for a bounded_fill of another size than the samples.
+inline constexpr size_t kFillCapFolds = 5;
 gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double frame_pixels,
                               std::span<const double> bounded_fill = {});
 
