@@ -207,30 +207,32 @@ TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
               v.worst_parallax);
 }
 
-// Rectangular view cells (the paper's test 13): the view space's regions as box cells, each planned through the shaft
-// from the cluster's centre around it. Checked:
-//   - every CPV that shows an impostor lies in that impostor's shaft;
-//   - the promise of the layered plan, by brute force: from viewpoints sampled in those CPVs' regions, points of the
-//     cluster's box are seen within the plan's error angle (<= the bound) of where their layer draws them (the point
-//     where the capture eye's ray through them meets the layer's plane);
-//   - the views keep the frame budget as with shafts, and the item buffers against full geometry stay within the bound
-//     plus a texel in all but one view in twenty. (Seen here: 128x128 frames of clusters 200-350 m away, where a facade
-//     seen edge-on is a one-pixel sliver that a neighbour in the same slab covers from the capture eye; the sliver's
-//     pixels then measure the distance to the rest of its object, 5-8 px, though every point is drawn within the
-//     bound: a crack, which the bench counts as such.)
+// The small city placed again with other candidate view cells (shafts and/or boxes) into a scratch folder.
+struct Replaced {
+  PlaceOptions options;
+  PlaceReport report;
+  std::string dir;
+};
+Replaced placeWithViewCells(bool shafts, bool boxes, const char* dir_name) {
+  const Placed& s = placed();
+  Replaced out;
+  out.options = s.options;
+  out.options.candidates.shafts = shafts;
+  out.options.candidates.rectangular_cells = boxes;
+  out.dir = test::scratchDir(dir_name).string();
+  out.report = placeImpostors(gpu::sharedHeadlessContext(), s.city.scene, s.profile, out.options, out.dir);
+  return out;
+}
+
 // No view cells (`place --view-cells none`, the control of what impostors add): the same problem view space and
 // visible sets as the placement with candidates, no impostor, every CPV's time as estimated.
 TEST(PlaceTest, WithoutViewCellsTheViewSpaceIsTheSameAndNothingIsPlaced) {
   const Placed& s = placed();
-  PlaceOptions options = s.options;
-  options.candidates.shafts = false;
-  options.candidates.rectangular_cells = false;
-  const std::string dir = test::scratchDir("place_none").string();
-  const PlaceReport r = placeImpostors(gpu::sharedHeadlessContext(), s.city.scene, s.profile, options, dir);
-  EXPECT_EQ(r.candidate_counts.considered, 0u);
-  EXPECT_EQ(r.impostors, 0u);
-  EXPECT_EQ(r.unsolved_cpvs, r.cpvs);
-  const store::PlacementIndex none = store::readPlacementIndex(dir);
+  const Replaced none_cells = placeWithViewCells(false, false, "place_none");
+  EXPECT_EQ(none_cells.report.candidate_counts.considered, 0u);
+  EXPECT_EQ(none_cells.report.impostors, 0u);
+  EXPECT_EQ(none_cells.report.unsolved_cpvs, none_cells.report.cpvs);
+  const store::PlacementIndex none = store::readPlacementIndex(none_cells.dir);
   const store::PlacementIndex with = store::readPlacementIndex(s.dir);
   ASSERT_EQ(none.cpvs.size(), with.cpvs.size());
   for (size_t c = 0; c < none.cpvs.size(); ++c) {
@@ -242,13 +244,23 @@ TEST(PlaceTest, WithoutViewCellsTheViewSpaceIsTheSameAndNothingIsPlaced) {
   for (size_t n = 0; n < none.nodes.size(); ++n) EXPECT_EQ(none.nodes[n].visible, with.nodes[n].visible) << n;
 }
 
+// Rectangular view cells (the paper's test 13): the view space's regions as box cells, each planned through the shaft
+// from the cluster's centre around it. Checked:
+//   - every CPV that shows an impostor lies in that impostor's shaft;
+//   - the promise of the layered plan, by brute force: from viewpoints sampled in those CPVs' regions, points of the
+//     cluster's box are seen within the plan's error angle (<= the bound) of where their layer draws them (the point
+//     where the capture eye's ray through them meets the layer's plane);
+//   - the views keep the frame budget as with shafts, and the item buffers against full geometry stay within the bound
+//     plus a texel in all but one view in twenty. (Seen here: 128x128 frames of clusters 200-350 m away, where a facade
+//     seen edge-on is a one-pixel sliver that a neighbour in the same slab covers from the capture eye; the sliver's
+//     pixels then measure the distance to the rest of its object, 5-8 px, though every point is drawn within the
+//     bound: a crack, which the bench counts as such.)
 TEST(PlaceTest, BoxViewCellsArePlannedThroughTheShaftAroundThem) {
   const Placed& s = placed();
-  PlaceOptions options = s.options;
-  options.candidates.shafts = false;
-  options.candidates.rectangular_cells = true;
-  const std::string dir = test::scratchDir("place_boxes").string();
-  const PlaceReport r = placeImpostors(gpu::sharedHeadlessContext(), s.city.scene, s.profile, options, dir);
+  const Replaced boxes = placeWithViewCells(false, true, "place_boxes");
+  const PlaceOptions& options = boxes.options;
+  const PlaceReport& r = boxes.report;
+  const std::string& dir = boxes.dir;
   EXPECT_GT(r.candidate_counts.kept, 0u);
   EXPECT_GT(r.impostors, 0u);
   EXPECT_LT(r.unsolved_cpvs, r.cpvs);
