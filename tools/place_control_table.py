@@ -2,13 +2,14 @@
 """The table of scripts/bench_place_control.sh: per budget and path, the placed frames with the budget's impostors
 and with none (median, max, frames over t_max), and how many impostors a frame drew.
 Usage: tools/place_control_table.py OUT TMAX [TMAX ...]"""
+import glob
 import json
 import os
 import sys
 
 
-def mode(run):
-    with open(os.path.join(run, "bench.json")) as f:
+def mode(bench_json):
+    with open(bench_json) as f:
         return json.load(f)["modes"]["placed"]
 
 
@@ -21,10 +22,12 @@ def main():
     print("|---:|---|---|---|---:|---:|")
     for t in budgets:
         for path in ("walk", "drive", "random"):
-            runs = [os.path.join(out, f"control-{path}-t{t}-{db}") for db in (f"place-b2-t{t}", f"place-none-t{t}")]
-            if not all(os.path.exists(os.path.join(r, "bench.json")) for r in runs):
+            # The budget's database at whichever bound the script was given (place-bB-tT), and the one without.
+            placed = sorted(glob.glob(os.path.join(out, f"control-{path}-t{t}-place-b*-t{t}", "bench.json")))
+            none = os.path.join(out, f"control-{path}-t{t}-place-none-t{t}", "bench.json")
+            if not placed or not os.path.exists(none):
                 continue
-            with_imp, none = (mode(r) for r in runs)
+            with_imp, none = mode(placed[0]), mode(none)
             info = with_imp["info"]
             frames = max(info.get("frames", 1.0), 1.0)
             print(f"| {t} | {path} | {with_imp['median_ms']:.1f} / {with_imp['max_ms']:.1f}, "

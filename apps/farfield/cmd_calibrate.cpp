@@ -63,8 +63,8 @@ void runCalibrateCommand(CalibrateArgs& args) {
   std::printf("model:              %.3f ms + %.3f ms/Mtri + %.4f ms/draw + %.3f ms/Mpixel + %.3f ms/Mpixel of "
               "estimated fill (fit r2 %.3f, %zu samples)\n",
               m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.ms_per_mfill, m.r2, m.samples);
-  const char* const counted_as = o.region_of ? "fitting views' objects counted from their regions, as placement counts them"
-                                             : "fitting views";
+  const char* const counted_as =
+      o.region_of ? "fitting views' objects counted from their regions, as placement counts them" : "fitting views";
   if (m.ms_per_mfill > 0.0 && m.fill_cap_pixels > 0.0)
     std::printf("fill counted up to: %.0f frames (the smallest bound summed over the %s)\n",
                 m.fill_cap_pixels / (double(o.width) * double(o.height)), counted_as);

@@ -288,18 +288,18 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     uint64_t triangles = 0, draws = 0;
     double fill = 0.0;
   };
+  const auto addObject = [&](Workload& w, uint32_t id, const Box3& region) {
+    w.triangles += cost[id].triangles;
+    w.draws += cost[id].draws;
+    if (profile.model.ms_per_mfill > 0.0) w.fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
+  };
   const auto workloadIn = [&](const Frustum& frustum, const Box3& region, const std::vector<uint32_t>* visible) {
     Workload w;
     ids.clear();
     bvh.queryFrustum(frustum, ids);
     const bool culled = visible && !visible->empty();
-    for (uint32_t id : ids) {
-      if (culled && !std::binary_search(visible->begin(), visible->end(), id)) continue;
-      w.triangles += cost[id].triangles;
-      w.draws += cost[id].draws;
-      if (profile.model.ms_per_mfill > 0.0)
-        w.fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
-    }
+    for (uint32_t id : ids)
+      if (!culled || std::binary_search(visible->begin(), visible->end(), id)) addObject(w, id, region);
     return w;
   };
   callbacks.estimate = [&](const Box3& region, const Vdi& vdi, const std::vector<uint32_t>* visible) {
@@ -357,16 +357,12 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     if (it != t_object_memo.end()) return it->second;
     const Box3& region = view_space.cpvs[cpv].region;
     const std::vector<uint32_t>* visible = visibleFrom(region);
-    uint64_t triangles = 0, draws = 0;
-    double fill = 0.0;
+    Workload w;
     for (uint32_t id : hierarchy.objects(node))
       if ((!visible || std::binary_search(visible->begin(), visible->end(), id)) &&
-          frusta[cpv].intersects(scene.objects[id - 1].world_bounds)) {
-        triangles += cost[id].triangles;
-        draws += cost[id].draws;
-        if (fill_saves) fill += fill_lens.objectPixels(scene.objects[id - 1].world_bounds, region);
-      }
-    return t_object_memo[key] = geometryMs(triangles, draws, profile.model.fillCredit(cpv_fill[cpv], fill));
+          frusta[cpv].intersects(scene.objects[id - 1].world_bounds))
+        addObject(w, id, region);
+    return t_object_memo[key] = geometryMs(w.triangles, w.draws, profile.model.fillCredit(cpv_fill[cpv], w.fill));
   };
   // An impostor's time: its quads and draw calls as geometry, plus what its alpha-tested layers fill (the profile's
   // layered draw term over the plan's quads seen from the nearest viewpoint on the axis; 0 for a profile without it).

@@ -192,8 +192,9 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     for (uint32_t id : view_ids) {
       const Box3& bounds = scene.objects[id - 1].world_bounds;
       check.fill += fill_lens.objectPixels(bounds, camera.eye);
-      check.region_fill += region ? fill_lens.objectPixels(bounds, *region) : fill_lens.objectPixels(bounds, camera.eye);
+      if (region) check.region_fill += fill_lens.objectPixels(bounds, *region);
     }
+    if (!region) check.region_fill = check.fill;
     return check;
   };
   // One timed render of a view's objects: placed frames through the occlusion culler, else frustum-culled clusters.
@@ -325,8 +326,8 @@ void writeCalibrationCsv(const CalibrateResult& result, const std::string& path)
     const ViewCheck& c = result.checks[i];
     const Vec3 d = c.camera.forward();
     out << i << ',' << c.camera.eye.x << ',' << c.camera.eye.y << ',' << c.camera.eye.z << ',' << d.x << ',' << d.y
-        << ',' << d.z << ',' << c.triangles << ',' << c.draw_calls << ',' << c.fill << ',' << c.region_fill << ',' << c.predicted_ms << ',' << c.measured_ms
-        << '\n';
+        << ',' << d.z << ',' << c.triangles << ',' << c.draw_calls << ',' << c.fill << ',' << c.region_fill << ','
+        << c.predicted_ms << ',' << c.measured_ms << '\n';
   }
   if (!out) throw Error(path, "write failed");
 }

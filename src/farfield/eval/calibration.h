@@ -33,7 +33,8 @@ struct CalibrateOptions {
   int repeats = 3;             // renders per view (passes over the views), the minimum kept
   double margin_quantile = 1.0;  // safety factor and margin: this quantile of measured / predicted and - (1 = max)
   // Fit the model's fill term (gpu/cost_model.h, core/object_fill.h) too, counted up to a cap chosen on the fitting
-  // views (2 to 8 frames, or none: fitWithFillCap). Off: the views' estimated fill is still written to the CSV, and the term is 0.
+  // views (2 to 8 frames, or none: fitWithFillCap). Off: the views' estimated fill is still written to the CSV, and
+  // the term is 0.
   // Uncapped, a region's fill bounded from its nearest point counts every adjacent building as a whole frame, and
   // placement's problem view space grew several times; capped and fitted on placed frames (visible_set) it gives the
   // tightest bound measured (docs/BENCHMARKS.md).
