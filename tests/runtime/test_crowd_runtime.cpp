@@ -156,6 +156,111 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetDrawsTheNearestAgentsAsGeometry) {
   EXPECT_TRUE(same(all, frame({{&unbudgeted, CrowdPolicy::Geometry}}, {agents}, nullptr)));
 }
 
+// Mixed's skinned agents at levels of detail: each takes the coarsest level whose measured distance stays within
+// geometry_lod_px pixels at its distance (recomputed here from the levels' distances and the agent's box), farther
+// agents never take finer levels, the baseline policy draws the mesh, and a coarse level covers the mesh's pixels in
+// the mesh's colour regions.
+TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) {
+  const scene::SkinnedModel man =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  CrowdModelOptions mo;
+  mo.facing_deg = 0.0f;
+  CrowdRuntimeOptions options = smallAtlas(8);
+  options.error_px = 0.001;  // the switch beyond every agent here: all geometry
+  options.geometry_lod_px = 0.5;
+  options.lod_ratios = {0.5, 0.25, 0.125};
+  for (int r = 0; r < scene::kColorRegions; ++r)  // one outfit of distinct region colours
+    options.region_tints.push_back(Vec4(float(r % 4) / 3.0f, float(r / 4) / 3.0f, 1.0f - float(r % 3) / 2.0f, 1.0f));
+  CrowdRuntime rt(std::span(&man, 1), std::span(&mo, 1), options);
+  const std::span<const double> level_m = rt.levelDistances(0);
+  const gpu::SkinnedGpuModel& gm = rt.gpuModel(0);
+  ASSERT_EQ(level_m.size(), 4u);
+  ASSERT_EQ(gm.levelCount(), 4u);
+  for (size_t l = 1; l < 4; ++l) EXPECT_LE(gm.triangleCount(l), gm.triangleCount(0) / (size_t(1) << l));
+
+  Camera camera;
+  camera.eye = Vec3(0, 0, 1.7f);
+  camera.at = Vec3(10, 0, 1.0f);
+  camera.width = camera.height = 128;
+  const double focal = 128.0 / (2.0 * std::tan(double(camera.fov_y) / 2.0));
+  gpu::RenderTarget target(128, 128);
+  gpu::LightSettings light;
+  auto levelOf = [&](uint64_t triangles) {
+    for (size_t l = 0; l < gm.levelCount(); ++l)
+      if (gm.triangleCount(l) == triangles) return int(l);
+    return -1;
+  };
+  auto coarsest = [&](double metres) {  // the rule, over the levels' distances
+    size_t level = 0;
+    for (size_t l = 1; l < level_m.size(); ++l)
+      if (level_m[l] <= options.geometry_lod_px * metres / focal) level = l;
+    return level;
+  };
+  int previous = 0;
+  for (float x : {2.0f, 6.0f, 15.0f, 40.0f, 100.0f}) {
+    std::vector<CrowdAgentState> agent(1);
+    agent[0].position = Vec3(x, 0.0f, 0.0f);
+    agent[0].object_id = 1;
+    target.bindForOpaquePass();
+    target.clear(light.sky_color);
+    const CrowdFrameStats st = rt.draw(camera, agent, CrowdPolicy::Mixed, light);
+    ASSERT_EQ(st.geometry, 1u) << x;
+    const int level = levelOf(st.draw.triangles);
+    ASSERT_GE(level, 0) << x;
+    EXPECT_EQ(st.coarser, level > 0 ? 1u : 0u);
+    // The agent's centre lies between its feet and its head: the rule's level at those distances brackets it.
+    const double near_m = glm::length(camera.eye - Vec3(x, 0.0f, std::min(1.7f, 1.75f)));
+    const double far_m = std::max(glm::length(camera.eye - Vec3(x, 0.0f, 0.0f)), glm::length(camera.eye - Vec3(x, 0.5f, 1.75f)));
+    EXPECT_GE(size_t(level), coarsest(near_m * 0.95)) << x;
+    EXPECT_LE(size_t(level), coarsest(far_m * 1.05)) << x;
+    EXPECT_GE(level, previous) << x;
+    previous = level;
+    const CrowdFrameStats base = rt.draw(camera, agent, CrowdPolicy::Geometry, light);
+    EXPECT_EQ(base.draw.triangles, gm.triangleCount(0));
+    EXPECT_EQ(base.coarser, 0u);
+  }
+  EXPECT_EQ(previous, 3);  // at 100 m the coarsest level holds
+
+  // At 6 m a coarse level against the mesh: the figure's pixels and their mean colour (the regions' tints).
+  std::vector<CrowdAgentState> agent(1);
+  agent[0].position = Vec3(6.0f, 0.0f, 0.0f);
+  agent[0].object_id = 1;
+  CrowdRuntimeOptions coarse = options;
+  coarse.geometry_lod_px = 20.0;  // the coarsest level everywhere
+  CrowdRuntime coarse_rt(std::span(&man, 1), std::span(&mo, 1), coarse);
+  auto render = [&](CrowdRuntime& r, CrowdPolicy policy) {
+    target.bindForOpaquePass();
+    target.clear(light.sky_color);
+    const CrowdFrameStats st = r.draw(camera, agent, policy, light);
+    r.finish();
+    return std::make_pair(st, std::make_pair(target.readColor(), target.readIds()));
+  };
+  const auto [mesh_st, mesh] = render(rt, CrowdPolicy::Geometry);
+  const auto [level_st, level] = render(coarse_rt, CrowdPolicy::Mixed);
+  EXPECT_EQ(level_st.draw.triangles, gm.triangleCount(3));
+  size_t both = 0, either = 0;
+  double mean_mesh[3] = {0, 0, 0}, mean_level[3] = {0, 0, 0};
+  size_t n_mesh = 0, n_level = 0;
+  for (size_t p = 0; p < mesh.second.pixels().size(); ++p) {
+    const bool a = mesh.second.pixels()[p] == 1, b = level.second.pixels()[p] == 1;
+    both += a && b;
+    either += a || b;
+    if (a) {
+      const image::Rgba8 c = mesh.first.pixels()[p];
+      mean_mesh[0] += c.r, mean_mesh[1] += c.g, mean_mesh[2] += c.b, ++n_mesh;
+    }
+    if (b) {
+      const image::Rgba8 c = level.first.pixels()[p];
+      mean_level[0] += c.r, mean_level[1] += c.g, mean_level[2] += c.b, ++n_level;
+    }
+  }
+  ASSERT_GT(n_mesh, 100u);
+  EXPECT_GT(double(both) / double(either), 0.8);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean_level[c] / double(n_level), mean_mesh[c] / double(n_mesh), 12.0) << c;
+  EXPECT_FALSE(std::equal(mesh.first.pixels().begin(), mesh.first.pixels().end(), level.first.pixels().begin(),
+                          [](const image::Rgba8& x, const image::Rgba8& y) { return x.r == y.r && x.g == y.g && x.b == y.b; }));
+}
+
 // cullBehind: agents behind a wall drawn first are left out and the frame is unchanged, pixel for pixel and id for id;
 // agents in front of it, or beside it, are drawn; the culling holds for one call only. Brute force: each agent is
 // hidden if, drawn alone over the wall, it leaves the wall's frame unchanged.

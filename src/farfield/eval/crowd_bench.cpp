@@ -150,6 +150,19 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
     md << "- crowd-mixed's geometry budget: " << thousands(size_t(options.runtime.max_geometry_triangles))
        << " skinned triangles a frame, the nearest agents first; the others inside their switch distance drawn as "
           "impostors (\"over the budget\")\n";
+  if (options.runtime.geometry_lod_px > 0.0) {
+    md << "- crowd-mixed's skinned agents at the coarsest level of detail within "
+       << fmt("%.2f", options.runtime.geometry_lod_px) << " px (levels held over every palette pose; "
+       << fmt("%.1f", result.lod_seconds) << " s to build):";
+    for (size_t m = 0; m < result.level_m.size(); ++m) {
+      md << " " << result.model_names[m];
+      for (size_t l = 0; l < result.level_m[m].size(); ++l)
+        md << (l == 0 ? " " : ", ") << thousands(size_t(result.level_triangles[m][l])) << " triangles "
+           << fmt("%.1f", result.level_m[m][l] * 100.0) << " cm";
+      md << ";";
+    }
+    md << "\n";
+  }
   md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
   md << "| agents | path | mode | median ms | crowd ms | speedup | crowd speedup | geometry / impostor agents | "
         "triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) | shadow casters / receiver px off |\n";
@@ -160,7 +173,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
          << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.2fx", r.speedup) << " | "
          << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
          << fmt("%.0f", r.impostor_agents)
-         << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string()) << " | "
+         << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string())
+         << (r.coarser > 0.0 ? " (" + fmt("%.0f", r.coarser) + " coarser)" : std::string()) << " | "
          << thousands(size_t(r.triangles)) << " | "
          << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
          << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
@@ -178,6 +192,8 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
   j["size"] = {options.width, options.height};
   j["bake_seconds"] = result.bake_seconds;
   j["max_geometry_triangles"] = options.runtime.max_geometry_triangles;
+  j["geometry_lod_px"] = options.runtime.geometry_lod_px;
+  j["lod_seconds"] = result.lod_seconds;
   for (size_t m = 0; m < result.layouts.size(); ++m) {
     const gpu::AtlasLayout& l = result.layouts[m];
     const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
@@ -188,7 +204,8 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"frame_error_m", c.frame_error_m}, {"from_bound", c.from_bound},
                            {"atlas_bytes", result.atlas_bytes[m]},
                            {"atlas_kib_per_frame", double(result.atlas_bytes[m]) / 1024.0 / l.frames},
-                           {"switch_m", result.switch_m[m]}});
+                           {"switch_m", result.switch_m[m]}, {"level_triangles", result.level_triangles[m]},
+                           {"level_m", result.level_m[m]}});
   }
   for (const CrowdRun& run : result.runs)
     for (const CrowdModeResult& r : run.modes)
@@ -200,6 +217,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
                            {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
                            {"in_view", r.in_view}, {"occluded", r.occluded}, {"over_budget_agents", r.over_budget},
+                           {"coarser_agents", r.coarser},
                            {"triangles", r.triangles},
                            {"shadow_casters", r.shadow_casters}, {"shadow_texel_m", r.shadow_texel_m},
                            {"receiver_bad_pixels", r.receiver_bad_pixels}});
@@ -257,7 +275,13 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
     result.atlas_choices.push_back(rt.atlasChoice(m));
     result.atlas_bytes.push_back(rt.impostor(m).byteSize());
     result.model_triangles.push_back(rt.modelTriangles(m));
+    result.level_triangles.emplace_back();
+    for (size_t l = 0; l < rt.gpuModel(m).levelCount(); ++l)
+      result.level_triangles.back().push_back(rt.gpuModel(m).triangleCount(l));
+    const std::span<const double> level_m = rt.levelDistances(m);
+    result.level_m.emplace_back(level_m.begin(), level_m.end());
   }
+  result.lod_seconds = rt.lodSeconds();
 
   gen::StreetWalkOptions wo;
   wo.frames = int(options.frames * options.frame_step + 1);
@@ -289,7 +313,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), psnr(specs.size()),
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
           in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
-          receiver_bad(specs.size()), occluded(specs.size()), over_budget(specs.size());
+          receiver_bad(specs.size()), occluded(specs.size()), over_budget(specs.size()), coarser(specs.size());
       std::vector<image::ColorImage> prev(specs.size());
       std::vector<image::IdImage> prev_ids(specs.size());
       image::ColorImage prev_ref;
@@ -345,6 +369,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           in_view[m].push_back(double(st.in_view));
           occluded[m].push_back(double(st.occluded));
           over_budget[m].push_back(double(st.over_budget));
+          coarser[m].push_back(double(st.coarser));
           tris[m].push_back(double(st.draw.triangles));
           casters[m].push_back(double(st.shadow_casters));
           shadow_texel[m].push_back(double(st.shadow_texel_m));
@@ -395,6 +420,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.in_view = mean(in_view[m]);
         r.occluded = mean(occluded[m]);
         r.over_budget = mean(over_budget[m]);
+        r.coarser = mean(coarser[m]);
         r.triangles = mean(tris[m]);
         r.shadow_casters = mean(casters[m]);
         r.shadow_texel_m = mean(shadow_texel[m]);

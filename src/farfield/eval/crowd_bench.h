@@ -59,6 +59,7 @@ struct CrowdModeResult {
   double geometry_agents = 0.0, impostor_agents = 0.0, in_view = 0.0, triangles = 0.0;  // means per frame
   double occluded = 0.0;  // mean per frame: agents in view left out behind the city (agent_occlusion)
   double over_budget = 0.0;  // mean per frame: impostors inside their switch distance (runtime.max_geometry_triangles)
+  double coarser = 0.0;      // mean per frame: geometry agents at a coarser level than the mesh (runtime.geometry_lod_px)
   double shadow_casters = 0.0, shadow_texel_m = 0.0;  // means per frame
   double receiver_bad_pixels = 0.0;  // mean per frame: non-agent pixels off by > 8/255 (shadow differences)
 };
@@ -77,6 +78,10 @@ struct CrowdBenchResult {
   std::vector<runtime::CrowdAtlasChoice> atlas_choices;
   std::vector<size_t> atlas_bytes;
   std::vector<uint64_t> model_triangles;
+  // Per model, per level of detail (level 0 the mesh): triangles and distance to the mesh over the palette (metres).
+  std::vector<std::vector<uint64_t>> level_triangles;
+  std::vector<std::vector<double>> level_m;
+  double lod_seconds = 0.0;
   std::vector<double> switch_m;  // per model at the bench's camera
   double bake_seconds = 0.0;
   double city_seconds = 0.0;

@@ -32,7 +32,8 @@ void setLight(const Program& p, const LightSettings& light) {
 }  // namespace
 
 SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& model_to_agent,
-                                 const std::vector<std::vector<Mat4>>& poses)
+                                 const std::vector<std::vector<Mat4>>& poses,
+                                 std::span<const scene::DeformingLevel> levels)
     : model_to_agent_(model_to_agent), base_color_(model.base_color) {
   scene::validateSkinnedModel(model);
   joint_count_ = uint32_t(model.skeleton.joints.size());
@@ -60,18 +61,35 @@ SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& m
     }
   }
   index_count_ = uint32_t(model.mesh.indices.size());
+  // Every level's indices in one buffer, and its triangles' regions (read by gl_PrimitiveID from its first).
+  std::vector<uint32_t> indices = model.mesh.indices;
+  std::vector<uint32_t> regions(index_count_ / 3, 0u);
+  for (size_t t = 0; t < model.regions.size() && t < regions.size(); ++t) regions[t] = model.regions[t];
+  levels_.push_back({0, index_count_, 0});
+  for (size_t l = 0; l < levels.size(); ++l) {
+    const scene::DeformingLevel& level = levels[l];
+    if (level.source_triangles.size() * 3 != level.indices.size())
+      throw Error(model.name, "level " + std::to_string(l + 1) + ": not one source triangle per triangle");
+    levels_.push_back({uint32_t(indices.size()), uint32_t(level.indices.size()), uint32_t(regions.size())});
+    for (uint32_t i : level.indices) {
+      if (i >= n) throw Error(model.name, "level " + std::to_string(l + 1) + ": index past the vertices");
+      indices.push_back(i);
+    }
+    for (uint32_t t : level.source_triangles) {
+      if (t >= index_count_ / 3) throw Error(model.name, "level " + std::to_string(l + 1) + ": source triangle out of range");
+      regions.push_back(regions[t]);
+    }
+  }
   glCreateBuffers(1, &vbo_);
   glNamedBufferStorage(vbo_, GLsizeiptr(n * sizeof(SkinVertex)), vertices.data(), 0);
   glCreateBuffers(1, &ibo_);
-  glNamedBufferStorage(ibo_, GLsizeiptr(index_count_ * sizeof(uint32_t)), model.mesh.indices.data(), 0);
+  glNamedBufferStorage(ibo_, GLsizeiptr(std::max<size_t>(indices.size(), 1) * sizeof(uint32_t)), indices.data(), 0);
   glCreateBuffers(1, &palette_);
   glNamedBufferStorage(palette_, GLsizeiptr(palette.size() * sizeof(Mat4)), palette.data(), 0);
-  std::vector<uint32_t> regions(index_count_ / 3, 0u);  // one uint per triangle, read by gl_PrimitiveID
-  for (size_t t = 0; t < model.regions.size() && t < regions.size(); ++t) regions[t] = model.regions[t];
   if (regions.empty()) regions.push_back(0u);
   glCreateBuffers(1, &regions_);
   glNamedBufferStorage(regions_, GLsizeiptr(regions.size() * sizeof(uint32_t)), regions.data(), 0);
-  bytes_ = n * sizeof(SkinVertex) + index_count_ * sizeof(uint32_t) + palette.size() * sizeof(Mat4) +
+  bytes_ = n * sizeof(SkinVertex) + indices.size() * sizeof(uint32_t) + palette.size() * sizeof(Mat4) +
            regions.size() * sizeof(uint32_t);
   glCreateVertexArrays(1, &vao_);
   glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(SkinVertex));
@@ -186,6 +204,7 @@ void CrowdRenderer::bindModel(const Program& p, const SkinnedGpuModel& model) co
   p.set("u_model_to_agent", model.model_to_agent_);
   p.set("u_joint_count", model.joint_count_);
   p.set("u_first_instance", 0u);
+  p.set("u_first_triangle", 0u);
   p.set("u_base_color", model.base_color_);
   p.set("u_textured", model.textured_ ? 1 : 0);
   if (model.textured_) model.texture_.bind(0);
@@ -213,19 +232,25 @@ uint32_t CrowdRenderer::uploadAgents(std::span<const CrowdAgentGpu> agents) {
   return agents_;
 }
 
-FrameStats CrowdRenderer::drawAgents(const SkinnedGpuModel& model, size_t count) const {
+FrameStats CrowdRenderer::drawAgents(const Program& p, const SkinnedGpuModel& model, size_t count,
+                                     size_t level) const {
+  FF_CHECK(level < model.levels_.size());
+  const SkinnedGpuModel::Level& l = model.levels_[level];
+  p.set("u_first_triangle", l.first_triangle);
   glBindVertexArray(model.vao_);
-  glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, GLsizei(count));
+  glDrawElementsInstanced(GL_TRIANGLES, GLsizei(l.index_count), GL_UNSIGNED_INT,
+                          reinterpret_cast<const void*>(size_t(l.first_index) * sizeof(uint32_t)), GLsizei(count));
   glBindVertexArray(0);
   FrameStats stats;
   stats.draw_calls = 1;
-  stats.triangles = model.triangleCount() * count;
+  stats.triangles = model.triangleCount(level) * count;
   stats.objects = uint32_t(count);
   return stats;
 }
 
 FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuModel& model,
-                                      std::span<const CrowdAgentGpu> agents, const LightSettings& light) {
+                                      std::span<const CrowdAgentGpu> agents, const LightSettings& light,
+                                      size_t level) {
   if (agents.empty() || model.index_count_ == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
@@ -235,7 +260,7 @@ FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuMode
   bindModel(skinned_, model);
   setLight(skinned_, light);
   glEnable(GL_CULL_FACE);
-  return drawAgents(model, agents.size());
+  return drawAgents(skinned_, model, agents.size(), level);
 }
 
 FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas,
@@ -310,14 +335,14 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
 }
 
 FrameStats CrowdRenderer::drawSkinnedDepth(const Mat4& light_view_proj, const SkinnedGpuModel& model,
-                                           std::span<const CrowdAgentGpu> agents) {
+                                           std::span<const CrowdAgentGpu> agents, size_t level) {
   if (agents.empty() || model.index_count_ == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
   skinned_depth_.use();
   skinned_depth_.set("u_view_proj", light_view_proj);
   bindModel(skinned_depth_, model);
-  return drawAgents(model, agents.size());
+  return drawAgents(skinned_depth_, model, agents.size(), level);
 }
 
 FrameStats CrowdRenderer::drawImpostorDepth(const Mat4& light_view_proj, const Vec3& to_light,

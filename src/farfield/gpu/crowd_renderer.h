@@ -12,6 +12,7 @@
 #include "farfield/gpu/program.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/gpu/texture.h"
+#include "farfield/scene/deforming_lod.h"
 #include "farfield/scene/skin.h"
 
 namespace farfield::gpu {
@@ -30,13 +31,15 @@ struct CrowdAgentGpu {
 static_assert(sizeof(CrowdAgentGpu) == 48);
 
 // A skinned model on the GPU with its pose palette. model_to_agent places the skinned (Z-up) model in agent space:
-// feet on z = 0, facing +x, at the agent's scale.
+// feet on z = 0, facing +x, at the agent's scale. Level 0 is the model's mesh; levels 1.. are coarser index buffers
+// over the same vertices (scene::deformingLevels), drawn with the same palette.
 class SkinnedGpuModel {
  public:
   // poses[p] holds the joint matrices of pose p (one per joint, scene::jointMatrices). Throws farfield::Error for
-  // an empty palette or a pose with the wrong joint count (after validateSkinnedModel).
+  // an empty palette, a pose with the wrong joint count (after validateSkinnedModel) or a level whose indices or
+  // source triangles are out of range.
   SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& model_to_agent,
-                  const std::vector<std::vector<Mat4>>& poses);
+                  const std::vector<std::vector<Mat4>>& poses, std::span<const scene::DeformingLevel> levels = {});
   ~SkinnedGpuModel();
   SkinnedGpuModel(const SkinnedGpuModel&) = delete;
   SkinnedGpuModel& operator=(const SkinnedGpuModel&) = delete;
@@ -44,7 +47,8 @@ class SkinnedGpuModel {
   uint32_t jointCount() const { return joint_count_; }
   uint32_t poseCount() const { return pose_count_; }
   uint32_t indexCount() const { return index_count_; }
-  uint64_t triangleCount() const { return index_count_ / 3; }
+  size_t levelCount() const { return levels_.size(); }
+  uint64_t triangleCount(size_t level = 0) const { return levels_[level].index_count / 3; }
   const Mat4& modelToAgent() const { return model_to_agent_; }
   size_t gpuBytes() const { return bytes_; }
 
@@ -52,6 +56,11 @@ class SkinnedGpuModel {
   friend class CrowdRenderer;
   uint32_t vao_ = 0, vbo_ = 0, ibo_ = 0, palette_ = 0, regions_ = 0;
   uint32_t index_count_ = 0, joint_count_ = 0, pose_count_ = 0;
+  // Per level: its range of the index buffer and its first triangle's colour region in the regions buffer.
+  struct Level {
+    uint32_t first_index = 0, index_count = 0, first_triangle = 0;
+  };
+  std::vector<Level> levels_;
   Mat4 model_to_agent_{1.0f};
   Vec4 base_color_{1.0f};
   Texture texture_;
@@ -114,7 +123,7 @@ class CrowdRenderer {
   // Draw into the bound target (RenderTarget::bindForOpaquePass), no clear, no wait: the agents of one model in one
   // instanced draw. Agents' `index` must be < the model's pose count (FF_CHECK).
   FrameStats drawSkinned(const Camera& camera, const SkinnedGpuModel& model, std::span<const CrowdAgentGpu> agents,
-                         const LightSettings& light);
+                         const LightSettings& light, size_t level = 0);
   // One instanced draw of quads; agents' `index` < frames and `view` < azimuths * elevations (FF_CHECK). With
   // blend_views, each quad blends the four views around its direction to the eye (bilinear in azimuth and
   // elevation) instead of showing `view`.
@@ -138,15 +147,15 @@ class CrowdRenderer {
   // `to_light` (unit, towards the light), each agent's `view` being its view cell towards the light, with the
   // baked depth per texel.
   FrameStats drawSkinnedDepth(const Mat4& light_view_proj, const SkinnedGpuModel& model,
-                              std::span<const CrowdAgentGpu> agents);
+                              std::span<const CrowdAgentGpu> agents, size_t level = 0);
   FrameStats drawImpostorDepth(const Mat4& light_view_proj, const Vec3& to_light, const ImpostorAtlasGpu& atlas,
                                std::span<const CrowdAgentGpu> agents);
 
  private:
   uint32_t uploadAgents(std::span<const CrowdAgentGpu> agents);
   void bindModel(const Program& p, const SkinnedGpuModel& model) const;
-  // One instanced draw of the model's mesh for `count` agents (program, model and agents bound), and its counts.
-  FrameStats drawAgents(const SkinnedGpuModel& model, size_t count) const;
+  // One instanced draw of the model's level for `count` agents (program, model and agents bound), and its counts.
+  FrameStats drawAgents(const Program& p, const SkinnedGpuModel& model, size_t count, size_t level) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
   Program skinned_, capture_, impostor_, impostor_blend_, skinned_depth_, impostor_depth_;
   uint32_t agents_ = 0, empty_vao_ = 0, tints_ = 0, outfits_ = 0;

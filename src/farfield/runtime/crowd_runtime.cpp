@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "farfield/core/error.h"
+#include "farfield/core/timer.h"
 
 namespace farfield::runtime {
 
@@ -28,6 +29,8 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
     throw Error("crowd runtime", "palette poses must be a positive multiple of the impostor frames");
   if (options.atlas_from_bound && (!(options.bound_switch_m > 0.0) || !(options.bound_focal_px > 0.0)))
     throw Error("crowd runtime", "the bound's switch distance and focal length must be positive");
+  if (!(options.geometry_lod_px >= 0.0) || !std::isfinite(options.geometry_lod_px))
+    throw Error("crowd runtime", "the geometry's level-of-detail bound must be a finite number of pixels >= 0");
   if (!options.region_tints.empty()) renderer_.setRegionTints(options.region_tints);
   for (size_t m = 0; m < models.size(); ++m) {
     const scene::SkinnedModel& sm = models[m];
@@ -49,7 +52,6 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
     const float s = model_options[m].height_m / height;
     const Vec3 c = raw.center();
     const Mat4 to_agent = glm::scale(Mat4(1.0f), Vec3(s)) * glm::translate(Mat4(1.0f), Vec3(-c.x, -c.y, -raw.lo.z)) * facing;
-    model.gpu = std::make_unique<gpu::SkinnedGpuModel>(sm, to_agent, poses);
     Box3 agent_bounds;
     std::vector<std::vector<Vec3>> pose_positions(poses.size());
     for (size_t p = 0; p < poses.size(); ++p)
@@ -57,6 +59,18 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
         pose_positions[p].push_back(Vec3(to_agent * Vec4(v, 1.0f)));
         agent_bounds.expand(pose_positions[p].back());
       }
+    std::vector<scene::DeformingLevel> levels;
+    if (options.geometry_lod_px > 0.0) {
+      const Stopwatch timer;
+      scene::DeformingLodOptions lod;
+      lod.triangle_ratios = options.lod_ratios;
+      // The colour regions are not passed as groups: holding their borders measured worse on the crowd bench
+      // (docs/BENCHMARKS.md, Crowds: skinned levels of detail).
+      levels = scene::deformingLevels(sm.mesh.indices, pose_positions, lod, sm.name);
+      for (const scene::DeformingLevel& l : levels) model.level_m.push_back(l.error);
+      lod_seconds_ += timer.seconds();
+    }
+    model.gpu = std::make_unique<gpu::SkinnedGpuModel>(sm, to_agent, poses, levels);
     model.centre = agent_bounds.center();
     model.radius = glm::length(agent_bounds.hi - model.centre);
     CrowdAtlasChoice& choice = model.choice;
@@ -83,6 +97,7 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
   }
   for (Lists* l : {&lists_, &caster_lists_}) {
     l->geometry.resize(models_.size());
+    for (size_t m = 0; m < models_.size(); ++m) l->geometry[m].resize(models_[m].level_m.size());
     l->impostors.resize(models_.size());
   }
 }
@@ -157,11 +172,9 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
   const Mat4 view_proj = camera.viewProjection();
   Frustum frustum = Frustum::fromMatrix(view_proj);
   for (Vec4& p : frustum.planes) p /= std::max(glm::length(Vec3(p)), 1e-20f);
-  for (size_t m = 0; m < models_.size(); ++m) {
-    lists_.geometry[m].clear();
-    lists_.impostors[m].clear();
-  }
+  clearLists(lists_);
   drawn_.assign(agents.size(), Drawn::NotDrawn);
+  level_.assign(agents.size(), 0);
   near_.clear();
   const bool budgeted = policy == CrowdPolicy::Mixed && options_.max_geometry_triangles > 0;
   for (size_t i = 0; i < agents.size(); ++i) {
@@ -187,7 +200,7 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
       near_.push_back({distance, uint32_t(i)});  // decided below, nearest first
       continue;
     }
-    addToLists(camera, a, uint32_t(i), impostor);
+    addToLists(camera, a, uint32_t(i), impostor, impostor ? 0 : levelFor(camera, a, uint32_t(i), policy));
   }
   if (near_.empty()) return;
   std::sort(near_.begin(), near_.end());
@@ -195,21 +208,43 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
   bool full = false;
   for (const auto& [distance, i] : near_) {
     const CrowdAgentState& a = agents[i];
-    const uint64_t t = models_[a.model].gpu->triangleCount();
+    const uint32_t level = levelFor(camera, a, i, policy);
+    const uint64_t t = models_[a.model].gpu->triangleCount(level);
     full = full || triangles + t > options_.max_geometry_triangles;
     if (!full) triangles += t;
     stats.over_budget += full ? 1 : 0;
-    addToLists(camera, a, i, full);
+    addToLists(camera, a, i, full, level);
   }
 }
 
-void CrowdRuntime::addToLists(const Camera& camera, const CrowdAgentState& a, uint32_t i, bool impostor) {
+uint32_t CrowdRuntime::levelFor(const Camera& camera, const CrowdAgentState& a, uint32_t i,
+                                CrowdPolicy policy) const {
+  const std::vector<double>& level_m = models_[a.model].level_m;
+  if (policy != CrowdPolicy::Mixed || level_m.size() < 2) return 0;
+  const double allowed =
+      options_.geometry_lod_px * double(glm::length(camera.eye - spheres_[i].centre)) / focalOf(camera);
+  uint32_t level = 0;
+  for (uint32_t l = 1; l < level_m.size(); ++l)
+    if (level_m[l] <= allowed) level = l;
+  return level;
+}
+
+void CrowdRuntime::clearLists(Lists& lists) {
+  for (size_t m = 0; m < models_.size(); ++m) {
+    for (auto& level : lists.geometry[m]) level.clear();
+    lists.impostors[m].clear();
+  }
+}
+
+void CrowdRuntime::addToLists(const Camera& camera, const CrowdAgentState& a, uint32_t i, bool impostor,
+                              uint32_t level) {
   const Model& model = models_[a.model];
   gpu::CrowdAgentGpu g = record(a);
   drawn_[i] = impostor ? Drawn::Impostor : Drawn::Geometry;
   if (!impostor) {
     g.index = cycleIndex(a.phase, options_.palette_poses);
-    lists_.geometry[a.model].push_back(g);
+    level_[i] = uint8_t(level);
+    lists_.geometry[a.model][level].push_back(g);
     return;
   }
   g.index = cycleIndex(a.phase, model.choice.frames);
@@ -220,14 +255,18 @@ void CrowdRuntime::addToLists(const Camera& camera, const CrowdAgentState& a, ui
 
 CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats) {
   for (size_t m = 0; m < models_.size(); ++m) {
-    stats.geometry += lists_.geometry[m].size();
     stats.impostors += lists_.impostors[m].size();
     auto add = [&](const gpu::FrameStats& f) {
       stats.draw.triangles += f.triangles;
       stats.draw.draw_calls += f.draw_calls;
       stats.draw.objects += f.objects;
     };
-    add(renderer_.drawSkinned(camera, *models_[m].gpu, lists_.geometry[m], light));
+    for (size_t l = 0; l < lists_.geometry[m].size(); ++l) {
+      const size_t n = lists_.geometry[m][l].size();
+      stats.geometry += n;
+      stats.coarser += l > 0 ? n : 0;
+      add(renderer_.drawSkinned(camera, *models_[m].gpu, lists_.geometry[m][l], light, l));
+    }
     add(renderer_.drawImpostors(camera, *models_[m].impostor->atlas, lists_.impostors[m], light, options_.blend_views));
   }
   return stats;
@@ -253,10 +292,7 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
   stats.shadow_texel_m = fit.projection.texel_m;
   if (fit.casters.empty()) return;
   const Vec3 to_light = -glm::normalize(light.direction);
-  for (size_t m = 0; m < models_.size(); ++m) {
-    caster_lists_.geometry[m].clear();
-    caster_lists_.impostors[m].clear();
-  }
+  clearLists(caster_lists_);
   // Each caster in the representation the camera's policy gives it; impostors show their view towards the light.
   for (uint32_t i : fit.casters) {
     const CrowdAgentState& a = agents[i];
@@ -264,7 +300,8 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
     gpu::CrowdAgentGpu g = record(a);
     if (!castsAsImpostor(camera, a, i, policy, shadows)) {
       g.index = cycleIndex(a.phase, options_.palette_poses);
-      caster_lists_.geometry[a.model].push_back(g);
+      const uint32_t level = drawn_[i] == Drawn::Geometry ? level_[i] : levelFor(camera, a, i, policy);
+      caster_lists_.geometry[a.model][level].push_back(g);
     } else {
       g.index = cycleIndex(a.phase, model.choice.frames);
       g.view = uint32_t(impostor::nearestView(model.impostor->grid, turn(-a.heading, to_light)));
@@ -272,7 +309,8 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
     }
   }
   for (size_t m = 0; m < models_.size(); ++m) {
-    renderer_.drawSkinnedDepth(fit.projection.view_proj, *models_[m].gpu, caster_lists_.geometry[m]);
+    for (size_t l = 0; l < caster_lists_.geometry[m].size(); ++l)
+      renderer_.drawSkinnedDepth(fit.projection.view_proj, *models_[m].gpu, caster_lists_.geometry[m][l], l);
     renderer_.drawImpostorDepth(fit.projection.view_proj, to_light, *models_[m].impostor->atlas,
                                 caster_lists_.impostors[m]);
   }

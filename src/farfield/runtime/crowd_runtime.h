@@ -69,6 +69,12 @@ struct CrowdRuntimeOptions {
   // outside the view then cast their shadows as impostors. A crowd as dense near the camera as far from it costs
   // geometry in proportion to its density without it (100,000 agents on the default city: 59 skinned agents a frame).
   uint64_t max_geometry_triangles = 0;
+  // Mixed's skinned agents at levels of detail that hold in every pose (scene::deformingLevels over the palette's
+  // poses in agent space, each level's distance to the mesh measured over every palette pose): an agent drawn as
+  // geometry takes the coarsest level whose distance stays within geometry_lod_px pixels at its distance; 0: the
+  // mesh alone. The Geometry policy (the baseline) always draws the mesh.
+  double geometry_lod_px = 0.0;
+  std::vector<double> lod_ratios{0.5, 0.25, 0.125, 0.0625};  // the levels' triangles as fractions of the mesh's
 };
 
 // The crowd's shadows (drawShadowed).
@@ -101,6 +107,7 @@ struct CrowdFrameStats {
   size_t geometry = 0;
   size_t impostors = 0;
   size_t over_budget = 0;  // of impostors: inside their switch distance, left out of Mixed's geometry budget
+  size_t coarser = 0;      // of geometry: drawn at a level of detail coarser than the mesh (geometry_lod_px)
   size_t shadow_casters = 0;  // drawShadowed: agents drawn into the shadow map
   float shadow_texel_m = 0.0f;
   gpu::FrameStats draw;
@@ -143,6 +150,9 @@ class CrowdRuntime {
   size_t atlasBytes() const;
   float cycleSeconds(size_t m) const { return models_[m].cycle_s; }
   uint64_t modelTriangles(size_t m) const { return models_[m].gpu->triangleCount(); }
+  // Model m's levels of detail: level 0 is the mesh (distance 0); their distances to it in agent metres.
+  std::span<const double> levelDistances(size_t m) const { return models_[m].level_m; }
+  double lodSeconds() const { return lod_seconds_; }
 
  private:
   struct Model {
@@ -152,18 +162,23 @@ class CrowdRuntime {
     float radius = 1.0f;
     float cycle_s = 1.0f;
     CrowdAtlasChoice choice;
+    std::vector<double> level_m{0.0};  // per level of detail: its distance to the mesh (agent metres)
   };
   // Agents' GPU records by model and representation (culled with the camera's frustum unless null).
   struct Lists {
-    std::vector<std::vector<gpu::CrowdAgentGpu>> geometry, impostors;  // per model
+    std::vector<std::vector<std::vector<gpu::CrowdAgentGpu>>> geometry;  // per model, per level of detail
+    std::vector<std::vector<gpu::CrowdAgentGpu>> impostors;               // per model
   };
+  void clearLists(Lists& lists);
   void classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                 CrowdFrameStats& stats);
   // Whether agent i casts its shadow as an impostor: under Mixed as classify drew it (after classify).
   bool castsAsImpostor(const Camera& camera, const CrowdAgentState& a, uint32_t i, CrowdPolicy policy,
                        const CrowdShadowOptions& shadows) const;
-  // Agent i into this frame's lists, as an impostor (its nearest view to the eye) or as geometry.
-  void addToLists(const Camera& camera, const CrowdAgentState& a, uint32_t i, bool impostor);
+  // Agent i into this frame's lists, as an impostor (its nearest view to the eye) or as geometry at `level`.
+  void addToLists(const Camera& camera, const CrowdAgentState& a, uint32_t i, bool impostor, uint32_t level);
+  // The level of detail agent i takes as geometry under the policy (Mixed: the coarsest within geometry_lod_px).
+  uint32_t levelFor(const Camera& camera, const CrowdAgentState& a, uint32_t i, CrowdPolicy policy) const;
   // Whether the box around the sphere lies behind cullBehind's depth over its whole footprint.
   bool hidden(const Mat4& view_proj, const Vec3& centre, float radius) const;
   CrowdFrameStats drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats);
@@ -183,11 +198,13 @@ class CrowdRuntime {
   // classify: per agent, how this frame draws it (castShadows casts it alike).
   enum class Drawn : uint8_t { NotDrawn, Geometry, Impostor };
   std::vector<Drawn> drawn_;
+  std::vector<uint8_t> level_;  // classify: per agent drawn as geometry, its level of detail
   std::vector<std::pair<float, uint32_t>> near_;  // classify: (distance, agent) inside the switch, under a budget
   std::vector<double> switch_m_;       // prepareFrame: per model, this frame's camera
   gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
   std::vector<float> depth_rows_;
   bool cull_next_ = false;
+  double lod_seconds_ = 0.0;
   std::unique_ptr<gpu::ShadowMap> shadow_map_;
   std::unique_ptr<gpu::ShadowReceiver> receiver_;
   gpu::ShadowProjection shadow_projection_;

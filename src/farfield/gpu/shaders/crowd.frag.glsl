@@ -32,6 +32,7 @@ uniform uint u_outfits;
 #endif
 
 layout(std430, binding = 3) readonly buffer Regions { uint regions[]; };
+uniform uint u_first_triangle;  // the drawn level's first triangle in regions (SkinnedGpuModel)
 uniform vec4 u_base_color;
 uniform int u_textured;
 layout(binding = 0) uniform sampler2D u_texture;
@@ -41,7 +42,7 @@ void main() {
   if (u_textured != 0) albedo *= texture(u_texture, v_uv);
   if (albedo.a < 0.5) discard;
 #ifndef FF_DEPTH_ONLY
-  const uint region = regions[gl_PrimitiveID];
+  const uint region = regions[u_first_triangle + uint(gl_PrimitiveID)];
   vec3 n = v_normal;
   if (dot(n, n) < 1e-12) n = cross(dFdx(v_world), dFdy(v_world));
   n = normalize(n);
