@@ -104,6 +104,10 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
   bench->add_option("--skinned-lod", o.runtime.geometry_lod_px,
                     "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels (0: the mesh)")
       ->capture_default_str();
+  bench->add_option("--skinned-lod-ratios", o.runtime.lod_ratios,
+                    "The levels' triangles as fractions of the mesh's, decreasing, comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
   bench->add_option("--samples", o.samples, "Sample frames saved per run")->capture_default_str();
   bench->add_flag("--atlas-from-bound", o.runtime.atlas_from_bound,
                   "Choose views, frames and texel per model from --error-px for impostors from --bound-switch on");

@@ -74,7 +74,8 @@ struct CrowdRuntimeOptions {
   // geometry takes the coarsest level whose distance stays within geometry_lod_px pixels at its distance; 0: the
   // mesh alone. The Geometry policy (the baseline) always draws the mesh.
   double geometry_lod_px = 0.0;
-  std::vector<double> lod_ratios{0.5, 0.25, 0.125, 0.0625};  // the levels' triangles as fractions of the mesh's
+  // The levels' triangles as fractions of the mesh's: close steps, so that the rule finds a level near each distance.
+  std::vector<double> lod_ratios{0.5, 0.35, 0.25, 0.18, 0.125, 0.09, 0.0625};
 };
 
 // The crowd's shadows (drawShadowed).

@@ -164,7 +164,10 @@ class Simplifier {
     }
   }
 
-  // Each pose's face planes weighted by area, and the planes through boundary edges perpendicular to their face.
+  // Each pose's face planes weighted by the square root of their area, and the planes through feature edges
+  // perpendicular to their face, weighted by ten times the edge's length. Weights by area (Garland and Heckbert's)
+  // made small, pointed parts cheap to merge away: CesiumMan's 584-triangle level was 4.1 cm off, 2.2 cm with these
+  // (and unweighted planes 2.4 cm, with the finer levels worse).
   void initQuadrics() {
     const size_t k = poses_.size();
     quadrics_.assign(points_.size() * k, Quadric{});
@@ -190,7 +193,7 @@ class Simplifier {
         const double len = glm::length(cr);
         if (!(len > 0.0)) continue;
         const DVec3 n = cr / len;
-        for (uint32_t pt : i) quadrics_[pt * k + p].addPlane(n, -glm::dot(n, a), 0.5 * len);
+        for (uint32_t pt : i) quadrics_[pt * k + p].addPlane(n, -glm::dot(n, a), std::sqrt(0.5 * len));
         for (int c = 0; c < 3; ++c) {
           const uint32_t u = i[c], v = i[(c + 1) % 3];
           const Uses& e = edge_uses[key(u, v)];
@@ -199,7 +202,7 @@ class Simplifier {
           const DVec3 m = glm::cross(ev, n);
           const double ml = glm::length(m);
           if (!(ml > 0.0)) continue;
-          const double w = 10.0 * glm::dot(ev, ev);  // features held ten times as firmly as faces
+          const double w = 10.0 * glm::length(ev);  // features held ten times as firmly as faces
           for (uint32_t pt : {u, v}) quadrics_[pt * k + p].addPlane(m / ml, -glm::dot(m / ml, pu), w);
         }
       }
