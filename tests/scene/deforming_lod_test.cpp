@@ -236,5 +236,32 @@ TEST(DeformingLod, GroupBordersStayWhereTheyAre) {
       [&] { deformingLevels(idx, poses, options, "grid", std::span(groups).first(3)); }, {"3 triangle groups for 128"});
 }
 
+TEST(DeformingLod, AMeshStoredAVertexPerCornerMergesByItsUvs) {
+  // The grid with every triangle corner its own vertex (flat shading stores meshes so): without uvs every point is
+  // split into as many sides as it has triangles and nothing merges; with the uvs (one chart) the corners of one uv
+  // are one side, and the levels are those of the welded grid's quality.
+  const int n = 8;
+  const std::vector<uint32_t> welded = gridIndices(n);
+  const std::vector<Vec3> grid = gridPose(n, 0.0f);
+  std::vector<uint32_t> idx;
+  std::vector<std::vector<Vec3>> poses(2);
+  std::vector<Vec2> uvs;
+  for (uint32_t i : welded) {
+    idx.push_back(uint32_t(poses[0].size()));
+    poses[0].push_back(grid[i]);
+    poses[1].push_back(grid[i] + Vec3(0.0f, 0.0f, 0.01f * (grid[i].x * grid[i].x + grid[i].y * grid[i].y)));
+    uvs.emplace_back(grid[i].x / float(n), grid[i].y / float(n));
+  }
+  DeformingLodOptions options;
+  options.triangle_ratios = {0.5, 0.25};
+  EXPECT_TRUE(deformingLevels(idx, poses, options, "corners").empty());
+  const std::vector<DeformingLevel> levels = deformingLevels(idx, poses, options, "corners", {}, uvs);
+  ASSERT_EQ(levels.size(), 2u);
+  EXPECT_LE(levels[1].indices.size() / 3, welded.size() / 3 / 4);
+  EXPECT_LT(levels[1].error, 0.25);
+  farfield::test::expectErrorMentions(
+      [&] { deformingLevels(idx, poses, options, "corners", {}, std::span(uvs).first(5)); }, {"5 uvs for 384 vertices"});
+}
+
 }  // namespace
 }  // namespace farfield::scene

@@ -66,7 +66,7 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
       lod.triangle_ratios = options.lod_ratios;
       // The colour regions are not passed as groups: holding their borders measured worse on the crowd bench
       // (docs/BENCHMARKS.md, Crowds: skinned levels of detail).
-      levels = scene::deformingLevels(sm.mesh.indices, pose_positions, lod, sm.name);
+      levels = scene::deformingLevels(sm.mesh.indices, pose_positions, lod, sm.name, {}, sm.mesh.uvs);
       for (const scene::DeformingLevel& l : levels) model.level_m.push_back(l.error);
       lod_seconds_ += timer.seconds();
     }

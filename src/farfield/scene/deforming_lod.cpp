@@ -17,6 +17,7 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/core/log.h"
 
 namespace farfield::scene {
 
@@ -69,9 +70,20 @@ void validate(std::span<const uint32_t> indices, std::span<const std::vector<Vec
 class Simplifier {
  public:
   Simplifier(std::span<const uint32_t> indices, std::span<const std::vector<Vec3>> poses,
-             std::span<const uint32_t> groups, double max_turn_deg)
+             std::span<const uint32_t> groups, std::span<const Vec2> uvs, double max_turn_deg)
       : poses_(poses), groups_(groups), cos_turn_(std::cos(max_turn_deg * kPi / 180.0)) {
     weld();
+    side_.resize(point_of_.size());
+    for (const std::vector<uint32_t>& vertices : points_)
+      for (uint32_t v : vertices) {
+        side_[v] = v;
+        if (!uvs.empty())
+          for (uint32_t w : vertices)
+            if (uvs[w] == uvs[v]) {
+              side_[v] = w;  // the point's first vertex of this uv
+              break;
+            }
+      }
     for (size_t t = 0; t * 3 < indices.size(); ++t) {
       const std::array<uint32_t, 3> c{indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]};
       if (point_of_[c[0]] == point_of_[c[1]] || point_of_[c[1]] == point_of_[c[2]] ||
@@ -219,9 +231,10 @@ class Simplifier {
     }
   }
 
-  // Which vertex of v each vertex of u becomes: the one beside it in a triangle of the edge, so that a point split
-  // by a seam merges along the seam, each side into its own side. False when a vertex of u that triangles use
-  // has no such vertex (u's side of the seam does not reach v) or two of them.
+  // Which vertex of v each vertex of u becomes: the one beside a vertex of u's side in a triangle of the edge, so that
+  // a point split by a seam merges along the seam, each side into its own side. A side is the vertex itself, or with
+  // uvs all the point's vertices of one uv (normals split for flat shading). False when a vertex of u that triangles
+  // use has no such vertex (its side does not reach v) or vertices of two sides.
   bool mapping(uint32_t u, uint32_t v) {
     map_.clear();
     for (uint32_t a : points_[u]) {
@@ -230,13 +243,15 @@ class Simplifier {
       for (uint32_t t : point_tris_[u]) {
         if (!alive_[t]) continue;
         const std::array<uint32_t, 3>& c = tris_[t];
-        if (c[0] != a && c[1] != a && c[2] != a) continue;
-        used = true;
-        for (uint32_t x : c)
-          if (point_of_[x] == v) {
-            if (b != UINT32_MAX && b != x) return false;
-            b = x;
-          }
+        used = used || c[0] == a || c[1] == a || c[2] == a;
+        uint32_t at_u = UINT32_MAX, at_v = UINT32_MAX;
+        for (uint32_t x : c) {
+          if (point_of_[x] == u) at_u = x;
+          if (point_of_[x] == v) at_v = x;
+        }
+        if (at_v == UINT32_MAX || side_[at_u] != side_[a]) continue;
+        if (b != UINT32_MAX && side_[b] != side_[at_v]) return false;
+        if (b == UINT32_MAX) b = at_v;
       }
       if (!used) continue;
       if (b == UINT32_MAX) return false;
@@ -364,6 +379,7 @@ class Simplifier {
   std::span<const uint32_t> groups_;  // per mesh triangle; empty: one group
   double cos_turn_;
   std::vector<uint32_t> point_of_;             // vertex -> point
+  std::vector<uint32_t> side_;                 // vertex -> its side of its point (mapping)
   std::vector<std::vector<uint32_t>> points_;  // point -> its vertices
   std::vector<std::array<uint32_t, 3>> tris_;  // corners as vertices
   std::vector<uint32_t> source_;               // per triangle: its index in the mesh
@@ -424,8 +440,11 @@ double deformingDistance(std::span<const uint32_t> full, std::span<const uint32_
 std::vector<DeformingLevel> deformingLevels(std::span<const uint32_t> indices,
                                             std::span<const std::vector<Vec3>> poses,
                                             const DeformingLodOptions& options, const std::string& source,
-                                            std::span<const uint32_t> triangle_groups) {
+                                            std::span<const uint32_t> triangle_groups, std::span<const Vec2> uvs) {
   validate(indices, poses, source);
+  if (!uvs.empty() && uvs.size() != poses[0].size())
+    throw Error(source, "deforming LOD: " + std::to_string(uvs.size()) + " uvs for " +
+                            std::to_string(poses[0].size()) + " vertices");
   if (!triangle_groups.empty() && triangle_groups.size() * 3 != indices.size())
     throw Error(source, "deforming LOD: " + std::to_string(triangle_groups.size()) + " triangle groups for " +
                             std::to_string(indices.size() / 3) + " triangles");
@@ -434,11 +453,15 @@ std::vector<DeformingLevel> deformingLevels(std::span<const uint32_t> indices,
     if (!(r > 0.0 && r < 1.0) || (i > 0 && !(r < options.triangle_ratios[i - 1])))
       throw Error(source, "deforming LOD: triangle ratios must decrease within (0, 1)");
   }
-  Simplifier simplifier(indices, poses, triangle_groups, options.max_normal_turn_deg);
+  Simplifier simplifier(indices, poses, triangle_groups, uvs, options.max_normal_turn_deg);
   const size_t start = simplifier.liveTriangles();
   std::vector<DeformingLevel> levels;
   for (double r : options.triangle_ratios) {
-    if (!simplifier.reduceTo(size_t(std::floor(r * double(start))))) break;
+    if (!simplifier.reduceTo(size_t(std::floor(r * double(start))))) {
+      FF_INFO(source << ": levels of detail stop at " << simplifier.liveTriangles() << " of " << start
+                     << " triangles: no merge left that keeps seams, features and every pose's orientation");
+      break;
+    }
     DeformingLevel level = simplifier.level();
     level.error = deformingDistance(indices, level.indices, poses);
     levels.push_back(std::move(level));

@@ -37,13 +37,16 @@ struct DeformingLodOptions {
 // surface split for their attributes (uv or normal seams): such a point merges along its seam, each of its vertices
 // into the vertex of the same side. triangle_groups (one per triangle, or empty) holds per-triangle attributes such as
 // colour regions: the borders between groups, like the surface's own border, are features, held by their quadrics,
-// and a point on one moves only along it (where features meet, it stays). Levels come coarsest last. Throws
-// farfield::Error naming `source` for no pose, poses of different sizes, an index count not a multiple of 3, an index
-// out of range, a non-finite position or groups not one per triangle.
+// and a point on one moves only along it (where features meet, it stays). With uvs (one per vertex, or empty), a
+// point's vertices of one uv are one side of it (normals split for flat shading), so meshes stored a vertex per
+// triangle corner merge too. Levels come coarsest last. Throws farfield::Error naming `source` for no pose, poses of
+// different sizes, an index count not a multiple of 3, an index out of range, a non-finite position, groups not one
+// per triangle or uvs not one per vertex.
 std::vector<DeformingLevel> deformingLevels(std::span<const uint32_t> indices,
                                             std::span<const std::vector<Vec3>> poses,
                                             const DeformingLodOptions& options, const std::string& source,
-                                            std::span<const uint32_t> triangle_groups = {});
+                                            std::span<const uint32_t> triangle_groups = {},
+                                            std::span<const Vec2> uvs = {});
 
 // The largest distance, over the poses, from the full mesh's vertices to the level's surface and from the level's
 // triangles (their centroids and edge midpoints) to the full mesh's surface (a two-sided, sampled Hausdorff
