@@ -102,7 +102,8 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
                     "switch distance, the others as impostors (0: none)")
       ->capture_default_str();
   bench->add_option("--skinned-lod", o.runtime.geometry_lod_px,
-                    "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels (0: the mesh)")
+                    "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels "
+                    "(0: the mesh)")
       ->capture_default_str();
   bench->add_option("--skinned-lod-ratios", o.runtime.lod_ratios,
                     "The levels' triangles as fractions of the mesh's, decreasing, comma-separated")

@@ -34,6 +34,14 @@ CrowdRuntimeOptions smallAtlas(int poses) {
   return o;
 }
 
+// Whether two frames have the same colours, pixel for pixel.
+bool same(const image::ColorImage& a, const image::ColorImage& b) {
+  return std::equal(a.pixels().begin(), a.pixels().end(), b.pixels().begin(),
+                    [](const image::Rgba8& x, const image::Rgba8& y) {
+                      return x.r == y.r && x.g == y.g && x.b == y.b;
+                    });
+}
+
 CrowdModelOptions foxOptions() {
   CrowdModelOptions mo;
   mo.height_m = 0.8f;
@@ -141,12 +149,6 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetDrawsTheNearestAgentsAsGeometry) {
       frame({{&unbudgeted, CrowdPolicy::Geometry}, {&unbudgeted, CrowdPolicy::Impostor}}, {near, far}, nullptr);
   const image::ColorImage opposite =
       frame({{&unbudgeted, CrowdPolicy::Impostor}, {&unbudgeted, CrowdPolicy::Geometry}}, {near, far}, nullptr);
-  const auto same = [](const image::ColorImage& a, const image::ColorImage& b) {
-    return std::equal(a.pixels().begin(), a.pixels().end(), b.pixels().begin(),
-                      [](const image::Rgba8& x, const image::Rgba8& y) {
-                        return x.r == y.r && x.g == y.g && x.b == y.b;
-                      });
-  };
   EXPECT_TRUE(same(budgeted, expected));
   EXPECT_FALSE(same(budgeted, opposite));
   // Without the budget every agent inside the switch is geometry.
@@ -208,9 +210,11 @@ TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) 
     const int level = levelOf(st.draw.triangles);
     ASSERT_GE(level, 0) << x;
     EXPECT_EQ(st.coarser, level > 0 ? 1u : 0u);
-    // The agent's centre lies between its feet and its head: the rule's level at those distances brackets it.
-    const double near_m = glm::length(camera.eye - Vec3(x, 0.0f, std::min(1.7f, 1.75f)));
-    const double far_m = std::max(glm::length(camera.eye - Vec3(x, 0.0f, 0.0f)), glm::length(camera.eye - Vec3(x, 0.5f, 1.75f)));
+    // The agent's centre lies within its box: the rule's levels at the box's nearest point (at eye height) and at
+    // its farthest bracket the level drawn.
+    const double near_m = glm::length(camera.eye - Vec3(x, 0.0f, camera.eye.z));
+    const double far_m = std::max(glm::length(camera.eye - Vec3(x, 0.0f, 0.0f)),
+                                  glm::length(camera.eye - Vec3(x, 0.5f, 1.75f)));
     EXPECT_GE(size_t(level), coarsest(near_m * 0.95)) << x;
     EXPECT_LE(size_t(level), coarsest(far_m * 1.05)) << x;
     EXPECT_GE(level, previous) << x;
@@ -257,8 +261,7 @@ TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) 
   ASSERT_GT(n_mesh, 100u);
   EXPECT_GT(double(both) / double(either), 0.8);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean_level[c] / double(n_level), mean_mesh[c] / double(n_mesh), 12.0) << c;
-  EXPECT_FALSE(std::equal(mesh.first.pixels().begin(), mesh.first.pixels().end(), level.first.pixels().begin(),
-                          [](const image::Rgba8& x, const image::Rgba8& y) { return x.r == y.r && x.g == y.g && x.b == y.b; }));
+  EXPECT_FALSE(same(mesh.first, level.first));
 }
 
 // cullBehind: agents behind a wall drawn first are left out and the frame is unchanged, pixel for pixel and id for id;

@@ -53,7 +53,8 @@ std::vector<uint32_t> gridIndices(int n) {
   std::vector<uint32_t> idx;
   const auto at = [n](int x, int y) { return uint32_t(y * (n + 1) + x); };
   for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) idx.insert(idx.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y), at(x + 1, y + 1), at(x, y + 1)});
+    for (int x = 0; x < n; ++x)
+      idx.insert(idx.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y), at(x + 1, y + 1), at(x, y + 1)});
   return idx;
 }
 
@@ -230,8 +231,9 @@ TEST(DeformingLod, GroupBordersStayWhereTheyAre) {
   const std::vector<DeformingLevel> ungrouped = deformingLevels(idx, poses, options, "grid");
   ASSERT_EQ(grouped.size(), 2u);
   ASSERT_EQ(ungrouped.size(), 2u);
-  for (const DeformingLevel& level : grouped) EXPECT_NEAR(leftArea(level), leftArea(DeformingLevel{idx, all, 0.0}), 1e-4);
-  EXPECT_GT(std::abs(leftArea(ungrouped.back()) - leftArea(DeformingLevel{idx, all, 0.0})), 0.25);  // without groups the border wanders
+  const double mesh_area = leftArea(DeformingLevel{idx, all, 0.0});
+  for (const DeformingLevel& level : grouped) EXPECT_NEAR(leftArea(level), mesh_area, 1e-4);
+  EXPECT_GT(std::abs(leftArea(ungrouped.back()) - mesh_area), 0.25);  // without groups the border wanders
   farfield::test::expectErrorMentions(
       [&] { deformingLevels(idx, poses, options, "grid", std::span(groups).first(3)); }, {"3 triangle groups for 128"});
 }
@@ -260,7 +262,8 @@ TEST(DeformingLod, AMeshStoredAVertexPerCornerMergesByItsUvs) {
   EXPECT_LE(levels[1].indices.size() / 3, welded.size() / 3 / 4);
   EXPECT_LT(levels[1].error, 0.25);
   farfield::test::expectErrorMentions(
-      [&] { deformingLevels(idx, poses, options, "corners", {}, std::span(uvs).first(5)); }, {"5 uvs for 384 vertices"});
+      [&] { deformingLevels(idx, poses, options, "corners", {}, std::span(uvs).first(5)); },
+      {"5 uvs for 384 vertices"});
 }
 
 }  // namespace

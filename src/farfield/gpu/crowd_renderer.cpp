@@ -60,12 +60,12 @@ SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& m
       v.weights[k] = model.weights[i][k];
     }
   }
-  index_count_ = uint32_t(model.mesh.indices.size());
   // Every level's indices in one buffer, and its triangles' regions (read by gl_PrimitiveID from its first).
   std::vector<uint32_t> indices = model.mesh.indices;
-  std::vector<uint32_t> regions(index_count_ / 3, 0u);
+  const size_t mesh_triangles = indices.size() / 3;
+  std::vector<uint32_t> regions(mesh_triangles, 0u);
   for (size_t t = 0; t < model.regions.size() && t < regions.size(); ++t) regions[t] = model.regions[t];
-  levels_.push_back({0, index_count_, 0});
+  levels_.push_back({0, uint32_t(indices.size()), 0});
   for (size_t l = 0; l < levels.size(); ++l) {
     const scene::DeformingLevel& level = levels[l];
     if (level.source_triangles.size() * 3 != level.indices.size())
@@ -76,7 +76,8 @@ SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& m
       indices.push_back(i);
     }
     for (uint32_t t : level.source_triangles) {
-      if (t >= index_count_ / 3) throw Error(model.name, "level " + std::to_string(l + 1) + ": source triangle out of range");
+      if (t >= mesh_triangles)
+        throw Error(model.name, "level " + std::to_string(l + 1) + ": source triangle out of range");
       regions.push_back(regions[t]);
     }
   }
@@ -251,7 +252,7 @@ FrameStats CrowdRenderer::drawAgents(const Program& p, const SkinnedGpuModel& mo
 FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuModel& model,
                                       std::span<const CrowdAgentGpu> agents, const LightSettings& light,
                                       size_t level) {
-  if (agents.empty() || model.index_count_ == 0) return {};
+  if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
   skinned_.use();
@@ -328,7 +329,7 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
                l.cell_height);
     capture_.set("u_view_proj", v.view_proj);
     capture_.set("u_capture_dir", v.to_camera);
-    glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.index_count_), GL_UNSIGNED_INT, nullptr, 1);
+    glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.indexCount()), GL_UNSIGNED_INT, nullptr, 1);
   }
   glBindVertexArray(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -336,7 +337,7 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
 
 FrameStats CrowdRenderer::drawSkinnedDepth(const Mat4& light_view_proj, const SkinnedGpuModel& model,
                                            std::span<const CrowdAgentGpu> agents, size_t level) {
-  if (agents.empty() || model.index_count_ == 0) return {};
+  if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
   skinned_depth_.use();

@@ -46,7 +46,7 @@ class SkinnedGpuModel {
 
   uint32_t jointCount() const { return joint_count_; }
   uint32_t poseCount() const { return pose_count_; }
-  uint32_t indexCount() const { return index_count_; }
+  uint32_t indexCount() const { return levels_[0].index_count; }  // the mesh's (level 0)
   size_t levelCount() const { return levels_.size(); }
   uint64_t triangleCount(size_t level = 0) const { return levels_[level].index_count / 3; }
   const Mat4& modelToAgent() const { return model_to_agent_; }
@@ -55,7 +55,7 @@ class SkinnedGpuModel {
  private:
   friend class CrowdRenderer;
   uint32_t vao_ = 0, vbo_ = 0, ibo_ = 0, palette_ = 0, regions_ = 0;
-  uint32_t index_count_ = 0, joint_count_ = 0, pose_count_ = 0;
+  uint32_t joint_count_ = 0, pose_count_ = 0;
   // Per level: its range of the index buffer and its first triangle's colour region in the regions buffer.
   struct Level {
     uint32_t first_index = 0, index_count = 0, first_triangle = 0;

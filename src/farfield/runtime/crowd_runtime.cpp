@@ -125,6 +125,7 @@ size_t CrowdRuntime::atlasBytes() const {
 void CrowdRuntime::prepareFrame(const Camera& camera, std::span<const CrowdAgentState> agents) {
   switch_m_.resize(models_.size());
   for (size_t m = 0; m < models_.size(); ++m) switch_m_[m] = switchDistances(m, camera).both();
+  lod_m_per_m_ = options_.geometry_lod_px / focalOf(camera);
   spheres_.resize(agents.size());
   for (size_t i = 0; i < agents.size(); ++i) {
     const CrowdAgentState& a = agents[i];
@@ -200,7 +201,7 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
       near_.push_back({distance, uint32_t(i)});  // decided below, nearest first
       continue;
     }
-    addToLists(camera, a, uint32_t(i), impostor, impostor ? 0 : levelFor(camera, a, uint32_t(i), policy));
+    addToLists(camera, a, uint32_t(i), impostor, impostor ? 0 : levelFor(a, distance, policy));
   }
   if (near_.empty()) return;
   std::sort(near_.begin(), near_.end());
@@ -208,7 +209,7 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
   bool full = false;
   for (const auto& [distance, i] : near_) {
     const CrowdAgentState& a = agents[i];
-    const uint32_t level = levelFor(camera, a, i, policy);
+    const uint32_t level = levelFor(a, distance, policy);
     const uint64_t t = models_[a.model].gpu->triangleCount(level);
     full = full || triangles + t > options_.max_geometry_triangles;
     if (!full) triangles += t;
@@ -217,12 +218,10 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
   }
 }
 
-uint32_t CrowdRuntime::levelFor(const Camera& camera, const CrowdAgentState& a, uint32_t i,
-                                CrowdPolicy policy) const {
+uint32_t CrowdRuntime::levelFor(const CrowdAgentState& a, float distance, CrowdPolicy policy) const {
   const std::vector<double>& level_m = models_[a.model].level_m;
   if (policy != CrowdPolicy::Mixed || level_m.size() < 2) return 0;
-  const double allowed =
-      options_.geometry_lod_px * double(glm::length(camera.eye - spheres_[i].centre)) / focalOf(camera);
+  const double allowed = lod_m_per_m_ * double(distance);
   uint32_t level = 0;
   for (uint32_t l = 1; l < level_m.size(); ++l)
     if (level_m[l] <= allowed) level = l;
@@ -300,7 +299,9 @@ void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentS
     gpu::CrowdAgentGpu g = record(a);
     if (!castsAsImpostor(camera, a, i, policy, shadows)) {
       g.index = cycleIndex(a.phase, options_.palette_poses);
-      const uint32_t level = drawn_[i] == Drawn::Geometry ? level_[i] : levelFor(camera, a, i, policy);
+      const uint32_t level = drawn_[i] == Drawn::Geometry
+                                 ? level_[i]
+                                 : levelFor(a, glm::length(camera.eye - spheres_[i].centre), policy);
       caster_lists_.geometry[a.model][level].push_back(g);
     } else {
       g.index = cycleIndex(a.phase, model.choice.frames);

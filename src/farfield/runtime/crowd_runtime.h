@@ -178,8 +178,9 @@ class CrowdRuntime {
                        const CrowdShadowOptions& shadows) const;
   // Agent i into this frame's lists, as an impostor (its nearest view to the eye) or as geometry at `level`.
   void addToLists(const Camera& camera, const CrowdAgentState& a, uint32_t i, bool impostor, uint32_t level);
-  // The level of detail agent i takes as geometry under the policy (Mixed: the coarsest within geometry_lod_px).
-  uint32_t levelFor(const Camera& camera, const CrowdAgentState& a, uint32_t i, CrowdPolicy policy) const;
+  // The level of detail an agent `distance` metres from the eye takes as geometry under the policy (Mixed: the
+  // coarsest within geometry_lod_px).
+  uint32_t levelFor(const CrowdAgentState& a, float distance, CrowdPolicy policy) const;
   // Whether the box around the sphere lies behind cullBehind's depth over its whole footprint.
   bool hidden(const Mat4& view_proj, const Vec3& centre, float radius) const;
   CrowdFrameStats drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats);
@@ -202,6 +203,7 @@ class CrowdRuntime {
   std::vector<uint8_t> level_;  // classify: per agent drawn as geometry, its level of detail
   std::vector<std::pair<float, uint32_t>> near_;  // classify: (distance, agent) inside the switch, under a budget
   std::vector<double> switch_m_;       // prepareFrame: per model, this frame's camera
+  double lod_m_per_m_ = 0.0;           // prepareFrame: a level's allowed distance per metre from the eye
   gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
   std::vector<float> depth_rows_;
   bool cull_next_ = false;

@@ -144,6 +144,7 @@ class Simplifier {
 
   DVec3 pos(size_t pose, uint32_t point) const { return DVec3(poses_[pose][points_[point][0]]); }
   uint32_t pointOf(uint32_t t, int corner) const { return point_of_[tris_[t][size_t(corner)]]; }
+  bool hasPoint(uint32_t t, uint32_t w) const { return pointOf(t, 0) == w || pointOf(t, 1) == w || pointOf(t, 2) == w; }
 
   // Vertices at the same position in every pose become one point.
   void weld() {
@@ -267,7 +268,7 @@ class Simplifier {
     uint32_t first = UINT32_MAX;
     int count = 0;
     for (uint32_t t : point_tris_[u]) {
-      if (!alive_[t] || (pointOf(t, 0) != w && pointOf(t, 1) != w && pointOf(t, 2) != w)) continue;
+      if (!alive_[t] || !hasPoint(t, w)) continue;
       if (count++ == 0)
         first = group(t);
       else if (group(t) != first)
@@ -298,13 +299,13 @@ class Simplifier {
     neighbours(v, nv_);
     size_t shared_tris = 0, common = 0;
     for (uint32_t t : point_tris_[u])
-      if (alive_[t] && (pointOf(t, 0) == v || pointOf(t, 1) == v || pointOf(t, 2) == v)) ++shared_tris;
+      if (alive_[t] && hasPoint(t, v)) ++shared_tris;
     for (uint32_t w : nu_) common += std::find(nv_.begin(), nv_.end(), w) != nv_.end() ? 1 : 0;
     if (common != shared_tris || !mapping(u, v)) return false;
     for (uint32_t t : point_tris_[u]) {
       if (!alive_[t]) continue;
-      uint32_t i[3] = {pointOf(t, 0), pointOf(t, 1), pointOf(t, 2)};
-      if (i[0] == v || i[1] == v || i[2] == v) continue;
+      if (hasPoint(t, v)) continue;
+      const uint32_t i[3] = {pointOf(t, 0), pointOf(t, 1), pointOf(t, 2)};
       for (size_t p = 0; p < poses_.size(); ++p) {
         DVec3 q[3], r[3];
         for (int c = 0; c < 3; ++c) {
@@ -332,10 +333,9 @@ class Simplifier {
 
   void pushBest(uint32_t u) {
     if (!point_alive_[u]) return;
-    neighbours(u, cand_);
-    const std::vector<uint32_t> cand = cand_;
+    neighbours(u, cand_);  // cost and valid use their own scratch lists
     Entry best{std::numeric_limits<double>::infinity(), u, u, version_[u]};
-    for (uint32_t v : cand) {
+    for (uint32_t v : cand_) {
       const double c = cost(u, v);
       if (c < best.cost && valid(u, v)) best = {c, u, v, version_[u]};
     }
@@ -347,7 +347,7 @@ class Simplifier {
     FF_CHECK(mapped);
     for (uint32_t t : point_tris_[u]) {
       if (!alive_[t]) continue;
-      if (pointOf(t, 0) == v || pointOf(t, 1) == v || pointOf(t, 2) == v) {
+      if (hasPoint(t, v)) {
         alive_[t] = 0;
         --live_;
         continue;
@@ -365,9 +365,8 @@ class Simplifier {
     std::erase_if(point_tris_[v], [&](uint32_t t) { return !alive_[t]; });
     const size_t k = poses_.size();
     for (size_t p = 0; p < k; ++p) quadrics_[v * k + p] += quadrics_[u * k + p];
-    neighbours(v, around_);
-    const std::vector<uint32_t> around = around_;
-    for (uint32_t w : around) {
+    neighbours(v, around_);  // pushBest fills cand_, not around_
+    for (uint32_t w : around_) {
       ++version_[w];
       pushBest(w);
     }
