@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Sprites per terrain tile (lod-sprite-tiles with the per-frame choice, lod-sprite-tiles-always without) against the
+# Sprites per terrain tile (lod-sprite-tiles with the per-frame choice, lod-sprite-tiles-each-frame deciding on every
+# frame, lod-sprite-tiles-always without a choice) against the
 # whole-frame sprite (lod-sprite, lod-sprite-always) and the high LOD, on the shared DEM and a fractal no test or
 # tuning used, at several tile sizes; then the table.
 # Usage: scripts/bench_terrain_tile_sprites.sh [OUT] [FRAMES]   (FARFIELD=path/to/farfield to use another binary)
@@ -9,7 +10,7 @@ FRAMES=${2:-600}
 FF=${FARFIELD:-build/release/bin/farfield}
 DEM=../shared/data/terrain/bigtujunga_srtm30m_utm11.tif
 FRACTAL=fractal:4097:31:relief=3000:roughness=0.6
-MODES=high,low,lod-sprite,lod-sprite-always,lod-sprite-tiles,lod-sprite-tiles-always
+MODES=high,low,lod-sprite,lod-sprite-always,lod-sprite-tiles,lod-sprite-tiles-each-frame,lod-sprite-tiles-always
 mkdir -p "$OUT"
 common=(--frames "$FRAMES" --epsilon 1 --modes "$MODES" --no-sweeps --no-section5 --quality-stride 5)
 for cells in 128 256 512; do

@@ -42,7 +42,8 @@ TEST(TerrainCostGL, FitsOneSamplePerWorkloadAndMeasuresTheReadBack) {
   o.pixel_errors = {1.0f, 8.0f};
   o.repeats = 1;
   const TerrainCost cost = calibrateTerrainCost(lod, renderer, o);
-  EXPECT_EQ(cost.frame.samples, 2u * 2u * 2u * 2u);  // sizes x views x thresholds x (textured, sprite)
+  // sizes x views x thresholds x (textured, sprite in 1 call, sprite in 15 calls)
+  EXPECT_EQ(cost.frame.samples, 2u * 2u * 2u * 3u);
   EXPECT_GT(cost.readback_ms_per_mpixel, 0.0);
   EXPECT_GT(cost.frameMs(1e5, 1, 64, 64), 0.0);
   EXPECT_GE(cost.frameMs(1e6, 1, 64, 64), cost.frameMs(1e3, 1, 64, 64));
@@ -56,6 +57,11 @@ TEST(TerrainCostGL, FitsOneSamplePerWorkloadAndMeasuresTheReadBack) {
   EXPECT_THROW(calibrateTerrainCost(lod, renderer, bad), Error);
   bad = o;
   bad.repeats = 0;
+  EXPECT_THROW(calibrateTerrainCost(lod, renderer, bad), Error);
+  bad = o;
+  bad.sprite_calls.clear();
+  EXPECT_THROW(calibrateTerrainCost(lod, renderer, bad), Error);
+  bad.sprite_calls = {1, -1};
   EXPECT_THROW(calibrateTerrainCost(lod, renderer, bad), Error);
 }
 

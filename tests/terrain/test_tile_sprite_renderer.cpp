@@ -197,6 +197,7 @@ TEST(TileSpriteRenderer, ChoicePicksTheCheaperPathOnConstructedCostProfiles) {
   for (const TerrainCost* cost : {&cheap_high, &expensive_high, &no_keyframes}) {
     TileSpriteRenderOptions o = tileOptions(32);
     o.cost = cost;
+    o.max_carried_high = 0;  // a choice on every frame (carried runs: the next test)
     TileSpriteRenderer tiles(*scene.lod, *scene.renderer, 128, 128, o);
     gpu::RenderTarget frame(128, 128);
     size_t high_frames = 0;
@@ -230,6 +231,75 @@ TEST(TileSpriteRenderer, ChoicePicksTheCheaperPathOnConstructedCostProfiles) {
   }
 }
 
+// After each choice of the high LOD the next frames draw it without deciding, in runs of 1, 2, 4, ... up to
+// max_carried_high frames, the same image as a decided high frame; a run ends, and the tiles are taken, within that
+// many frames of the costs turning in their favour.
+TEST(TileSpriteRenderer, ChoicesOfTheHighLodAreCarriedInDoublingRuns) {
+  Scene scene(testFractal());
+  const float top = scene.hf.maxHeight();
+  auto camera = [&](int f) {
+    return makeCamera(Vec3(1280 + 6.0f * f, 700 + 12.0f * f, top + 1200), Vec3(1280 + 6.0f * f, 1300 + 12.0f * f, 0));
+  };
+  TerrainCost cost;  // the high LOD cheap (a draw per tile sprite dear), then dear
+  cost.frame.base_ms = 1.0;
+  cost.frame.ms_per_draw = 100.0;
+  TileSpriteRenderOptions o = tileOptions(32);
+  o.cost = &cost;
+  o.max_carried_high = 4;
+  TileSpriteRenderer tiles(*scene.lod, *scene.renderer, 128, 128, o);
+  gpu::RenderTarget frame(128, 128);
+  // Frame 0 learns the high LOD's size; then decided frames start runs of 1, 2, 4, 4, ... carried frames.
+  std::vector<bool> expected_carried{false, false, true, false, true, true, false, true, true, true, true, false};
+  for (int run = 0; run < 2; ++run) expected_carried.insert(expected_carried.end(), {true, true, true, true, false});
+  size_t carried = 0;
+  for (size_t f = 0; f < expected_carried.size(); ++f) {
+    frame.clear(kSky);
+    TileSpriteRenderFrame info;
+    tiles.render(camera(int(f)), frame, &info);
+    ASSERT_EQ(info.path, TerrainPath::High) << "frame " << f;
+    EXPECT_EQ(info.carried, expected_carried[f]) << "frame " << f;
+    carried += info.carried;
+    if (info.carried) {  // nothing decided: no tile counted, no prediction
+      EXPECT_EQ(info.tiles_in_view, 0u);
+      EXPECT_EQ(info.predicted_high_ms, 0.0);
+    } else if (f > 0) {
+      EXPECT_GT(info.tiles_in_view, 0u);
+      EXPECT_GT(info.predicted_high_ms, 0.0);
+    }
+    if (f % 5 == 2) {  // carried or not, the frame is the high LOD's
+      const image::ColorImage high = scene.renderLod(camera(int(f)), 1.0f), image = frame.readColor();
+      EXPECT_GT(image::psnr(image, high), 60.0) << "frame " << f;
+    }
+  }
+  EXPECT_EQ(tiles.counters().carried_high_frames, carried);
+  EXPECT_EQ(tiles.counters().high_frames, expected_carried.size());
+  // The high LOD turns dear: the first decided frame takes the tiles, at most max_carried_high frames later.
+  cost.frame.ms_per_draw = 0.0;
+  cost.frame.ms_per_mtriangle = 1e6;
+  int waited = 0;
+  for (int f = int(expected_carried.size());; ++f, ++waited) {
+    ASSERT_LE(waited, o.max_carried_high);
+    frame.clear(kSky);
+    TileSpriteRenderFrame info;
+    tiles.render(camera(f), frame, &info);
+    if (info.path == TerrainPath::Sprite) break;
+    EXPECT_TRUE(info.carried) << "frame " << f;
+  }
+  EXPECT_EQ(waited, 4);  // the run of 4 started by the last decided frame above
+  // ... and a later choice of the high LOD starts again from a run of one frame.
+  cost = TerrainCost{};
+  cost.frame.base_ms = 1.0;
+  cost.frame.ms_per_draw = 100.0;
+  std::vector<bool> carried_after;
+  for (int f = 0; f < 4; ++f) {
+    frame.clear(kSky);
+    TileSpriteRenderFrame info;
+    tiles.render(camera(40 + f), frame, &info);
+    carried_after.push_back(info.carried);
+  }
+  EXPECT_EQ(carried_after, (std::vector<bool>{false, true, false, true}));
+}
+
 TEST(TileSpriteRenderer, BadOptionsAreRefused) {
   Scene scene(testFractal());
   TileSpriteRenderOptions o = tileOptions(0);
@@ -239,6 +309,9 @@ TEST(TileSpriteRenderer, BadOptionsAreRefused) {
   EXPECT_THROW(TileSpriteRenderer(*scene.lod, *scene.renderer, 64, 64, o), Error);
   o = tileOptions(32);
   o.max_half_angle_deg = 90.0f;
+  EXPECT_THROW(TileSpriteRenderer(*scene.lod, *scene.renderer, 64, 64, o), Error);
+  o = tileOptions(32);
+  o.max_carried_high = -1;
   EXPECT_THROW(TileSpriteRenderer(*scene.lod, *scene.renderer, 64, 64, o), Error);
   TileSpriteRenderer ok(*scene.lod, *scene.renderer, 64, 64, tileOptions(32));
   gpu::RenderTarget frame(32, 32);

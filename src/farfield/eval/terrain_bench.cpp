@@ -296,10 +296,9 @@ void runQuality(Experiment& x) {
   }
   std::vector<std::pair<std::string, std::unique_ptr<terrain::TileSpriteRenderer>>> tiles;
   for (const std::string& name : o.modes) {
-    bool choose = false;
-    if (isTileSpriteMode(name, &choose))
+    if (isTileSpriteMode(name))
       tiles.emplace_back(name, std::make_unique<terrain::TileSpriteRenderer>(*data.lod, renderer, o.width, o.height,
-                                                                             tileSpriteOptions(*x.run, choose)));
+                                                                             tileSpriteOptions(*x.run, name)));
   }
   // Figure 6 and 7's views: over the plain (40% of the path) and over the mountains (70%).
   const std::set<size_t> views{bench.frame_indices[bench.frame_indices.size() * 2 / 5],

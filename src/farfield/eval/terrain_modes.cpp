@@ -182,14 +182,19 @@ std::map<std::string, double> SpriteMode::info() const {
 }
 
 bool isTileSpriteMode(const std::string& mode_name, bool* choose) {
-  if (mode_name != "lod-sprite-tiles" && mode_name != "lod-sprite-tiles-always") return false;
-  if (choose) *choose = mode_name == "lod-sprite-tiles";
+  if (mode_name != "lod-sprite-tiles" && mode_name != "lod-sprite-tiles-always" &&
+      mode_name != "lod-sprite-tiles-each-frame")
+    return false;
+  if (choose) *choose = mode_name != "lod-sprite-tiles-always";
   return true;
 }
 
-terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run, bool choose) {
+terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run, const std::string& mode_name) {
   terrain::TileSpriteRenderOptions o;
+  bool choose = false;
+  isTileSpriteMode(mode_name, &choose);
   if (choose && run.cost) o.cost = &*run.cost;
+  if (mode_name == "lod-sprite-tiles-each-frame") o.max_carried_high = 0;
   o.tile_cells = run.sprite_tile_cells;
   o.epsilon = run.epsilon;
   o.high_error = run.high_error;
@@ -202,7 +207,7 @@ void TileSpriteMode::prepare(const ModeContext& context) {
   run_ = terrainRunFor(context, name());
   sprite_ = std::make_unique<terrain::TileSpriteRenderer>(*run_->data->lod, run_->gpuRenderer(), context.width,
                                                           context.height,
-                                                          tileSpriteOptions(*run_, name_ == "lod-sprite-tiles"));
+                                                          tileSpriteOptions(*run_, name_));
 }
 
 void TileSpriteMode::frame(FrameContext& frame) {
@@ -230,7 +235,8 @@ std::map<std::string, double> TileSpriteMode::info() const {
           {"peak_sprites", double(c.peak_sprites)},
           {"peak_sprite_bytes", double(c.peak_sprite_bytes)},
           {"high_frames", double(c.high_frames)},
-          {"high_frame_fraction", double(c.high_frames) / frames}};
+          {"high_frame_fraction", double(c.high_frames) / frames},
+          {"carried_high_frames", double(c.carried_high_frames)}};
 }
 
 void registerTerrainModes() {
@@ -265,6 +271,10 @@ void registerTerrainModes() {
                [](const ModeContext&) { return std::make_unique<TileSpriteMode>("lod-sprite-tiles"); });
   registerMode("lod-sprite-tiles-always", "terrain: LOD-sprite with a sprite per terrain tile on every frame",
                [](const ModeContext&) { return std::make_unique<TileSpriteMode>("lod-sprite-tiles-always"); });
+  registerMode("lod-sprite-tiles-each-frame",
+               "terrain: lod-sprite-tiles deciding on every frame, without runs of frames carried on a choice of "
+               "the high LOD (the baseline of those runs)",
+               [](const ModeContext&) { return std::make_unique<TileSpriteMode>("lod-sprite-tiles-each-frame"); });
 }
 
 }  // namespace farfield::eval

@@ -142,14 +142,16 @@ class SpriteMode : public Mode {
   size_t last_frame_ = 0;
 };
 
-// The options of the tile modes with the run's thresholds (the mode's and the quality pass's), with the run's cost
-// model (the per-frame choice) when `choose` and the run has one.
-terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run, bool choose);
-// "lod-sprite-tiles" (with the per-frame choice) and "lod-sprite-tiles-always" (the tile path on every frame).
+// The options of the tile mode `mode_name` with the run's thresholds (the mode's and the quality pass's), with the
+// run's cost model (the per-frame choice) for the modes that choose, when the run has one.
+terrain::TileSpriteRenderOptions tileSpriteOptions(const TerrainRun& run, const std::string& mode_name);
+// "lod-sprite-tiles" (with the per-frame choice), "lod-sprite-tiles-each-frame" (the choice made on every frame, no
+// carried runs of the high LOD) and "lod-sprite-tiles-always" (the tile path on every frame).
 bool isTileSpriteMode(const std::string& mode_name, bool* choose = nullptr);
 
 // `lod-sprite-tiles`: a sprite per terrain tile (terrain/tile_sprite_renderer.h), choosing per frame between the tiles
-// and the high LOD by the run's calibrated cost; `lod-sprite-tiles-always`: the tile path on every frame. Each pass
+// and the high LOD by the run's calibrated cost; `lod-sprite-tiles-each-frame`: the same choice made on every frame
+// (TileSpriteRenderOptions::max_carried_high 0); `lod-sprite-tiles-always`: the tile path on every frame. Each pass
 // over the path starts from scratch, as SpriteMode's. Under `farfield bench`: --mode-option tile_cells=N.
 class TileSpriteMode : public Mode {
  public:
@@ -160,7 +162,8 @@ class TileSpriteMode : public Mode {
   // epsilon_px, tile_cells, frames, tile_keyframes, frames_with_keyframes (share too), tile_frames_in_view,
   // tile_keyframe_fraction (of tile-frames in view), view_framed_keyframes, keyframe_triangles_per_frame,
   // sprite_triangle_share (of the low mesh's triangles), peak_sprites, peak_sprite_bytes (of the last pass),
-  // high_frames and high_frame_fraction (frames drawn as the high LOD by the choice).
+  // high_frames and high_frame_fraction (frames drawn as the high LOD by the choice), carried_high_frames (of those,
+  // drawn on an earlier frame's choice without deciding).
   std::map<std::string, double> info() const override;
 
  private:
@@ -171,8 +174,8 @@ class TileSpriteMode : public Mode {
   size_t last_frame_ = 0;
 };
 
-// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict, lod-sprite-cache, lod-sprite-tiles
-// and lod-sprite-tiles-always to the mode registry (mode.h). Idempotent.
+// Adds high, high-tiles, low, lod-sprite, lod-sprite-always, lod-sprite-predict, lod-sprite-cache, lod-sprite-tiles,
+// lod-sprite-tiles-each-frame and lod-sprite-tiles-always to the mode registry (mode.h). Idempotent.
 // Called by runTerrainBench and by the executable at start-up (the eval library is static: a static registration
 // object in it would be dropped by the linker).
 void registerTerrainModes();

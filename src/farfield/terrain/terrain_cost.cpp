@@ -42,6 +42,9 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
   if (options.pixel_errors.empty()) throw Error(where, "no LOD thresholds to time");
   for (float e : options.pixel_errors)
     if (!(e > 0.0f)) throw Error(where, "LOD thresholds must be positive (pixels)");
+  if (options.sprite_calls.empty()) throw Error(where, "no draw-call counts to time");
+  for (int c : options.sprite_calls)
+    if (c < 0 || c > 256) throw Error(where, "sprite draw calls must be 0..256 (0: the original texture alone)");
   for (const Camera& v : options.views) v.validate(where);
   const int fw = options.views.front().width, fh = options.views.front().height;
   const int kw = options.keyframe_width > 0 ? options.keyframe_width : fw;
@@ -69,8 +72,11 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
       renderer.drawTextured(camera, target, 0, mesh.triangleCount(), 0);
       renderer.drawSprite(camera, target, sprite.colorTexture(), sprite_view_proj, 0, mesh.triangleCount(), 0);
       renderer.finish();
+      // Each mesh drawn with the original texture in one call, and as a sprite frame: half the triangles with the
+      // sprite, in sprite_calls calls (a frame with sprites per tile draws one a tile), the rest in one call.
       for (const float tau : options.pixel_errors)
-        for (const bool with_sprite : {false, true}) {
+        for (const int sprite_calls : options.sprite_calls) {
+          const bool with_sprite = sprite_calls > 0;
           std::vector<double> times;
           double triangles = 0.0;
           for (int r = 0; r < options.repeats; ++r) {
@@ -80,7 +86,11 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
             renderer.setIndices(mesh.indices, 0);
             const size_t n = mesh.triangleCount();
             if (with_sprite) {
-              renderer.drawSprite(camera, target, sprite.colorTexture(), sprite_view_proj, 0, n / 2, 0);
+              const size_t calls = size_t(sprite_calls);
+              for (size_t c = 0; c < calls; ++c) {
+                const size_t first = n / 2 * c / calls, last = n / 2 * (c + 1) / calls;
+                renderer.drawSprite(camera, target, sprite.colorTexture(), sprite_view_proj, first, last - first, 0);
+              }
               renderer.drawTextured(camera, target, n / 2, n - n / 2, 0);
             } else {
               renderer.drawTextured(camera, target, 0, n, 0);
@@ -89,7 +99,7 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
             times.push_back(clock.milliseconds());
             triangles = double(n);
           }
-          samples.push_back({triangles, with_sprite ? 2.0 : 1.0, double(w) * double(h), median(times)});
+          samples.push_back({triangles, double(sprite_calls + 1), double(w) * double(h), median(times)});
         }
       if (size) {
         for (int r = 0; r < options.repeats; ++r) {

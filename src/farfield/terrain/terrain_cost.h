@@ -36,11 +36,15 @@ struct TerrainCostOptions {
   int keyframe_width = 0;     // the keyframe target (frame plus guard band); 0 = the views' size
   int keyframe_height = 0;
   std::vector<float> pixel_errors{1.0f, 2.0f, 4.0f, 16.0f};  // LOD thresholds timed (the triangle term's spread)
+  // Sprite frames timed per threshold: half the mesh drawn with a sprite in this many calls (0: the whole mesh with the
+  // original texture in one call), the rest in one call. The draw-call term's spread: tile modes draw a call per
+  // tile with a sprite, and with only 1 and 2 calls timed its fit swung from 0 to 0.7 ms a call between runs.
+  std::vector<int> sprite_calls{0, 1, 15};
   int repeats = 3;            // timed renders per workload (median kept; one untimed warm-up per view and size)
 };
 
-// Times the LOD meshes of the views at each threshold, drawn with the original texture and (two draw calls, as a
-// sprite frame draws them) with a sprite, into a frame-size and a keyframe-size target, and the z-buffer read back
+// Times the LOD meshes of the views at each threshold, drawn with the original texture and, in sprite_calls + 1 draw
+// calls, with a sprite, into a frame-size and a keyframe-size target, and the z-buffer read back
 // of the keyframe target; fits TerrainCost::frame (gpu::CostModel::fit) and the read-back term. Needs a current
 // context; must not run inside a timed frame. Throws farfield::Error for no views or bad options.
 TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer,

@@ -54,6 +54,7 @@ TileSpriteRenderer::TileSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRende
   if (!(options.view_margin >= 0.0f && options.view_margin <= 1.0f))
     throw Error("lod-sprite-tiles", "view margin must be 0..1 (share of the frame size per side)");
   if (options.keep_frames < 0) throw Error("lod-sprite-tiles", "keep_frames must not be negative");
+  if (options.max_carried_high < 0) throw Error("lod-sprite-tiles", "max_carried_high must not be negative");
   tiles_x_ = (lod.width() - 2) / options.tile_cells + 1;
   tiles_y_ = (lod.height() - 2) / options.tile_cells + 1;
   // Height range per tile, over its grid points (borders included).
@@ -88,6 +89,7 @@ void TileSpriteRenderer::reset() {
   frame_ = 0;
   high_triangles_ = low_at_high_ = 0;
   high_known_ = false;
+  high_streak_ = carry_high_ = 0;
   lifetimes_.clear();
 }
 
@@ -175,6 +177,33 @@ bool TileSpriteRenderer::chooseHigh(size_t due, TileSpriteRenderFrame& info) con
   // path_choice.h's rule, each keyframe over its own expected lifetime: the tiles when their frame plus the
   // keyframes' share per frame of their lives costs less than the high LOD.
   return p.sprite_ms + amortised_ms >= p.high_ms;
+}
+
+gpu::FrameStats TileSpriteRenderer::drawHigh(const Camera& camera, gpu::RenderTarget& target,
+                                             TileSpriteRenderFrame& info) {
+  gpu::FrameStats stats;
+  info.path = TerrainPath::High;
+  gpu::addDraw(stats, renderLodFrame(lod_, renderer_, camera, LodSettings{options_.high_error, true, false}, target,
+                                     high_));
+  info.high_triangles = high_.triangleCount();
+  info.max_tile_error_px = 0.0;
+  ++counters_.high_frames;
+  if (info.carried) {
+    ++counters_.carried_high_frames;
+  } else {
+    // The next run of frames drawn without deciding: 1, 2, 4, ... up to max_carried_high for each choice of the high
+    // LOD in a row (not for the first frame, drawn to learn the high LOD's size). Then that size beside this frame's
+    // low mesh (the choice scales one by the other).
+    if (high_known_) {
+      high_streak_ = std::min(high_streak_ + 1, 30);
+      carry_high_ = std::min(options_.max_carried_high, 1 << (high_streak_ - 1));
+    }
+    high_triangles_ = high_.triangleCount();
+    low_at_high_ = low_.triangleCount();
+    high_known_ = true;
+  }
+  countFrame(info);
+  return stats;
 }
 
 uint64_t TileSpriteRenderer::spriteBytes() const {
@@ -277,6 +306,13 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
     throw Error("lod-sprite-tiles", "camera size differs from the renderer's frame size");
   ++frame_;
   TileSpriteRenderFrame info;
+  if (carry_high_ > 0) {
+    --carry_high_;
+    info.carried = true;
+    const gpu::FrameStats stats = drawHigh(camera, target, info);
+    if (out) *out = info;
+    return stats;
+  }
   gpu::FrameStats stats;
   lod_.build(camera, LodSettings{options_.low_error, true, true}, low_);
   info.low_triangles = low_.triangleCount();
@@ -335,19 +371,11 @@ gpu::FrameStats TileSpriteRenderer::render(const Camera& camera, gpu::RenderTarg
 
   // The per-frame choice: the high LOD when the tiles do not pay.
   if (chooseHigh(due_count, info)) {
-    info.path = TerrainPath::High;
-    gpu::addDraw(stats, renderLodFrame(lod_, renderer_, camera, LodSettings{options_.high_error, true, false}, target,
-                                       high_));
-    info.high_triangles = high_.triangleCount();
-    high_triangles_ = high_.triangleCount();
-    low_at_high_ = low_.triangleCount();
-    high_known_ = true;
-    ++counters_.high_frames;
-    info.max_tile_error_px = 0.0;
-    countFrame(info);
+    gpu::addDraw(stats, drawHigh(camera, target, info));
     if (out) *out = info;
     return stats;
   }
+  high_streak_ = 0;
 
   // The tile path: refresh the tiles due, then draw every tile with its sprite or without.
   frame_indices_.clear();

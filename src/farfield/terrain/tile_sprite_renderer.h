@@ -36,6 +36,13 @@
 // last sprite served; a tile without one: the median of recent lifetimes). A frame drawn as the high LOD renders no
 // keyframe; the tiles due stay due. The high LOD's size is the latest one drawn, scaled by the low mesh's size since
 // (their ratio changes slowly along a path).
+//
+// Deciding costs time the high LOD does not pay (the low mesh, its sorting into tiles, equation 2 per tile: about 3 %
+// of a high frame on the fractals where the tiles lose, docs/BENCHMARKS.md). So after a frame the choice gave to the
+// high LOD, the next frames draw the high LOD without deciding, for a run that doubles with each further such
+// choice in a row (1, 2, 4, ... up to max_carried_high frames) and ends at the first choice of the tiles: where the
+// tiles lose for long, deciding costs 1 / max_carried_high of what it did, and where they win a frame that turns to
+// them is found within that many frames.
 #pragma once
 
 #include <cstddef>
@@ -72,10 +79,14 @@ struct TileSpriteRenderOptions {
   int keep_frames = 30;            // frames a sprite is kept out of view
   // The per-frame choice between the high LOD and the tile path (see above); null = always the tile path.
   const TerrainCost* cost = nullptr;
+  // Frames at most that draw the high LOD on an earlier frame's choice, without deciding (see above); 0: decide on
+  // every frame.
+  int max_carried_high = 8;
 };
 
 struct TileSpriteRenderFrame {
   TerrainPath path = TerrainPath::Sprite;  // High: the frame drew the high-resolution LOD (the per-frame choice)
+  bool carried = false;  // path High on an earlier frame's choice: the tiles were not evaluated (nor counted)
   size_t tiles_due = 0;           // tiles in view whose sprite was missing or over epsilon
   double predicted_high_ms = 0.0;   // with a cost model: this frame's alternatives (path_choice.h's PathCosts)
   double predicted_sprite_ms = 0.0;
@@ -94,6 +105,7 @@ struct TileSpriteRenderFrame {
 struct TileSpriteCounters {
   size_t frames = 0;
   size_t high_frames = 0;  // frames drawn as the high-resolution LOD (the per-frame choice)
+  size_t carried_high_frames = 0;  // of high_frames: on an earlier frame's choice, without deciding
   size_t frames_with_keyframes = 0;
   size_t tile_keyframes = 0;
   size_t tile_frames_in_view = 0;
@@ -139,6 +151,8 @@ class TileSpriteRenderer {
   bool frame(const Camera& camera, GridRect region, Camera& out) const;
   // Whether this frame draws the high LOD instead of the tiles (options_.cost), with its predictions in `info`.
   bool chooseHigh(size_t due, TileSpriteRenderFrame& info) const;
+  // Draws the high LOD as this frame (the choice's or a carried one), counts it and sets the next carried run.
+  gpu::FrameStats drawHigh(const Camera& camera, gpu::RenderTarget& target, TileSpriteRenderFrame& info);
   void countFrame(const TileSpriteRenderFrame& info);
   void renderKeyframe(Sprite& sprite, TileSpriteRenderFrame& info, gpu::FrameStats& stats);
   gpu::RenderTarget takeTarget(int width, int height);
@@ -161,6 +175,8 @@ class TileSpriteRenderer {
   // The per-frame choice: the latest high LOD drawn (its triangles and the low mesh's then) and recent lifetimes.
   uint64_t high_triangles_ = 0, low_at_high_ = 0;
   bool high_known_ = false;
+  int high_streak_ = 0;  // frames in a row the choice (not a carried run) drew the high LOD
+  int carry_high_ = 0;   // frames still to draw the high LOD without deciding
   std::deque<uint64_t> lifetimes_;
   std::vector<uint32_t> keyframe_indices_, frame_indices_;
 };
