@@ -3,7 +3,8 @@
 OUTDIR/figures, written next to them as PNG:
 
   fig08_path.png                   the camera path over the terrain (Figure 8)
-  fig06_views.png                  Figure 6/7 panels: low, high, LOD-sprite and the two difference images per view
+  fig06_views.png                  Figure 6/7 panels: low, high, LOD-sprite and the two difference images per view,
+                                   then each tile mode's frame and its difference to high
   fig09_triangles.png              triangles per frame, semi-log (high, low, LOD-sprite)
   fig10_error.png                  LOD-sprite error (pixels) per frame
   fig11_time.png                   frame time per frame for every mode (red ticks: frames where lod-sprite
@@ -21,6 +22,13 @@ import csv
 import math
 import os
 import sys
+
+
+def psnr(a, b):
+    """PSNR in dB of two images read by matplotlib (floats in 0..1) on their RGB channels, 8-bit scale; capped at 99."""
+    diff = (a[..., :3].astype(float) - b[..., :3].astype(float)) * 255.0
+    mse = float((diff * diff).mean())
+    return 99.0 if mse <= 0.0 else min(99.0, 10.0 * math.log10(255.0 * 255.0 / mse))
 
 
 def read_csv(path):
@@ -182,23 +190,34 @@ def main(argv):
 
             panels = [("a_low", "(a) low"), ("b_high", "(b) high"), ("c_lod_sprite", "(c) LOD-sprite"),
                       ("d_diff_low_high", "(d) |low - high| x4"), ("e_diff_high_lod_sprite", "(e) |high - LOD-sprite| x4")]
+            # The tile modes' frames of the same views (view1_f_MODE.png), with their difference to high (g).
+            fig06 = os.path.join(d, "fig06")
+            tile_modes = sorted({f[len("view1_f_"):-4] for f in os.listdir(fig06) if f.startswith("view1_f_")}
+                                if os.path.isdir(fig06) else [])
+            for m in tile_modes:
+                panels += [("f_" + m, "(f) " + m), ("g_diff_high_" + m, "(g) |high - %s| x4" % m)]
             n = len(views["view"])
-            fig, axes = plt.subplots(n, 5, figsize=(15, 3.2 * n), squeeze=False)
+            fig, axes = plt.subplots(n, len(panels), figsize=(3 * len(panels), 3.2 * n), squeeze=False)
             for r in range(n):
                 v = int(views["view"][r])
+                high = None
                 for c, (suffix, title) in enumerate(panels):
-                    path = os.path.join(d, "fig06", "view%d_%s.png" % (v, suffix))
+                    path = os.path.join(fig06, "view%d_%s.png" % (v, suffix))
                     ax = axes[r][c]
                     ax.axis("off")
-                    if os.path.exists(path):
-                        ax.imshow(mpimg.imread(path))
+                    image = mpimg.imread(path) if os.path.exists(path) else None
+                    if image is not None:
+                        ax.imshow(image)
                     label = title
                     if suffix == "a_low":
                         label += " %d tris, %.1f dB" % (views["low_triangles"][r], views["psnr_low_vs_high_db"][r])
                     if suffix == "b_high":
                         label += " %d tris" % views["high_triangles"][r]
+                        high = image
                     if suffix == "c_lod_sprite":
                         label += " %.1f dB" % views["psnr_lod_sprite_vs_high_db"][r]
+                    if suffix.startswith("f_") and image is not None and high is not None:
+                        label += " %.1f dB" % psnr(high, image)
                     ax.set_title(label, fontsize=8)
             save(fig, "fig06_views.png")
     except (KeyError, ValueError, TypeError) as err:
