@@ -101,6 +101,9 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
                     "crowd-mixed's geometry budget: skinned triangles a frame for the nearest agents inside their "
                     "switch distance, the others as impostors (0: none)")
       ->capture_default_str();
+  bench->add_flag("--budget-coarsens", o.runtime.budget_coarsens,
+                  "Under --geometry-triangles, agents also take coarser levels of detail (--skinned-lod), the least "
+                  "error on screen first, before impostors");
   bench->add_option("--skinned-lod", o.runtime.geometry_lod_px,
                     "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels "
                     "(0: the mesh)")

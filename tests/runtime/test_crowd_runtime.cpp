@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "farfield/gpu/context.h"
@@ -262,6 +263,121 @@ TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) 
   EXPECT_GT(double(both) / double(either), 0.8);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean_level[c] / double(n_level), mean_mesh[c] / double(n_mesh), 12.0) << c;
   EXPECT_FALSE(same(mesh.first, level.first));
+}
+
+// Under a geometry budget with levels of detail and budget_coarsens, agents take coarser levels or become impostors,
+// the least error on screen first (a level's distance to the mesh, an impostor's bound scaled from its switch, both over the agent's
+// distance): the choice drawn keeps the budget, and its largest error on screen is the smallest any choice keeps
+// within the budget (brute force over every choice of levels at least as coarse as the bound's, and impostors).
+TEST_F(CrowdRuntimeGl, AGeometryBudgetTakesTheLeastErrorOnScreenFirst) {
+  const scene::SkinnedModel man =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  CrowdModelOptions mo;
+  mo.facing_deg = 0.0f;
+  CrowdRuntimeOptions options = smallAtlas(8);
+  options.error_px = 0.005;  // the switch beyond every agent here: all inside it
+  options.geometry_lod_px = 0.05;
+  options.lod_ratios = {0.5, 0.25, 0.125};
+  CrowdRuntime unbudgeted(std::span(&man, 1), std::span(&mo, 1), options);
+  const std::span<const double> level_m = unbudgeted.levelDistances(0);
+  const gpu::SkinnedGpuModel& gm = unbudgeted.gpuModel(0);
+  ASSERT_EQ(gm.levelCount(), 4u);
+
+  Camera camera;
+  camera.eye = Vec3(0, 0, 1.7f);
+  camera.at = Vec3(10, 0, 1.0f);
+  camera.width = camera.height = 128;
+  std::vector<CrowdAgentState> agents(4);
+  std::vector<float> distance(agents.size());
+  for (size_t i = 0; i < agents.size(); ++i) {
+    agents[i].position = Vec3(4.0f + 5.0f * float(i), (float(i) - 1.5f) * 1.5f, 0.0f);
+    agents[i].object_id = uint32_t(i + 1);
+    distance[i] = glm::length(camera.eye - (agents[i].position + Vec3(0, 0, 0.875f)));
+  }
+  const double focal = 128.0 / (2.0 * std::tan(double(camera.fov_y) / 2.0));
+  const double switch_m = unbudgeted.switchDistances(0, camera).both();
+  ASSERT_GT(switch_m, double(distance.back()) + 2.0);
+  const double impostor_m = options.error_px * switch_m / focal;  // an impostor's error, metres over the distance
+  gpu::RenderTarget target(128, 128);
+  gpu::LightSettings light;
+  target.bindForOpaquePass();
+  const CrowdFrameStats free_st = unbudgeted.draw(camera, agents, CrowdPolicy::Mixed, light);
+  ASSERT_EQ(free_st.geometry, 4u);
+  // Each agent's choices: the bound's level, the coarser ones that show less than an impostor, the impostor (-1).
+  std::vector<std::vector<int>> rungs(agents.size());
+  for (size_t i = 0; i < agents.size(); ++i) {
+    const int bound = unbudgeted.drawnLevel(i);
+    rungs[i].push_back(bound);
+    for (int l = bound + 1; l < 4; ++l)
+      if (level_m[size_t(l)] < impostor_m) rungs[i].push_back(l);
+    rungs[i].push_back(-1);
+  }
+  auto errorOf = [&](size_t i, int l) { return (l < 0 ? impostor_m : level_m[size_t(l)]) / double(distance[i]); };
+  auto trianglesOf = [&](int l) { return l < 0 ? uint64_t(0) : gm.triangleCount(size_t(l)); };
+  auto bestMax = [&](uint64_t budget) {  // brute force over every choice
+    double best = 1e30;
+    std::vector<size_t> pick(agents.size(), 0);
+    for (;;) {
+      uint64_t triangles = 0;
+      double worst = 0.0;
+      for (size_t i = 0; i < agents.size(); ++i) {
+        triangles += trianglesOf(rungs[i][pick[i]]);
+        worst = std::max(worst, errorOf(i, rungs[i][pick[i]]));
+      }
+      if (triangles <= budget) best = std::min(best, worst);
+      size_t i = 0;
+      while (i < pick.size() && ++pick[i] == rungs[i].size()) pick[i++] = 0;
+      if (i == pick.size()) return best;
+    }
+  };
+  const uint64_t coarsest = 4 * gm.triangleCount(3);
+  ASSERT_LT(coarsest, free_st.draw.triangles);
+  size_t impostors_seen = 0, coarsened_seen = 0;
+  // Budgets: shares of the unbudgeted triangles, under the coarsest levels of all four, and one triangle.
+  const uint64_t f = free_st.draw.triangles;
+  for (const uint64_t budget : {f * 9 / 10, f * 6 / 10, f * 35 / 100, 3 * gm.triangleCount(3) - 1, uint64_t(1)}) {
+    CrowdRuntimeOptions o = options;
+    o.max_geometry_triangles = budget;
+    o.budget_coarsens = true;
+    const double share = double(budget) / double(f);
+    CrowdRuntime rt(std::span(&man, 1), std::span(&mo, 1), o);
+    const CrowdFrameStats st = rt.draw(camera, agents, CrowdPolicy::Mixed, light);
+    EXPECT_EQ(st.geometry + st.impostors, 4u) << share;
+    EXPECT_EQ(st.over_budget, st.impostors) << share;
+    EXPECT_LE(st.draw.triangles - 2 * st.impostors, o.max_geometry_triangles) << share;
+    double worst = 0.0;
+    for (size_t i = 0; i < agents.size(); ++i) {
+      const int l = rt.drawnLevel(i);
+      EXPECT_TRUE(std::find(rungs[i].begin(), rungs[i].end(), l) != rungs[i].end()) << share << " " << i;
+      worst = std::max(worst, errorOf(i, l));
+    }
+    const double best = bestMax(o.max_geometry_triangles);
+    EXPECT_NEAR(worst, best, 1e-6 * best) << share;
+    impostors_seen += st.impostors;
+    coarsened_seen += st.coarsened;
+    if (budget == 1) {
+      EXPECT_EQ(st.impostors, 4u);  // a budget of one triangle: all impostors
+    }
+  }
+  EXPECT_GT(coarsened_seen, 0u);  // both kinds of step were taken
+  EXPECT_GT(impostors_seen, 4u);
+  // Without budget_coarsens the agents keep the bound's levels and the farthest become impostors, as many as the
+  // budget asks and no more.
+  CrowdRuntimeOptions o = options;
+  o.max_geometry_triangles = f * 6 / 10;
+  CrowdRuntime rt(std::span(&man, 1), std::span(&mo, 1), o);
+  const CrowdFrameStats st = rt.draw(camera, agents, CrowdPolicy::Mixed, light);
+  EXPECT_EQ(st.coarsened, 0u);
+  ASSERT_GT(st.impostors, 0u);
+  uint64_t kept = 0;
+  for (size_t i = 0; i < agents.size(); ++i) {  // agents[i] nearer than agents[i + 1]
+    const bool impostor = i >= agents.size() - st.impostors;
+    EXPECT_EQ(rt.drawnLevel(i), impostor ? -1 : rungs[i].front()) << i;
+    if (!impostor) kept += gm.triangleCount(size_t(rungs[i].front()));
+  }
+  EXPECT_LE(kept, o.max_geometry_triangles);
+  const size_t next = agents.size() - st.impostors;
+  EXPECT_GT(kept + gm.triangleCount(size_t(rungs[next].front())), o.max_geometry_triangles);
 }
 
 // cullBehind: agents behind a wall drawn first are left out and the frame is unchanged, pixel for pixel and id for id;

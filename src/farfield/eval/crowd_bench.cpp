@@ -149,7 +149,11 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
   if (options.runtime.max_geometry_triangles > 0)
     md << "- crowd-mixed's geometry budget: " << thousands(size_t(options.runtime.max_geometry_triangles))
        << " skinned triangles a frame, the nearest agents first; the others inside their switch distance drawn as "
-          "impostors (\"over the budget\")\n";
+          "impostors (\"over the budget\")"
+       << (options.runtime.budget_coarsens
+               ? "; first, coarser levels of detail (\"coarsened for the budget\"), the least error on screen first"
+               : "")
+       << "\n";
   if (options.runtime.geometry_lod_px > 0.0) {
     md << "- crowd-mixed's skinned agents at the coarsest level of detail within "
        << fmt("%.2f", options.runtime.geometry_lod_px) << " px (levels held over every palette pose; "
@@ -174,7 +178,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
          << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
          << fmt("%.0f", r.impostor_agents)
          << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string())
-         << (r.coarser > 0.0 ? " (" + fmt("%.0f", r.coarser) + " coarser)" : std::string()) << " | "
+         << (r.coarser > 0.0 ? " (" + fmt("%.0f", r.coarser) + " coarser)" : std::string())
+         << (r.coarsened > 0.0 ? " (" + fmt("%.0f", r.coarsened) + " coarsened for the budget)" : std::string()) << " | "
          << thousands(size_t(r.triangles)) << " | "
          << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
          << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
@@ -192,6 +197,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
   j["size"] = {options.width, options.height};
   j["bake_seconds"] = result.bake_seconds;
   j["max_geometry_triangles"] = options.runtime.max_geometry_triangles;
+  j["budget_coarsens"] = options.runtime.budget_coarsens;
   j["geometry_lod_px"] = options.runtime.geometry_lod_px;
   j["lod_seconds"] = result.lod_seconds;
   for (size_t m = 0; m < result.layouts.size(); ++m) {
@@ -217,7 +223,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
                            {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
                            {"in_view", r.in_view}, {"occluded", r.occluded}, {"over_budget_agents", r.over_budget},
-                           {"coarser_agents", r.coarser},
+                           {"coarser_agents", r.coarser}, {"coarsened_for_budget_agents", r.coarsened},
                            {"triangles", r.triangles},
                            {"shadow_casters", r.shadow_casters}, {"shadow_texel_m", r.shadow_texel_m},
                            {"receiver_bad_pixels", r.receiver_bad_pixels}});
@@ -313,7 +319,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), psnr(specs.size()),
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
           in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
-          receiver_bad(specs.size()), occluded(specs.size()), over_budget(specs.size()), coarser(specs.size());
+          receiver_bad(specs.size()), occluded(specs.size()), over_budget(specs.size()), coarser(specs.size()),
+          coarsened(specs.size());
       std::vector<image::ColorImage> prev(specs.size());
       std::vector<image::IdImage> prev_ids(specs.size());
       image::ColorImage prev_ref;
@@ -370,6 +377,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           occluded[m].push_back(double(st.occluded));
           over_budget[m].push_back(double(st.over_budget));
           coarser[m].push_back(double(st.coarser));
+          coarsened[m].push_back(double(st.coarsened));
           tris[m].push_back(double(st.draw.triangles));
           casters[m].push_back(double(st.shadow_casters));
           shadow_texel[m].push_back(double(st.shadow_texel_m));
@@ -421,6 +429,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.occluded = mean(occluded[m]);
         r.over_budget = mean(over_budget[m]);
         r.coarser = mean(coarser[m]);
+        r.coarsened = mean(coarsened[m]);
         r.triangles = mean(tris[m]);
         r.shadow_casters = mean(casters[m]);
         r.shadow_texel_m = mean(shadow_texel[m]);

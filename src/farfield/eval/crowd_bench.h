@@ -60,6 +60,7 @@ struct CrowdModeResult {
   double occluded = 0.0;  // mean per frame: agents in view left out behind the city (agent_occlusion)
   double over_budget = 0.0;  // mean per frame: impostors inside their switch distance (runtime.max_geometry_triangles)
   double coarser = 0.0;      // mean per frame: geometry agents at a coarser level than the mesh (runtime.geometry_lod_px)
+  double coarsened = 0.0;    // mean per frame: of those, coarser than the bound gives them, for the geometry budget
   double shadow_casters = 0.0, shadow_texel_m = 0.0;  // means per frame
   double receiver_bad_pixels = 0.0;  // mean per frame: non-agent pixels off by > 8/255 (shadow differences)
 };

@@ -1,6 +1,8 @@
 #include "farfield/runtime/crowd_runtime.h"
 
 #include <algorithm>
+#include <limits>
+#include <queue>
 #include <cmath>
 
 #include "farfield/core/error.h"
@@ -126,6 +128,10 @@ void CrowdRuntime::prepareFrame(const Camera& camera, std::span<const CrowdAgent
   switch_m_.resize(models_.size());
   for (size_t m = 0; m < models_.size(); ++m) switch_m_[m] = switchDistances(m, camera).both();
   lod_m_per_m_ = options_.geometry_lod_px / focalOf(camera);
+  // Inside its switch an impostor's error grows as 1 / distance from the bound at the switch: error_px * switch_m
+  // pixel-metres, or error_px * switch_m / focal metres over the distance, as a level's distance to the mesh is.
+  impostor_m_.resize(models_.size());
+  for (size_t m = 0; m < models_.size(); ++m) impostor_m_[m] = options_.error_px * switch_m_[m] / focalOf(camera);
   spheres_.resize(agents.size());
   for (size_t i = 0; i < agents.size(); ++i) {
     const CrowdAgentState& a = agents[i];
@@ -203,18 +209,63 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
     }
     addToLists(camera, a, uint32_t(i), impostor, impostor ? 0 : levelFor(a, distance, policy));
   }
-  if (near_.empty()) return;
-  std::sort(near_.begin(), near_.end());
+  if (!near_.empty()) fitBudget(camera, agents, stats);
+}
+
+void CrowdRuntime::fitBudget(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdFrameStats& stats) {
+  // Each agent's ladder: the level the bound gives it, with budget_coarsens the coarser levels whose distance to the
+  // mesh is under what an impostor inside its switch shows (impostor_m_), then the impostor. Both errors on screen are metres over the
+  // agent's distance. While the triangles exceed the budget, the step taken is the agent's whose next rung shows the
+  // least: the largest error on screen ends as small as the budget allows.
+  const size_t n = near_.size();
+  constexpr uint32_t kImpostor = std::numeric_limits<uint32_t>::max();
+  auto modelOf = [&](size_t k) -> const Model& { return models_[agents[near_[k].second].model]; };
+  auto trianglesAt = [&](size_t k) -> uint64_t {
+    return near_level_[k] == kImpostor ? 0 : modelOf(k).gpu->triangleCount(near_level_[k]);
+  };
+  // Whether the next rung is a coarser level (else the impostor).
+  auto coarserLevel = [&](size_t k) {
+    const Model& model = modelOf(k);
+    const uint32_t l = near_level_[k];
+    return options_.budget_coarsens && l + 1 < model.level_m.size() &&
+           model.level_m[l + 1] < impostor_m_[agents[near_[k].second].model];
+  };
+  // The next rung's distance (metres) or -1 at the impostor.
+  auto nextMetres = [&](size_t k) {
+    const uint32_t l = near_level_[k];
+    if (l == kImpostor) return -1.0;
+    const Model& model = modelOf(k);
+    return coarserLevel(k) ? model.level_m[l + 1] : impostor_m_[agents[near_[k].second].model];
+  };
+  near_level_.resize(n);
   uint64_t triangles = 0;
-  bool full = false;
-  for (const auto& [distance, i] : near_) {
-    const CrowdAgentState& a = agents[i];
-    const uint32_t level = levelFor(a, distance, policy);
-    const uint64_t t = models_[a.model].gpu->triangleCount(level);
-    full = full || triangles + t > options_.max_geometry_triangles;
-    if (!full) triangles += t;
-    stats.over_budget += full ? 1 : 0;
-    addToLists(camera, a, i, full, level);
+  for (size_t k = 0; k < n; ++k) {
+    near_level_[k] = levelFor(agents[near_[k].second], near_[k].first, CrowdPolicy::Mixed);
+    triangles += trianglesAt(k);
+  }
+  using Step = std::pair<double, size_t>;  // (next rung's distance on screen, near_ entry)
+  std::priority_queue<Step, std::vector<Step>, std::greater<>> steps;
+  auto push = [&](size_t k) {
+    const double m = nextMetres(k);
+    if (m >= 0.0) steps.push({m / std::max(double(near_[k].first), 1e-3), k});
+  };
+  if (triangles > options_.max_geometry_triangles)
+    for (size_t k = 0; k < n; ++k) push(k);
+  while (triangles > options_.max_geometry_triangles && !steps.empty()) {
+    const size_t k = steps.top().second;
+    steps.pop();
+    triangles -= trianglesAt(k);
+    near_level_[k] = coarserLevel(k) ? near_level_[k] + 1 : kImpostor;
+    triangles += trianglesAt(k);
+    push(k);
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const auto [distance, i] = near_[k];
+    const bool impostor = near_level_[k] == kImpostor;
+    stats.over_budget += impostor ? 1 : 0;
+    if (!impostor)
+      stats.coarsened += near_level_[k] > levelFor(agents[i], distance, CrowdPolicy::Mixed) ? 1 : 0;
+    addToLists(camera, agents[i], i, impostor, impostor ? 0 : near_level_[k]);
   }
 }
 

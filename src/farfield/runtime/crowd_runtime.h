@@ -63,12 +63,20 @@ struct CrowdRuntimeOptions {
   bool blend_views = false;
   // Colour-region tints: outfit o, region r at o * scene::kColorRegions + r; empty = one outfit of white.
   std::vector<Vec4> region_tints;
-  // Mixed's geometry budget (skinned triangles a frame; 0: none): of the agents in view nearer than their switch
-  // distance, the nearest are drawn as geometry while their triangles stay within it, the others as impostors inside
-  // their switch distance (CrowdFrameStats::over_budget: where the error bound gives way to the frame's cost). Agents
+  // Mixed's geometry budget (skinned triangles a frame; 0: none) for the agents in view nearer than their switch
+  // distance. Where their levels of detail (geometry_lod_px) exceed it, agents become impostors inside their switch
+  // distance (CrowdFrameStats::over_budget), or with budget_coarsens also take coarser levels
+  // (CrowdFrameStats::coarsened), one step at a time, each to the agent whose next step shows the least error on
+  // screen: a level's distance to the mesh, or an impostor's error, which grows as 1 / distance from the bound at the
+  // switch (levels that show more than the impostor are skipped). For one model the impostors are the farthest
+  // agents. Where the error bound gives way to the frame's cost, the largest error on screen ends as small as the
+  // budget allows. Agents
   // outside the view then cast their shadows as impostors. A crowd as dense near the camera as far from it costs
   // geometry in proportion to its density without it (100,000 agents on the default city: 59 skinned agents a frame).
   uint64_t max_geometry_triangles = 0;
+  // Under the budget, coarser levels as well as impostors (above). Off by default: on the crowd bench's walks the
+  // coarser levels kept the budget at a lower PSNR than impostors of the farthest (docs/BENCHMARKS.md, Crowds).
+  bool budget_coarsens = false;
   // Mixed's skinned agents at levels of detail that hold in every pose (scene::deformingLevels over the palette's
   // poses in agent space, each level's distance to the mesh measured over every palette pose): an agent drawn as
   // geometry takes the coarsest level whose distance stays within geometry_lod_px pixels at its distance; 0: the
@@ -109,6 +117,7 @@ struct CrowdFrameStats {
   size_t impostors = 0;
   size_t over_budget = 0;  // of impostors: inside their switch distance, left out of Mixed's geometry budget
   size_t coarser = 0;      // of geometry: drawn at a level of detail coarser than the mesh (geometry_lod_px)
+  size_t coarsened = 0;    // of geometry: at a level coarser than geometry_lod_px gives them, for the budget
   size_t shadow_casters = 0;  // drawShadowed: agents drawn into the shadow map
   float shadow_texel_m = 0.0f;
   gpu::FrameStats draw;
@@ -154,6 +163,11 @@ class CrowdRuntime {
   // Model m's levels of detail: level 0 is the mesh (distance 0); their distances to it in agent metres.
   std::span<const double> levelDistances(size_t m) const { return models_[m].level_m; }
   double lodSeconds() const { return lod_seconds_; }
+  // After draw or drawShadowed: agent i's level of detail if that call drew it as geometry; -1 for an impostor or an
+  // agent not drawn (out of view, hidden, or i past the agents given).
+  int drawnLevel(size_t i) const {
+    return i < drawn_.size() && drawn_[i] == Drawn::Geometry ? int(level_[i]) : -1;
+  }
 
  private:
   struct Model {
@@ -173,6 +187,9 @@ class CrowdRuntime {
   void clearLists(Lists& lists);
   void classify(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                 CrowdFrameStats& stats);
+  // Mixed under a geometry budget: near_'s agents (inside their switch) into the lists, at coarser levels or as
+  // impostors as the budget asks (CrowdRuntimeOptions::max_geometry_triangles), the least error on screen first.
+  void fitBudget(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdFrameStats& stats);
   // Whether agent i casts its shadow as an impostor: under Mixed as classify drew it (after classify).
   bool castsAsImpostor(const Camera& camera, const CrowdAgentState& a, uint32_t i, CrowdPolicy policy,
                        const CrowdShadowOptions& shadows) const;
@@ -202,6 +219,8 @@ class CrowdRuntime {
   std::vector<Drawn> drawn_;
   std::vector<uint8_t> level_;  // classify: per agent drawn as geometry, its level of detail
   std::vector<std::pair<float, uint32_t>> near_;  // classify: (distance, agent) inside the switch, under a budget
+  std::vector<uint32_t> near_level_;             // fitBudget: per near_ entry, its level (max: an impostor)
+  std::vector<double> impostor_m_;  // prepareFrame: per model, an impostor's error inside its switch (see fitBudget)
   std::vector<double> switch_m_;       // prepareFrame: per model, this frame's camera
   double lod_m_per_m_ = 0.0;           // prepareFrame: a level's allowed distance per metre from the eye
   gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
