@@ -43,6 +43,16 @@ bool same(const image::ColorImage& a, const image::ColorImage& b) {
                     });
 }
 
+scene::SkinnedModel loadMan() {
+  return scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+}
+
+CrowdModelOptions manOptions() {
+  CrowdModelOptions mo;
+  mo.facing_deg = 0.0f;
+  return mo;
+}
+
 CrowdModelOptions foxOptions() {
   CrowdModelOptions mo;
   mo.height_m = 0.8f;
@@ -164,10 +174,8 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetDrawsTheNearestAgentsAsGeometry) {
 // agents never take finer levels, the baseline policy draws the mesh, and a coarse level covers the mesh's pixels in
 // the mesh's colour regions.
 TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) {
-  const scene::SkinnedModel man =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
-  CrowdModelOptions mo;
-  mo.facing_deg = 0.0f;
+  const scene::SkinnedModel man = loadMan();
+  const CrowdModelOptions mo = manOptions();
   CrowdRuntimeOptions options = smallAtlas(8);
   options.error_px = 0.001;  // the switch beyond every agent here: all geometry
   options.geometry_lod_px = 0.5;
@@ -266,14 +274,13 @@ TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) 
 }
 
 // Under a geometry budget with levels of detail and budget_coarsens, agents take coarser levels or become impostors,
-// the least error on screen first (a level's distance to the mesh, an impostor's bound scaled from its switch, both over the agent's
-// distance): the choice drawn keeps the budget, and its largest error on screen is the smallest any choice keeps
-// within the budget (brute force over every choice of levels at least as coarse as the bound's, and impostors).
+// the least error on screen first (a level's distance to the mesh, an impostor's bound scaled from its switch, both
+// over the agent's distance): the choice drawn keeps the budget, and its largest error on screen is the smallest any
+// choice keeps within the budget (brute force over every choice of levels at least as coarse as the bound's, and
+// impostors).
 TEST_F(CrowdRuntimeGl, AGeometryBudgetTakesTheLeastErrorOnScreenFirst) {
-  const scene::SkinnedModel man =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
-  CrowdModelOptions mo;
-  mo.facing_deg = 0.0f;
+  const scene::SkinnedModel man = loadMan();
+  const CrowdModelOptions mo = manOptions();
   CrowdRuntimeOptions options = smallAtlas(8);
   options.error_px = 0.005;  // the switch beyond every agent here: all inside it
   options.geometry_lod_px = 0.05;

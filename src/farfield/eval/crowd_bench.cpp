@@ -179,7 +179,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
          << fmt("%.0f", r.impostor_agents)
          << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string())
          << (r.coarser > 0.0 ? " (" + fmt("%.0f", r.coarser) + " coarser)" : std::string())
-         << (r.coarsened > 0.0 ? " (" + fmt("%.0f", r.coarsened) + " coarsened for the budget)" : std::string()) << " | "
+         << (r.coarsened > 0.0 ? " (" + fmt("%.0f", r.coarsened) + " coarsened for the budget)" : std::string())
+         << " | "
          << thousands(size_t(r.triangles)) << " | "
          << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
          << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
