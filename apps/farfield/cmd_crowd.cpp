@@ -64,6 +64,8 @@ void run(CrowdArgs& a) {
     throw Error("--azimuths/--elevations", "must be at least 1");
   if (a.octahedral == 1 || a.octahedral < 0) throw Error("--octahedral", "must be 0 (off) or at least 2 views a side");
   if (a.octahedral >= 2) a.o.runtime.grid = impostor::ViewGrid::octahedralGrid(a.octahedral);
+  if (a.o.runtime.budget_coarsens && (a.o.runtime.max_geometry_triangles == 0 || !(a.o.runtime.geometry_lod_px > 0.0)))
+    throw Error("--budget-coarsens", "needs a budget (--geometry-triangles) and levels of detail (--skinned-lod)");
   const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), a.o);
   std::printf("%s\nwrote %s/{crowd.json,crowd.md,frames/}\n", r.markdown.c_str(), a.o.out_dir.c_str());
 }
