@@ -151,7 +151,7 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
        << " skinned triangles a frame, the nearest agents first; the others inside their switch distance drawn as "
           "impostors (\"over the budget\")"
        << (options.runtime.budget_coarsens
-               ? "; first, coarser levels of detail (\"coarsened for the budget\"), the least error on screen first"
+               ? "; coarser levels of detail too (\"coarsened for the budget\"), each step the least error on screen"
                : "")
        << "\n";
   if (options.runtime.geometry_lod_px > 0.0) {

@@ -1,9 +1,9 @@
 #include "farfield/runtime/crowd_runtime.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <queue>
-#include <cmath>
 
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
@@ -204,7 +204,7 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
     const bool impostor = policy == CrowdPolicy::Impostor ||
                           (policy == CrowdPolicy::Mixed && double(distance) >= switch_m_[a.model]);
     if (!impostor && budgeted) {
-      near_.push_back({distance, uint32_t(i)});  // decided below, nearest first
+      near_.push_back({distance, uint32_t(i)});  // decided by fitBudget
       continue;
     }
     addToLists(camera, a, uint32_t(i), impostor, impostor ? 0 : levelFor(a, distance, policy));
@@ -293,7 +293,7 @@ void CrowdRuntime::addToLists(const Camera& camera, const CrowdAgentState& a, ui
   drawn_[i] = impostor ? Drawn::Impostor : Drawn::Geometry;
   if (!impostor) {
     g.index = cycleIndex(a.phase, options_.palette_poses);
-    level_[i] = uint8_t(level);
+    level_[i] = level;
     lists_.geometry[a.model][level].push_back(g);
     return;
   }

@@ -217,7 +217,7 @@ class CrowdRuntime {
   // classify: per agent, how this frame draws it (castShadows casts it alike).
   enum class Drawn : uint8_t { NotDrawn, Geometry, Impostor };
   std::vector<Drawn> drawn_;
-  std::vector<uint8_t> level_;  // classify: per agent drawn as geometry, its level of detail
+  std::vector<uint32_t> level_;  // classify: per agent drawn as geometry, its level of detail
   std::vector<std::pair<float, uint32_t>> near_;  // classify: (distance, agent) inside the switch, under a budget
   std::vector<uint32_t> near_level_;             // fitBudget: per near_ entry, its level (max: an impostor)
   std::vector<double> impostor_m_;  // prepareFrame: per model, an impostor's error inside its switch (see fitBudget)
