@@ -37,6 +37,7 @@ struct CrowdArgs {
   std::string size = "512x512";
   std::string models = "../shared/data/models/CesiumMan.glb,../shared/data/models/Fox.glb";
   int octahedral = 0;
+  bool palette_skinning = false;
 };
 
 void run(CrowdArgs& a) {
@@ -63,6 +64,7 @@ void run(CrowdArgs& a) {
   if (a.o.runtime.grid.azimuths < 1 || a.o.runtime.grid.elevations < 1)
     throw Error("--azimuths/--elevations", "must be at least 1");
   if (a.octahedral == 1 || a.octahedral < 0) throw Error("--octahedral", "must be 0 (off) or at least 2 views a side");
+  if (a.palette_skinning) a.o.runtime.skinning = gpu::Skinning::Palette;
   if (a.octahedral >= 2) a.o.runtime.grid = impostor::ViewGrid::octahedralGrid(a.octahedral);
   if (a.o.runtime.budget_coarsens && (a.o.runtime.max_geometry_triangles == 0 || !(a.o.runtime.geometry_lod_px > 0.0)))
     throw Error("--budget-coarsens", "needs a budget (--geometry-triangles) and levels of detail (--skinned-lod)");
@@ -106,6 +108,10 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
   bench->add_flag("--budget-coarsens", o.runtime.budget_coarsens,
                   "Under --geometry-triangles, agents also take coarser levels of detail (--skinned-lod), the least "
                   "error on screen first, before impostors");
+  bench->add_flag(
+      "--palette-skinning", a->palette_skinning,
+      "Skinned agents blend four joint matrices of their palette pose per vertex instead of reading the pose's "
+      "vertices skinned once at start-up (the same images; for comparing the two)");
   bench->add_option("--skinned-lod", o.runtime.geometry_lod_px,
                     "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels "
                     "(0: the mesh)")

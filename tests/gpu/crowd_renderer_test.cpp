@@ -15,7 +15,8 @@
 namespace farfield::gpu {
 namespace {
 
-class CrowdRendererGl : public test::GpuTest {};
+// The same check for each way of skinning (gpu::Skinning).
+class CrowdSkinningGl : public test::GpuTest, public ::testing::WithParamInterface<Skinning> {};
 
 struct Compare {
   size_t covered = 0;  // pixels either image shows an agent
@@ -38,14 +39,15 @@ Compare compare(const image::ColorImage& a, const image::IdImage& ia, const imag
   return c;
 }
 
-TEST_F(CrowdRendererGl, InstancedGpuSkinningEqualsCpuSkinning) {
+TEST_P(CrowdSkinningGl, InstancedGpuSkinningEqualsCpuSkinning) {
   const scene::SkinnedModel man =
       scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
   const scene::Animation* walk = &man.animations[0];
   std::vector<std::vector<Mat4>> poses;
   for (int p = 0; p < 4; ++p) poses.push_back(scene::jointMatrices(man, walk, walk->start + 0.23f * float(p)));
   const Mat4 to_agent = glm::rotate(Mat4(1.0f), 0.3f, Vec3(0, 0, 1));
-  SkinnedGpuModel gpu_model(man, to_agent, poses);
+  SkinnedGpuModel gpu_model(man, to_agent, poses, {}, GetParam());
+  EXPECT_EQ(gpu_model.skinning(), GetParam());
   CrowdRenderer crowd;
   // Three outfits of distinct region tints; agent i wears outfit i + 1 (mod 3).
   std::vector<Vec4> tints(3 * scene::kColorRegions);
@@ -113,6 +115,11 @@ TEST_F(CrowdRendererGl, InstancedGpuSkinningEqualsCpuSkinning) {
                                 wrong_target.readIds());
   EXPECT_GT(double(wrong.bad), 0.05 * double(wrong.covered)) << wrong.bad << " of " << wrong.covered;
 }
+
+INSTANTIATE_TEST_SUITE_P(Skinnings, CrowdSkinningGl, ::testing::Values(Skinning::Palette, Skinning::BakedPoses),
+                         [](const ::testing::TestParamInfo<Skinning>& info) {
+                           return info.param == Skinning::Palette ? "Palette" : "BakedPoses";
+                         });
 
 }  // namespace
 }  // namespace farfield::gpu

@@ -146,6 +146,11 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
     md << "- shadows: one " << options.shadow.map_size << "x" << options.shadow.map_size << " map, receivers within "
        << fmt("%.0f", options.shadow.distance_m) << " m, in the reference and every mode"
        << (options.impostor_shadows ? " (crowd-mixed's geometry agents cast as impostors)" : "") << "\n";
+  md << "- skinning: "
+     << (options.runtime.skinning == gpu::Skinning::BakedPoses
+             ? "baked poses (each palette pose's vertices skinned once, read per agent)"
+             : "palette (four joint matrices blended per vertex)")
+     << ", in the reference and every mode\n";
   if (options.runtime.max_geometry_triangles > 0)
     md << "- crowd-mixed's geometry budget: " << thousands(size_t(options.runtime.max_geometry_triangles))
        << " skinned triangles a frame, the nearest agents first; the others inside their switch distance drawn as "
@@ -199,6 +204,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
   j["bake_seconds"] = result.bake_seconds;
   j["max_geometry_triangles"] = options.runtime.max_geometry_triangles;
   j["budget_coarsens"] = options.runtime.budget_coarsens;
+  j["skinning"] = options.runtime.skinning == gpu::Skinning::BakedPoses ? "baked-poses" : "palette";
   j["geometry_lod_px"] = options.runtime.geometry_lod_px;
   j["lod_seconds"] = result.lod_seconds;
   for (size_t m = 0; m < result.layouts.size(); ++m) {

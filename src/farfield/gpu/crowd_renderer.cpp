@@ -21,6 +21,26 @@ struct SkinVertex {
 };
 static_assert(sizeof(SkinVertex) == 56);
 
+// One vertex of one pose, skinned (BakedPoses; std430 in skin.vert.glsl).
+struct BakedVertex {
+  Vec4 position;  // w unused
+  Vec4 normal;    // w unused
+};
+static_assert(sizeof(BakedVertex) == 32);
+
+// Every pose's vertices skinned on the CPU, pose p's vertex i at p * vertices + i.
+std::vector<BakedVertex> bakePoses(const scene::SkinnedModel& model, const std::vector<std::vector<Mat4>>& poses) {
+  const size_t n = model.mesh.positions.size();
+  std::vector<BakedVertex> baked(poses.size() * n);
+  for (size_t p = 0; p < poses.size(); ++p) {
+    const scene::Mesh posed = scene::skinMesh(model, poses[p]);
+    for (size_t i = 0; i < n; ++i)
+      baked[p * n + i] = {Vec4(posed.positions[i], 0.0f),
+                          Vec4(posed.normals.empty() ? Vec3(0.0f) : posed.normals[i], 0.0f)};
+  }
+  return baked;
+}
+
 void setLight(const Program& p, const LightSettings& light) {
   Vec3 dir = light.direction;
   dir = glm::length(dir) > 0.0f ? glm::normalize(dir) : Vec3(0.0f, 0.0f, -1.0f);
@@ -33,8 +53,8 @@ void setLight(const Program& p, const LightSettings& light) {
 
 SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& model_to_agent,
                                  const std::vector<std::vector<Mat4>>& poses,
-                                 std::span<const scene::DeformingLevel> levels)
-    : model_to_agent_(model_to_agent), base_color_(model.base_color) {
+                                 std::span<const scene::DeformingLevel> levels, Skinning skinning)
+    : skinning_(skinning), model_to_agent_(model_to_agent), base_color_(model.base_color) {
   scene::validateSkinnedModel(model);
   joint_count_ = uint32_t(model.skeleton.joints.size());
   if (poses.empty()) throw Error(model.name, "no poses for the GPU palette");
@@ -48,6 +68,7 @@ SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& m
   }
   pose_count_ = uint32_t(poses.size());
   const size_t n = model.mesh.positions.size();
+  vertex_count_ = uint32_t(n);
   std::vector<SkinVertex> vertices(n);
   for (size_t i = 0; i < n; ++i) {
     SkinVertex& v = vertices[i];
@@ -86,12 +107,19 @@ SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& m
   glCreateBuffers(1, &ibo_);
   glNamedBufferStorage(ibo_, GLsizeiptr(std::max<size_t>(indices.size(), 1) * sizeof(uint32_t)), indices.data(), 0);
   glCreateBuffers(1, &palette_);
-  glNamedBufferStorage(palette_, GLsizeiptr(palette.size() * sizeof(Mat4)), palette.data(), 0);
+  size_t pose_bytes = 0;
+  if (skinning == Skinning::BakedPoses) {
+    const std::vector<BakedVertex> baked = bakePoses(model, poses);
+    pose_bytes = std::max<size_t>(baked.size(), 1) * sizeof(BakedVertex);
+    glNamedBufferStorage(palette_, GLsizeiptr(pose_bytes), baked.empty() ? nullptr : baked.data(), 0);
+  } else {
+    pose_bytes = palette.size() * sizeof(Mat4);
+    glNamedBufferStorage(palette_, GLsizeiptr(pose_bytes), palette.data(), 0);
+  }
   if (regions.empty()) regions.push_back(0u);
   glCreateBuffers(1, &regions_);
   glNamedBufferStorage(regions_, GLsizeiptr(regions.size() * sizeof(uint32_t)), regions.data(), 0);
-  bytes_ = n * sizeof(SkinVertex) + indices.size() * sizeof(uint32_t) + palette.size() * sizeof(Mat4) +
-           regions.size() * sizeof(uint32_t);
+  bytes_ = n * sizeof(SkinVertex) + indices.size() * sizeof(uint32_t) + pose_bytes + regions.size() * sizeof(uint32_t);
   glCreateVertexArrays(1, &vao_);
   glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(SkinVertex));
   glVertexArrayElementBuffer(vao_, ibo_);
@@ -173,12 +201,20 @@ image::ColorImage ImpostorAtlasGpu::readNormalDepth(int layer) const {
   return readLayer(normal_depth_, layout_.width(), layout_.height(), layer);
 }
 
+namespace {
+constexpr const char* kBaked = "#define FF_BAKED_POSES 1\n";
+}  // namespace
+
 CrowdRenderer::CrowdRenderer()
-    : skinned_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl")),
-      capture_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_CAPTURE 1")),
+    : skinned_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl"),
+               Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", kBaked)},
+      capture_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_CAPTURE 1\n"),
+               Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", std::string(kBaked) + "#define FF_CAPTURE 1\n")},
+      skinned_depth_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_DEPTH_ONLY 1\n"),
+                     Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl",
+                                           std::string(kBaked) + "#define FF_DEPTH_ONLY 1\n")},
       impostor_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl")),
       impostor_blend_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl", "#define FF_BLEND_VIEWS 1")),
-      skinned_depth_(Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_DEPTH_ONLY 1")),
       impostor_depth_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl", "#define FF_DEPTH_ONLY 1")) {
   glCreateBuffers(1, &agents_);
   glCreateVertexArrays(1, &empty_vao_);
@@ -201,9 +237,22 @@ void CrowdRenderer::setRegionTints(std::span<const Vec4> tints) {
   outfits_ = uint32_t(tints.size() / size_t(scene::kColorRegions));
 }
 
+const Program& CrowdRenderer::skinnedProgram(const SkinnedGpuModel& model) const {
+  return skinned_[model.skinning_ == Skinning::BakedPoses ? 1 : 0];
+}
+const Program& CrowdRenderer::captureProgram(const SkinnedGpuModel& model) const {
+  return capture_[model.skinning_ == Skinning::BakedPoses ? 1 : 0];
+}
+const Program& CrowdRenderer::skinnedDepthProgram(const SkinnedGpuModel& model) const {
+  return skinned_depth_[model.skinning_ == Skinning::BakedPoses ? 1 : 0];
+}
+
 void CrowdRenderer::bindModel(const Program& p, const SkinnedGpuModel& model) const {
   p.set("u_model_to_agent", model.model_to_agent_);
-  p.set("u_joint_count", model.joint_count_);
+  if (model.skinning_ == Skinning::BakedPoses)
+    p.set("u_vertex_count", model.vertex_count_);
+  else
+    p.set("u_joint_count", model.joint_count_);
   p.set("u_first_instance", 0u);
   p.set("u_first_triangle", 0u);
   p.set("u_base_color", model.base_color_);
@@ -255,13 +304,14 @@ FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuMode
   if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
-  skinned_.use();
-  skinned_.set("u_view_proj", camera.viewProjection());
-  skinned_.set("u_outfits", outfits_);
-  bindModel(skinned_, model);
-  setLight(skinned_, light);
+  const Program& p = skinnedProgram(model);
+  p.use();
+  p.set("u_view_proj", camera.viewProjection());
+  p.set("u_outfits", outfits_);
+  bindModel(p, model);
+  setLight(p, light);
   glEnable(GL_CULL_FACE);
-  return drawAgents(skinned_, model, agents.size(), level);
+  return drawAgents(p, model, agents.size(), level);
 }
 
 FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas,
@@ -318,17 +368,18 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
   CrowdAgentGpu agent = origin;
   agent.index = pose;
   uploadAgents(std::span<const CrowdAgentGpu>(&agent, 1));
-  capture_.use();
-  bindModel(capture_, model);
-  capture_.set("u_capture_centre", l.centre);
-  capture_.set("u_capture_radius", l.radius);
+  const Program& capture = captureProgram(model);
+  capture.use();
+  bindModel(capture, model);
+  capture.set("u_capture_centre", l.centre);
+  capture.set("u_capture_radius", l.radius);
   glBindVertexArray(model.vao_);
   for (const CaptureView& v : views) {
     FF_CHECK(v.cell >= 0 && v.cell < l.azimuths * l.elevations);
     glViewport((v.cell % l.azimuths) * l.cell_width, (v.cell / l.azimuths) * l.cell_height, l.cell_width,
                l.cell_height);
-    capture_.set("u_view_proj", v.view_proj);
-    capture_.set("u_capture_dir", v.to_camera);
+    capture.set("u_view_proj", v.view_proj);
+    capture.set("u_capture_dir", v.to_camera);
     glDrawElementsInstanced(GL_TRIANGLES, GLsizei(model.indexCount()), GL_UNSIGNED_INT, nullptr, 1);
   }
   glBindVertexArray(0);
@@ -340,10 +391,11 @@ FrameStats CrowdRenderer::drawSkinnedDepth(const Mat4& light_view_proj, const Sk
   if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
-  skinned_depth_.use();
-  skinned_depth_.set("u_view_proj", light_view_proj);
-  bindModel(skinned_depth_, model);
-  return drawAgents(skinned_depth_, model, agents.size(), level);
+  const Program& p = skinnedDepthProgram(model);
+  p.use();
+  p.set("u_view_proj", light_view_proj);
+  bindModel(p, model);
+  return drawAgents(p, model, agents.size(), level);
 }
 
 FrameStats CrowdRenderer::drawImpostorDepth(const Mat4& light_view_proj, const Vec3& to_light,

@@ -30,16 +30,25 @@ struct CrowdAgentGpu {
 };
 static_assert(sizeof(CrowdAgentGpu) == 48);
 
+// How a skinned model's vertices reach their pose. Agents only ever take the palette's sampled poses, so each pose
+// can be skinned once (on the CPU, scene::skinMesh) and every agent read its pose's vertices: BakedPoses stores
+// poses x vertices positions and normals (32 bytes each) and its vertex shader reads one position and one normal
+// instead of blending four joint matrices; Palette stores the joint matrices and blends them per vertex (linear
+// blend skinning on the GPU). The same images either way; on llvmpipe the baked poses draw skinned agents faster
+// (docs/BENCHMARKS.md, Crowds).
+enum class Skinning { Palette, BakedPoses };
+
 // A skinned model on the GPU with its pose palette. model_to_agent places the skinned (Z-up) model in agent space:
 // feet on z = 0, facing +x, at the agent's scale. Level 0 is the model's mesh; levels 1.. are coarser index buffers
-// over the same vertices (scene::deformingLevels), drawn with the same palette.
+// over the same vertices (scene::deformingLevels), drawn with the same poses.
 class SkinnedGpuModel {
  public:
   // poses[p] holds the joint matrices of pose p (one per joint, scene::jointMatrices). Throws farfield::Error for
   // an empty palette, a pose with the wrong joint count (after validateSkinnedModel) or a level whose indices or
   // source triangles are out of range.
   SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& model_to_agent,
-                  const std::vector<std::vector<Mat4>>& poses, std::span<const scene::DeformingLevel> levels = {});
+                  const std::vector<std::vector<Mat4>>& poses, std::span<const scene::DeformingLevel> levels = {},
+                  Skinning skinning = Skinning::BakedPoses);
   ~SkinnedGpuModel();
   SkinnedGpuModel(const SkinnedGpuModel&) = delete;
   SkinnedGpuModel& operator=(const SkinnedGpuModel&) = delete;
@@ -50,12 +59,15 @@ class SkinnedGpuModel {
   size_t levelCount() const { return levels_.size(); }
   uint64_t triangleCount(size_t level = 0) const { return levels_[level].index_count / 3; }
   const Mat4& modelToAgent() const { return model_to_agent_; }
+  Skinning skinning() const { return skinning_; }
   size_t gpuBytes() const { return bytes_; }
 
  private:
   friend class CrowdRenderer;
+  // palette_: the joint matrices (Palette) or every pose's skinned vertices (BakedPoses), storage binding 0.
   uint32_t vao_ = 0, vbo_ = 0, ibo_ = 0, palette_ = 0, regions_ = 0;
-  uint32_t joint_count_ = 0, pose_count_ = 0;
+  uint32_t joint_count_ = 0, pose_count_ = 0, vertex_count_ = 0;
+  Skinning skinning_ = Skinning::BakedPoses;
   // Per level: its range of the index buffer and its first triangle's colour region in the regions buffer.
   struct Level {
     uint32_t first_index = 0, index_count = 0, first_triangle = 0;
@@ -157,7 +169,12 @@ class CrowdRenderer {
   // One instanced draw of the model's level for `count` agents (program, model and agents bound), and its counts.
   FrameStats drawAgents(const Program& p, const SkinnedGpuModel& model, size_t count, size_t level) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
-  Program skinned_, capture_, impostor_, impostor_blend_, skinned_depth_, impostor_depth_;
+  // The skinned programs of a model's skinning: [0] Palette, [1] BakedPoses.
+  const Program& skinnedProgram(const SkinnedGpuModel& model) const;
+  const Program& captureProgram(const SkinnedGpuModel& model) const;
+  const Program& skinnedDepthProgram(const SkinnedGpuModel& model) const;
+  Program skinned_[2], capture_[2], skinned_depth_[2];
+  Program impostor_, impostor_blend_, impostor_depth_;
   uint32_t agents_ = 0, empty_vao_ = 0, tints_ = 0, outfits_ = 0;
 };
 

@@ -72,7 +72,7 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
       for (const scene::DeformingLevel& l : levels) model.level_m.push_back(l.error);
       lod_seconds_ += timer.seconds();
     }
-    model.gpu = std::make_unique<gpu::SkinnedGpuModel>(sm, to_agent, poses, levels);
+    model.gpu = std::make_unique<gpu::SkinnedGpuModel>(sm, to_agent, poses, levels, options.skinning);
     model.centre = agent_bounds.center();
     model.radius = glm::length(agent_bounds.hi - model.centre);
     CrowdAtlasChoice& choice = model.choice;

@@ -84,6 +84,9 @@ struct CrowdRuntimeOptions {
   double geometry_lod_px = 0.0;
   // The levels' triangles as fractions of the mesh's: close steps, so that the rule finds a level near each distance.
   std::vector<double> lod_ratios{0.5, 0.35, 0.25, 0.18, 0.125, 0.09, 0.0625};
+  // How skinned agents reach their palette pose (gpu::Skinning), in every policy and the atlas bake: the same images;
+  // the baked poses are faster on llvmpipe, the palette the smaller (joint matrices instead of vertices per pose).
+  gpu::Skinning skinning = gpu::Skinning::BakedPoses;
 };
 
 // The crowd's shadows (drawShadowed).
