@@ -64,6 +64,8 @@ void run(CrowdArgs& a) {
   if (a.o.runtime.grid.azimuths < 1 || a.o.runtime.grid.elevations < 1)
     throw Error("--azimuths/--elevations", "must be at least 1");
   if (a.octahedral == 1 || a.octahedral < 0) throw Error("--octahedral", "must be 0 (off) or at least 2 views a side");
+  if (a.palette_skinning && a.o.compare_skinning)
+    throw Error("--compare-skinning", "compares the palette with the baked poses: leave out --palette-skinning");
   if (a.palette_skinning) a.o.runtime.skinning = gpu::Skinning::Palette;
   if (a.octahedral >= 2) a.o.runtime.grid = impostor::ViewGrid::octahedralGrid(a.octahedral);
   if (a.o.runtime.budget_coarsens && (a.o.runtime.max_geometry_triangles == 0 || !(a.o.runtime.geometry_lod_px > 0.0)))
@@ -112,6 +114,9 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
       "--palette-skinning", a->palette_skinning,
       "Skinned agents blend four joint matrices of their palette pose per vertex instead of reading the pose's "
       "vertices skinned once at start-up (the same images; for comparing the two)");
+  bench->add_flag("--compare-skinning", o.compare_skinning,
+                  "Also crowd-geometry-palette and crowd-mixed-palette: the same policies with joint matrices blended "
+                  "per vertex, timed on the same frames");
   bench->add_option("--skinned-lod", o.runtime.geometry_lod_px,
                     "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels "
                     "(0: the mesh)")

@@ -34,6 +34,7 @@ expect_error("--view-min/--view-max" path views builtin:cubes --view-min 1,2,3 -
 expect_error("profile.json" place builtin:cubes --profile ${WORK}/profile.json -o ${WORK}/placed)
 expect_error("--tmax" bench builtin:cubes --path ${WORK}/nopath.json --tmax -3 -o ${WORK}/b)
 expect_error("--budget-coarsens: needs a budget" crowd bench --budget-coarsens --skinned-lod 0.1 -o ${WORK}/crowd)
+expect_error("--compare-skinning: compares the palette" crowd bench --compare-skinning --palette-skinning -o ${WORK}/crowd)
 # A mode option no mode of the run reads (a typo) is refused, after the modes are made.
 execute_process(COMMAND ${FARFIELD} path orbit builtin:cubes --frames 2 -o ${WORK}/orbit.json RESULT_VARIABLE rc
                 OUTPUT_QUIET)

@@ -76,6 +76,26 @@ TEST(CrowdBench, AgentsCulledBehindTheCityLeaveTheGeometryFrameExact) {
   EXPECT_NE(r.markdown.find("hidden behind the city"), std::string::npos);
 }
 
+// --compare-skinning adds the palette-skinned policies; they draw the baked reference's frames to rounding (the
+// geometry mode's crowd pixels well above the impostors' PSNR) and the same agents as their baked counterparts.
+TEST(CrowdBench, PaletteSkinningDrawsTheBakedPosesFrames) {
+  eval::CrowdBenchOptions o = tinyOptions();
+  o.compare_skinning = true;
+  const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), o);
+  ASSERT_EQ(r.runs.size(), 1u);
+  const eval::CrowdRun& run = r.runs[0];
+  ASSERT_EQ(run.modes.size(), 5u);
+  EXPECT_EQ(run.modes[3].name, "crowd-geometry-palette");
+  EXPECT_EQ(run.modes[4].name, "crowd-mixed-palette");
+  EXPECT_GT(run.modes[0].in_view, 0.0);
+  EXPECT_EQ(run.modes[3].geometry_agents, run.modes[0].geometry_agents);
+  EXPECT_EQ(run.modes[4].geometry_agents, run.modes[2].geometry_agents);
+  EXPECT_GT(run.modes[3].psnr_min, 45.0);
+  EXPECT_LT(run.modes[3].bad_share_mean, 0.01);
+  EXPECT_NEAR(run.modes[4].psnr_mean, run.modes[2].psnr_mean, 1.0);
+  EXPECT_NE(r.markdown.find("skinning: baked poses"), std::string::npos);
+}
+
 TEST(CrowdBench, BadOptionsAreErrors) {
   eval::CrowdBenchOptions o = tinyOptions();
   o.frames = 1;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -33,12 +34,18 @@ constexpr float kNominalSpeed = 1.3f;  // m/s at which a model's walk cycle is p
 struct ModeSpec {
   std::string name;
   runtime::CrowdPolicy policy;
+  bool palette = false;  // drawn by the palette-skinning runtime (CrowdBenchOptions::compare_skinning)
 };
 
-std::vector<ModeSpec> modeSpecs() {
-  return {{"crowd-geometry", runtime::CrowdPolicy::Geometry},
-          {"crowd-impostor", runtime::CrowdPolicy::Impostor},
-          {"crowd-mixed", runtime::CrowdPolicy::Mixed}};
+std::vector<ModeSpec> modeSpecs(bool compare_skinning) {
+  std::vector<ModeSpec> specs{{"crowd-geometry", runtime::CrowdPolicy::Geometry},
+                              {"crowd-impostor", runtime::CrowdPolicy::Impostor},
+                              {"crowd-mixed", runtime::CrowdPolicy::Mixed}};
+  if (compare_skinning) {
+    specs.push_back({"crowd-geometry-palette", runtime::CrowdPolicy::Geometry, true});
+    specs.push_back({"crowd-mixed-palette", runtime::CrowdPolicy::Mixed, true});
+  }
+  return specs;
 }
 
 // An elevated path: the pedestrian walk raised by 14 m (a first-floor balcony, a bus roof), looking down the street
@@ -283,6 +290,12 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
   rt_options.region_tints = gen::crowdRegionTints(options.crowd_seed, options.outfits);
   runtime::CrowdRuntime rt(models, model_options, rt_options);
   result.bake_seconds = rt.bakeSeconds();
+  std::unique_ptr<runtime::CrowdRuntime> rt_palette;
+  if (options.compare_skinning && rt_options.skinning != gpu::Skinning::Palette) {
+    runtime::CrowdRuntimeOptions palette_options = rt_options;
+    palette_options.skinning = gpu::Skinning::Palette;
+    rt_palette = std::make_unique<runtime::CrowdRuntime>(models, model_options, palette_options);
+  }
   for (size_t m = 0; m < rt.modelCount(); ++m) {
     result.layouts.push_back(rt.impostor(m).layout);
     result.atlas_choices.push_back(rt.atlasChoice(m));
@@ -305,7 +318,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
     for (size_t m = 0; m < rt.modelCount(); ++m) result.switch_m.push_back(rt.switchDistances(m, c).both());
   }
   if (!options.out_dir.empty()) fs::create_directories(fs::path(options.out_dir) / "frames");
-  const std::vector<ModeSpec> specs = modeSpecs();
+  const std::vector<ModeSpec> specs = modeSpecs(options.compare_skinning);
   const gpu::LightSettings light = renderer.light();
 
   for (const std::string& path_name : options.paths) {
@@ -371,9 +384,10 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           city_culler.draw(renderer, camera, items, item_bounds, target);
           rt.finish();
           const double city_ms = clock.milliseconds();
-          if (options.agent_occlusion) rt.cullBehind(target);
-          const runtime::CrowdFrameStats st = drawCrowd(rt, camera, states, specs[m].policy, light, target, options);
-          rt.finish();
+          runtime::CrowdRuntime& mode_rt = specs[m].palette && rt_palette ? *rt_palette : rt;
+          if (options.agent_occlusion) mode_rt.cullBehind(target);
+          const runtime::CrowdFrameStats st = drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
+          mode_rt.finish();
           const double total = clock.milliseconds();
           if (k == 0) continue;
           wall[m].push_back(total);

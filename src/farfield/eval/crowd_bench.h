@@ -44,6 +44,9 @@ struct CrowdBenchOptions {
   // reference and crowd-geometry always cast geometry.
   bool impostor_shadows = false;
   runtime::CrowdShadowOptions shadow;
+  // Adds crowd-geometry-palette and crowd-mixed-palette: the same policies through a second runtime whose skinned
+  // agents blend joint matrices (gpu::Skinning::Palette), timed in the same process on the same frames as the others.
+  bool compare_skinning = false;
   std::string out_dir;
   int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)
 };
