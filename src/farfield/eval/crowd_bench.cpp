@@ -386,7 +386,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           const double city_ms = clock.milliseconds();
           runtime::CrowdRuntime& mode_rt = specs[m].palette && rt_palette ? *rt_palette : rt;
           if (options.agent_occlusion) mode_rt.cullBehind(target);
-          const runtime::CrowdFrameStats st = drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
+          const runtime::CrowdFrameStats st =
+              drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
           mode_rt.finish();
           const double total = clock.milliseconds();
           if (k == 0) continue;

@@ -41,6 +41,8 @@ std::vector<BakedVertex> bakePoses(const scene::SkinnedModel& model, const std::
   return baked;
 }
 
+constexpr const char* kBaked = "#define FF_BAKED_POSES 1\n";  // skin.vert.glsl for Skinning::BakedPoses
+
 void setLight(const Program& p, const LightSettings& light) {
   Vec3 dir = light.direction;
   dir = glm::length(dir) > 0.0f ? glm::normalize(dir) : Vec3(0.0f, 0.0f, -1.0f);
@@ -201,15 +203,12 @@ image::ColorImage ImpostorAtlasGpu::readNormalDepth(int layer) const {
   return readLayer(normal_depth_, layout_.width(), layout_.height(), layer);
 }
 
-namespace {
-constexpr const char* kBaked = "#define FF_BAKED_POSES 1\n";
-}  // namespace
-
 CrowdRenderer::CrowdRenderer()
     : skinned_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl"),
                Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", kBaked)},
       capture_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_CAPTURE 1\n"),
-               Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", std::string(kBaked) + "#define FF_CAPTURE 1\n")},
+               Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl",
+                                     std::string(kBaked) + "#define FF_CAPTURE 1\n")},
       skinned_depth_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_DEPTH_ONLY 1\n"),
                      Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl",
                                            std::string(kBaked) + "#define FF_DEPTH_ONLY 1\n")},
@@ -237,14 +236,8 @@ void CrowdRenderer::setRegionTints(std::span<const Vec4> tints) {
   outfits_ = uint32_t(tints.size() / size_t(scene::kColorRegions));
 }
 
-const Program& CrowdRenderer::skinnedProgram(const SkinnedGpuModel& model) const {
-  return skinned_[model.skinning_ == Skinning::BakedPoses ? 1 : 0];
-}
-const Program& CrowdRenderer::captureProgram(const SkinnedGpuModel& model) const {
-  return capture_[model.skinning_ == Skinning::BakedPoses ? 1 : 0];
-}
-const Program& CrowdRenderer::skinnedDepthProgram(const SkinnedGpuModel& model) const {
-  return skinned_depth_[model.skinning_ == Skinning::BakedPoses ? 1 : 0];
+size_t CrowdRenderer::skinningIndex(const SkinnedGpuModel& model) {
+  return model.skinning_ == Skinning::BakedPoses ? 1 : 0;
 }
 
 void CrowdRenderer::bindModel(const Program& p, const SkinnedGpuModel& model) const {
@@ -304,7 +297,7 @@ FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuMode
   if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
-  const Program& p = skinnedProgram(model);
+  const Program& p = skinned_[skinningIndex(model)];
   p.use();
   p.set("u_view_proj", camera.viewProjection());
   p.set("u_outfits", outfits_);
@@ -368,7 +361,7 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
   CrowdAgentGpu agent = origin;
   agent.index = pose;
   uploadAgents(std::span<const CrowdAgentGpu>(&agent, 1));
-  const Program& capture = captureProgram(model);
+  const Program& capture = capture_[skinningIndex(model)];
   capture.use();
   bindModel(capture, model);
   capture.set("u_capture_centre", l.centre);
@@ -391,7 +384,7 @@ FrameStats CrowdRenderer::drawSkinnedDepth(const Mat4& light_view_proj, const Sk
   if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
-  const Program& p = skinnedDepthProgram(model);
+  const Program& p = skinned_depth_[skinningIndex(model)];
   p.use();
   p.set("u_view_proj", light_view_proj);
   bindModel(p, model);

@@ -169,10 +169,8 @@ class CrowdRenderer {
   // One instanced draw of the model's level for `count` agents (program, model and agents bound), and its counts.
   FrameStats drawAgents(const Program& p, const SkinnedGpuModel& model, size_t count, size_t level) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
-  // The skinned programs of a model's skinning: [0] Palette, [1] BakedPoses.
-  const Program& skinnedProgram(const SkinnedGpuModel& model) const;
-  const Program& captureProgram(const SkinnedGpuModel& model) const;
-  const Program& skinnedDepthProgram(const SkinnedGpuModel& model) const;
+  // The skinned programs, one per skinning: [0] Palette, [1] BakedPoses (skinningIndex).
+  static size_t skinningIndex(const SkinnedGpuModel& model);
   Program skinned_[2], capture_[2], skinned_depth_[2];
   Program impostor_, impostor_blend_, impostor_depth_;
   uint32_t agents_ = 0, empty_vao_ = 0, tints_ = 0, outfits_ = 0;
