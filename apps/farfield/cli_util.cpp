@@ -44,6 +44,14 @@ Box3 parseViewSpace(const std::string& view_min, const std::string& view_max, co
   return Box3::fromPoints(parseVec3("--view-min", view_min), parseVec3("--view-max", view_max));
 }
 
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
 IVec2 parseSize(const std::string& option, const std::string& text) {
   const auto x = text.find('x');
   int w = 0, h = 0;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "farfield/core/bounds.h"
 #include "farfield/core/math.h"
@@ -17,6 +18,8 @@ IVec2 parseSize(const std::string& option, const std::string& text);
 // The view space of --view-min/--view-max, or of --around PATH (gen::eyeBounds with --margin); an empty box for none.
 Box3 parseViewSpace(const std::string& view_min, const std::string& view_max, const std::string& around = {},
                     float margin_m = 0.0f);
+// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
+std::vector<std::string> splitList(const std::string& text);
 // Creates the parent directory of a file path if needed.
 void ensureParentDirectory(const std::string& file);
 

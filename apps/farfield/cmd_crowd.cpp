@@ -6,7 +6,6 @@
 // Animated crowds with multi-view impostors on a generated city: eval::runCrowdBench (eval/crowd_bench.h).
 #include <cstdio>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,14 +20,6 @@
 
 namespace farfield::app {
 namespace {
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 struct CrowdArgs {
   eval::CrowdBenchOptions o;

@@ -1,6 +1,6 @@
 // farfield view SCENE [--impostors DB] [--mode M] [--path P | --replay P] [--screenshot-at N,M -o DIR] [--exit]
 //               [--record OUT.json] [--size WxH] [--tmax MS] [--error-px PX] [--streets FILE] [--walk] [--tint]
-//               [--terrain DEM|fractal:... [--terrain-scale S]]
+//               [--terrain DEM|fractal:... [--terrain-scale S]] [--crowd N [--crowd-models a.glb,b.glb] ...]
 // The interactive viewer (farfield/view/viewer.h): a window with panels over the runtime; keys in docs/VIEWER.md.
 // The allocator is set up for timing first (farfield/core/allocator.h).
 #include <memory>
@@ -22,6 +22,7 @@ struct ViewArgs {
   std::string size = "1280x720";
   std::string screenshot_at;
   bool walk = false;
+  std::string crowd_models = "../shared/data/models/CesiumMan.glb,../shared/data/models/Fox.glb";
 };
 
 std::vector<size_t> parseFrameList(const std::string& option, const std::string& text) {
@@ -52,6 +53,7 @@ void runViewCommand(ViewArgs& args) {
   if (!args.screenshot_at.empty()) o.screenshot_at = parseFrameList("--screenshot-at", args.screenshot_at);
   if (args.walk) o.navigation = view::Navigation::Walk;
   o.scene_file = args.scene;
+  o.crowd.models = splitList(args.crowd_models);
   view::checkViewerOptions(o);  // cheap checks before the scene is loaded
   const scene::Scene scene = scene::loadScene(args.scene);
   view::runViewer(scene, o);
@@ -83,6 +85,20 @@ const RegisterCommand reg("view", [](CLI::App& app) {
                   "Terrain under the city in full and culled, drawn by LOD-sprite: the DEM or fractal:... the city was "
                   "made on (gen city --terrain)");
   cmd->add_option("--terrain-scale", o.terrain_scale, "Vertical scale the city was made with (gen city --terrain-scale)")
+      ->capture_default_str();
+  cmd->add_option("--crowd", o.crowd.agents,
+                  "Agents walking the sidewalks of the street graph, drawn over every mode as crowd-mixed (0: none)")
+      ->capture_default_str();
+  cmd->add_option("--crowd-models", args->crowd_models, "Skinned glTF models of the crowd, comma-separated")
+      ->capture_default_str();
+  cmd->add_option("--crowd-seed", o.crowd.seed, "Crowd seed")->capture_default_str();
+  cmd->add_option("--crowd-error-px", o.crowd.error_px, "The crowd impostors' error bound (pixels)")
+      ->capture_default_str();
+  cmd->add_option("--crowd-lod-px", o.crowd.lod_px,
+                  "Skinned agents at levels of detail within this many pixels (0: the mesh; seconds to build)")
+      ->capture_default_str();
+  cmd->add_option("--crowd-triangles", o.crowd.max_triangles,
+                  "Skinned triangles a frame for the nearest agents, the others as impostors (0: no budget)")
       ->capture_default_str();
   cmd->callback([args] { runViewCommand(*args); });
 });

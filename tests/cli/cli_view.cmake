@@ -1,7 +1,7 @@
 # farfield view as a script: bad arguments and bad databases give "error: ..." naming the input and exit code 2 (never
 # a crash), and a scripted replay writes its screenshots and recorded path and exits 0. The window needs a display
 # (ctest runs under xvfb-run, see the Makefile); without one only the checks made before the window opens run.
-# Run by ctest with -DFARFIELD=<binary> -DWORK=<scratch dir>.
+# Run by ctest with -DFARFIELD=<binary> -DSOURCE_DIR=<repository> -DWORK=<scratch dir>.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 include(${CMAKE_CURRENT_LIST_DIR}/cli_helpers.cmake)
@@ -21,6 +21,9 @@ expect_error("--path/--replay" view builtin:cubes --path ${WORK}/orbit.json --re
 expect_error("no-such-scene.glb" view ${WORK}/no-such-scene.glb ${script})
 expect_error("nopath.json" view builtin:cubes --replay ${WORK}/nopath.json --exit)
 expect_error("--terrain-scale" view builtin:cubes --terrain fractal:129:5 --terrain-scale 0 ${script})
+expect_error("no-such-model.glb" view builtin:cubes --crowd 10 --crowd-models ${WORK}/no-such-model.glb ${script})
+set(man ${SOURCE_DIR}/../shared/data/models/CesiumMan.glb)
+expect_error("--crowd-error-px" view builtin:cubes --crowd 10 --crowd-models ${man} --crowd-error-px 0 ${script})
 
 if(NOT DEFINED ENV{DISPLAY})
   message(STATUS "skipped: no DISPLAY for the window checks (run under xvfb-run)")
@@ -69,3 +72,16 @@ if(LAST_OUT MATCHES "identical")
 endif()
 expect_error("gen city --terrain" view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_bad --terrain ${terrain}
              --terrain-scale 2)
+
+# A crowd on the city's sidewalks, drawn over the mode's frame: the frame differs from the city alone where agents
+# stand; a scene without a street graph is refused naming --crowd.
+run_ok(${FARFIELD} gen city --blocks 12 --seed 3 --detail 0 -o ${WORK}/cc.glb)
+run_ok(${FARFIELD} path street ${WORK}/cc.streets.json --frames 3 -o ${WORK}/cc_walk.json)
+set(cc_script --mode culled --replay ${WORK}/cc_walk.json --screenshot-at 2 --exit --size 160x120)
+run_ok(${FARFIELD} view ${WORK}/cc.glb ${cc_script} -o ${WORK}/cc_alone)
+run_ok(${FARFIELD} view ${WORK}/cc.glb ${cc_script} -o ${WORK}/cc_crowd --crowd 400 --crowd-models ${man})
+run_ok(${FARFIELD} diff ${WORK}/cc_alone/frame_2.png ${WORK}/cc_crowd/frame_2.png)
+if(LAST_OUT MATCHES "identical")
+  message(FATAL_ERROR "farfield view --crowd drew the same frame as without the crowd:\n${LAST_OUT}")
+endif()
+expect_error("--crowd: needs the city's street graph" view builtin:cubes ${script} --crowd 10 --crowd-models ${man})

@@ -14,6 +14,7 @@
 #include "farfield/core/log.h"
 #include "farfield/core/timer.h"
 #include "farfield/eval/crowd_metrics.h"
+#include "farfield/eval/crowd_walk.h"
 #include "farfield/eval/frame_runner.h"
 #include "farfield/eval/mode.h"
 #include "farfield/gen/camera_path.h"
@@ -22,14 +23,11 @@
 #include "farfield/gpu/occlusion_culler.h"
 #include "farfield/image/metrics.h"
 #include "farfield/image/png_io.h"
-#include "farfield/scene/gltf_skin.h"
 
 namespace fs = std::filesystem;
 
 namespace farfield::eval {
 namespace {
-
-constexpr float kNominalSpeed = 1.3f;  // m/s at which a model's walk cycle is played at its own rate
 
 struct ModeSpec {
   std::string name;
@@ -64,37 +62,14 @@ gen::CameraPath elevated(const gen::CameraPath& walk) {
   return out;
 }
 
-std::vector<runtime::CrowdAgentState> agentStates(const gen::Crowd& crowd, const runtime::CrowdRuntime& rt, float t) {
-  std::vector<runtime::CrowdAgentState> states(crowd.agents.size());
-  for (size_t i = 0; i < crowd.agents.size(); ++i) {
-    const gen::CrowdAgent& a = crowd.agents[i];
-    const gen::AgentPose p = gen::agentPose(crowd, i, t);
-    runtime::CrowdAgentState& s = states[i];
-    s.model = a.model;
-    s.position = p.position;
-    s.heading = p.heading;
-    const float stride = kNominalSpeed * rt.cycleSeconds(a.model);
-    const float phase = a.phase + p.walked / stride;
-    s.phase = phase - std::floor(phase);
-    s.tint = a.tint;
-    s.outfit = a.outfit;
-    s.object_id = kCrowdIdBit | uint32_t(i);
-  }
-  return states;
-}
-
 // The crowd into `target` (holding the city), with or without the agents' shadows.
 runtime::CrowdFrameStats drawCrowd(runtime::CrowdRuntime& rt, const Camera& camera,
                                    std::span<const runtime::CrowdAgentState> states, runtime::CrowdPolicy policy,
                                    const gpu::LightSettings& light, const gpu::RenderTarget& target,
                                    const CrowdBenchOptions& options) {
-  if (options.shadows) {
-    runtime::CrowdShadowOptions shadow = options.shadow;
-    shadow.impostor_casters = options.impostor_shadows && policy == runtime::CrowdPolicy::Mixed;
-    return rt.drawShadowed(camera, states, policy, light, target, shadow);
-  }
-  target.bindForOpaquePass();
-  return rt.draw(camera, states, policy, light);
+  runtime::CrowdShadowOptions shadow = options.shadow;
+  shadow.impostor_casters = options.impostor_shadows && policy == runtime::CrowdPolicy::Mixed;
+  return drawCrowdFrame(rt, camera, states, policy, light, target, options.shadows, shadow);
 }
 
 std::string fmt(const char* f, double v) {
@@ -259,18 +234,10 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
   CrowdBenchResult result;
   result.renderer = context.description();
 
-  std::vector<scene::SkinnedModel> models;
-  std::vector<runtime::CrowdModelOptions> model_options;
-  for (size_t m = 0; m < options.models.size(); ++m) {
-    scene::SkinImportStats stats;
-    models.push_back(scene::importSkinnedModel(options.models[m], &stats));
-    for (const std::string& w : stats.warnings()) FF_WARN(options.models[m] << ": " << w);
-    runtime::CrowdModelOptions mo;
-    mo.height_m = options.model_heights[m];
-    mo.facing_deg = options.model_facing_deg[m];
-    model_options.push_back(mo);
-    result.model_names.push_back(fs::path(options.models[m]).filename().string());
-  }
+  CrowdModels crowd_models = loadCrowdModels(options.models, options.model_heights, options.model_facing_deg);
+  const std::vector<scene::SkinnedModel>& models = crowd_models.models;
+  const std::vector<runtime::CrowdModelOptions>& model_options = crowd_models.options;
+  result.model_names = crowd_models.names;
 
   Stopwatch city_clock;
   gen::CityOptions co;
@@ -355,7 +322,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         const size_t pf = std::min(k * options.frame_step, path.frames.size() - 1);
         const Camera camera = pathCamera(path, pf, options.width, options.height);
         const float t = float(pf) / path.fps;
-        const std::vector<runtime::CrowdAgentState> states = agentStates(crowd, rt, t);
+        const std::vector<runtime::CrowdAgentState> states = crowdAgentStates(crowd, rt, t);
         ids.clear();
         items.clear();
         item_bounds.clear();

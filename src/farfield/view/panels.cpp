@@ -100,6 +100,7 @@ PanelActions drawMainPanel(PanelState& s) {
   ImGui::PlotLines("##gpu", h.gpuMs().data(), int(h.gpuMs().size()), int(h.offset()), overlay, 0.0f, top,
                    ImVec2(320, 48));
   ImGui::Text("triangles %" PRIu64 ", draw calls %u", s.frame.triangles, s.frame.draw_calls);
+  if (s.crowd) ImGui::Text("crowd: %zu skinned, %zu impostors", s.crowd_geometry, s.crowd_impostors);
   drawWalkthrough(s);
   drawPromises(s);
   float t_max = float(s.t_max_ms);

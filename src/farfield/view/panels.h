@@ -31,6 +31,8 @@ struct PanelState {
   uint64_t gpu_budget_bytes = 0;
   // This frame.
   ViewFrame frame;
+  bool crowd = false;  // a crowd is drawn over the frame (its time and triangles are in `frame`)
+  size_t crowd_geometry = 0, crowd_impostors = 0;
   const FrameHistory* history = nullptr;
   std::string path_status;              // "" = no path
   std::string record_status;            // "" = not recording

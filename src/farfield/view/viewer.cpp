@@ -105,6 +105,27 @@ class Viewer {
     modes_ = std::make_unique<ModeRenderer>(scene_, gpu_scene_, bvh_, renderer_, target_, settings);
     selectMode(options_.mode.empty() ? defaultMode(database_) : options_.mode);
     startingPose();
+    if (options_.crowd.agents > 0) {
+      if (!graph_)
+        throw Error("--crowd", "needs the city's street graph (CITY.streets.json next to the scene, or --streets)");
+      const extract::GroundHeight* ground = ground_.get();
+      crowd_ = std::make_unique<ViewerCrowd>(
+          *graph_, [ground](float x, float y) { return ground->at(x, y); }, options_.crowd, options_.height);
+      panel_.crowd = true;
+      FF_INFO("crowd: " << crowd_->agentCount() << " agents, atlases baked in " << crowd_->bakeSeconds() << " s");
+    }
+  }
+
+  // The crowd over the mode's frame, its time and counts added to the frame's.
+  void drawCrowd(double dt) {
+    const bool replaying = player_.active() && !player_.realTime();
+    crowd_time_ = replaying ? double(player_.frame()) / 30.0 : crowd_time_ + dt;
+    const ViewerCrowdFrame f = crowd_->draw(camera_, float(crowd_time_), renderer_.light(), target_);
+    panel_.frame.cpu_ms += f.ms;
+    panel_.frame.triangles += f.stats.draw.triangles;
+    panel_.frame.draw_calls += f.stats.draw.draw_calls;
+    panel_.crowd_geometry = f.stats.geometry;
+    panel_.crowd_impostors = f.stats.impostors;
   }
 
   void run() {
@@ -278,6 +299,7 @@ class Viewer {
                                                      : controller_.camera(options_.width, options_.height);
     if (player_.active() && !player_.paused()) controller_.setPose(camera_);
     panel_.frame = modes_->render(camera_, shown_, panel_.tint);
+    if (crowd_) drawCrowd(dt);
     const runtime::FramePlan* plan = panel_.frame.plan;
     const runtime::Walkthrough* walkthrough = modes_->walkthrough();
     panel_.bound_px = plan ? plan->report.bound_px : 0.0;
@@ -297,14 +319,16 @@ class Viewer {
     }
     if (check_requested_ || panel_.check_every_frame) {
       check_requested_ = false;
-      if (panel_.tint) modes_->redraw(camera_, shown_ - 1, false);
+      if (panel_.tint || crowd_) modes_->redraw(camera_, shown_ - 1, false);
       check_ = checkAgainstReference(renderer_, reference_items_, camera_, target_, reference_target_,
                                      scene_.objects.size(), panel_.bound_px);
       check_->frame = shown_ - 1;
       history_.addCheck(check_->over_bound);
       heatmap_texture_ = gpu::Texture::fromImage(check_->heatmap, false);
       parallax_texture_ = gpu::Texture::fromImage(check_->parallax, false);
-      if (panel_.tint) modes_->redraw(camera_, shown_ - 1, true);  // show the tinted frame again
+      // The tinted frame again, and the crowd (the reference has none, so the check measured the frame without).
+      if (panel_.tint || crowd_) modes_->redraw(camera_, shown_ - 1, panel_.tint);
+      if (crowd_) crowd_->draw(camera_, float(crowd_time_), renderer_.light(), target_);
     }
   }
 
@@ -363,6 +387,8 @@ class Viewer {
   std::optional<urban::StreetGraph> graph_;
   std::unique_ptr<extract::GroundHeight> ground_;
   std::unique_ptr<ModeRenderer> modes_;
+  std::unique_ptr<ViewerCrowd> crowd_;
+  double crowd_time_ = 0.0;  // seconds
   CameraController controller_;
   PathPlayer player_;
   CameraRecorder recorder_;
@@ -395,6 +421,16 @@ void checkViewerOptions(const ViewerOptions& o) {
   if (!o.screenshot_at.empty() && o.out_dir.empty()) throw Error("--screenshot-at", "needs -o DIR");
   if (o.exit_at_end && o.replay.empty() && o.screenshot_at.empty())
     throw Error("--exit", "needs --replay or --screenshot-at (otherwise nothing would be shown)");
+  if (o.crowd.agents > 0) {
+    if (o.crowd.models.empty() || o.crowd.models.size() > 2)
+      throw Error("--crowd-models", "one or two skinned glTF files (heights 1.75 m and 0.8 m)");
+    for (const std::string& f : o.crowd.models)
+      if (!fs::exists(f)) throw Error(f, "no such file (--crowd-models)");
+    if (!(o.crowd.error_px > 0.0) || !std::isfinite(o.crowd.error_px))
+      throw Error("--crowd-error-px", "must be a number of pixels > 0");
+    if (!(o.crowd.lod_px >= 0.0) || !std::isfinite(o.crowd.lod_px))
+      throw Error("--crowd-lod-px", "must be a number of pixels >= 0");
+  }
 }
 
 void runViewer(const scene::Scene& scene, const ViewerOptions& options) {

@@ -15,6 +15,7 @@
 
 #include "farfield/scene/scene.h"
 #include "farfield/view/camera_controller.h"
+#include "farfield/view/viewer_crowd.h"
 
 namespace farfield::view {
 
@@ -40,6 +41,9 @@ struct ViewerOptions {
   Navigation navigation = Navigation::Fly;
   std::string terrain;             // a terrain under the city in full and culled (DEM file or fractal:...; "" = none)
   float terrain_scale = 1.0f;      // the vertical scale the city was made with (gen city --terrain-scale)
+  // A crowd on the street graph's sidewalks, drawn over every mode's frame (viewer_crowd.h; crowd.agents 0: none).
+  // Its time follows the display (a replay: 30 frames a second of the path).
+  ViewerCrowdOptions crowd;
 };
 
 // Checks the options that need no window (sizes, files to read); throws farfield::Error naming the option.

@@ -1,0 +1,44 @@
+// A crowd walking a city's sidewalks, as the crowd bench and the viewer draw it: the skinned models loaded with their
+// heights and facings, the agents' states (position, heading, walk phase) at a time from gen's routes, and one
+// frame of the crowd drawn into a target holding the city, with or without the agents' shadows.
+#pragma once
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gen/crowd.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/runtime/crowd_runtime.h"
+#include "farfield/scene/skin.h"
+
+namespace farfield::eval {
+
+// The skinned models of a crowd and the runtime's options for each (height in metres, facing in degrees).
+struct CrowdModels {
+  std::vector<scene::SkinnedModel> models;
+  std::vector<runtime::CrowdModelOptions> options;
+  std::vector<std::string> names;  // the files' names, for reports
+};
+
+// Loads each file (scene::importSkinnedModel; its import warnings logged). Throws farfield::Error naming the file,
+// or for no files or fewer heights or facings than files.
+CrowdModels loadCrowdModels(std::span<const std::string> files, std::span<const float> heights,
+                            std::span<const float> facing_deg);
+
+// Every agent's state at time t (seconds): where gen's route puts it, its heading, and its walk phase advanced by the
+// distance walked over its model's stride at the nominal speed (the cycle played at its own rate at 1.3 m/s). Object
+// ids are kCrowdIdBit | agent index.
+std::vector<runtime::CrowdAgentState> crowdAgentStates(const gen::Crowd& crowd, const runtime::CrowdRuntime& rt,
+                                                       float t);
+
+// The crowd into `target` (holding the city): with shadows through rt.drawShadowed (the casters' shadows on the
+// city), else rt.draw into the target's opaque pass.
+runtime::CrowdFrameStats drawCrowdFrame(runtime::CrowdRuntime& rt, const Camera& camera,
+                                        std::span<const runtime::CrowdAgentState> states, runtime::CrowdPolicy policy,
+                                        const gpu::LightSettings& light, const gpu::RenderTarget& target, bool shadows,
+                                        const runtime::CrowdShadowOptions& shadow);
+
+}  // namespace farfield::eval

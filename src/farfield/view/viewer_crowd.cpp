@@ -1,0 +1,48 @@
+#include "farfield/view/viewer_crowd.h"
+
+#include <cmath>
+#include <utility>
+
+#include "farfield/core/timer.h"
+
+namespace farfield::view {
+
+ViewerCrowd::ViewerCrowd(const urban::StreetGraph& streets, std::function<float(float, float)> ground_height,
+                         const ViewerCrowdOptions& options, int height_px)
+    : options_(options) {
+  const std::vector<float> heights{1.75f, 0.8f}, facing{0.0f, 90.0f};
+  models_ = eval::loadCrowdModels(options.models, heights, facing);
+  gen::CrowdOptions co;
+  co.agents = options.agents;
+  co.seed = options.seed;
+  co.model_shares.assign({0.7f, 0.3f});
+  co.model_shares.resize(models_.models.size());
+  co.ground_height = std::move(ground_height);
+  crowd_ = gen::generateCrowd(streets, co);
+  runtime::CrowdRuntimeOptions ro;
+  ro.error_px = options.error_px;
+  ro.geometry_lod_px = options.lod_px;
+  ro.max_geometry_triangles = options.max_triangles;
+  ro.bound_focal_px = double(height_px) / (2.0 * std::tan(double(Camera{}.fov_y) / 2.0));
+  ro.region_tints = crowd_.region_tints;
+  rt_ = std::make_unique<runtime::CrowdRuntime>(models_.models, models_.options, ro);
+}
+
+ViewerCrowd::~ViewerCrowd() = default;
+
+ViewerCrowdFrame ViewerCrowd::draw(const Camera& camera, float t, const gpu::LightSettings& light,
+                                   const gpu::RenderTarget& target) {
+  const Stopwatch clock;
+  const std::vector<runtime::CrowdAgentState> states = eval::crowdAgentStates(crowd_, *rt_, t);
+  runtime::CrowdShadowOptions shadow;
+  shadow.impostor_casters = true;
+  rt_->cullBehind(target);
+  ViewerCrowdFrame frame;
+  frame.stats = eval::drawCrowdFrame(*rt_, camera, states, runtime::CrowdPolicy::Mixed, light, target,
+                                     options_.shadows, shadow);
+  rt_->finish();
+  frame.ms = clock.milliseconds();
+  return frame;
+}
+
+}  // namespace farfield::view
