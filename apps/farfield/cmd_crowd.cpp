@@ -105,6 +105,11 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
       "--palette-skinning", a->palette_skinning,
       "Skinned agents blend four joint matrices of their palette pose per vertex instead of reading the pose's "
       "vertices skinned once at start-up (the same images; for comparing the two)");
+  bench->add_option("--repeats", o.timing_passes,
+                    "Timing passes over the frames; each frame's fastest render is kept (the images are the first "
+                    "pass's)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
   bench->add_flag("--compare-skinning", o.compare_skinning,
                   "Also crowd-geometry-palette and crowd-mixed-palette: the same policies with joint matrices blended "
                   "per vertex, timed on the same frames");

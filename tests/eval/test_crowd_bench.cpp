@@ -81,6 +81,7 @@ TEST(CrowdBench, AgentsCulledBehindTheCityLeaveTheGeometryFrameExact) {
 TEST(CrowdBench, PaletteSkinningDrawsTheBakedPosesFrames) {
   eval::CrowdBenchOptions o = tinyOptions();
   o.compare_skinning = true;
+  o.timing_passes = 2;
   const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), o);
   ASSERT_EQ(r.runs.size(), 1u);
   const eval::CrowdRun& run = r.runs[0];
@@ -94,6 +95,8 @@ TEST(CrowdBench, PaletteSkinningDrawsTheBakedPosesFrames) {
   EXPECT_LT(run.modes[3].bad_share_mean, 0.01);
   EXPECT_NEAR(run.modes[4].psnr_mean, run.modes[2].psnr_mean, 1.0);
   EXPECT_NE(r.markdown.find("skinning: baked poses"), std::string::npos);
+  EXPECT_NE(r.markdown.find("fastest of 2 passes"), std::string::npos);
+  for (const eval::CrowdModeResult& m : run.modes) EXPECT_GT(m.wall.median, 0.0) << m.name;
 }
 
 TEST(CrowdBench, BadOptionsAreErrors) {
@@ -105,5 +108,8 @@ TEST(CrowdBench, BadOptionsAreErrors) {
   EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
   o = tinyOptions();
   o.paths = {"sideways"};
+  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
+  o = tinyOptions();
+  o.timing_passes = 0;
   EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
 }

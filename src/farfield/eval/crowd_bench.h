@@ -27,6 +27,8 @@ struct CrowdBenchOptions {
   uint64_t path_seed = 5;
   size_t frames = 8;        // measured frames per run
   size_t frame_step = 15;   // path frames between measured frames (30 fps path: 0.5 s)
+  // Passes over the frames, each frame's fastest render kept per mode (the first pass also measures the images).
+  int timing_passes = 1;
   int width = 512;
   int height = 512;
   std::vector<std::string> models;  // glTF files; default ../shared/data/models CesiumMan.glb and Fox.glb
