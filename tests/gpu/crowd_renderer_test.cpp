@@ -15,6 +15,7 @@
 namespace farfield::gpu {
 namespace {
 
+class CrowdRendererGlCutout : public test::GpuTest {};
 // The same check for each way of skinning (gpu::Skinning).
 class CrowdSkinningGl : public test::GpuTest, public ::testing::WithParamInterface<Skinning> {};
 
@@ -114,6 +115,37 @@ TEST_P(CrowdSkinningGl, InstancedGpuSkinningEqualsCpuSkinning) {
   const Compare wrong = compare(gpu_target.readColor(), gpu_target.readIds(), wrong_target.readColor(),
                                 wrong_target.readIds());
   EXPECT_GT(double(wrong.bad), 0.05 * double(wrong.covered)) << wrong.bad << " of " << wrong.covered;
+}
+
+// A model whose texture is transparent is cut out (nothing drawn); an opaque one is drawn without the cut-out test.
+TEST_F(CrowdRendererGlCutout, ATransparentTextureIsCutOutAndAnOpaqueOneDrawsWithoutTheTest) {
+  scene::SkinnedModel man =
+      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  ASSERT_TRUE(man.texture);
+  const std::vector<std::vector<Mat4>> poses{scene::jointMatrices(man, &man.animations[0], man.animations[0].start)};
+  CrowdRenderer crowd;
+  Renderer renderer;
+  const Camera camera = test::testCamera(Vec3(0.0f, -3.6f, 1.0f), Vec3(0.0f, 0.0f, 0.8f), 96);
+  std::vector<CrowdAgentGpu> agents(1);
+  agents[0].object_id = 7;
+  auto agentPixels = [&](const SkinnedGpuModel& model) {
+    RenderTarget target(96, 96);
+    target.bindForOpaquePass();
+    target.clear(renderer.light().sky_color);
+    crowd.drawSkinned(camera, model, agents, renderer.light());
+    size_t n = 0;
+    for (uint32_t id : target.readIds().pixels()) n += id == 7u ? 1 : 0;
+    return n;
+  };
+  const SkinnedGpuModel opaque(man, Mat4(1.0f), poses);
+  EXPECT_FALSE(opaque.cutout());
+  EXPECT_GT(agentPixels(opaque), 200u);
+  image::ColorImage clear = *man.texture;
+  for (image::Rgba8& t : clear.pixels()) t.a = 40;
+  man.texture = std::make_shared<const image::ColorImage>(std::move(clear));
+  const SkinnedGpuModel transparent(man, Mat4(1.0f), poses);
+  EXPECT_TRUE(transparent.cutout());
+  EXPECT_EQ(agentPixels(transparent), 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Skinnings, CrowdSkinningGl, ::testing::Values(Skinning::Palette, Skinning::BakedPoses),

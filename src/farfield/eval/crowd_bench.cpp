@@ -107,7 +107,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
   for (size_t m = 0; m < result.layouts.size(); ++m) {
     const gpu::AtlasLayout& l = result.layouts[m];
     const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
-    md << "- " << result.model_names[m] << ": " << thousands(result.model_triangles[m]) << " triangles; atlas "
+    md << "- " << result.model_names[m] << ": " << thousands(result.model_triangles[m]) << " triangles"
+       << (result.model_cutout[m] ? " (texels cut out)" : " (opaque: no cut-out test)") << "; atlas "
        << (c.from_bound ? "chosen from the bound (" + fmt("%.2f", options.runtime.error_px) + " px from " +
                               fmt("%.1f", options.runtime.bound_switch_m) + " m on)"
                         : std::string("fixed"))
@@ -197,6 +198,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
     const gpu::AtlasLayout& l = result.layouts[m];
     const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
     j["models"].push_back({{"file", result.model_names[m]}, {"triangles", result.model_triangles[m]},
+                           {"cutout", bool(result.model_cutout[m])},
                            {"azimuths", l.azimuths}, {"elevations", l.elevations},
                            {"octahedral", l.octahedral}, {"frames", l.frames},
                            {"cell", {l.cell_width, l.cell_height}}, {"texel_m", c.texel_m},
@@ -273,6 +275,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
     result.atlas_choices.push_back(rt.atlasChoice(m));
     result.atlas_bytes.push_back(rt.impostor(m).byteSize());
     result.model_triangles.push_back(rt.modelTriangles(m));
+    result.model_cutout.push_back(rt.gpuModel(m).cutout());
     result.level_triangles.emplace_back();
     for (size_t l = 0; l < rt.gpuModel(m).levelCount(); ++l)
       result.level_triangles.back().push_back(rt.gpuModel(m).triangleCount(l));

@@ -84,6 +84,7 @@ struct CrowdBenchResult {
   std::vector<runtime::CrowdAtlasChoice> atlas_choices;
   std::vector<size_t> atlas_bytes;
   std::vector<uint64_t> model_triangles;
+  std::vector<bool> model_cutout;  // per model: texels cut out (gpu::SkinnedGpuModel::cutout)
   // Per model, per level of detail (level 0 the mesh): triangles and distance to the mesh over the palette (metres).
   std::vector<std::vector<uint64_t>> level_triangles;
   std::vector<std::vector<double>> level_m;

@@ -43,6 +43,12 @@ std::vector<BakedVertex> bakePoses(const scene::SkinnedModel& model, const std::
 
 constexpr const char* kBaked = "#define FF_BAKED_POSES 1\n";  // skin.vert.glsl for Skinning::BakedPoses
 
+// skin.vert.glsl + crowd.frag.glsl with the skinning's and the cut-out's defines and `extra`.
+Program skinnedProgram(bool baked, bool cutout, const std::string& extra = "") {
+  return Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl",
+                               std::string(baked ? kBaked : "") + (cutout ? "#define FF_CUTOUT 1\n" : "") + extra);
+}
+
 void setLight(const Program& p, const LightSettings& light) {
   Vec3 dir = light.direction;
   dir = glm::length(dir) > 0.0f ? glm::normalize(dir) : Vec3(0.0f, 0.0f, -1.0f);
@@ -138,10 +144,18 @@ SkinnedGpuModel::SkinnedGpuModel(const scene::SkinnedModel& model, const Mat4& m
   attrib(2, 2, GL_FLOAT, offsetof(SkinVertex, uv), false);
   attrib(3, 4, GL_UNSIGNED_SHORT, offsetof(SkinVertex, joints), true);
   attrib(4, 4, GL_FLOAT, offsetof(SkinVertex, weights), false);
+  // The shader's cut-out test, albedo.a = base alpha x texel alpha < 0.5, over every texel (filtered values lie
+  // between texels').
+  cutout_ = base_color_.a < 0.5f;
   if (model.texture) {
     texture_ = Texture::fromImage(*model.texture, true);
     textured_ = true;
     bytes_ += texture_.byteSize();
+    for (const image::Rgba8& t : model.texture->pixels())
+      if (base_color_.a * float(t.a) / 255.0f < 0.5f) {
+        cutout_ = true;
+        break;
+      }
   }
 }
 
@@ -204,14 +218,14 @@ image::ColorImage ImpostorAtlasGpu::readNormalDepth(int layer) const {
 }
 
 CrowdRenderer::CrowdRenderer()
-    : skinned_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl"),
-               Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", kBaked)},
-      capture_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_CAPTURE 1\n"),
-               Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl",
-                                     std::string(kBaked) + "#define FF_CAPTURE 1\n")},
-      skinned_depth_{Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl", "#define FF_DEPTH_ONLY 1\n"),
-                     Program::fromEmbedded("skin.vert.glsl", "crowd.frag.glsl",
-                                           std::string(kBaked) + "#define FF_DEPTH_ONLY 1\n")},
+    : skinned_{{skinnedProgram(false, false), skinnedProgram(false, true)},
+               {skinnedProgram(true, false), skinnedProgram(true, true)}},
+      skinned_depth_{{skinnedProgram(false, false, "#define FF_DEPTH_ONLY 1\n"),
+                      skinnedProgram(false, true, "#define FF_DEPTH_ONLY 1\n")},
+                     {skinnedProgram(true, false, "#define FF_DEPTH_ONLY 1\n"),
+                      skinnedProgram(true, true, "#define FF_DEPTH_ONLY 1\n")}},
+      capture_{skinnedProgram(false, true, "#define FF_CAPTURE 1\n"),
+               skinnedProgram(true, true, "#define FF_CAPTURE 1\n")},
       impostor_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl")),
       impostor_blend_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl", "#define FF_BLEND_VIEWS 1")),
       impostor_depth_(Program::fromEmbedded("multiview.vert.glsl", "multiview.frag.glsl", "#define FF_DEPTH_ONLY 1")) {
@@ -236,8 +250,8 @@ void CrowdRenderer::setRegionTints(std::span<const Vec4> tints) {
   outfits_ = uint32_t(tints.size() / size_t(scene::kColorRegions));
 }
 
-size_t CrowdRenderer::skinningIndex(const SkinnedGpuModel& model) {
-  return model.skinning_ == Skinning::BakedPoses ? 1 : 0;
+const Program& CrowdRenderer::program(const Program (&programs)[2][2], const SkinnedGpuModel& model) const {
+  return programs[model.skinning_ == Skinning::BakedPoses ? 1 : 0][model.cutout_ ? 1 : 0];
 }
 
 void CrowdRenderer::bindModel(const Program& p, const SkinnedGpuModel& model) const {
@@ -297,7 +311,7 @@ FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuMode
   if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
-  const Program& p = skinned_[skinningIndex(model)];
+  const Program& p = program(skinned_, model);
   p.use();
   p.set("u_view_proj", camera.viewProjection());
   p.set("u_outfits", outfits_);
@@ -361,7 +375,7 @@ void CrowdRenderer::capture(const SkinnedGpuModel& model, uint32_t pose, Imposto
   CrowdAgentGpu agent = origin;
   agent.index = pose;
   uploadAgents(std::span<const CrowdAgentGpu>(&agent, 1));
-  const Program& capture = capture_[skinningIndex(model)];
+  const Program& capture = capture_[model.skinning_ == Skinning::BakedPoses ? 1 : 0];
   capture.use();
   bindModel(capture, model);
   capture.set("u_capture_centre", l.centre);
@@ -384,7 +398,7 @@ FrameStats CrowdRenderer::drawSkinnedDepth(const Mat4& light_view_proj, const Sk
   if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
-  const Program& p = skinned_depth_[skinningIndex(model)];
+  const Program& p = program(skinned_depth_, model);
   p.use();
   p.set("u_view_proj", light_view_proj);
   bindModel(p, model);

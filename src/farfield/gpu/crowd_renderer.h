@@ -60,6 +60,9 @@ class SkinnedGpuModel {
   uint64_t triangleCount(size_t level = 0) const { return levels_[level].index_count / 3; }
   const Mat4& modelToAgent() const { return model_to_agent_; }
   Skinning skinning() const { return skinning_; }
+  // Whether some texel's albedo alpha (base colour x texture) is below 0.5, so that drawing must cut it out; without,
+  // the fragment shader has no discard and the depth test can run before it.
+  bool cutout() const { return cutout_; }
   size_t gpuBytes() const { return bytes_; }
 
  private:
@@ -68,6 +71,7 @@ class SkinnedGpuModel {
   uint32_t vao_ = 0, vbo_ = 0, ibo_ = 0, palette_ = 0, regions_ = 0;
   uint32_t joint_count_ = 0, pose_count_ = 0, vertex_count_ = 0;
   Skinning skinning_ = Skinning::BakedPoses;
+  bool cutout_ = true;
   // Per level: its range of the index buffer and its first triangle's colour region in the regions buffer.
   struct Level {
     uint32_t first_index = 0, index_count = 0, first_triangle = 0;
@@ -169,9 +173,10 @@ class CrowdRenderer {
   // One instanced draw of the model's level for `count` agents (program, model and agents bound), and its counts.
   FrameStats drawAgents(const Program& p, const SkinnedGpuModel& model, size_t count, size_t level) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
-  // The skinned programs, one per skinning: [0] Palette, [1] BakedPoses (skinningIndex).
-  static size_t skinningIndex(const SkinnedGpuModel& model);
-  Program skinned_[2], capture_[2], skinned_depth_[2];
+  // The skinned programs by skinning ([0] Palette, [1] BakedPoses) and, for drawing, cut-out ([0] none, [1] cut out):
+  // the model's (program()). The bake always cuts out.
+  const Program& program(const Program (&programs)[2][2], const SkinnedGpuModel& model) const;
+  Program skinned_[2][2], skinned_depth_[2][2], capture_[2];
   Program impostor_, impostor_blend_, impostor_depth_;
   uint32_t agents_ = 0, empty_vao_ = 0, tints_ = 0, outfits_ = 0;
 };

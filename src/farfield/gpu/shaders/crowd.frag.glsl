@@ -1,12 +1,14 @@
 #version 450 core
 // Farfield crowd fragment shader for skinned agents: albedo = base colour * texture * agent tint * the tint of the
 // triangle's colour region in the agent's outfit (regions per triangle at binding 3, indexed by gl_PrimitiveID;
-// tints at binding 2: outfit o's region r at (o mod u_outfits) * 16 + r); texels with alpha below 0.5 cut out. Lit as
-// mesh.frag.glsl: albedo * (ambient + light_color * max(dot(n, -light_dir), 0)).
+// tints at binding 2: outfit o's region r at (o mod u_outfits) * 16 + r); with FF_CUTOUT, texels with alpha below 0.5
+// cut out. Lit as mesh.frag.glsl: albedo * (ambient + light_color * max(dot(n, -light_dir), 0)).
 // FF_CAPTURE (multi-view impostor bake): attachment 0 = the untinted albedo, its alpha coding the colour region r as
 // (16 (r + 1) - 1) / 255 (coverage: alpha >= 8/255); attachment 1 = the normal (agent space, 0.5 n + 0.5) and in
 // alpha the depth along u_capture_dir from u_capture_centre over u_capture_radius (0.5 d + 0.5).
-// FF_DEPTH_ONLY (shadow casters): the cut-out test alone, no colour.
+// FF_DEPTH_ONLY (shadow casters): no colour.
+// FF_CUTOUT: texels with alpha below 0.5 are cut out (discard). Left out for models that have none
+// (gpu::SkinnedGpuModel::cutout), so that the depth test can run before the shader.
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -40,7 +42,9 @@ layout(binding = 0) uniform sampler2D u_texture;
 void main() {
   vec4 albedo = u_base_color;
   if (u_textured != 0) albedo *= texture(u_texture, v_uv);
+#ifdef FF_CUTOUT
   if (albedo.a < 0.5) discard;
+#endif
 #ifndef FF_DEPTH_ONLY
   const uint region = regions[u_first_triangle + uint(gl_PrimitiveID)];
   vec3 n = v_normal;
