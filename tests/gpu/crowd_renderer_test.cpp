@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "farfield/core/error.h"
@@ -133,9 +134,8 @@ TEST_F(CrowdRendererGlCutout, ATransparentTextureIsCutOutAndAnOpaqueOneDrawsWith
     target.bindForOpaquePass();
     target.clear(renderer.light().sky_color);
     crowd.drawSkinned(camera, model, agents, renderer.light());
-    size_t n = 0;
-    for (uint32_t id : target.readIds().pixels()) n += id == 7u ? 1 : 0;
-    return n;
+    const image::IdImage ids = target.readIds();
+    return size_t(std::count(ids.pixels().begin(), ids.pixels().end(), 7u));
   };
   const SkinnedGpuModel opaque(man, Mat4(1.0f), poses);
   EXPECT_FALSE(opaque.cutout());
