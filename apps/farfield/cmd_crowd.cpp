@@ -59,8 +59,11 @@ void run(CrowdArgs& a) {
     throw Error("--compare-skinning", "compares the palette with the baked poses: leave out --palette-skinning");
   if (a.palette_skinning) a.o.runtime.skinning = gpu::Skinning::Palette;
   if (a.octahedral >= 2) a.o.runtime.grid = impostor::ViewGrid::octahedralGrid(a.octahedral);
-  if (a.o.runtime.budget_coarsens && (a.o.runtime.max_geometry_triangles == 0 || !(a.o.runtime.geometry_lod_px > 0.0)))
-    throw Error("--budget-coarsens", "needs a budget (--geometry-triangles) and levels of detail (--skinned-lod)");
+  if (a.o.runtime.budget_coarsens &&
+      ((a.o.runtime.max_geometry_triangles == 0 && !(a.o.runtime.geometry_ms > 0.0)) ||
+       !(a.o.runtime.geometry_lod_px > 0.0)))
+    throw Error("--budget-coarsens",
+                "needs a budget (--geometry-triangles or --geometry-ms) and levels of detail (--skinned-lod)");
   const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), a.o);
   std::printf("%s\nwrote %s/{crowd.json,crowd.md,frames/}\n", r.markdown.c_str(), a.o.out_dir.c_str());
 }
@@ -98,6 +101,11 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
                     "crowd-mixed's geometry budget: skinned triangles a frame for the nearest agents inside their "
                     "switch distance, the others as impostors (0: none)")
       ->capture_default_str();
+  bench->add_option("--geometry-ms", o.runtime.geometry_ms,
+                    "crowd-mixed's geometry budget in milliseconds of skinned drawing a frame, from the measured time "
+                    "per triangle (0: none; with --geometry-triangles the smaller holds)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   bench->add_flag("--budget-coarsens", o.runtime.budget_coarsens,
                   "Under --geometry-triangles, agents also take coarser levels of detail (--skinned-lod), the least "
                   "error on screen first, before impostors");

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
@@ -167,6 +168,47 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetDrawsTheNearestAgentsAsGeometry) {
   EXPECT_EQ(st.geometry, 4u);
   EXPECT_EQ(st.over_budget, 0u);
   EXPECT_TRUE(same(all, frame({{&unbudgeted, CrowdPolicy::Geometry}}, {agents}, nullptr)));
+}
+
+// A budget in milliseconds: the first frame allows the estimator's first triangles, the skinned draws are timed, and
+// the next frame's budget is the milliseconds over the measured time per triangle; the skinned triangles drawn never
+// exceed the frame's budget.
+TEST_F(CrowdRuntimeGl, AGeometryBudgetInMillisecondsFollowsTheMeasuredTimePerTriangle) {
+  const scene::SkinnedModel man = loadMan();
+  const CrowdModelOptions mo = manOptions();
+  CrowdRuntimeOptions options = smallAtlas(8);
+  options.geometry_ms = 1000.0;  // every agent fits once the cost is measured
+  CrowdRuntime rt(std::span(&man, 1), std::span(&mo, 1), options);
+  Camera camera;
+  camera.eye = Vec3(0, 0, 1.5f);
+  camera.at = Vec3(10, 0, 1.0f);
+  camera.width = camera.height = 96;
+  const double d = rt.switchDistances(0, camera).both();
+  std::vector<CrowdAgentState> agents(4);  // 4 x 4,672 triangles, more than the first 10,000
+  for (size_t i = 0; i < agents.size(); ++i) {
+    const double x = std::min(d * 0.8, 8.0) - 1.0 * double(i);
+    agents[i].position = Vec3(float(x), float(double(i) - 1.5), 0.0f);
+    agents[i].object_id = uint32_t(i + 1);
+  }
+  gpu::RenderTarget target(96, 96);
+  gpu::LightSettings light;
+  target.bindForOpaquePass();
+  CrowdFrameStats first = rt.draw(camera, agents, CrowdPolicy::Mixed, light);
+  rt.finish();
+  EXPECT_EQ(first.budget_triangles, 10000u);
+  EXPECT_EQ(first.geometry, 2u);  // two meshes fit the first budget
+  EXPECT_LE(first.draw.triangles - 2 * first.impostors, first.budget_triangles);
+  const double ms = rt.collectGeometryMs();
+  EXPECT_GT(ms, 0.0);
+  EXPECT_NEAR(rt.msPerSkinnedTriangle(), ms / double(2 * man.mesh.triangleCount()), 1e-12);
+  const CrowdFrameStats second = rt.draw(camera, agents, CrowdPolicy::Mixed, light);
+  rt.finish();
+  EXPECT_EQ(second.budget_triangles, uint64_t(std::floor(1000.0 / rt.msPerSkinnedTriangle() + 1e-9)));
+  EXPECT_EQ(second.geometry, 4u);
+  EXPECT_DOUBLE_EQ(second.geometry_ms, ms);
+  CrowdRuntimeOptions bad = smallAtlas(8);
+  bad.geometry_ms = -1.0;
+  EXPECT_THROW(CrowdRuntime(std::span(&man, 1), std::span(&mo, 1), bad), farfield::Error);
 }
 
 // Mixed's skinned agents at levels of detail: each takes the coarsest level whose measured distance stays within

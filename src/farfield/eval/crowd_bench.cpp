@@ -138,6 +138,9 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
              ? "baked poses (each palette pose's vertices skinned once, read per agent)"
              : "palette (four joint matrices blended per vertex)")
      << ", in the reference and every mode\n";
+  if (options.runtime.geometry_ms > 0.0)
+    md << "- crowd-mixed's geometry budget in time: " << fmt("%.1f", options.runtime.geometry_ms)
+       << " ms of skinned drawing a frame, as triangles at the measured time per triangle (moving average)\n";
   if (options.runtime.max_geometry_triangles > 0)
     md << "- crowd-mixed's geometry budget: " << thousands(size_t(options.runtime.max_geometry_triangles))
        << " skinned triangles a frame, the nearest agents first; the others inside their switch distance drawn as "
@@ -178,6 +181,16 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
          << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
          << fmt("%.2f", run.reference_popping_mean) << ") | " << fmt("%.0f", r.shadow_casters) << " / "
          << fmt("%.0f", r.receiver_bad_pixels) << " |\n";
+  if (options.runtime.geometry_ms > 0.0) {
+    md << "\ncrowd-mixed's skinned draws against the " << fmt("%.1f", options.runtime.geometry_ms)
+       << " ms budget (the frames that drew skinned agents):\n";
+    for (const CrowdRun& run : result.runs)
+      for (const CrowdModeResult& r : run.modes)
+        if (r.skinned_ms.count > 0)
+          md << "- " << thousands(run.agents) << " agents, " << run.path << ", " << r.name << ": median "
+             << fmt("%.2f", r.skinned_ms.median) << " ms, max " << fmt("%.2f", r.skinned_ms.max) << " ms; "
+             << r.skinned_over << " of " << r.skinned_ms.count << " frames over\n";
+  }
   return md.str();
 }
 
@@ -221,7 +234,9 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"coarser_agents", r.coarser}, {"coarsened_for_budget_agents", r.coarsened},
                            {"triangles", r.triangles},
                            {"shadow_casters", r.shadow_casters}, {"shadow_texel_m", r.shadow_texel_m},
-                           {"receiver_bad_pixels", r.receiver_bad_pixels}});
+                           {"receiver_bad_pixels", r.receiver_bad_pixels},
+                           {"skinned_ms_median", r.skinned_ms.median}, {"skinned_ms_max", r.skinned_ms.max},
+                           {"skinned_frames", r.skinned_ms.count}, {"skinned_frames_over_budget", r.skinned_over}});
   std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
   std::ofstream(fs::path(options.out_dir) / "crowd.md") << result.markdown;
 }
@@ -315,7 +330,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
           in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
           receiver_bad(specs.size()), occluded(specs.size()), over_budget(specs.size()), coarser(specs.size()),
-          coarsened(specs.size());
+          coarsened(specs.size()), skinned(specs.size());
       std::vector<image::ColorImage> prev(specs.size());
       std::vector<image::IdImage> prev_ids(specs.size());
       image::ColorImage prev_ref;
@@ -342,6 +357,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       // reference's city pixels), then the crowd.
       struct Timed {
         double total = 0.0, crowd = 0.0;
+        double skinned = -1.0;  // crowd-mixed's measured skinned draws under runtime.geometry_ms; -1: none
         runtime::CrowdFrameStats stats;
       };
       auto drawTimed = [&](size_t m, const Camera& camera, std::span<const runtime::CrowdAgentState> states) {
@@ -358,6 +374,9 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         mode_rt.finish();
         out.total = clock.milliseconds();
         out.crowd = out.total - city_ms;
+        if (options.runtime.geometry_ms > 0.0 && specs[m].policy == runtime::CrowdPolicy::Mixed &&
+            out.stats.geometry > 0)
+          out.skinned = mode_rt.collectGeometryMs();
         return out;
       };
       for (size_t k = 0; k <= options.frames; ++k) {  // k = 0: the untimed warm-up frame
@@ -385,6 +404,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           if (k == 0) continue;
           wall[m].push_back(timed.total);
           crowd_ms[m].push_back(timed.crowd);
+          skinned[m].push_back(timed.skinned);
           geo[m].push_back(double(st.geometry));
           imp[m].push_back(double(st.impostors));
           in_view[m].push_back(double(st.in_view));
@@ -433,6 +453,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
             const Timed timed = drawTimed(m, camera, states);
             wall[m][k - 1] = std::min(wall[m][k - 1], timed.total);
             crowd_ms[m][k - 1] = std::min(crowd_ms[m][k - 1], timed.crowd);
+            if (timed.skinned >= 0.0)
+              skinned[m][k - 1] = skinned[m][k - 1] < 0.0 ? timed.skinned : std::min(skinned[m][k - 1], timed.skinned);
           }
         }
       }
@@ -447,6 +469,12 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.name = specs[m].name;
         r.wall = summarize(wall[m]);
         r.crowd = summarize(crowd_ms[m]);
+        std::vector<double> timed_skinned;
+        for (double v : skinned[m])
+          if (v >= 0.0) timed_skinned.push_back(v);
+        r.skinned_ms = summarize(timed_skinned);
+        r.skinned_over = size_t(std::count_if(timed_skinned.begin(), timed_skinned.end(),
+                                              [&](double v) { return v > options.runtime.geometry_ms; }));
         r.psnr_mean = mean(psnr[m]);
         r.psnr_min = psnr[m].empty() ? 0.0 : *std::min_element(psnr[m].begin(), psnr[m].end());
         r.bad_share_mean = mean(bad[m]);

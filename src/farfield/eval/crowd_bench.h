@@ -68,6 +68,10 @@ struct CrowdModeResult {
   double coarsened = 0.0;    // mean per frame: of those, coarser than the bound gives them, for the geometry budget
   double shadow_casters = 0.0, shadow_texel_m = 0.0;  // means per frame
   double receiver_bad_pixels = 0.0;  // mean per frame: non-agent pixels off by > 8/255 (shadow differences)
+  // With runtime.geometry_ms (crowd-mixed): the measured skinned draws of the frames that drew skinned agents (the
+  // fastest of the passes), and how many of them took longer than the budget.
+  FrameSummary skinned_ms;
+  size_t skinned_over = 0;
 };
 
 struct CrowdRun {

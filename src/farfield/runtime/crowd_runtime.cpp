@@ -33,6 +33,8 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
     throw Error("crowd runtime", "the bound's switch distance and focal length must be positive");
   if (!(options.geometry_lod_px >= 0.0) || !std::isfinite(options.geometry_lod_px))
     throw Error("crowd runtime", "the geometry's level-of-detail bound must be a finite number of pixels >= 0");
+  if (!(options.geometry_ms >= 0.0) || !std::isfinite(options.geometry_ms))
+    throw Error("crowd runtime", "the geometry budget must be a finite number of milliseconds >= 0");
   if (!options.region_tints.empty()) renderer_.setRegionTints(options.region_tints);
   for (size_t m = 0; m < models.size(); ++m) {
     const scene::SkinnedModel& sm = models[m];
@@ -125,6 +127,10 @@ size_t CrowdRuntime::atlasBytes() const {
 }
 
 void CrowdRuntime::prepareFrame(const Camera& camera, std::span<const CrowdAgentState> agents) {
+  collectGeometryMs();
+  budget_triangles_ = options_.max_geometry_triangles > 0 ? options_.max_geometry_triangles : UINT64_MAX;
+  if (options_.geometry_ms > 0.0)
+    budget_triangles_ = std::min(budget_triangles_, triangle_rate_.trianglesFor(options_.geometry_ms));
   switch_m_.resize(models_.size());
   for (size_t m = 0; m < models_.size(); ++m) switch_m_[m] = switchDistances(m, camera).both();
   lod_m_per_m_ = options_.geometry_lod_px / focalOf(camera);
@@ -183,7 +189,11 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
   drawn_.assign(agents.size(), Drawn::NotDrawn);
   level_.assign(agents.size(), 0);
   near_.clear();
-  const bool budgeted = policy == CrowdPolicy::Mixed && options_.max_geometry_triangles > 0;
+  const bool budgeted = policy == CrowdPolicy::Mixed && this->budgeted();
+  if (budgeted) {
+    stats.budget_triangles = budget_triangles_;
+    stats.geometry_ms = last_geometry_ms_;
+  }
   for (size_t i = 0; i < agents.size(); ++i) {
     const CrowdAgentState& a = agents[i];
     const Vec3 centre = spheres_[i].centre;
@@ -249,9 +259,9 @@ void CrowdRuntime::fitBudget(const Camera& camera, std::span<const CrowdAgentSta
     const double m = nextMetres(k);
     if (m >= 0.0) steps.push({m / std::max(double(near_[k].first), 1e-3), k});
   };
-  if (triangles > options_.max_geometry_triangles)
+  if (triangles > budget_triangles_)
     for (size_t k = 0; k < n; ++k) push(k);
-  while (triangles > options_.max_geometry_triangles && !steps.empty()) {
+  while (triangles > budget_triangles_ && !steps.empty()) {
     const size_t k = steps.top().second;
     steps.pop();
     triangles -= trianglesAt(k);
@@ -303,20 +313,44 @@ void CrowdRuntime::addToLists(const Camera& camera, const CrowdAgentState& a, ui
   lists_.impostors[a.model].push_back(g);
 }
 
+double CrowdRuntime::collectGeometryMs() {
+  if (geometry_timed_) {  // the last frame's skinned draws (waits for the result if the GPU is still on them)
+    last_geometry_ms_ = geometry_timer_->elapsedMs();
+    triangle_rate_.observe(last_geometry_ms_, timed_triangles_);
+    geometry_timed_ = false;
+  }
+  return last_geometry_ms_;
+}
+
 CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSettings& light, CrowdFrameStats stats) {
-  for (size_t m = 0; m < models_.size(); ++m) {
-    stats.impostors += lists_.impostors[m].size();
-    auto add = [&](const gpu::FrameStats& f) {
-      stats.draw.triangles += f.triangles;
-      stats.draw.draw_calls += f.draw_calls;
-      stats.draw.objects += f.objects;
-    };
+  auto add = [&](const gpu::FrameStats& f) {
+    stats.draw.triangles += f.triangles;
+    stats.draw.draw_calls += f.draw_calls;
+    stats.draw.objects += f.objects;
+  };
+  // The skinned agents first, timed under a budget in milliseconds; then the impostors.
+  size_t skinned = 0;
+  for (size_t m = 0; m < models_.size(); ++m)
+    for (const std::vector<gpu::CrowdAgentGpu>& list : lists_.geometry[m]) skinned += list.size();
+  const bool timed = options_.geometry_ms > 0.0 && skinned > 0;
+  if (timed) {
+    if (!geometry_timer_) geometry_timer_ = std::make_unique<gpu::GpuTimer>();
+    geometry_timer_->begin();
+  }
+  for (size_t m = 0; m < models_.size(); ++m)
     for (size_t l = 0; l < lists_.geometry[m].size(); ++l) {
       const size_t n = lists_.geometry[m][l].size();
       stats.geometry += n;
       stats.coarser += l > 0 ? n : 0;
       add(renderer_.drawSkinned(camera, *models_[m].gpu, lists_.geometry[m][l], light, l));
     }
+  if (timed) {
+    geometry_timer_->end();
+    geometry_timed_ = true;
+    timed_triangles_ = stats.draw.triangles;
+  }
+  for (size_t m = 0; m < models_.size(); ++m) {
+    stats.impostors += lists_.impostors[m].size();
     add(renderer_.drawImpostors(camera, *models_[m].impostor->atlas, lists_.impostors[m], light, options_.blend_views));
   }
   return stats;
@@ -376,7 +410,7 @@ bool CrowdRuntime::castsAsImpostor(const Camera& camera, const CrowdAgentState& 
   if (drawn_[i] == Drawn::Geometry) return false;
   // Not drawn (out of view or hidden): by its distance, or as an impostor under a geometry budget, which only the
   // drawn agents share.
-  return options_.max_geometry_triangles > 0 ||
+  return budgeted() ||
          double(glm::length(camera.eye - spheres_[i].centre)) >= switch_m_[a.model];
 }
 

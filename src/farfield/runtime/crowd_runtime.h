@@ -13,11 +13,13 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/gpu/crowd_renderer.h"
+#include "farfield/gpu/gpu_timer.h"
 #include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/shadow_map.h"
 #include "farfield/impostor/multi_view.h"
 #include "farfield/runtime/crowd_shadows.h"
+#include "farfield/runtime/triangle_rate.h"
 #include "farfield/scene/skin.h"
 
 namespace farfield::runtime {
@@ -74,6 +76,11 @@ struct CrowdRuntimeOptions {
   // outside the view then cast their shadows as impostors. A crowd as dense near the camera as far from it costs
   // geometry in proportion to its density without it (100,000 agents on the default city: 59 skinned agents a frame).
   uint64_t max_geometry_triangles = 0;
+  // Mixed's geometry budget in milliseconds of skinned drawing a frame (0: none), beside or instead of the triangles
+  // above (the smaller holds): each frame's skinned draws are timed (gpu::GpuTimer), and the budget in triangles is
+  // geometry_ms over the moving average of the measured time per triangle (runtime::TriangleRate; 10,000 triangles
+  // before the first measurement). A frame's measurement is read when the next frame is prepared.
+  double geometry_ms = 0.0;
   // Under the budget, coarser levels as well as impostors (above). Off by default: on the crowd bench's walks the
   // coarser levels kept the budget at a lower PSNR than impostors of the farthest (docs/BENCHMARKS.md, Crowds).
   bool budget_coarsens = false;
@@ -123,6 +130,8 @@ struct CrowdFrameStats {
   size_t coarsened = 0;    // of geometry: at a level coarser than geometry_lod_px gives them, for the budget
   size_t shadow_casters = 0;  // drawShadowed: agents drawn into the shadow map
   float shadow_texel_m = 0.0f;
+  uint64_t budget_triangles = 0;  // Mixed under a budget: this frame's skinned triangles allowed (0: no budget)
+  double geometry_ms = 0.0;       // with geometry_ms: the last measured skinned draws (the previous frame's), ms
   gpu::FrameStats draw;
 };
 
@@ -153,6 +162,11 @@ class CrowdRuntime {
   void cullBehind(const gpu::RenderTarget& target);
   // Waits for the GPU (frame timings).
   void finish() const { renderer_.finish(); }
+  // With CrowdRuntimeOptions::geometry_ms: the time of the last timed frame's skinned draws (ms; waits for it), taken
+  // into the budget's cost per triangle now rather than when the next frame is prepared; 0 before any.
+  double collectGeometryMs();
+  // The budget's current cost per skinned triangle (ms; 0 before the first measurement).
+  double msPerSkinnedTriangle() const { return triangle_rate_.msPerTriangle(); }
   // The switch distance of model m for a camera (metres; Dobbyn's texel rule and the view error bound).
   impostor::SwitchDistances switchDistances(size_t m, const Camera& camera) const;
   size_t modelCount() const { return models_.size(); }
@@ -226,6 +240,15 @@ class CrowdRuntime {
   std::vector<double> impostor_m_;  // prepareFrame: per model, an impostor's error inside its switch (see fitBudget)
   std::vector<double> switch_m_;       // prepareFrame: per model, this frame's camera
   double lod_m_per_m_ = 0.0;           // prepareFrame: a level's allowed distance per metre from the eye
+  // The geometry budget: budgeted() says whether there is one, budget_triangles_ is this frame's (prepareFrame).
+  bool budgeted() const { return options_.max_geometry_triangles > 0 || options_.geometry_ms > 0.0; }
+  uint64_t budget_triangles_ = 0;
+  // geometry_ms: the skinned draws' timer, whether it holds an unread frame and how many triangles that frame drew.
+  TriangleRate triangle_rate_;
+  std::unique_ptr<gpu::GpuTimer> geometry_timer_;
+  bool geometry_timed_ = false;
+  uint64_t timed_triangles_ = 0;
+  double last_geometry_ms_ = 0.0;
   gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
   std::vector<float> depth_rows_;
   bool cull_next_ = false;
