@@ -1,5 +1,6 @@
 // The skinned triangles' measured cost: a moving average of frames' time per triangle, turned into a triangle budget
-// for a time budget; frames with too few triangles or no time are left out.
+// for a time budget divided by the recent frames' largest measured / predicted ratio; frames with too few triangles
+// or no time are left out.
 #include "farfield/runtime/triangle_rate.h"
 
 #include <gtest/gtest.h>
@@ -18,11 +19,26 @@ TEST(TriangleRate, FirstBudgetThenTheMeasuredCostsMovingAverage) {
   rate.observe(10.0, 100000);  // 0.1 us a triangle
   EXPECT_TRUE(rate.known());
   EXPECT_DOUBLE_EQ(rate.msPerTriangle(), 1e-4);
+  EXPECT_DOUBLE_EQ(rate.safetyFactor(), 1.0);
   EXPECT_EQ(rate.trianglesFor(5.0), 50000u);
-  rate.observe(20.0, 100000);  // 0.2 us: the average moves halfway
+  rate.observe(20.0, 100000);  // 0.2 us: the average moves halfway, and this frame took 2x its prediction
   EXPECT_NEAR(rate.msPerTriangle(), 1.5e-4, 1e-12);
-  EXPECT_NEAR(double(rate.trianglesFor(3.0)), 20000.0, 1.0);  // floor of 3 / 1.5e-4 in doubles
+  EXPECT_NEAR(rate.safetyFactor(), 2.0, 1e-12);
+  EXPECT_NEAR(double(rate.trianglesFor(3.0)), 3.0 / (1.5e-4 * 2.0), 1.0);
   EXPECT_EQ(rate.trianglesFor(0.0), 0u);
+}
+
+TEST(TriangleRate, TheSafetyFactorIsTheLargestRatioOfTheWindow) {
+  TriangleRate rate(1.0, 1, 0, 3);  // the newest frame alone is the average
+  rate.observe(1.0, 1000);
+  rate.observe(1.5, 1000);  // predicted 1.0: ratio 1.5
+  rate.observe(1.5, 1000);  // 1.0
+  rate.observe(1.2, 1000);  // 0.8
+  EXPECT_NEAR(rate.safetyFactor(), 1.5, 1e-12);
+  rate.observe(1.2, 1000);  // 1.0: the 1.5 leaves the window of 3
+  EXPECT_NEAR(rate.safetyFactor(), 1.0, 1e-12);
+  // A budget that the window's worst frame would have kept: 1.2 ms per 1,000 triangles.
+  EXPECT_NEAR(double(rate.trianglesFor(6.0)), 5000.0, 1.0);
 }
 
 TEST(TriangleRate, FramesThatSayNothingAreLeftOut) {
@@ -37,4 +53,5 @@ TEST(TriangleRate, FramesThatSayNothingAreLeftOut) {
   EXPECT_DOUBLE_EQ(rate.msPerTriangle(), 1e-4);
   EXPECT_THROW(TriangleRate(0.0), Error);
   EXPECT_THROW(TriangleRate(1.5), Error);
+  EXPECT_THROW(TriangleRate(0.3, 1000, 10000, 0), Error);
 }

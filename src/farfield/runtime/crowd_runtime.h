@@ -78,8 +78,9 @@ struct CrowdRuntimeOptions {
   uint64_t max_geometry_triangles = 0;
   // Mixed's geometry budget in milliseconds of skinned drawing a frame (0: none), beside or instead of the triangles
   // above (the smaller holds): each frame's skinned draws are timed (gpu::GpuTimer), and the budget in triangles is
-  // geometry_ms over the moving average of the measured time per triangle (runtime::TriangleRate; 10,000 triangles
-  // before the first measurement). A frame's measurement is read when the next frame is prepared.
+  // geometry_ms over the moving average of the measured time per triangle times the largest measured / predicted
+  // ratio of the last 16 frames (runtime::TriangleRate; 10,000 triangles before the first measurement). A frame's
+  // measurement is read when the next frame is prepared.
   double geometry_ms = 0.0;
   // Under the budget, coarser levels as well as impostors (above). Off by default: on the crowd bench's walks the
   // coarser levels kept the budget at a lower PSNR than impostors of the farthest (docs/BENCHMARKS.md, Crowds).

@@ -23,6 +23,7 @@ ViewerCrowd::ViewerCrowd(const urban::StreetGraph& streets, std::function<float(
   ro.error_px = options.error_px;
   ro.geometry_lod_px = options.lod_px;
   ro.max_geometry_triangles = options.max_triangles;
+  ro.geometry_ms = options.geometry_ms;
   ro.bound_focal_px = double(height_px) / (2.0 * std::tan(double(Camera{}.fov_y) / 2.0));
   ro.region_tints = crowd_.region_tints;
   rt_ = std::make_unique<runtime::CrowdRuntime>(models_.models, models_.options, ro);

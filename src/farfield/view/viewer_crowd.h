@@ -26,6 +26,7 @@ struct ViewerCrowdOptions {
   double error_px = 1.0;            // the impostors' bound (crowd-mixed's switch)
   double lod_px = 0.0;              // skinned levels of detail within this many pixels (0: the mesh; seconds to build)
   uint64_t max_triangles = 20000;   // skinned triangles a frame (0: no budget)
+  double geometry_ms = 0.0;         // skinned drawing a frame in ms, at the measured time per triangle (0: none)
   bool shadows = true;
 };
 
