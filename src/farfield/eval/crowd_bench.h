@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "farfield/eval/crowd_walk.h"
 #include "farfield/eval/frame_stats.h"
 #include "farfield/gpu/context.h"
 #include "farfield/runtime/crowd_runtime.h"
@@ -32,10 +33,9 @@ struct CrowdBenchOptions {
   int width = 512;
   int height = 512;
   std::vector<std::string> models;  // glTF files; default ../shared/data/models CesiumMan.glb and Fox.glb
-  std::vector<float> model_heights{1.75f, 0.8f};
-  // Turn bringing each model's front to +x (CesiumMan walks along +x once Z up; the Fox faces glTF's +z, -y).
-  std::vector<float> model_facing_deg{0.0f, 90.0f};
-  std::vector<float> model_shares{0.7f, 0.3f};
+  std::vector<float> model_heights = kCrowdModelHeights;  // per model; the defaults are the shared models'
+  std::vector<float> model_facing_deg = kCrowdModelFacingDeg;
+  std::vector<float> model_shares = kCrowdModelShares;
   runtime::CrowdRuntimeOptions runtime;  // its bound_focal_px is set from the frame size (60 degrees)
   size_t outfits = 32;                   // colour-region outfits drawn from
   bool shadows = true;                   // agents cast shadows (reference and every mode)

@@ -16,6 +16,12 @@
 
 namespace farfield::eval {
 
+// The shared models' defaults (../shared/data/models CesiumMan.glb, Fox.glb), by model index: heights in metres, the
+// turn bringing each front to +x (CesiumMan walks along +x once Z up; the Fox faces glTF's +z, -y), shares of agents.
+inline const std::vector<float> kCrowdModelHeights{1.75f, 0.8f};
+inline const std::vector<float> kCrowdModelFacingDeg{0.0f, 90.0f};
+inline const std::vector<float> kCrowdModelShares{0.7f, 0.3f};
+
 // The skinned models of a crowd and the runtime's options for each (height in metres, facing in degrees).
 struct CrowdModels {
   std::vector<scene::SkinnedModel> models;

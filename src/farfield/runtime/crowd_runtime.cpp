@@ -333,6 +333,7 @@ CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSe
   for (size_t m = 0; m < models_.size(); ++m)
     for (const std::vector<gpu::CrowdAgentGpu>& list : lists_.geometry[m]) skinned += list.size();
   const bool timed = options_.geometry_ms > 0.0 && skinned > 0;
+  const uint64_t triangles_before = stats.draw.triangles;
   if (timed) {
     if (!geometry_timer_) geometry_timer_ = std::make_unique<gpu::GpuTimer>();
     geometry_timer_->begin();
@@ -347,7 +348,7 @@ CrowdFrameStats CrowdRuntime::drawLists(const Camera& camera, const gpu::LightSe
   if (timed) {
     geometry_timer_->end();
     geometry_timed_ = true;
-    timed_triangles_ = stats.draw.triangles;
+    timed_triangles_ = stats.draw.triangles - triangles_before;
   }
   for (size_t m = 0; m < models_.size(); ++m) {
     stats.impostors += lists_.impostors[m].size();

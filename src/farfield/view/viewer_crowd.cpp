@@ -1,6 +1,7 @@
 #include "farfield/view/viewer_crowd.h"
 
 #include <cmath>
+#include <cstddef>
 #include <utility>
 
 #include "farfield/core/timer.h"
@@ -10,13 +11,12 @@ namespace farfield::view {
 ViewerCrowd::ViewerCrowd(const urban::StreetGraph& streets, std::function<float(float, float)> ground_height,
                          const ViewerCrowdOptions& options, int height_px)
     : options_(options) {
-  const std::vector<float> heights{1.75f, 0.8f}, facing{0.0f, 90.0f};
-  models_ = eval::loadCrowdModels(options.models, heights, facing);
+  models_ = eval::loadCrowdModels(options.models, eval::kCrowdModelHeights, eval::kCrowdModelFacingDeg);
   gen::CrowdOptions co;
   co.agents = options.agents;
   co.seed = options.seed;
-  co.model_shares.assign({0.7f, 0.3f});
-  co.model_shares.resize(models_.models.size());
+  co.model_shares.assign(eval::kCrowdModelShares.begin(),
+                         eval::kCrowdModelShares.begin() + std::ptrdiff_t(models_.models.size()));
   co.ground_height = std::move(ground_height);
   crowd_ = gen::generateCrowd(streets, co);
   runtime::CrowdRuntimeOptions ro;
