@@ -29,6 +29,8 @@
 #include "farfield/eval/terrain_modes.h"
 #include "farfield/eval/terrain_paths.h"
 #include "farfield/eval/terrain_tiles.h"
+#include "farfield/terrain/dem_io.h"
+#include "farfield/terrain/fractal.h"
 #include "farfield/terrain/terrain_data.h"
 
 namespace farfield::app {
@@ -117,8 +119,8 @@ void runTiles(eval::TerrainTilesOptions& o, const std::string& size) {
   o.width = s.x;
   o.height = s.y;
   const eval::TerrainTilesResult result = eval::runTerrainTiles(o);
-  std::printf("%s\nwrote %s/{tiles.json,tiles.md,tiles_frames.csv} in %.0f s\n", result.markdown.c_str(),
-              o.out_dir.c_str(), result.seconds);
+  std::printf("%s\nwrote %s/{tiles.json,tiles.md,tiles_frames.csv%s} in %.0f s\n", result.markdown.c_str(),
+              o.out_dir.c_str(), o.render ? ",frames/" : "", result.seconds);
   if (result.check_mismatches > 0) throw Error("--check-stride", "the tiled LOD differed from the whole grid's");
 }
 
@@ -132,6 +134,21 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
   info->add_option("dem", *info_dem, "DEM file or fractal:SIZE[:SEED]")->required();
   info->add_option("--block", *info_block, "LOD block size in cells")->capture_default_str();
   info->callback([info_dem, info_block] { runInfo(*info_dem, *info_block); });
+
+  auto export_args = std::make_shared<std::pair<std::string, std::string>>();
+  auto* exp = cmd->add_subcommand("export", "Write a DEM (or fractal:SIZE[:SEED][...]) as a Float32 GeoTIFF, e.g. "
+                                            "a large fractal for `terrain tiles`, which reads it tile by tile");
+  exp->add_option("dem", export_args->first, "DEM file or fractal:SIZE[:SEED][...]")->required();
+  exp->add_option("-o,--output", export_args->second, "GeoTIFF to write")->required();
+  exp->callback([export_args] {
+    const std::string& spec = export_args->first;
+    const terrain::Heightfield hf = spec.rfind("fractal:", 0) == 0
+                                        ? terrain::fractalTerrain(terrain::parseFractalSpec(spec))
+                                        : terrain::loadDem(spec);
+    terrain::writeDem(hf, export_args->second);
+    std::printf("wrote %s: %dx%d points, %.1f m cells, heights %.1f..%.1f m\n", export_args->second.c_str(),
+                hf.width, hf.height, hf.cell_x, double(hf.minHeight()), double(hf.maxHeight()));
+  });
 
   struct PathArgs {
     std::string dem, output;
@@ -205,6 +222,10 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
                                                             "whole-frame sprite (0 = no)")->capture_default_str();
   tiles->add_option("--epsilon", to.epsilon, "Sprite error threshold, pixels")->capture_default_str();
   tiles->add_option("--low-error", to.low_error, "Low-resolution LOD threshold, pixels")->capture_default_str();
+  tiles->add_flag("--render", to.render, "Draw every frame from GPU patches paged under --gpu-budget-mb, timed, "
+                                         "with sample frames in OUTDIR/frames");
+  tiles->add_option("--gpu-budget-mb", to.gpu_budget_mb, "GPU memory budget of the tiles' patches, MiB")
+      ->capture_default_str();
   tiles->callback([t] { runTiles(t->first, t->second); });
 });
 

@@ -107,6 +107,9 @@ TEST(TerrainModesGL, HighTilesDrawsTheHighLodFromPagedTiles) {
   EXPECT_NEAR(tiles->mean_triangles, r.mode("high")->mean_triangles, 0.1 * r.mode("high")->mean_triangles + 10.0);
   EXPECT_GT(tiles->info.at("tile_loads"), 0.0);
   EXPECT_LE(tiles->info.at("tile_peak_resident_bytes"), tiles->info.at("tile_budget_bytes"));
+  // Drawn from GPU patches paged under their own budget.
+  EXPECT_GT(tiles->info.at("patch_loads"), 0.0);
+  EXPECT_LE(tiles->info.at("patch_peak_gpu_bytes"), tiles->info.at("patch_gpu_budget_bytes"));
   currentTerrainRun().reset();
 }
 

@@ -9,8 +9,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "farfield/terrain/fractal.h"
+#include "farfield/terrain/terrain_data.h"
 #include "support/expect_error.h"
 #include "support/test_support.h"
+#include "terrain/test_raster.h"
 
 namespace farfield::eval {
 namespace {
@@ -45,6 +48,50 @@ TEST(TerrainTiles, PagedLodMatchesTheWholeGridWithinTheBudget) {
   EXPECT_GT(j["whole_keyframes"].get<size_t>(), 0u);
   EXPECT_GT(j["tile_sprite_refreshes"].get<size_t>(), 0u);
   EXPECT_NE(r.markdown.find("sprites per tile"), std::string::npos);
+}
+
+// A DEM file is read into the cache tile by tile and the flythrough planned on the cache's overview: per frame the
+// same LOD as the run that holds the whole grid (the check forces that), and drawn from GPU patches in budget.
+TEST(TerrainTilesGL, ADemFileIsStreamedAndDrawnFromPagedPatches) {
+  const terrain::Heightfield hf = terrain::fractalTerrain(terrain::parseFractalSpec("fractal:257:4:relief=600"));
+  std::vector<double> values(hf.size());
+  for (int r = 0; r < hf.height; ++r)  // raster row 0 north
+    for (int c = 0; c < hf.width; ++c) values[size_t(r) * size_t(hf.width) + size_t(c)] = hf.at(c, hf.height - 1 - r);
+  const double gt[6] = {500000.0, hf.cell_x, 0.0, 4000000.0, 0.0, -hf.cell_y};
+  const std::string dem = (test::scratchDir("terrain_tiles_dem") / "dem.tif").string();
+  terrain::test::writeRaster(dem, "GTiff", GDT_Float32, hf.width, hf.height, values, nullptr, gt);
+
+  TerrainTilesOptions o = smallRun("terrain_tiles_streamed");
+  o.dem = dem;
+  o.check_stride = 0;
+  o.sprite_tile_cells = 0;
+  o.render = true;
+  o.gpu_budget_mb = 1.0;
+  o.sample_stride = 10;
+  runTerrainTiles(o);
+  TerrainTilesOptions w = smallRun("terrain_tiles_whole");
+  w.dem = dem;
+  w.sprite_tile_cells = 0;
+  runTerrainTiles(w);
+
+  auto json = [](const std::string& dir) {
+    std::ifstream in(std::filesystem::path(dir) / "tiles.json");
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json s = json(o.out_dir), h = json(w.out_dir);
+  EXPECT_TRUE(s["streamed"].get<bool>());
+  EXPECT_FALSE(h["streamed"].get<bool>());
+  EXPECT_EQ(s["grid"], h["grid"]);
+  EXPECT_EQ(s["triangles_mean"].get<double>(), h["triangles_mean"].get<double>());
+  EXPECT_EQ(s["triangles_max"].get<size_t>(), h["triangles_max"].get<size_t>());
+  const nlohmann::json& r = s["render"];
+  EXPECT_GT(r["triangles_mean"].get<double>(), 100.0);
+  EXPECT_GT(r["patch_loads"].get<size_t>(), 0u);
+  EXPECT_LE(r["gpu_peak_bytes"].get<size_t>(), r["gpu_budget_bytes"].get<size_t>());
+  EXPECT_GT(r["whole_grid_gpu_bytes"].get<size_t>(), 0u);
+  for (const char* f : {"frame_00000.png", "frame_00010.png", "frame_00020.png"})
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(o.out_dir) / "frames" / f)) << f;
+  EXPECT_GT(s["process_peak_rss"].get<size_t>(), 0u);
 }
 
 TEST(TerrainTiles, BadOptionsAreRefused) {

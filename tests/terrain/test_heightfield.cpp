@@ -17,33 +17,15 @@
 #include "farfield/terrain/heightfield.h"
 #include "farfield/terrain/terrain_data.h"
 #include "support/test_support.h"
+#include "terrain/test_raster.h"
 
 namespace farfield::terrain {
 namespace {
 
+using test::writeRaster;
+
 std::string demPath() {
   return (farfield::test::sharedDataDir() / "terrain" / "bigtujunga_srtm30m_utm11.tif").string();
-}
-
-// Writes a single-band raster with GDAL: `driver` through an in-memory copy (PNG and netCDF only support copies).
-void writeRaster(const std::string& path, const char* driver, GDALDataType type, int w, int h,
-                 const std::vector<double>& values, const double* nodata, const double* geotransform) {
-  GDALAllRegister();
-  GDALDriverH mem = GDALGetDriverByName("MEM");
-  ASSERT_NE(mem, nullptr);
-  GDALDatasetH ds = GDALCreate(mem, "", w, h, 1, type, nullptr);
-  ASSERT_NE(ds, nullptr);
-  if (geotransform) GDALSetGeoTransform(ds, const_cast<double*>(geotransform));
-  GDALRasterBandH band = GDALGetRasterBand(ds, 1);
-  if (nodata) GDALSetRasterNoDataValue(band, *nodata);
-  std::vector<double> copy = values;
-  ASSERT_EQ(GDALRasterIO(band, GF_Write, 0, 0, w, h, copy.data(), w, h, GDT_Float64, 0, 0), CE_None);
-  GDALDriverH out = GDALGetDriverByName(driver);
-  ASSERT_NE(out, nullptr) << driver;
-  GDALDatasetH written = GDALCreateCopy(out, path.c_str(), ds, FALSE, nullptr, nullptr, nullptr);
-  ASSERT_NE(written, nullptr) << path;
-  GDALClose(written);
-  GDALClose(ds);
 }
 
 TEST(Dem, BigTujungaLoadsWithSizeRangeAndNodataOfTheFile) {

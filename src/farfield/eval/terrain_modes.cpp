@@ -70,6 +70,7 @@ std::map<std::string, double> LodMode::info() const {
 }
 
 TiledLodMode::~TiledLodMode() {
+  paged_.reset();
   pager_.reset();
   cache_.reset();
   if (!cache_path_.empty()) {
@@ -90,14 +91,13 @@ void TiledLodMode::prepare(const ModeContext& context) {
   terrain::TileCache::write(run_->data->hf, run_->data->lod->block(), tile_blocks, cache_path_);
   cache_ = std::make_unique<terrain::TileCache>(cache_path_);
   pager_ = std::make_unique<terrain::TilePager>(*cache_, size_t(budget));
+  paged_ = std::make_unique<terrain::PagedTerrainRenderer>(
+      *pager_, size_t(mebibytesOption(context, "gpu_budget_mb", uint64_t(256) << 20)));
 }
 
 void TiledLodMode::frame(FrameContext& frame) {
   gpu::RenderTarget& target = frame.beginOwnPass();
-  terrain::buildTiledLod(*pager_, frame.camera(), terrain::LodSettings{run_->high_error, true, false}, mesh_);
-  gpu::TerrainRenderer& renderer = run_->gpuRenderer();
-  renderer.setIndices(mesh_.indices, 0);
-  frame.addStats(renderer.drawTextured(frame.camera(), target, 0, mesh_.triangleCount(), 0));
+  frame.addStats(paged_->draw(frame.camera(), terrain::LodSettings{run_->high_error, true, false}, target).draw);
 }
 
 std::map<std::string, double> TiledLodMode::info() const {
@@ -106,7 +106,11 @@ std::map<std::string, double> TiledLodMode::info() const {
           {"tile_loads", double(s.loads)},
           {"tile_evictions", double(s.evictions)},
           {"tile_peak_resident_bytes", double(s.peak_resident_bytes)},
-          {"tile_budget_bytes", double(pager_->budget())}};
+          {"tile_budget_bytes", double(pager_->budget())},
+          {"patch_loads", double(paged_->stats().loads)},
+          {"patch_evictions", double(paged_->stats().evictions)},
+          {"patch_peak_gpu_bytes", double(paged_->stats().peak_gpu_bytes)},
+          {"patch_gpu_budget_bytes", double(paged_->budget())}};
 }
 
 terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon) {

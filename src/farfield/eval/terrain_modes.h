@@ -21,6 +21,7 @@
 #include "farfield/eval/mode.h"
 #include "farfield/gpu/terrain_renderer.h"
 #include "farfield/terrain/lod_sprite.h"
+#include "farfield/terrain/paged_terrain.h"
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_cost.h"
 #include "farfield/terrain/terrain_data.h"
@@ -84,9 +85,11 @@ class LodMode : public Mode {
 };
 
 // `high-tiles`: the high LOD built per tile from a tile cache of the run's terrain paged under a budget
-// (terrain/tiled_lod.h; the same mesh as `high` up to triangles outside the frustum). Mode options: tile_blocks=N
-// (LOD blocks per tile side, default 4), tile_budget_mb=MB (default 256). The cache is written at prepare() to a
-// temporary file, removed with the mode. info(): pixel_error, tile loads, evictions, peak resident bytes.
+// (terrain/tiled_lod.h; the same mesh as `high` up to triangles outside the frustum), each tile drawn from its own
+// GPU patch paged under a GPU budget (terrain/paged_terrain.h; its texture computed from its heights at one texel a
+// point of its step, not a texture given to the run). Mode options: tile_blocks=N (LOD blocks per tile side,
+// default 4), tile_budget_mb=MB (default 256), gpu_budget_mb=MB (default 256). The cache is written at prepare() to
+// a temporary file, removed with the mode. info(): pixel_error, tile and patch loads, evictions, peak bytes.
 class TiledLodMode : public Mode {
  public:
   TiledLodMode() = default;
@@ -101,7 +104,7 @@ class TiledLodMode : public Mode {
   std::string cache_path_;
   std::unique_ptr<terrain::TileCache> cache_;
   std::unique_ptr<terrain::TilePager> pager_;
-  terrain::LodMesh mesh_;
+  std::unique_ptr<terrain::PagedTerrainRenderer> paged_;
 };
 
 // Paper: "lod-sprite" (with the run's cost model, the per-frame choice); Always: "lod-sprite-always" (every frame the

@@ -16,8 +16,12 @@
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
 #include "farfield/eval/terrain_paths.h"
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/image/png_io.h"
 #include "farfield/terrain/dem_io.h"
 #include "farfield/terrain/fractal.h"
+#include "farfield/terrain/paged_terrain.h"
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_data.h"
 #include "farfield/terrain/tile_cache.h"
@@ -29,6 +33,8 @@ namespace farfield::eval {
 namespace {
 
 namespace fs = std::filesystem;
+
+const Vec4 kSky{0.62f, 0.74f, 0.88f, 1.0f};  // the terrain bench's sky (terrain_modes.h)
 
 // Resident set of this process, bytes (Linux; 0 elsewhere).
 size_t residentSetBytes() {
@@ -44,6 +50,15 @@ void writeFile(const fs::path& file, const std::string& text) {
   if (!out) throw Error(file.string(), "cannot write");
 }
 
+// The process's peak resident set, bytes (VmHWM; Linux; 0 elsewhere).
+size_t peakResidentSetBytes() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmHWM:", 0) == 0) return size_t(std::stoull(line.substr(6))) * 1024;
+  return 0;
+}
+
 double mib(size_t bytes) { return double(bytes) / (1024.0 * 1024.0); }
 
 struct FrameRow {
@@ -52,6 +67,10 @@ struct FrameRow {
   size_t resident = 0, loads = 0, evictions = 0;
   double ms = 0.0;
   int check = -1;  // -1 not checked, 0 same, 1 differs
+  // With render: the frame drawn from the patches (LOD, patch loads, draw, to the GPU's end), its triangles, the
+  // patches made for it, the patches' GPU bytes after it.
+  double frame_ms = 0.0;
+  size_t drawn_triangles = 0, patch_loads = 0, gpu_bytes = 0;
   terrain::TileSpriteFrame sprites;
 };
 
@@ -67,32 +86,55 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   fs::create_directories(out);
   const std::string cache_path = o.cache.empty() ? (out / "terrain.tiles").string() : o.cache;
 
-  // The heightfield is needed to write the cache and to place the flythrough; then it is dropped (unless checked).
-  auto hf = std::make_unique<terrain::Heightfield>(
-      terrain::cropForBlocks(o.dem.rfind("fractal:", 0) == 0 ? terrain::fractalTerrain(terrain::parseFractalSpec(o.dem))
-                                                             : terrain::loadDem(o.dem),
-                             o.block));
-  const std::string source = hf->source;
-  const int grid_w = hf->width, grid_h = hf->height;
+  // A DEM file is read window by window into the cache and never held whole, unless the whole grid's LOD is
+  // asked for (the check, the sprites per tile); a fractal is generated whole, written, then dropped.
+  const bool fractal = o.dem.rfind("fractal:", 0) == 0;
+  const bool streamed = !fractal && o.check_stride == 0 && o.sprite_tile_cells == 0;
+  std::unique_ptr<terrain::Heightfield> hf;
+  std::string source;
   double write_seconds = 0.0;
-  if (!o.reuse_cache) {
-    const Stopwatch w;
-    terrain::TileCache::write(*hf, o.block, o.tile_blocks, cache_path);
-    write_seconds = w.seconds();
+  if (streamed) {
+    const terrain::DemReader dem(o.dem);
+    source = dem.header().source;
+    if (!o.reuse_cache) {
+      const Stopwatch w;
+      terrain::TileCache::write(dem, o.block, o.tile_blocks, cache_path);
+      write_seconds = w.seconds();
+    }
+  } else {
+    hf = std::make_unique<terrain::Heightfield>(terrain::cropForBlocks(
+        fractal ? terrain::fractalTerrain(terrain::parseFractalSpec(o.dem)) : terrain::loadDem(o.dem), o.block));
+    source = hf->source;
+    if (!o.reuse_cache) {
+      const Stopwatch w;
+      terrain::TileCache::write(*hf, o.block, o.tile_blocks, cache_path);
+      write_seconds = w.seconds();
+    }
   }
+  const terrain::TileCache cache(cache_path);
+  if (hf && (cache.layout().width != hf->width || cache.layout().height != hf->height))
+    throw Error(cache_path, "tile cache does not match " + source + " at block " + std::to_string(o.block));
+  if (cache.layout().block != o.block)
+    throw Error(cache_path, "tile cache has LOD blocks of " + std::to_string(cache.layout().block) + " cells, not " +
+                                std::to_string(o.block));
+  const int grid_w = cache.layout().width, grid_h = cache.layout().height;
+  // The flythrough is planned on the grid, or on the cache's overview (at most about 2,049 x 2,049 points).
+  int overview_step = 1;
+  while (!hf && overview_step < o.block / 2 &&
+         uint64_t(grid_w / overview_step) * uint64_t(grid_h / overview_step) > (uint64_t(2049) * 2049))
+    overview_step *= 2;
+  const terrain::Heightfield plan = hf ? terrain::Heightfield() : cache.overview(overview_step);
+  const terrain::Heightfield& planned_on = hf ? *hf : plan;
   terrain::FlythroughOptions fo;
   fo.frames = o.frames;
   fo.clearance = o.clearance;
-  const gen::CameraPath path = flythroughCameraPath(*hf, fo);
-  const ClipPlanes clip = terrainClipPlanes(*hf, path);
+  const gen::CameraPath path = flythroughCameraPath(planned_on, fo);
+  const ClipPlanes clip = terrainClipPlanes(planned_on, path);
   std::unique_ptr<terrain::QuadtreeLod> whole;
   if (o.check_stride > 0 || o.sprite_tile_cells > 0) whole = std::make_unique<terrain::QuadtreeLod>(*hf, o.block);
   else hf.reset();
   const size_t rss_after_drop = residentSetBytes();
 
-  const terrain::TileCache cache(cache_path);
-  if (cache.layout().width != grid_w || cache.layout().height != grid_h || cache.layout().block != o.block)
-    throw Error(cache_path, "tile cache does not match " + source + " at block " + std::to_string(o.block));
   terrain::TilePager pager(cache, size_t(o.budget_mb * 1024.0 * 1024.0));
   terrain::LodSettings settings;
   settings.pixel_error = o.pixel_error;
@@ -100,6 +142,16 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   terrain::LodMesh mesh, check;
   TerrainTilesResult result;
   size_t rss_peak = rss_after_drop;
+  // Drawing: a context, a target, and the patches paged under their budget.
+  std::unique_ptr<gpu::RenderTarget> target;
+  std::unique_ptr<terrain::PagedTerrainRenderer> paged;
+  if (o.render) {
+    if (!(o.gpu_budget_mb > 0.0)) throw Error("--gpu-budget-mb", "must be positive");
+    gpu::sharedHeadlessContext().makeCurrent();
+    target = std::make_unique<gpu::RenderTarget>(o.width, o.height);
+    paged = std::make_unique<terrain::PagedTerrainRenderer>(pager, size_t(o.gpu_budget_mb * 1024.0 * 1024.0));
+    fs::create_directories(out / "frames");
+  }
   std::unique_ptr<terrain::TileSprites> tile_sprites;
   if (o.sprite_tile_cells > 0)
     tile_sprites = std::make_unique<terrain::TileSprites>(
@@ -131,6 +183,21 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
       row.check = sorted(a) == sorted(b) ? 0 : 1;
       result.check_mismatches += size_t(row.check);
     }
+    if (paged) {
+      target->clear(kSky);
+      const Stopwatch draw;
+      const terrain::PagedTerrainFrame pf = paged->draw(camera, settings, *target);
+      paged->finish();
+      row.frame_ms = draw.milliseconds();
+      row.drawn_triangles = pf.draw.triangles;
+      row.patch_loads = pf.patch_loads;
+      row.gpu_bytes = paged->stats().gpu_bytes;
+      if (o.sample_stride > 0 && f % o.sample_stride == 0) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%05zu.png", f);
+        image::writePng((out / "frames" / name).string(), target->readColor());
+      }
+    }
     if (tile_sprites) row.sprites = tile_sprites->advance(camera);
     if (f % 50 == 0) rss_peak = std::max(rss_peak, residentSetBytes());
     rows.push_back(row);
@@ -140,7 +207,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   std::ostringstream csv;
   csv << "frame,triangles,tiles_in_view,tiles_culled,full_resolution_tiles,coarsest_step,resident_bytes,loads,"
          "evictions,lod_ms,check,sprite_tiles_in_view,sprite_tiles_refreshed,sprite_tiles_triangles,"
-         "whole_keyframe,whole_keyframe_triangles\n";
+         "whole_keyframe,whole_keyframe_triangles,frame_ms,drawn_triangles,patch_loads,patch_gpu_bytes\n";
   struct {
     size_t tile_refreshes = 0, tile_views = 0, whole_keyframes = 0;
     uint64_t tile_triangles = 0, whole_triangles = 0;
@@ -154,7 +221,8 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
         << r.tiles.full_resolution_tiles << ',' << r.tiles.coarsest_step << ',' << r.resident << ',' << r.loads << ','
         << r.evictions << ',' << r.ms << ',' << r.check << ',' << r.sprites.tiles_in_view << ','
         << r.sprites.tiles_refreshed << ',' << r.sprites.refreshed_triangles << ',' << int(r.sprites.whole_keyframe)
-        << ',' << r.sprites.whole_triangles << '\n';
+        << ',' << r.sprites.whole_triangles << ',' << r.frame_ms << ',' << r.drawn_triangles << ','
+        << r.patch_loads << ',' << r.gpu_bytes << '\n';
     sprite.tile_refreshes += r.sprites.tiles_refreshed;
     sprite.tile_views += r.sprites.tiles_in_view;
     sprite.tile_triangles += r.sprites.refreshed_triangles;
@@ -198,6 +266,9 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   j["lod_ms_median"] = ms[ms.size() / 2];
   j["process_rss_after_dropping_heightfield"] = rss_after_drop;
   j["process_rss_peak_during_flythrough"] = rss_peak;
+  j["streamed"] = streamed;
+  j["overview_step"] = hf || whole ? 1 : overview_step;
+  j["process_peak_rss"] = peakResidentSetBytes();
   j["checked_frames"] = o.check_stride ? (rows.size() + o.check_stride - 1) / o.check_stride : 0;
   j["check_mismatches"] = result.check_mismatches;
   if (tile_sprites) {
@@ -210,6 +281,44 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     j["whole_keyframes"] = sprite.whole_keyframes;
     j["whole_keyframe_fraction"] = double(sprite.whole_keyframes) / double(rows.size());
     j["whole_keyframe_triangles"] = sprite.whole_triangles;
+  }
+  std::string render_md;
+  if (paged) {
+    std::vector<double> fms;
+    size_t drawn_max = 0, drawn_sum = 0;
+    for (const FrameRow& r : rows) {
+      fms.push_back(r.frame_ms);
+      drawn_max = std::max(drawn_max, r.drawn_triangles);
+      drawn_sum += r.drawn_triangles;
+    }
+    std::sort(fms.begin(), fms.end());
+    double fsum = 0.0;
+    for (double v : fms) fsum += v;
+    const terrain::PagedTerrainStats& ps = paged->stats();
+    // What drawing the whole grid would hold on the GPU: every point's position and a texel a point with mipmaps.
+    const size_t whole_gpu = size_t(grid_w) * size_t(grid_h) * (sizeof(Vec3) + 4 * 4 / 3);
+    j["render"] = {{"frame_ms_mean", fsum / double(fms.size())},
+                   {"frame_ms_median", fms[fms.size() / 2]},
+                   {"frame_ms_p99", fms[std::min(fms.size() - 1, fms.size() * 99 / 100)]},
+                   {"frame_ms_max", fms.back()},
+                   {"triangles_mean", double(drawn_sum) / double(rows.size())},
+                   {"triangles_max", drawn_max},
+                   {"patch_loads", ps.loads},
+                   {"patch_evictions", ps.evictions},
+                   {"patch_seconds", ps.load_seconds},
+                   {"gpu_budget_bytes", paged->budget()},
+                   {"gpu_peak_bytes", ps.peak_gpu_bytes},
+                   {"whole_grid_gpu_bytes", whole_gpu}};
+    char line[640];
+    std::snprintf(line, sizeof line,
+                  "\ndrawn from GPU patches: frame %.1f ms mean, %.1f median, %.1f p99, %.1f max (LOD, patch loads "
+                  "and draw, to the GPU's end); %.0f triangles mean, %zu max; %zu patch loads (%.1f s), %zu "
+                  "evictions; GPU peak %.0f MiB of a %.0f MiB budget (the whole grid's positions and texture: "
+                  "%.0f MiB)\n",
+                  fsum / double(fms.size()), fms[fms.size() / 2], double(j["render"]["frame_ms_p99"]), fms.back(),
+                  double(drawn_sum) / double(rows.size()), drawn_max, ps.loads, ps.load_seconds, ps.evictions,
+                  mib(ps.peak_gpu_bytes), mib(paged->budget()), mib(whole_gpu));
+    render_md = line;
   }
   writeFile(out / "tiles.json", j.dump(2) + "\n");
 
@@ -225,10 +334,11 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                 size_t(j["checked_frames"]), result.check_mismatches);
   md << line;
   std::snprintf(line, sizeof line,
-                "\ncache %.0f MiB written in %.1f s; tiles loaded %.0f MiB in %.1f s; process RSS %.0f MiB after "
-                "dropping the heightfield, at most %.0f MiB sampled during the flythrough\n",
-                mib(fs::file_size(cache_path)), write_seconds, mib(st.bytes_loaded), st.load_seconds,
-                mib(rss_after_drop), mib(rss_peak));
+                "\ncache %.0f MiB written in %.1f s (%s); tiles loaded %.0f MiB in %.1f s; process RSS %.0f MiB "
+                "before the flythrough, at most %.0f MiB sampled during it; peak RSS of the run %.0f MiB\n",
+                mib(fs::file_size(cache_path)), write_seconds,
+                streamed ? "the DEM read tile by tile, never whole" : "from the whole grid", mib(st.bytes_loaded),
+                st.load_seconds, mib(rss_after_drop), mib(rss_peak), mib(peakResidentSetBytes()));
   md << line;
   if (tile_sprites) {
     std::snprintf(line, sizeof line,
@@ -242,6 +352,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                   double(sprite.whole_triangles) / double(rows.size()));
     md << line;
   }
+  md << render_md;
   result.markdown = md.str();
   writeFile(out / "tiles.md", result.markdown);
   result.seconds = total.seconds();

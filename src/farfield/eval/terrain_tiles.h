@@ -1,10 +1,12 @@
 // The tiled-terrain experiment (issue 18: large terrains held in tiles and paged under a memory budget, the
 // quadtree LOD of Chen et al. 1999 section 2.2 built per tile): a DEM or fractal is written as a tile cache
-// (terrain/tile_cache.h), the heightfield is dropped, and a flythrough builds the LOD every frame from tiles paged
-// under the budget (terrain/tile_pager.h, terrain/tiled_lod.h). Reports per frame the triangles, the tiles in view
-// and at full resolution, the resident bytes, loads and evictions; optionally checks the mesh against the whole
-// grid's LOD on every K-th frame (small terrains: that LOD holds the whole grid), and compares sprites per tile with
-// the whole-frame sprite (terrain/tile_sprites.h).
+// (terrain/tile_cache.h). A DEM file is read tile by tile and never held whole, and the flythrough is planned on the
+// cache's overview, unless the whole grid's LOD is asked for (the check, the sprites per tile); a fractal is
+// generated whole, written, and dropped. The flythrough builds the LOD every frame from tiles paged under the budget
+// (terrain/tile_pager.h, terrain/tiled_lod.h). Reports per frame the triangles, the tiles in view and at full
+// resolution, the resident bytes, loads and evictions, and the process's peak resident set; optionally checks the
+// mesh against the whole grid's LOD on every K-th frame (small terrains: that LOD holds the whole grid), and
+// compares sprites per tile with the whole-frame sprite (terrain/tile_sprites.h).
 #pragma once
 
 #include <cstddef>
@@ -16,7 +18,7 @@ struct TerrainTilesOptions {
   std::string dem;         // DEM file or fractal:SIZE[:SEED][...] (terrain_data.h)
   std::string out_dir;     // tiles.json, tiles.md, tiles_frames.csv (and terrain.tiles unless cache is set)
   std::string cache;       // tile cache path; "" = OUT/terrain.tiles
-  bool reuse_cache = false;  // read an existing cache instead of writing it (the flythrough still needs the DEM)
+  bool reuse_cache = false;  // read an existing cache instead of writing it
   int block = 128;         // LOD block, cells
   int tile_blocks = 8;     // blocks per tile side
   double budget_mb = 256;  // the pager's budget, MiB
@@ -31,6 +33,11 @@ struct TerrainTilesOptions {
   int sprite_tile_cells = 0;
   double epsilon = 1.0;
   float low_error = 4.0f;
+  // Draw every frame from the tiles' GPU patches (terrain/paged_terrain.h) paged under gpu_budget_mb, timed to the
+  // end of the GPU's work, with every sample_stride-th frame written to OUT/frames.
+  bool render = false;
+  double gpu_budget_mb = 256;
+  size_t sample_stride = 100;
 };
 
 struct TerrainTilesResult {

@@ -14,7 +14,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "farfield/terrain/heightfield.h"
 
@@ -29,6 +31,45 @@ struct DemLoadOptions {
   uint64_t max_grid_points = uint64_t(1) << 28;
 };
 
+// The whole raster (checked against max_grid_points before anything is read).
 Heightfield loadDem(const std::string& path, const DemLoadOptions& options = {});
+
+// Writes hf as a single-band Float32 GeoTIFF (BigTIFF when large), row 0 north: its cell size, georeferencing
+// (geo_origin and crs, when set) and no nodata. loadDem reads the same heights back. Throws farfield::Error naming
+// path when GDAL cannot write it.
+void writeDem(const Heightfield& hf, const std::string& path);
+
+// A DEM raster read by windows, for rasters larger than memory (a tile cache is written from one: tile_cache.h).
+// Opening reads the header only (the same checks and notes as loadDem). A window holds exactly the heights loadDem
+// would give its points: nodata is filled from a margin of 3 * kNodataFillRings points around the window, beyond
+// the fill's reach at the whole raster's lowest height (found by one pass over the raster, on the first window
+// with nodata in it).
+class DemReader {
+ public:
+  explicit DemReader(const std::string& path, const DemLoadOptions& options = {});
+  ~DemReader();
+  DemReader(const DemReader&) = delete;
+  DemReader& operator=(const DemReader&) = delete;
+
+  // Size, cell size, georeferencing, source and notes; no heights.
+  const Heightfield& header() const { return header_; }
+  int width() const { return header_.width; }
+  int height() const { return header_.height; }
+  // Grid points [i0, i0 + w) x [j0, j0 + h) (row 0 south, as in heightfield.h), with nodata flagged in the
+  // window's mask and filled. Throws farfield::Error naming the file for a window outside the raster, a window of
+  // more than max_grid_points points, a read error, or a raster without a valid point.
+  Heightfield read(int i0, int j0, int w, int h) const;
+  // Nodata grid points in the whole raster (one pass over it, once).
+  size_t nodataCount() const;
+
+ private:
+  struct Impl;
+  Heightfield readRaw(int i0, int j0, int w, int h, std::vector<uint8_t>& mask) const;
+  void scan() const;
+
+  std::unique_ptr<Impl> impl_;
+  DemLoadOptions options_;
+  Heightfield header_;
+};
 
 }  // namespace farfield::terrain

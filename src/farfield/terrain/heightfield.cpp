@@ -79,17 +79,24 @@ Heightfield Heightfield::crop(int i0, int j0, int w, int h) const {
   return out;
 }
 
-void fillNodata(Heightfield& hf, const std::vector<uint8_t>& mask) {
+void fillNodata(Heightfield& hf, const std::vector<uint8_t>& mask, float far_height) {
   FF_CHECK(mask.size() == hf.size());
   size_t missing = 0;
   for (uint8_t m : mask) missing += m ? 1 : 0;
   hf.nodata = mask;
   hf.nodata_count = missing;
   if (missing == 0) return;
-  if (missing == hf.size()) throw Error(hf.source, "every grid point is nodata (nothing to build a terrain from)");
+  if (std::isnan(far_height)) {
+    if (missing == hf.size()) throw Error(hf.source, "every grid point is nodata (nothing to build a terrain from)");
+    far_height = std::numeric_limits<float>::max();
+    for (size_t k = 0; k < hf.size(); ++k)
+      if (!mask[k]) far_height = std::min(far_height, hf.heights[k]);
+  }
 
   // Breadth-first from the valid points: a hole's rim fills first, from valid neighbours, then the next ring from
-  // the rim, so every filled height is a mean of heights that are at most one step nearer the data.
+  // the rim, so every filled height is a mean of heights that are at most one step nearer the data. Ring r's values
+  // depend only on grid points within r steps: kNodataFillRings bounds that, so a window read with a margin of
+  // 3 * kNodataFillRings points fills its own points as the whole grid does (DemReader).
   const int w = hf.width, h = hf.height;
   std::vector<uint8_t> known(hf.size());
   for (size_t k = 0; k < hf.size(); ++k) known[k] = mask[k] ? 0 : 1;
@@ -110,11 +117,11 @@ void fillNodata(Heightfield& hf, const std::vector<uint8_t>& mask) {
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i)
       if (known[hf.index(i, j)]) enqueueNeighbours(i, j, ring);
-  while (!ring.empty()) {
+  for (int r = 1; r <= kNodataFillRings && !ring.empty(); ++r) {
     // All points of a ring take their value from points known before the ring started.
     std::vector<float> values(ring.size());
-    for (size_t r = 0; r < ring.size(); ++r) {
-      const int i = int(ring[r] % uint32_t(w)), j = int(ring[r] / uint32_t(w));
+    for (size_t q = 0; q < ring.size(); ++q) {
+      const int i = int(ring[q] % uint32_t(w)), j = int(ring[q] / uint32_t(w));
       double sum = 0.0;
       int count = 0;
       for (int dj = -1; dj <= 1; ++dj)
@@ -125,16 +132,19 @@ void fillNodata(Heightfield& hf, const std::vector<uint8_t>& mask) {
           ++count;
         }
       FF_CHECK(count > 0);
-      values[r] = float(sum / count);
+      values[q] = float(sum / count);
     }
     next.clear();
-    for (size_t r = 0; r < ring.size(); ++r) {
-      hf.heights[ring[r]] = values[r];
-      known[ring[r]] = 1;
+    for (size_t q = 0; q < ring.size(); ++q) {
+      hf.heights[ring[q]] = values[q];
+      known[ring[q]] = 1;
     }
     for (uint32_t k : ring) enqueueNeighbours(int(k % uint32_t(w)), int(k / uint32_t(w)), next);
     ring.swap(next);
   }
+  // Farther than kNodataFillRings steps from any data (open sea in a coastal DEM): flat, at far_height.
+  for (size_t k = 0; k < hf.size(); ++k)
+    if (!known[k]) hf.heights[k] = far_height;
 }
 
 Heightfield cropForBlocks(const Heightfield& hf, int block) {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -64,9 +65,14 @@ struct Heightfield {
 
 // Fills the grid points flagged in `mask` (1 = no data) from their valid neighbours: grid points are filled in
 // order of their distance (in grid steps, 8-neighbourhood) to the nearest valid point, each with the mean of its
-// already known 8-neighbours, so holes fill inwards from their rims with a smooth blend. Sets hf.nodata = mask and
-// hf.nodata_count. Throws farfield::Error (naming hf.source) when every grid point is flagged.
-void fillNodata(Heightfield& hf, const std::vector<uint8_t>& mask);
+// already known 8-neighbours, so holes fill inwards from their rims with a smooth blend. Points farther than
+// kNodataFillRings steps from any valid point take far_height (NaN: the lowest valid height of hf), so that what a
+// point gets depends only on the grid within 3 * kNodataFillRings steps of it (a window read of a large raster
+// fills as the whole raster would). Sets hf.nodata = mask and hf.nodata_count. Throws farfield::Error (naming
+// hf.source) when every grid point is flagged and far_height is NaN.
+inline constexpr int kNodataFillRings = 64;
+void fillNodata(Heightfield& hf, const std::vector<uint8_t>& mask,
+                float far_height = std::numeric_limits<float>::quiet_NaN());
 
 // The largest centred sub-grid whose size is (a * block + 1) x (b * block + 1) with a, b >= 1 (block a power of
 // two), which is what the quadtree LOD needs. Throws farfield::Error when the grid is smaller than block + 1.

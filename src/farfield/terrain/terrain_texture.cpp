@@ -41,7 +41,9 @@ image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& o)
   if (o.scale < 1 || o.scale > 4) throw Error("texture scale", "must be 1..4");
   const int tw = hf.width * o.scale, th = hf.height * o.scale;
   image::ColorImage tex(tw, th);
-  const float lo = hf.minHeight(), hi = hf.maxHeight();
+  if (o.step < 1) throw Error("texture step", "must be 1 or more");
+  const bool own_range = !(o.ramp_lo < o.ramp_hi);
+  const float lo = own_range ? hf.minHeight() : o.ramp_lo, hi = own_range ? hf.maxHeight() : o.ramp_hi;
   const float span = hi > lo ? hi - lo : 1.0f;
   const Vec3 to_light = -glm::normalize(o.light_direction);
   const float rock = float(degToRad(o.rock_slope_deg));
@@ -58,7 +60,7 @@ image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& o)
       const float zy = (hf.sample(x, y + dy) - hf.sample(x, y - dy)) / float(2 * dy);
       const Vec3 n = glm::normalize(Vec3(-zx, -zy, 1.0f));
       const float slope = std::acos(std::clamp(n.z, -1.0f, 1.0f));
-      Vec3 c = elevationColor((z - lo) / span + 0.04f * (hashNoise(tx, ty) - 0.5f));
+      Vec3 c = elevationColor((z - lo) / span + 0.04f * (hashNoise(o.origin.x * o.scale + tx * o.step, o.origin.y * o.scale + ty * o.step) - 0.5f));
       const float r = std::clamp((slope - rock * 0.7f) / (rock * 0.6f), 0.0f, 1.0f);
       c = glm::mix(c, Vec3(0.47f, 0.44f, 0.42f), r);
       const float shade = o.ambient + (1.0f - o.ambient) * std::max(glm::dot(n, to_light), 0.0f);

@@ -21,6 +21,13 @@ struct TextureOptions {
   Vec3 light_direction{-0.5f, 0.6f, -0.62f};  // direction the light travels (from the north-west, down)
   float ambient = 0.45f;
   float rock_slope_deg = 35.0f;  // slopes steeper than this turn to rock
+  // A part of a larger terrain (a paged tile, paged_terrain.h): the heights the elevation ramp spans (ramp_lo >=
+  // ramp_hi: the heightfield's own range), and the larger grid's point at the heightfield's (0, 0) and the step
+  // between its points, which place the per-texel variation. With the larger terrain's range, step 1 and scale 1,
+  // the part's texels are the larger texture's texels at those points.
+  float ramp_lo = 0.0f, ramp_hi = 0.0f;
+  IVec2 origin{0};
+  int step = 1;
 };
 
 image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& options = {});

@@ -12,9 +12,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/core/progress.h"
 #include "farfield/terrain/quadtree_lod.h"
 
 namespace farfield::terrain {
@@ -84,7 +86,6 @@ BlockRect TileLayout::storedBlocks(int tx, int ty) const {
 }
 
 void TileCache::write(const Heightfield& hf, int block, int tile_blocks, const std::string& path) {
-  if (tile_blocks < 1) throw Error(path, "tiles must be at least one LOD block wide");
   TileLayout layout;
   layout.width = hf.width;
   layout.height = hf.height;
@@ -92,10 +93,37 @@ void TileCache::write(const Heightfield& hf, int block, int tile_blocks, const s
   layout.tile_blocks = tile_blocks;
   layout.cell_x = hf.cell_x;
   layout.cell_y = hf.cell_y;
-  if (block < 2 || (block & (block - 1)) != 0 || (hf.width - 1) % block != 0 || (hf.height - 1) % block != 0 ||
-      hf.width < 3 || hf.height < 3)
-    throw Error(hf.source, std::to_string(hf.width) + "x" + std::to_string(hf.height) +
-                               " grid is not made of whole LOD blocks of " + std::to_string(block) + " cells");
+  write(layout, hf.source, [&](int i0, int j0, int w, int h) { return hf.crop(i0, j0, w, h); }, path);
+}
+
+void TileCache::write(const DemReader& dem, int block, int tile_blocks, const std::string& path) {
+  if (block < 2 || (block & (block - 1)) != 0) throw Error(path, "LOD block must be a power of two >= 2");
+  const int a = (dem.width() - 1) / block, b = (dem.height() - 1) / block;
+  if (a < 1 || b < 1)
+    throw Error(dem.header().source, std::to_string(dem.width()) + "x" + std::to_string(dem.height()) +
+                                         " raster is smaller than one LOD block of " + std::to_string(block + 1) +
+                                         "x" + std::to_string(block + 1) + " points");
+  TileLayout layout;
+  layout.width = a * block + 1;
+  layout.height = b * block + 1;
+  layout.block = block;
+  layout.tile_blocks = tile_blocks;
+  layout.cell_x = dem.header().cell_x;
+  layout.cell_y = dem.header().cell_y;
+  // Centred, as cropForBlocks crops the whole raster.
+  const int ci = (dem.width() - layout.width) / 2, cj = (dem.height() - layout.height) / 2;
+  write(layout, dem.header().source, [&](int i0, int j0, int w, int h) { return dem.read(ci + i0, cj + j0, w, h); },
+        path);
+}
+
+void TileCache::write(const TileLayout& layout, const std::string& source, const HeightWindow& window,
+                      const std::string& path) {
+  const int block = layout.block;
+  if (layout.tile_blocks < 1) throw Error(path, "tiles must be at least one LOD block wide");
+  if (block < 2 || (block & (block - 1)) != 0 || (layout.width - 1) % block != 0 ||
+      (layout.height - 1) % block != 0 || layout.width < 3 || layout.height < 3)
+    throw Error(source, std::to_string(layout.width) + "x" + std::to_string(layout.height) +
+                            " grid is not made of whole LOD blocks of " + std::to_string(block) + " cells");
   const int levels = layout.levels();
   const int tiles = layout.tilesX() * layout.tilesY();
 
@@ -117,11 +145,15 @@ void TileCache::write(const Heightfield& hf, int block, int tile_blocks, const s
   out.write(zeros.data(), std::streamsize(zeros.size()));
 
   std::vector<TileInfo> infos;
+  // A bar for grids of more than 16 M points (an 8,193 x 8,193 raster's cache takes a minute).
+  std::unique_ptr<Progress> progress;
+  if (uint64_t(layout.width) * uint64_t(layout.height) > (uint64_t(1) << 24)) progress = std::make_unique<Progress>("tile cache", uint64_t(tiles));
   for (int ty = 0; ty < layout.tilesY(); ++ty)
     for (int tx = 0; tx < layout.tilesX(); ++tx) {
       const BlockRect stored = layout.storedBlocks(tx, ty), own = layout.tileBlocks(tx, ty);
-      const Heightfield grid = hf.crop(stored.x0 * block, stored.y0 * block, storedWidth(stored, block),
-                                       storedHeight(stored, block));
+      const Heightfield grid = window(stored.x0 * block, stored.y0 * block, storedWidth(stored, block),
+                                      storedHeight(stored, block));
+      FF_CHECK(grid.width == storedWidth(stored, block) && grid.height == storedHeight(stored, block));
       const QuadtreeLod lod(grid, block, IVec2(stored.x0 * block, stored.y0 * block));
       TileInfo info;
       info.tx = tx;
@@ -154,6 +186,7 @@ void TileCache::write(const Heightfield& hf, int block, int tile_blocks, const s
           put(out, sum);
         }
       infos.push_back(std::move(info));
+      if (progress) progress->advance();
     }
   out.seekp(std::streamoff(index_at));
   for (const TileInfo& info : infos) {
@@ -262,6 +295,27 @@ int TileCache::stepFor(int tx, int ty, const Vec3& eye, double lambda, float tau
       finest = 2 << l;
   }
   return std::clamp(finest / 4, 1, layout_.block / 2);
+}
+
+Heightfield TileCache::overview(int step) const {
+  const TileLayout& l = layout_;
+  if (step < 1 || step > l.block / 2 || (step & (step - 1)) != 0)
+    throw Error(path_, "overview step " + std::to_string(step) + " is not a power of two from 1 to " +
+                           std::to_string(l.block / 2));
+  Heightfield out((l.width - 1) / step + 1, (l.height - 1) / step + 1, 1.0);
+  out.cell_x = l.cell_x * step;
+  out.cell_y = l.cell_y * step;
+  out.source = path_ + " at step " + std::to_string(step);
+  for (int ty = 0; ty < l.tilesY(); ++ty)
+    for (int tx = 0; tx < l.tilesX(); ++tx) {
+      const TileGrid g = read(tx, ty, step);
+      const int per_block = l.block / step;
+      // The tile's own blocks, edges included (neighbours write the same heights on shared edges).
+      for (int j = g.blocks.y0 * per_block; j <= g.blocks.y1 * per_block; ++j)
+        for (int i = g.blocks.x0 * per_block; i <= g.blocks.x1 * per_block; ++i)
+          out.at(g.origin.x / step + i, g.origin.y / step + j) = g.hf.at(i, j);
+    }
+  return out;
 }
 
 TileGrid TileCache::read(int tx, int ty, int step) const {

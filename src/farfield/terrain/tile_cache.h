@@ -20,10 +20,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "farfield/core/bounds.h"
+#include "farfield/terrain/dem_io.h"
 #include "farfield/terrain/heightfield.h"
 
 namespace farfield::terrain {
@@ -71,6 +73,15 @@ class TileCache {
   // Writes hf (whole LOD blocks: cropForBlocks) as a tile cache. tile_blocks >= 1. Throws farfield::Error naming
   // path when it cannot be written, or hf when it is not made of whole blocks.
   static void write(const Heightfield& hf, int block, int tile_blocks, const std::string& path);
+  // Writes the cache of a DEM raster cropped to whole blocks as cropForBlocks crops it, reading one tile and its
+  // apron at a time: a raster larger than memory. The same file as writing loadDem's heightfield (cropped).
+  static void write(const DemReader& dem, int block, int tile_blocks, const std::string& path);
+  // Grid points [i0, i0 + w) x [j0, j0 + h) of the grid being written.
+  using HeightWindow = std::function<Heightfield(int i0, int j0, int w, int h)>;
+  // The general form: layout's size, block, tiling and cells; each tile's stored region read from `window`.
+  // `source` names the grid in errors.
+  static void write(const TileLayout& layout, const std::string& source, const HeightWindow& window,
+                    const std::string& path);
 
   // Opens a cache and reads its index; throws farfield::Error naming path for a missing, short or damaged file.
   explicit TileCache(const std::string& path);
@@ -91,6 +102,9 @@ class TileCache {
 
   // Reads tile (tx, ty) at `step` (a power of two, 1 .. block / 2). Throws farfield::Error naming the file.
   TileGrid read(int tx, int ty, int step) const;
+  // The whole grid at every step-th point (a power of two, 1 .. block / 2), read tile by tile: what a flythrough or
+  // a map is planned on without holding the grid. cell = step * the grid's cell; source "<file> at step N".
+  Heightfield overview(int step) const;
   // Bytes a tile read at step holds once it has its LOD (tile_pager.h): heights, errors, radii and positions.
   size_t residentBytes(int tx, int ty, int step) const;
 

@@ -5,9 +5,8 @@
 
 namespace farfield::terrain {
 
-void buildTiledLod(TilePager& pager, const Camera& camera, const LodSettings& settings, LodMesh& out,
-                   TiledLodFrame* frame) {
-  out.clear();
+TiledLodFrame visitTiledLod(TilePager& pager, const Camera& camera, const LodSettings& settings,
+                            const TileLodVisitor& visit) {
   TiledLodFrame f;
   const TileCache& cache = pager.cache();
   const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
@@ -22,12 +21,21 @@ void buildTiledLod(TilePager& pager, const Camera& camera, const LodSettings& se
       const int step = cache.stepFor(tx, ty, camera.eye, lambda, settings.pixel_error);
       const TerrainTile& tile = pager.acquire(tx, ty, step);
       tile.lod->build(camera, settings, piece, &tile.window);
-      out.indices.insert(out.indices.end(), piece.indices.begin(), piece.indices.end());
-      out.quadrants.insert(out.quadrants.end(), piece.quadrants.begin(), piece.quadrants.end());
+      visit(tile, piece);
       ++f.tiles_in_view;
       f.full_resolution_tiles += tile.grid.step == 1 ? 1 : 0;
       f.coarsest_step = std::max(f.coarsest_step, tile.grid.step);
     }
+  return f;
+}
+
+void buildTiledLod(TilePager& pager, const Camera& camera, const LodSettings& settings, LodMesh& out,
+                   TiledLodFrame* frame) {
+  out.clear();
+  const TiledLodFrame f = visitTiledLod(pager, camera, settings, [&](const TerrainTile&, const LodMesh& piece) {
+    out.indices.insert(out.indices.end(), piece.indices.begin(), piece.indices.end());
+    out.quadrants.insert(out.quadrants.end(), piece.quadrants.begin(), piece.quadrants.end());
+  });
   // A quadrant on a tile's edge comes from both tiles (its two triangles lie on either side).
   std::sort(out.quadrants.begin(), out.quadrants.end(),
             [](const LodQuadrant& a, const LodQuadrant& b) { return a.centre < b.centre; });

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 
 #include "farfield/core/camera.h"
 #include "farfield/terrain/quadtree_lod.h"
@@ -20,6 +21,13 @@ struct TiledLodFrame {
   size_t full_resolution_tiles = 0;  // acquired at step 1
   int coarsest_step = 1;
 };
+
+// Visits every tile whose box meets the view frustum (all tiles without settings.cull), acquired from the pager at
+// the coarsest step that gives the full grid's mesh, with its LOD piece for the camera (indices of the whole grid).
+// The tile and piece are valid during the call. Returns the frame's tile counts.
+using TileLodVisitor = std::function<void(const TerrainTile& tile, const LodMesh& piece)>;
+TiledLodFrame visitTiledLod(TilePager& pager, const Camera& camera, const LodSettings& settings,
+                            const TileLodVisitor& visit);
 
 // Builds the LOD mesh of the pager's terrain for a camera (indices of the whole grid; quadrants sorted by centre,
 // each once). Loads and evicts tiles through the pager.

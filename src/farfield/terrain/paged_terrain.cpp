@@ -1,0 +1,161 @@
+// A large terrain drawn from paged tiles, each from its own GPU patch (issue 18; see paged_terrain.h).
+#include "farfield/terrain/paged_terrain.h"
+
+#include <algorithm>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+#include "farfield/core/timer.h"
+#include "farfield/gpu/terrain_renderer.h"
+#include "farfield/terrain/terrain_texture.h"
+
+namespace farfield::terrain {
+namespace {
+
+// A tile's own points at its step: [x0, x1] x [y0, y1] of its grid (the apron left out: no triangle of the tile
+// reaches it).
+struct OwnPoints {
+  int x0, y0, x1, y1;
+  int width() const { return x1 - x0 + 1; }
+  int height() const { return y1 - y0 + 1; }
+};
+
+OwnPoints ownPoints(const TileLayout& layout, const BlockRect& own_blocks_in_stored, int step) {
+  const int per_block = layout.block / step;
+  return {own_blocks_in_stored.x0 * per_block, own_blocks_in_stored.y0 * per_block,
+          own_blocks_in_stored.x1 * per_block, own_blocks_in_stored.y1 * per_block};
+}
+
+size_t mipmappedBytes(size_t w, size_t h) {
+  size_t bytes = 0;
+  while (true) {
+    bytes += w * h * 4;
+    if (w == 1 && h == 1) return bytes;
+    w = std::max<size_t>(w / 2, 1);
+    h = std::max<size_t>(h / 2, 1);
+  }
+}
+
+}  // namespace
+
+PagedTerrainRenderer::PagedTerrainRenderer(TilePager& pager, size_t gpu_budget_bytes)
+    : pager_(pager), budget_(gpu_budget_bytes) {
+  const TileLayout& l = pager.cache().layout();
+  size_t largest = 0;
+  for (int ty = 0; ty < l.tilesY(); ++ty)
+    for (int tx = 0; tx < l.tilesX(); ++tx) largest = std::max(largest, patchBytes(tx, ty, 1));
+  if (largest > budget_)
+    throw Error("paged terrain", "a GPU budget of " + std::to_string(budget_ >> 20) + " MiB cannot hold a tile at full " +
+                                     "resolution (" + std::to_string((largest + (1 << 20) - 1) >> 20) + " MiB)");
+}
+
+PagedTerrainRenderer::~PagedTerrainRenderer() = default;
+
+size_t PagedTerrainRenderer::patchBytes(int tx, int ty, int step) const {
+  const TileLayout& l = pager_.cache().layout();
+  const BlockRect own = l.tileBlocks(tx, ty);
+  const size_t per_block = size_t(l.block / step);
+  const size_t w = size_t(own.x1 - own.x0) * per_block + 1, h = size_t(own.y1 - own.y0) * per_block + 1;
+  // The texture spans the own points and one more on each side where the grid continues: at most w + 2, h + 2.
+  const size_t index_store = (w - 1) * (h - 1) * 2 * 3 * sizeof(uint32_t);
+  return w * h * sizeof(Vec3) + mipmappedBytes(w + 2, h + 2) + index_store + index_store / 2;
+}
+
+void PagedTerrainRenderer::evict() {
+  FF_CHECK(!lru_.empty());
+  const Patch& p = lru_.back();
+  stats_.gpu_bytes -= p.bytes;
+  where_.erase({p.tx, p.ty});
+  lru_.pop_back();
+  ++stats_.evictions;
+  stats_.patches = lru_.size();
+}
+
+PagedTerrainRenderer::Patch& PagedTerrainRenderer::acquire(const TerrainTile& tile) {
+  const int step = tile.grid.step;
+  auto found = where_.find({tile.tx, tile.ty});
+  if (found != where_.end()) {
+    if (found->second->step == step) {
+      lru_.splice(lru_.begin(), lru_, found->second);
+      return lru_.front();
+    }
+    // Another step: the tile's LOD indexes its grid at the pager's step, which the patch must match.
+    stats_.gpu_bytes -= found->second->bytes;
+    lru_.erase(found->second);
+    where_.erase(found);
+  }
+  const size_t bytes = patchBytes(tile.tx, tile.ty, step);
+  while (!lru_.empty() && stats_.gpu_bytes + bytes > budget_) evict();
+  FF_CHECK(stats_.gpu_bytes + bytes <= budget_);
+
+  const Stopwatch timer;
+  const TileCache& cache = pager_.cache();
+  const TileLayout& l = cache.layout();
+  const TileGrid& g = tile.grid;
+  const OwnPoints own = ownPoints(l, g.blocks, step);
+  Patch p;
+  p.tx = tile.tx;
+  p.ty = tile.ty;
+  p.step = step;
+  p.first = g.origin + IVec2(own.x0, own.y0) * step;
+  p.width = own.width();
+  p.bytes = bytes;
+  std::vector<Vec3> positions;
+  positions.reserve(size_t(own.width()) * size_t(own.height()));
+  for (int y = own.y0; y <= own.y1; ++y)
+    for (int x = own.x0; x <= own.x1; ++x) {
+      const int gx = g.origin.x + x * step, gy = g.origin.y + y * step;
+      positions.emplace_back(float(gx * l.cell_x), float(gy * l.cell_y), g.hf.at(x, y));
+    }
+  // The texture over the own points and one more on each side where the tile's grid has them, so that the
+  // normals at the tile's edge see both sides (as the whole texture's do).
+  const int tx0 = std::max(own.x0 - 1, 0), ty0 = std::max(own.y0 - 1, 0);
+  const int tx1 = std::min(own.x1 + 1, g.hf.width - 1), ty1 = std::min(own.y1 + 1, g.hf.height - 1);
+  const Heightfield part = g.hf.crop(tx0, ty0, tx1 - tx0 + 1, ty1 - ty0 + 1);
+  TextureOptions to;
+  to.ramp_lo = cache.minHeight();
+  to.ramp_hi = cache.maxHeight();
+  to.origin = (g.origin + IVec2(tx0, ty0) * step);
+  to.step = step;
+  const image::ColorImage texture = terrainTexture(part, to);
+  // uv of world x: texel i of the part is centred on its point i, at world (origin.x + (tx0 + i) * step) * cell.
+  const double cx = l.cell_x * step, cy = l.cell_y * step;
+  const double wx0 = double(to.origin.x) * l.cell_x, wy0 = double(to.origin.y) * l.cell_y;
+  const Vec2 uv_scale(float(1.0 / (cx * part.width)), float(1.0 / (cy * part.height)));
+  const Vec2 uv_offset(float((0.5 - wx0 / cx) / part.width), float((0.5 - wy0 / cy) / part.height));
+  p.gpu = std::make_unique<gpu::TerrainPatch>(positions, texture, uv_scale, uv_offset);
+  stats_.load_seconds += timer.seconds();
+  ++stats_.loads;
+  stats_.gpu_bytes += bytes;
+  stats_.peak_gpu_bytes = std::max(stats_.peak_gpu_bytes, stats_.gpu_bytes);
+  lru_.push_front(std::move(p));
+  where_[{tile.tx, tile.ty}] = lru_.begin();
+  stats_.patches = lru_.size();
+  return lru_.front();
+}
+
+PagedTerrainFrame PagedTerrainRenderer::draw(const Camera& camera, const LodSettings& settings,
+                                             gpu::RenderTarget& target) {
+  PagedTerrainFrame frame;
+  const size_t loads_before = stats_.loads;
+  const uint32_t grid_width = uint32_t(pager_.cache().layout().width);
+  frame.tiles = visitTiledLod(pager_, camera, settings, [&](const TerrainTile& tile, const LodMesh& piece) {
+    if (piece.indices.empty()) return;
+    Patch& p = acquire(tile);
+    // Whole-grid indices to the patch's: every vertex of the piece lies on the tile's step lattice, inside its
+    // own points.
+    local_.resize(piece.indices.size());
+    const int step = p.step;
+    for (size_t k = 0; k < piece.indices.size(); ++k) {
+      const uint32_t v = piece.indices[k];
+      const int x = (int(v % grid_width) - p.first.x) / step, y = (int(v / grid_width) - p.first.y) / step;
+      local_[k] = uint32_t(x + y * p.width);
+    }
+    p.gpu->setIndices(local_);
+    gpu::addDraw(frame.draw, renderer_.draw(camera, target, *p.gpu));
+  });
+  frame.patch_loads = stats_.loads - loads_before;
+  return frame;
+}
+
+}  // namespace farfield::terrain
