@@ -226,6 +226,9 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
                                          "with sample frames in OUTDIR/frames");
   tiles->add_option("--gpu-budget-mb", to.gpu_budget_mb, "GPU memory budget of the tiles' patches, MiB")
       ->capture_default_str();
+  tiles->add_option("--prefetch-frames", to.prefetch_frames, "With --render: load tiles this many frames ahead of the "
+                                                             "camera's motion on a worker thread (0 = on demand)")
+      ->capture_default_str();
   tiles->callback([t] { runTiles(t->first, t->second); });
 });
 

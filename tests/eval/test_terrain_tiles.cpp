@@ -66,6 +66,7 @@ TEST(TerrainTilesGL, ADemFileIsStreamedAndDrawnFromPagedPatches) {
   o.check_stride = 0;
   o.sprite_tile_cells = 0;
   o.render = true;
+  o.budget_mb = 0.5;  // tiles come with their positions and texture until drawn
   o.gpu_budget_mb = 1.0;
   o.sample_stride = 10;
   runTerrainTiles(o);

@@ -67,8 +67,8 @@ struct FrameRow {
   size_t resident = 0, loads = 0, evictions = 0;
   double ms = 0.0;
   int check = -1;  // -1 not checked, 0 same, 1 differs
-  // With render: the frame drawn from the patches (LOD, patch loads, draw, to the GPU's end), its triangles, the
-  // patches made for it, the patches' GPU bytes after it.
+  // With render: the frame drawn from the patches (LOD, tile reads, patch loads, draw, to the GPU's end; also in
+  // ms, which is then that frame), its triangles, the patches made for it, the patches' GPU bytes after it.
   double frame_ms = 0.0;
   size_t drawn_triangles = 0, patch_loads = 0, gpu_bytes = 0;
   terrain::TileSpriteFrame sprites;
@@ -149,7 +149,9 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     if (!(o.gpu_budget_mb > 0.0)) throw Error("--gpu-budget-mb", "must be positive");
     gpu::sharedHeadlessContext().makeCurrent();
     target = std::make_unique<gpu::RenderTarget>(o.width, o.height);
-    paged = std::make_unique<terrain::PagedTerrainRenderer>(pager, size_t(o.gpu_budget_mb * 1024.0 * 1024.0));
+    if (o.prefetch_frames < 0) throw Error("--prefetch-frames", "must be 0 or more");
+    paged = std::make_unique<terrain::PagedTerrainRenderer>(pager, size_t(o.gpu_budget_mb * 1024.0 * 1024.0),
+                                                            o.prefetch_frames);
     fs::create_directories(out / "frames");
   }
   std::unique_ptr<terrain::TileSprites> tile_sprites;
@@ -159,10 +161,29 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   for (size_t f = 0; f < path.frames.size(); ++f) {
     const Camera camera = path.camera(f, o.width, o.height, clip.near_plane, clip.far_plane);
     FrameRow row;
-    const Stopwatch sw;
-    terrain::buildTiledLod(pager, camera, settings, mesh, &row.tiles);
-    row.ms = sw.milliseconds();
-    row.triangles = mesh.triangleCount();
+    if (paged) {
+      // The frame as a renderer draws it: the LOD per tile, the tiles read (or taken from the prefetch), the
+      // patches made, the draw, to the GPU's end.
+      target->clear(kSky);
+      const Stopwatch draw;
+      const terrain::PagedTerrainFrame pf = paged->draw(camera, settings, *target);
+      paged->finish();
+      row.frame_ms = row.ms = draw.milliseconds();
+      row.tiles = pf.tiles;
+      row.triangles = row.drawn_triangles = pf.draw.triangles;
+      row.patch_loads = pf.patch_loads;
+      row.gpu_bytes = paged->stats().gpu_bytes;
+      if (o.sample_stride > 0 && f % o.sample_stride == 0) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%05zu.png", f);
+        image::writePng((out / "frames" / name).string(), target->readColor());
+      }
+    } else {
+      const Stopwatch sw;
+      terrain::buildTiledLod(pager, camera, settings, mesh, &row.tiles);
+      row.ms = sw.milliseconds();
+      row.triangles = mesh.triangleCount();
+    }
     row.resident = pager.stats().resident_bytes;
     row.loads = pager.stats().loads;
     row.evictions = pager.stats().evictions;
@@ -182,21 +203,6 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
       };
       row.check = sorted(a) == sorted(b) ? 0 : 1;
       result.check_mismatches += size_t(row.check);
-    }
-    if (paged) {
-      target->clear(kSky);
-      const Stopwatch draw;
-      const terrain::PagedTerrainFrame pf = paged->draw(camera, settings, *target);
-      paged->finish();
-      row.frame_ms = draw.milliseconds();
-      row.drawn_triangles = pf.draw.triangles;
-      row.patch_loads = pf.patch_loads;
-      row.gpu_bytes = paged->stats().gpu_bytes;
-      if (o.sample_stride > 0 && f % o.sample_stride == 0) {
-        char name[32];
-        std::snprintf(name, sizeof name, "frame_%05zu.png", f);
-        image::writePng((out / "frames" / name).string(), target->readColor());
-      }
     }
     if (tile_sprites) row.sprites = tile_sprites->advance(camera);
     if (f % 50 == 0) rss_peak = std::max(rss_peak, residentSetBytes());
@@ -303,6 +309,12 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                    {"frame_ms_max", fms.back()},
                    {"triangles_mean", double(drawn_sum) / double(rows.size())},
                    {"triangles_max", drawn_max},
+                   {"prefetch_frames", o.prefetch_frames},
+                   {"tiles_prefetched", st.prefetched},
+                   {"prefetch_hits", st.prefetch_hits},
+                   {"prefetch_waits", st.prefetch_waits},
+                   {"prefetch_dropped", st.prefetch_dropped},
+                   {"tile_loads_waited_for", st.loads},
                    {"patch_loads", ps.loads},
                    {"patch_evictions", ps.evictions},
                    {"patch_seconds", ps.load_seconds},
@@ -311,13 +323,15 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                    {"whole_grid_gpu_bytes", whole_gpu}};
     char line[640];
     std::snprintf(line, sizeof line,
-                  "\ndrawn from GPU patches: frame %.1f ms mean, %.1f median, %.1f p99, %.1f max (LOD, patch loads "
-                  "and draw, to the GPU's end); %.0f triangles mean, %zu max; %zu patch loads (%.1f s), %zu "
-                  "evictions; GPU peak %.0f MiB of a %.0f MiB budget (the whole grid's positions and texture: "
-                  "%.0f MiB)\n",
+                  "\ndrawn from GPU patches: frame %.1f ms mean, %.1f median, %.1f p99, %.1f max (LOD, tile reads "
+                  "waited for, patch loads and draw, to the GPU's end); %.0f triangles mean, %zu max; %zu patch "
+                  "loads (%.1f s), %zu evictions; GPU peak %.0f MiB of a %.0f MiB budget (the whole grid's "
+                  "positions and texture: %.0f MiB); tiles prefetched %d frames ahead: %zu (%zu of them used, %zu "
+                  "waited for in flight), %zu read on demand\n",
                   fsum / double(fms.size()), fms[fms.size() / 2], double(j["render"]["frame_ms_p99"]), fms.back(),
                   double(drawn_sum) / double(rows.size()), drawn_max, ps.loads, ps.load_seconds, ps.evictions,
-                  mib(ps.peak_gpu_bytes), mib(paged->budget()), mib(whole_gpu));
+                  mib(ps.peak_gpu_bytes), mib(paged->budget()), mib(whole_gpu), o.prefetch_frames, st.prefetched,
+                  st.prefetch_hits, st.prefetch_waits, st.loads);
     render_md = line;
   }
   writeFile(out / "tiles.json", j.dump(2) + "\n");

@@ -34,9 +34,11 @@ struct TerrainTilesOptions {
   double epsilon = 1.0;
   float low_error = 4.0f;
   // Draw every frame from the tiles' GPU patches (terrain/paged_terrain.h) paged under gpu_budget_mb, timed to the
-  // end of the GPU's work, with every sample_stride-th frame written to OUT/frames.
+  // end of the GPU's work, with every sample_stride-th frame written to OUT/frames; tiles prefetched on a worker
+  // thread prefetch_frames ahead.
   bool render = false;
   double gpu_budget_mb = 256;
+  int prefetch_frames = 32;  // with render: tiles loaded ahead along the camera's motion (0 = every tile on demand)
   size_t sample_stride = 100;
 };
 

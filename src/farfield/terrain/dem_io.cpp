@@ -213,6 +213,9 @@ Heightfield DemReader::readRaw(int i0, int j0, int w, int h, std::vector<uint8_t
       }
     }
   }
+  // GDAL keeps the raster's blocks it read in its process-wide cache (by default 5 % of the machine's memory, which
+  // held the whole of a 1 GiB raster read by windows); drop them, the window is copied.
+  GDALFlushRasterCache(m.band);
   return hf;
 }
 

@@ -12,6 +12,7 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -42,8 +43,10 @@ struct PagedTerrainFrame {
 class PagedTerrainRenderer {
  public:
   // Needs a current context; the pager must outlive the renderer. Throws farfield::Error when the budget cannot
-  // hold the largest tile's patch at step 1 (a frame may need any tile at full resolution).
-  PagedTerrainRenderer(TilePager& pager, size_t gpu_budget_bytes);
+  // hold the largest tile's patch at step 1 (a frame may need any tile at full resolution). prefetch_frames > 0:
+  // after each frame, the tiles of the camera moved on by its last motion, half and all of that many frames ahead,
+  // are handed to the pager's prefetch (TilePager::prefetch), so a steady flight rarely waits for a tile read.
+  PagedTerrainRenderer(TilePager& pager, size_t gpu_budget_bytes, int prefetch_frames = 32);
   ~PagedTerrainRenderer();
 
   // Draws the terrain's LOD for the camera into the target (bound; not cleared; no wait).
@@ -68,8 +71,12 @@ class PagedTerrainRenderer {
   Patch& acquire(const TerrainTile& tile);
   void evict();
 
+  void prefetchAhead(const Camera& camera, const LodSettings& settings);
+
   TilePager& pager_;
   size_t budget_;
+  int prefetch_frames_;
+  std::optional<Camera> last_camera_;
   gpu::TerrainPatchRenderer renderer_;
   PagedTerrainStats stats_;
   std::list<Patch> lru_;  // most recently used first

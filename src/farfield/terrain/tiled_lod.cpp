@@ -5,27 +5,36 @@
 
 namespace farfield::terrain {
 
-TiledLodFrame visitTiledLod(TilePager& pager, const Camera& camera, const LodSettings& settings,
-                            const TileLodVisitor& visit) {
-  TiledLodFrame f;
-  const TileCache& cache = pager.cache();
+std::vector<TileRequest> tilesInView(const TileCache& cache, const Camera& camera, const LodSettings& settings,
+                                     size_t* culled) {
+  std::vector<TileRequest> out;
   const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
   const double lambda = QuadtreeLod::pixelsPerRadian(camera);
-  LodMesh piece;
+  size_t n = 0;
   for (int ty = 0; ty < cache.layout().tilesY(); ++ty)
     for (int tx = 0; tx < cache.layout().tilesX(); ++tx) {
       if (settings.cull && !frustum.intersects(cache.tileBox(tx, ty))) {
-        ++f.tiles_culled;
+        ++n;
         continue;
       }
-      const int step = cache.stepFor(tx, ty, camera.eye, lambda, settings.pixel_error);
-      const TerrainTile& tile = pager.acquire(tx, ty, step);
-      tile.lod->build(camera, settings, piece, &tile.window);
-      visit(tile, piece);
-      ++f.tiles_in_view;
-      f.full_resolution_tiles += tile.grid.step == 1 ? 1 : 0;
-      f.coarsest_step = std::max(f.coarsest_step, tile.grid.step);
+      out.push_back({tx, ty, cache.stepFor(tx, ty, camera.eye, lambda, settings.pixel_error)});
     }
+  if (culled) *culled = n;
+  return out;
+}
+
+TiledLodFrame visitTiledLod(TilePager& pager, const Camera& camera, const LodSettings& settings,
+                            const TileLodVisitor& visit) {
+  TiledLodFrame f;
+  LodMesh piece;
+  for (const TileRequest& r : tilesInView(pager.cache(), camera, settings, &f.tiles_culled)) {
+    const TerrainTile& tile = pager.acquire(r.tx, r.ty, r.step);
+    tile.lod->build(camera, settings, piece, &tile.window);
+    visit(tile, piece);
+    ++f.tiles_in_view;
+    f.full_resolution_tiles += tile.grid.step == 1 ? 1 : 0;
+    f.coarsest_step = std::max(f.coarsest_step, tile.grid.step);
+  }
   return f;
 }
 

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <vector>
 
 #include "farfield/core/camera.h"
 #include "farfield/terrain/quadtree_lod.h"
@@ -21,6 +22,11 @@ struct TiledLodFrame {
   size_t full_resolution_tiles = 0;  // acquired at step 1
   int coarsest_step = 1;
 };
+
+// The tiles a frame of this camera draws: those whose box meets the view frustum (all without settings.cull), each
+// at the coarsest step that still gives the whole grid's mesh (TileCache::stepFor). `culled`: the others' count.
+std::vector<TileRequest> tilesInView(const TileCache& cache, const Camera& camera, const LodSettings& settings,
+                                     size_t* culled = nullptr);
 
 // Visits every tile whose box meets the view frustum (all tiles without settings.cull), acquired from the pager at
 // the coarsest step that gives the full grid's mesh, with its LOD piece for the camera (indices of the whole grid).
