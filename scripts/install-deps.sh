@@ -10,7 +10,7 @@ packages=(
   # math, GL, windowing, UI
   libglm-dev libepoxy-dev libegl-dev libgl-dev libgl1-mesa-dri libegl-mesa0 libglfw3-dev libimgui-dev xvfb xauth
   # import / export / formats
-  libassimp-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libpng-dev libzstd-dev
+  libassimp-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libpng-dev libzstd-dev libxxhash-dev
   # geometry, GIS
   libcgal-dev libgmp-dev libmpfr-dev libmeshoptimizer-dev libgdal-dev libosmium2-dev libproj-dev libexpat1-dev libbz2-dev zlib1g-dev
   libcitygml-dev

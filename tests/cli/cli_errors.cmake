@@ -63,3 +63,11 @@ expect_error("--sweep-frames: frame count: 1.0000000000000001e+300 is out of ran
 expect_error("--sweep-frames: frame count: 75.5 is not a whole number" terrain bench fractal:33 --sweep-frames 75.5
              -o ${WORK}/terrain)
 expect_error("fractal:99999999999: SIZE" terrain info fractal:99999999999)
+expect_error("no-such-dem.tif: DEM file not found" terrain export ${WORK}/no-such-dem.tif -o ${WORK}/e.tif)
+expect_error("/no-such-dir/e.tif" terrain export fractal:33 -o /no-such-dir/e.tif)
+expect_error("--gpu-budget-mb: must be positive" terrain tiles fractal:65 --block 16 --frames 4 --render
+             --gpu-budget-mb 0 -o ${WORK}/tiles)
+expect_error("--prefetch-frames: must be 0 or more" terrain tiles fractal:65 --block 16 --frames 4 --render
+             --prefetch-frames -1 -o ${WORK}/tiles)
+expect_error("a GPU budget of 0.01 MiB cannot hold a tile" terrain tiles fractal:65 --block 16 --frames 4 --render
+             --gpu-budget-mb 0.01 -o ${WORK}/tiles)

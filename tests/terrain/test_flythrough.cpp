@@ -98,5 +98,23 @@ TEST(TerrainTexture, GridPointsMapToTexelCentres) {
   EXPECT_NE(tex.at(4, 0), tex.at(4, 4));
 }
 
+// Scale 1 reads grid points directly; the texels are those of the bilinear lookups, edges included.
+TEST(TerrainTexture, TheDirectPathGivesTheBilinearLookupsTexels) {
+  FractalOptions f;
+  f.size = 65;
+  f.seed = 12;
+  f.cell_size = 25.0;
+  f.relief = 900.0;
+  Heightfield hf = fractalTerrain(f);
+  hf = hf.crop(0, 0, 65, 40);  // not square
+  TextureOptions slow;
+  slow.bilinear_lookups = true;
+  const image::ColorImage a = terrainTexture(hf), b = terrainTexture(hf, slow);
+  size_t differ = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x) differ += a.at(x, y) != b.at(x, y) ? 1 : 0;
+  EXPECT_EQ(differ, 0u);
+}
+
 }  // namespace
 }  // namespace farfield::terrain

@@ -114,7 +114,8 @@ TEST(PagedTerrainGL, ABudgetBelowOneTileIsRefused) {
   const Heightfield hf = test::tiledTestFractal();
   const TileCache cache(test::writeTestCache(hf, "paged_terrain_refused"));
   TilePager pager(cache, size_t(64) << 20);
-  farfield::test::expectErrorMentions([&] { PagedTerrainRenderer(pager, 1000); }, {"GPU budget", "full resolution"});
+  farfield::test::expectErrorMentions([&] { PagedTerrainRenderer(pager, 1000); },
+                                      {cache.path(), "GPU budget", "full resolution"});
 }
 
 }  // namespace

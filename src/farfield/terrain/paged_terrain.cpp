@@ -2,6 +2,7 @@
 #include "farfield/terrain/paged_terrain.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <utility>
 
 #include "farfield/core/check.h"
@@ -96,9 +97,14 @@ PagedTerrainRenderer::PagedTerrainRenderer(TilePager& pager, size_t gpu_budget_b
   size_t largest = 0;
   for (int ty = 0; ty < l.tilesY(); ++ty)
     for (int tx = 0; tx < l.tilesX(); ++tx) largest = std::max(largest, patchBytes(tx, ty, 1));
-  if (largest > budget_)
-    throw Error("paged terrain", "a GPU budget of " + std::to_string(budget_ >> 20) + " MiB cannot hold a tile at full " +
-                                     "resolution (" + std::to_string((largest + (1 << 20) - 1) >> 20) + " MiB)");
+  if (largest > budget_) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "a GPU budget of %.2f MiB cannot hold a tile at full resolution (%.2f MiB); raise it or use "
+                  "smaller tiles",
+                  double(budget_) / double(1 << 20), double(largest) / double(1 << 20));
+    throw Error(pager.cache().path(), text);
+  }
 }
 
 PagedTerrainRenderer::~PagedTerrainRenderer() = default;

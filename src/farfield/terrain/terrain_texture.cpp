@@ -47,27 +47,45 @@ image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& o)
   const float span = hi > lo ? hi - lo : 1.0f;
   const Vec3 to_light = -glm::normalize(o.light_direction);
   const float rock = float(degToRad(o.rock_slope_deg));
+  const double dx = 0.5 * hf.cell_x, dy = 0.5 * hf.cell_y;
+  // The texel's colour from its height and the slopes of the bilinear surface there (central differences of half
+  // a cell).
+  auto shade = [&](int tx, int ty, float z, float zx, float zy) {
+    const Vec3 n = glm::normalize(Vec3(-zx, -zy, 1.0f));
+    const float slope = std::acos(std::clamp(n.z, -1.0f, 1.0f));
+    Vec3 c = elevationColor((z - lo) / span +
+                            0.04f * (hashNoise(o.origin.x * o.scale + tx * o.step, o.origin.y * o.scale + ty * o.step) -
+                                     0.5f));
+    const float r = std::clamp((slope - rock * 0.7f) / (rock * 0.6f), 0.0f, 1.0f);
+    c = glm::mix(c, Vec3(0.47f, 0.44f, 0.42f), r);
+    const float light = o.ambient + (1.0f - o.ambient) * std::max(glm::dot(n, to_light), 0.0f);
+    c *= light * 1.15f;
+    c = glm::clamp(c, Vec3(0.0f), Vec3(1.0f));
+    tex.at(tx, ty) = image::Rgba8(uint8_t(std::lround(c.r * 255)), uint8_t(std::lround(c.g * 255)),
+                                  uint8_t(std::lround(c.b * 255)), 255);
+  };
+  if (o.scale == 1 && !o.bilinear_lookups) {
+    // Texel centres on grid points: the surface half a cell away is the mean of two neighbours (the point itself
+    // at the grid's edge, where the bilinear sample clamps), as Heightfield::sample gives it, without its lookups.
+    auto half = [&](int i, int j, int di, int dj) {
+      const int ni = i + di, nj = j + dj;
+      if (ni < 0 || nj < 0 || ni >= hf.width || nj >= hf.height) return hf.at(i, j);
+      return float((double(hf.at(i, j)) + double(hf.at(ni, nj))) * 0.5);
+    };
+    for (int j = 0; j < th; ++j)
+      for (int i = 0; i < tw; ++i)
+        shade(i, j, hf.at(i, j), (half(i, j, 1, 0) - half(i, j, -1, 0)) / float(2 * dx),
+              (half(i, j, 0, 1) - half(i, j, 0, -1)) / float(2 * dy));
+    return tex;
+  }
   for (int ty = 0; ty < th; ++ty)
     for (int tx = 0; tx < tw; ++tx) {
       // Grid position of the texel centre.
       const double gx = (tx + 0.5) / o.scale - 0.5, gy = (ty + 0.5) / o.scale - 0.5;
       const double x = std::clamp(gx, 0.0, double(hf.width - 1)) * hf.cell_x;
       const double y = std::clamp(gy, 0.0, double(hf.height - 1)) * hf.cell_y;
-      const float z = hf.sample(x, y);
-      // Normal from the bilinear surface (central differences of half a cell).
-      const double dx = 0.5 * hf.cell_x, dy = 0.5 * hf.cell_y;
-      const float zx = (hf.sample(x + dx, y) - hf.sample(x - dx, y)) / float(2 * dx);
-      const float zy = (hf.sample(x, y + dy) - hf.sample(x, y - dy)) / float(2 * dy);
-      const Vec3 n = glm::normalize(Vec3(-zx, -zy, 1.0f));
-      const float slope = std::acos(std::clamp(n.z, -1.0f, 1.0f));
-      Vec3 c = elevationColor((z - lo) / span + 0.04f * (hashNoise(o.origin.x * o.scale + tx * o.step, o.origin.y * o.scale + ty * o.step) - 0.5f));
-      const float r = std::clamp((slope - rock * 0.7f) / (rock * 0.6f), 0.0f, 1.0f);
-      c = glm::mix(c, Vec3(0.47f, 0.44f, 0.42f), r);
-      const float shade = o.ambient + (1.0f - o.ambient) * std::max(glm::dot(n, to_light), 0.0f);
-      c *= shade * 1.15f;
-      c = glm::clamp(c, Vec3(0.0f), Vec3(1.0f));
-      tex.at(tx, ty) = image::Rgba8(uint8_t(std::lround(c.r * 255)), uint8_t(std::lround(c.g * 255)),
-                                    uint8_t(std::lround(c.b * 255)), 255);
+      shade(tx, ty, hf.sample(x, y), (hf.sample(x + dx, y) - hf.sample(x - dx, y)) / float(2 * dx),
+            (hf.sample(x, y + dy) - hf.sample(x, y - dy)) / float(2 * dy));
     }
   return tex;
 }

@@ -28,6 +28,9 @@ struct TextureOptions {
   float ramp_lo = 0.0f, ramp_hi = 0.0f;
   IVec2 origin{0};
   int step = 1;
+  // Every texel through Heightfield::sample's bilinear lookups, as scales above 1 are (scale 1 otherwise reads its
+  // grid points directly, several times faster, to the same texels): for checks.
+  bool bilinear_lookups = false;
 };
 
 image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& options = {});

@@ -14,7 +14,7 @@
 //
 // File: "FFTILES1", version, grid and tiling sizes, cell sizes, one index record per tile (height range, the level
 // maxima, the data offset), then per tile three planes of floats (heights, errors, radii), row-major, south row
-// first, and a checksum (FNV-1a 64) per row of each plane. Written to a temporary file and renamed. A reader checks
+// first, and a checksum (XXH3, 64 bits) per row of each plane. Written to a temporary file and renamed. A reader checks
 // the header, the index, that every tile's data lie inside the file and every row it reads against its checksum,
 // and names the file (and the tile, plane and row) in every error.
 #pragma once
