@@ -4,6 +4,8 @@
 
 #include <fcntl.h>
 #include <unistd.h>
+// xxHash inlined from its header (libxxhash-dev): no library to link.
+#define XXH_INLINE_ALL
 #include <xxhash.h>
 
 #include <algorithm>
