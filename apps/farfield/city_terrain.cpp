@@ -13,9 +13,7 @@ namespace farfield::app {
 std::string setCityTerrain(gen::CityOptions& options, const std::string& spec, float vertical_scale) {
   if (!(vertical_scale > 0.0f && std::isfinite(vertical_scale)))
     throw Error("--terrain-scale", "must be a finite number > 0");
-  const bool fractal = spec.rfind("fractal:", 0) == 0;
-  auto hf = std::make_shared<const terrain::Heightfield>(
-      fractal ? terrain::fractalTerrain(terrain::parseFractalSpec(spec)) : terrain::loadDem(spec));
+  auto hf = std::make_shared<const terrain::Heightfield>(terrain::loadHeightfield(spec));
   if (hf->width < 2 || hf->height < 2) throw Error(spec, "the terrain needs at least 2 x 2 grid points");
   const double cx = 0.5 * hf->extentX(), cy = 0.5 * hf->extentY();
   const float base = hf->sample(cx, cy);

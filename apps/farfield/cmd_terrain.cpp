@@ -30,7 +30,6 @@
 #include "farfield/eval/terrain_paths.h"
 #include "farfield/eval/terrain_tiles.h"
 #include "farfield/terrain/dem_io.h"
-#include "farfield/terrain/fractal.h"
 #include "farfield/terrain/terrain_data.h"
 
 namespace farfield::app {
@@ -141,10 +140,7 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
   exp->add_option("dem", export_args->first, "DEM file or fractal:SIZE[:SEED][...]")->required();
   exp->add_option("-o,--output", export_args->second, "GeoTIFF to write")->required();
   exp->callback([export_args] {
-    const std::string& spec = export_args->first;
-    const terrain::Heightfield hf = spec.rfind("fractal:", 0) == 0
-                                        ? terrain::fractalTerrain(terrain::parseFractalSpec(spec))
-                                        : terrain::loadDem(spec);
+    const terrain::Heightfield hf = terrain::loadHeightfield(export_args->first);
     terrain::writeDem(hf, export_args->second);
     std::printf("wrote %s: %dx%d points, %.1f m cells, heights %.1f..%.1f m\n", export_args->second.c_str(),
                 hf.width, hf.height, hf.cell_x, double(hf.minHeight()), double(hf.maxHeight()));

@@ -17,6 +17,15 @@
 namespace farfield::runtime {
 namespace {
 
+// A square view from eye towards at (the camera's other settings at their defaults).
+Camera viewCamera(Vec3 eye, Vec3 at, int size) {
+  Camera camera;
+  camera.eye = eye;
+  camera.at = at;
+  camera.width = camera.height = size;
+  return camera;
+}
+
 class CrowdRuntimeGl : public ::testing::Test {
  protected:
   void SetUp() override { gpu::sharedHeadlessContext(); }
@@ -66,10 +75,7 @@ TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
   CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), smallAtlas(8));
   EXPECT_GT(rt.atlasBytes(), 0u);
 
-  Camera camera;
-  camera.eye = Vec3(0, 0, 1.7f);
-  camera.at = Vec3(10, 0, 1.0f);
-  camera.width = camera.height = 128;
+  Camera camera = viewCamera(Vec3(0, 0, 1.7f), Vec3(10, 0, 1.0f), 128);
   const impostor::SwitchDistances sw = rt.switchDistances(0, camera);
   // Dobbyn's rule: a texel of the atlas covers one pixel at texel * focal metres.
   const double focal = 128.0 / (2.0 * std::tan(double(camera.fov_y) / 2.0));
@@ -122,10 +128,7 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetDrawsTheNearestAgentsAsGeometry) {
   CrowdRuntimeOptions unbudgeted_options = smallAtlas(8);
   CrowdRuntime unbudgeted(std::span(&fox, 1), std::span(&mo, 1), unbudgeted_options);
 
-  Camera camera;
-  camera.eye = Vec3(0, 0, 1.2f);
-  camera.at = Vec3(10, 0, 0.4f);
-  camera.width = camera.height = 128;
+  Camera camera = viewCamera(Vec3(0, 0, 1.2f), Vec3(10, 0, 0.4f), 128);
   const double d = rt.switchDistances(0, camera).both();
   ASSERT_GT(d, 3.0);
   // Four agents inside the switch, listed far to near, spread across the view.
@@ -179,10 +182,7 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetInMillisecondsFollowsTheMeasuredTimePerTri
   CrowdRuntimeOptions options = smallAtlas(8);
   options.geometry_ms = 1000.0;  // every agent fits once the cost is measured
   CrowdRuntime rt(std::span(&man, 1), std::span(&mo, 1), options);
-  Camera camera;
-  camera.eye = Vec3(0, 0, 1.5f);
-  camera.at = Vec3(10, 0, 1.0f);
-  camera.width = camera.height = 96;
+  Camera camera = viewCamera(Vec3(0, 0, 1.5f), Vec3(10, 0, 1.0f), 96);
   const double d = rt.switchDistances(0, camera).both();
   std::vector<CrowdAgentState> agents(4);  // 4 x 4,672 triangles, more than the first 10,000
   for (size_t i = 0; i < agents.size(); ++i) {
@@ -231,10 +231,7 @@ TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) 
   ASSERT_EQ(gm.levelCount(), 4u);
   for (size_t l = 1; l < 4; ++l) EXPECT_LE(gm.triangleCount(l), gm.triangleCount(0) / (size_t(1) << l));
 
-  Camera camera;
-  camera.eye = Vec3(0, 0, 1.7f);
-  camera.at = Vec3(10, 0, 1.0f);
-  camera.width = camera.height = 128;
+  Camera camera = viewCamera(Vec3(0, 0, 1.7f), Vec3(10, 0, 1.0f), 128);
   const double focal = 128.0 / (2.0 * std::tan(double(camera.fov_y) / 2.0));
   gpu::RenderTarget target(128, 128);
   gpu::LightSettings light;
@@ -332,10 +329,7 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetTakesTheLeastErrorOnScreenFirst) {
   const gpu::SkinnedGpuModel& gm = unbudgeted.gpuModel(0);
   ASSERT_EQ(gm.levelCount(), 4u);
 
-  Camera camera;
-  camera.eye = Vec3(0, 0, 1.7f);
-  camera.at = Vec3(10, 0, 1.0f);
-  camera.width = camera.height = 128;
+  Camera camera = viewCamera(Vec3(0, 0, 1.7f), Vec3(10, 0, 1.0f), 128);
   std::vector<CrowdAgentState> agents(4);
   std::vector<float> distance(agents.size());
   for (size_t i = 0; i < agents.size(); ++i) {
@@ -443,10 +437,7 @@ TEST_F(CrowdRuntimeGl, AgentsBehindTheCityAreLeftOutAndTheFrameIsUnchanged) {
   const gpu::DrawItem& item = wall.item;
   gpu::Renderer renderer;
   const gpu::LightSettings light = renderer.light();
-  Camera camera;
-  camera.eye = Vec3(0, 0, 1.2f);
-  camera.at = Vec3(10, 0, 1.0f);
-  camera.width = camera.height = 128;
+  Camera camera = viewCamera(Vec3(0, 0, 1.2f), Vec3(10, 0, 1.0f), 128);
   std::vector<CrowdAgentState> agents;
   for (float x : {6.0f, 14.0f, 20.0f})  // in front of the wall, behind it, far behind it
     for (float y : {-1.0f, 0.5f, 4.5f}) {  // behind the wall's middle, near its edge, beside it
@@ -504,10 +495,7 @@ TEST_F(CrowdRuntimeGl, ImpostorCoversTheGeometryAtAnyHeading) {
   CrowdModelOptions mo;
   mo.height_m = 0.8f;
   CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), o);
-  Camera camera;
-  camera.eye = Vec3(0, 0, 1.7f);
-  camera.at = Vec3(25, 0, 0.4f);
-  camera.width = camera.height = 160;
+  Camera camera = viewCamera(Vec3(0, 0, 1.7f), Vec3(25, 0, 0.4f), 160);
   camera.fov_y = float(degToRad(4.0));
   gpu::RenderTarget target(160, 160);
   gpu::LightSettings light;
@@ -607,10 +595,7 @@ TEST_F(CrowdRuntimeGl, BlendedViewsChangeSmoothlyWhereTheNearestViewJumps) {
   CrowdRuntime nearest(std::span(&fox, 1), std::span(&mo, 1), o);
   o.blend_views = true;
   CrowdRuntime blended(std::span(&fox, 1), std::span(&mo, 1), o);
-  Camera camera;
-  camera.eye = Vec3(0, 0, 1.7f);
-  camera.at = Vec3(25, 0, 0.4f);
-  camera.width = camera.height = 160;
+  Camera camera = viewCamera(Vec3(0, 0, 1.7f), Vec3(25, 0, 0.4f), 160);
   camera.fov_y = float(degToRad(4.0));
   gpu::RenderTarget target(160, 160);
   gpu::LightSettings light;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <vector>
@@ -20,7 +21,6 @@
 #include "farfield/gpu/render_target.h"
 #include "farfield/image/png_io.h"
 #include "farfield/terrain/dem_io.h"
-#include "farfield/terrain/fractal.h"
 #include "farfield/terrain/paged_terrain.h"
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_data.h"
@@ -88,29 +88,23 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
 
   // A DEM file is read window by window into the cache and never held whole, unless the whole grid's LOD is
   // asked for (the check, the sprites per tile); a fractal is generated whole, written, then dropped.
-  const bool fractal = o.dem.rfind("fractal:", 0) == 0;
-  const bool streamed = !fractal && o.check_stride == 0 && o.sprite_tile_cells == 0;
+  const bool streamed = !terrain::isFractalSpec(o.dem) && o.check_stride == 0 && o.sprite_tile_cells == 0;
   std::unique_ptr<terrain::Heightfield> hf;
-  std::string source;
-  double write_seconds = 0.0;
+  std::optional<terrain::DemReader> dem;
   if (streamed) {
-    const terrain::DemReader dem(o.dem);
-    source = dem.header().source;
-    if (!o.reuse_cache) {
-      const Stopwatch w;
-      terrain::TileCache::write(dem, o.block, o.tile_blocks, cache_path);
-      write_seconds = w.seconds();
-    }
+    dem.emplace(o.dem);
   } else {
-    hf = std::make_unique<terrain::Heightfield>(terrain::cropForBlocks(
-        fractal ? terrain::fractalTerrain(terrain::parseFractalSpec(o.dem)) : terrain::loadDem(o.dem), o.block));
-    source = hf->source;
-    if (!o.reuse_cache) {
-      const Stopwatch w;
-      terrain::TileCache::write(*hf, o.block, o.tile_blocks, cache_path);
-      write_seconds = w.seconds();
-    }
+    hf = std::make_unique<terrain::Heightfield>(terrain::cropForBlocks(terrain::loadHeightfield(o.dem), o.block));
   }
+  const std::string source = hf ? hf->source : dem->header().source;
+  double write_seconds = 0.0;
+  if (!o.reuse_cache) {
+    const Stopwatch w;
+    if (hf) terrain::TileCache::write(*hf, o.block, o.tile_blocks, cache_path);
+    else terrain::TileCache::write(*dem, o.block, o.tile_blocks, cache_path);
+    write_seconds = w.seconds();
+  }
+  dem.reset();
   const terrain::TileCache cache(cache_path);
   if (hf && (cache.layout().width != hf->width || cache.layout().height != hf->height))
     throw Error(cache_path, "tile cache does not match " + source + " at block " + std::to_string(o.block));
@@ -273,7 +267,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   j["process_rss_after_dropping_heightfield"] = rss_after_drop;
   j["process_rss_peak_during_flythrough"] = rss_peak;
   j["streamed"] = streamed;
-  j["overview_step"] = hf || whole ? 1 : overview_step;
+  j["overview_step"] = overview_step;  // 1 where the flythrough was planned on the grid itself
   j["process_peak_rss"] = peakResidentSetBytes();
   j["checked_frames"] = o.check_stride ? (rows.size() + o.check_stride - 1) / o.check_stride : 0;
   j["check_mismatches"] = result.check_mismatches;

@@ -10,6 +10,34 @@
 
 namespace farfield::gpu {
 
+uint32_t createPositionArray(std::span<const Vec3> positions, uint32_t& vbo) {
+  glCreateBuffers(1, &vbo);
+  glNamedBufferStorage(vbo, GLsizeiptr(positions.size_bytes()), positions.data(), 0);
+  uint32_t vao = 0;
+  glCreateVertexArrays(1, &vao);
+  glVertexArrayVertexBuffer(vao, 0, vbo, 0, sizeof(Vec3));
+  glEnableVertexArrayAttrib(vao, 0);
+  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(vao, 0, 0);
+  return vao;
+}
+
+void refillIndices(uint32_t buffer, std::span<const uint32_t> indices, size_t& capacity_bytes) {
+  FF_CHECK(indices.size() % 3 == 0);
+  const size_t bytes = indices.size_bytes();
+  if (bytes > capacity_bytes || bytes < capacity_bytes / 4) capacity_bytes = std::max<size_t>(bytes + bytes / 2, 64);
+  glNamedBufferData(buffer, GLsizeiptr(capacity_bytes), nullptr, GL_STREAM_DRAW);
+  if (bytes) glNamedBufferSubData(buffer, 0, GLsizeiptr(bytes), indices.data());
+}
+
+void useTextured(Program& program, const Camera& camera, Vec2 uv_scale, Vec2 uv_offset) {
+  program.use();
+  program.set("u_view_proj", camera.viewProjection());
+  glUniform2fv(program.uniformLocation("u_uv_scale"), 1, glm::value_ptr(uv_scale));
+  glUniform2fv(program.uniformLocation("u_uv_offset"), 1, glm::value_ptr(uv_offset));
+  program.set("u_object_id", uint32_t(1));
+}
+
 TerrainPatch::TerrainPatch(std::span<const Vec3> positions, const image::ColorImage& texture, Vec2 uv_scale,
                            Vec2 uv_offset)
     : uv_scale_(uv_scale), uv_offset_(uv_offset) {
@@ -18,14 +46,8 @@ TerrainPatch::TerrainPatch(std::span<const Vec3> positions, const image::ColorIm
   vertex_count_ = positions.size();
   texture_ = Texture::fromImage(texture, true);
   texture_.setClampToEdge();
-  glCreateBuffers(1, &vbo_);
-  glNamedBufferStorage(vbo_, GLsizeiptr(positions.size_bytes()), positions.data(), 0);
+  vao_ = createPositionArray(positions, vbo_);
   glCreateBuffers(1, &ibo_);
-  glCreateVertexArrays(1, &vao_);
-  glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(Vec3));
-  glEnableVertexArrayAttrib(vao_, 0);
-  glVertexArrayAttribFormat(vao_, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao_, 0, 0);
   glVertexArrayElementBuffer(vao_, ibo_);
 }
 
@@ -36,14 +58,8 @@ TerrainPatch::~TerrainPatch() {
 }
 
 void TerrainPatch::setIndices(std::span<const uint32_t> indices) {
-  FF_CHECK(indices.size() % 3 == 0);
+  refillIndices(ibo_, indices, index_capacity_bytes_);
   index_count_ = indices.size();
-  const size_t bytes = indices.size_bytes();
-  // Orphan-and-refill with headroom, as TerrainRenderer::setIndices.
-  if (bytes > index_capacity_bytes_ || bytes < index_capacity_bytes_ / 4)
-    index_capacity_bytes_ = std::max<size_t>(bytes + bytes / 2, 64);
-  glNamedBufferData(ibo_, GLsizeiptr(index_capacity_bytes_), nullptr, GL_STREAM_DRAW);
-  if (bytes) glNamedBufferSubData(ibo_, 0, GLsizeiptr(bytes), indices.data());
 }
 
 size_t TerrainPatch::gpuBytes() const {
@@ -59,11 +75,7 @@ FrameStats TerrainPatchRenderer::draw(const Camera& camera, RenderTarget& target
   if (patch.index_count_ == 0) return stats;
   camera.validate("camera");
   target.bindForOpaquePass();
-  textured_.use();
-  textured_.set("u_view_proj", camera.viewProjection());
-  glUniform2fv(textured_.uniformLocation("u_uv_scale"), 1, glm::value_ptr(patch.uv_scale_));
-  glUniform2fv(textured_.uniformLocation("u_uv_offset"), 1, glm::value_ptr(patch.uv_offset_));
-  textured_.set("u_object_id", uint32_t(1));
+  useTextured(textured_, camera, patch.uv_scale_, patch.uv_offset_);
   patch.texture_.bind(0);
   glBindVertexArray(patch.vao_);
   glDrawElements(GL_TRIANGLES, GLsizei(patch.index_count_), GL_UNSIGNED_INT, nullptr);

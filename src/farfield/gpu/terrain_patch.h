@@ -16,6 +16,15 @@
 
 namespace farfield::gpu {
 
+// Building blocks of the terrain's draws, shared with TerrainRenderer (needs a current context):
+// a vertex array whose attribute 0 reads a new buffer of positions (returned in vbo);
+uint32_t createPositionArray(std::span<const Vec3> positions, uint32_t& vbo);
+// an index store refilled by orphaning (draws issued before keep the old list), sized with headroom so that its
+// allocation stays the same from frame to frame; capacity_bytes is the store's size, kept between calls;
+void refillIndices(uint32_t buffer, std::span<const uint32_t> indices, size_t& capacity_bytes);
+// the textured program's state for a draw: the camera, uv = world_xy * uv_scale + uv_offset, object id 1.
+void useTextured(Program& program, const Camera& camera, Vec2 uv_scale, Vec2 uv_offset);
+
 class TerrainPatch {
  public:
   // Needs a current context. positions: the patch's vertices (indices refer to them); texture sampled at

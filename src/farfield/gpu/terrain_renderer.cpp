@@ -7,6 +7,7 @@
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
+#include "farfield/gpu/terrain_patch.h"
 
 namespace farfield::gpu {
 
@@ -21,14 +22,8 @@ TerrainRenderer::TerrainRenderer(std::span<const Vec3> positions, const image::C
   textured_ = Program::fromEmbedded("terrain.vert.glsl", "terrain.frag.glsl");
   sprite_ = Program::fromEmbedded("terrain.vert.glsl", "terrain.frag.glsl", "#define FF_SPRITE 1");
 
-  glCreateBuffers(1, &vbo_);
-  glNamedBufferStorage(vbo_, GLsizeiptr(positions.size_bytes()), positions.data(), 0);
+  vao_ = createPositionArray(positions, vbo_);
   glCreateBuffers(kSlots, ibo_);
-  glCreateVertexArrays(1, &vao_);
-  glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(Vec3));
-  glEnableVertexArrayAttrib(vao_, 0);
-  glVertexArrayAttribFormat(vao_, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao_, 0, 0);
 }
 
 TerrainRenderer::~TerrainRenderer() {
@@ -39,15 +34,8 @@ TerrainRenderer::~TerrainRenderer() {
 
 void TerrainRenderer::setIndices(std::span<const uint32_t> indices, int slot) {
   FF_CHECK(slot >= 0 && slot < kSlots);
-  FF_CHECK(indices.size() % 3 == 0);
+  refillIndices(ibo_[slot], indices, index_capacity_bytes_[slot]);
   index_count_[slot] = indices.size();
-  const size_t bytes = indices.size_bytes();
-  // Orphan-and-refill: a fresh store each time (the driver keeps the old one for draws still in flight), sized with
-  // some headroom so that the allocation size stays the same from frame to frame.
-  size_t& capacity = index_capacity_bytes_[slot];
-  if (bytes > capacity || bytes < capacity / 4) capacity = std::max<size_t>(bytes + bytes / 2, 64);
-  glNamedBufferData(ibo_[slot], GLsizeiptr(capacity), nullptr, GL_STREAM_DRAW);
-  if (bytes) glNamedBufferSubData(ibo_[slot], 0, GLsizeiptr(bytes), indices.data());
 }
 
 void TerrainRenderer::setState(const Camera& camera, RenderTarget& target, int slot) {
@@ -79,11 +67,7 @@ FrameStats TerrainRenderer::drawTextured(const Camera& camera, RenderTarget& tar
   FrameStats stats;
   if (count == 0) return stats;
   setState(camera, target, slot);
-  textured_.use();
-  textured_.set("u_view_proj", camera.viewProjection());
-  glUniform2fv(textured_.uniformLocation("u_uv_scale"), 1, glm::value_ptr(uv_scale_));
-  glUniform2fv(textured_.uniformLocation("u_uv_offset"), 1, glm::value_ptr(uv_offset_));
-  textured_.set("u_object_id", uint32_t(1));
+  useTextured(textured_, camera, uv_scale_, uv_offset_);
   texture_.bind(0);
   drawRange(first, count);
   stats.triangles = count;

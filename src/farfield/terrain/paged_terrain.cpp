@@ -145,7 +145,8 @@ PagedTerrainRenderer::Patch& PagedTerrainRenderer::acquire(const TerrainTile& ti
 
   const Stopwatch timer;
   std::unique_ptr<TileDrawData> made;
-  if (!tile.draw) made = tileDrawData(pager_.cache(), tile);  // loaded before the preparer was set
+  // A tile whose data went with an earlier patch (released on upload), should that patch have been evicted.
+  if (!tile.draw) made = tileDrawData(pager_.cache(), tile);
   const TileDrawData& d = tile.draw ? *tile.draw : *made;
   Patch p;
   p.tx = tile.tx;

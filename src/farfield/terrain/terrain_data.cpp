@@ -30,7 +30,7 @@ FractalOptions parseFractalSpec(const std::string& spec) {
   const std::string usage =
       "expected fractal:SIZE or fractal:SIZE:SEED, then optionally :relief=M :roughness=R :cell=M (SIZE = 2^n + 1, "
       "e.g. fractal:513:7 or fractal:8193:3:relief=4000:roughness=0.62)";
-  if (spec.rfind("fractal:", 0) != 0) throw Error(spec, usage);
+  if (!isFractalSpec(spec)) throw Error(spec, usage);
   std::vector<std::string_view> parts;
   std::string_view rest = std::string_view(spec).substr(8);
   for (size_t colon; (colon = rest.find(':')) != std::string_view::npos; rest = rest.substr(colon + 1))
@@ -62,13 +62,13 @@ FractalOptions parseFractalSpec(const std::string& spec) {
   return f;
 }
 
+Heightfield loadHeightfield(const std::string& spec, const DemLoadOptions& dem) {
+  return isFractalSpec(spec) ? fractalTerrain(parseFractalSpec(spec)) : loadDem(spec, dem);
+}
+
 std::unique_ptr<TerrainData> TerrainData::load(const std::string& spec, const TerrainLoadOptions& options) {
   auto data = std::make_unique<TerrainData>();
-  if (spec.rfind("fractal:", 0) == 0) {
-    data->source = fractalTerrain(parseFractalSpec(spec));
-  } else {
-    data->source = loadDem(spec, options.dem);
-  }
+  data->source = loadHeightfield(spec, options.dem);
   if (!(options.centred_scale >= 0.0f && std::isfinite(options.centred_scale)))
     throw Error(spec, "the terrain's vertical scale must be a finite number >= 0");
   const double cx = 0.5 * data->source.extentX(), cy = 0.5 * data->source.extentY();

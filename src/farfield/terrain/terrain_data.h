@@ -31,6 +31,12 @@ struct TerrainLoadOptions {
 // number (fractalTerrain then checks that SIZE is 2^n + 1 and the ranges).
 FractalOptions parseFractalSpec(const std::string& spec);
 
+// Whether spec names a fractal ("fractal:...") rather than a DEM file.
+inline bool isFractalSpec(const std::string& spec) { return spec.rfind("fractal:", 0) == 0; }
+// The heightfield a spec names: the fractal it describes (parseFractalSpec) or the DEM file loaded whole (loadDem,
+// with `dem`). Throws farfield::Error for bad specs or files.
+Heightfield loadHeightfield(const std::string& spec, const DemLoadOptions& dem = {});
+
 struct TerrainData {
   Heightfield source;  // as loaded (before cropping)
   Heightfield hf;      // cropped to whole LOD blocks; the terrain everything renders

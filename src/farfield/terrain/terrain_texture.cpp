@@ -39,9 +39,9 @@ float hashNoise(int i, int j) {
 image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& o) {
   if (hf.width < 2 || hf.height < 2) throw Error(hf.source, "heightfield too small for a texture");
   if (o.scale < 1 || o.scale > 4) throw Error("texture scale", "must be 1..4");
+  if (o.step < 1) throw Error("texture step", "must be 1 or more");
   const int tw = hf.width * o.scale, th = hf.height * o.scale;
   image::ColorImage tex(tw, th);
-  if (o.step < 1) throw Error("texture step", "must be 1 or more");
   const bool own_range = !(o.ramp_lo < o.ramp_hi);
   const float lo = own_range ? hf.minHeight() : o.ramp_lo, hi = own_range ? hf.maxHeight() : o.ramp_hi;
   const float span = hi > lo ? hi - lo : 1.0f;

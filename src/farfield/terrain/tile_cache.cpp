@@ -308,7 +308,7 @@ Heightfield TileCache::overview(int step) const {
   out.source = path_ + " at step " + std::to_string(step);
   for (int ty = 0; ty < l.tilesY(); ++ty)
     for (int tx = 0; tx < l.tilesX(); ++tx) {
-      const TileGrid g = read(tx, ty, step);
+      const TileGrid g = readPlanes(tx, ty, step, 1);  // the heights alone
       const int per_block = l.block / step;
       // The tile's own blocks, edges included (neighbours write the same heights on shared edges).
       for (int j = g.blocks.y0 * per_block; j <= g.blocks.y1 * per_block; ++j)
@@ -318,7 +318,9 @@ Heightfield TileCache::overview(int step) const {
   return out;
 }
 
-TileGrid TileCache::read(int tx, int ty, int step) const {
+TileGrid TileCache::read(int tx, int ty, int step) const { return readPlanes(tx, ty, step, 3); }
+
+TileGrid TileCache::readPlanes(int tx, int ty, int step, int planes_wanted) const {
   const TileLayout& l = layout_;
   FF_CHECK(tx >= 0 && ty >= 0 && tx < l.tilesX() && ty < l.tilesY());
   FF_CHECK(step >= 1 && step <= l.block / 2 && (step & (step - 1)) == 0);
@@ -333,15 +335,17 @@ TileGrid TileCache::read(int tx, int ty, int step) const {
   g.hf.cell_x = l.cell_x * step;
   g.hf.cell_y = l.cell_y * step;
   g.hf.source = path_ + " tile (" + std::to_string(tx) + ", " + std::to_string(ty) + ")";
-  g.error.resize(g.hf.size());
-  g.radius.resize(g.hf.size());
+  if (planes_wanted == 3) {
+    g.error.resize(g.hf.size());
+    g.radius.resize(g.hf.size());
+  }
 
   const int fd = ::open(path_.c_str(), O_RDONLY);
   if (fd < 0) throw Error(path_, "cannot open the tile cache");
   std::vector<float> row(static_cast<size_t>(w));
   float* planes[3] = {g.hf.heights.data(), g.error.data(), g.radius.data()};
   const uint64_t plane_bytes = uint64_t(w) * uint64_t(h) * sizeof(float);
-  for (int p = 0; p < 3; ++p)
+  for (int p = 0; p < planes_wanted; ++p)
     for (int j = 0; j < hs; ++j) {
       const uint64_t at = info(tx, ty).offset + uint64_t(p) * plane_bytes + uint64_t(j) * step * w * sizeof(float);
       const size_t want = row.size() * sizeof(float);

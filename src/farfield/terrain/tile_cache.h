@@ -109,6 +109,9 @@ class TileCache {
   size_t residentBytes(int tx, int ty, int step) const;
 
  private:
+  // The first planes_wanted planes of a tile (1: heights; 3: heights, errors, radii) at step.
+  TileGrid readPlanes(int tx, int ty, int step, int planes_wanted) const;
+
   std::string path_;
   TileLayout layout_;
   std::vector<TileInfo> tiles_;

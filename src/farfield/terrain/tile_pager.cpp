@@ -211,9 +211,8 @@ void TilePager::prefetch(std::span<const TileRequest> requests) {
     if (found != where_.end() && (*found->second)->grid.step <= r.step) continue;
     {
       const std::lock_guard lock(mutex_);
-      auto flying = in_flight_.find({r.tx, r.ty});
-      if (flying != in_flight_.end() && flying->second <= r.step) continue;
-      if (flying != in_flight_.end()) continue;  // asked for coarser: that load goes on; acquire() will refine
+      // Asked for already, at this step or another: that load goes on (acquire() refines a coarser one).
+      if (in_flight_.count({r.tx, r.ty})) continue;
     }
     const size_t bytes = bytesOf(r.tx, r.ty, r.step);
     if (!makeRoom(bytes, round_)) {
