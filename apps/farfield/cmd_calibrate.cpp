@@ -94,8 +94,9 @@ void runCalibrateCommand(CalibrateArgs& args) {
   if (r.profile.layered.calibrated) {
     const gpu::LayeredCost& l = r.profile.layered;
     const eval::LayeredCalibrateResult& lr = r.layered;
-    std::printf("layered draw:       %.3f ms + %.4f ms/layer + %.3f ms/Mpixel of quads (fit r2 %.3f, %zu samples)\n",
-                l.draw.base_ms, l.draw.ms_per_draw, l.draw.ms_per_mpixel, l.draw.r2, l.draw.samples);
+    std::printf("layered draw:       %.3f ms + %.4f ms/layer + %.3f ms/Mpixel of %s (fit r2 %.3f, %zu samples)\n",
+                l.draw.base_ms, l.draw.ms_per_draw, l.draw.ms_per_mpixel,
+                args.options.layer_tiles ? "tiles" : "whole quads", l.draw.r2, l.draw.samples);
     std::printf("layered capture:    %.3f ms + %.3f ms/Mtri + %.4f ms/layer + %.3f ms/Mtexel (fit r2 %.3f)\n",
                 l.capture.base_ms, l.capture.ms_per_mtriangle, l.capture.ms_per_draw, l.capture.ms_per_mpixel,
                 l.capture.r2);
@@ -141,6 +142,9 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--layered-error-px", args->options.layered_error_px,
                   "Error bound of the layered impostors calibrated on, pixels")->capture_default_str();
+  cmd->add_flag("!--no-layer-tiles", args->options.layer_tiles,
+                "Time the layers drawn as whole quads, their fill counted over them (a profile for place "
+                "--no-layer-tiles, for comparisons)");
   cmd->callback([args] { runCalibrateCommand(*args); });
 });
 

@@ -156,6 +156,8 @@ const RegisterCommand reg("place", [](CLI::App& app) {
                   "(e.g. 2,4; each > 1); default none")
       ->delimiter(',');
   cmd->add_flag("--bound-cracks", o.layered.bound_cracks, "Halve layer spacing so cracks also stay under the bound");
+  cmd->add_flag("!--no-layer-tiles", o.layer_tiles, "Charge the layers' fill over their whole quads, as placement did "
+                                                   "before layers were drawn as their tiles (for comparisons)");
   cmd->add_flag("!--no-id-textures", o.layered.id_textures, "Leave out the per-texel object ids (half the impostors' "
                                                              "memory; bench then cannot measure their parallax)");
   cmd->callback([args] { runPlaceCommand(*args); });

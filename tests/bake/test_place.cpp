@@ -102,6 +102,10 @@ TEST(PlaceTest, ProblemViewsExistAndMostAreSolved) {
   nlohmann::json before = index.options;
   before.erase("visibility_grid");
   EXPECT_EQ(placeOptionsFromJson(before, "index").visibility_grid, 2);
+  // One placed before layers were drawn as their tiles charged whole quads.
+  EXPECT_EQ(index.options.at("layer_tiles"), true);
+  before.erase("layer_tiles");
+  EXPECT_FALSE(placeOptionsFromJson(before, "index").layer_tiles);
 }
 
 struct ViewChecks {

@@ -153,7 +153,8 @@ TEST(EnvironmentMapPlanTest, TheLayersInViewAreTheQuadsTheFrustumMeets) {
       if (!ahead.intersects(box)) continue;
       ++expected_quads;
       const double t = double(glm::length(centre - c)) - plan.radius;
-      expected_fill += std::min(4.0 * layer.half_u * layer.half_v * std::pow(bound.focalPixels() / t, 2.0), frame);
+      expected_fill += std::min(4.0 * layer.half_u * layer.half_v * std::pow(bound.focalPixels() / t, 2.0), frame) *
+                       double(layer.cover);  // the share of the quad its tiles draw
     }
   EXPECT_EQ(seen.quads, expected_quads);
   EXPECT_NEAR(seen.fill_pixels, expected_fill, 1e-3 * expected_fill);
@@ -204,7 +205,21 @@ TEST_F(ImpostorGpuTest, EnvironmentMapFromItsCentreMatchesTheFarFieldGeometry) {
   ASSERT_TRUE(plan.near_objects.empty());
   ASSERT_EQ(plan.faces.size(), 4u);
   std::vector<GpuLayeredImpostor> faces;
-  for (const EnvMapFace& f : plan.faces) faces.emplace_back(captureLayered(*renderer_, scene, f.objects, f.plan));
+  double planned = 0.0, texels = 0.0;
+  for (const EnvMapFace& f : plan.faces) {
+    LayeredImpostor captured = captureLayered(*renderer_, scene, f.objects, f.plan);
+    measureLayerCover(captured);
+    // The cover planned from the objects each slab meets bounds the tiles the capture gives.
+    for (size_t i = 0; i < f.plan.layers.size(); ++i) {
+      const LayerPlan& lp = f.plan.layers[i];
+      const double n = double(lp.width) * lp.height;
+      EXPECT_GE(double(lp.cover) * n, double(captured.plan.layers[i].cover) * n - 1e-3) << "face " << f.face << " layer " << i;
+      planned += double(lp.cover) * n;
+      texels += n;
+    }
+    faces.emplace_back(captured);
+  }
+  EXPECT_LT(planned, 0.8 * texels);  // an environment map's layers are mostly empty: the tiles skip most of them
   std::vector<gpu::DrawItem> impostor_items, geometry_items = scene.drawItems();
   for (const GpuLayeredImpostor& f : faces) f.appendDrawItems(impostor_items, 1);
 

@@ -11,12 +11,16 @@
 #include "farfield/core/error.h"
 #include "farfield/image/metrics.h"
 #include "impostor/impostor_fixture.h"
+#include "impostor/layered_cluster.h"
 
 namespace farfield::impostor {
 namespace {
 
 using test::BoxScene;
+using test::Cluster;
 using test::ImpostorGpuTest;
+using test::testBound;
+using test::viewFrom;
 
 // Angle (radians) between a and b seen from eye, in double.
 double angleAt(const DVec3& eye, const DVec3& a, const DVec3& b) {
@@ -242,37 +246,6 @@ TEST(LayeredPlanTest, BadInputIsAnErrorNamingIt) {
 
 // --- rendered -----------------------------------------------------------------------------------------------------
 
-// A small cluster: boxes at different depths along the shaft's axis, overlapping in its view (occlusion edges).
-struct Cluster {
-  BoxScene s;
-  std::vector<uint32_t> ids;
-  Box3 box;
-  Shaft shaft;
-  Cluster() {
-    ids.push_back(s.addBox({-6.0f, -10.0f, 0.0f}, {-1.0f, -6.0f, 6.0f}, {0.85f, 0.25f, 0.2f}));
-    ids.push_back(s.addBox({-2.0f, -3.0f, 0.0f}, {3.0f, 1.0f, 9.0f}, {0.25f, 0.75f, 0.3f}));
-    ids.push_back(s.addBox({1.0f, 4.0f, 0.0f}, {7.0f, 9.0f, 5.0f}, {0.2f, 0.35f, 0.85f}));
-    ids.push_back(s.addBox({-7.0f, 5.0f, 2.0f}, {-2.0f, 10.0f, 8.0f}, {0.9f, 0.8f, 0.2f}));
-    for (const Box3& b : s.boxes) box.expand(b);
-    shaft = Shaft::make(box.center(), Vec3(0.0f, -1.0f, 0.3f), float(degToRad(30.0)), 60.0f);
-  }
-};
-
-ErrorBound testBound() {
-  ErrorBound bound;
-  bound.pixels = 2.0;
-  bound.width = bound.height = 128;
-  bound.fov_y = degToRad(25.0);
-  return bound;
-}
-
-Camera viewFrom(const Vec3& eye, const Shaft& shaft, const ErrorBound& bound) {
-  Camera camera = test::makeCamera(eye, shaft.apex, bound.width, 0.5f, 2000.0f);
-  camera.height = bound.height;
-  camera.fov_y = float(bound.fov_y);
-  return camera;
-}
-
 // How far each pixel is from being right (pixels): a pixel showing object A where the reference shows B is right
 // after a move of min(distance in the impostor frame to a pixel showing B, distance in the reference to a pixel
 // showing A); background counts as an object. Ids, unlike colours, have no filtering or shading in them, so this is
@@ -387,7 +360,8 @@ TEST_F(ImpostorGpuTest, LayeredPlanEstimatesAreTheMeasuredMemory) {
     options.id_textures = ids;
     const LayeredPlan plan = planLayered(c.box, c.shaft, testBound(), options);
     const LayeredImpostor impostor = captureLayered(*renderer_, scene, c.ids, plan);
-    const GpuLayeredImpostor gpu_impostor(impostor);
+    // The plan counts a quad a layer; drawn as tiles, the rectangles are counted once measured (layer_tiles_test).
+    const GpuLayeredImpostor gpu_impostor(impostor, LayerDraw::WholeQuads);
     EXPECT_EQ(gpu_impostor.gpuBytes(), plan.bytes());
     EXPECT_EQ(impostor.cpuBytes(), size_t(plan.texels) * 4 * (ids ? 2 : 1));
     EXPECT_GE(plan.texture_bytes, impostor.cpuBytes());  // the atlases hold every layer (and their padding)

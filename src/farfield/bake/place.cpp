@@ -401,6 +401,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
     placement::CandidateSet kept;
     kept.counts = all.counts;
     std::vector<impostor::LayeredPlan> plans;
+    std::vector<Box3> parts;  // the candidate's objects: each layer's cover planned from them
     for (const placement::Candidate& original : all.candidates) {
       const std::optional<Shaft> shaft = placement::planningShaft(original, hierarchy);
       if (!shaft) {
@@ -420,8 +421,11 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
                      c.cpvs.end());
       if (c.cpvs.empty()) continue;
       try {
+        parts.clear();
+        if (options.layer_tiles)
+          for (uint32_t id : hierarchy.objects(c.node)) parts.push_back(scene.objects[id - 1].world_bounds);
         impostor::LayeredPlan plan = impostor::planLayered(hierarchy.nodes()[size_t(c.node)].bounds, *shaft,
-                                                           pass_bound, options.layered);
+                                                           pass_bound, options.layered, parts);
         if (!plan.keepsBound()) {
           if (pass == 0) ++report.candidates_unplannable;
           continue;
@@ -481,7 +485,10 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
       // will draw, still bounded from the region's nearest point.
       placement::GeneratedImpostor made{double(imp.plan.bytes()), {}};
       made.t_impostor.reserve(c.cpvs.size());
-      for (uint32_t cpv : c.cpvs) made.t_impostor.push_back(tImpostor(imp.plan, cpv));
+      impostor::LayeredPlan charged = imp.plan;  // the cropped quads, over their tiles or (without) whole
+      if (!options.layer_tiles)
+        for (impostor::LayerPlan& layer : charged.layers) layer.cover = 1.0f;
+      for (uint32_t cpv : c.cpvs) made.t_impostor.push_back(tImpostor(charged, cpv));
       return made;
     });
     greedy_total_s += greedy_clock.seconds() - (capture_s - capture_before);
@@ -590,6 +597,7 @@ nlohmann::json placeOptionsToJson(const PlaceOptions& o) {
           {"visibility_grid", o.visibility_grid},
           {"seed", o.seed},
           {"fallback_bound_factors", o.fallback_bound_factors},
+          {"layer_tiles", o.layer_tiles},
           {"hierarchy", {{"max_levels", o.hierarchy.max_levels},
                          {"min_objects_to_split", o.hierarchy.min_objects_to_split}}},
           {"candidates", {{"shafts", c.shafts},
@@ -642,6 +650,8 @@ PlaceOptions placeOptionsFromJson(const nlohmann::json& j, const std::string& so
   if (r.has("visibility_grid")) r.number("visibility_grid", o.visibility_grid);
   r.number("seed", o.seed);
   r.numbers("fallback_bound_factors", o.fallback_bound_factors);
+  // Databases placed before layers were drawn as their tiles charged whole quads.
+  o.layer_tiles = r.has("layer_tiles") ? r.boolean("layer_tiles") : false;
   StrictJson h = r.object("hierarchy");
   h.number("max_levels", o.hierarchy.max_levels);
   h.number("min_objects_to_split", o.hierarchy.min_objects_to_split);

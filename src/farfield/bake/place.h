@@ -76,6 +76,10 @@ struct PlaceOptions {
   // views keep the frame budget at a larger parallax (the record keeps its own bound, and the runtime counts the
   // impostors it draws at a coarser bound). Empty: none (the views stay over t_max, reported unsolved). Each > 1.
   std::vector<double> fallback_bound_factors;
+  // Charge each layer's fill over the tiles the runtime draws (impostor::layerTiles: planned from the cluster's
+  // objects before capture, measured after). false: over the whole quads, as placement did before tiles (a comparison:
+  // the runtime draws the tiles either way).
+  bool layer_tiles = true;
   bool progress = true;
   std::string scene_label;          // recorded in the database
   uint32_t seed = 0;                // reserved for sampling; recorded

@@ -285,6 +285,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     lo.height = options.height;
     lo.fov_deg = options.fov_deg;
     lo.error_px = options.layered_error_px;
+    lo.layer_tiles = options.layer_tiles;
     lo.view_space = space;
     lo.fit_samples = options.layered_samples;
     lo.validation_samples = options.layered_samples;
@@ -297,6 +298,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   result.wall_s = wall.seconds();
   profile.validation = {{"views", result.checks.size()},
                         {"fill_term", options.fill_term},
+                        {"layered_fill_over", options.layer_tiles ? "tiles" : "whole quads"},
                         {"frames", placed ? "placed: visible set of the eye's region, occlusion-culled; whole objects"
                                           : "frustum-culled full geometry"},
                         {"repeats", options.repeats},

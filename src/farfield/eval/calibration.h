@@ -57,6 +57,7 @@ struct CalibrateOptions {
   // view space, at the same frame size; 0 samples: none (the profile's layered cost stays uncalibrated).
   size_t layered_samples = 40;  // fitting samples; as many again validate
   double layered_error_px = 2.0;
+  bool layer_tiles = true;      // the layers drawn as their tiles (false: whole quads; LayeredCalibrateOptions)
 };
 
 struct ViewCheck {

@@ -24,11 +24,12 @@ namespace {
 nlohmann::json boxJson(const Box3& b) { return {{"lo", {b.lo.x, b.lo.y, b.lo.z}}, {"hi", {b.hi.x, b.hi.y, b.hi.z}}}; }
 
 // Captures one face layer by layer (each layer drawing only the objects its slab meets), cuts every layer to its
-// data and returns the cropped plan; adds the covered texels.
+// data and returns the cropped plan with each layer's cover measured; adds the covered texels.
 impostor::LayeredPlan captureFace(gpu::Renderer& renderer, const gpu::GpuScene& gpu_scene, const scene::Scene& scene,
                                   const impostor::EnvMapFace& face, uint64_t* covered) {
   const impostor::LayeredPlan& plan = face.plan;
   std::vector<impostor::LayerCrop> crops;
+  std::vector<float> covers;
   crops.reserve(plan.layers.size());
   for (size_t i = 0; i < plan.layers.size(); ++i) {
     impostor::LayeredPlan one = plan;
@@ -39,9 +40,11 @@ impostor::LayeredPlan captureFace(gpu::Renderer& renderer, const gpu::GpuScene& 
     const impostor::LayeredImpostor captured = impostor::captureLayered(renderer, gpu_scene, face.layer_objects[i], one);
     *covered += captured.layers[0].data_texels;
     crops.push_back(impostor::dataCrop(captured.layers[0]));
+    covers.push_back(impostor::cropLayered(captured).plan.layers[0].cover);  // the tiles drawn, measured
   }
   impostor::LayeredPlan cropped = plan;
   impostor::cropLayers(cropped, crops);
+  for (size_t i = 0; i < covers.size(); ++i) cropped.layers[i].cover = covers[i];
   return cropped;
 }
 

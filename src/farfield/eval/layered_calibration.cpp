@@ -113,8 +113,11 @@ LayeredCalibrateResult calibrateLayered(gpu::Renderer& renderer, const gpu::GpuS
     s.layers = plan.quads();
     s.texels = plan.texels;
     Stopwatch capture;
-    const impostor::GpuLayeredImpostor gpu(
-        impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene, ids, plan)));
+    impostor::LayeredImpostor cut = impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene, ids, plan));
+    if (!o.layer_tiles)
+      for (impostor::LayerPlan& layer : cut.plan.layers) layer.cover = 1.0f;
+    const impostor::GpuLayeredImpostor gpu(cut, o.layer_tiles ? impostor::LayerDraw::Tiles
+                                                               : impostor::LayerDraw::WholeQuads);
     s.capture_ms = capture.milliseconds();
     // The view: the capture eye (fitting) or a random viewpoint of the shaft up to twice its minimum distance
     // (validation), looking at the cluster.
@@ -136,7 +139,8 @@ LayeredCalibrateResult calibrateLayered(gpu::Renderer& renderer, const gpu::GpuS
       with = std::min(with, renderer.render(view, items, target).wall_ms);
     }
     s.view = view;
-    s.fill_pixels = impostor::layeredFillPixels(plan, double(glm::length(view.eye - plan.shaft.apex)), bound);
+    // The fill of what is drawn: the cropped quads' tiles.
+    s.fill_pixels = impostor::layeredFillPixels(cut.plan, double(glm::length(view.eye - plan.shaft.apex)), bound);
     s.draw_ms = std::max(0.0, with - without);
     (fitting ? result.fit : result.checks).push_back(s);
     if (o.progress) progress.advance();

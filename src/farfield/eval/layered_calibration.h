@@ -39,6 +39,9 @@ struct LayeredCalibrateOptions {
   // Floor of a prediction in the ratios (ms): the difference of two frames is noise below it.
   double noise_floor_ms = 0.25;
   impostor::LayeredOptions layered;
+  // The impostors drawn as their tiles, the fill counted over them; false: drawn as whole quads, the fill counted over
+  // them (a profile for placement without tiles, PlaceOptions::layer_tiles; comparisons).
+  bool layer_tiles = true;
   uint32_t seed = 7;
   bool progress = false;
 };
@@ -48,7 +51,7 @@ struct LayeredSample {
   uint64_t triangles = 0;     // rendered by the capture: the cluster's, once per layer
   uint32_t layers = 0;
   uint64_t texels = 0;        // captured (uncropped plan)
-  double fill_pixels = 0.0;   // impostor::layeredFillPixels of the plan at the view's distance from the apex
+  double fill_pixels = 0.0;   // impostor::layeredFillPixels of the drawn (cropped, tiled) layers at the view's distance
   double capture_ms = 0.0;    // measured
   double draw_ms = 0.0;       // measured: impostor frame less empty frame, >= 0
   double capture_predicted_ms = 0.0;  // raw model (validation samples)

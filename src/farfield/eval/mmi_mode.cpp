@@ -50,6 +50,7 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
   o.max_updates = countOption(context, "dynamic_max_updates", o.max_updates);
   o.min_lifetime_frames = numberOption(context, "dynamic_min_lifetime", o.min_lifetime_frames, 0.0);
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);
+  o.layer_tiles = switchOption(context, "layer_tiles", true);
   if (switchOption(context, "occlusion", true))
     occlusion_.emplace(occluderShareOption(context, runtime::representationName(representation)));
 }

@@ -102,6 +102,15 @@ EnvMapFace planFace(int face, const Vec3& c, double d, double r, double dw, std:
     out.layer_objects.push_back(std::move(in_slab));
   }
   plan.spacing = 0.0;
+  // Each layer's cover from the boxes of the objects its slab meets (the tiles GpuLayeredImpostor will draw).
+  for (size_t i = 0; i < plan.layers.size(); ++i) {
+    std::vector<Box3> parts;
+    for (uint32_t id : out.layer_objects[i])
+      parts.push_back(std::lower_bound(objects.begin(), objects.end(), id,
+                                       [](const FaceObject& o, uint32_t v) { return o.id < v; })
+                          ->bounds);
+    plan.layers[i].cover = plannedLayerCover(plan, i, parts);
+  }
   packAtlases(plan);
   plan.texture_bytes = 0;
   for (const IVec2& s : plan.atlas_sizes) plan.texture_bytes += size_t(s.x) * size_t(s.y) * 4;
@@ -208,7 +217,8 @@ EnvMapLayersInView envMapLayersInView(const EnvMapPlan& plan, const Frustum& vie
       const double gap = std::max(t_m - plan.radius, 1e-2 * t_m);
       ++in_view.quads;
       in_view.fill_pixels +=
-          std::min(4.0 * double(layer.half_u) * double(layer.half_v) * focal * focal / (gap * gap), cap);
+          std::min(4.0 * double(layer.half_u) * double(layer.half_v) * focal * focal / (gap * gap), cap) *
+          double(layer.cover);
     }
   }
   return in_view;

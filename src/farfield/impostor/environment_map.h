@@ -79,7 +79,8 @@ EnvMapPlan planEnvironmentMap(const Box3& cell, double far_distance, std::span<c
                               const ErrorBound& bound, const EnvMapOptions& options = {});
 
 // What a view of the cell draws of its environment map: the layer quads whose bounds meet `view` (a frustum from
-// inside the cell, e.g. a CPV's enclosing frustum), and the frame pixels they cover, transparent texels included,
+// inside the cell, e.g. a CPV's enclosing frustum), and the frame pixels their tiles cover (LayerPlan::cover,
+// planned from the slabs' objects or measured), transparent texels included,
 // seen from the cell's nearest viewpoint to each quad (distance t_m - r, each quad capped at the frame) in frames of
 // `frame`'s focal length: the fill the alpha test pays, as impostor::layeredFillPixels estimates a placed impostor's.
 struct EnvMapLayersInView {

@@ -126,15 +126,23 @@ std::array<FramePoint, 8> frameCorners(const Box3& box, const Vec3& apex, const 
   return out;
 }
 
-// Half extents, on the plane z = depth, of what E sees of the box between z = za and z = zb: the vertices of the
+// The rectangle, on the plane z = depth, of what E sees of the box between z = za and z = zb: the vertices of the
 // box cut by the slab (corners inside it, edges crossing its planes) projected from E (a projective map of a convex
-// polytope: its extremes are at vertices).
-Vec2 slabFootprint(const std::array<FramePoint, 8>& c, double za, double zb, double depth, double d) {
-  double au = 0.0, av = 0.0;
+// polytope: its extremes are at vertices). Empty (lo > hi) when the box misses the slab.
+struct PlaneRect {
+  double u_lo = std::numeric_limits<double>::max(), v_lo = u_lo;
+  double u_hi = std::numeric_limits<double>::lowest(), v_hi = u_hi;
+  bool empty() const { return u_lo > u_hi; }
+};
+
+PlaneRect slabRect(const std::array<FramePoint, 8>& c, double za, double zb, double depth, double d) {
+  PlaneRect r;
   const auto add = [&](double u, double v, double z) {
     const double scale = (d - depth) / (d - z);
-    au = std::max(au, std::abs(u) * scale);
-    av = std::max(av, std::abs(v) * scale);
+    r.u_lo = std::min(r.u_lo, u * scale);
+    r.u_hi = std::max(r.u_hi, u * scale);
+    r.v_lo = std::min(r.v_lo, v * scale);
+    r.v_hi = std::max(r.v_hi, v * scale);
   };
   for (const FramePoint& p : c)
     if (p.z >= za && p.z <= zb) add(p.u, p.v, p.z);
@@ -149,7 +157,31 @@ Vec2 slabFootprint(const std::array<FramePoint, 8>& c, double za, double zb, dou
         add(a.u + t * (b.u - a.u), a.v + t * (b.v - a.v), plane);
       }
     }
-  return Vec2(float(au), float(av));
+  return r;
+}
+
+// Half extents of slabRect around the axis.
+Vec2 slabFootprint(const std::array<FramePoint, 8>& c, double za, double zb, double depth, double d) {
+  const PlaneRect r = slabRect(c, za, zb, depth, d);
+  if (r.empty()) return Vec2(0.0f);
+  return Vec2(float(std::max(std::abs(r.u_lo), std::abs(r.u_hi))), float(std::max(std::abs(r.v_lo), std::abs(r.v_hi))));
+}
+
+// The texels of the tiles (kLayerTile, aligned to texel (0, 0)) of a layer image `width` x `height`, `s` metres a
+// texel, that can hold data of a part seen in `r` or lie within a texel of it: a texel is captured where its centre
+// lies in the part's projection, and a tile is drawn within a texel of a captured one (two texels of slack).
+uint64_t partTileTexels(const PlaneRect& r, const LayerPlan& layer, double s) {
+  if (r.empty()) return 0;
+  const auto column = [&](double u) { return (u + double(layer.half_u)) / s; };
+  const auto row = [&](double v) { return (double(layer.half_v) - v) / s; };
+  const auto tileDown = [](double t, int n) { return std::clamp(int(std::floor(t)) - 2, 0, n) / kLayerTile * kLayerTile; };
+  const auto tileUp = [](double t, int n) {
+    const int i = std::clamp(int(std::ceil(t)) + 2, 0, n);
+    return std::min(n, (i + kLayerTile - 1) / kLayerTile * kLayerTile);
+  };
+  const int x0 = tileDown(column(r.u_lo), layer.width), x1 = tileUp(column(r.u_hi), layer.width);
+  const int y0 = tileDown(row(r.v_hi), layer.height), y1 = tileUp(row(r.v_lo), layer.height);
+  return x1 > x0 && y1 > y0 ? uint64_t(x1 - x0) * uint64_t(y1 - y0) : 0;
 }
 
 // Margin by which a capture slab reaches past its nominal planes, so that a face lying exactly on a slab plane
@@ -159,9 +191,12 @@ double slabMargin(const LayeredPlan& plan) { return 1e-4 * double(plan.shaft.min
 }  // namespace
 
 LayeredPlan planLayered(const Box3& box, const Shaft& shaft_in, const ErrorBound& bound,
-                        const LayeredOptions& options) {
+                        const LayeredOptions& options, std::span<const Box3> parts) {
   if (box.empty() || !isFinite(box.lo) || !isFinite(box.hi))
     throw Error("layered impostor box", "empty or not finite (a cluster needs bounds)");
+  for (size_t i = 0; i < parts.size(); ++i)
+    if (parts[i].empty() || !isFinite(parts[i].lo) || !isFinite(parts[i].hi))
+      throw Error("layered impostor part " + std::to_string(i), "empty or not finite");
   const Shaft shaft =
       Shaft::make(shaft_in.apex, shaft_in.axis, shaft_in.apex_angle, shaft_in.min_distance, "layered impostor shaft");
   bound.validate("layered impostor error bound");
@@ -269,10 +304,27 @@ LayeredPlan planLayered(const Box3& box, const Shaft& shaft_in, const ErrorBound
     const double pixels = 4.0 * layer.half_u * layer.half_v * focal * focal / (distance * distance);
     plan.fill_pixels += std::min(pixels, double(bound.width) * double(bound.height));
   }
+  if (!parts.empty())
+    for (size_t i = 0; i < plan.layers.size(); ++i) plan.layers[i].cover = plannedLayerCover(plan, i, parts);
   packAtlases(plan);
   for (const IVec2& a : plan.atlas_sizes)
     plan.texture_bytes += size_t(a.x) * size_t(a.y) * 4 * (options.id_textures ? 2 : 1);
   return plan;
+}
+
+float plannedLayerCover(const LayeredPlan& plan, size_t layer_index, std::span<const Box3> parts) {
+  FF_CHECK(layer_index < plan.layers.size() && !plan.cropped);
+  const LayerPlan& layer = plan.layers[layer_index];
+  const DVec3 axis(plan.shaft.axis), right(plan.right), up(plan.up);
+  const double d = plan.shaft.min_distance, margin = slabMargin(plan);
+  const double texel = 2.0 * double(layer.half_u) / double(layer.width);
+  uint64_t reached = 0;
+  for (const Box3& part : parts) {
+    const std::array<FramePoint, 8> corners = frameCorners(part, plan.shaft.apex, axis, right, up);
+    reached += partTileTexels(slabRect(corners, layer.z_lo - margin, layer.z_hi + margin, layer.depth, d), layer, texel);
+  }
+  const double texels = double(layer.width) * double(layer.height);
+  return std::min(1.0f, std::nextafter(float(double(reached) / texels), 2.0f));  // rounded up: a bound
 }
 
 size_t LayeredImpostor::cpuBytes() const {
@@ -419,6 +471,9 @@ void cropLayers(LayeredPlan& plan, std::span<const LayerCrop> crops) {
     // A texel is s metres a side in the quad's plane (half_u = width * s / 2); column x spans [-half_u + x s, ...],
     // row y spans [half_v - (y + 1) s, half_v - y s] (row 0 at the top, towards +up).
     const double s = 2.0 * double(layer.half_u) / double(layer.width);
+    // The same area of tiles, now over the smaller quad (the cut drops only texels without data).
+    const double kept = double(c.width) * double(c.height) / (double(layer.width) * double(layer.height));
+    layer.cover = std::min(1.0f, std::nextafter(float(double(layer.cover) / kept), 2.0f));
     layer.offset_u = float(double(layer.offset_u) - layer.half_u + (c.x + 0.5 * c.width) * s);
     layer.offset_v = float(double(layer.offset_v) + layer.half_v - (c.y + 0.5 * c.height) * s);
     layer.half_u = float(0.5 * c.width * s);
@@ -490,10 +545,83 @@ LayeredImpostor cropLayered(const LayeredImpostor& impostor) {
     cut.render_ms = layer.render_ms;
     out.layers.push_back(std::move(cut));
   }
+  measureLayerCover(out);
   return out;
 }
 
-GpuLayeredImpostor::GpuLayeredImpostor(const LayeredImpostor& impostor) {
+std::vector<LayerCrop> layerTiles(const image::ColorImage& color, IVec2 origin) {
+  const int w = color.width(), h = color.height();
+  std::vector<LayerCrop> out;
+  if (w < 1 || h < 1) return out;
+  // Texel column x of the image is column x + origin.x of the grid; tile t spans grid columns [t T, (t + 1) T).
+  const int t = kLayerTile;
+  const int tx0 = origin.x / t, tx1 = (origin.x + w - 1) / t, ty0 = origin.y / t, ty1 = (origin.y + h - 1) / t;
+  const int tiles_x = tx1 - tx0 + 1, tiles_y = ty1 - ty0 + 1;
+  // A tile is drawn if a texel within one of it has alpha > 0: mark every tile within one texel of such a texel.
+  std::vector<uint8_t> drawn(size_t(tiles_x) * size_t(tiles_y), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (color.at(x, y).a == 0) continue;
+      const int gx = x + origin.x, gy = y + origin.y;  // >= 0: (gx - 1) / t is gx's own tile at gx = 0
+      for (int ty = (gy - 1) / t; ty <= (gy + 1) / t; ++ty)
+        for (int tx = (gx - 1) / t; tx <= (gx + 1) / t; ++tx)
+          if (tx >= tx0 && tx <= tx1 && ty >= ty0 && ty <= ty1)
+            drawn[size_t(ty - ty0) * size_t(tiles_x) + size_t(tx - tx0)] = 1;
+    }
+  // Runs along each tile row, joined with the rectangle above when it spans the same tiles.
+  std::vector<std::pair<int, int>> above;  // (first tile, end tile) of the previous row's runs
+  std::vector<size_t> above_rect;          // their rectangles in `out`
+  for (int ty = 0; ty < tiles_y; ++ty) {
+    std::vector<std::pair<int, int>> runs;
+    std::vector<size_t> run_rect;
+    for (int tx = 0; tx < tiles_x;) {
+      if (!drawn[size_t(ty) * size_t(tiles_x) + size_t(tx)]) {
+        ++tx;
+        continue;
+      }
+      const int first = tx;
+      while (tx < tiles_x && drawn[size_t(ty) * size_t(tiles_x) + size_t(tx)]) ++tx;
+      // The run's texels, clipped to the image.
+      const int x0 = std::max(0, (tx0 + first) * t - origin.x), x1 = std::min(w, (tx0 + tx) * t - origin.x);
+      const int y0 = std::max(0, (ty0 + ty) * t - origin.y), y1 = std::min(h, (ty0 + ty + 1) * t - origin.y);
+      const auto it = std::find(above.begin(), above.end(), std::make_pair(first, tx));
+      size_t rect;
+      if (it != above.end()) {
+        rect = above_rect[size_t(it - above.begin())];
+        out[rect].height = y1 - out[rect].y;
+      } else {
+        rect = out.size();
+        out.push_back({x0, y0, x1 - x0, y1 - y0});
+      }
+      runs.push_back({first, tx});
+      run_rect.push_back(rect);
+    }
+    above = std::move(runs);
+    above_rect = std::move(run_rect);
+  }
+  return out;
+}
+
+void measureLayerCover(LayeredImpostor& impostor) {
+  if (impostor.layers.size() != impostor.plan.layers.size())
+    throw Error("layered impostor", std::to_string(impostor.layers.size()) + " layer images for " +
+                                        std::to_string(impostor.plan.layers.size()) + " planned layers");
+  size_t rectangles = 0;
+  for (size_t i = 0; i < impostor.layers.size(); ++i) {
+    LayerPlan& lp = impostor.plan.layers[i];
+    const image::ColorImage& color = impostor.layers[i].color;
+    if (color.width() != lp.width || color.height() != lp.height)
+      throw Error("layered impostor layer " + std::to_string(i), "image does not match the plan's size");
+    uint64_t area = 0;
+    const std::vector<LayerCrop> tiles = layerTiles(color, IVec2(lp.crop_x, lp.crop_y));
+    for (const LayerCrop& r : tiles) area += uint64_t(r.width) * uint64_t(r.height);
+    lp.cover = float(double(area) / (double(lp.width) * double(lp.height)));
+    rectangles += tiles.size();
+  }
+  impostor.plan.mesh_bytes = rectangles * kLayerQuadBytes;
+}
+
+GpuLayeredImpostor::GpuLayeredImpostor(const LayeredImpostor& impostor, LayerDraw draw) {
   const LayeredPlan& plan = impostor.plan;
   FF_CHECK(impostor.layers.size() == plan.layers.size());
   FF_CHECK(plan.atlas_spots.size() == plan.layers.size());
@@ -519,18 +647,30 @@ GpuLayeredImpostor::GpuLayeredImpostor(const LayeredImpostor& impostor) {
         if (ids && !layer.ids.empty()) id_images[spot.atlas].at(spot.x + x, spot.y + y) = layer.ids.at(sx, sy);
       }
     const IVec2 size = plan.atlas_sizes[spot.atlas];
-    const Vec2 uv0(float(spot.x) / float(size.x), float(spot.y) / float(size.y));
-    const Vec2 uv1(float(spot.x + lp.width) / float(size.x), float(spot.y + lp.height) / float(size.y));
+    // Texel column x of the layer spans [-half_u + x s, -half_u + (x + 1) s] along right from the quad's centre, row y
+    // [half_v - (y + 1) s, half_v - y s] along up (row 0 at the top); uv (0, 0) is the atlas spot's top-left texel.
     const Vec3 centre = plan.shaft.apex + lp.depth * plan.shaft.axis + lp.offset_u * plan.right + lp.offset_v * plan.up;
-    const Vec3 du = lp.half_u * plan.right, dv = lp.half_v * plan.up;
+    const float s = 2.0f * lp.half_u / float(lp.width);
+    const std::vector<LayerCrop> rects = draw == LayerDraw::Tiles
+                                             ? layerTiles(layer.color, IVec2(lp.crop_x, lp.crop_y))
+                                             : std::vector<LayerCrop>{{0, 0, lp.width, lp.height}};
     scene::Mesh& mesh = meshes[spot.atlas];
-    const uint32_t base = uint32_t(mesh.positions.size());
-    // uv (0, 0) is the image's top-left (row 0): the capture's -right, +up corner.
-    mesh.positions.insert(mesh.positions.end(), {centre - du + dv, centre + du + dv, centre + du - dv, centre - du - dv});
-    mesh.uvs.insert(mesh.uvs.end(), {uv0, Vec2(uv1.x, uv0.y), uv1, Vec2(uv0.x, uv1.y)});
-    mesh.normals.insert(mesh.normals.end(), 4, plan.shaft.axis);
-    // Counter-clockwise seen from the viewers (right x up = axis).
-    for (uint32_t k : {3u, 2u, 1u, 3u, 1u, 0u}) mesh.indices.push_back(base + k);
+    for (const LayerCrop& r : rects) {
+      const auto corner = [&](int x, int y) {
+        return centre + (-lp.half_u + float(x) * s) * plan.right + (lp.half_v - float(y) * s) * plan.up;
+      };
+      const auto uv = [&](int x, int y) {
+        return Vec2(float(spot.x + x) / float(size.x), float(spot.y + y) / float(size.y));
+      };
+      const int x0 = r.x, y0 = r.y, x1 = r.x + r.width, y1 = r.y + r.height;
+      const uint32_t base = uint32_t(mesh.positions.size());
+      mesh.positions.insert(mesh.positions.end(), {corner(x0, y0), corner(x1, y0), corner(x1, y1), corner(x0, y1)});
+      mesh.uvs.insert(mesh.uvs.end(), {uv(x0, y0), uv(x1, y0), uv(x1, y1), uv(x0, y1)});
+      mesh.normals.insert(mesh.normals.end(), 4, plan.shaft.axis);
+      // Counter-clockwise seen from the viewers (right x up = axis).
+      for (uint32_t k : {3u, 2u, 1u, 3u, 1u, 0u}) mesh.indices.push_back(base + k);
+      ++rectangles_;
+    }
     ++quads_;
   }
   for (size_t a = 0; a < meshes.size(); ++a) {

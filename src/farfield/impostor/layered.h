@@ -63,6 +63,10 @@ struct LayerPlan {
   // offset_v along ::up from the axis (0 for an uncropped layer).
   int crop_x = 0, crop_y = 0;
   float offset_u = 0.0f, offset_v = 0.0f;
+  // The fraction of the quad's area that is drawn (GpuLayeredImpostor draws a layer as the rectangles of its tiles
+  // that hold data, layerTiles), at most 1. Planned from the cluster's parts (planLayered), an upper bound of what
+  // the capture gives; measured from the images once captured (measureLayerCover); 1 without either.
+  float cover = 1.0f;
 };
 
 // A rectangle of a layer's captured image, texels, row 0 at the top.
@@ -102,24 +106,28 @@ struct LayeredPlan {
   // Estimates before generation (the placement optimiser's memory and render cost).
   uint64_t texels = 0;             // sum of the layers' width * height
   size_t texture_bytes = 0;        // colour (+ ids) atlas textures
-  size_t mesh_bytes = 0;           // quads' vertex and index buffers
+  size_t mesh_bytes = 0;           // quads' vertex and index buffers (one quad a layer; measureLayerCover: the tiles')
   size_t bytes() const { return texture_bytes + mesh_bytes; }
   uint32_t quads() const { return uint32_t(layers.size()); }
   uint32_t draws() const { return uint32_t(atlas_sizes.size()); }  // draw calls: one per atlas
   // Pixels of the bound's frame the quads cover (transparent texels included: the fill-rate cost of an alpha test)
-  // from the nearest viewpoint on the axis, each quad capped at the frame.
+  // from the nearest viewpoint on the axis, each quad capped at the frame; the drawn part of it (LayerPlan::cover) is
+  // what impostor::layeredFillPixels counts.
   double fill_pixels = 0.0;
 
   bool keepsBound() const { return !layers_capped && error_angle <= bound_angle; }
   bool cropped = false;  // cropLayers was applied: the layers are parts of the captured images
 };
 
-// Plans the layers of the cluster `box` for the viewpoints of `shaft` under `bound`. Pure arithmetic, no GL. Throws
-// farfield::Error naming the input for an empty or non-finite box, a shaft that is not valid (see Shaft::make) or
-// whose minimum distance does not clear the cluster (min_distance <= radius: viewpoints inside or next to it), a bound
-// that fails ErrorBound::validate or has no pixels, and options out of range.
+// Plans the layers of the cluster `box` for the viewpoints of `shaft` under `bound`. Pure arithmetic, no GL. With the
+// boxes of the cluster's parts (its objects' world bounds, inside `box`), each layer's cover is planned: the tiles
+// (layerTiles) that the parts cut by its slab can reach, seen from the capture eye, summed over the parts and capped
+// at 1, so that it bounds the cover the capture measures. Throws farfield::Error naming the input for an empty or
+// non-finite box or part, a shaft that is not valid (see Shaft::make) or whose minimum distance does not clear the
+// cluster (min_distance <= radius: viewpoints inside or next to it), a bound that fails ErrorBound::validate or has
+// no pixels, and options out of range.
 LayeredPlan planLayered(const Box3& box, const Shaft& shaft, const ErrorBound& bound,
-                        const LayeredOptions& options = {});
+                        const LayeredOptions& options = {}, std::span<const Box3> parts = {});
 
 struct Layer {
   image::ColorImage color;  // RGBA, alpha 255 where the slab's objects cover the texel, 0 elsewhere
@@ -143,7 +151,8 @@ LayeredImpostor captureLayered(gpu::Renderer& renderer, const gpu::GpuScene& sce
 
 // The plan with layer i cut to crops[i], a rectangle of its captured image (plan.layers[i].width x height, the plan
 // not cropped yet): each quad shrinks to its rectangle and moves with it, the atlases are packed again and texels and
-// texture_bytes counted again (fill_pixels stays the estimate of the whole quads: an upper bound). Throws
+// texture_bytes counted again (fill_pixels stays the estimate of the whole quads: an upper bound; a layer's cover
+// grows with the cut so that it bounds the same area, capped at 1). Throws
 // farfield::Error naming the layer for a crop count other than the layer count, an empty crop, a crop outside its
 // image, or a plan already cropped.
 void cropLayers(LayeredPlan& plan, std::span<const LayerCrop> crops);
@@ -155,15 +164,38 @@ LayerCrop dataCrop(const Layer& layer);
 
 // The impostor with every layer cut to its dataCrop: the same image from every viewpoint (what is dropped is
 // transparent black, and the texels that bilinear filtering and the edge clamp now read at a cut are too), fewer
-// texels. The layers' data_texels and render_ms are kept. Throws farfield::Error for an impostor whose images do not
-// match its plan or whose plan is already cropped.
+// texels, and the layers' cover measured (measureLayerCover). The layers' data_texels and render_ms are kept. Throws
+// farfield::Error for an impostor whose images do not match its plan or whose plan is already cropped.
 LayeredImpostor cropLayered(const LayeredImpostor& impostor);
+
+// Tiles: a layer is drawn as the tiles of kLayerTile x kLayerTile texels of its captured image (aligned to the
+// captured image's texel (0, 0), so to (crop_x, crop_y) in a cropped one) that hold a texel with alpha > 0 or lie
+// within one texel of one, merged into rectangles (runs along a row, equal runs of consecutive rows joined). Every
+// fragment of a layer's quad outside them samples, bilinearly, only transparent texels, which the alpha test discards:
+// the tiles draw the quad's image and shade only near its data (a layer holds 10-70 % of its rectangle).
+inline constexpr int kLayerTile = 8;
+
+// The rectangles, in texels of `color` (row 0 at the top), of its tiles with data, the grid's origin at
+// (-origin.x, -origin.y) of the image (a cropped layer's crop_x, crop_y). Each texel lies in at most one rectangle.
+std::vector<LayerCrop> layerTiles(const image::ColorImage& color, IVec2 origin = IVec2(0));
+
+// The cover of layer `layer` of an uncropped plan made by planLayered (or laid out alike: impostor/environment_map.h)
+// from the boxes of what its slab may hold: planLayered's bound. Pure arithmetic.
+float plannedLayerCover(const LayeredPlan& plan, size_t layer, std::span<const Box3> parts);
+
+// Sets each layer's cover to its tiles' area over its image's, and mesh_bytes to their rectangles': what
+// GpuLayeredImpostor draws. Throws farfield::Error for an impostor whose images do not match its plan.
+void measureLayerCover(LayeredImpostor& impostor);
 
 inline constexpr int kAtlasSide = 4096;
 inline constexpr int kAtlasPadding = 2;  // texels around each layer image, its edge texels repeated (clamp to edge)
-// A layer quad's vertex and index buffers: GpuMesh's interleaved position, normal and uv floats (32 bytes a vertex)
-// and 32-bit indices.
+// A layer quad's (or tile rectangle's) vertex and index buffers: GpuMesh's interleaved position, normal and uv floats
+// (32 bytes a vertex) and 32-bit indices.
 inline constexpr size_t kLayerQuadBytes = 4 * 8 * sizeof(float) + 6 * sizeof(uint32_t);
+
+// How GpuLayeredImpostor draws a layer: as its tiles (layerTiles), or as its whole quad (for comparisons: the same
+// image, every texel shaded).
+enum class LayerDraw { Tiles, WholeQuads };
 
 // Packs plan.layers into atlases (sets atlas_spots and atlas_sizes; texture_bytes is the caller's): shelves, tallest
 // layers first, at most kAtlasSide a side unless a layer alone is larger. planLayered and cropLayers call it; a plan
@@ -171,19 +203,20 @@ inline constexpr size_t kLayerQuadBytes = 4 * 8 * sizeof(float) + 6 * sizeof(uin
 void packAtlases(LayeredPlan& plan);
 
 // The layers on the GPU: per atlas (LayeredPlan::atlas_sizes) one texture (and id texture) and one mesh of its layers'
-// quads (normal = the axis, uvs into the atlas), with an unlit, double-sided material: one draw call per atlas. The
-// renderer's alpha test cuts out texels with alpha below 0.5 and its depth test composes the layers (and any geometry
-// around them), so the draw order does not change the image. Needs a current context. Movable; draw items point into
-// it.
+// tile rectangles (LayerDraw::Tiles; whole quads with LayerDraw::WholeQuads; normal = the axis, uvs into the atlas),
+// with an unlit, double-sided material: one draw call per atlas. The renderer's alpha test cuts out texels with alpha
+// below 0.5 and its depth test composes the layers (and any geometry around them), so the draw order does not change
+// the image. Needs a current context. Movable; draw items point into it.
 class GpuLayeredImpostor {
  public:
-  explicit GpuLayeredImpostor(const LayeredImpostor& impostor);
+  explicit GpuLayeredImpostor(const LayeredImpostor& impostor, LayerDraw draw = LayerDraw::Tiles);
   GpuLayeredImpostor(GpuLayeredImpostor&&) noexcept = default;
   GpuLayeredImpostor& operator=(GpuLayeredImpostor&&) noexcept = default;
 
   // Appends one item per atlas; object_id is written where a layer has no id texture.
   void appendDrawItems(std::vector<gpu::DrawItem>& out, uint32_t object_id = 0) const;
-  uint32_t quads() const { return quads_; }
+  uint32_t quads() const { return quads_; }           // layers
+  uint32_t rectangles() const { return rectangles_; } // quads drawn: tile rectangles, or one per layer
   uint32_t draws() const { return uint32_t(meshes_.size()); }
   size_t gpuBytes() const;  // measured: the textures' and buffers' sizes
 
@@ -192,6 +225,7 @@ class GpuLayeredImpostor {
   std::vector<std::unique_ptr<gpu::Texture>> textures_, id_textures_;
   std::vector<std::unique_ptr<gpu::GpuMaterial>> materials_;
   uint32_t quads_ = 0;
+  uint32_t rectangles_ = 0;
 };
 
 }  // namespace farfield::impostor

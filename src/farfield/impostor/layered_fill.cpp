@@ -17,7 +17,7 @@ double layeredFillPixels(const LayeredPlan& plan, double distance, const ErrorBo
   for (const LayerPlan& layer : plan.layers) {
     const double gap = std::max({d - plan.radius, d * cos_theta - double(layer.depth), floor});
     const double pixels = 4.0 * double(layer.half_u) * double(layer.half_v) * focal * focal / (gap * gap);
-    sum += std::min(pixels, cap);
+    sum += std::min(pixels, cap) * double(layer.cover);
   }
   return sum;
 }

@@ -372,8 +372,9 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
           impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene_, n.objects, plan));
       n.layered = std::make_unique<impostor::GpuLayeredImpostor>(captured);
       n.layered_bytes = n.layered->gpuBytes();
-      // Valid while the eye stays in the shaft: bounded from its nearest viewpoints.
-      n.layered_draw_ms = lc.drawBoundMs(double(plan.quads()), impostor::layeredFillPixels(plan, 0.0, bound));
+      // Valid while the eye stays in the shaft: bounded from its nearest viewpoints, over the tiles drawn.
+      n.layered_draw_ms =
+          lc.drawBoundMs(double(plan.quads()), impostor::layeredFillPixels(captured.plan, 0.0, bound));
       texture_bytes_ += n.layered_bytes;
       st.texels_written_bytes += size_t(captured.plan.texels) * 4;
       st.uploaded_bytes += n.layered_bytes;  // read back per layer, cropped, uploaded again

@@ -85,6 +85,8 @@ struct WalkthroughOptions {
                                                // written there when the walkthrough ends
   bool object_ids = true;                      // impostors carry per-texel object ids (item buffers show objects)
   std::string cell_lookup;                     // "street" or "nearest"; "" = the database's
+  bool layer_tiles = true;                     // Placed: layers drawn as their tiles (false: whole quads, the same
+                                               // image with every texel shaded; for comparisons)
   // MmiDynamic.
   double frame_budget_ms = 1000.0 / 30.0;
   double dynamic_error_px = 2.0;               // a dynamic impostor is refreshed beyond this error

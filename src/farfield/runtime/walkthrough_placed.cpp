@@ -81,7 +81,8 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
         Stopwatch timer;
         const impostor::LayeredImpostor imp = store::loadPlacedImpostor(options_.database, record);
         Placed::Resident r;
-        r.gpu = std::make_unique<impostor::GpuLayeredImpostor>(imp);
+        r.gpu = std::make_unique<impostor::GpuLayeredImpostor>(
+            imp, options_.layer_tiles ? impostor::LayerDraw::Tiles : impostor::LayerDraw::WholeQuads);
         r.error_rad = imp.plan.error_angle;
         r.bytes = r.gpu->gpuBytes();
         p.resident_bytes += r.bytes;

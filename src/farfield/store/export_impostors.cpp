@@ -126,9 +126,10 @@ class PipelineExport {
   ImpostorExportStats& stats_;
 };
 
-// One quad per layer, as GpuLayeredImpostor draws it (layered.cpp) but with each layer's own image: uv (0, 0) at the
-// image's top-left texel, the capture's -right, +up corner; counter-clockwise seen from the viewers. One glTF mesh with
-// a primitive per layer (far to near), so a CPV drawing the impostor needs one node.
+// One quad per layer, as GpuLayeredImpostor draws it with LayerDraw::WholeQuads (layered.cpp; the same image as its
+// tiles) but with each layer's own image: uv (0, 0) at the image's top-left texel, the capture's -right, +up corner;
+// counter-clockwise seen from the viewers. One glTF mesh with a primitive per layer (far to near), so a CPV drawing
+// the impostor needs one node.
 int layeredMesh(scene::GltfBuilder& builder, const impostor::LayeredImpostor& imp, const std::string& name) {
   const impostor::LayeredPlan& plan = imp.plan;
   std::vector<scene::Mesh> quads(plan.layers.size());

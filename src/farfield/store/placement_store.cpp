@@ -724,6 +724,7 @@ impostor::LayeredImpostor loadPlacedImpostor(const std::string& dir, const Store
     layer.render_ms = s.render_ms;
     out.layers.push_back(std::move(layer));
   }
+  impostor::measureLayerCover(out);  // what GpuLayeredImpostor will draw of each layer
   return out;
 }
 
