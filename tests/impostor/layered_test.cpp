@@ -418,15 +418,7 @@ TEST_F(ImpostorGpuTest, CroppedLayersDrawTheSameImageWithFewerTexels) {
   std::vector<gpu::DrawItem> items_full, items_cropped;
   gpu_full.appendDrawItems(items_full);
   gpu_cropped.appendDrawItems(items_cropped);
-  for (const float t : {0.0f, 0.3f, 0.7f, 1.0f}) {
-    const Camera camera = viewFrom(c.shaft.sample(t, 1.0f, 0.5f, 2.0f * c.shaft.min_distance), c.shaft, bound);
-    const test::Frame a = test::renderItems(*renderer_, camera, items_full);
-    const test::Frame b = test::renderItems(*renderer_, camera, items_cropped);
-    size_t ids_differ = 0;
-    for (size_t p = 0; p < a.ids.pixelCount(); ++p) ids_differ += a.ids.pixels()[p] != b.ids.pixels()[p] ? 1 : 0;
-    EXPECT_LE(ids_differ, a.ids.pixelCount() / 1000) << "viewpoint " << t;
-    EXPECT_LT(image::shareOverThreshold(a.color, b.color, 8), 0.001) << "viewpoint " << t;
-  }
+  test::expectSameImage(*renderer_, c, bound, items_full, items_cropped);
   // A crop outside its image, a wrong count, or cropping twice are errors.
   LayeredPlan plan = full.plan;
   std::vector<LayerCrop> crops(plan.layers.size(), LayerCrop{0, 0, 1, 1});
