@@ -26,7 +26,6 @@ if [ ! -f "$OUT/profile-whole.json" ]; then
 import json, sys
 profile, whole = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
 profile["layered"] = whole["layered"]
-profile["validation"]["layered_fill_over"] = "whole quads"
 profile["validation"]["layered_from"] = sys.argv[2]
 json.dump(profile, open(sys.argv[3], "w"), indent=2)
 PY

@@ -100,6 +100,8 @@ void runCalibrateCommand(CalibrateArgs& args) {
     std::printf("layered capture:    %.3f ms + %.3f ms/Mtri + %.4f ms/layer + %.3f ms/Mtexel (fit r2 %.3f)\n",
                 l.capture.base_ms, l.capture.ms_per_mtriangle, l.capture.ms_per_draw, l.capture.ms_per_mpixel,
                 l.capture.r2);
+    std::printf("layered tiles:      drawn as their tiles / as whole quads, the same impostors and views: p50 %.3f, "
+                "all samples' sum %.3f\n", lr.tiles_over_whole_p50, lr.tiles_over_whole_sum);
     std::printf("layered validation: %zu clusters; draw measured/predicted p50 %.3f p95 %.3f max %.3f (factor %.3f); "
                 "capture p50 %.3f p95 %.3f max %.3f (factor %.3f); %zu plans skipped\n",
                 lr.checks.size(), lr.draw_ratio_p50, lr.draw_ratio_p95, lr.draw_ratio_max, l.draw_safety_factor,

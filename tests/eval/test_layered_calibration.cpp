@@ -70,6 +70,10 @@ TEST(LayeredCalibrationTest, FactorsBoundEveryValidationSample) {
   }
   EXPECT_LE(r.draw_ratio_p50, r.draw_ratio_max);
   EXPECT_EQ(c.validation["validation_samples"], o.validation_samples);
+  // Every impostor was drawn both ways too (which is faster is the report's question, not a unit test's).
+  EXPECT_GT(r.tiles_over_whole_p50, 0.0);
+  EXPECT_GT(r.tiles_over_whole_sum, 0.0);
+  EXPECT_EQ(c.validation["fill_over"], "tiles");
   // The fits are non-negative least squares: no term makes more work cheaper. (Whether the measured capture times
   // grow with the work is a timing question for `farfield calibrate`'s report, not for a unit test: under a loaded
   // machine the halves of 12 samples came out in either order.)

@@ -298,7 +298,6 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   result.wall_s = wall.seconds();
   profile.validation = {{"views", result.checks.size()},
                         {"fill_term", options.fill_term},
-                        {"layered_fill_over", options.layer_tiles ? "tiles" : "whole quads"},
                         {"frames", placed ? "placed: visible set of the eye's region, occlusion-culled; whole objects"
                                           : "frustum-culled full geometry"},
                         {"repeats", options.repeats},

@@ -131,13 +131,18 @@ LayeredCalibrateResult calibrateLayered(gpu::Renderer& renderer, const gpu::GpuS
     view.fov_y = float(degToRad(double(o.fov_deg)));
     view.near_plane = 0.5f;
     view.far_plane = 20000.0f;
-    std::vector<gpu::DrawItem> items;
+    std::vector<gpu::DrawItem> items, other_items;
     gpu.appendDrawItems(items);
-    double with = std::numeric_limits<double>::infinity(), without = with;
+    const impostor::GpuLayeredImpostor other(cut, o.layer_tiles ? impostor::LayerDraw::WholeQuads
+                                                                 : impostor::LayerDraw::Tiles);
+    other.appendDrawItems(other_items);
+    double with = std::numeric_limits<double>::infinity(), without = with, with_other = with;
     for (int r = 0; r < o.repeats; ++r) {
       without = std::min(without, renderer.render(view, {}, target).wall_ms);
       with = std::min(with, renderer.render(view, items, target).wall_ms);
+      with_other = std::min(with_other, renderer.render(view, other_items, target).wall_ms);
     }
+    s.draw_other_ms = std::max(0.0, with_other - without);
     s.view = view;
     // The fill of what is drawn: the cropped quads' tiles.
     s.fill_pixels = impostor::layeredFillPixels(cut.plan, double(glm::length(view.eye - plan.shaft.apex)), bound);
@@ -169,6 +174,18 @@ LayeredCalibrateResult calibrateLayered(gpu::Renderer& renderer, const gpu::GpuS
   result.capture_ratio_p50 = percentile(capture_ratios, 50.0);
   result.capture_ratio_p95 = percentile(capture_ratios, 95.0);
   result.capture_ratio_max = percentile(capture_ratios, 100.0);
+  std::vector<double> tiles_over_whole;
+  double tiles_sum = 0.0, whole_sum = 0.0;
+  for (const std::vector<LayeredSample>* set : {&result.fit, &result.checks})
+    for (const LayeredSample& s : *set) {
+      const double tiles = o.layer_tiles ? s.draw_ms : s.draw_other_ms;
+      const double whole = o.layer_tiles ? s.draw_other_ms : s.draw_ms;
+      tiles_over_whole.push_back(std::max(tiles, o.noise_floor_ms) / std::max(whole, o.noise_floor_ms));
+      tiles_sum += tiles;
+      whole_sum += whole;
+    }
+  result.tiles_over_whole_p50 = percentile(tiles_over_whole, 50.0);
+  result.tiles_over_whole_sum = whole_sum > 0.0 ? tiles_sum / whole_sum : 1.0;
   cost.draw_safety_factor = std::max(1.0, result.draw_ratio_max);
   cost.capture_safety_factor = std::max(1.0, result.capture_ratio_max);
   // A prediction below the noise floor is bounded by the floor times the factor (see the ratios above).
@@ -183,7 +200,10 @@ LayeredCalibrateResult calibrateLayered(gpu::Renderer& renderer, const gpu::GpuS
                      {"draw_ratio_max", result.draw_ratio_max},
                      {"capture_ratio_p50", result.capture_ratio_p50},
                      {"capture_ratio_p95", result.capture_ratio_p95},
-                     {"capture_ratio_max", result.capture_ratio_max}};
+                     {"capture_ratio_max", result.capture_ratio_max},
+                     {"fill_over", o.layer_tiles ? "tiles" : "whole quads"},
+                     {"tiles_over_whole_draw_p50", result.tiles_over_whole_p50},
+                     {"tiles_over_whole_draw_sum", result.tiles_over_whole_sum}};
   result.wall_s = wall.seconds();
   return result;
 }

@@ -54,6 +54,9 @@ struct LayeredSample {
   double fill_pixels = 0.0;   // impostor::layeredFillPixels of the drawn (cropped, tiled) layers at the view's distance
   double capture_ms = 0.0;    // measured
   double draw_ms = 0.0;       // measured: impostor frame less empty frame, >= 0
+  // The same impostor from the same view drawn the other way (whole quads when the layers are drawn as their tiles,
+  // and the reverse), timed in the same renders' loop: what the tiles save, measured.
+  double draw_other_ms = 0.0;
   double capture_predicted_ms = 0.0;  // raw model (validation samples)
   double draw_predicted_ms = 0.0;
 };
@@ -64,6 +67,8 @@ struct LayeredCalibrateResult {
   // measured / max(predicted, noise floor) over the validation samples
   double draw_ratio_p50 = 0, draw_ratio_p95 = 0, draw_ratio_max = 0;
   double capture_ratio_p50 = 0, capture_ratio_p95 = 0, capture_ratio_max = 0;
+  // Over every sample: draw time as tiles / as whole quads, per sample (median) and summed.
+  double tiles_over_whole_p50 = 0, tiles_over_whole_sum = 0;
   size_t skipped = 0;  // clusters drawn whose plan could not keep the bound or did not clear the cluster
   double wall_s = 0.0;
 };
