@@ -486,8 +486,7 @@ PlaceReport placeImpostors(gpu::Context& context, const scene::Scene& scene, con
       placement::GeneratedImpostor made{double(imp.plan.bytes()), {}};
       made.t_impostor.reserve(c.cpvs.size());
       impostor::LayeredPlan charged = imp.plan;  // the cropped quads, over their tiles or (without) whole
-      if (!options.layer_tiles)
-        for (impostor::LayerPlan& layer : charged.layers) layer.cover = 1.0f;
+      if (!options.layer_tiles) impostor::coverWholeQuads(charged);
       for (uint32_t cpv : c.cpvs) made.t_impostor.push_back(tImpostor(charged, cpv));
       return made;
     });

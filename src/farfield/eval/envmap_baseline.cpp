@@ -39,8 +39,9 @@ impostor::LayeredPlan captureFace(gpu::Renderer& renderer, const gpu::GpuScene& 
     impostor::packAtlases(one);
     const impostor::LayeredImpostor captured = impostor::captureLayered(renderer, gpu_scene, face.layer_objects[i], one);
     *covered += captured.layers[0].data_texels;
-    crops.push_back(impostor::dataCrop(captured.layers[0]));
-    covers.push_back(impostor::cropLayered(captured).plan.layers[0].cover);  // the tiles drawn, measured
+    const impostor::LayerPlan cut = impostor::cropLayered(captured).plan.layers[0];  // its data, its tiles measured
+    crops.push_back({cut.crop_x, cut.crop_y, cut.width, cut.height});
+    covers.push_back(cut.cover);
   }
   impostor::LayeredPlan cropped = plan;
   impostor::cropLayers(cropped, crops);

@@ -114,8 +114,7 @@ LayeredCalibrateResult calibrateLayered(gpu::Renderer& renderer, const gpu::GpuS
     s.texels = plan.texels;
     Stopwatch capture;
     impostor::LayeredImpostor cut = impostor::cropLayered(impostor::captureLayered(renderer, gpu_scene, ids, plan));
-    if (!o.layer_tiles)
-      for (impostor::LayerPlan& layer : cut.plan.layers) layer.cover = 1.0f;
+    if (!o.layer_tiles) impostor::coverWholeQuads(cut.plan);
     const impostor::GpuLayeredImpostor gpu(cut, o.layer_tiles ? impostor::LayerDraw::Tiles
                                                                : impostor::LayerDraw::WholeQuads);
     s.capture_ms = capture.milliseconds();

@@ -621,6 +621,10 @@ void measureLayerCover(LayeredImpostor& impostor) {
   impostor.plan.mesh_bytes = rectangles * kLayerQuadBytes;
 }
 
+void coverWholeQuads(LayeredPlan& plan) {
+  for (LayerPlan& layer : plan.layers) layer.cover = 1.0f;
+}
+
 GpuLayeredImpostor::GpuLayeredImpostor(const LayeredImpostor& impostor, LayerDraw draw) {
   const LayeredPlan& plan = impostor.plan;
   FF_CHECK(impostor.layers.size() == plan.layers.size());

@@ -187,6 +187,10 @@ float plannedLayerCover(const LayeredPlan& plan, size_t layer, std::span<const B
 // GpuLayeredImpostor draws. Throws farfield::Error for an impostor whose images do not match its plan.
 void measureLayerCover(LayeredImpostor& impostor);
 
+// Every layer's cover set to 1: the fill charged over the whole quads (placement and calibration for comparisons with
+// drawing the whole quads; PlaceOptions::layer_tiles, LayeredCalibrateOptions::layer_tiles).
+void coverWholeQuads(LayeredPlan& plan);
+
 inline constexpr int kAtlasSide = 4096;
 inline constexpr int kAtlasPadding = 2;  // texels around each layer image, its edge texels repeated (clamp to edge)
 // A layer quad's (or tile rectangle's) vertex and index buffers: GpuMesh's interleaved position, normal and uv floats
