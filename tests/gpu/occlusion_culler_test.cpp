@@ -10,6 +10,7 @@
 #include "farfield/gpu/render_target.h"
 #include "farfield/scene/builtin.h"
 #include "gpu/gpu_fixture.h"
+#include "gpu/street_scene.h"
 
 namespace farfield::gpu {
 namespace {
@@ -148,63 +149,18 @@ TEST(ProjectBox, FootprintHoldsEveryPointOfTheBoxAndNearestIsItsNearestDepth) {
   EXPECT_GT(projected, 100);
 }
 
-// A street canyon: two rows of tall walls along y, with many small towers behind them, a few in the street and
-// kiosks along the walls.
+// The street canyon of street_scene.h, culled per cluster of 12 triangles.
 class OcclusionStreetTest : public GpuTest {
  protected:
   void SetUp() override {
     GpuTest::SetUp();
-    std::mt19937 rng(21);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    scene::Material wall;
-    wall.base_color = Vec4(0.8f, 0.7f, 0.6f, 1.0f);
-    const uint32_t walls = scene_.addMaterial(wall);
-    wall.base_color = Vec4(0.3f, 0.4f, 0.8f, 1.0f);
-    const uint32_t towers = scene_.addMaterial(wall);
-    for (int side = -1; side <= 1; side += 2)
-      for (int k = 0; k < 6; ++k) {
-        scene::Object object;
-        const float x0 = float(side) * 6.0f + (side > 0 ? 0.0f : -1.0f);
-        object.parts.push_back({scene_.addMesh(scene::makeBox(Vec3(x0, k * 20.0f - 60.0f, 0.0f),
-                                                              Vec3(x0 + 1.0f, k * 20.0f - 40.5f, 15.0f))),
-                                walls});
-        scene_.addObject(std::move(object));
-      }
-    for (int i = 0; i < 120; ++i) {
-      scene::Object object;
-      const float side = i % 5 == 0 ? 0.0f : (i % 2 ? 1.0f : -1.0f);
-      const Vec3 lo(side == 0.0f ? -3.0f + 5.0f * u(rng) : side * (9.0f + 40.0f * u(rng)), -60.0f + 120.0f * u(rng),
-                    0.0f);
-      const Vec3 size(0.5f + 2.0f * u(rng), 0.5f + 2.0f * u(rng), side == 0.0f ? 1.0f : 3.0f + 25.0f * u(rng));
-      object.parts.push_back({scene_.addMesh(scene::makeBox(lo, lo + size)), towers});
-      scene_.addObject(std::move(object));
-    }
-    // Kiosks just in front of the walls: seen over the wall's depth alone, nearly as far as it (a test that hid
-    // boxes a little too eagerly would drop them).
-    for (int i = 0; i < 30; ++i) {
-      scene::Object object;
-      const float side = i % 2 ? 1.0f : -1.0f;
-      const Vec3 lo(side > 0 ? 4.6f + 0.3f * u(rng) : -5.9f + 0.3f * u(rng), -60.0f + 120.0f * u(rng), 0.5f);
-      object.parts.push_back({scene_.addMesh(scene::makeBox(lo, lo + Vec3(1.0f, 1.0f, 1.0f + 2.0f * u(rng)))), walls});
-      scene_.addObject(std::move(object));
-    }
+    scene_ = test::streetCanyonScene();
     GpuSceneOptions options;
     options.cluster_triangles = 12;
     gpu_scene_ = std::make_unique<GpuScene>(scene_, options);
   }
 
-  // A 96 x 64 camera in the street at eye height, or above the walls looking down a little.
-  static Camera streetCamera(std::mt19937& rng, bool above) {
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-    Camera camera;
-    camera.width = 96;
-    camera.height = 64;
-    camera.near_plane = 0.2f;
-    camera.far_plane = 500.0f;
-    camera.eye = Vec3(3.0f * u(rng), 50.0f * u(rng), above ? 30.0f : 1.7f);
-    camera.at = camera.eye + Vec3(0.8f * u(rng), u(rng), 0.2f * u(rng) - (above ? 0.5f : 0.0f));
-    return camera;
-  }
+  static Camera streetCamera(std::mt19937& rng, bool above) { return test::streetCanyonCamera(rng, above); }
 
   scene::Scene scene_;
   std::unique_ptr<GpuScene> gpu_scene_;

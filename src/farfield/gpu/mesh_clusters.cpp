@@ -17,6 +17,7 @@ namespace {
 // back to the eye together (the facades on one side of a street); the last class holds triangles without a normal,
 // which never count as facing away.
 constexpr int kUp = 0, kDown = 1, kSectors = 8, kNoArea = 2 + kSectors, kClasses = kNoArea + 1;
+static_assert(kNoArea == kNoFacing);
 // Normals closer than this (|n - normal|) share a facing group; more groups than kMaxGroups make a cluster that is
 // never tested for facing (it would rarely face away as a whole, and the test would cost more than it saves).
 constexpr double kGroupSpread = 1e-3;
@@ -54,6 +55,8 @@ Triangle describe(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 }  // namespace
+
+int facingClass(const Vec3& a, const Vec3& b, const Vec3& c) { return describe(a, b, c).facing_class; }
 
 ClusteredIndices clusterTriangles(const scene::Mesh& mesh, uint32_t max_triangles, uint32_t min_facing_triangles) {
   if (max_triangles == 0) throw Error("clusterTriangles", "max_triangles must be at least 1");

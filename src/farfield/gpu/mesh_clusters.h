@@ -63,4 +63,9 @@ scene::Mesh reorderedMesh(const scene::Mesh& mesh, const ClusteredIndices& clust
 
 bool facesAway(const MeshCluster& cluster, std::span<const FacingGroup> facing, const Vec3& eye);
 
+// The facing class of a triangle (counter-clockwise front): 0 up (normal z > 0.7), 1 down (z < -0.7), 2..9 eight
+// sectors of horizontal directions, kNoFacing for a triangle without area.
+inline constexpr int kNoFacing = 10;
+int facingClass(const Vec3& a, const Vec3& b, const Vec3& c);
+
 }  // namespace farfield::gpu

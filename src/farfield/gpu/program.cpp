@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
+#include <initializer_list>
 #include <regex>
 #include <sstream>
 #include <utility>
@@ -95,23 +96,17 @@ Program Program::fromEmbedded(const std::string& vertex, const std::string& frag
                      {fragment, withDefines(fragment, shaderSource(fragment), defines)});
 }
 
-Program Program::fromSources(const ShaderStageSource& vertex, const ShaderStageSource& fragment) {
-  GLuint vs = compile(GL_VERTEX_SHADER, vertex);
-  GLuint fs = 0;
-  try {
-    fs = compile(GL_FRAGMENT_SHADER, fragment);
-  } catch (...) {
-    glDeleteShader(vs);
-    throw;
-  }
+namespace {
+
+// Links the compiled shaders into a program (the shaders are deleted either way); throws naming `what`.
+GLuint link(std::initializer_list<GLuint> shaders, const std::string& what) {
   GLuint handle = glCreateProgram();
-  glAttachShader(handle, vs);
-  glAttachShader(handle, fs);
+  for (GLuint shader : shaders) glAttachShader(handle, shader);
   glLinkProgram(handle);
-  glDetachShader(handle, vs);
-  glDetachShader(handle, fs);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
+  for (GLuint shader : shaders) {
+    glDetachShader(handle, shader);
+    glDeleteShader(shader);
+  }
   GLint ok = 0;
   glGetProgramiv(handle, GL_LINK_STATUS, &ok);
   if (!ok) {
@@ -122,8 +117,30 @@ Program Program::fromSources(const ShaderStageSource& vertex, const ShaderStageS
     log.resize(std::strlen(log.c_str()));
     while (!log.empty() && std::isspace(static_cast<unsigned char>(log.back()))) log.pop_back();
     glDeleteProgram(handle);
-    throw Error(vertex.name + " + " + fragment.name, "link failed: " + log);
+    throw Error(what, "link failed: " + log);
   }
+  return handle;
+}
+
+}  // namespace
+
+Program Program::computeFromEmbedded(const std::string& compute, const std::string& defines) {
+  const GLuint cs = compile(GL_COMPUTE_SHADER, {compute, withDefines(compute, shaderSource(compute), defines)});
+  Program program;
+  program.handle_ = link({cs}, compute);
+  return program;
+}
+
+Program Program::fromSources(const ShaderStageSource& vertex, const ShaderStageSource& fragment) {
+  GLuint vs = compile(GL_VERTEX_SHADER, vertex);
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, fragment);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  const GLuint handle = link({vs, fs}, vertex.name + " + " + fragment.name);
   Program program;
   program.handle_ = handle;
   return program;

@@ -1,4 +1,4 @@
-// GLSL program from embedded or given sources. Compile and link errors throw farfield::Error naming the shader and
+// GLSL program (vertex and fragment, or compute) from embedded or given sources. Compile and link errors throw farfield::Error naming the shader and
 // the line of the error.
 #pragma once
 
@@ -21,6 +21,8 @@ class Program {
   // From embedded shader names (shaderSource); defines are inserted after the #version line ("#define X 1").
   static Program fromEmbedded(const std::string& vertex, const std::string& fragment, const std::string& defines = "");
   static Program fromSources(const ShaderStageSource& vertex, const ShaderStageSource& fragment);
+  // A compute program from an embedded shader.
+  static Program computeFromEmbedded(const std::string& compute, const std::string& defines = "");
   ~Program();
   Program(Program&& other) noexcept;
   Program& operator=(Program&& other) noexcept;

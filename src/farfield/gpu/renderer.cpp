@@ -93,6 +93,7 @@ FrameStats Renderer::draw(const Camera& camera, std::span<const DrawItem> items,
   FrameStats stats;
 
   target.bindForOpaquePass();
+  if (last_wins_ties_) glDepthFunc(GL_GEQUAL);
 
   // Per-frame uniforms on every variant (cheap, and the loop below then only switches programs).
   const Mat4 view_proj = camera.viewProjection();
@@ -208,6 +209,7 @@ FrameStats Renderer::draw(const Camera& camera, std::span<const DrawItem> items,
   }
   glBindVertexArray(0);
   if (mirrored) glFrontFace(GL_CCW);
+  if (last_wins_ties_) glDepthFunc(GL_GREATER);
 
   std::sort(im.ids.begin(), im.ids.end());
   stats.objects = uint32_t(std::unique(im.ids.begin(), im.ids.end()) - im.ids.begin());

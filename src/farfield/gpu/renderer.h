@@ -80,6 +80,10 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   LightSettings& light() { return light_; }
+  // Depth ties (coplanar surfaces of different objects): by default the first item drawn keeps the pixel
+  // (GL_GREATER); with last_wins_ties the last one does (GL_GEQUAL). The pixels where the two frames differ are those
+  // whose content depends on draw order, which any renderer resolves its own way; comparisons leave them out.
+  void setLastWinsTies(bool last_wins_ties) { last_wins_ties_ = last_wins_ties; }
   // Clears the target, draws the items and waits for the GPU (glFinish) so the wall time is the frame's.
   FrameStats render(const Camera& camera, std::span<const DrawItem> items, RenderTarget& target,
                     RenderMode mode = RenderMode::Shaded);
@@ -91,6 +95,7 @@ class Renderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   LightSettings light_;
+  bool last_wins_ties_ = false;
 };
 
 struct GpuSceneOptions {

@@ -139,4 +139,43 @@ size_t Texture::byteSize() const {
   return mipmaps_ ? base * 4 / 3 : base;
 }
 
+uint32_t makeColorTextureArray(std::span<const image::ColorImage* const> layers) {
+  if (layers.empty()) throw Error("texture array", "no images");
+  const int width = layers[0]->width(), height = layers[0]->height();
+  for (const image::ColorImage* image : layers)
+    if (image->empty() || image->width() != width || image->height() != height)
+      throw Error("texture array", "images of " + std::to_string(width) + "x" + std::to_string(height) +
+                                       " and " + std::to_string(image->width()) + "x" +
+                                       std::to_string(image->height()) + " mixed");
+  GLint max_size = 0, max_layers = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  if (width > max_size || height > max_size || int(layers.size()) > max_layers)
+    throw Error("texture array", std::to_string(layers.size()) + " layers of " + std::to_string(width) + "x" +
+                                     std::to_string(height) + " exceed the driver's limits");
+  GLuint handle = 0;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &handle);
+  glTextureStorage3D(handle, levelCount(width, height), GL_RGBA8, width, height, GLsizei(layers.size()));
+  glTextureParameteri(handle, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTextureParameteri(handle, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(handle, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTextureParameteri(handle, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  if (maxAnisotropy() > 1.0f) glTextureParameterf(handle, GL_TEXTURE_MAX_ANISOTROPY, maxAnisotropy());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  for (size_t i = 0; i < layers.size(); ++i)
+    glTextureSubImage3D(handle, 0, 0, 0, GLint(i), width, height, 1, GL_RGBA, GL_UNSIGNED_BYTE, layers[i]->data());
+  glGenerateTextureMipmap(handle);
+  return handle;
+}
+
+size_t colorTextureArrayBytes(int width, int height, int layers) {
+  size_t bytes = 0;
+  for (int w = width, h = height;; w = std::max(w / 2, 1), h = std::max(h / 2, 1)) {
+    bytes += size_t(w) * size_t(h) * 4 * size_t(layers);
+    if (w == 1 && h == 1) break;
+  }
+  return bytes;
+}
+
 }  // namespace farfield::gpu

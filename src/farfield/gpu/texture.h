@@ -3,7 +3,9 @@
 // top-left corner and v grows downwards (the glTF convention; OBJ-style uvs with v up need v' = 1 - v).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "farfield/image/image.h"
 
@@ -41,5 +43,12 @@ class Texture {
   TextureFormat format_ = TextureFormat::Rgba8;
   bool mipmaps_ = false;
 };
+
+// A GL_TEXTURE_2D_ARRAY of equally sized colour images, one layer each, sampled as Texture::fromImage's textures are
+// (mipmaps, trilinear filtering, the same anisotropy, repeat wrapping). Returns the GL name, which the caller deletes.
+// Throws farfield::Error for no images, an empty one or mixed sizes.
+uint32_t makeColorTextureArray(std::span<const image::ColorImage* const> layers);
+// The GPU bytes of such an array (all mip levels).
+size_t colorTextureArrayBytes(int width, int height, int layers);
 
 }  // namespace farfield::gpu

@@ -1,0 +1,314 @@
+#include "farfield/gpu/gl_counters.h"
+
+#include <epoxy/egl.h>
+#include <epoxy/gl.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <tuple>
+#include <type_traits>
+
+namespace farfield::gpu {
+
+GlCounters& GlCounters::operator-=(const GlCounters& o) {
+  calls -= o.calls;
+  draw_calls -= o.draw_calls;
+  dispatches -= o.dispatches;
+  syncs -= o.syncs;
+  upload_bytes -= o.upload_bytes;
+  driver_ms -= o.driver_ms;
+  measure_ms -= o.measure_ms;
+  return *this;
+}
+
+namespace {
+
+struct ThreadState {
+  GlCounters counters;
+  int paused = 0;  // inside GlMeasurement scopes
+};
+thread_local ThreadState t_state;
+std::atomic<bool> g_installed{false};
+
+int64_t nowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Driver time of one call.
+class Timed {
+ public:
+  explicit Timed(GlCounters& c) : c_(c), start_(nowNs()) {}
+  ~Timed() { c_.driver_ms += double(nowNs() - start_) * 1e-6; }
+  Timed(const Timed&) = delete;
+  Timed& operator=(const Timed&) = delete;
+
+ private:
+  GlCounters& c_;
+  int64_t start_;
+};
+
+enum class Kind {
+  Plain,     // counted
+  Draw,      // counted, a draw call, timed
+  Dispatch,  // counted, a compute dispatch, timed
+  Work,      // counted, GPU work that a software rasterizer does inside the call (clears, blits, copies), timed
+  Sync,      // counted, always waits for the GPU, timed
+  Extra,     // counted, timed; the extra function adds uploads or decides whether it waited
+};
+
+// The driver's entry points used by the extra functions to look at state without being counted.
+PFNGLGETINTEGERVPROC g_get_integer = nullptr;
+PFNGLGETQUERYOBJECTIVPROC g_get_query_iv = nullptr;
+
+// The wrapper of one entry point: Slot is the address of libepoxy's function pointer (epoxy_glDrawElements, ...).
+// Extra, when not void, is a function object called with the counters and the call's arguments before the call.
+template <auto Slot, Kind K, typename Extra = void>
+struct Hook;
+
+template <typename R, typename... A, R (**Slot)(A...), Kind K, typename Extra>
+struct Hook<Slot, K, Extra> {
+  using Fn = R (*)(A...);
+  static inline Fn real = nullptr;
+
+  static R call(A... args) {
+    ThreadState& t = t_state;
+    if (t.paused) return real(args...);
+    GlCounters& c = t.counters;
+    ++c.calls;
+    if constexpr (K == Kind::Draw) ++c.draw_calls;
+    if constexpr (K == Kind::Dispatch) ++c.dispatches;
+    if constexpr (K == Kind::Sync) ++c.syncs;
+    if constexpr (!std::is_void_v<Extra>) Extra{}(c, args...);
+    if constexpr (K == Kind::Plain) {
+      return real(args...);
+    } else {
+      Timed timed(c);
+      return real(args...);
+    }
+  }
+  static void install(void* proc) {
+    real = reinterpret_cast<Fn>(proc);
+    *Slot = &call;
+  }
+};
+
+// ---- bytes and conditional waits -------------------------------------------------------------------------------
+
+uint64_t pixelBytes(GLenum format, GLenum type) {
+  uint64_t components = 4;
+  switch (format) {
+    case GL_RED: case GL_RED_INTEGER: case GL_DEPTH_COMPONENT: case GL_STENCIL_INDEX: components = 1; break;
+    case GL_RG: case GL_RG_INTEGER: case GL_DEPTH_STENCIL: components = 2; break;
+    case GL_RGB: case GL_RGB_INTEGER: case GL_BGR: components = 3; break;
+    default: components = 4;
+  }
+  switch (type) {
+    case GL_UNSIGNED_BYTE: case GL_BYTE: return components;
+    case GL_UNSIGNED_SHORT: case GL_SHORT: case GL_HALF_FLOAT: return 2 * components;
+    case GL_UNSIGNED_INT_24_8: case GL_UNSIGNED_INT_8_8_8_8_REV: return 4;
+    default: return 4 * components;  // GL_FLOAT, GL_INT, GL_UNSIGNED_INT
+  }
+}
+
+bool bound(GLenum binding) {
+  GLint buffer = 0;
+  if (g_get_integer) g_get_integer(binding, &buffer);
+  return buffer != 0;
+}
+
+void bufferStorage(GlCounters& c, GLuint, GLsizeiptr size, const void* data, GLbitfield) {
+  if (data) c.upload_bytes += uint64_t(size);
+}
+void bufferData(GlCounters& c, GLuint, GLsizeiptr size, const void* data, GLenum) {
+  if (data) c.upload_bytes += uint64_t(size);
+}
+void bufferDataTarget(GlCounters& c, GLenum, GLsizeiptr size, const void* data, GLenum) {
+  if (data) c.upload_bytes += uint64_t(size);
+}
+void bufferSubData(GlCounters& c, GLuint, GLintptr, GLsizeiptr size, const void*) { c.upload_bytes += uint64_t(size); }
+void bufferSubDataTarget(GlCounters& c, GLenum, GLintptr, GLsizeiptr size, const void*) {
+  c.upload_bytes += uint64_t(size);
+}
+void textureSubImage2D(GlCounters& c, GLuint, GLint, GLint, GLint, GLsizei w, GLsizei h, GLenum format, GLenum type,
+                       const void*) {
+  if (!bound(GL_PIXEL_UNPACK_BUFFER_BINDING)) c.upload_bytes += uint64_t(w) * uint64_t(h) * pixelBytes(format, type);
+}
+void textureSubImage3D(GlCounters& c, GLuint, GLint, GLint, GLint, GLint, GLsizei w, GLsizei h, GLsizei d,
+                       GLenum format, GLenum type, const void*) {
+  if (!bound(GL_PIXEL_UNPACK_BUFFER_BINDING))
+    c.upload_bytes += uint64_t(w) * uint64_t(h) * uint64_t(d) * pixelBytes(format, type);
+}
+
+// Reads into client memory wait for the GPU; into a pixel pack buffer they do not.
+void readPixels(GlCounters& c, GLint, GLint, GLsizei, GLsizei, GLenum, GLenum, void*) {
+  if (!bound(GL_PIXEL_PACK_BUFFER_BINDING)) ++c.syncs;
+}
+void getTextureImage(GlCounters& c, GLuint, GLint, GLenum, GLenum, GLsizei, void*) {
+  if (!bound(GL_PIXEL_PACK_BUFFER_BINDING)) ++c.syncs;
+}
+void getTextureSubImage(GlCounters& c, GLuint, GLint, GLint, GLint, GLint, GLsizei, GLsizei, GLsizei, GLenum, GLenum,
+                        GLsizei, void*) {
+  if (!bound(GL_PIXEL_PACK_BUFFER_BINDING)) ++c.syncs;
+}
+// A query's result asked for before it is available makes the CPU wait for it.
+void queryWaits(GlCounters& c, GLuint id, GLenum pname) {
+  if (pname != GL_QUERY_RESULT) return;
+  GLint available = 1;
+  if (g_get_query_iv) g_get_query_iv(id, GL_QUERY_RESULT_AVAILABLE, &available);
+  if (!available) ++c.syncs;
+}
+void queryObjectui64(GlCounters& c, GLuint id, GLenum pname, GLuint64*) { queryWaits(c, id, pname); }
+void queryObjecti64(GlCounters& c, GLuint id, GLenum pname, GLint64*) { queryWaits(c, id, pname); }
+void queryObjectiv(GlCounters& c, GLuint id, GLenum pname, GLint*) { queryWaits(c, id, pname); }
+void queryObjectuiv(GlCounters& c, GLuint id, GLenum pname, GLuint*) { queryWaits(c, id, pname); }
+void clientWaitSync(GlCounters& c, GLsync, GLbitfield, GLuint64 timeout) {
+  if (timeout > 0) ++c.syncs;
+}
+void mapBufferRange(GlCounters& c, GLuint, GLintptr, GLsizeiptr, GLbitfield access) {
+  if ((access & GL_MAP_READ_BIT) && !(access & GL_MAP_UNSYNCHRONIZED_BIT)) ++c.syncs;
+}
+
+// Uniform values: Bytes each; Count is the index of the argument holding their number (-1: one value).
+template <uint64_t Bytes, int Count = -1>
+struct Uniform {
+  template <class... A>
+  void operator()(GlCounters& c, A... args) const {
+    uint64_t count = 1;
+    if constexpr (Count >= 0) count = uint64_t(std::get<Count>(std::tuple<A...>(args...)));
+    c.upload_bytes += Bytes * count;
+  }
+};
+// A plain function as the Extra of a hook.
+template <auto F>
+struct Call {
+  template <class... A>
+  void operator()(GlCounters& c, A... args) const {
+    F(c, args...);
+  }
+};
+
+struct Entry {
+  const char* name;
+  void (*install)(void*);
+};
+
+#define FF_HOOK(fn, kind) Entry{#fn, &Hook<&epoxy_##fn, Kind::kind>::install}
+#define FF_HOOK_EXTRA(fn, extra) Entry{#fn, &Hook<&epoxy_##fn, Kind::Extra, Call<extra>>::install}
+#define FF_HOOK_UPLOAD(fn, extra) Entry{#fn, &Hook<&epoxy_##fn, Kind::Plain, Call<extra>>::install}
+#define FF_HOOK_UNIFORM(fn, ...) Entry{#fn, &Hook<&epoxy_##fn, Kind::Plain, Uniform<__VA_ARGS__>>::install}
+
+// Every entry point Farfield calls (tests/gpu/gl_counters_test.cpp checks the sources against this list).
+const Entry kEntries[] = {
+    // draws and dispatches
+    FF_HOOK(glDrawArrays, Draw), FF_HOOK(glDrawArraysInstanced, Draw), FF_HOOK(glDrawElements, Draw),
+    FF_HOOK(glDrawElementsInstanced, Draw), FF_HOOK(glDrawElementsBaseVertex, Draw),
+    FF_HOOK(glDrawElementsInstancedBaseVertexBaseInstance, Draw), FF_HOOK(glMultiDrawElementsIndirect, Draw),
+    FF_HOOK(glMultiDrawElementsIndirectCountARB, Draw), FF_HOOK(glMultiDrawElementsIndirectCount, Draw),
+    FF_HOOK(glMultiDrawArraysIndirect, Draw), FF_HOOK(glDispatchCompute, Dispatch),
+    FF_HOOK(glDispatchComputeIndirect, Dispatch),
+    // GPU work inside the call on a software rasterizer
+    FF_HOOK(glClear, Work), FF_HOOK(glClearNamedFramebufferfv, Work), FF_HOOK(glClearNamedFramebufferuiv, Work),
+    FF_HOOK(glClearNamedFramebufferiv, Work), FF_HOOK(glBlitNamedFramebuffer, Work),
+    FF_HOOK(glGenerateTextureMipmap, Work), FF_HOOK(glCopyNamedBufferSubData, Work),
+    FF_HOOK(glClearNamedBufferSubData, Work), FF_HOOK(glClearNamedBufferData, Work), FF_HOOK(glClearTexImage, Work),
+    FF_HOOK(glFlush, Work),
+    // waits
+    FF_HOOK(glFinish, Sync), FF_HOOK(glGetNamedBufferSubData, Sync), FF_HOOK_EXTRA(glReadPixels, readPixels),
+    FF_HOOK_EXTRA(glGetTextureImage, getTextureImage), FF_HOOK_EXTRA(glGetTextureSubImage, getTextureSubImage),
+    FF_HOOK_EXTRA(glGetQueryObjectui64v, queryObjectui64), FF_HOOK_EXTRA(glGetQueryObjecti64v, queryObjecti64),
+    FF_HOOK_EXTRA(glGetQueryObjectiv, queryObjectiv), FF_HOOK_EXTRA(glGetQueryObjectuiv, queryObjectuiv),
+    FF_HOOK_EXTRA(glClientWaitSync, clientWaitSync), FF_HOOK_EXTRA(glMapNamedBufferRange, mapBufferRange),
+    // uploads
+    FF_HOOK_UPLOAD(glNamedBufferStorage, bufferStorage), FF_HOOK_UPLOAD(glNamedBufferData, bufferData),
+    FF_HOOK_UPLOAD(glNamedBufferSubData, bufferSubData), FF_HOOK_UPLOAD(glBufferData, bufferDataTarget),
+    FF_HOOK_UPLOAD(glBufferSubData, bufferSubDataTarget), FF_HOOK_UPLOAD(glTextureSubImage2D, textureSubImage2D),
+    FF_HOOK_UPLOAD(glTextureSubImage3D, textureSubImage3D),
+    FF_HOOK_UNIFORM(glUniform1i, 4), FF_HOOK_UNIFORM(glUniform1ui, 4),
+    FF_HOOK_UNIFORM(glUniform1f, 4), FF_HOOK_UNIFORM(glUniform2f, 8),
+    FF_HOOK_UNIFORM(glUniform2i, 8), FF_HOOK_UNIFORM(glUniform2fv, 8, 1),
+    FF_HOOK_UNIFORM(glUniform3fv, 12, 1), FF_HOOK_UNIFORM(glUniform4fv, 16, 1),
+    FF_HOOK_UNIFORM(glUniform4f, 16), FF_HOOK_UNIFORM(glUniformMatrix3fv, 36, 1),
+    FF_HOOK_UNIFORM(glUniformMatrix4fv, 64, 1), FF_HOOK_UNIFORM(glProgramUniform1f, 4),
+    FF_HOOK_UNIFORM(glProgramUniform1i, 4),
+    FF_HOOK_UNIFORM(glProgramUniform1ui, 4),
+    FF_HOOK_UNIFORM(glProgramUniform2i, 8),
+    FF_HOOK_UNIFORM(glProgramUniform2f, 8),
+    FF_HOOK_UNIFORM(glProgramUniform2iv, 8, 2),
+    FF_HOOK_UNIFORM(glProgramUniform3fv, 12, 2),
+    FF_HOOK_UNIFORM(glProgramUniform4fv, 16, 2),
+    FF_HOOK_UNIFORM(glProgramUniformMatrix4fv, 64, 2),
+    // state, objects, queries
+    FF_HOOK(glAttachShader, Plain), FF_HOOK(glBeginQuery, Plain), FF_HOOK(glBindBuffer, Plain),
+    FF_HOOK(glBindBufferBase, Plain), FF_HOOK(glBindBufferRange, Plain), FF_HOOK(glBindFramebuffer, Plain),
+    FF_HOOK(glBindImageTexture, Plain), FF_HOOK(glBindTextureUnit, Plain), FF_HOOK(glBindVertexArray, Plain),
+    FF_HOOK(glBlendFuncSeparate, Plain), FF_HOOK(glCheckNamedFramebufferStatus, Plain),
+    FF_HOOK(glClearColor, Plain), FF_HOOK(glClearDepth, Plain), FF_HOOK(glClipControl, Plain),
+    FF_HOOK(glColorMask, Plain), FF_HOOK(glColorMaski, Plain), FF_HOOK(glCompileShader, Plain),
+    FF_HOOK(glCreateBuffers, Plain), FF_HOOK(glCreateFramebuffers, Plain), FF_HOOK(glCreateProgram, Plain),
+    FF_HOOK(glCreateQueries, Plain), FF_HOOK(glCreateShader, Plain), FF_HOOK(glCreateTextures, Plain),
+    FF_HOOK(glCreateVertexArrays, Plain), FF_HOOK(glCullFace, Plain), FF_HOOK(glDebugMessageCallback, Plain),
+    FF_HOOK(glDeleteBuffers, Plain), FF_HOOK(glDeleteFramebuffers, Plain), FF_HOOK(glDeleteProgram, Plain),
+    FF_HOOK(glDeleteQueries, Plain), FF_HOOK(glDeleteShader, Plain), FF_HOOK(glDeleteSync, Plain),
+    FF_HOOK(glDeleteTextures, Plain), FF_HOOK(glDeleteVertexArrays, Plain), FF_HOOK(glDepthFunc, Plain),
+    FF_HOOK(glDepthMask, Plain), FF_HOOK(glDetachShader, Plain), FF_HOOK(glDisable, Plain),
+    FF_HOOK(glEnable, Plain), FF_HOOK(glEnableVertexArrayAttrib, Plain), FF_HOOK(glEndQuery, Plain),
+    FF_HOOK(glFenceSync, Plain), FF_HOOK(glFrontFace, Plain), FF_HOOK(glGetFloatv, Plain),
+    FF_HOOK(glGetIntegerv, Plain), FF_HOOK(glGetProgramInfoLog, Plain), FF_HOOK(glGetProgramiv, Plain),
+    FF_HOOK(glGetShaderInfoLog, Plain), FF_HOOK(glGetShaderiv, Plain), FF_HOOK(glGetString, Plain),
+    FF_HOOK(glGetSynciv, Plain), FF_HOOK(glGetUniformLocation, Plain), FF_HOOK(glLinkProgram, Plain),
+    FF_HOOK(glMemoryBarrier, Plain), FF_HOOK(glNamedFramebufferDrawBuffer, Plain),
+    FF_HOOK(glNamedFramebufferDrawBuffers, Plain), FF_HOOK(glNamedFramebufferReadBuffer, Plain),
+    FF_HOOK(glNamedFramebufferTexture, Plain), FF_HOOK(glNamedFramebufferTextureLayer, Plain),
+    FF_HOOK(glPixelStorei, Plain), FF_HOOK(glPolygonOffset, Plain), FF_HOOK(glQueryCounter, Plain),
+    FF_HOOK(glReadBuffer, Plain), FF_HOOK(glShaderSource, Plain), FF_HOOK(glTextureParameterf, Plain),
+    FF_HOOK(glTextureParameterfv, Plain), FF_HOOK(glTextureParameteri, Plain), FF_HOOK(glTextureStorage2D, Plain),
+    FF_HOOK(glTextureStorage3D, Plain), FF_HOOK(glUnmapNamedBuffer, Plain), FF_HOOK(glUseProgram, Plain),
+    FF_HOOK(glVertexArrayAttribBinding, Plain), FF_HOOK(glVertexArrayAttribFormat, Plain),
+    FF_HOOK(glVertexArrayAttribIFormat, Plain), FF_HOOK(glVertexArrayBindingDivisor, Plain),
+    FF_HOOK(glVertexArrayElementBuffer, Plain), FF_HOOK(glVertexArrayVertexBuffer, Plain),
+    FF_HOOK(glViewport, Plain),
+};
+
+#undef FF_HOOK
+#undef FF_HOOK_EXTRA
+#undef FF_HOOK_UPLOAD
+#undef FF_HOOK_UNIFORM
+
+}  // namespace
+
+bool installGlCounters() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (const char* env = std::getenv("FF_GL_COUNTERS"); env && std::strcmp(env, "0") == 0) return;
+    if (!eglGetCurrentContext()) return;  // only EGL contexts: a GLX-only process keeps libepoxy's own pointers
+    g_get_integer = reinterpret_cast<PFNGLGETINTEGERVPROC>(eglGetProcAddress("glGetIntegerv"));
+    g_get_query_iv = reinterpret_cast<PFNGLGETQUERYOBJECTIVPROC>(eglGetProcAddress("glGetQueryObjectiv"));
+    if (!g_get_integer || !g_get_query_iv) return;
+    for (const Entry& e : kEntries)
+      if (void* proc = reinterpret_cast<void*>(eglGetProcAddress(e.name))) e.install(proc);
+    g_installed = true;
+  });
+  return g_installed;
+}
+
+bool glCountersInstalled() { return g_installed; }
+
+GlCounters glCounters() { return t_state.counters; }
+
+GlMeasurement::GlMeasurement() : start_ns_(nowNs()) { ++t_state.paused; }
+
+GlMeasurement::~GlMeasurement() {
+  if (--t_state.paused == 0) t_state.counters.measure_ms += double(nowNs() - start_ns_) * 1e-6;
+}
+
+std::vector<std::string> countedGlFunctions() {
+  std::vector<std::string> names;
+  for (const Entry& e : kEntries) names.emplace_back(e.name);
+  return names;
+}
+
+}  // namespace farfield::gpu

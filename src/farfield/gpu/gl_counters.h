@@ -1,0 +1,64 @@
+// What a frame asks of OpenGL, counted at every call: GL calls, draw calls, compute dispatches, bytes sent from the
+// CPU, CPU-GPU synchronisations, and the CPU time spent inside the calls that do or wait for GPU work. These do not
+// depend on the machine (but the last), so they say on llvmpipe what a frame will cost on a GPU: a frame that issues
+// 200,000 draw calls or waits once for the GPU is slow everywhere (DESIGN.md, "The GPU-driven frame").
+//
+// How: libepoxy calls OpenGL through one public function pointer per entry point (epoxy_glDrawElements, ...).
+// installGlCounters() points those Farfield calls at counting wrappers that call the driver's entry point, taken from
+// eglGetProcAddress (which, under libglvnd, dispatches to whatever context is current, EGL or GLX). Counters are per
+// thread, so a frame on the render thread is not mixed with a bake worker's GL work.
+//
+// What counts as what:
+//   - a synchronisation is a call that makes the CPU wait for the GPU: glFinish, glReadPixels and glGetTextureImage
+//     into client memory, glGetNamedBufferSubData, a map of a buffer for reading, glClientWaitSync that had to wait,
+//     and a query result asked for before it was available;
+//   - uploaded bytes are the buffer and texture data and the uniform values sent from client memory;
+//   - driver time is the CPU time inside draws, dispatches, clears, blits, copies and synchronisations: on llvmpipe
+//     the rasterizer's own work (vertex shading, binning, compute shaders) runs inside them on the calling thread, so
+//     a frame's own CPU time is its CPU time less driver time less the measurement's own waits (GlMeasurement).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace farfield::gpu {
+
+struct GlCounters {
+  uint64_t calls = 0;         // GL entry points called
+  uint64_t draw_calls = 0;    // glDraw* and glMultiDraw* calls (a multi-draw counts once)
+  uint64_t dispatches = 0;    // glDispatchCompute*
+  uint64_t syncs = 0;         // calls that waited (or may have waited) for the GPU
+  uint64_t upload_bytes = 0;  // buffer, texture and uniform data sent from client memory
+  double driver_ms = 0.0;     // CPU time inside the calls that do or wait for GPU work
+  double measure_ms = 0.0;    // time inside GlMeasurement scopes (their GL calls are not counted)
+
+  GlCounters& operator-=(const GlCounters& o);
+  friend GlCounters operator-(GlCounters a, const GlCounters& b) { return a -= b; }
+};
+
+// Points Farfield's GL entry points at the counting wrappers; needs a current context. Idempotent and thread-safe; the
+// first call installs for the whole process. Returns false (and counts nothing) where the driver's entry points
+// cannot be resolved; FF_GL_COUNTERS=0 in the environment turns it off.
+bool installGlCounters();
+bool glCountersInstalled();
+// The calling thread's totals since installation (all zero before it).
+GlCounters glCounters();
+
+// A scope whose GL calls are the measurement's, not the frame's (the harness's glFinish that ends a timed frame, a
+// timer's own waits): they are not counted, and the scope's whole duration goes to measure_ms. Nests.
+class GlMeasurement {
+ public:
+  GlMeasurement();
+  ~GlMeasurement();
+  GlMeasurement(const GlMeasurement&) = delete;
+  GlMeasurement& operator=(const GlMeasurement&) = delete;
+
+ private:
+  int64_t start_ns_;
+};
+
+// The entry points that are counted (for the test that every gl* call in Farfield's sources is among them).
+std::vector<std::string> countedGlFunctions();
+
+}  // namespace farfield::gpu

@@ -1,0 +1,393 @@
+#include "farfield/gpu/gpu_culler.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <string>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+#include "farfield/gpu/program.h"
+
+namespace farfield::gpu {
+namespace {
+
+constexpr GLuint kWorkGroup = 64;        // gpu_cull.comp.glsl's local size
+constexpr GLuint kMaxGroupsX = 65535;    // dispatches wider than this go into y
+constexpr size_t kCommandBytes = 5 * sizeof(uint32_t);
+constexpr size_t kStatCount = 8;         // gpu_cull.comp.glsl's statistics
+constexpr size_t kRing = 8;              // frames of statistics in flight
+constexpr int kMaxLevels = 16;
+
+enum Variant { kPlain = 0, kTextured = 1, kItems = 2, kVariants = 3 };
+
+GLuint createBuffer(size_t bytes, const void* data, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT) {
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), data, flags);
+  return buffer;
+}
+
+}  // namespace
+
+struct GpuCuller::Impl {
+  Program cull = Program::computeFromEmbedded("gpu_cull.comp.glsl");
+  Program pyramid = Program::computeFromEmbedded("depth_pyramid.comp.glsl");
+  std::array<Program, kVariants> draw{
+      Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1"),
+      Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1\n#define FF_TEXTURED 1"),
+      Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1\n#define FF_ITEM_BUFFER 1")};
+
+  struct CullLocations {
+    int view_proj, planes, eye, viewport, phase, compact, cone, instance_count, levels, level_size, margin;
+  } cl{};
+  struct PyramidLocations {
+    int src_size, dst_size, from_depth;
+  } pl{};
+  struct DrawLocations {
+    int view_proj, light_dir, light_color, ambient;
+  };
+  std::array<DrawLocations, kVariants> dl{};
+
+  GLuint enabled = 0, visibility = 0, counts = 0, group_first = 0;
+  std::array<GLuint, 2> commands{};  // per phase
+  uint32_t groups = 0;
+  uint32_t instances = 0;
+
+  // The plan's objects: enabled_ids (sorted), or all.
+  bool all_enabled = true;
+  std::vector<uint32_t> enabled_ids, next_ids;
+  std::vector<uint32_t> changes;
+
+  // Depth pyramid levels 1.. (level 0 is the target's depth).
+  GLuint pyramid_texture = 0;
+  int width = 0, height = 0;
+  std::vector<std::array<int, 2>> level_size;  // level 0 first
+
+  struct Slot {
+    GLuint buffer = 0;
+    const uint32_t* mapped = nullptr;
+    GLsync fence = nullptr;
+    uint64_t frame = 0;
+  };
+  std::array<Slot, kRing> ring{};
+  size_t ring_next = 0;  // the slot the next frame writes
+
+  Impl() {
+    const GLuint c = cull.handle();
+    cl = {glGetUniformLocation(c, "u_view_proj"),      glGetUniformLocation(c, "u_planes"),
+          glGetUniformLocation(c, "u_eye"),            glGetUniformLocation(c, "u_viewport"),
+          glGetUniformLocation(c, "u_phase"),          glGetUniformLocation(c, "u_compact"),
+          glGetUniformLocation(c, "u_cone"),           glGetUniformLocation(c, "u_instance_count"),
+          glGetUniformLocation(c, "u_levels"),         glGetUniformLocation(c, "u_level_size"),
+          glGetUniformLocation(c, "u_margin")};
+    const GLuint p = pyramid.handle();
+    pl = {glGetUniformLocation(p, "u_src_size"), glGetUniformLocation(p, "u_dst_size"),
+          glGetUniformLocation(p, "u_from_depth")};
+    for (int v = 0; v < kVariants; ++v) {
+      const GLuint h = draw[size_t(v)].handle();
+      dl[size_t(v)] = {glGetUniformLocation(h, "u_view_proj"), glGetUniformLocation(h, "u_light_dir"),
+                       glGetUniformLocation(h, "u_light_color"), glGetUniformLocation(h, "u_ambient")};
+    }
+  }
+
+  ~Impl() {
+    const GLuint buffers[] = {enabled, visibility, counts, group_first, commands[0], commands[1]};
+    glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
+    if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
+    for (Slot& s : ring) {
+      if (s.fence) glDeleteSync(s.fence);
+      if (s.buffer) {
+        glUnmapNamedBuffer(s.buffer);
+        glDeleteBuffers(1, &s.buffer);
+      }
+    }
+  }
+
+  // Pyramid levels for a width x height target: level k + 1 is ceil(level k / 2) until 1 x 1 (DepthPyramid's).
+  void sizePyramid(int w, int h) {
+    if (w == width && h == height) return;
+    width = w, height = h;
+    level_size.clear();
+    level_size.push_back({w, h});
+    while (level_size.back()[0] > 1 || level_size.back()[1] > 1) {
+      const auto [pw, ph] = level_size.back();
+      level_size.push_back({(pw + 1) / 2, (ph + 1) / 2});
+    }
+    FF_CHECK_MSG(int(level_size.size()) <= kMaxLevels, "render target too large for the depth pyramid");
+    std::array<int, 2 * kMaxLevels> sizes{};
+    for (size_t k = 0; k < level_size.size(); ++k) sizes[2 * k] = level_size[k][0], sizes[2 * k + 1] = level_size[k][1];
+    glProgramUniform2iv(cull.handle(), cl.level_size, GLsizei(level_size.size()), sizes.data());
+    if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
+    pyramid_texture = 0;
+    if (level_size.size() < 2) return;
+    // GL's mip levels halve rounding down; levels rounding up fit in those of the next power of two.
+    int pw = 1, ph = 1;
+    while (pw < level_size[1][0]) pw *= 2;
+    while (ph < level_size[1][1]) ph *= 2;
+    const int mips = int(level_size.size()) - 1;
+    glCreateTextures(GL_TEXTURE_2D, 1, &pyramid_texture);
+    glTextureStorage2D(pyramid_texture, mips, GL_R32F, pw, ph);
+    glTextureParameteri(pyramid_texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+    glTextureParameteri(pyramid_texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(pyramid_texture, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(pyramid_texture, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+};
+
+GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
+    : arena_(arena), options_(options), impl_(std::make_unique<Impl>()) {
+  Impl& im = *impl_;
+  indirect_count_ = options.compact && (epoxy_gl_version() >= 46 || epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
+  const size_t objects = arena.scene().objects.size();
+  im.instances = uint32_t(arena.instances().size());
+  im.groups = uint32_t(arena.groups().size());
+  const std::vector<uint32_t> ones(std::max<size_t>(objects, 1), 1u);
+  im.enabled = createBuffer(ones.size() * sizeof(uint32_t), ones.data());
+  im.visibility = createBuffer(size_t(im.instances) * sizeof(uint32_t), nullptr);
+  glClearNamedBufferData(im.visibility, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  for (GLuint& c : im.commands) {
+    c = createBuffer(size_t(im.instances) * kCommandBytes, nullptr);
+    glClearNamedBufferData(c, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  }
+  // Counts: the early phase's per group, the late phase's per group, then the statistics.
+  im.counts = createBuffer((2 * size_t(im.groups) + kStatCount) * sizeof(uint32_t), nullptr);
+  std::vector<uint32_t> first(std::max<size_t>(im.groups, 1), 0);
+  for (uint32_t g = 0; g < im.groups; ++g) first[g] = arena.groups()[g].first_instance;
+  im.group_first = createBuffer(first.size() * sizeof(uint32_t), first.data());
+  for (Impl::Slot& s : im.ring) {
+    const GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+    s.buffer = createBuffer(kStatCount * sizeof(uint32_t), nullptr, flags);
+    s.mapped = static_cast<const uint32_t*>(
+        glMapNamedBufferRange(s.buffer, 0, GLsizeiptr(kStatCount * sizeof(uint32_t)), flags));
+    FF_CHECK_MSG(s.mapped != nullptr, "mapping a statistics buffer failed");
+  }
+}
+
+GpuCuller::~GpuCuller() = default;
+
+void GpuCuller::setAllObjects() {
+  Impl& im = *impl_;
+  if (im.all_enabled) return;
+  const size_t objects = arena_.scene().objects.size();
+  if (objects > 0) {
+    const uint32_t one = 1;
+    glClearNamedBufferSubData(im.enabled, GL_R32UI, 0, GLsizeiptr(objects * sizeof(uint32_t)), GL_RED_INTEGER,
+                              GL_UNSIGNED_INT, &one);
+  }
+  im.all_enabled = true;
+  im.enabled_ids.clear();
+}
+
+void GpuCuller::setObjects(std::span<const uint32_t> ids) {
+  Impl& im = *impl_;
+  const size_t objects = arena_.scene().objects.size();
+  im.next_ids.assign(ids.begin(), ids.end());
+  if (!std::is_sorted(im.next_ids.begin(), im.next_ids.end())) std::sort(im.next_ids.begin(), im.next_ids.end());
+  im.next_ids.erase(std::unique(im.next_ids.begin(), im.next_ids.end()), im.next_ids.end());
+  if (!im.next_ids.empty() && (im.next_ids.front() == 0 || im.next_ids.back() > objects))
+    throw Error("object id " + std::to_string(im.next_ids.front() == 0 ? 0u : im.next_ids.back()),
+                "out of range (the scene has " + std::to_string(objects) + " objects, ids from 1)");
+  if (im.all_enabled) {
+    // From all to a list: clear everything once, then set the list.
+    if (objects > 0) glClearNamedBufferData(im.enabled, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    im.enabled_ids.clear();
+    im.all_enabled = false;
+  }
+  // The symmetric difference of the sorted lists: objects whose state changes.
+  im.changes.clear();
+  std::set_symmetric_difference(im.enabled_ids.begin(), im.enabled_ids.end(), im.next_ids.begin(),
+                                im.next_ids.end(), std::back_inserter(im.changes));
+  // Runs of consecutive ids go up in one call each, with the new state of each.
+  std::vector<uint32_t> values;
+  for (size_t i = 0; i < im.changes.size();) {
+    size_t j = i + 1;
+    while (j < im.changes.size() && im.changes[j] == im.changes[j - 1] + 1) ++j;
+    values.resize(j - i);
+    for (size_t k = i; k < j; ++k)
+      values[k - i] = std::binary_search(im.next_ids.begin(), im.next_ids.end(), im.changes[k]) ? 1u : 0u;
+    glNamedBufferSubData(im.enabled, GLintptr(im.changes[i] - 1) * GLintptr(sizeof(uint32_t)),
+                         GLsizeiptr(values.size() * sizeof(uint32_t)), values.data());
+    i = j;
+  }
+  std::swap(im.enabled_ids, im.next_ids);
+}
+
+void GpuCuller::resetHistory() {
+  glClearNamedBufferData(impl_->visibility, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+}
+
+FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMode mode, const LightSettings& light) {
+  camera.validate("camera");
+  Impl& im = *impl_;
+  FrameStats stats;
+  const uint64_t frame = frames_++;
+  im.sizePyramid(target.width(), target.height());
+  target.bindForOpaquePass();
+  if (im.instances == 0) return stats;
+
+  // ---- per-frame uniforms ----
+  const Mat4 view_proj = camera.viewProjection();
+  const Frustum frustum = Frustum::fromMatrix(view_proj);
+  const GLuint c = im.cull.handle();
+  glProgramUniformMatrix4fv(c, im.cl.view_proj, 1, GL_FALSE, glm::value_ptr(view_proj));
+  glProgramUniform4fv(c, im.cl.planes, 6, glm::value_ptr(frustum.planes[0]));
+  glProgramUniform3fv(c, im.cl.eye, 1, glm::value_ptr(camera.eye));
+  glProgramUniform2i(c, im.cl.viewport, target.width(), target.height());
+  glProgramUniform1i(c, im.cl.compact, indirect_count_ ? 1 : 0);
+  glProgramUniform1i(c, im.cl.cone, options_.cone ? 1 : 0);
+  glProgramUniform1ui(c, im.cl.instance_count, im.instances);
+  glProgramUniform1f(c, im.cl.margin, options_.occlusion_margin);
+  glProgramUniform1i(c, im.cl.levels, int(im.level_size.size()));
+  Vec3 light_dir = light.direction;
+  light_dir = glm::length(light_dir) > 0.0f ? glm::normalize(light_dir) : Vec3(0.0f, 0.0f, -1.0f);
+  const int variant_of_mode = mode == RenderMode::ItemBuffer ? kItems : -1;
+  for (int v = 0; v < kVariants; ++v) {
+    if (variant_of_mode >= 0 ? v != variant_of_mode : v == kItems) continue;
+    const GLuint h = im.draw[size_t(v)].handle();
+    const Impl::DrawLocations& l = im.dl[size_t(v)];
+    glProgramUniformMatrix4fv(h, l.view_proj, 1, GL_FALSE, glm::value_ptr(view_proj));
+    if (l.light_dir >= 0) glProgramUniform3fv(h, l.light_dir, 1, glm::value_ptr(light_dir));
+    if (l.light_color >= 0) glProgramUniform3fv(h, l.light_color, 1, glm::value_ptr(light.color));
+    if (l.ambient >= 0) glProgramUniform1f(h, l.ambient, light.ambient);
+  }
+
+  // ---- buffers ----
+  const SceneArena::Buffers& b = arena_.buffers();
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b.clusters);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, b.instances);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, b.objects);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, b.materials);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, im.enabled);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, im.visibility);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, im.group_first);
+  const GLsizeiptr group_bytes = GLsizeiptr(im.groups * sizeof(uint32_t));
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 9, im.counts, 2 * group_bytes, GLsizeiptr(kStatCount * sizeof(uint32_t)));
+  glClearNamedBufferData(im.counts, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+
+  const GLuint work_groups = (im.instances + kWorkGroup - 1) / kWorkGroup;
+  const GLuint groups_x = std::min(work_groups, kMaxGroupsX);
+  const GLuint groups_y = (work_groups + groups_x - 1) / groups_x;
+
+  auto cullPhase = [&](int phase, int commands) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, im.commands[size_t(commands)]);
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 7, im.counts, commands * group_bytes, std::max<GLsizeiptr>(group_bytes, 4));
+    glProgramUniform1i(c, im.cl.phase, phase);
+    glUseProgram(c);
+    // Units 2 and 3: the depth and the pyramid, unbound again before anything draws into the depth.
+    glBindTextureUnit(2, target.depthTexture().handle());
+    glBindTextureUnit(3, im.pyramid_texture);
+    glDispatchCompute(groups_x, groups_y, 1);
+    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glBindTextureUnit(2, 0);
+    glBindTextureUnit(3, 0);
+  };
+
+  auto drawPhase = [&](int commands) {
+    glBindVertexArray(b.vertex_array);
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, im.commands[size_t(commands)]);
+    if (indirect_count_) glBindBuffer(GL_PARAMETER_BUFFER_ARB, im.counts);
+    int current = -1;
+    bool culling = true, mirrored = false;
+    for (uint32_t g = 0; g < im.groups; ++g) {
+      const MaterialGroup& group = arena_.groups()[g];
+      if (group.instance_count == 0) continue;
+      const int variant = mode == RenderMode::ItemBuffer ? kItems : (group.texture_array >= 0 ? kTextured : kPlain);
+      if (variant != current) {
+        im.draw[size_t(variant)].use();
+        current = variant;
+      }
+      if (variant == kTextured) glBindTextureUnit(0, arena_.textureArray(group.texture_array));
+      if (group.double_sided == culling) {
+        culling = !group.double_sided;
+        if (culling) glEnable(GL_CULL_FACE);
+        else glDisable(GL_CULL_FACE);
+      }
+      if (group.mirrored != mirrored) {
+        mirrored = group.mirrored;
+        glFrontFace(mirrored ? GL_CW : GL_CCW);
+      }
+      const void* offset = reinterpret_cast<const void*>(uintptr_t(group.first_instance) * kCommandBytes);
+      if (indirect_count_) {
+        glMultiDrawElementsIndirectCountARB(GL_TRIANGLES, GL_UNSIGNED_INT, offset,
+                                            GLintptr(commands * group_bytes + g * sizeof(uint32_t)),
+                                            GLsizei(group.instance_count), GLsizei(kCommandBytes));
+      } else {
+        glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, offset, GLsizei(group.instance_count),
+                                    GLsizei(kCommandBytes));
+      }
+      ++stats.draw_calls;
+    }
+    if (!culling) glEnable(GL_CULL_FACE);
+    if (mirrored) glFrontFace(GL_CCW);
+    glBindVertexArray(0);
+  };
+
+  if (!options_.occlusion) {
+    cullPhase(2, 1);
+    drawPhase(1);
+  } else {
+    cullPhase(0, 0);
+    drawPhase(0);
+    // The pyramid from the early phase's depth.
+    glUseProgram(im.pyramid.handle());
+    glBindTextureUnit(2, target.depthTexture().handle());
+    const GLuint p = im.pyramid.handle();
+    for (size_t k = 1; k < im.level_size.size(); ++k) {
+      const auto [sw, sh] = im.level_size[k - 1];
+      const auto [dw, dh] = im.level_size[k];
+      glProgramUniform2i(p, im.pl.src_size, sw, sh);
+      glProgramUniform2i(p, im.pl.dst_size, dw, dh);
+      glProgramUniform1i(p, im.pl.from_depth, k == 1 ? 1 : 0);
+      glBindImageTexture(0, im.pyramid_texture, GLint(k == 1 ? 0 : k - 2), GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+      glBindImageTexture(1, im.pyramid_texture, GLint(k - 1), GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+      glDispatchCompute(GLuint(dw + 7) / 8, GLuint(dh + 7) / 8, 1);
+      glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    }
+    glBindTextureUnit(2, 0);
+    cullPhase(1, 1);
+    drawPhase(1);
+  }
+  glUseProgram(0);
+
+  // ---- statistics, read frames later ----
+  Impl::Slot& slot = im.ring[im.ring_next];
+  if (!slot.fence) {
+    glCopyNamedBufferSubData(im.counts, slot.buffer, 2 * group_bytes, 0, GLsizeiptr(kStatCount * sizeof(uint32_t)));
+    slot.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    slot.frame = frame;
+    im.ring_next = (im.ring_next + 1) % kRing;
+  }
+  return stats;
+}
+
+std::vector<GpuCullStats> GpuCuller::finishedStats() {
+  Impl& im = *impl_;
+  std::vector<GpuCullStats> out;
+  // Slots are filled in ring order: the oldest unfinished one follows the last one written.
+  for (size_t n = 0; n < kRing; ++n) {
+    Impl::Slot& s = im.ring[(im.ring_next + n) % kRing];
+    if (!s.fence) continue;
+    GLint status = GL_UNSIGNALED;
+    glGetSynciv(s.fence, GL_SYNC_STATUS, 1, nullptr, &status);
+    if (status != GL_SIGNALED) break;
+    glDeleteSync(s.fence);
+    s.fence = nullptr;
+    GpuCullStats st;
+    st.frame = s.frame;
+    const uint32_t* v = s.mapped;
+    st.instances_in_plan = v[0];
+    st.drawn_early = v[1];
+    st.drawn_late = v[2];
+    st.triangles = uint64_t(v[3]) + uint64_t(v[4]);
+    st.frustum_culled = v[5];
+    st.cone_culled = v[6];
+    st.occlusion_culled = v[7];
+    out.push_back(st);
+  }
+  return out;
+}
+
+}  // namespace farfield::gpu

@@ -1,0 +1,413 @@
+#include "farfield/gpu/scene_arena.h"
+
+#include <epoxy/gl.h>
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <map>
+#include <string>
+#include <unordered_map>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+#include "farfield/gpu/mesh_clusters.h"
+#include "farfield/gpu/texture.h"
+
+namespace farfield::gpu {
+namespace {
+
+struct Vertex {  // as gpu_mesh.cpp's: the same attributes at the same locations
+  float position[3];
+  float normal[3];
+  float uv[2];
+};
+static_assert(sizeof(Vertex) == 32);
+
+// std430 records of the shaders (gpu_cull.comp.glsl, arena.vert.glsl).
+struct GpuCluster {
+  float sphere[4];
+  float cone_apex[4];  // xyz, w = cutoff
+  float cone_axis[4];
+  float box_lo[4];
+  float box_hi[4];
+  uint32_t range[4];  // first index, index count, base vertex, 0
+};
+static_assert(sizeof(GpuCluster) == 96);
+struct GpuObject {
+  float model[16];
+  float normal[16];   // the inverse transpose of the model's 3x3 part, in the first three columns
+  float misc[4];      // x: largest scale of the model's axes
+  uint32_t info[4];   // object id, flags (kObjectAffine)
+};
+static_assert(sizeof(GpuObject) == 160);
+struct GpuMaterial {
+  float base_color[4];
+  uint32_t info[4];  // unlit, texture layer, 0, 0
+};
+
+constexpr uint32_t kObjectAffine = 1;  // the shader may cull it (a projective transform is always drawn)
+constexpr uint8_t kMirrored = 1, kSimilarity = 2, kAffine = 4;
+constexpr uint32_t kConeTestBit = 1u << 31;
+
+uint8_t transformKind(const Mat4& m) {
+  uint8_t kind = 0;
+  const bool affine = m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f && m[3][3] == 1.0f;
+  if (affine) kind |= kAffine;
+  const Mat3 linear(m);
+  const float det = glm::determinant(linear);
+  if (det < 0.0f) kind |= kMirrored;
+  // Angles are kept when the axes are orthogonal and of equal length (a rotation, a uniform scale, a mirror).
+  const Vec3 a = linear[0], b = linear[1], c = linear[2];
+  const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+  const float scale = std::max({la, lb, lc});
+  const float tol = 1e-4f * scale * scale;
+  if (affine && det != 0.0f && std::abs(la - lb) <= 1e-4f * scale && std::abs(la - lc) <= 1e-4f * scale &&
+      std::abs(glm::dot(a, b)) <= tol && std::abs(glm::dot(a, c)) <= tol && std::abs(glm::dot(b, c)) <= tol)
+    kind |= kSimilarity;
+  return kind;
+}
+
+GpuObject gpuObject(const scene::Object& object) {
+  GpuObject g{};
+  const Mat4& m = object.transform;
+  std::copy(glm::value_ptr(m), glm::value_ptr(m) + 16, g.model);
+  const Mat3 linear(m);
+  const Mat3 normal = glm::determinant(linear) != 0.0f ? glm::transpose(glm::inverse(linear)) : Mat3(1.0f);
+  const Mat4 normal4(normal);
+  std::copy(glm::value_ptr(normal4), glm::value_ptr(normal4) + 16, g.normal);
+  g.misc[0] = std::max({glm::length(linear[0]), glm::length(linear[1]), glm::length(linear[2])});
+  g.info[0] = object.id;
+  g.info[1] = (transformKind(m) & kAffine) ? kObjectAffine : 0u;
+  return g;
+}
+
+void checkMesh(const scene::Mesh& mesh) {
+  const size_t n = mesh.positions.size();
+  if (!mesh.normals.empty() && mesh.normals.size() != n)
+    throw Error("mesh", std::to_string(mesh.normals.size()) + " normals for " + std::to_string(n) + " positions");
+  if (!mesh.uvs.empty() && mesh.uvs.size() != n)
+    throw Error("mesh", std::to_string(mesh.uvs.size()) + " uvs for " + std::to_string(n) + " positions");
+  if (mesh.indices.size() % 3 != 0)
+    throw Error("mesh", std::to_string(mesh.indices.size()) + " indices, expected a multiple of 3");
+  for (size_t i = 0; i < mesh.indices.size(); ++i)
+    if (mesh.indices[i] >= n)
+      throw Error("mesh", "index " + std::to_string(i) + " is " + std::to_string(mesh.indices[i]) + ", only " +
+                              std::to_string(n) + " vertices");
+}
+
+GLuint makeBuffer(const void* data, size_t bytes, size_t& total) {
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  // An empty buffer still gets a name and 16 bytes, so bindings stay valid for a scene without triangles.
+  glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes ? data : nullptr,
+                       GL_DYNAMIC_STORAGE_BIT);
+  total += bytes;
+  return buffer;
+}
+
+}  // namespace
+
+bool coneRejects(const ArenaCluster& cluster, const Vec3& eye) {
+  if (!(cluster.cone_cutoff < 1.0f)) return false;
+  const Vec3 d = cluster.cone_apex - eye;
+  const float length = glm::length(d);
+  if (!(length > 0.0f)) return false;
+  // Margin: a nearly edge-on triangle that rounding turns towards the eye must still be drawn (as facesAway's).
+  return glm::dot(d / length, cluster.cone_axis) >= cluster.cone_cutoff + 1e-3f;
+}
+
+SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) : scene_(&scene) {
+  FF_CHECK(options.max_vertices >= 3 && options.max_vertices <= 255);
+  FF_CHECK(options.max_triangles >= 4 && options.max_triangles <= 512 && options.max_triangles % 4 == 0);
+
+  // ---- meshes: clusters, vertices and indices ----
+  std::vector<Vertex> vertices;
+  std::vector<uint32_t> indices;
+  mesh_clusters_.reserve(scene.meshes.size());
+  std::vector<meshopt_Meshlet> meshlets;
+  std::vector<unsigned int> meshlet_vertices;
+  std::vector<unsigned char> meshlet_triangles;
+  std::vector<uint32_t> local;  // a mesh's indices in cluster order
+  std::vector<unsigned int> remap;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const scene::Mesh& mesh = scene.meshes[m];
+    try {
+      checkMesh(mesh);
+    } catch (const Error& e) {
+      throw Error("scene mesh " + std::to_string(m), e.what());
+    }
+    const uint32_t first_cluster = uint32_t(clusters_.size());
+    if (mesh.indices.empty() || mesh.positions.empty()) {
+      mesh_clusters_.emplace_back(first_cluster, 0);
+      continue;
+    }
+    const float* positions = &mesh.positions[0].x;
+    const size_t vertex_count = mesh.positions.size();
+    // The triangles by facing class (small classes and triangles without area pooled last), each class cut into
+    // clusters by meshoptimizer.
+    const size_t triangle_count = mesh.indices.size() / 3;
+    std::array<std::vector<uint32_t>, kNoFacing + 2> by_class;
+    for (size_t t = 0; t < triangle_count; ++t) {
+      const uint32_t* tri = &mesh.indices[3 * t];
+      const int c = options.min_facing_triangles > 0
+                        ? facingClass(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]])
+                        : kNoFacing;
+      by_class[size_t(c)].insert(by_class[size_t(c)].end(), tri, tri + 3);
+    }
+    for (int c = 0; c < kNoFacing; ++c)
+      if (by_class[size_t(c)].size() / 3 < options.min_facing_triangles) {
+        auto& pool = by_class[kNoFacing + 1];
+        pool.insert(pool.end(), by_class[size_t(c)].begin(), by_class[size_t(c)].end());
+        by_class[size_t(c)].clear();
+      }
+    by_class[kNoFacing + 1].insert(by_class[kNoFacing + 1].end(), by_class[kNoFacing].begin(),
+                                   by_class[kNoFacing].end());
+    by_class[kNoFacing].clear();
+    size_t count = 0;
+    meshlets.clear();
+    meshlet_vertices.clear();
+    meshlet_triangles.clear();
+    for (const std::vector<uint32_t>& part : by_class) {
+      if (part.empty()) continue;
+      const size_t bound = meshopt_buildMeshletsBound(part.size(), options.max_vertices, options.max_triangles);
+      meshlets.resize(count + bound);
+      const size_t vertex_base = meshlet_vertices.size(), triangle_base = meshlet_triangles.size();
+      meshlet_vertices.resize(vertex_base + bound * options.max_vertices);
+      meshlet_triangles.resize(triangle_base + bound * options.max_triangles * 3);
+      const size_t made = meshopt_buildMeshlets(&meshlets[count], &meshlet_vertices[vertex_base],
+                                                &meshlet_triangles[triangle_base], part.data(), part.size(), positions,
+                                                vertex_count, sizeof(Vec3), options.max_vertices,
+                                                options.max_triangles, options.cone_weight);
+      for (size_t k = count; k < count + made; ++k) {
+        meshlets[k].vertex_offset += uint32_t(vertex_base);
+        meshlets[k].triangle_offset += uint32_t(triangle_base);
+      }
+      count += made;
+    }
+    // The clusters' triangles as the mesh's own indices, cluster after cluster; then the vertices renumbered in the
+    // order those first use them (meshopt_optimizeVertexFetchRemap), so that a cluster's vertices lie together.
+    local.clear();
+    std::vector<std::pair<uint32_t, uint32_t>> ranges;  // per cluster: first, count in `local`
+    for (size_t c = 0; c < count; ++c) {
+      const meshopt_Meshlet& ml = meshlets[c];
+      ranges.emplace_back(uint32_t(local.size()), ml.triangle_count * 3);
+      for (uint32_t t = 0; t < ml.triangle_count * 3; ++t)
+        local.push_back(meshlet_vertices[ml.vertex_offset + meshlet_triangles[ml.triangle_offset + t]]);
+    }
+    remap.resize(vertex_count);
+    const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), local.data(), local.size(), vertex_count);
+    const uint32_t base_vertex = uint32_t(vertices.size());
+    vertices.resize(vertices.size() + used);
+    for (size_t v = 0; v < vertex_count; ++v) {
+      if (remap[v] == ~0u) continue;
+      const Vec3& p = mesh.positions[v];
+      const Vec3 n = mesh.normals.empty() ? Vec3(0.0f) : mesh.normals[v];
+      const Vec2 uv = mesh.uvs.empty() ? Vec2(0.0f) : mesh.uvs[v];
+      vertices[base_vertex + remap[v]] = {{p.x, p.y, p.z}, {n.x, n.y, n.z}, {uv.x, uv.y}};
+    }
+    for (size_t c = 0; c < count; ++c) {
+      const meshopt_Meshlet& ml = meshlets[c];
+      const meshopt_Bounds b =
+          meshopt_computeMeshletBounds(&meshlet_vertices[ml.vertex_offset], &meshlet_triangles[ml.triangle_offset],
+                                       ml.triangle_count, positions, vertex_count, sizeof(Vec3));
+      ArenaCluster cluster;
+      cluster.center = Vec3(b.center[0], b.center[1], b.center[2]);
+      cluster.radius = b.radius;
+      cluster.cone_apex = Vec3(b.cone_apex[0], b.cone_apex[1], b.cone_apex[2]);
+      cluster.cone_axis = Vec3(b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]);
+      cluster.cone_cutoff = b.cone_cutoff;
+      for (uint32_t v = 0; v < ml.vertex_count; ++v) cluster.bounds.expand(mesh.positions[meshlet_vertices[ml.vertex_offset + v]]);
+      // The sphere must hold the box's vertices whatever meshoptimizer's rounding: grow it to their farthest.
+      for (uint32_t v = 0; v < ml.vertex_count; ++v)
+        cluster.radius = std::max(cluster.radius,
+                                  glm::length(mesh.positions[meshlet_vertices[ml.vertex_offset + v]] - cluster.center));
+      cluster.first_index = uint32_t(indices.size());
+      cluster.index_count = ranges[c].second;
+      cluster.base_vertex = base_vertex;
+      for (uint32_t i = 0; i < ranges[c].second; ++i) indices.push_back(remap[local[ranges[c].first + i]]);
+      clusters_.push_back(cluster);
+    }
+    mesh_clusters_.emplace_back(first_cluster, uint32_t(count));
+  }
+
+  // ---- textures: one array per image size, one layer per distinct image ----
+  std::map<std::pair<int, int>, std::vector<const image::ColorImage*>> by_size;
+  std::unordered_map<const image::ColorImage*, std::pair<int, int>> layer_of;  // image -> (array, layer)
+  for (const scene::Material& m : scene.materials)
+    if (m.texture && !m.texture->empty() && !layer_of.count(m.texture.get())) {
+      auto& layers = by_size[{m.texture->width(), m.texture->height()}];
+      layer_of[m.texture.get()] = {-1, int(layers.size())};
+      layers.push_back(m.texture.get());
+    }
+  for (auto& [size, images] : by_size) {
+    const int array = int(texture_arrays_.size());
+    texture_arrays_.push_back(makeColorTextureArray(images));
+    gpu_bytes_ += colorTextureArrayBytes(size.first, size.second, int(images.size()));
+    for (const image::ColorImage* image : images) layer_of[image].first = array;
+  }
+
+  // ---- materials ----
+  std::vector<GpuMaterial> materials(std::max<size_t>(scene.materials.size(), 1));
+  std::vector<int> material_array(scene.materials.size(), -1);
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const scene::Material& m = scene.materials[i];
+    GpuMaterial& g = materials[i];
+    std::copy(glm::value_ptr(m.base_color), glm::value_ptr(m.base_color) + 4, g.base_color);
+    g.info[0] = m.unlit ? 1u : 0u;
+    if (m.texture && !m.texture->empty()) {
+      const auto [array, layer] = layer_of.at(m.texture.get());
+      material_array[i] = array;
+      g.info[1] = uint32_t(layer);
+    }
+  }
+
+  // ---- objects and instances, grouped ----
+  object_kind_.resize(scene.objects.size());
+  std::map<std::tuple<int, bool, bool>, uint32_t> group_of;
+  struct Pending {
+    ArenaInstance instance;
+    std::tuple<int, bool, bool> key;
+  };
+  std::vector<Pending> pending;
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    const scene::Object& object = scene.objects[o];
+    const uint8_t kind = transformKind(object.transform);
+    object_kind_[o] = kind;
+    for (const scene::Part& part : object.parts) {
+      if (part.mesh >= scene.meshes.size() || part.material >= scene.materials.size())
+        throw Error("object " + std::to_string(object.id) + " ('" + object.name + "')",
+                    "part refers to mesh " + std::to_string(part.mesh) + " / material " +
+                        std::to_string(part.material) + " of " + std::to_string(scene.meshes.size()) + " / " +
+                        std::to_string(scene.materials.size()));
+      const scene::Material& material = scene.materials[part.material];
+      const auto key = std::make_tuple(material_array[part.material], material.double_sided, bool(kind & kMirrored));
+      group_of.emplace(key, 0);
+      const auto [first, n] = mesh_clusters_[part.mesh];
+      for (uint32_t c = first; c < first + n; ++c) {
+        ArenaInstance instance;
+        instance.cluster = c;
+        instance.object = uint32_t(o);
+        instance.material = part.material;
+        instance.cone_test = !material.double_sided && (kind & kSimilarity) && clusters_[c].cone_cutoff < 1.0f;
+        pending.push_back({instance, key});
+      }
+    }
+  }
+  for (auto& [key, index] : group_of) {
+    index = uint32_t(groups_.size());
+    MaterialGroup g;
+    g.texture_array = std::get<0>(key);
+    g.double_sided = std::get<1>(key);
+    g.mirrored = std::get<2>(key);
+    groups_.push_back(g);
+  }
+  for (Pending& p : pending) p.instance.group = group_of.at(p.key);
+  std::stable_sort(pending.begin(), pending.end(),
+                   [](const Pending& a, const Pending& b) { return a.instance.group < b.instance.group; });
+  instances_.reserve(pending.size());
+  std::vector<uint32_t> gpu_instances;
+  gpu_instances.reserve(4 * pending.size());
+  for (const Pending& p : pending) {
+    const ArenaInstance& in = p.instance;
+    MaterialGroup& g = groups_[in.group];
+    if (g.instance_count == 0) g.first_instance = uint32_t(instances_.size());
+    ++g.instance_count;
+    g.triangles += clusters_[in.cluster].index_count / 3;
+    triangles_ += clusters_[in.cluster].index_count / 3;
+    instances_.push_back(in);
+    gpu_instances.insert(gpu_instances.end(),
+                         {in.cluster, in.object, in.material, in.group | (in.cone_test ? kConeTestBit : 0u)});
+  }
+
+  // ---- GPU buffers ----
+  std::vector<GpuCluster> gpu_clusters(clusters_.size());
+  for (size_t c = 0; c < clusters_.size(); ++c) {
+    const ArenaCluster& a = clusters_[c];
+    GpuCluster& g = gpu_clusters[c];
+    g = {{a.center.x, a.center.y, a.center.z, a.radius},
+         {a.cone_apex.x, a.cone_apex.y, a.cone_apex.z, a.cone_cutoff},
+         {a.cone_axis.x, a.cone_axis.y, a.cone_axis.z, 0.0f},
+         {a.bounds.lo.x, a.bounds.lo.y, a.bounds.lo.z, 0.0f},
+         {a.bounds.hi.x, a.bounds.hi.y, a.bounds.hi.z, 0.0f},
+         {a.first_index, a.index_count, a.base_vertex, 0u}};
+  }
+  std::vector<uint32_t> identity(std::max<size_t>(instances_.size(), 1));
+  for (uint32_t i = 0; i < identity.size(); ++i) identity[i] = i;
+  vertex_count_ = vertices.size();
+  index_count_ = indices.size();
+  vertex_buffer_ = makeBuffer(vertices.data(), vertices.size() * sizeof(Vertex), gpu_bytes_);
+  index_buffer_ = makeBuffer(indices.data(), indices.size() * sizeof(uint32_t), gpu_bytes_);
+  instance_ids_ = makeBuffer(identity.data(), identity.size() * sizeof(uint32_t), gpu_bytes_);
+  buffers_.clusters = makeBuffer(gpu_clusters.data(), gpu_clusters.size() * sizeof(GpuCluster), gpu_bytes_);
+  buffers_.instances = makeBuffer(gpu_instances.data(), gpu_instances.size() * sizeof(uint32_t), gpu_bytes_);
+  buffers_.materials = makeBuffer(materials.data(), materials.size() * sizeof(GpuMaterial), gpu_bytes_);
+  buffers_.objects = makeBuffer(nullptr, scene.objects.size() * sizeof(GpuObject), gpu_bytes_);
+  uploadObjects(0, uint32_t(scene.objects.size()));
+
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  glVertexArrayVertexBuffer(vao, 0, vertex_buffer_, 0, sizeof(Vertex));
+  glVertexArrayElementBuffer(vao, index_buffer_);
+  const GLuint offsets[3] = {offsetof(Vertex, position), offsetof(Vertex, normal), offsetof(Vertex, uv)};
+  const GLint sizes[3] = {3, 3, 2};
+  for (GLuint attribute = 0; attribute < 3; ++attribute) {
+    glEnableVertexArrayAttrib(vao, attribute);
+    glVertexArrayAttribFormat(vao, attribute, sizes[attribute], GL_FLOAT, GL_FALSE, offsets[attribute]);
+    glVertexArrayAttribBinding(vao, attribute, 0);
+  }
+  // The instance index: one value per instance from 0, 1, 2, ...; a draw's baseInstance picks its instance.
+  glVertexArrayVertexBuffer(vao, 1, instance_ids_, 0, sizeof(uint32_t));
+  glVertexArrayBindingDivisor(vao, 1, 1);
+  glEnableVertexArrayAttrib(vao, 3);
+  glVertexArrayAttribIFormat(vao, 3, 1, GL_UNSIGNED_INT, 0);
+  glVertexArrayAttribBinding(vao, 3, 1);
+  buffers_.vertex_array = vao;
+}
+
+SceneArena::~SceneArena() {
+  if (buffers_.vertex_array) glDeleteVertexArrays(1, &buffers_.vertex_array);
+  const GLuint buffers[] = {vertex_buffer_,       index_buffer_,       instance_ids_,       buffers_.clusters,
+                            buffers_.instances,   buffers_.objects,    buffers_.materials};
+  glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
+  if (!texture_arrays_.empty()) glDeleteTextures(GLsizei(texture_arrays_.size()), texture_arrays_.data());
+}
+
+std::vector<uint32_t> SceneArena::readIndices() const {
+  std::vector<uint32_t> indices(index_count_);
+  if (index_count_) glGetNamedBufferSubData(index_buffer_, 0, GLsizeiptr(index_count_ * sizeof(uint32_t)), indices.data());
+  return indices;
+}
+
+std::vector<Vec3> SceneArena::readVertexPositions() const {
+  std::vector<Vertex> vertices(vertex_count_);
+  if (vertex_count_)
+    glGetNamedBufferSubData(vertex_buffer_, 0, GLsizeiptr(vertex_count_ * sizeof(Vertex)), vertices.data());
+  std::vector<Vec3> positions(vertex_count_);
+  for (size_t i = 0; i < vertex_count_; ++i)
+    positions[i] = Vec3(vertices[i].position[0], vertices[i].position[1], vertices[i].position[2]);
+  return positions;
+}
+
+void SceneArena::uploadObjects(uint32_t first, uint32_t count) {
+  if (count == 0) return;
+  std::vector<GpuObject> objects(count);
+  for (uint32_t i = 0; i < count; ++i) objects[i] = gpuObject(scene_->objects[first + i]);
+  glNamedBufferSubData(buffers_.objects, GLintptr(first) * GLintptr(sizeof(GpuObject)),
+                       GLsizeiptr(count * sizeof(GpuObject)), objects.data());
+}
+
+void SceneArena::updateTransforms(std::span<const uint32_t> ids) {
+  for (uint32_t id : ids) {
+    if (id == 0 || id > scene_->objects.size())
+      throw Error("object id " + std::to_string(id),
+                  "out of range (the scene has " + std::to_string(scene_->objects.size()) + " objects, ids from 1)");
+    const uint8_t kind = transformKind(scene_->objects[id - 1].transform);
+    FF_CHECK((kind & (kMirrored | kSimilarity)) == (object_kind_[id - 1] & (kMirrored | kSimilarity)));
+    uploadObjects(id - 1, 1);
+  }
+}
+
+}  // namespace farfield::gpu

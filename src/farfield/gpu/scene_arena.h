@@ -1,0 +1,126 @@
+// A scene's geometry arena (DESIGN.md, "The GPU-driven frame"): every static mesh in one vertex and one index buffer,
+// cut into clusters of at most 124 triangles by meshoptimizer (meshopt_buildMeshlets) with their bounds and normal
+// cones (meshopt_computeMeshletBounds); object transforms, materials and the cluster instances (object part x mesh
+// cluster) in GPU buffers; colour textures in arrays, one per size, so that a pass draws every material of a group
+// with one multi-draw. gpu::GpuCuller culls and draws it without the CPU touching a cluster.
+//
+// Why meshoptimizer's clusters and not GpuScene's (gpu/mesh_clusters.h): those are culling units of 2,048 triangles
+// sized for one draw call each on the CPU path; here a cluster costs no draw call, so clusters as small as the GPU
+// culls well are best, and meshopt_buildMeshlets makes them compact in space and in normal direction (cone_weight)
+// with bounds and a cone in the form the culling shader tests. docs/DESIGN-NOTES.md compares the two.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "farfield/core/bounds.h"
+#include "farfield/core/math.h"
+#include "farfield/scene/scene.h"
+
+namespace farfield::gpu {
+
+struct ArenaOptions {
+  uint32_t max_vertices = 64;    // per cluster (meshoptimizer: at most 255)
+  uint32_t max_triangles = 124;  // per cluster (at most 512, a multiple of 4)
+  float cone_weight = 0.5f;      // meshoptimizer's balance of compact clusters against narrow normal cones
+  // Before meshoptimizer cuts a mesh, its triangles are split by facing (gpu/mesh_clusters.h, facingClass: up, down,
+  // eight horizontal sectors) where a class holds at least this many; smaller classes stay together. A building of
+  // a few dozen triangles is then one cluster (a cluster per wall would cost more draws than its back walls save),
+  // and a detailed facade's clusters have cones narrow enough to be culled from behind. 0: no split.
+  uint32_t min_facing_triangles = 32;
+};
+
+// One cluster of a mesh, in the mesh's own space.
+struct ArenaCluster {
+  Vec3 center{0.0f};  // bounding sphere
+  float radius = 0.0f;
+  Box3 bounds;        // of its vertices
+  // Normal cone (meshopt_Bounds): every triangle faces away from an eye e with
+  // dot(normalize(cone_apex - e), cone_axis) >= cone_cutoff. cone_cutoff >= 1: never tested.
+  Vec3 cone_apex{0.0f};
+  Vec3 cone_axis{0.0f, 0.0f, 1.0f};
+  float cone_cutoff = 1.0f;
+  uint32_t first_index = 0;  // into the arena's index buffer
+  uint32_t index_count = 0;
+  uint32_t base_vertex = 0;  // its mesh's first vertex in the arena's vertex buffer
+};
+
+// A cluster drawn for an object part.
+struct ArenaInstance {
+  uint32_t cluster = 0;
+  uint32_t object = 0;    // index into Scene::objects (id - 1)
+  uint32_t material = 0;  // index into Scene::materials
+  uint32_t group = 0;     // material group
+  bool cone_test = false;  // single-sided material, a transform that keeps angles, a cone that can reject
+};
+
+// Instances that one multi-draw draws: same texture array, same face culling, same winding.
+struct MaterialGroup {
+  int texture_array = -1;   // -1: untextured
+  bool double_sided = false;
+  bool mirrored = false;    // object transforms that flip handedness (drawn with clockwise fronts)
+  uint32_t first_instance = 0;  // instances [first_instance, first_instance + instance_count) are this group's
+  uint32_t instance_count = 0;
+  uint64_t triangles = 0;
+};
+
+// The eye test of a cluster's normal cone, as the culling shader makes it (both in the mesh's own space): true when
+// every triangle of the cluster faces away from the eye, with a margin for the GPU's rounding of nearly edge-on ones.
+bool coneRejects(const ArenaCluster& cluster, const Vec3& eye);
+
+class SceneArena {
+ public:
+  // Uploads the scene's meshes, materials, textures and objects. Needs a current context; keeps a pointer to the
+  // scene, which must outlive it. Throws farfield::Error for a mesh or a part that cannot be drawn (naming it).
+  explicit SceneArena(const scene::Scene& scene, const ArenaOptions& options = {});
+  ~SceneArena();
+  SceneArena(const SceneArena&) = delete;
+  SceneArena& operator=(const SceneArena&) = delete;
+
+  const scene::Scene& scene() const { return *scene_; }
+  std::span<const ArenaCluster> clusters() const { return clusters_; }
+  // Clusters of scene mesh m: clusters()[meshClusters(m).first, + second).
+  std::pair<uint32_t, uint32_t> meshClusters(uint32_t mesh) const { return mesh_clusters_.at(mesh); }
+  std::span<const ArenaInstance> instances() const { return instances_; }
+  std::span<const MaterialGroup> groups() const { return groups_; }
+  uint64_t triangleCount() const { return triangles_; }
+  size_t gpuBytes() const { return gpu_bytes_; }
+
+  // Re-uploads the transforms of these objects (ids, 1-based) after the scene's objects changed them. A change of
+  // handedness or of whether the transform keeps angles needs a new arena (FF_CHECK).
+  void updateTransforms(std::span<const uint32_t> ids);
+
+  // The index buffer read back from the GPU (a wait: for tests and tools, never in a frame). Cluster c's triangles are
+  // indices [first_index, + index_count) plus its base_vertex, numbered as the mesh's vertices after the arena's
+  // reordering; readVertexPositions() gives their positions.
+  std::vector<uint32_t> readIndices() const;
+  std::vector<Vec3> readVertexPositions() const;
+
+  // GL names for gpu::GpuCuller.
+  struct Buffers {
+    uint32_t vertex_array = 0;  // positions, normals, uvs (locations 0-2) and the instance index (3, per instance)
+    uint32_t clusters = 0, instances = 0, objects = 0, materials = 0;
+  };
+  const Buffers& buffers() const { return buffers_; }
+  // The GL texture of texture array i (MaterialGroup::texture_array).
+  uint32_t textureArray(int i) const { return texture_arrays_.at(size_t(i)); }
+
+ private:
+  void uploadObjects(uint32_t first, uint32_t count);
+
+  const scene::Scene* scene_;
+  std::vector<ArenaCluster> clusters_;
+  std::vector<std::pair<uint32_t, uint32_t>> mesh_clusters_;
+  std::vector<ArenaInstance> instances_;
+  std::vector<MaterialGroup> groups_;
+  std::vector<uint8_t> object_kind_;  // per object: bit 0 mirrored, bit 1 keeps angles (similarity)
+  uint64_t triangles_ = 0;
+  size_t gpu_bytes_ = 0;
+  Buffers buffers_;
+  uint32_t vertex_buffer_ = 0, index_buffer_ = 0, instance_ids_ = 0;
+  size_t vertex_count_ = 0, index_count_ = 0;
+  std::vector<uint32_t> texture_arrays_;
+};
+
+}  // namespace farfield::gpu

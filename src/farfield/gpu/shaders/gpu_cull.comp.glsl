@@ -1,0 +1,174 @@
+#version 450 core
+// Farfield cluster culling (gpu/gpu_culler.h): one invocation per cluster instance of the arena (gpu/scene_arena.h).
+// An instance is in view when its object is drawn in this frame's plan, its bounding sphere meets the frustum and its
+// normal cone does not turn every triangle away from the eye. Phases:
+//   0 (early): instances in view that were visible in the last frame are drawn;
+//   1 (late): instances in view are tested against the depth pyramid built from the early phase's depth; those not
+//     hidden are visible, and drawn unless the early phase drew them; the visibility is kept for the next frame;
+//   2 (all): instances in view are drawn (no occlusion), and are the visible ones.
+// Drawn instances become indirect draw commands: compacted per material group (an atomic counter per group, drawn
+// with glMultiDrawElementsIndirectCount) or, without compaction, each in its own slot, culled ones left empty.
+// The occlusion test is gpu::OcclusionCuller's (occlusion_culler.cpp: projectBox, DepthPyramid::farthest, hides),
+// the same conservative arithmetic: a box is hidden only when all of it lies behind the stored depth at every pixel
+// it may cover.
+
+layout(local_size_x = 64) in;
+
+struct Cluster {
+  vec4 sphere;     // centre, radius (mesh space)
+  vec4 cone_apex;  // xyz, w = cutoff
+  vec4 cone_axis;
+  vec4 box_lo;
+  vec4 box_hi;
+  uvec4 range;     // first index, index count, base vertex
+};
+struct Object {
+  mat4 model;
+  mat4 normal_matrix;
+  vec4 misc;   // x: largest axis scale
+  uvec4 info;  // id, flags (1: affine)
+};
+struct Command {
+  uint count;
+  uint instance_count;
+  uint first_index;
+  int base_vertex;
+  uint base_instance;
+};
+
+layout(std430, binding = 0) readonly buffer Clusters { Cluster clusters[]; };
+layout(std430, binding = 1) readonly buffer Instances { uvec4 instances[]; };  // cluster, object, material, group
+layout(std430, binding = 2) readonly buffer Objects { Object objects[]; };
+layout(std430, binding = 4) readonly buffer Enabled { uint enabled[]; };        // per object: drawn in the plan
+layout(std430, binding = 5) buffer Visibility { uint visible[]; };              // per instance: visible last frame
+layout(std430, binding = 6) writeonly buffer Commands { Command commands[]; };
+layout(std430, binding = 7) buffer Counts { uint counts[]; };                   // per group: commands written
+layout(std430, binding = 8) readonly buffer GroupFirst { uint group_first[]; };
+layout(std430, binding = 9) buffer Stats { uint stats[]; };
+
+layout(binding = 2) uniform sampler2D u_depth;    // pyramid level 0: the frame's depth
+layout(binding = 3) uniform sampler2D u_pyramid;  // levels 1.. in its mip levels 0..
+
+uniform mat4 u_view_proj;
+uniform vec4 u_planes[6];
+uniform vec3 u_eye;
+uniform ivec2 u_viewport;
+uniform int u_phase;
+uniform int u_compact;
+uniform int u_cone;
+uniform uint u_instance_count;
+uniform int u_levels;
+uniform ivec2 u_level_size[16];
+uniform float u_margin;  // relative depth margin of the occlusion test
+
+// Statistics (gpu_culler.cpp, GpuCullStats): summed in shared memory, added once per work group.
+const int kEnabled = 0, kDrawnEarly = 1, kDrawnLate = 2, kTrianglesEarly = 3, kTrianglesLate = 4, kFrustum = 5,
+          kCone = 6, kOccluded = 7, kStatCount = 8;
+shared uint s_stats[kStatCount];
+
+float levelTexel(int k, ivec2 p) {
+  return k == 0 ? texelFetch(u_depth, p, 0).r : texelFetch(u_pyramid, p, k - 1).r;
+}
+
+// DepthPyramid::farthest over the pixels [x0, x1] x [y0, y1] (inside the image, not empty).
+float farthest(int x0, int y0, int x1, int y1) {
+  int k = 0;
+  while (k + 1 < u_levels && ((x1 >> k) - (x0 >> k) > 1 || (y1 >> k) - (y0 >> k) > 1)) ++k;
+  float result = 3.0e38;
+  for (int y = y0 >> k; y <= (y1 >> k); ++y)
+    for (int x = x0 >> k; x <= (x1 >> k); ++x) result = min(result, levelTexel(k, ivec2(x, y)));
+  return result;
+}
+
+// projectBox + DepthPyramid::hides.
+bool hidden(vec3 lo, vec3 hi, mat4 mvp) {
+  float min_x = 3.0e38, min_y = 3.0e38, max_x = -3.0e38, max_y = -3.0e38, nearest = -3.0e38;
+  for (int i = 0; i < 8; ++i) {
+    const vec3 corner = vec3((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y, (i & 4) != 0 ? hi.z : lo.z);
+    const vec4 clip = mvp * vec4(corner, 1.0);
+    if (!(clip.w > 1e-6)) return false;  // reaches the eye: never hidden
+    const float x = (clip.x / clip.w * 0.5 + 0.5) * float(u_viewport.x);
+    const float y = (clip.y / clip.w * 0.5 + 0.5) * float(u_viewport.y);
+    min_x = min(min_x, x), max_x = max(max_x, x);
+    min_y = min(min_y, y), max_y = max(max_y, y);
+    nearest = max(nearest, clip.z / clip.w);
+  }
+  const int x0 = max(0, int(floor(max(min_x, -2.0))) - 1);
+  const int y0 = max(0, int(floor(max(min_y, -2.0))) - 1);
+  const int x1 = min(u_viewport.x - 1, int(floor(min(max_x, float(u_viewport.x) + 1.0))) + 1);
+  const int y1 = min(u_viewport.y - 1, int(floor(min(max_y, float(u_viewport.y) + 1.0))) + 1);
+  if (x0 > x1 || y0 > y1) return true;  // in front of the eye and covering no pixel centre
+  return nearest * (1.0 + u_margin) + 1e-12 < farthest(x0, y0, x1, y1);
+}
+
+void emit(uint i, uint group, Cluster c) {
+  const uint slot = u_compact != 0 ? group_first[group] + atomicAdd(counts[group], 1u) : i;
+  commands[slot] = Command(c.range.y, 1u, c.range.x, int(c.range.z), i);
+}
+
+void main() {
+  if (gl_LocalInvocationIndex < uint(kStatCount)) s_stats[gl_LocalInvocationIndex] = 0u;
+  barrier();
+
+  const uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
+                 gl_LocalInvocationIndex;
+  if (i < u_instance_count) {
+    const uvec4 instance = instances[i];
+    const uint group = instance.w & 0xffffu;
+    const bool cone_test = u_cone != 0 && (instance.w & 0x80000000u) != 0u;
+    const Cluster c = clusters[instance.x];
+    bool in_view = enabled[instance.y] != 0u;
+    bool drawn = false, occluded = false;
+    const mat4 model = objects[instance.y].model;
+    const bool affine = (objects[instance.y].info.y & 1u) != 0u;
+    if (in_view) {
+      atomicAdd(s_stats[kEnabled], 1u);
+      if (affine) {
+        const vec3 centre = (model * vec4(c.sphere.xyz, 1.0)).xyz;
+        const float radius = c.sphere.w * objects[instance.y].misc.x;
+        for (int p = 0; p < 6; ++p)
+          if (dot(u_planes[p].xyz, centre) + u_planes[p].w < -radius) in_view = false;
+        if (!in_view) atomicAdd(s_stats[kFrustum], 1u);
+      }
+      if (in_view && cone_test) {
+        // coneRejects (scene_arena.cpp), in world space: the transform keeps angles (SceneArena checks).
+        const vec3 apex = (model * vec4(c.cone_apex.xyz, 1.0)).xyz;
+        const vec3 axis = normalize(mat3(model) * c.cone_axis.xyz);
+        const vec3 d = apex - u_eye;
+        const float len = length(d);
+        if (len > 0.0 && dot(d / len, axis) >= c.cone_apex.w + 1e-3) {
+          in_view = false;
+          atomicAdd(s_stats[kCone], 1u);
+        }
+      }
+    }
+    if (u_phase == 0) {
+      drawn = in_view && visible[i] != 0u;
+    } else if (u_phase == 1) {
+      occluded = in_view && affine && hidden(c.box_lo.xyz, c.box_hi.xyz, u_view_proj * model);
+      const bool now_visible = in_view && !occluded;
+      drawn = now_visible && visible[i] == 0u;
+      visible[i] = now_visible ? 1u : 0u;
+      if (occluded) atomicAdd(s_stats[kOccluded], 1u);
+    } else {
+      drawn = in_view;
+      visible[i] = in_view ? 1u : 0u;
+    }
+    if (drawn) {
+      emit(i, group, c);
+      atomicAdd(s_stats[u_phase == 0 ? kDrawnEarly : kDrawnLate], 1u);
+      atomicAdd(s_stats[u_phase == 0 ? kTrianglesEarly : kTrianglesLate], c.range.y / 3u);
+    } else if (u_compact == 0) {
+      commands[i] = Command(0u, 0u, 0u, 0, 0u);
+    }
+  }
+
+  barrier();
+  if (gl_LocalInvocationIndex < uint(kStatCount)) {
+    const uint value = s_stats[gl_LocalInvocationIndex];
+    // The early phase's in-view counts would count the late phase's again: only the late (or only) phase adds them.
+    const bool counted = gl_LocalInvocationIndex == uint(kDrawnEarly) || gl_LocalInvocationIndex == uint(kTrianglesEarly)
+                             ? u_phase == 0 : u_phase != 0;
+    if (counted && value != 0u) atomicAdd(stats[gl_LocalInvocationIndex], value);
+  }
+}
