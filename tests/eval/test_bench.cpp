@@ -359,14 +359,23 @@ TEST(Bench, CsvMarkdownAndSampleFrames) {
   ASSERT_EQ(csv.size(), 1u + 3u * 2u);
   EXPECT_EQ(csv[0].rfind("frame,path_frame,mode,order,wall_ms,gpu_ms,triangles", 0), 0u);
   EXPECT_NE(csv[0].find(",parallax_p99_px,over_bound,popping"), std::string::npos) << csv[0];
+  EXPECT_NE(csv[0].find(",popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,syncs"), std::string::npos) << csv[0];
+  const auto field = [](const std::string& line, size_t k) {
+    size_t start = 0;
+    for (size_t i = 0; i < k; ++i) start = line.find(',', start) + 1;
+    return line.substr(start, line.find(',', start) - start);
+  };
   for (size_t i = 1; i < csv.size(); ++i) {
-    EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 14) << csv[i];
+    EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 20) << csv[i];
+    // The GL counters are on in the bench: every frame has its calls counted, and culled waits for nothing.
+    EXPECT_GT(std::stoul(field(csv[i], 17)), 0u) << csv[i];
+    if (csv[i].find(",culled,") != std::string::npos) EXPECT_EQ(field(csv[i], 20), "0") << csv[i];
     // No bound for full and culled (no --error-px, neither reports one): the over_bound column says "-".
     EXPECT_NE(csv[i].find(",-,"), std::string::npos) << csv[i];
   }
   // Popping: empty for the first measured frame, a number after (0 here: both modes draw what the reference does).
-  EXPECT_EQ(csv[1].back(), ',') << csv[1];
-  EXPECT_NE(csv.back().back(), ',') << csv.back();
+  EXPECT_EQ(field(csv[1], 14), "") << csv[1];
+  EXPECT_NE(field(csv.back(), 14), "") << csv.back();
 
   const std::string md = readText(run.dir / "bench.md");
   EXPECT_NE(md.find("| mode |"), std::string::npos);

@@ -65,7 +65,8 @@ size_t pixelsNotEqualTo(const image::ColorImage& img, const image::Rgba8& color)
 TEST(CulledMode, SameImagesAsFullWithFewerTriangles) {
   Harness h;
   auto full = h.make("full");
-  auto culled = h.make("culled");
+  auto culled = h.make("culled-cpu");
+  auto gpu_culled = h.make("culled");
   auto frustum = h.make("frustum");
   FrameRunner runner(*h.renderer, *h.target);
   const gen::CameraPath path = test::sideWalkPath(4);
@@ -82,6 +83,8 @@ TEST(CulledMode, SameImagesAsFullWithFewerTriangles) {
     const image::ColorImage culled_image = h.target->readColor();
     const FrameRecord fr = runner.run(*frustum, camera, i);
     const image::ColorImage frustum_image = h.target->readColor();
+    const FrameRecord g = runner.run(*gpu_culled, camera, i);
+    const image::ColorImage gpu_image = h.target->readColor();
 
     // The view shows geometry (so the comparison means something): most pixels are not the sky.
     const image::Rgba8 sky = full_image.at(kSize / 2, 0);
@@ -90,9 +93,20 @@ TEST(CulledMode, SameImagesAsFullWithFewerTriangles) {
       const double psnr = image::psnr(full_image, *image);
       EXPECT_TRUE(std::isinf(psnr) || psnr > 50.0) << "PSNR " << psnr;
     }
-    // Occlusion culling is exact: the frame of "culled" is the frame of "frustum", from fewer triangles or as many.
+    // Occlusion culling is exact: the frame of "culled-cpu" is the frame of "frustum", from fewer triangles or as
+    // many; so is the GPU-driven frame of "culled" (this scene has no coplanar surfaces of different objects), from
+    // a few multi-draws and without waiting for the GPU, where the CPU path read the occluders' depth back.
     EXPECT_TRUE(culled_image.pixels() == frustum_image.pixels());
+    EXPECT_TRUE(gpu_image.pixels() == frustum_image.pixels());
     EXPECT_LE(c.triangles, fr.triangles);
+    EXPECT_GT(g.triangles, 0u);
+    EXPECT_LT(g.triangles, f.triangles);
+    EXPECT_LT(g.objects, f.objects);
+    ASSERT_TRUE(g.counted);
+    EXPECT_EQ(g.syncs, 0u);
+    EXPECT_GE(c.syncs, 1u);
+    EXPECT_LE(g.draw_calls, 2 * h.context.arena().groups().size());
+    EXPECT_LT(g.draw_calls, fr.draw_calls);
 
     EXPECT_EQ(f.triangles, all_triangles);
     EXPECT_EQ(f.objects, uint32_t(h.scene.objects.size()));
@@ -110,7 +124,8 @@ TEST(CulledMode, SameImagesAsFullWithFewerTriangles) {
 TEST(CulledMode, NothingInViewDrawsNothing) {
   Harness h;
   auto full = h.make("full");
-  auto culled = h.make("culled");
+  auto culled = h.make("culled-cpu");
+  auto gpu_culled = h.make("culled");
   FrameRunner runner(*h.renderer, *h.target);
   gen::CameraPath path;
   path.frames.push_back(test::skyFrame());
@@ -124,6 +139,11 @@ TEST(CulledMode, NothingInViewDrawsNothing) {
   EXPECT_EQ(c.triangles, 0u);
   EXPECT_EQ(c.draw_calls, 0u);
   EXPECT_TRUE(std::isinf(image::psnr(full_image, culled_image)));
+  // The GPU-driven frame issues its multi-draws whatever they hold; none draws a triangle.
+  const FrameRecord g = runner.run(*gpu_culled, camera, 0);
+  EXPECT_EQ(g.triangles, 0u);
+  EXPECT_EQ(g.objects, 0u);
+  EXPECT_TRUE(std::isinf(image::psnr(full_image, h.target->readColor())));
 }
 
 // A mode that draws its frame itself in two passes (first the boxes, then the ground), as impostor modes will.

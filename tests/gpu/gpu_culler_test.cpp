@@ -1,5 +1,6 @@
 #include "farfield/gpu/gpu_culler.h"
 
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -225,11 +226,12 @@ TEST_F(GpuCullerTest, FramesEqualFrustumCulledFramesAlongAWalk) {
           early += s.drawn_early;
         }
       }
-      EXPECT_GT(occluded, 1000u);
+      EXPECT_GT(occluded, 500u);
       EXPECT_GT(coned, 200u);
       EXPECT_LT(ties, 20 * cameras.size());
       EXPECT_GT(outside, 1000u);
       EXPECT_GT(early, 1000u);  // the history is used
+      EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
     }
   }
 }
@@ -291,7 +293,7 @@ TEST_F(GpuCullerTest, AFrameWaitsForNothingAndDrawsOncePerMaterialGroupAndPhase)
   EXPECT_EQ((glCounters() - glCounters()).syncs, 0u);
 }
 
-// With occlusion off, the clusters drawn are those a CPU brute force over the same sphere and cone tests finds.
+// With occlusion off, the clusters drawn are those a CPU brute force over the same sphere, box and cone tests finds.
 TEST_F(GpuCullerTest, StatisticsMatchABruteForceCountOfClustersInView) {
   GpuCullOptions options;
   options.occlusion = false;
@@ -312,6 +314,9 @@ TEST_F(GpuCullerTest, StatisticsMatchABruteForceCountOfClustersInView) {
       bool in_view = true;
       for (const Vec4& p : frustum.planes)
         if (glm::dot(Vec3(p), centre) + p.w < -c.radius * scale) in_view = false;
+      Frustum local;
+      for (size_t k = 0; k < 6; ++k) local.planes[k] = frustum.planes[k] * object.transform;
+      if (!local.intersects(c.bounds)) in_view = false;
       if (in_view && in.cone_test) {
         ArenaCluster world = c;
         world.cone_apex = Vec3(object.transform * Vec4(c.cone_apex, 1.0f));

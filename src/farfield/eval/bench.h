@@ -13,6 +13,9 @@
 //    "baseline": "full", "baseline_added": bool, "reference": bool, "warmup_frames_per_mode": 1,
 //    "percentiles": "linear interpolation between closest ranks", "psnr_cap_db": 99,
 //    "modes": {"full": {"median_ms", "p95_ms", "p99_ms", "max_ms", "mean_ms", "gpu_median_ms", "gpu_p95_ms",
+//                       "cpu_median_ms", "cpu_p95_ms", "cpu_max_ms", "driver_median_ms", "mean_gl_calls",
+//                       "max_gl_calls", "max_draw_calls", "mean_dispatches", "mean_upload_bytes", "max_upload_bytes",
+//                       "mean_syncs", "max_syncs", "frames_with_syncs" (null where GL calls were not counted),
 //                       "mean_triangles", "mean_draw_calls", "mean_objects", "speedup_vs_full",
 //                       "psnr_db_mean", "psnr_db_min", "ssim_mean", "bad_pixel_share_mean", "crack_share_mean",
 //                       "parallax_p99_px_mean", "parallax_p99_px_max", "error_bound_px", "error_bound_source",
@@ -82,6 +85,8 @@ struct ModeResult {
                                               // psnr_db capped at kPsnrCapDb
   FrameSummary wall;
   FrameSummary gpu;
+  FrameSummary cpu;   // Farfield's own CPU time per frame (FrameRecord::cpu_ms)
+  CallSummary calls;  // GL calls, uploads and synchronisations per frame
   double mean_triangles = 0.0;
   double mean_draw_calls = 0.0;
   double mean_objects = 0.0;
@@ -173,8 +178,9 @@ void writeBenchJson(const BenchResult& result, const std::string& file);
 // A markdown table (one row per mode) with a short header (scene, size, frames, renderer, date, notes).
 void writeBenchMarkdown(const BenchResult& result, const std::string& file);
 // One row per frame per mode: frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,
-// psnr_db,ssim,bad_pixel_share,parallax_p99_px,over_bound,popping (error columns empty without a reference;
-// over_bound is 1 or 0, "-" without a bound, empty when not measured; popping is empty for the first frame).
+// psnr_db,ssim,bad_pixel_share,parallax_p99_px,over_bound,popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,
+// syncs (error columns empty without a reference; over_bound is 1 or 0, "-" without a bound, empty when not measured;
+// popping is empty for the first frame; the last six empty where GL calls were not counted).
 void writeFramesCsv(const BenchResult& result, const std::string& file);
 // bench.json, bench.md and frames.csv into out_dir (created if missing).
 void writeBenchOutputs(const BenchResult& result, const std::string& out_dir);

@@ -6,6 +6,7 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/eval/gpu_culled_mode.h"
 #include "farfield/eval/occlusion_pass.h"
 
 namespace farfield::eval {
@@ -22,6 +23,12 @@ const std::string& ModeContext::requireOption(const std::string& key, const std:
   if (it == options.end())
     throw Error("mode '" + mode_name + "'", "needs the option '" + key + "' (--mode-option " + key + "=VALUE)");
   return it->second;
+}
+
+const gpu::SceneArena& ModeContext::arena() const {
+  FF_CHECK_MSG(scene != nullptr, "ModeContext::arena() needs the scene");
+  if (!arena_slot->arena) arena_slot->arena = std::make_unique<gpu::SceneArena>(*scene);
+  return *arena_slot->arena;
 }
 
 std::map<std::string, std::string> parseModeOptions(const std::vector<std::string>& items) {
@@ -93,16 +100,17 @@ class FullMode final : public Mode {
   std::vector<gpu::DrawItem> items_;
 };
 
-// View-frustum culling: object bounds through the BVH, then the clusters of those objects' meshes (GpuScene's
-// culling units: in the frustum and not all facing away); what a plain renderer does before any impostor. With
-// occlusion (the "culled" mode), the nearest clusters are drawn first and the others hidden behind their depth are
-// dropped (gpu::OcclusionCuller: exact, the frame stays the frame of "frustum").
+// View-frustum culling on the CPU: object bounds through the BVH, then the clusters of those objects' meshes
+// (GpuScene's culling units: in the frustum and not all facing away); what a plain renderer does before any impostor.
+// With occlusion (the "culled-cpu" mode, "culled" before the GPU-driven frame), the nearest clusters are drawn first,
+// their depth read back, and the others hidden behind it dropped (gpu::OcclusionCuller: exact, the frame stays the
+// frame of "frustum").
 class CulledMode final : public Mode {
  public:
   CulledMode(const ModeContext& context, bool occlusion) : gpu_scene_(context.gpu_scene), bvh_(context.bvh) {
-    if (occlusion) occlusion_.emplace(occluderShareOption(context, "culled"));
+    if (occlusion) occlusion_.emplace(occluderShareOption(context, "culled-cpu"));
   }
-  std::string name() const override { return occlusion_ ? "culled" : "frustum"; }
+  std::string name() const override { return occlusion_ ? "culled-cpu" : "frustum"; }
   void frame(FrameContext& frame) override {
     ids_.clear();
     bvh_->queryFrustum(Frustum::fromMatrix(frame.camera().viewProjection()), ids_);
@@ -150,8 +158,12 @@ Registry& registry() {
     auto* reg = new Registry;
     reg->entries["full"] = {"every object of the scene (the baseline)",
                             [](const ModeContext&) { return std::make_unique<FullMode>(); }};
-    reg->entries["culled"] = {"clusters in the view frustum (BVH), not facing away, not hidden behind the nearest ones",
-                              [](const ModeContext& c) { return std::make_unique<CulledMode>(c, true); }};
+    reg->entries["culled"] = {"the GPU-driven frame: the scene's clusters culled by compute shaders (frustum, normal "
+                              "cones, two-phase hierarchical-Z occlusion), one multi-draw per material group",
+                              [](const ModeContext& c) { return std::make_unique<GpuCulledMode>(c); }};
+    reg->entries["culled-cpu"] = {"clusters in the view frustum (BVH), not facing away, not hidden behind the nearest "
+                                  "ones (culled on the CPU, the occluders' depth read back)",
+                                  [](const ModeContext& c) { return std::make_unique<CulledMode>(c, true); }};
     reg->entries["frustum"] = {"clusters in the view frustum (BVH) and not facing away: culled without occlusion",
                                [](const ModeContext& c) { return std::make_unique<CulledMode>(c, false); }};
     return reg;

@@ -6,8 +6,8 @@
 // frame), or both. The harness times the whole frame the same way for every mode: from the call of Mode::frame()
 // (so culling and selection on the CPU count) through the clear, every pass and glFinish.
 //
-// Modes are created by name from a registry. Built in: "full" (every object) and "culled" (objects whose world
-// bounds intersect the view frustum, through scene::Bvh::queryFrustum). Later modules add theirs with registerMode()
+// Modes are created by name from a registry. Built in: "full" (every object), "culled" (the GPU-driven frame:
+// eval/gpu_culled_mode.h), "culled-cpu" and "frustum" (culling on the CPU). Later modules add theirs with registerMode()
 // (or a static RegisterMode object in a translation unit that the executable links for certain: static libraries
 // drop object files nothing refers to) without touching the harness.
 #pragma once
@@ -15,6 +15,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <span>
 #include <string>
@@ -23,6 +24,7 @@
 #include "farfield/core/camera.h"
 #include "farfield/gpu/gpu_timer.h"
 #include "farfield/gpu/renderer.h"
+#include "farfield/gpu/scene_arena.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/scene/scene.h"
 
@@ -43,6 +45,14 @@ struct ModeContext {
   // Keys the modes asked for (option(), requireOption()), shared by the copies of a context: see
   // eval/mode_options.h, checkEveryOptionRead.
   std::shared_ptr<std::set<std::string>> read_keys = std::make_shared<std::set<std::string>>();
+
+  // The scene's geometry arena (gpu/scene_arena.h) for the GPU-driven modes: made on first use (the context current)
+  // and shared by the copies of this context.
+  const gpu::SceneArena& arena() const;
+  struct ArenaSlot {
+    std::unique_ptr<gpu::SceneArena> arena;
+  };
+  std::shared_ptr<ArenaSlot> arena_slot = std::make_shared<ArenaSlot>();
 
   // The option's value, or fallback when absent.
   std::string option(const std::string& key, const std::string& fallback = {}) const;
@@ -131,6 +141,9 @@ class Mode {
   virtual void frame(FrameContext& frame) = 0;
   // Numbers about the run the mode wants reported (bench.json "modes.<name>.info"), e.g. impostor count, bytes.
   virtual std::map<std::string, double> info() const { return {}; }
+  // What the GPU counted of the mode's last frame of this path frame, read back late (a GPU-driven mode knows its
+  // triangles and objects only then): the harness asks after it has waited for the frame. None by default.
+  virtual std::optional<gpu::FrameStats> lateFrameStats(size_t /*path_frame*/) { return std::nullopt; }
 };
 
 // Makes a mode; cheap (heavy work belongs in prepare()). May throw farfield::Error for bad options.

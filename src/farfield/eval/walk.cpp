@@ -67,19 +67,22 @@ WalkResult runWalk(gpu::Context& context, const scene::Scene& scene, const gen::
 void writeWalkCsv(const WalkResult& result, const std::string& file) {
   std::ofstream out(file);
   if (!out) throw Error(file, "cannot open for writing");
-  out << "frame,path_frame,mode,wall_ms,gpu_ms,triangles,draw_calls,objects\n";
-  char line[256];
+  out << "frame,path_frame,mode,wall_ms,gpu_ms,triangles,draw_calls,objects,cpu_ms,driver_ms,gl_calls,dispatches,"
+         "upload_bytes,syncs\n";
+  char line[512];
   for (size_t i = 0; i < result.frames.size(); ++i) {
     const FrameRecord& f = result.frames[i];
-    std::snprintf(line, sizeof(line), "%zu,%zu,%s,%.4f,%.4f,%llu,%u,%u\n", i, f.path_frame, result.mode.c_str(),
-                  f.wall_ms, f.gpu_ms, (unsigned long long)f.triangles, f.draw_calls, f.objects);
+    std::snprintf(line, sizeof(line), "%zu,%zu,%s,%.4f,%.4f,%llu,%u,%u,%.4f,%.4f,%llu,%u,%llu,%u\n", i, f.path_frame,
+                  result.mode.c_str(), f.wall_ms, f.gpu_ms, (unsigned long long)f.triangles, f.draw_calls, f.objects,
+                  f.cpu_ms, f.driver_ms, (unsigned long long)f.gl_calls, f.dispatches,
+                  (unsigned long long)f.upload_bytes, f.syncs);
     out << line;
   }
   if (!out) throw Error(file, "write failed");
 }
 
 std::string formatWalkSummary(const WalkResult& r) {
-  char buf[1024];
+  char buf[2048];
   std::snprintf(buf, sizeof(buf),
                 "mode:            %s\n"
                 "renderer:        %s\n"
@@ -87,14 +90,26 @@ std::string formatWalkSummary(const WalkResult& r) {
                 "frames:          %zu\n"
                 "wall ms:         median %.3f  p95 %.3f  p99 %.3f  max %.3f  mean %.3f\n"
                 "gpu ms:          median %.3f  p95 %.3f  p99 %.3f  max %.3f\n"
+                "own cpu ms:      median %.3f  p95 %.3f  max %.3f (Farfield's own code: wall less driver and waits)\n"
                 "triangles:       %.0f (mean per frame)\n"
                 "draw calls:      %.1f (mean per frame)\n"
                 "objects drawn:   %.1f (mean per frame)\n"
                 "percentiles:     linear interpolation between closest ranks\n",
                 r.mode.c_str(), r.renderer.c_str(), r.width, r.height, r.frames.size(), r.wall.median, r.wall.p95,
-                r.wall.p99, r.wall.max, r.wall.mean, r.gpu.median, r.gpu.p95, r.gpu.p99, r.gpu.max, r.mean_triangles,
-                r.mean_draw_calls, r.mean_objects);
-  return buf;
+                r.wall.p99, r.wall.max, r.wall.mean, r.gpu.median, r.gpu.p95, r.gpu.p99, r.gpu.max, r.cpu.median,
+                r.cpu.p95, r.cpu.max, r.mean_triangles, r.mean_draw_calls, r.mean_objects);
+  std::string text = buf;
+  if (r.calls.counted) {
+    std::snprintf(buf, sizeof(buf),
+                  "gl calls:        %.1f (mean per frame), %.1f compute dispatches\n"
+                  "uploaded:        %.0f bytes (mean per frame), max %llu\n"
+                  "synchronisations: %.2f (mean per frame), max %u, %zu frames with one or more\n",
+                  r.calls.gl_calls_mean, r.calls.dispatches_mean, r.calls.upload_bytes_mean,
+                  (unsigned long long)r.calls.upload_bytes_max, r.calls.syncs_mean, r.calls.syncs_max,
+                  r.calls.frames_with_syncs);
+    text += buf;
+  }
+  return text;
 }
 
 }  // namespace farfield::eval

@@ -35,6 +35,8 @@ struct WalkResult {
   std::vector<FrameRecord> frames;
   FrameSummary wall;  // over FrameRecord::wall_ms
   FrameSummary gpu;   // over FrameRecord::gpu_ms
+  FrameSummary cpu;   // over FrameRecord::cpu_ms (Farfield's own CPU time)
+  CallSummary calls;  // GL calls, uploads and synchronisations
   double mean_triangles = 0.0;
   double mean_draw_calls = 0.0;
   double mean_objects = 0.0;

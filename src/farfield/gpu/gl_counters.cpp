@@ -256,7 +256,7 @@ const Entry kEntries[] = {
     FF_HOOK(glDeleteTextures, Plain), FF_HOOK(glDeleteVertexArrays, Plain), FF_HOOK(glDepthFunc, Plain),
     FF_HOOK(glDepthMask, Plain), FF_HOOK(glDetachShader, Plain), FF_HOOK(glDisable, Plain),
     FF_HOOK(glEnable, Plain), FF_HOOK(glEnableVertexArrayAttrib, Plain), FF_HOOK(glEndQuery, Plain),
-    FF_HOOK(glFenceSync, Plain), FF_HOOK(glFrontFace, Plain), FF_HOOK(glGetFloatv, Plain),
+    FF_HOOK(glFenceSync, Plain), FF_HOOK(glFrontFace, Plain), FF_HOOK(glGetError, Plain), FF_HOOK(glGetFloatv, Plain),
     FF_HOOK(glGetIntegerv, Plain), FF_HOOK(glGetProgramInfoLog, Plain), FF_HOOK(glGetProgramiv, Plain),
     FF_HOOK(glGetShaderInfoLog, Plain), FF_HOOK(glGetShaderiv, Plain), FF_HOOK(glGetString, Plain),
     FF_HOOK(glGetSynciv, Plain), FF_HOOK(glGetUniformLocation, Plain), FF_HOOK(glLinkProgram, Plain),

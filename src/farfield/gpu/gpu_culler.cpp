@@ -17,7 +17,7 @@ namespace {
 constexpr GLuint kWorkGroup = 64;        // gpu_cull.comp.glsl's local size
 constexpr GLuint kMaxGroupsX = 65535;    // dispatches wider than this go into y
 constexpr size_t kCommandBytes = 5 * sizeof(uint32_t);
-constexpr size_t kStatCount = 8;         // gpu_cull.comp.glsl's statistics
+constexpr size_t kStatCount = 9;         // gpu_cull.comp.glsl's statistics
 constexpr size_t kRing = 8;              // frames of statistics in flight
 constexpr int kMaxLevels = 16;
 
@@ -41,7 +41,7 @@ struct GpuCuller::Impl {
       Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1\n#define FF_ITEM_BUFFER 1")};
 
   struct CullLocations {
-    int view_proj, planes, eye, viewport, phase, compact, cone, instance_count, levels, level_size, margin;
+    int view_proj, planes, eye, viewport, phase, compact, cone, instance_count, levels, level_size, margin, frame;
   } cl{};
   struct PyramidLocations {
     int src_size, dst_size, from_depth;
@@ -51,8 +51,10 @@ struct GpuCuller::Impl {
   };
   std::array<DrawLocations, kVariants> dl{};
 
-  GLuint enabled = 0, visibility = 0, counts = 0, group_first = 0;
-  std::array<GLuint, 2> commands{};  // per phase
+  GLuint enabled = 0, visibility = 0, stats = 0, group_first = 0, object_frame = 0;
+  // Per phase: the commands, and the number written per group (buffers of their own: bound whole, no offset
+  // alignment to respect).
+  std::array<GLuint, 2> commands{}, counts{};
   uint32_t groups = 0;
   uint32_t instances = 0;
 
@@ -82,7 +84,7 @@ struct GpuCuller::Impl {
           glGetUniformLocation(c, "u_phase"),          glGetUniformLocation(c, "u_compact"),
           glGetUniformLocation(c, "u_cone"),           glGetUniformLocation(c, "u_instance_count"),
           glGetUniformLocation(c, "u_levels"),         glGetUniformLocation(c, "u_level_size"),
-          glGetUniformLocation(c, "u_margin")};
+          glGetUniformLocation(c, "u_margin"),         glGetUniformLocation(c, "u_frame")};
     const GLuint p = pyramid.handle();
     pl = {glGetUniformLocation(p, "u_src_size"), glGetUniformLocation(p, "u_dst_size"),
           glGetUniformLocation(p, "u_from_depth")};
@@ -94,7 +96,8 @@ struct GpuCuller::Impl {
   }
 
   ~Impl() {
-    const GLuint buffers[] = {enabled, visibility, counts, group_first, commands[0], commands[1]};
+    const GLuint buffers[] = {enabled,     visibility,  stats,     group_first,
+                              object_frame, commands[0], commands[1], counts[0], counts[1]};
     glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
     if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
     for (Slot& s : ring) {
@@ -146,14 +149,16 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   im.groups = uint32_t(arena.groups().size());
   const std::vector<uint32_t> ones(std::max<size_t>(objects, 1), 1u);
   im.enabled = createBuffer(ones.size() * sizeof(uint32_t), ones.data());
+  im.object_frame = createBuffer(ones.size() * sizeof(uint32_t), nullptr);
+  glClearNamedBufferData(im.object_frame, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   im.visibility = createBuffer(size_t(im.instances) * sizeof(uint32_t), nullptr);
   glClearNamedBufferData(im.visibility, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   for (GLuint& c : im.commands) {
     c = createBuffer(size_t(im.instances) * kCommandBytes, nullptr);
     glClearNamedBufferData(c, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   }
-  // Counts: the early phase's per group, the late phase's per group, then the statistics.
-  im.counts = createBuffer((2 * size_t(im.groups) + kStatCount) * sizeof(uint32_t), nullptr);
+  for (GLuint& c : im.counts) c = createBuffer(size_t(im.groups) * sizeof(uint32_t), nullptr);
+  im.stats = createBuffer(kStatCount * sizeof(uint32_t), nullptr);
   std::vector<uint32_t> first(std::max<size_t>(im.groups, 1), 0);
   for (uint32_t g = 0; g < im.groups; ++g) first[g] = arena.groups()[g].first_instance;
   im.group_first = createBuffer(first.size() * sizeof(uint32_t), first.data());
@@ -241,6 +246,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glProgramUniform1ui(c, im.cl.instance_count, im.instances);
   glProgramUniform1f(c, im.cl.margin, options_.occlusion_margin);
   glProgramUniform1i(c, im.cl.levels, int(im.level_size.size()));
+  glProgramUniform1ui(c, im.cl.frame, uint32_t(frame + 1));
   Vec3 light_dir = light.direction;
   light_dir = glm::length(light_dir) > 0.0f ? glm::normalize(light_dir) : Vec3(0.0f, 0.0f, -1.0f);
   const int variant_of_mode = mode == RenderMode::ItemBuffer ? kItems : -1;
@@ -263,9 +269,10 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, im.enabled);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, im.visibility);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, im.group_first);
-  const GLsizeiptr group_bytes = GLsizeiptr(im.groups * sizeof(uint32_t));
-  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 9, im.counts, 2 * group_bytes, GLsizeiptr(kStatCount * sizeof(uint32_t)));
-  glClearNamedBufferData(im.counts, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, im.object_frame);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, im.stats);
+  for (GLuint buffer : {im.counts[0], im.counts[1], im.stats})
+    glClearNamedBufferData(buffer, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
   const GLuint work_groups = (im.instances + kWorkGroup - 1) / kWorkGroup;
   const GLuint groups_x = std::min(work_groups, kMaxGroupsX);
@@ -273,7 +280,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
 
   auto cullPhase = [&](int phase, int commands) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, im.commands[size_t(commands)]);
-    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 7, im.counts, commands * group_bytes, std::max<GLsizeiptr>(group_bytes, 4));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, im.counts[size_t(commands)]);
     glProgramUniform1i(c, im.cl.phase, phase);
     glUseProgram(c);
     // Units 2 and 3: the depth and the pyramid, unbound again before anything draws into the depth.
@@ -288,7 +295,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   auto drawPhase = [&](int commands) {
     glBindVertexArray(b.vertex_array);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, im.commands[size_t(commands)]);
-    if (indirect_count_) glBindBuffer(GL_PARAMETER_BUFFER_ARB, im.counts);
+    if (indirect_count_) glBindBuffer(GL_PARAMETER_BUFFER_ARB, im.counts[size_t(commands)]);
     int current = -1;
     bool culling = true, mirrored = false;
     for (uint32_t g = 0; g < im.groups; ++g) {
@@ -312,7 +319,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
       const void* offset = reinterpret_cast<const void*>(uintptr_t(group.first_instance) * kCommandBytes);
       if (indirect_count_) {
         glMultiDrawElementsIndirectCountARB(GL_TRIANGLES, GL_UNSIGNED_INT, offset,
-                                            GLintptr(commands * group_bytes + g * sizeof(uint32_t)),
+                                            GLintptr(g * sizeof(uint32_t)),
                                             GLsizei(group.instance_count), GLsizei(kCommandBytes));
       } else {
         glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, offset, GLsizei(group.instance_count),
@@ -355,7 +362,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   // ---- statistics, read frames later ----
   Impl::Slot& slot = im.ring[im.ring_next];
   if (!slot.fence) {
-    glCopyNamedBufferSubData(im.counts, slot.buffer, 2 * group_bytes, 0, GLsizeiptr(kStatCount * sizeof(uint32_t)));
+    glCopyNamedBufferSubData(im.stats, slot.buffer, 0, 0, GLsizeiptr(kStatCount * sizeof(uint32_t)));
     slot.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     slot.frame = frame;
     im.ring_next = (im.ring_next + 1) % kRing;
@@ -385,6 +392,7 @@ std::vector<GpuCullStats> GpuCuller::finishedStats() {
     st.frustum_culled = v[5];
     st.cone_culled = v[6];
     st.occlusion_culled = v[7];
+    st.objects = v[8];
     out.push_back(st);
   }
   return out;

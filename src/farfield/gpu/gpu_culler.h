@@ -46,6 +46,7 @@ struct GpuCullStats {
   uint32_t drawn_early = 0;        // clusters drawn in the first phase
   uint32_t drawn_late = 0;         // in the second (or only) phase
   uint64_t triangles = 0;          // drawn in both
+  uint32_t objects = 0;            // distinct objects drawn
   uint32_t frustum_culled = 0, cone_culled = 0, occlusion_culled = 0;
 };
 

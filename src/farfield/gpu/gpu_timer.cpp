@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <string>
 
+#include "farfield/gpu/gl_counters.h"
+
 namespace farfield::gpu {
 
 bool currentRendererIsSoftware() {
@@ -26,6 +28,8 @@ GpuTimer::~GpuTimer() {
 void GpuTimer::begin() {
   if (source_ == Source::CpuClock) {
     // Earlier work (uploads, another pass) must not be counted: a software rasterizer would do it inside our span.
+    // The wait is the measurement's, not the frame's (gl_counters.h).
+    GlMeasurement measurement;
     glFinish();
     since_begin_.restart();
     return;
@@ -36,6 +40,7 @@ void GpuTimer::begin() {
 
 void GpuTimer::end() {
   if (source_ == Source::CpuClock) {
+    GlMeasurement measurement;
     glFinish();  // the work is done when the rasterizer threads are
     cpu_clock_ms_ = since_begin_.milliseconds();
   } else {

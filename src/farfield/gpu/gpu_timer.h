@@ -10,6 +10,7 @@
 //     about the full 50 ms after drawing into another one, so that the bench's GPU column alternated between near 0
 //     and the real value as its modes took turns after the reference), and it leaves out vertex processing and
 //     binning, which llvmpipe does on the calling thread.
+// The timer's own waits are measurement (gpu/gl_counters.h, GlMeasurement): not counted as the frame's.
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 #version 450 core
 // Farfield cluster culling (gpu/gpu_culler.h): one invocation per cluster instance of the arena (gpu/scene_arena.h).
-// An instance is in view when its object is drawn in this frame's plan, its bounding sphere meets the frustum and its
-// normal cone does not turn every triangle away from the eye. Phases:
+// An instance is in view when its object is drawn in this frame's plan, its bounding sphere and its box meet the
+// frustum and its normal cone does not turn every triangle away from the eye. Phases:
 //   0 (early): instances in view that were visible in the last frame are drawn;
 //   1 (late): instances in view are tested against the depth pyramid built from the early phase's depth; those not
 //     hidden are visible, and drawn unless the early phase drew them; the visibility is kept for the next frame;
@@ -45,6 +45,7 @@ layout(std430, binding = 6) writeonly buffer Commands { Command commands[]; };
 layout(std430, binding = 7) buffer Counts { uint counts[]; };                   // per group: commands written
 layout(std430, binding = 8) readonly buffer GroupFirst { uint group_first[]; };
 layout(std430, binding = 9) buffer Stats { uint stats[]; };
+layout(std430, binding = 10) buffer ObjectFrame { uint object_frame[]; };    // per object: last frame it was drawn
 
 layout(binding = 2) uniform sampler2D u_depth;    // pyramid level 0: the frame's depth
 layout(binding = 3) uniform sampler2D u_pyramid;  // levels 1.. in its mip levels 0..
@@ -60,10 +61,11 @@ uniform uint u_instance_count;
 uniform int u_levels;
 uniform ivec2 u_level_size[16];
 uniform float u_margin;  // relative depth margin of the occlusion test
+uniform uint u_frame;    // this frame's number + 1 (object_frame starts at 0)
 
 // Statistics (gpu_culler.cpp, GpuCullStats): summed in shared memory, added once per work group.
 const int kEnabled = 0, kDrawnEarly = 1, kDrawnLate = 2, kTrianglesEarly = 3, kTrianglesLate = 4, kFrustum = 5,
-          kCone = 6, kOccluded = 7, kStatCount = 8;
+          kCone = 6, kOccluded = 7, kObjects = 8, kStatCount = 9;
 shared uint s_stats[kStatCount];
 
 float levelTexel(int k, ivec2 p) {
@@ -126,8 +128,15 @@ void main() {
       if (affine) {
         const vec3 centre = (model * vec4(c.sphere.xyz, 1.0)).xyz;
         const float radius = c.sphere.w * objects[instance.y].misc.x;
-        for (int p = 0; p < 6; ++p)
+        for (int p = 0; p < 6; ++p) {
           if (dot(u_planes[p].xyz, centre) + u_planes[p].w < -radius) in_view = false;
+          // The box in the object's own space against the plane taken there (Frustum::intersects): tighter for flat
+          // and long clusters than the sphere.
+          const vec4 local = u_planes[p] * model;
+          const vec3 corner = vec3(local.x >= 0.0 ? c.box_hi.x : c.box_lo.x, local.y >= 0.0 ? c.box_hi.y : c.box_lo.y,
+                                   local.z >= 0.0 ? c.box_hi.z : c.box_lo.z);
+          if (dot(local.xyz, corner) + local.w < 0.0) in_view = false;
+        }
         if (!in_view) atomicAdd(s_stats[kFrustum], 1u);
       }
       if (in_view && cone_test) {
@@ -158,6 +167,8 @@ void main() {
       emit(i, group, c);
       atomicAdd(s_stats[u_phase == 0 ? kDrawnEarly : kDrawnLate], 1u);
       atomicAdd(s_stats[u_phase == 0 ? kTrianglesEarly : kTrianglesLate], c.range.y / 3u);
+      // Distinct objects: the first instance of an object drawn in this frame counts it.
+      if (atomicExchange(object_frame[instance.y], u_frame) != u_frame) atomicAdd(s_stats[kObjects], 1u);
     } else if (u_compact == 0) {
       commands[i] = Command(0u, 0u, 0u, 0, 0u);
     }
@@ -167,8 +178,9 @@ void main() {
   if (gl_LocalInvocationIndex < uint(kStatCount)) {
     const uint value = s_stats[gl_LocalInvocationIndex];
     // The early phase's in-view counts would count the late phase's again: only the late (or only) phase adds them.
-    const bool counted = gl_LocalInvocationIndex == uint(kDrawnEarly) || gl_LocalInvocationIndex == uint(kTrianglesEarly)
-                             ? u_phase == 0 : u_phase != 0;
+    const uint k = gl_LocalInvocationIndex;
+    const bool counted = k == uint(kObjects) || (k == uint(kDrawnEarly) || k == uint(kTrianglesEarly) ? u_phase == 0
+                                                                                                        : u_phase != 0);
     if (counted && value != 0u) atomicAdd(stats[gl_LocalInvocationIndex], value);
   }
 }

@@ -1,0 +1,78 @@
+#include "farfield/eval/gpu_culled_mode.h"
+
+#include "farfield/core/error.h"
+
+namespace farfield::eval {
+namespace {
+
+bool onOff(const ModeContext& context, const std::string& key, bool fallback, const std::string& mode_name) {
+  const std::string value = context.option(key, fallback ? "on" : "off");
+  if (value == "on") return true;
+  if (value == "off") return false;
+  throw Error("mode '" + mode_name + "'", key + " must be on or off, got '" + value + "'");
+}
+
+}  // namespace
+
+gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string& mode_name) {
+  gpu::GpuCullOptions options;
+  options.occlusion = onOff(context, "gpu_occlusion", options.occlusion, mode_name);
+  options.cone = onOff(context, "gpu_cones", options.cone, mode_name);
+  options.compact = onOff(context, "gpu_compact", options.compact, mode_name);
+  return options;
+}
+
+GpuCulledMode::GpuCulledMode(const ModeContext& context) : options_(gpuCullOptions(context, "culled")) {}
+
+void GpuCulledMode::prepare(const ModeContext& context) {
+  culler_ = std::make_unique<gpu::GpuCuller>(context.arena(), options_);
+}
+
+void GpuCulledMode::frame(FrameContext& frame) {
+  gpu::RenderTarget& target = frame.beginOwnPass();
+  path_frame_of_.push_back(frame.pathFrame());
+  frame.addStats(culler_->draw(frame.camera(), target, gpu::RenderMode::Shaded, frame.renderer().light()));
+}
+
+void GpuCulledMode::collect() {
+  for (const gpu::GpuCullStats& s : culler_->finishedStats()) {
+    latest_[path_frame_of_.at(s.frame)] = s;
+    frames_ += 1.0;
+    early_ += s.drawn_early;
+    late_ += s.drawn_late;
+    frustum_ += s.frustum_culled;
+    cone_ += s.cone_culled;
+    occluded_ += s.occlusion_culled;
+  }
+}
+
+std::optional<gpu::FrameStats> GpuCulledMode::lateFrameStats(size_t path_frame) {
+  collect();
+  const auto it = latest_.find(path_frame);
+  if (it == latest_.end()) return std::nullopt;
+  gpu::FrameStats stats;
+  stats.triangles = it->second.triangles;
+  stats.objects = it->second.objects;
+  return stats;
+}
+
+std::map<std::string, double> GpuCulledMode::info() const {
+  std::map<std::string, double> out;
+  if (!culler_) return out;
+  const gpu::SceneArena& arena = culler_->arena();
+  out["arena_clusters"] = double(arena.clusters().size());
+  out["arena_instances"] = double(arena.instances().size());
+  out["arena_material_groups"] = double(arena.groups().size());
+  out["arena_gpu_bytes"] = double(arena.gpuBytes());
+  out["indirect_count"] = culler_->indirectCount() ? 1.0 : 0.0;
+  if (frames_ > 0.0) {
+    out["gpu_clusters_drawn_early"] = early_ / frames_;
+    out["gpu_clusters_drawn_late"] = late_ / frames_;
+    out["gpu_frustum_culled"] = frustum_ / frames_;
+    out["gpu_cone_culled"] = cone_ / frames_;
+    out["gpu_occlusion_culled"] = occluded_ / frames_;
+  }
+  return out;
+}
+
+}  // namespace farfield::eval

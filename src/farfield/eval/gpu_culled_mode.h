@@ -1,0 +1,48 @@
+// "culled": the GPU-driven frame (DESIGN.md; gpu/gpu_culler.h). The scene's arena culled by compute shaders
+// (frustum, normal cones, two-phase hierarchical-Z occlusion against its own depth) and drawn with one multi-draw per
+// material group and phase; nothing waits for the GPU inside the frame. Its frame is the frame of "frustum" (every
+// cluster in view), up to pixels whose content depends on draw order (coplanar surfaces of different objects).
+// Triangles and objects drawn are counted on the GPU and read after the frame (Mode::lateFrameStats).
+//
+// Options (--mode-option): gpu_occlusion=on|off (the pyramid test; off: frustum and cones only), gpu_cones=on|off,
+// gpu_compact=on|off (compacted command lists with glMultiDrawElementsIndirectCount where the driver has it).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "farfield/eval/mode.h"
+#include "farfield/gpu/gpu_culler.h"
+
+namespace farfield::eval {
+
+// The GpuCuller options of a run's --mode-option keys (gpu_occlusion, gpu_cones, gpu_compact: on or off); throws
+// farfield::Error naming the key for another value.
+gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string& mode_name);
+
+class GpuCulledMode final : public Mode {
+ public:
+  explicit GpuCulledMode(const ModeContext& context);
+  std::string name() const override { return "culled"; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override;
+  // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, indirect_count (1 or 0), and per frame
+  // (means over the frames whose statistics came back): gpu_clusters_drawn_early, gpu_clusters_drawn_late,
+  // gpu_frustum_culled, gpu_cone_culled, gpu_occlusion_culled.
+  std::map<std::string, double> info() const override;
+
+ private:
+  void collect();
+
+  gpu::GpuCullOptions options_;
+  std::unique_ptr<gpu::GpuCuller> culler_;
+  std::vector<size_t> path_frame_of_;  // per culler frame
+  std::map<size_t, gpu::GpuCullStats> latest_;  // per path frame, the last statistics that came back
+  double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0;
+};
+
+}  // namespace farfield::eval
