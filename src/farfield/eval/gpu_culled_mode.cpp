@@ -43,6 +43,8 @@ void GpuCulledMode::collect() {
     frustum_ += s.frustum_culled;
     cone_ += s.cone_culled;
     occluded_ += s.occlusion_culled;
+    commands_ += s.commands;
+    triangles_ += double(s.triangles);
   }
 }
 
@@ -71,6 +73,8 @@ std::map<std::string, double> GpuCulledMode::info() const {
     out["gpu_frustum_culled"] = frustum_ / frames_;
     out["gpu_cone_culled"] = cone_ / frames_;
     out["gpu_occlusion_culled"] = occluded_ / frames_;
+    out["gpu_draw_commands"] = commands_ / frames_;
+    out["gpu_triangles"] = triangles_ / frames_;
   }
   return out;
 }

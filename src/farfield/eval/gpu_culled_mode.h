@@ -32,7 +32,8 @@ class GpuCulledMode final : public Mode {
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override;
   // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, indirect_count (1 or 0), and per frame
   // (means over the frames whose statistics came back): gpu_clusters_drawn_early, gpu_clusters_drawn_late,
-  // gpu_frustum_culled, gpu_cone_culled, gpu_occlusion_culled.
+  // gpu_frustum_culled, gpu_cone_culled, gpu_occlusion_culled, gpu_draw_commands (indirect draws after merging runs
+  // of clusters), gpu_triangles.
   std::map<std::string, double> info() const override;
 
  private:
@@ -42,7 +43,8 @@ class GpuCulledMode final : public Mode {
   std::unique_ptr<gpu::GpuCuller> culler_;
   std::vector<size_t> path_frame_of_;  // per culler frame
   std::map<size_t, gpu::GpuCullStats> latest_;  // per path frame, the last statistics that came back
-  double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0;
+  double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0, commands_ = 0.0;
+  double triangles_ = 0.0;
 };
 
 }  // namespace farfield::eval

@@ -215,7 +215,7 @@ const Entry kEntries[] = {
     FF_HOOK(glClearNamedFramebufferiv, Work), FF_HOOK(glBlitNamedFramebuffer, Work),
     FF_HOOK(glGenerateTextureMipmap, Work), FF_HOOK(glCopyNamedBufferSubData, Work),
     FF_HOOK(glClearNamedBufferSubData, Work), FF_HOOK(glClearNamedBufferData, Work), FF_HOOK(glClearTexImage, Work),
-    FF_HOOK(glFlush, Work),
+    FF_HOOK(glFlush, Work), FF_HOOK(glMemoryBarrier, Work),
     // waits
     FF_HOOK(glFinish, Sync), FF_HOOK(glGetNamedBufferSubData, Sync), FF_HOOK_EXTRA(glReadPixels, readPixels),
     FF_HOOK_EXTRA(glGetTextureImage, getTextureImage), FF_HOOK_EXTRA(glGetTextureSubImage, getTextureSubImage),
@@ -260,7 +260,7 @@ const Entry kEntries[] = {
     FF_HOOK(glGetIntegerv, Plain), FF_HOOK(glGetProgramInfoLog, Plain), FF_HOOK(glGetProgramiv, Plain),
     FF_HOOK(glGetShaderInfoLog, Plain), FF_HOOK(glGetShaderiv, Plain), FF_HOOK(glGetString, Plain),
     FF_HOOK(glGetSynciv, Plain), FF_HOOK(glGetUniformLocation, Plain), FF_HOOK(glLinkProgram, Plain),
-    FF_HOOK(glMemoryBarrier, Plain), FF_HOOK(glNamedFramebufferDrawBuffer, Plain),
+    FF_HOOK(glNamedFramebufferDrawBuffer, Plain),
     FF_HOOK(glNamedFramebufferDrawBuffers, Plain), FF_HOOK(glNamedFramebufferReadBuffer, Plain),
     FF_HOOK(glNamedFramebufferTexture, Plain), FF_HOOK(glNamedFramebufferTextureLayer, Plain),
     FF_HOOK(glPixelStorei, Plain), FF_HOOK(glPolygonOffset, Plain), FF_HOOK(glQueryCounter, Plain),

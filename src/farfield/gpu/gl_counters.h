@@ -13,8 +13,9 @@
 //     into client memory, glGetNamedBufferSubData, a map of a buffer for reading, glClientWaitSync that had to wait,
 //     and a query result asked for before it was available;
 //   - uploaded bytes are the buffer and texture data and the uniform values sent from client memory;
-//   - driver time is the CPU time inside draws, dispatches, clears, blits, copies and synchronisations: on llvmpipe
-//     the rasterizer's own work (vertex shading, binning, compute shaders) runs inside them on the calling thread, so
+//   - driver time is the CPU time inside draws, dispatches, clears, blits, copies, memory barriers and
+//     synchronisations: on llvmpipe the rasterizer's own work (vertex shading, binning, compute shaders, the flushes a
+//     barrier makes) runs inside them on the calling thread, so
 //     a frame's own CPU time is its CPU time less driver time less the measurement's own waits (GlMeasurement).
 #pragma once
 

@@ -17,7 +17,7 @@ namespace {
 constexpr GLuint kWorkGroup = 64;        // gpu_cull.comp.glsl's local size
 constexpr GLuint kMaxGroupsX = 65535;    // dispatches wider than this go into y
 constexpr size_t kCommandBytes = 5 * sizeof(uint32_t);
-constexpr size_t kStatCount = 9;         // gpu_cull.comp.glsl's statistics
+constexpr size_t kStatCount = 10;        // gpu_cull.comp.glsl's statistics
 constexpr size_t kRing = 8;              // frames of statistics in flight
 constexpr int kMaxLevels = 16;
 
@@ -33,7 +33,11 @@ GLuint createBuffer(size_t bytes, const void* data, GLbitfield flags = GL_DYNAMI
 }  // namespace
 
 struct GpuCuller::Impl {
-  Program cull = Program::computeFromEmbedded("gpu_cull.comp.glsl");
+  // The culling stages (gpu_cull.comp.glsl): parts, the work list's dispatch, clusters, draw commands.
+  Program parts = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_PARTS 1");
+  Program args = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_ARGS 1");
+  Program cull = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_CLUSTERS 1");
+  Program emit = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_EMIT 1");
   Program pyramid = Program::computeFromEmbedded("depth_pyramid.comp.glsl");
   std::array<Program, kVariants> draw{
       Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1"),
@@ -41,8 +45,9 @@ struct GpuCuller::Impl {
       Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1\n#define FF_ITEM_BUFFER 1")};
 
   struct CullLocations {
-    int view_proj, planes, eye, viewport, phase, compact, cone, instance_count, levels, level_size, margin, frame;
-  } cl{};
+    int view_proj, planes, eye, viewport, phase, compact, cone, count, levels, level_size, margin, frame;
+  };
+  CullLocations cl{}, part_l{}, emit_l{};
   struct PyramidLocations {
     int src_size, dst_size, from_depth;
   } pl{};
@@ -51,7 +56,7 @@ struct GpuCuller::Impl {
   };
   std::array<DrawLocations, kVariants> dl{};
 
-  GLuint enabled = 0, visibility = 0, stats = 0, group_first = 0, object_frame = 0;
+  GLuint enabled = 0, visibility = 0, stats = 0, group_first = 0, object_frame = 0, work = 0, drawn = 0;
   // Per phase: the commands, and the number written per group (buffers of their own: bound whole, no offset
   // alignment to respect).
   std::array<GLuint, 2> commands{}, counts{};
@@ -77,14 +82,20 @@ struct GpuCuller::Impl {
   std::array<Slot, kRing> ring{};
   size_t ring_next = 0;  // the slot the next frame writes
 
+  static CullLocations locate(const Program& program) {
+    const GLuint c = program.handle();
+    return {glGetUniformLocation(c, "u_view_proj"), glGetUniformLocation(c, "u_planes"),
+            glGetUniformLocation(c, "u_eye"),       glGetUniformLocation(c, "u_viewport"),
+            glGetUniformLocation(c, "u_phase"),     glGetUniformLocation(c, "u_compact"),
+            glGetUniformLocation(c, "u_cone"),      glGetUniformLocation(c, "u_count"),
+            glGetUniformLocation(c, "u_levels"),    glGetUniformLocation(c, "u_level_size"),
+            glGetUniformLocation(c, "u_margin"),    glGetUniformLocation(c, "u_frame")};
+  }
+
   Impl() {
-    const GLuint c = cull.handle();
-    cl = {glGetUniformLocation(c, "u_view_proj"),      glGetUniformLocation(c, "u_planes"),
-          glGetUniformLocation(c, "u_eye"),            glGetUniformLocation(c, "u_viewport"),
-          glGetUniformLocation(c, "u_phase"),          glGetUniformLocation(c, "u_compact"),
-          glGetUniformLocation(c, "u_cone"),           glGetUniformLocation(c, "u_instance_count"),
-          glGetUniformLocation(c, "u_levels"),         glGetUniformLocation(c, "u_level_size"),
-          glGetUniformLocation(c, "u_margin"),         glGetUniformLocation(c, "u_frame")};
+    cl = locate(cull);
+    part_l = locate(parts);
+    emit_l = locate(emit);
     const GLuint p = pyramid.handle();
     pl = {glGetUniformLocation(p, "u_src_size"), glGetUniformLocation(p, "u_dst_size"),
           glGetUniformLocation(p, "u_from_depth")};
@@ -96,8 +107,8 @@ struct GpuCuller::Impl {
   }
 
   ~Impl() {
-    const GLuint buffers[] = {enabled,     visibility,  stats,     group_first,
-                              object_frame, commands[0], commands[1], counts[0], counts[1]};
+    const GLuint buffers[] = {enabled,     visibility,  stats,     group_first, object_frame,
+                              commands[0], commands[1], counts[0], counts[1],   work,        drawn};
     glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
     if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
     for (Slot& s : ring) {
@@ -153,6 +164,9 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   glClearNamedBufferData(im.object_frame, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   im.visibility = createBuffer(size_t(im.instances) * sizeof(uint32_t), nullptr);
   glClearNamedBufferData(im.visibility, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  im.drawn = createBuffer(size_t(im.instances) * sizeof(uint32_t), nullptr);
+  // The work list: the dispatch of the cluster stages (x, y, z) and its length, then the instances.
+  im.work = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
   for (GLuint& c : im.commands) {
     c = createBuffer(size_t(im.instances) * kCommandBytes, nullptr);
     glClearNamedBufferData(c, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -241,12 +255,16 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glProgramUniform4fv(c, im.cl.planes, 6, glm::value_ptr(frustum.planes[0]));
   glProgramUniform3fv(c, im.cl.eye, 1, glm::value_ptr(camera.eye));
   glProgramUniform2i(c, im.cl.viewport, target.width(), target.height());
-  glProgramUniform1i(c, im.cl.compact, indirect_count_ ? 1 : 0);
   glProgramUniform1i(c, im.cl.cone, options_.cone ? 1 : 0);
-  glProgramUniform1ui(c, im.cl.instance_count, im.instances);
   glProgramUniform1f(c, im.cl.margin, options_.occlusion_margin);
   glProgramUniform1i(c, im.cl.levels, int(im.level_size.size()));
   glProgramUniform1ui(c, im.cl.frame, uint32_t(frame + 1));
+  const GLuint pp = im.parts.handle();
+  glProgramUniform4fv(pp, im.part_l.planes, 6, glm::value_ptr(frustum.planes[0]));
+  glProgramUniform1ui(pp, im.part_l.count, uint32_t(arena_.parts().size()));
+  const GLuint e = im.emit.handle();
+  glProgramUniform1i(e, im.emit_l.compact, indirect_count_ ? 1 : 0);
+  glProgramUniform1ui(e, im.emit_l.count, im.instances);
   Vec3 light_dir = light.direction;
   light_dir = glm::length(light_dir) > 0.0f ? glm::normalize(light_dir) : Vec3(0.0f, 0.0f, -1.0f);
   const int variant_of_mode = mode == RenderMode::ItemBuffer ? kItems : -1;
@@ -270,26 +288,42 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, im.visibility);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, im.group_first);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, im.object_frame);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, b.parts);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.work);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, im.drawn);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, im.stats);
   for (GLuint buffer : {im.counts[0], im.counts[1], im.stats})
     glClearNamedBufferData(buffer, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  glClearNamedBufferSubData(im.work, GL_R32UI, 0, 4 * sizeof(uint32_t), GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
-  const GLuint work_groups = (im.instances + kWorkGroup - 1) / kWorkGroup;
-  const GLuint groups_x = std::min(work_groups, kMaxGroupsX);
-  const GLuint groups_y = (work_groups + groups_x - 1) / groups_x;
+  // The parts in view put their clusters on the work list; its length becomes the cluster stages' dispatch.
+  const GLuint part_groups = (uint32_t(arena_.parts().size()) + kWorkGroup - 1) / kWorkGroup;
+  glUseProgram(pp);
+  glDispatchCompute(std::min(part_groups, kMaxGroupsX), (part_groups + kMaxGroupsX - 1) / kMaxGroupsX, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  glUseProgram(im.args.handle());
+  glDispatchCompute(1, 1, 1);
+  glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.work);
 
   auto cullPhase = [&](int phase, int commands) {
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, im.commands[size_t(commands)]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, im.counts[size_t(commands)]);
     glProgramUniform1i(c, im.cl.phase, phase);
     glUseProgram(c);
     // Units 2 and 3: the depth and the pyramid, unbound again before anything draws into the depth.
     glBindTextureUnit(2, target.depthTexture().handle());
     glBindTextureUnit(3, im.pyramid_texture);
-    glDispatchCompute(groups_x, groups_y, 1);
-    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glDispatchComputeIndirect(0);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);
+    // Runs of drawn clusters into commands.
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, im.commands[size_t(commands)]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, im.counts[size_t(commands)]);
+    if (!indirect_count_)  // every slot is drawn: those of no run must be empty
+      glClearNamedBufferData(im.commands[size_t(commands)], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    glUseProgram(e);
+    glDispatchComputeIndirect(0);
+    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
   };
 
   auto drawPhase = [&](int commands) {
@@ -386,6 +420,7 @@ std::vector<GpuCullStats> GpuCuller::finishedStats() {
     st.frame = s.frame;
     const uint32_t* v = s.mapped;
     st.instances_in_plan = v[0];
+    st.commands = v[9];
     st.drawn_early = v[1];
     st.drawn_late = v[2];
     st.triangles = uint64_t(v[3]) + uint64_t(v[4]);

@@ -47,6 +47,7 @@ struct GpuCullStats {
   uint32_t drawn_late = 0;         // in the second (or only) phase
   uint64_t triangles = 0;          // drawn in both
   uint32_t objects = 0;            // distinct objects drawn
+  uint32_t commands = 0;           // indirect draws (runs of consecutive clusters of a part) in both phases
   uint32_t frustum_culled = 0, cone_culled = 0, occlusion_culled = 0;
 };
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <map>
 #include <string>
 #include <unordered_map>
@@ -270,6 +271,7 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
   struct Pending {
     ArenaInstance instance;
     std::tuple<int, bool, bool> key;
+    uint32_t part;
   };
   std::vector<Pending> pending;
   for (size_t o = 0; o < scene.objects.size(); ++o) {
@@ -286,13 +288,18 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
       const auto key = std::make_tuple(material_array[part.material], material.double_sided, bool(kind & kMirrored));
       group_of.emplace(key, 0);
       const auto [first, n] = mesh_clusters_[part.mesh];
+      const uint32_t part_index = uint32_t(parts_.size());
+      ArenaPart arena_part;
+      arena_part.object = uint32_t(o);
+      for (uint32_t c = first; c < first + n; ++c) arena_part.bounds.expand(clusters_[c].bounds);
+      parts_.push_back(arena_part);
       for (uint32_t c = first; c < first + n; ++c) {
         ArenaInstance instance;
         instance.cluster = c;
         instance.object = uint32_t(o);
         instance.material = part.material;
         instance.cone_test = !material.double_sided && (kind & kSimilarity) && clusters_[c].cone_cutoff < 1.0f;
-        pending.push_back({instance, key});
+        pending.push_back({instance, key, part_index});
       }
     }
   }
@@ -317,6 +324,9 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
     ++g.instance_count;
     g.triangles += clusters_[in.cluster].index_count / 3;
     triangles_ += clusters_[in.cluster].index_count / 3;
+    ArenaPart& part = parts_[p.part];
+    if (part.instance_count == 0) part.first_instance = uint32_t(instances_.size());
+    ++part.instance_count;
     instances_.push_back(in);
     gpu_instances.insert(gpu_instances.end(),
                          {in.cluster, in.object, in.material, in.group | (in.cone_test ? kConeTestBit : 0u)});
@@ -334,6 +344,18 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
          {a.bounds.hi.x, a.bounds.hi.y, a.bounds.hi.z, 0.0f},
          {a.first_index, a.index_count, a.base_vertex, 0u}};
   }
+  // Parts: object, first instance, count, 0; box lo; box hi (gpu_cull.comp.glsl's Part).
+  std::vector<float> gpu_parts;
+  gpu_parts.reserve(12 * parts_.size());
+  for (const ArenaPart& part : parts_) {
+    const uint32_t info[4] = {part.object, part.first_instance, part.instance_count, 0u};
+    float words[4];
+    std::memcpy(words, info, sizeof(info));
+    const Box3 b = part.bounds.empty() ? Box3::fromPoints(Vec3(0.0f), Vec3(0.0f)) : part.bounds;
+    gpu_parts.insert(gpu_parts.end(), {words[0], words[1], words[2], words[3], b.lo.x, b.lo.y, b.lo.z, 0.0f, b.hi.x,
+                                       b.hi.y, b.hi.z, 0.0f});
+  }
+  buffers_.parts = makeBuffer(gpu_parts.data(), gpu_parts.size() * sizeof(float), gpu_bytes_);
   std::vector<uint32_t> identity(std::max<size_t>(instances_.size(), 1));
   for (uint32_t i = 0; i < identity.size(); ++i) identity[i] = i;
   vertex_count_ = vertices.size();
@@ -369,8 +391,8 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
 
 SceneArena::~SceneArena() {
   if (buffers_.vertex_array) glDeleteVertexArrays(1, &buffers_.vertex_array);
-  const GLuint buffers[] = {vertex_buffer_,       index_buffer_,       instance_ids_,       buffers_.clusters,
-                            buffers_.instances,   buffers_.objects,    buffers_.materials};
+  const GLuint buffers[] = {vertex_buffer_,      index_buffer_,    instance_ids_,      buffers_.clusters,
+                            buffers_.instances,  buffers_.objects, buffers_.materials, buffers_.parts};
   glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
   if (!texture_arrays_.empty()) glDeleteTextures(GLsizei(texture_arrays_.size()), texture_arrays_.data());
 }

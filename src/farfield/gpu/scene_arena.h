@@ -55,6 +55,14 @@ struct ArenaInstance {
   bool cone_test = false;  // single-sided material, a transform that keeps angles, a cone that can reject
 };
 
+// The instances of one object part (its mesh's clusters, contiguous among the instances): culled whole first.
+struct ArenaPart {
+  uint32_t object = 0;  // index into Scene::objects
+  uint32_t first_instance = 0;
+  uint32_t instance_count = 0;
+  Box3 bounds;  // its mesh's, in the object's own space
+};
+
 // Instances that one multi-draw draws: same texture array, same face culling, same winding.
 struct MaterialGroup {
   int texture_array = -1;   // -1: untextured
@@ -83,6 +91,7 @@ class SceneArena {
   // Clusters of scene mesh m: clusters()[meshClusters(m).first, + second).
   std::pair<uint32_t, uint32_t> meshClusters(uint32_t mesh) const { return mesh_clusters_.at(mesh); }
   std::span<const ArenaInstance> instances() const { return instances_; }
+  std::span<const ArenaPart> parts() const { return parts_; }
   std::span<const MaterialGroup> groups() const { return groups_; }
   uint64_t triangleCount() const { return triangles_; }
   size_t gpuBytes() const { return gpu_bytes_; }
@@ -100,7 +109,7 @@ class SceneArena {
   // GL names for gpu::GpuCuller.
   struct Buffers {
     uint32_t vertex_array = 0;  // positions, normals, uvs (locations 0-2) and the instance index (3, per instance)
-    uint32_t clusters = 0, instances = 0, objects = 0, materials = 0;
+    uint32_t clusters = 0, instances = 0, objects = 0, materials = 0, parts = 0;
   };
   const Buffers& buffers() const { return buffers_; }
   // The GL texture of texture array i (MaterialGroup::texture_array).
@@ -113,6 +122,7 @@ class SceneArena {
   std::vector<ArenaCluster> clusters_;
   std::vector<std::pair<uint32_t, uint32_t>> mesh_clusters_;
   std::vector<ArenaInstance> instances_;
+  std::vector<ArenaPart> parts_;
   std::vector<MaterialGroup> groups_;
   std::vector<uint8_t> object_kind_;  // per object: bit 0 mirrored, bit 1 keeps angles (similarity)
   uint64_t triangles_ = 0;

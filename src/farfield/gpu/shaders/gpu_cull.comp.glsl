@@ -1,18 +1,26 @@
 #version 450 core
-// Farfield cluster culling (gpu/gpu_culler.h): one invocation per cluster instance of the arena (gpu/scene_arena.h).
-// An instance is in view when its object is drawn in this frame's plan, its bounding sphere and its box meet the
-// frustum and its normal cone does not turn every triangle away from the eye. Phases:
-//   0 (early): instances in view that were visible in the last frame are drawn;
-//   1 (late): instances in view are tested against the depth pyramid built from the early phase's depth; those not
-//     hidden are visible, and drawn unless the early phase drew them; the visibility is kept for the next frame;
-//   2 (all): instances in view are drawn (no occlusion), and are the visible ones.
-// Drawn instances become indirect draw commands: compacted per material group (an atomic counter per group, drawn
-// with glMultiDrawElementsIndirectCount) or, without compaction, each in its own slot, culled ones left empty.
+// Farfield cluster culling (gpu/gpu_culler.h), in stages compiled from this one file (FF_STAGE_*):
+//   PARTS (one invocation per object part): parts of objects in this frame's plan whose box meets the frustum put
+//     their cluster instances on the work list; the others are culled whole;
+//   ARGS (one invocation): the work list's length as the indirect dispatch of the next stages;
+//   CLUSTERS (one per work list entry): an instance is in view when its sphere and box meet the frustum and its normal
+//     cone does not turn every triangle away from the eye; then, by phase,
+//       0 (early): those in view that were visible in the last frame are drawn,
+//       1 (late): those in view are tested against the depth pyramid built from the early phase's depth; those not
+//         hidden are visible, and drawn unless the early phase drew them; the visibility is kept for the next frame,
+//       2 (all): those in view are drawn (no occlusion) and are the visible ones;
+//   EMIT (one per work list entry): each run of consecutive drawn clusters of one object part (contiguous indices)
+//     becomes one indirect draw command, compacted per material group (an atomic counter per group, drawn with
+//     glMultiDrawElementsIndirectCount) or in its first instance's own slot (the other slots cleared).
 // The occlusion test is gpu::OcclusionCuller's (occlusion_culler.cpp: projectBox, DepthPyramid::farthest, hides),
 // the same conservative arithmetic: a box is hidden only when all of it lies behind the stored depth at every pixel
 // it may cover.
 
+#ifdef FF_STAGE_ARGS
+layout(local_size_x = 1) in;
+#else
 layout(local_size_x = 64) in;
+#endif
 
 struct Cluster {
   vec4 sphere;     // centre, radius (mesh space)
@@ -35,17 +43,25 @@ struct Command {
   int base_vertex;
   uint base_instance;
 };
+struct Part {
+  uvec4 info;  // object, first instance, instance count
+  vec4 box_lo;  // of its mesh, in the object's own space
+  vec4 box_hi;
+};
 
 layout(std430, binding = 0) readonly buffer Clusters { Cluster clusters[]; };
 layout(std430, binding = 1) readonly buffer Instances { uvec4 instances[]; };  // cluster, object, material, group
 layout(std430, binding = 2) readonly buffer Objects { Object objects[]; };
 layout(std430, binding = 4) readonly buffer Enabled { uint enabled[]; };        // per object: drawn in the plan
 layout(std430, binding = 5) buffer Visibility { uint visible[]; };              // per instance: visible last frame
-layout(std430, binding = 6) writeonly buffer Commands { Command commands[]; };
+layout(std430, binding = 6) buffer Commands { Command commands[]; };
 layout(std430, binding = 7) buffer Counts { uint counts[]; };                   // per group: commands written
 layout(std430, binding = 8) readonly buffer GroupFirst { uint group_first[]; };
 layout(std430, binding = 9) buffer Stats { uint stats[]; };
 layout(std430, binding = 10) buffer ObjectFrame { uint object_frame[]; };    // per object: last frame it was drawn
+layout(std430, binding = 11) readonly buffer Parts { Part parts[]; };
+layout(std430, binding = 12) buffer Work { uvec4 dispatch_args; uint work[]; };  // dispatch_args.w: list length
+layout(std430, binding = 13) buffer Drawn { uint drawn_flag[]; };            // per instance: drawn in this phase
 
 layout(binding = 2) uniform sampler2D u_depth;    // pyramid level 0: the frame's depth
 layout(binding = 3) uniform sampler2D u_pyramid;  // levels 1.. in its mip levels 0..
@@ -57,17 +73,70 @@ uniform ivec2 u_viewport;
 uniform int u_phase;
 uniform int u_compact;
 uniform int u_cone;
-uniform uint u_instance_count;
+uniform uint u_count;    // PARTS: parts; the instances of the arena otherwise
 uniform int u_levels;
 uniform ivec2 u_level_size[16];
 uniform float u_margin;  // relative depth margin of the occlusion test
 uniform uint u_frame;    // this frame's number + 1 (object_frame starts at 0)
 
 // Statistics (gpu_culler.cpp, GpuCullStats): summed in shared memory, added once per work group.
-const int kEnabled = 0, kDrawnEarly = 1, kDrawnLate = 2, kTrianglesEarly = 3, kTrianglesLate = 4, kFrustum = 5,
-          kCone = 6, kOccluded = 7, kObjects = 8, kStatCount = 9;
+const int kInPlan = 0, kDrawnEarly = 1, kDrawnLate = 2, kTrianglesEarly = 3, kTrianglesLate = 4, kFrustum = 5,
+          kCone = 6, kOccluded = 7, kObjects = 8, kCommands = 9, kStatCount = 10;
 shared uint s_stats[kStatCount];
 
+void beginStats() {
+  if (gl_LocalInvocationIndex < uint(kStatCount)) s_stats[gl_LocalInvocationIndex] = 0u;
+  barrier();
+}
+void endStats() {
+  barrier();
+  if (gl_LocalInvocationIndex < uint(kStatCount) && s_stats[gl_LocalInvocationIndex] != 0u)
+    atomicAdd(stats[gl_LocalInvocationIndex], s_stats[gl_LocalInvocationIndex]);
+}
+uint invocation() {
+  return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+}
+
+// The box [lo, hi] of an object's own space under `model` against the frustum (Frustum::intersects, with each plane
+// taken into that space): false only when it certainly lies outside.
+bool boxInFrustum(vec3 lo, vec3 hi, mat4 model) {
+  for (int p = 0; p < 6; ++p) {
+    const vec4 local = u_planes[p] * model;
+    const vec3 corner = vec3(local.x >= 0.0 ? hi.x : lo.x, local.y >= 0.0 ? hi.y : lo.y, local.z >= 0.0 ? hi.z : lo.z);
+    if (dot(local.xyz, corner) + local.w < 0.0) return false;
+  }
+  return true;
+}
+
+#if defined(FF_STAGE_PARTS)
+void main() {
+  beginStats();
+  const uint i = invocation();
+  if (i < u_count) {
+    const Part part = parts[i];
+    const uint object = part.info.x, count = part.info.z;
+    if (enabled[object] != 0u && count > 0u) {
+      atomicAdd(s_stats[kInPlan], count);
+      const bool affine = (objects[object].info.y & 1u) != 0u;
+      if (!affine || boxInFrustum(part.box_lo.xyz, part.box_hi.xyz, objects[object].model)) {
+        const uint base = atomicAdd(dispatch_args.w, count);
+        for (uint k = 0u; k < count; ++k) work[base + k] = part.info.y + k;
+      } else {
+        atomicAdd(s_stats[kFrustum], count);
+      }
+    }
+  }
+  endStats();
+}
+
+#elif defined(FF_STAGE_ARGS)
+void main() {
+  const uint groups = (dispatch_args.w + 63u) / 64u;
+  const uint x = min(groups, 65535u);
+  dispatch_args.xyz = uvec3(x, x == 0u ? 0u : (groups + x - 1u) / x, 1u);
+}
+
+#elif defined(FF_STAGE_CLUSTERS)
 float levelTexel(int k, ivec2 p) {
   return k == 0 ? texelFetch(u_depth, p, 0).r : texelFetch(u_pyramid, p, k - 1).r;
 }
@@ -103,58 +172,43 @@ bool hidden(vec3 lo, vec3 hi, mat4 mvp) {
   return nearest * (1.0 + u_margin) + 1e-12 < farthest(x0, y0, x1, y1);
 }
 
-void emit(uint i, uint group, Cluster c) {
-  const uint slot = u_compact != 0 ? group_first[group] + atomicAdd(counts[group], 1u) : i;
-  commands[slot] = Command(c.range.y, 1u, c.range.x, int(c.range.z), i);
-}
 
 void main() {
-  if (gl_LocalInvocationIndex < uint(kStatCount)) s_stats[gl_LocalInvocationIndex] = 0u;
-  barrier();
-
-  const uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
-                 gl_LocalInvocationIndex;
-  if (i < u_instance_count) {
+  beginStats();
+  const uint w = invocation();
+  if (w < dispatch_args.w) {
+    const uint i = work[w];
     const uvec4 instance = instances[i];
-    const uint group = instance.w & 0xffffu;
     const bool cone_test = u_cone != 0 && (instance.w & 0x80000000u) != 0u;
     const Cluster c = clusters[instance.x];
-    bool in_view = enabled[instance.y] != 0u;
-    bool drawn = false, occluded = false;
     const mat4 model = objects[instance.y].model;
     const bool affine = (objects[instance.y].info.y & 1u) != 0u;
-    if (in_view) {
-      atomicAdd(s_stats[kEnabled], 1u);
-      if (affine) {
-        const vec3 centre = (model * vec4(c.sphere.xyz, 1.0)).xyz;
-        const float radius = c.sphere.w * objects[instance.y].misc.x;
-        for (int p = 0; p < 6; ++p) {
-          if (dot(u_planes[p].xyz, centre) + u_planes[p].w < -radius) in_view = false;
-          // The box in the object's own space against the plane taken there (Frustum::intersects): tighter for flat
-          // and long clusters than the sphere.
-          const vec4 local = u_planes[p] * model;
-          const vec3 corner = vec3(local.x >= 0.0 ? c.box_hi.x : c.box_lo.x, local.y >= 0.0 ? c.box_hi.y : c.box_lo.y,
-                                   local.z >= 0.0 ? c.box_hi.z : c.box_lo.z);
-          if (dot(local.xyz, corner) + local.w < 0.0) in_view = false;
-        }
-        if (!in_view) atomicAdd(s_stats[kFrustum], 1u);
-      }
-      if (in_view && cone_test) {
-        // coneRejects (scene_arena.cpp), in world space: the transform keeps angles (SceneArena checks).
-        const vec3 apex = (model * vec4(c.cone_apex.xyz, 1.0)).xyz;
-        const vec3 axis = normalize(mat3(model) * c.cone_axis.xyz);
-        const vec3 d = apex - u_eye;
-        const float len = length(d);
-        if (len > 0.0 && dot(d / len, axis) >= c.cone_apex.w + 1e-3) {
-          in_view = false;
-          atomicAdd(s_stats[kCone], 1u);
-        }
+    bool in_view = true;
+    if (affine) {
+      const vec3 centre = (model * vec4(c.sphere.xyz, 1.0)).xyz;
+      const float radius = c.sphere.w * objects[instance.y].misc.x;
+      for (int p = 0; p < 6; ++p)
+        if (dot(u_planes[p].xyz, centre) + u_planes[p].w < -radius) in_view = false;
+      // The cluster's box too: tighter than the sphere for flat and long clusters.
+      in_view = in_view && boxInFrustum(c.box_lo.xyz, c.box_hi.xyz, model);
+      if (!in_view && u_phase != 0) atomicAdd(s_stats[kFrustum], 1u);
+    }
+    if (in_view && cone_test) {
+      // coneRejects (scene_arena.cpp), in world space: the transform keeps angles (SceneArena checks).
+      const vec3 apex = (model * vec4(c.cone_apex.xyz, 1.0)).xyz;
+      const vec3 axis = normalize(mat3(model) * c.cone_axis.xyz);
+      const vec3 d = apex - u_eye;
+      const float len = length(d);
+      if (len > 0.0 && dot(d / len, axis) >= c.cone_apex.w + 1e-3) {
+        in_view = false;
+        if (u_phase != 0) atomicAdd(s_stats[kCone], 1u);
       }
     }
+    bool drawn = false;
     if (u_phase == 0) {
       drawn = in_view && visible[i] != 0u;
     } else if (u_phase == 1) {
-      occluded = in_view && affine && hidden(c.box_lo.xyz, c.box_hi.xyz, u_view_proj * model);
+      const bool occluded = in_view && affine && hidden(c.box_lo.xyz, c.box_hi.xyz, u_view_proj * model);
       const bool now_visible = in_view && !occluded;
       drawn = now_visible && visible[i] == 0u;
       visible[i] = now_visible ? 1u : 0u;
@@ -163,24 +217,45 @@ void main() {
       drawn = in_view;
       visible[i] = in_view ? 1u : 0u;
     }
+    drawn_flag[i] = drawn ? 1u : 0u;
     if (drawn) {
-      emit(i, group, c);
       atomicAdd(s_stats[u_phase == 0 ? kDrawnEarly : kDrawnLate], 1u);
       atomicAdd(s_stats[u_phase == 0 ? kTrianglesEarly : kTrianglesLate], c.range.y / 3u);
       // Distinct objects: the first instance of an object drawn in this frame counts it.
       if (atomicExchange(object_frame[instance.y], u_frame) != u_frame) atomicAdd(s_stats[kObjects], 1u);
-    } else if (u_compact == 0) {
-      commands[i] = Command(0u, 0u, 0u, 0, 0u);
     }
   }
-
-  barrier();
-  if (gl_LocalInvocationIndex < uint(kStatCount)) {
-    const uint value = s_stats[gl_LocalInvocationIndex];
-    // The early phase's in-view counts would count the late phase's again: only the late (or only) phase adds them.
-    const uint k = gl_LocalInvocationIndex;
-    const bool counted = k == uint(kObjects) || (k == uint(kDrawnEarly) || k == uint(kTrianglesEarly) ? u_phase == 0
-                                                                                                        : u_phase != 0);
-    if (counted && value != 0u) atomicAdd(stats[gl_LocalInvocationIndex], value);
-  }
+  endStats();
 }
+
+#elif defined(FF_STAGE_EMIT)
+
+// Whether instance b continues instance a in one draw: the same object, material and group, and b's indices right
+// after a's over the same vertices (consecutive clusters of one part). Both are then on the work list together.
+bool continues(uint a, uint b) {
+  const uvec4 ia = instances[a], ib = instances[b];
+  if (ia.y != ib.y || ia.z != ib.z || (ia.w & 0xffffu) != (ib.w & 0xffffu)) return false;
+  const uvec4 ra = clusters[ia.x].range, rb = clusters[ib.x].range;
+  return ra.z == rb.z && ra.x + ra.y == rb.x;
+}
+
+void main() {
+  beginStats();
+  const uint w = invocation();
+  if (w < dispatch_args.w) {
+    const uint i = work[w];
+    if (drawn_flag[i] != 0u && !(i > 0u && continues(i - 1u, i) && drawn_flag[i - 1u] != 0u)) {
+      // The head of a run: draw through its last drawn successor.
+      const uvec4 range = clusters[instances[i].x].range;
+      uint count = range.y;
+      for (uint j = i; j + 1u < u_count && continues(j, j + 1u) && drawn_flag[j + 1u] != 0u; ++j)
+        count += clusters[instances[j + 1u].x].range.y;
+      const uint group = instances[i].w & 0xffffu;
+      const uint slot = u_compact != 0 ? group_first[group] + atomicAdd(counts[group], 1u) : i;
+      commands[slot] = Command(count, 1u, range.x, int(range.z), i);
+      atomicAdd(s_stats[kCommands], 1u);
+    }
+  }
+  endStats();
+}
+#endif
