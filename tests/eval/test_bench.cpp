@@ -369,7 +369,9 @@ TEST(Bench, CsvMarkdownAndSampleFrames) {
     EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 20) << csv[i];
     // The GL counters are on in the bench: every frame has its calls counted, and culled waits for nothing.
     EXPECT_GT(std::stoul(field(csv[i], 17)), 0u) << csv[i];
-    if (csv[i].find(",culled,") != std::string::npos) EXPECT_EQ(field(csv[i], 20), "0") << csv[i];
+    if (csv[i].find(",culled,") != std::string::npos) {
+      EXPECT_EQ(field(csv[i], 20), "0") << csv[i];
+    }
     // No bound for full and culled (no --error-px, neither reports one): the over_bound column says "-".
     EXPECT_NE(csv[i].find(",-,"), std::string::npos) << csv[i];
   }
