@@ -305,12 +305,13 @@ TEST(ImpostorModeTest, CellsWithoutImpostorFallBackToCulledGeometry) {
     expected_fallbacks += cells.lookup(f.eye, f.at - f.eye) != s.visited.front() ? 1 : 0;
   ASSERT_GT(expected_fallbacks, 0u);
 
-  const BenchResult r = runModes(s, {"culled-cpu", "depth-mesh"}, {{"impostor_dir", dir}});
+  const BenchResult r = runModes(s, {"culled-cpu", "depth-mesh"}, {{"impostor_dir", dir}, {"geometry", "cpu"}});
   const ModeResult* depth = r.mode("depth-mesh");
   const ModeResult* culled = r.mode("culled-cpu");
   EXPECT_EQ(depth->info.at("fallback_frames"), double(expected_fallbacks));
   EXPECT_EQ(depth->info.at("cell_loads"), 1.0);
-  // Fallback frames are the culled-cpu mode's frames (frustum, facing and occlusion culling of every object in view):
+  // With geometry culled on the CPU, fallback frames are the culled-cpu mode's frames (frustum, facing and occlusion
+  // culling of every object in view):
   // identical images and triangle counts.
   for (size_t k = 0; k < depth->frames.size(); ++k) {
     const gen::PathFrame& f = s.path.frames[depth->frames[k].path_frame];

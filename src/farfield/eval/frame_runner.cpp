@@ -86,8 +86,8 @@ FrameRecord FrameRunner::run(Mode& mode, const Camera& camera, size_t path_frame
     stats.gpu_ms = std::min(timer_.elapsedMs(), clock.milliseconds());
     record.wall_ms = clock.milliseconds();
     if (const std::optional<gpu::FrameStats> late = mode.lateFrameStats(path_frame)) {
-      stats.triangles = late->triangles;
-      stats.objects = late->objects;
+      stats.triangles += late->triangles;
+      stats.objects += late->objects;
     }
   }
   const gpu::GlCounters used = gpu::glCounters() - before;

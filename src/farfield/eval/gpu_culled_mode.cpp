@@ -22,19 +22,16 @@ gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string
   return options;
 }
 
-GpuCulledMode::GpuCulledMode(const ModeContext& context) : options_(gpuCullOptions(context, "culled")) {}
+GpuCullRun::GpuCullRun(const ModeContext& context, const gpu::GpuCullOptions& options)
+    : culler_(std::make_unique<gpu::GpuCuller>(context.arena(), options)) {}
 
-void GpuCulledMode::prepare(const ModeContext& context) {
-  culler_ = std::make_unique<gpu::GpuCuller>(context.arena(), options_);
-}
-
-void GpuCulledMode::frame(FrameContext& frame) {
+void GpuCullRun::draw(FrameContext& frame) {
   gpu::RenderTarget& target = frame.beginOwnPass();
   path_frame_of_.push_back(frame.pathFrame());
   frame.addStats(culler_->draw(frame.camera(), target, gpu::RenderMode::Shaded, frame.renderer().light()));
 }
 
-void GpuCulledMode::collect() {
+void GpuCullRun::collect() {
   for (const gpu::GpuCullStats& s : culler_->finishedStats()) {
     latest_[path_frame_of_.at(s.frame)] = s;
     frames_ += 1.0;
@@ -48,7 +45,7 @@ void GpuCulledMode::collect() {
   }
 }
 
-std::optional<gpu::FrameStats> GpuCulledMode::lateFrameStats(size_t path_frame) {
+std::optional<gpu::FrameStats> GpuCullRun::lateFrameStats(size_t path_frame) {
   collect();
   const auto it = latest_.find(path_frame);
   if (it == latest_.end()) return std::nullopt;
@@ -58,9 +55,8 @@ std::optional<gpu::FrameStats> GpuCulledMode::lateFrameStats(size_t path_frame) 
   return stats;
 }
 
-std::map<std::string, double> GpuCulledMode::info() const {
+std::map<std::string, double> GpuCullRun::info() const {
   std::map<std::string, double> out;
-  if (!culler_) return out;
   const gpu::SceneArena& arena = culler_->arena();
   out["arena_clusters"] = double(arena.clusters().size());
   out["arena_instances"] = double(arena.instances().size());
@@ -78,5 +74,9 @@ std::map<std::string, double> GpuCulledMode::info() const {
   }
   return out;
 }
+
+GpuCulledMode::GpuCulledMode(const ModeContext& context) : options_(gpuCullOptions(context, "culled")) {}
+
+void GpuCulledMode::prepare(const ModeContext& context) { run_.emplace(context, options_); }
 
 }  // namespace farfield::eval

@@ -4,8 +4,9 @@
 // cluster in view), up to pixels whose content depends on draw order (coplanar surfaces of different objects).
 // Triangles and objects drawn are counted on the GPU and read after the frame (Mode::lateFrameStats).
 //
-// Options (--mode-option): gpu_occlusion=on|off (the pyramid test; off: frustum and cones only), gpu_cones=on|off,
-// gpu_compact=on|off (compacted command lists with glMultiDrawElementsIndirectCount where the driver has it).
+// Options (--mode-option), shared by every mode that draws through the arena: gpu_occlusion=on|off (the pyramid test;
+// off: frustum and cones only), gpu_cones=on|off, gpu_compact=on|off (compacted command lists with
+// glMultiDrawElementsIndirectCount where the driver has it).
 #pragma once
 
 #include <map>
@@ -23,28 +24,44 @@ namespace farfield::eval {
 // farfield::Error naming the key for another value.
 gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string& mode_name);
 
+// A GpuCuller over the run's arena drawing into bench frames, its statistics read late and kept per path frame.
+class GpuCullRun {
+ public:
+  // Needs the context current (makes the run's arena on first use).
+  GpuCullRun(const ModeContext& context, const gpu::GpuCullOptions& options);
+  gpu::GpuCuller& culler() { return *culler_; }
+  // Draws the culler's frame as a pass of `frame` (FrameContext::beginOwnPass).
+  void draw(FrameContext& frame);
+  // Triangles and objects of the last frame drawn for this path frame, once the GPU has finished it.
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame);
+  // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, indirect_count (1 or 0), and per frame
+  // (means over the frames whose statistics came back): gpu_clusters_drawn_early, gpu_clusters_drawn_late,
+  // gpu_frustum_culled, gpu_cone_culled, gpu_occlusion_culled, gpu_draw_commands (indirect draws after merging runs
+  // of clusters), gpu_triangles.
+  std::map<std::string, double> info() const;
+
+ private:
+  void collect();
+
+  std::unique_ptr<gpu::GpuCuller> culler_;
+  std::vector<size_t> path_frame_of_;           // per culler frame
+  std::map<size_t, gpu::GpuCullStats> latest_;  // per path frame, the last statistics that came back
+  double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0, commands_ = 0.0;
+  double triangles_ = 0.0;
+};
+
 class GpuCulledMode final : public Mode {
  public:
   explicit GpuCulledMode(const ModeContext& context);
   std::string name() const override { return "culled"; }
   void prepare(const ModeContext& context) override;
-  void frame(FrameContext& frame) override;
-  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override;
-  // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, indirect_count (1 or 0), and per frame
-  // (means over the frames whose statistics came back): gpu_clusters_drawn_early, gpu_clusters_drawn_late,
-  // gpu_frustum_culled, gpu_cone_culled, gpu_occlusion_culled, gpu_draw_commands (indirect draws after merging runs
-  // of clusters), gpu_triangles.
-  std::map<std::string, double> info() const override;
+  void frame(FrameContext& frame) override { run_->draw(frame); }
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override { return run_->lateFrameStats(path_frame); }
+  std::map<std::string, double> info() const override { return run_ ? run_->info() : std::map<std::string, double>{}; }
 
  private:
-  void collect();
-
   gpu::GpuCullOptions options_;
-  std::unique_ptr<gpu::GpuCuller> culler_;
-  std::vector<size_t> path_frame_of_;  // per culler frame
-  std::map<size_t, gpu::GpuCullStats> latest_;  // per path frame, the last statistics that came back
-  double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0, commands_ = 0.0;
-  double triangles_ = 0.0;
+  std::optional<GpuCullRun> run_;
 };
 
 }  // namespace farfield::eval

@@ -51,7 +51,8 @@ ImpostorMode::ImpostorMode(std::string technique, const ModeContext& context) : 
   o.cell_lookup = context.option("cell_lookup");
   if (!o.cell_lookup.empty()) urban::parseCellLookup(o.cell_lookup, "--mode-option cell_lookup");
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);
-  if (switchOption(context, "occlusion", true)) occlusion_.emplace(occluderShareOption(context, technique_));
+  geometry_.emplace(context, technique_);
+  geometry_->configure(o);
 }
 
 ImpostorMode::~ImpostorMode() = default;
@@ -77,18 +78,19 @@ void ImpostorMode::prepare(const ModeContext& context) {
   options_.width = context.width;
   options_.height = context.height;
   // The walkthrough checks the rest: the scene, the single stage (Smi), the stage lists.
+  geometry_->prepare(context);
   walkthrough_ = std::make_unique<runtime::Walkthrough>(*context.scene, *context.gpu_scene, *context.bvh,
                                                         *context.renderer, options_);
 }
 
 void ImpostorMode::frame(FrameContext& frame) {
   const runtime::FramePlan& plan = walkthrough_->plan(frame.camera());
-  submitPlan(frame, plan, occlusion_ ? &*occlusion_ : nullptr);
+  geometry_->submit(frame, plan);
 }
 
 std::map<std::string, double> ImpostorMode::info() const {
   std::map<std::string, double> info = walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
-  if (occlusion_) info.merge(occlusion_->info());
+  info.merge(geometry_->info());
   return info;
 }
 

@@ -16,7 +16,8 @@
 //                         grid-mesh): a store holds one kind
 //   depth_mesh_dir=DIR    store for the depth-mesh mode only (overrides impostor_dir), likewise grid_mesh_dir=DIR:
 //                         for the two stores of `bake --technique depth-mesh -o A` and `--technique grid-mesh -o B`
-//   error_px=PX, gpu_budget_mb=MB, memory_budget_mb=MB, streaming_csv=FILE, occlusion=on|off, occluder_share=S (as
+//   error_px=PX, gpu_budget_mb=MB, memory_budget_mb=MB, streaming_csv=FILE, geometry=gpu|cpu, occlusion=on|off,
+//   occluder_share=S (as
 //   mmi_mode.h), read_ahead=on|off, impostor_ids=object|layer, cell_lookup=street|nearest
 //                         as for the smi mode (eval/mmi_mode.h)
 #pragma once
@@ -27,7 +28,7 @@
 #include <string>
 
 #include "farfield/eval/mode.h"
-#include "farfield/eval/occlusion_pass.h"
+#include "farfield/eval/plan_geometry.h"
 #include "farfield/runtime/walkthrough.h"
 
 namespace farfield::eval {
@@ -49,6 +50,9 @@ class ImpostorMode final : public Mode {
   // the single stage: re-bake), one without the single stage, or one whose single mesh is of the other kind.
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
+    return geometry_->lateFrameStats(path_frame);
+  }
   // The walkthrough's statistics (runtime::Walkthrough::statistics): cells, loads, fallback frames, triangles, and
   // the bound with the layer draws it turned into geometry.
   std::map<std::string, double> info() const override;
@@ -57,7 +61,7 @@ class ImpostorMode final : public Mode {
   std::string technique_;
   runtime::WalkthroughOptions options_;
   std::unique_ptr<runtime::Walkthrough> walkthrough_;
-  std::optional<OcclusionPass> occlusion_;  // the plans' geometry occlusion-culled (--mode-option occlusion=on)
+  std::optional<PlanGeometry> geometry_;  // how the plans' geometry is drawn (--mode-option geometry, occlusion)
 };
 
 }  // namespace farfield::eval

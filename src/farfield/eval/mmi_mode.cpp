@@ -51,8 +51,8 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
   o.min_lifetime_frames = numberOption(context, "dynamic_min_lifetime", o.min_lifetime_frames, 0.0);
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);
   o.layer_tiles = switchOption(context, "layer_tiles", true);
-  if (switchOption(context, "occlusion", true))
-    occlusion_.emplace(occluderShareOption(context, runtime::representationName(representation)));
+  geometry_.emplace(context, runtime::representationName(representation));
+  geometry_->configure(o);
 }
 
 MmiMode::~MmiMode() = default;
@@ -60,20 +60,21 @@ MmiMode::~MmiMode() = default;
 void MmiMode::prepare(const ModeContext& context) {
   options_.width = context.width;
   options_.height = context.height;
+  geometry_->prepare(context);
   walkthrough_ = std::make_unique<runtime::Walkthrough>(*context.scene, *context.gpu_scene, *context.bvh, *context.renderer,
                                                options_);
 }
 
 void MmiMode::frame(FrameContext& frame) {
   const runtime::FramePlan& plan = walkthrough_->plan(frame.camera(), [&] { frame.beginOwnPass(); });
-  submitPlan(frame, plan, occlusion_ ? &*occlusion_ : nullptr);
+  geometry_->submit(frame, plan);
   if (plan.report.updates > 0) frame.addStats(plan.report.update_stats);
 }
 
 std::map<std::string, double> MmiMode::info() const {
   // The walkthrough reports its bound (error_bound_px) for the representations that draw impostors only.
   std::map<std::string, double> info = walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
-  if (occlusion_) info.merge(occlusion_->info());
+  info.merge(geometry_->info());
   return info;
 }
 

@@ -23,8 +23,12 @@
 //   cell_lookup=street|nearest  as for the depth-mesh mode
 //   error_px=PX             the error bound in pixels of this walk's frames (default: the bake's --error-px); the
 //                           bound's angle follows from the frame size and field of view (core/error_bound.h)
-//   occlusion=on|off        the plan's geometry occlusion-culled against the depth of its nearest items (exact:
-//                           the same frame; default on); occluder_share=S the triangle share drawn first (0.1)
+//   geometry=gpu|cpu        the plan's geometry culled and drawn on the GPU through the run's arena (default; as
+//                           the culled mode, gpu_occlusion, gpu_cones, gpu_compact apply) or culled per cluster on
+//                           the CPU (eval/plan_geometry.h)
+//   occlusion=on|off        the plan's geometry occlusion-culled (exact: the same frame; default on); on the CPU
+//                           path against the depth of its nearest items, occluder_share=S the triangle share drawn
+//                           first (0.1)
 //   mmi-dynamic only:
 //   frame_budget_ms=MS      the desired frame time (default 33.3: 30 Hz)
 //   dynamic_error_px=PX     a layer is refreshed when its error angle exceeds PX pixels (default 2)
@@ -41,7 +45,7 @@
 #include <string>
 
 #include "farfield/eval/mode.h"
-#include "farfield/eval/occlusion_pass.h"
+#include "farfield/eval/plan_geometry.h"
 #include "farfield/runtime/walkthrough.h"
 
 namespace farfield::eval {
@@ -57,12 +61,15 @@ class MmiMode final : public Mode {
   std::string name() const override { return runtime::representationName(options_.representation); }
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
+    return geometry_->lateFrameStats(path_frame);
+  }
   std::map<std::string, double> info() const override;
 
  private:
   runtime::WalkthroughOptions options_;
   std::unique_ptr<runtime::Walkthrough> walkthrough_;
-  std::optional<OcclusionPass> occlusion_;  // the plans' geometry occlusion-culled (--mode-option occlusion=on)
+  std::optional<PlanGeometry> geometry_;  // how the plans' geometry is drawn (--mode-option geometry, occlusion)
 };
 
 }  // namespace farfield::eval

@@ -142,7 +142,8 @@ class Mode {
   // Numbers about the run the mode wants reported (bench.json "modes.<name>.info"), e.g. impostor count, bytes.
   virtual std::map<std::string, double> info() const { return {}; }
   // What the GPU counted of the mode's last frame of this path frame, read back late (a GPU-driven mode knows its
-  // triangles and objects only then): the harness asks after it has waited for the frame. None by default.
+  // triangles and objects only then): the harness asks after it has waited for the frame and adds them to what the
+  // frame's passes reported. None by default.
   virtual std::optional<gpu::FrameStats> lateFrameStats(size_t /*path_frame*/) { return std::nullopt; }
 };
 

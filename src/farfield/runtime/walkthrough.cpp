@@ -91,6 +91,9 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
     throw Error(me, "needs an impostor database: a directory written by farfield bake --pipeline pvs,near-far,single,mmi (or farfield place for the placed mode)");
   if (!(options_.error_px >= 0.0) || !std::isfinite(options_.error_px))
     throw Error(me, "error bound must be a finite number of pixels >= 0");
+  object_triangles_.assign(scene.objects.size() + 1, 0);
+  for (const scene::Object& o : scene.objects)
+    for (const scene::Part& p : o.parts) object_triangles_[o.id] += scene.meshes[p.mesh].triangleCount();
   if (kind == Representation::Placed) {
     openPlacement();
     return;
@@ -151,9 +154,6 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
     reader_ = std::make_unique<store::CellReader>(options_.database, index_, reader);
   }
   invalid_object_.assign(scene.objects.size() + 1, 0);
-  object_triangles_.assign(scene.objects.size() + 1, 0);
-  for (const scene::Object& o : scene.objects)
-    for (const scene::Part& p : o.parts) object_triangles_[o.id] += scene.meshes[p.mesh].triangleCount();
   layer_id_base_ = uint32_t(scene.objects.size() + 1);
   if (kind == Representation::MmiDynamic) {
     // A few tenths of a second on llvmpipe: cap the triangles per workload so big scenes calibrate as fast.
@@ -283,6 +283,21 @@ void Walkthrough::readAhead(uint32_t half_edge, const Vec3& eye) {
     if (!cells_.count(next)) reader_->prefetch(next);
 }
 
+void Walkthrough::setGeometry(FramePlan& plan, const Camera& camera) {
+  if (options_.geometry_items) {
+    // GpuScene::appendDrawItems takes an empty list as "all objects".
+    if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera, &plan.geometry_bounds);
+    plan.geometry_items = plan.items.size();
+    for (const gpu::DrawItem& item : plan.items) plan.report.geometry_triangles += item.triangleCount();
+    return;
+  }
+  if (ids_ != plan.geometry_objects) {
+    plan.geometry_objects.assign(ids_.begin(), ids_.end());
+    ++plan.geometry_version;
+  }
+  for (uint32_t id : ids_) plan.report.geometry_triangles += object_triangles_[id];
+}
+
 const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<void()>& before_gpu_work) {
   if (placed_) return planPlaced(camera);
   FramePlan& plan = plan_;
@@ -372,10 +387,7 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   stats_.resident_bytes_max = std::max(stats_.resident_bytes_max, resident_bytes_);
   if (report.over_gpu_budget) ++stats_.over_gpu_budget_frames;
   std::sort(ids_.begin(), ids_.end());
-  // GpuScene::appendDrawItems takes an empty list as "all objects".
-  if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera, &plan.geometry_bounds);
-  plan.geometry_items = plan.items.size();
-  for (const gpu::DrawItem& item : plan.items) report.geometry_triangles += item.triangleCount();
+  setGeometry(plan, camera);
   stats_.geometry_triangles += double(report.geometry_triangles);
   if (report.layers_as_geometry > 0) ++stats_.invalid_frames;
   stats_.invalid_layer_draws += report.layers_as_geometry;

@@ -87,6 +87,10 @@ struct WalkthroughOptions {
   std::string cell_lookup;                     // "street" or "nearest"; "" = the database's
   bool layer_tiles = true;                     // Placed: layers drawn as their tiles (false: whole quads, the same
                                                // image with every texel shaded; for comparisons)
+  // true: the plan's geometry as draw items culled per cluster on the CPU (FramePlan::items, geometry_items);
+  // false: as the objects a GPU-driven frame culls itself (FramePlan::geometry_objects, gpu::GpuCuller), the items
+  // then holding the impostors only.
+  bool geometry_items = true;
   // MmiDynamic.
   double frame_budget_ms = 1000.0 / 30.0;
   double dynamic_error_px = 2.0;               // a dynamic impostor is refreshed beyond this error
@@ -143,7 +147,8 @@ struct FrameReport {
   double bound_rad = 0.0;         // at the frame's corner pixel (ErrorBound::angle)
   size_t layers_as_geometry = 0;  // the error bound is kept by drawing these as geometry
   size_t layers_unchecked = 0;    // the bound cannot be checked (no validity regions)
-  uint64_t geometry_triangles = 0;  // drawn (after culling per cluster)
+  uint64_t geometry_triangles = 0;  // drawn (after culling per cluster); with geometry_objects, of those objects
+                                    // whole (the GPU culls their clusters)
   uint64_t impostor_triangles = 0;
   double predicted_ms = 0.0;      // MmiDynamic: the cost model's prediction before updates (0 otherwise)
   bool over_budget = false;       // MmiDynamic: the prediction exceeded the budget
@@ -159,6 +164,12 @@ struct FramePlan {
   // the frame stays the same) before it draws the rest of the items.
   size_t geometry_items = 0;
   std::vector<Box3> geometry_bounds;
+  // Without geometry items (WalkthroughOptions::geometry_items false): the objects (ids, ascending) drawn as geometry,
+  // those of the frame's view that no impostor stands for, for a GPU-driven frame to cull per cluster
+  // (gpu::GpuCuller::setObjects). geometry_version changes exactly when the list does, so a frame that sees it
+  // unchanged sends nothing.
+  std::vector<uint32_t> geometry_objects;
+  uint64_t geometry_version = 0;
   std::vector<LayerDecision> layers;  // per layer of the current cell, or per impostor of the current CPV (Placed)
   FrameReport report;
 };
@@ -195,6 +206,8 @@ class Walkthrough {
   void readAhead(uint32_t half_edge, const Vec3& eye);
   void evict(uint32_t keep);
   void dropStaleDynamic(const Camera& camera, Cell& cell);
+  // The frame's geometry (ids_, ascending) into the plan: items culled per cluster, or the objects.
+  void setGeometry(FramePlan& plan, const Camera& camera);
   void updateDynamic(const Camera& camera, Cell& cell, const std::function<void()>& before_gpu_work);
 
   const scene::Scene& scene_;

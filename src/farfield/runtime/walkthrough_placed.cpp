@@ -31,9 +31,6 @@ void Walkthrough::openPlacement() {
     options_.error_px = o["error_px"].get<double>();
   }
   p.hidden.assign(scene_.objects.size() + 1, 0);
-  p.object_triangles.assign(scene_.objects.size() + 1, 0);
-  for (const scene::Object& o : scene_.objects)
-    for (const scene::Part& part : o.parts) p.object_triangles[o.id] += scene_.meshes[part.mesh].triangleCount();
 }
 
 const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
@@ -113,7 +110,7 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
       } else {
         ClusterAsGeometry g{id, 0};
         for (uint32_t o : record.objects)
-          if (std::binary_search(ids_.begin(), ids_.end(), o)) g.triangles += p.object_triangles[o];
+          if (std::binary_search(ids_.begin(), ids_.end(), o)) g.triangles += object_triangles_[o];
         plan.layers.push_back(g);
         ++report.layers_as_geometry;
         ++p.stats.geometry_fallbacks;
@@ -122,10 +119,9 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   }
   // Geometry: every object in the frustum that no impostor of this frame stands for.
   ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [&](uint32_t id) { return p.hidden[id] != 0; }), ids_.end());
-  // The geometry items come first, with their bounds, so an engine can occlusion-cull them (gpu::OcclusionCuller).
-  if (!ids_.empty()) gpu_scene_.appendDrawItems(ids_, plan.items, camera, &plan.geometry_bounds);
-  plan.geometry_items = plan.items.size();
-  for (const gpu::DrawItem& item : plan.items) report.geometry_triangles += item.triangleCount();
+  // The geometry items come first, with their bounds, so an engine can occlusion-cull them (gpu::OcclusionCuller);
+  // or the objects, for a GPU-driven frame.
+  setGeometry(plan, camera);
   for (uint32_t id : drawn) {
     const Placed::Resident& r = p.resident.at(id);
     r.gpu->appendDrawItems(plan.items);

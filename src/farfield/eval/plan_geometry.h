@@ -1,0 +1,46 @@
+// How a walkthrough mode draws its plans' geometry (--mode-option geometry=gpu|cpu, default gpu):
+//   gpu: the plan lists its geometry objects (runtime::WalkthroughOptions::geometry_items false) and a GpuCullRun over
+//        the run's arena culls and draws their clusters on the GPU, as the culled mode does (gpu_occlusion, gpu_cones,
+//        gpu_compact apply); the plan's CPU work is its choice of objects, and only a change of it is uploaded;
+//   cpu: the plan's items culled per cluster on the CPU, occlusion-culled against the depth of their nearest ones
+//        (the culled-cpu mode's pass) unless occlusion=off.
+// Either way the plan's impostors follow in the frame's main pass. occlusion=off turns occlusion off on both paths.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "farfield/eval/gpu_culled_mode.h"
+#include "farfield/eval/mode.h"
+#include "farfield/eval/occlusion_pass.h"
+#include "farfield/runtime/walkthrough.h"
+
+namespace farfield::eval {
+
+class PlanGeometry {
+ public:
+  // Reads geometry, occlusion and occluder_share (cpu), gpu_* (gpu); throws farfield::Error naming the mode for a bad
+  // value.
+  PlanGeometry(const ModeContext& context, const std::string& mode_name);
+  bool gpuDriven() const { return gpu_; }
+  // Sets the walkthrough's options to match (geometry items or objects).
+  void configure(runtime::WalkthroughOptions& options) const { options.geometry_items = !gpu_; }
+  void prepare(const ModeContext& context);
+  // Draws the plan's geometry now and queues its impostors in the frame's main pass.
+  void submit(FrameContext& frame, const runtime::FramePlan& plan);
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame);
+  // The occlusion pass's or the GPU run's numbers, and geometry_gpu (1 or 0), geometry_uploads (plan changes sent).
+  std::map<std::string, double> info() const;
+
+ private:
+  bool gpu_ = true;
+  gpu::GpuCullOptions gpu_options_;
+  std::optional<GpuCullRun> run_;
+  std::optional<OcclusionPass> occlusion_;
+  uint64_t version_ = ~uint64_t(0);
+  size_t uploads_ = 0;
+};
+
+}  // namespace farfield::eval
