@@ -57,6 +57,7 @@ struct GpuCuller::Impl {
   std::array<DrawLocations, kVariants> dl{};
 
   GLuint enabled = 0, visibility = 0, stats = 0, group_first = 0, object_frame = 0, work = 0, drawn = 0;
+  GLuint drawn_list = 0;  // the instances drawn in this frame (the history pass's work list)
   // Per phase: the commands, and the number written per group (buffers of their own: bound whole, no offset
   // alignment to respect).
   std::array<GLuint, 2> commands{}, counts{};
@@ -108,7 +109,8 @@ struct GpuCuller::Impl {
 
   ~Impl() {
     const GLuint buffers[] = {enabled,     visibility,  stats,     group_first, object_frame,
-                              commands[0], commands[1], counts[0], counts[1],   work,        drawn};
+                              commands[0], commands[1], counts[0], counts[1],   work,        drawn,
+                              drawn_list};
     glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
     if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
     for (Slot& s : ring) {
@@ -167,6 +169,7 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   im.drawn = createBuffer(size_t(im.instances) * sizeof(uint32_t), nullptr);
   // The work list: the dispatch of the cluster stages (x, y, z) and its length, then the instances.
   im.work = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
+  im.drawn_list = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
   for (GLuint& c : im.commands) {
     c = createBuffer(size_t(im.instances) * kCommandBytes, nullptr);
     glClearNamedBufferData(c, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -291,10 +294,12 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, b.parts);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.work);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, im.drawn);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, im.drawn_list);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, im.stats);
   for (GLuint buffer : {im.counts[0], im.counts[1], im.stats})
     glClearNamedBufferData(buffer, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-  glClearNamedBufferSubData(im.work, GL_R32UI, 0, 4 * sizeof(uint32_t), GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  for (GLuint list : {im.work, im.drawn_list})
+    glClearNamedBufferSubData(list, GL_R32UI, 0, 4 * sizeof(uint32_t), GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
   // The parts in view put their clusters on the work list; its length becomes the cluster stages' dispatch.
   const GLuint part_groups = (uint32_t(arena_.parts().size()) + kWorkGroup - 1) / kWorkGroup;
@@ -305,6 +310,25 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glDispatchCompute(1, 1, 1);
   glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
   glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.work);
+
+  // The depth pyramid of what the target holds now (DepthPyramid::build on the GPU).
+  auto buildPyramid = [&]() {
+    glUseProgram(im.pyramid.handle());
+    glBindTextureUnit(2, target.depthTexture().handle());
+    const GLuint p = im.pyramid.handle();
+    for (size_t k = 1; k < im.level_size.size(); ++k) {
+      const auto [sw, sh] = im.level_size[k - 1];
+      const auto [dw, dh] = im.level_size[k];
+      glProgramUniform2i(p, im.pl.src_size, sw, sh);
+      glProgramUniform2i(p, im.pl.dst_size, dw, dh);
+      glProgramUniform1i(p, im.pl.from_depth, k == 1 ? 1 : 0);
+      glBindImageTexture(0, im.pyramid_texture, GLint(k == 1 ? 0 : k - 2), GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+      glBindImageTexture(1, im.pyramid_texture, GLint(k - 1), GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+      glDispatchCompute(GLuint(dw + 7) / 8, GLuint(dh + 7) / 8, 1);
+      glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    }
+    glBindTextureUnit(2, 0);
+  };
 
   auto cullPhase = [&](int phase, int commands) {
     glProgramUniform1i(c, im.cl.phase, phase);
@@ -372,24 +396,27 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   } else {
     cullPhase(0, 0);
     drawPhase(0);
-    // The pyramid from the early phase's depth.
-    glUseProgram(im.pyramid.handle());
-    glBindTextureUnit(2, target.depthTexture().handle());
-    const GLuint p = im.pyramid.handle();
-    for (size_t k = 1; k < im.level_size.size(); ++k) {
-      const auto [sw, sh] = im.level_size[k - 1];
-      const auto [dw, dh] = im.level_size[k];
-      glProgramUniform2i(p, im.pl.src_size, sw, sh);
-      glProgramUniform2i(p, im.pl.dst_size, dw, dh);
-      glProgramUniform1i(p, im.pl.from_depth, k == 1 ? 1 : 0);
-      glBindImageTexture(0, im.pyramid_texture, GLint(k == 1 ? 0 : k - 2), GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-      glBindImageTexture(1, im.pyramid_texture, GLint(k - 1), GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-      glDispatchCompute(GLuint(dw + 7) / 8, GLuint(dh + 7) / 8, 1);
-      glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    }
-    glBindTextureUnit(2, 0);
+    buildPyramid();
     cullPhase(1, 1);
     drawPhase(1);
+    if (options_.refine_history) {
+      // The drawn instances become the work list: their dispatch, then the test against the final depth.
+      buildPyramid();
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.drawn_list);
+      glUseProgram(im.args.handle());
+      glDispatchCompute(1, 1, 1);
+      glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+      glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.drawn_list);
+      glProgramUniform1i(c, im.cl.phase, 3);
+      glUseProgram(c);
+      glBindTextureUnit(2, target.depthTexture().handle());
+      glBindTextureUnit(3, im.pyramid_texture);
+      glDispatchComputeIndirect(0);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      glBindTextureUnit(2, 0);
+      glBindTextureUnit(3, 0);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.work);
+    }
   }
   glUseProgram(0);
 

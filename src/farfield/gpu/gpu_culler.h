@@ -7,7 +7,7 @@
 //   2. a depth pyramid is built on the GPU from the target's depth, and every cluster in view is tested against it
 //      (gpu/occlusion_culler.h's conservative test: hidden only when all of its box lies behind the depth over every
 //      pixel it may cover); those not hidden that the early phase did not draw are drawn, and the result is what the
-//      next frame's early phase draws.
+//      next frame's early phase draws (refined by the frame's final depth: GpuCullOptions::refine_history).
 // The frame is the one that drawing every cluster in view would give: a cluster left out is out of view, turned away
 // or behind depth that was already drawn, and later draws only bring depth nearer. Nothing is read back; statistics
 // (clusters and triangles drawn, culled by each test) are copied on the GPU and read frames later (finishedStats).
@@ -34,6 +34,9 @@ struct GpuCullOptions {
   // Compacted command lists drawn with glMultiDrawElementsIndirectCount where the driver has it (GL 4.6 or
   // ARB_indirect_parameters); false, or without it: glMultiDrawElementsIndirect over every slot, culled ones empty.
   bool compact = true;
+  // After both phases: a pyramid of the frame's final depth decides which clusters the next frame draws first (those
+  // it does not hide), at the cost of a second pyramid and test; false: those the second phase found visible.
+  bool refine_history = true;
   // Relative depth margin of the occlusion test (DepthPyramid::hides). A negative one hides boxes that are in front
   // of the stored depth: the tests break the test with it and check that frames then differ.
   float occlusion_margin = 1e-5f;

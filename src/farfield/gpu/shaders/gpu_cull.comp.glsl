@@ -2,13 +2,17 @@
 // Farfield cluster culling (gpu/gpu_culler.h), in stages compiled from this one file (FF_STAGE_*):
 //   PARTS (one invocation per object part): parts of objects in this frame's plan whose box meets the frustum put
 //     their cluster instances on the work list; the others are culled whole;
-//   ARGS (one invocation): the work list's length as the indirect dispatch of the next stages;
+//   ARGS (one invocation): the length of the list bound as the work list as the indirect dispatch of the next stages;
 //   CLUSTERS (one per work list entry): an instance is in view when its sphere and box meet the frustum and its normal
 //     cone does not turn every triangle away from the eye; then, by phase,
 //       0 (early): those in view that were visible in the last frame are drawn,
 //       1 (late): those in view are tested against the depth pyramid built from the early phase's depth; those not
 //         hidden are visible, and drawn unless the early phase drew them; the visibility is kept for the next frame,
-//       2 (all): those in view are drawn (no occlusion) and are the visible ones;
+//       2 (all): those in view are drawn (no occlusion) and are the visible ones,
+//       3 (history, over the instances drawn in this frame, whose list phases 0 and 1 keep): those not hidden by the
+//         pyramid of the frame's final depth are the visible ones the next frame's early phase draws (without it, a
+//         cluster drawn late stays "visible" when later clusters hid it, and after a camera cut the next frame draws
+//         everything in view first); the others are no longer visible;
 //   EMIT (one per work list entry): each run of consecutive drawn clusters of one object part (contiguous indices)
 //     becomes one indirect draw command, compacted per material group (an atomic counter per group, drawn with
 //     glMultiDrawElementsIndirectCount) or in its first instance's own slot (the other slots cleared).
@@ -62,6 +66,7 @@ layout(std430, binding = 10) buffer ObjectFrame { uint object_frame[]; };    // 
 layout(std430, binding = 11) readonly buffer Parts { Part parts[]; };
 layout(std430, binding = 12) buffer Work { uvec4 dispatch_args; uint work[]; };  // dispatch_args.w: list length
 layout(std430, binding = 13) buffer Drawn { uint drawn_flag[]; };            // per instance: drawn in this phase
+layout(std430, binding = 14) buffer DrawnList { uvec4 drawn_args; uint drawn_list[]; };  // instances drawn this frame
 
 layout(binding = 2) uniform sampler2D u_depth;    // pyramid level 0: the frame's depth
 layout(binding = 3) uniform sampler2D u_pyramid;  // levels 1.. in its mip levels 0..
@@ -183,6 +188,7 @@ void main() {
     const Cluster c = clusters[instance.x];
     const mat4 model = objects[instance.y].model;
     const bool affine = (objects[instance.y].info.y & 1u) != 0u;
+    const bool counting = u_phase == 1 || u_phase == 2;  // the frame's statistics come from one pass
     bool in_view = true;
     if (affine) {
       const vec3 centre = (model * vec4(c.sphere.xyz, 1.0)).xyz;
@@ -191,7 +197,7 @@ void main() {
         if (dot(u_planes[p].xyz, centre) + u_planes[p].w < -radius) in_view = false;
       // The cluster's box too: tighter than the sphere for flat and long clusters.
       in_view = in_view && boxInFrustum(c.box_lo.xyz, c.box_hi.xyz, model);
-      if (!in_view && u_phase != 0) atomicAdd(s_stats[kFrustum], 1u);
+      if (!in_view && counting) atomicAdd(s_stats[kFrustum], 1u);
     }
     if (in_view && cone_test) {
       // coneRejects (scene_arena.cpp), in world space: the transform keeps angles (SceneArena checks).
@@ -201,11 +207,14 @@ void main() {
       const float len = length(d);
       if (len > 0.0 && dot(d / len, axis) >= c.cone_apex.w + 1e-3) {
         in_view = false;
-        if (u_phase != 0) atomicAdd(s_stats[kCone], 1u);
+        if (counting) atomicAdd(s_stats[kCone], 1u);
       }
     }
     bool drawn = false;
-    if (u_phase == 0) {
+    if (u_phase == 3) {
+      // The history for the next frame: visible in this frame's final depth.
+      visible[i] = in_view && !(affine && hidden(c.box_lo.xyz, c.box_hi.xyz, u_view_proj * model)) ? 1u : 0u;
+    } else if (u_phase == 0) {
       drawn = in_view && visible[i] != 0u;
     } else if (u_phase == 1) {
       const bool occluded = in_view && affine && hidden(c.box_lo.xyz, c.box_hi.xyz, u_view_proj * model);
@@ -217,8 +226,9 @@ void main() {
       drawn = in_view;
       visible[i] = in_view ? 1u : 0u;
     }
-    drawn_flag[i] = drawn ? 1u : 0u;
+    if (u_phase != 3) drawn_flag[i] = drawn ? 1u : 0u;
     if (drawn) {
+      drawn_list[atomicAdd(drawn_args.w, 1u)] = i;
       atomicAdd(s_stats[u_phase == 0 ? kDrawnEarly : kDrawnLate], 1u);
       atomicAdd(s_stats[u_phase == 0 ? kTrianglesEarly : kTrianglesLate], c.range.y / 3u);
       // Distinct objects: the first instance of an object drawn in this frame counts it.
