@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Figures for docs/BENCHMARKS.md ("Occlusion culling"): the culled baseline with occlusion culling (mode "culled")
+# Figures for docs/BENCHMARKS.md ("Occlusion culling"): the CPU culled baseline with occlusion culling (mode
+# "culled-cpu", called "culled" before the GPU-driven frame took that name)
 # against the frustum-only culling it replaced (mode "frustum"), in one process on the same frames, with
 # full-geometry reference frames (both must be identical to them), on the default city and cities of other seeds
 # and sizes, on a car drive and a pedestrian walk of 300 frames at 640x360.
@@ -29,13 +30,13 @@ for c in "${cases[@]}"; do
   mkdir -p "$run"
   "$FARFIELD" path street "$city/city.streets.json" --frames 300 --seed "$seed" "${car[@]}" --fov 60 -o "$run/path.json" \
     > "$run/path.txt"
-  "$FARFIELD" bench "$city/city.glb" --path "$run/path.json" --modes frustum,culled --reference --size 640x360 \
+  "$FARFIELD" bench "$city/city.glb" --path "$run/path.json" --modes frustum,culled-cpu --reference --size 640x360 \
     --stride "$STRIDE" --repeats "$REPEATS" -o "$run/bench" > "$run/bench.txt" 2>&1
   python3 - "$run/bench/bench.json" "$blocks" "$seed" "$path" >> "$table" <<'PY'
 import json, sys
 b = json.load(open(sys.argv[1]))
 m = b["modes"]
-f, c = m["frustum"], m["culled"]
+f, c = m["frustum"], m["culled-cpu"]
 info = c.get("info", {})
 same = all(x["psnr_db_min"] >= 99.0 for x in (f, c))
 print(f"| {sys.argv[2]}, seed {sys.argv[3]} | {sys.argv[4]} | {b['frames']} | {f['median_ms']:.1f} | "

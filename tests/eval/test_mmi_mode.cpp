@@ -326,6 +326,30 @@ TEST_F(MmiModeTest, OnlineStoreRunsTheMissingStagesAndMatchesTheBakedStore) {
   EXPECT_EQ(online.mode("local")->info.at("online_runs"), 0.0);
 }
 
+// The plans' geometry drawn through the arena on the GPU (geometry=gpu, the default) or culled on the CPU
+// (geometry=cpu) gives the same frames: the same error against the reference on every frame, the same cracks.
+TEST_F(MmiModeTest, GeometryOnTheGpuDrawsTheFramesOfGeometryOnTheCpu) {
+  const MmiCity& s = mmiCity();
+  const BenchResult gpu = runModes(s.path, {"visible", "mmi"}, s.store, {{"geometry", "gpu"}});
+  const BenchResult cpu = runModes(s.path, {"visible", "mmi"}, s.store, {{"geometry", "cpu"}});
+  for (const char* name : {"visible", "mmi"}) {
+    SCOPED_TRACE(name);
+    const ModeResult* g = gpu.mode(name);
+    const ModeResult* c = cpu.mode(name);
+    ASSERT_TRUE(g && c);
+    EXPECT_EQ(g->info.at("geometry_gpu"), 1.0);
+    EXPECT_EQ(c->info.at("geometry_gpu"), 0.0);
+    EXPECT_GT(g->info.at("geometry_uploads"), 0.0);  // the plan changes along the walk ...
+    EXPECT_LE(g->info.at("geometry_uploads"), double(g->frames.size() + 1));  // ... at most once a frame
+    ASSERT_EQ(g->errors.size(), c->errors.size());
+    for (size_t k = 0; k < g->errors.size(); ++k) {
+      EXPECT_NEAR(g->errors[k].psnr_db, c->errors[k].psnr_db, 0.5) << "frame " << k;
+      EXPECT_NEAR(g->crack_shares[k], c->crack_shares[k], 1e-4) << "frame " << k;
+      EXPECT_EQ(g->frames[k].syncs, 0u) << "frame " << k;
+    }
+  }
+}
+
 TEST_F(MmiModeTest, BadStoresAndOptionsAreErrors) {
   const MmiCity& s = mmiCity();
   registerImpostorModes();

@@ -14,6 +14,7 @@
 #include "farfield/core/error.h"
 #include "farfield/gen/city.h"
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/gpu_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "support/test_support.h"
 
@@ -96,6 +97,57 @@ TEST_F(WalkthroughTest, WhereNoImpostorIsValidThePlanIsTheGeometryOfTheCell) {
     EXPECT_EQ(target.readColor().pixels(), reference_target.readColor().pixels()) << "frame " << f;
   }
   EXPECT_GT(frames, 3u);
+}
+
+// A plan for a GPU-driven frame (geometry_items false) lists its geometry as objects: drawn by gpu::GpuCuller over
+// the scene's arena, then its impostors, every frame equals the frame of the plan's items (geometry culled on the
+// CPU), the impostors included; the list's version changes exactly when the list does.
+TEST_F(WalkthroughTest, APlansGeometryObjectsDrawnOnTheGpuEqualItsItems) {
+  const BakedCity& s = bakedCity();
+  const scene::Scene& scene = s.city.scene;
+  const gpu::GpuScene gpu_scene(scene);
+  const scene::Bvh bvh(scene);
+  const gpu::SceneArena arena(scene);
+  gpu::GpuCuller culler(arena);
+  gpu::Renderer renderer;
+  gpu::RenderTarget target(160, 96), reference_target(160, 96);
+  for (const double error_px : {1e-4, 0.0}) {  // every layer as geometry; the bake's bound (impostors)
+    WalkthroughOptions options;
+    options.database = s.store;
+    options.error_px = error_px;
+    Walkthrough with_items(scene, gpu_scene, bvh, renderer, options);
+    options.geometry_items = false;
+    Walkthrough with_objects(scene, gpu_scene, bvh, renderer, options);
+    std::vector<uint32_t> last;
+    uint64_t version = 0;
+    size_t impostor_items = 0;
+    for (size_t f = 0; f < s.path.frames.size(); ++f) {
+      const Camera camera = s.path.camera(f, 160, 96);
+      const FramePlan& a = with_items.plan(camera);
+      renderer.render(camera, a.items, reference_target);
+      const FramePlan& b = with_objects.plan(camera);
+      EXPECT_EQ(b.geometry_items, 0u);
+      EXPECT_TRUE(std::is_sorted(b.geometry_objects.begin(), b.geometry_objects.end()));
+      EXPECT_EQ(b.geometry_version != version, b.geometry_objects != last) << "frame " << f;
+      version = b.geometry_version;
+      last = b.geometry_objects;
+      // Every object the items draw is listed.
+      for (size_t i = 0; i < a.geometry_items; ++i)
+        EXPECT_TRUE(std::binary_search(last.begin(), last.end(), a.items[i].object_id)) << "frame " << f;
+      ASSERT_EQ(b.items.size(), a.items.size() - a.geometry_items) << "frame " << f;  // the impostors
+      impostor_items += b.items.size();
+      culler.setObjects(b.geometry_objects);
+      target.bind();
+      target.clear(renderer.light().sky_color);
+      culler.draw(camera, target, gpu::RenderMode::Shaded, renderer.light());
+      renderer.draw(camera, b.items, target);
+      EXPECT_EQ(target.readIds().pixels(), reference_target.readIds().pixels()) << "frame " << f;
+      EXPECT_EQ(target.readColor().pixels(), reference_target.readColor().pixels()) << "frame " << f;
+    }
+    if (error_px == 0.0) {
+      EXPECT_GT(impostor_items, 0u);
+    }
+  }
 }
 
 TEST_F(WalkthroughTest, UnderTheBakesBoundImpostorsAreDrawnOnlyInsideTheirRegions) {

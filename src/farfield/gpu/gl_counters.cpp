@@ -4,7 +4,11 @@
 #include <epoxy/gl.h>
 
 #include <atomic>
+#if defined(__x86_64__) || defined(__i386__)
+#include <x86intrin.h>
+#endif
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -27,37 +31,44 @@ GlCounters& GlCounters::operator-=(const GlCounters& o) {
 namespace {
 
 struct ThreadState {
-  GlCounters counters;
+  GlCounters counters;    // driver_ms from driver_ticks when read
+  uint64_t driver_ticks = 0;
   int paused = 0;  // inside GlMeasurement scopes
 };
 thread_local ThreadState t_state;
 std::atomic<bool> g_installed{false};
+bool g_profile = false;  // FF_GL_PROFILE: every call timed per entry point, printed at exit
 
 int64_t nowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
-// Driver time of one call.
-class Timed {
- public:
-  explicit Timed(GlCounters& c) : c_(c), start_(nowNs()) {}
-  ~Timed() { c_.driver_ms += double(nowNs() - start_) * 1e-6; }
-  Timed(const Timed&) = delete;
-  Timed& operator=(const Timed&) = delete;
+// The clock of driver time: the time-stamp counter where there is one (a few nanoseconds a read; every GL call reads
+// it twice), calibrated against the steady clock between installation and each reading of the counters.
+#if defined(__x86_64__) || defined(__i386__)
+inline uint64_t ticks() { return __rdtsc(); }
+#else
+inline uint64_t ticks() { return uint64_t(nowNs()); }
+#endif
+uint64_t g_tick0 = 0;
+int64_t g_ns0 = 0;
 
- private:
-  GlCounters& c_;
-  int64_t start_;
-};
+double ticksToMs(uint64_t t) {
+  const uint64_t dt = ticks() - g_tick0;
+  const int64_t dns = nowNs() - g_ns0;
+  const double ns_per_tick = dt > 0 && dns > 0 ? double(dns) / double(dt) : 1.0;
+  return double(t) * ns_per_tick * 1e-6;
+}
 
+// What a call counts as besides a GL call (every call is timed as driver time).
 enum class Kind {
-  Plain,     // counted
-  Draw,      // counted, a draw call, timed
-  Dispatch,  // counted, a compute dispatch, timed
-  Work,      // counted, GPU work that a software rasterizer does inside the call (clears, blits, copies), timed
-  Sync,      // counted, always waits for the GPU, timed
-  Extra,     // counted, timed; the extra function adds uploads or decides whether it waited
+  Plain,     // state, objects, queries, uploads
+  Draw,      // a draw call
+  Dispatch,  // a compute dispatch
+  Work,      // GPU work that a software rasterizer does inside the call (clears, blits, copies, barriers, fences)
+  Sync,      // always waits for the GPU
+  Extra,     // the extra function decides whether it waited
 };
 
 // The driver's entry points used by the extra functions to look at state without being counted.
@@ -73,8 +84,19 @@ template <typename R, typename... A, R (**Slot)(A...), Kind K, typename Extra>
 struct Hook<Slot, K, Extra> {
   using Fn = R (*)(A...);
   static inline Fn real = nullptr;
+  static inline std::atomic<uint64_t> profile_calls{0}, profile_ns{0};
+
+  struct Profiled {
+    int64_t start = g_profile ? nowNs() : 0;
+    ~Profiled() {
+      if (!g_profile) return;
+      ++profile_calls;
+      profile_ns += uint64_t(nowNs() - start);
+    }
+  };
 
   static R call(A... args) {
+    Profiled profiled;
     ThreadState& t = t_state;
     if (t.paused) return real(args...);
     GlCounters& c = t.counters;
@@ -83,16 +105,21 @@ struct Hook<Slot, K, Extra> {
     if constexpr (K == Kind::Dispatch) ++c.dispatches;
     if constexpr (K == Kind::Sync) ++c.syncs;
     if constexpr (!std::is_void_v<Extra>) Extra{}(c, args...);
-    if constexpr (K == Kind::Plain) {
-      return real(args...);
-    } else {
-      Timed timed(c);
-      return real(args...);
-    }
+    struct Timed {
+      uint64_t& total;
+      uint64_t start = ticks();
+      ~Timed() { total += ticks() - start; }
+    } timed{t.driver_ticks};
+    return real(args...);
   }
   static void install(void* proc) {
     real = reinterpret_cast<Fn>(proc);
     *Slot = &call;
+  }
+  static void report(const char* name) {
+    if (profile_calls)
+      std::fprintf(stderr, "gl profile: %-44s %12llu calls %12.3f ms\n", name,
+                   static_cast<unsigned long long>(profile_calls.load()), double(profile_ns.load()) * 1e-6);
   }
 };
 
@@ -194,12 +221,15 @@ struct Call {
 struct Entry {
   const char* name;
   void (*install)(void*);
+  void (*report)(const char*);
 };
 
-#define FF_HOOK(fn, kind) Entry{#fn, &Hook<&epoxy_##fn, Kind::kind>::install}
-#define FF_HOOK_EXTRA(fn, extra) Entry{#fn, &Hook<&epoxy_##fn, Kind::Extra, Call<extra>>::install}
-#define FF_HOOK_UPLOAD(fn, extra) Entry{#fn, &Hook<&epoxy_##fn, Kind::Plain, Call<extra>>::install}
-#define FF_HOOK_UNIFORM(fn, ...) Entry{#fn, &Hook<&epoxy_##fn, Kind::Plain, Uniform<__VA_ARGS__>>::install}
+// (fn is pasted at once: glDrawArrays and the like are themselves macros of libepoxy's.)
+#define FF_ENTRY(name, slot, ...) Entry{name, &Hook<&slot, __VA_ARGS__>::install, &Hook<&slot, __VA_ARGS__>::report}
+#define FF_HOOK(fn, kind) FF_ENTRY(#fn, epoxy_##fn, Kind::kind)
+#define FF_HOOK_EXTRA(fn, extra) FF_ENTRY(#fn, epoxy_##fn, Kind::Extra, Call<extra>)
+#define FF_HOOK_UPLOAD(fn, extra) FF_ENTRY(#fn, epoxy_##fn, Kind::Plain, Call<extra>)
+#define FF_HOOK_UNIFORM(fn, ...) FF_ENTRY(#fn, epoxy_##fn, Kind::Plain, Uniform<__VA_ARGS__>)
 
 // Every entry point Farfield calls (tests/gpu/gl_counters_test.cpp checks the sources against this list).
 const Entry kEntries[] = {
@@ -215,7 +245,7 @@ const Entry kEntries[] = {
     FF_HOOK(glClearNamedFramebufferiv, Work), FF_HOOK(glBlitNamedFramebuffer, Work),
     FF_HOOK(glGenerateTextureMipmap, Work), FF_HOOK(glCopyNamedBufferSubData, Work),
     FF_HOOK(glClearNamedBufferSubData, Work), FF_HOOK(glClearNamedBufferData, Work), FF_HOOK(glClearTexImage, Work),
-    FF_HOOK(glFlush, Work), FF_HOOK(glMemoryBarrier, Work),
+    FF_HOOK(glFlush, Work), FF_HOOK(glMemoryBarrier, Work), FF_HOOK(glFenceSync, Work),
     // waits
     FF_HOOK(glFinish, Sync), FF_HOOK(glGetNamedBufferSubData, Sync), FF_HOOK_EXTRA(glReadPixels, readPixels),
     FF_HOOK_EXTRA(glGetTextureImage, getTextureImage), FF_HOOK_EXTRA(glGetTextureSubImage, getTextureSubImage),
@@ -256,7 +286,7 @@ const Entry kEntries[] = {
     FF_HOOK(glDeleteTextures, Plain), FF_HOOK(glDeleteVertexArrays, Plain), FF_HOOK(glDepthFunc, Plain),
     FF_HOOK(glDepthMask, Plain), FF_HOOK(glDetachShader, Plain), FF_HOOK(glDisable, Plain),
     FF_HOOK(glEnable, Plain), FF_HOOK(glEnableVertexArrayAttrib, Plain), FF_HOOK(glEndQuery, Plain),
-    FF_HOOK(glFenceSync, Plain), FF_HOOK(glFrontFace, Plain), FF_HOOK(glGetError, Plain), FF_HOOK(glGetFloatv, Plain),
+    FF_HOOK(glFrontFace, Plain), FF_HOOK(glGetError, Plain), FF_HOOK(glGetFloatv, Plain),
     FF_HOOK(glGetIntegerv, Plain), FF_HOOK(glGetProgramInfoLog, Plain), FF_HOOK(glGetProgramiv, Plain),
     FF_HOOK(glGetShaderInfoLog, Plain), FF_HOOK(glGetShaderiv, Plain), FF_HOOK(glGetString, Plain),
     FF_HOOK(glGetSynciv, Plain), FF_HOOK(glGetUniformLocation, Plain), FF_HOOK(glLinkProgram, Plain),
@@ -273,6 +303,7 @@ const Entry kEntries[] = {
     FF_HOOK(glViewport, Plain),
 };
 
+#undef FF_ENTRY
 #undef FF_HOOK
 #undef FF_HOOK_EXTRA
 #undef FF_HOOK_UPLOAD
@@ -290,14 +321,26 @@ bool installGlCounters() {
     if (!g_get_integer || !g_get_query_iv) return;
     for (const Entry& e : kEntries)
       if (void* proc = reinterpret_cast<void*>(eglGetProcAddress(e.name))) e.install(proc);
+    g_tick0 = ticks();
+    g_ns0 = nowNs();
     g_installed = true;
+    if (const char* env = std::getenv("FF_GL_PROFILE"); env && std::strcmp(env, "0") != 0) {
+      g_profile = true;
+      std::atexit([] {
+        for (const Entry& e : kEntries) e.report(e.name);
+      });
+    }
   });
   return g_installed;
 }
 
 bool glCountersInstalled() { return g_installed; }
 
-GlCounters glCounters() { return t_state.counters; }
+GlCounters glCounters() {
+  GlCounters c = t_state.counters;
+  c.driver_ms = ticksToMs(t_state.driver_ticks);
+  return c;
+}
 
 GlMeasurement::GlMeasurement() : start_ns_(nowNs()) { ++t_state.paused; }
 

@@ -1,7 +1,11 @@
 // What a frame asks of OpenGL, counted at every call: GL calls, draw calls, compute dispatches, bytes sent from the
-// CPU, CPU-GPU synchronisations, and the CPU time spent inside the calls that do or wait for GPU work. These do not
-// depend on the machine (but the last), so they say on llvmpipe what a frame will cost on a GPU: a frame that issues
-// 200,000 draw calls or waits once for the GPU is slow everywhere (DESIGN.md, "The GPU-driven frame").
+// CPU, CPU-GPU synchronisations, and the time spent inside GL calls (the driver's). All but the last do not depend
+// on the machine, so they say on llvmpipe what a frame will cost on a GPU: a frame that issues 200,000 draw calls or
+// waits once for the GPU is slow everywhere (DESIGN.md, "The GPU-driven frame"). A frame's own CPU time, the time in
+// Farfield's own code, is its wall time less the driver's and less the measurement's (GlMeasurement).
+//
+// FF_GL_PROFILE=1 in the environment also times every call per entry point and prints the totals at exit (a
+// developer's view of where a frame's driver time goes; it slows every call a little).
 //
 // How: libepoxy calls OpenGL through one public function pointer per entry point (epoxy_glDrawElements, ...).
 // installGlCounters() points those Farfield calls at counting wrappers that call the driver's entry point, taken from
@@ -13,10 +17,9 @@
 //     into client memory, glGetNamedBufferSubData, a map of a buffer for reading, glClientWaitSync that had to wait,
 //     and a query result asked for before it was available;
 //   - uploaded bytes are the buffer and texture data and the uniform values sent from client memory;
-//   - driver time is the CPU time inside draws, dispatches, clears, blits, copies, memory barriers and
-//     synchronisations: on llvmpipe the rasterizer's own work (vertex shading, binning, compute shaders, the flushes a
-//     barrier makes) runs inside them on the calling thread, so
-//     a frame's own CPU time is its CPU time less driver time less the measurement's own waits (GlMeasurement).
+//   - driver time is the time inside every GL call, read from the time-stamp counter (a few nanoseconds a read, two
+//     reads a call: about 1 ms per 50,000 calls); on llvmpipe the rasterizer's own work (vertex shading, binning,
+//     compute shaders, the flushes a barrier makes) runs inside the calls on the calling thread.
 #pragma once
 
 #include <cstdint>
@@ -31,7 +34,7 @@ struct GlCounters {
   uint64_t dispatches = 0;    // glDispatchCompute*
   uint64_t syncs = 0;         // calls that waited (or may have waited) for the GPU
   uint64_t upload_bytes = 0;  // buffer, texture and uniform data sent from client memory
-  double driver_ms = 0.0;     // CPU time inside the calls that do or wait for GPU work
+  double driver_ms = 0.0;     // time inside GL calls
   double measure_ms = 0.0;    // time inside GlMeasurement scopes (their GL calls are not counted)
 
   GlCounters& operator-=(const GlCounters& o);

@@ -156,7 +156,8 @@ struct GpuCuller::Impl {
 GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
     : arena_(arena), options_(options), impl_(std::make_unique<Impl>()) {
   Impl& im = *impl_;
-  indirect_count_ = options.compact && (epoxy_gl_version() >= 46 || epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
+  core_count_ = epoxy_gl_version() >= 46;
+  indirect_count_ = options.compact && (core_count_ || epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
   const size_t objects = arena.scene().objects.size();
   im.instances = uint32_t(arena.instances().size());
   im.groups = uint32_t(arena.groups().size());
@@ -375,9 +376,11 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
         glFrontFace(mirrored ? GL_CW : GL_CCW);
       }
       const void* offset = reinterpret_cast<const void*>(uintptr_t(group.first_instance) * kCommandBytes);
-      if (indirect_count_) {
-        glMultiDrawElementsIndirectCountARB(GL_TRIANGLES, GL_UNSIGNED_INT, offset,
-                                            GLintptr(g * sizeof(uint32_t)),
+      if (indirect_count_ && core_count_) {
+        glMultiDrawElementsIndirectCount(GL_TRIANGLES, GL_UNSIGNED_INT, offset, GLintptr(g * sizeof(uint32_t)),
+                                         GLsizei(group.instance_count), GLsizei(kCommandBytes));
+      } else if (indirect_count_) {
+        glMultiDrawElementsIndirectCountARB(GL_TRIANGLES, GL_UNSIGNED_INT, offset, GLintptr(g * sizeof(uint32_t)),
                                             GLsizei(group.instance_count), GLsizei(kCommandBytes));
       } else {
         glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, offset, GLsizei(group.instance_count),

@@ -87,6 +87,7 @@ class GpuCuller {
   const SceneArena& arena_;
   GpuCullOptions options_;
   bool indirect_count_ = false;
+  bool core_count_ = false;  // GL 4.6: the core entry point, else ARB_indirect_parameters
   uint64_t frames_ = 0;
   std::unique_ptr<Impl> impl_;
 };

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Farfield beside a peer: the same city along the same path at the same size drawn by OpenSceneGraph 3.6 (Debian's
+# libopenscenegraph-dev; bench/osg_peer: per-object transforms, OSG's per-drawable view-frustum culling, a shader of
+# the same cost as Farfield's), with and without osgSim::Impostor, then by Farfield's frustum, culled-cpu and culled
+# (the GPU-driven frame) modes; one table of milliseconds per frame (docs/BENCHMARKS.md, "The GPU-driven frame").
+#
+#   scripts/bench_peer_osg.sh [FARFIELD] [OUT] [SCENE PATH]
+#
+# Without SCENE and PATH it makes the demo's city and drive (400 blocks, detail 2, seed 1). Environment: SIZE
+# (640x360), STRIDE (5), IMPOSTORS ("100:4 200:8": osgSim::Impostor threshold in metres and pixel error),
+# OSG_BUILD (build/osg-peer: where the peer is built). OpenSceneGraph draws into a GLX pbuffer: without a display the
+# peer runs under xvfb-run (Mesa's llvmpipe; on a GPU machine give it an X server of the GPU).
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+FARFIELD=$(readlink -f "${1:-$here/build/release/bin/farfield}")
+OUT=$(readlink -m "${2:-$here/out/bench/peer-osg}")
+SCENE=${3:-}
+PATHFILE=${4:-}
+SIZE=${SIZE:-640x360}
+STRIDE=${STRIDE:-5}
+IMPOSTORS=${IMPOSTORS:-"100:4 200:8"}
+OSG_BUILD=${OSG_BUILD:-$here/build/osg-peer}
+mkdir -p "$OUT"
+export FF_PROGRESS=0
+
+# OpenSceneGraph: a Debian package the project does not install by default.
+if ! dpkg-query -W -f='${Status}' libopenscenegraph-dev 2>/dev/null | grep -q "install ok installed"; then
+  echo "bench_peer_osg: installing libopenscenegraph-dev (apt-get)" >&2
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo=sudo
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q libopenscenegraph-dev > "$OUT/apt.txt"
+fi
+cmake -S "$here" -B "$OSG_BUILD" -DCMAKE_BUILD_TYPE=Release -DFF_BUILD_TESTS=OFF -DFF_BUILD_BENCH=OFF \
+  -DFF_BUILD_OSG_PEER=ON > "$OUT/cmake.txt"
+cmake --build "$OSG_BUILD" -j "$(nproc)" --target osg_peer > "$OUT/build.txt"
+PEER=$OSG_BUILD/bin/osg_peer
+
+if [ -z "$SCENE" ]; then
+  SCENE=$OUT/city.glb
+  PATHFILE=$OUT/path.json
+  [ -f "$SCENE" ] || "$FARFIELD" gen city --blocks 400 --detail 2 --seed 1 --objects buildings -o "$SCENE" > "$OUT/gen.txt"
+  [ -f "$PATHFILE" ] || "$FARFIELD" path street "$OUT/city.streets.json" --frames 300 --seed 1 --car --fov 60 \
+    -o "$PATHFILE" > /dev/null
+fi
+xvfb=()
+if [ -z "${DISPLAY:-}" ]; then
+  command -v xvfb-run > /dev/null || { echo "bench_peer_osg: no display and no xvfb-run" >&2; exit 2; }
+  xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24")
+fi
+
+"${xvfb[@]}" "$PEER" "$SCENE" "$PATHFILE" --size "$SIZE" --stride "$STRIDE" --mode full --tag osg \
+  --csv "$OUT/osg.csv" > "$OUT/osg.txt" 2>&1
+for imp in $IMPOSTORS; do
+  threshold=${imp%%:*} pixels=${imp##*:}
+  "${xvfb[@]}" "$PEER" "$SCENE" "$PATHFILE" --size "$SIZE" --stride "$STRIDE" --mode impostor --threshold "$threshold" \
+    --pixel-error "$pixels" --tag "osg-impostor-$threshold-$pixels" > "$OUT/osg-impostor-$threshold-$pixels.txt" 2>&1
+done
+"$FARFIELD" bench "$SCENE" --path "$PATHFILE" --modes frustum,culled-cpu,culled --size "$SIZE" --stride "$STRIDE" \
+  -o "$OUT/farfield" > "$OUT/farfield.txt" 2>&1
+
+python3 - "$OUT" > "$OUT/peer.md" <<'PY'
+import glob, json, re, sys
+out = sys.argv[1]
+print("| renderer | mode | frames | median ms | p95 ms | p99 ms | max ms | first ms |")
+print("|---|---|---:|---:|---:|---:|---:|---:|")
+for f in sorted(glob.glob(f"{out}/osg*.txt")):
+    text = open(f).read()
+    gl = re.search(r"GL_RENDERER=(.*?) GL_VERSION", text)
+    r = re.search(r"RESULT (.*)", text)
+    if not r:
+        print(f"| OpenSceneGraph | {f} | failed | | | | | |")
+        continue
+    v = dict(kv.split("=", 1) for kv in r.group(1).split())
+    print(f"| OpenSceneGraph 3.6 ({gl.group(1) if gl else '?'}) | {v['tag']} | {v['frames']} | {float(v['median']):.2f} | "
+          f"{float(v['p95']):.2f} | {float(v['p99']):.2f} | {float(v['max']):.2f} | {float(v['first']):.2f} |")
+b = json.load(open(f"{out}/farfield/bench.json"))
+for name, m in b["modes"].items():
+    print(f"| Farfield ({b['renderer'].split(' / ')[0]}) | {name} | {b['frames']} | {m['median_ms']:.2f} | {m['p95_ms']:.2f} | "
+          f"{m['p99_ms']:.2f} | {m['max_ms']:.2f} | |")
+PY
+cat "$OUT/peer.md"

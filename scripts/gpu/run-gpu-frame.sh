@@ -1,0 +1,117 @@
+#!/usr/bin/env bash
+# The GPU-driven frame on a GPU machine without Debian's development packages, in one command (the device tool's
+# machine: docs/BENCHMARKS.md, "The GPU-driven frame"). Same layout as ../shared/gpu/run-benchmarks.sh: in the current
+# folder .gpu/ff.tar.xz (the release build bundled by ../shared/gpu/bundle.sh) and .gl/*.deb (libglvnd, unpacked into
+# / first unless SKIP_GL is set). Writes OUT/<stage>.tgz (bench.json, frames.csv, cull checks, logs; no images) and
+# OUT/log.txt; prints a summary per stage.
+#
+# Stages (STAGES, default "smoke heldout big demo check"):
+#   smoke    a small city, one bench; stops everything unless the NVIDIA driver drew it
+#   heldout  a 400-block detail-3 city (about 17 M triangles) and a 300-frame car drive at 1920x1080: frustum,
+#            culled-cpu and culled (the GPU-driven frame), GPU time from timer queries, own CPU time, syncs
+#   big      the 100,000-block city (detail 0) at 1920x1080, 150 frames: the same modes
+#   demo     the default city at 640x360 (make demo's): the same modes
+#   check    farfield cull-check on the held-out city at 1920x1080 (GPU-culled frames against frustum-culled ones)
+set -uo pipefail
+STAGES=${STAGES:-smoke heldout big demo check}
+OUTD=${OUT:-/tmp/out}
+mkdir -p "$OUTD"
+exec > >(tee -a "$OUTD/log.txt") 2>&1
+[ -n "${SKIP_GL:-}" ] || { for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig; }
+mkdir -p /tmp/ff && tar -C /tmp -xJf .gpu/ff.tar.xz
+export LD_LIBRARY_PATH=/tmp/ff/lib:/usr/local/nvidia/lib64:/usr/local/nvidia/lib
+[ -f /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json ] &&
+  export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
+export FF_PROGRESS=0
+FF=/tmp/ff/bin/farfield
+W=/tmp/w
+mkdir -p $W
+cd $W || exit 1
+t0=$(date +%s)
+say() { echo "== [$(($(date +%s) - t0)) s] $*"; }
+keep() {
+  local name=$1
+  shift
+  tar -czf "$OUTD/$name.tgz" --exclude='*.glb' --exclude='*.bin' --exclude='*.png' "$@" 2>/dev/null
+}
+summ() {
+  python3 - "$@" <<'PY'
+import json, sys
+for p in sys.argv[1:]:
+    try:
+        j = json.load(open(p))
+    except Exception as e:
+        print(p, "unreadable", e)
+        continue
+    print("#", p, "renderer:", j.get("renderer"), "size:", j.get("size"), "frames:", j.get("frames"))
+    for name, m in j["modes"].items():
+        keys = ["median_ms", "p99_ms", "gpu_median_ms", "cpu_median_ms", "cpu_p95_ms", "mean_draw_calls",
+                "mean_gl_calls", "mean_upload_bytes", "mean_syncs", "mean_triangles", "psnr_db_min"]
+        print("  ", name, {k: m.get(k) for k in keys if k in m})
+PY
+}
+bench3() {  # bench3 DIR SIZE STRIDE [FRAMES]: frustum, culled-cpu, culled on DIR/city.glb along DIR/path.json
+  local d=$1 size=$2 stride=$3 frames=${4:-0}
+  timeout 400 $FF bench $d/city.glb --path $d/path.json --modes frustum,culled-cpu,culled --size "$size" \
+    --stride "$stride" --frames "$frames" -o $d/bench > $d/bench.txt 2>&1
+  echo "rc $?"
+  summ $d/bench/bench.json
+}
+say "machine"
+nvidia-smi -L
+nproc
+
+if [[ " $STAGES " == *" smoke "* ]]; then
+  say "smoke"
+  timeout 120 $FF gen city --blocks 16 --seed 3 -o s.glb > /dev/null &&
+    timeout 120 $FF path street s.streets.json --frames 20 --seed 3 -o s.json > /dev/null &&
+    timeout 120 $FF bench s.glb --path s.json --modes culled --size 640x360 -o smoke > smoke.txt 2>&1
+  rc=$?
+  summ smoke/bench.json
+  if [ $rc -ne 0 ] || ! grep -qi nvidia smoke/bench.json; then
+    say "SMOKE FAILED (rc $rc): not on the NVIDIA GPU"
+    keep smoke smoke smoke.txt
+    exit 3
+  fi
+fi
+
+if [[ " $STAGES " == *" heldout "* || " $STAGES " == *" check "* ]]; then
+  H=heldout
+  mkdir -p $H
+  [ -f $H/city.glb ] || timeout 300 $FF gen city --blocks 400 --detail 3 --seed 97 --objects buildings -o $H/city.glb > $H/gen.txt 2>&1
+  $FF path street $H/city.streets.json --frames 300 --seed 5 --car --fov 60 -o $H/path.json > /dev/null 2>&1
+fi
+if [[ " $STAGES " == *" heldout "* ]]; then
+  say "heldout: 400 blocks, detail 3, 1920x1080"
+  bench3 $H 1920x1080 1
+  keep heldout $H/bench/bench.json $H/bench/frames.csv $H/*.txt
+fi
+
+if [[ " $STAGES " == *" big "* ]]; then
+  say "big: 100,000 blocks, detail 0, 1920x1080"
+  B=big
+  mkdir -p $B
+  timeout 300 $FF gen city --blocks 100000 --detail 0 --seed 3 -o $B/city.glb > $B/gen.txt 2>&1
+  $FF path street $B/city.streets.json --frames 300 --seed 41 --car --fov 60 -o $B/path.json > /dev/null 2>&1
+  bench3 $B 1920x1080 2 150
+  keep big $B/bench/bench.json $B/bench/frames.csv $B/*.txt
+fi
+
+if [[ " $STAGES " == *" demo "* ]]; then
+  say "demo: the default city, 640x360"
+  D=demo
+  mkdir -p $D
+  timeout 120 $FF gen city --blocks 400 --detail 2 --seed 1 --objects buildings -o $D/city.glb > $D/gen.txt 2>&1
+  $FF path street $D/city.streets.json --frames 300 --seed 1 --car --fov 60 -o $D/path.json > /dev/null 2>&1
+  bench3 $D 640x360 1
+  keep demo $D/bench/bench.json $D/bench/frames.csv $D/*.txt
+fi
+
+if [[ " $STAGES " == *" check "* ]]; then
+  say "check: GPU-culled against frustum-culled frames, held-out city, 1920x1080"
+  timeout 300 $FF cull-check $H/city.glb --path $H/path.json --size 1920x1080 --stride 5 -o $H/check > $H/check.txt 2>&1
+  echo "rc $?"
+  tail -6 $H/check.txt
+  keep check $H/check $H/check.txt
+fi
+say "done"
