@@ -8,8 +8,9 @@
 #
 # Without SCENE and PATH it makes the demo's city and drive (400 blocks, detail 2, seed 1). Environment: SIZE
 # (640x360), STRIDE (5), IMPOSTORS ("100:4 200:8": osgSim::Impostor threshold in metres and pixel error),
-# OSG_BUILD (build/osg-peer: where the peer is built). OpenSceneGraph draws into a GLX pbuffer: without a display the
-# peer runs under xvfb-run (Mesa's llvmpipe; on a GPU machine give it an X server of the GPU).
+# OSG_BUILD (build/osg-peer: where the peer is built). OpenSceneGraph draws into a GLX window: without a display the
+# peer runs under xvfb-run (Mesa's llvmpipe; on a GPU machine give it an X server of the GPU). The last frame of each
+# peer run is saved next to the table (osg-last.png, ...) as evidence of what it drew.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 FARFIELD=$(readlink -f "${1:-$here/build/release/bin/farfield}")
@@ -48,12 +49,14 @@ if [ -z "${DISPLAY:-}" ]; then
   xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24")
 fi
 
-"${xvfb[@]}" "$PEER" "$SCENE" "$PATHFILE" --size "$SIZE" --stride "$STRIDE" --mode full --tag osg \
-  --csv "$OUT/osg.csv" > "$OUT/osg.txt" 2>&1
+# A window of the display (Mesa's GLX pbuffers answer its frame copies with X errors on Xvfb); the last frame saved.
+"${xvfb[@]}" "$PEER" "$SCENE" "$PATHFILE" --size "$SIZE" --stride "$STRIDE" --mode full --tag osg --window \
+  --csv "$OUT/osg.csv" --screenshot "$OUT/osg-last.png" > "$OUT/osg.txt" 2>&1
 for imp in $IMPOSTORS; do
   threshold=${imp%%:*} pixels=${imp##*:}
   "${xvfb[@]}" "$PEER" "$SCENE" "$PATHFILE" --size "$SIZE" --stride "$STRIDE" --mode impostor --threshold "$threshold" \
-    --pixel-error "$pixels" --tag "osg-impostor-$threshold-$pixels" > "$OUT/osg-impostor-$threshold-$pixels.txt" 2>&1
+    --pixel-error "$pixels" --tag "osg-impostor-$threshold-$pixels" --window \
+    --screenshot "$OUT/osg-impostor-$threshold-$pixels-last.png" > "$OUT/osg-impostor-$threshold-$pixels.txt" 2>&1
 done
 "$FARFIELD" bench "$SCENE" --path "$PATHFILE" --modes frustum,culled-cpu,culled --size "$SIZE" --stride "$STRIDE" \
   -o "$OUT/farfield" > "$OUT/farfield.txt" 2>&1

@@ -7,7 +7,7 @@
 // --threshold metres, re-rendered when its error exceeds --pixel-error pixels).
 //
 //   osg_peer SCENE PATH.json [--size WxH] [--stride K] [--frames N] [--warmup N] [--mode full|impostor]
-//            [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE]
+//            [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE] [--window] [--screenshot FILE.png]
 //
 // Prints "RESULT tag=... mode=... frames=N median=... p95=... p99=... max=... mean=... first=..." (milliseconds per
 // frame: osgViewer::Viewer::frame(), update, cull and draw, through glFinish). Needs a display (GLX pbuffer): Xvfb
@@ -37,6 +37,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
+#include "farfield/image/png_io.h"
 #include "farfield/scene/import.h"
 
 namespace {
@@ -91,11 +92,14 @@ struct Args {
   int width = 640, height = 360;
   size_t stride = 1, frames = 0, warmup = 1;
   float threshold = 100.0f, pixel_error = 4.0f;
+  bool window = false;       // a window instead of a pbuffer
+  std::string screenshot;    // the last frame as a PNG
 };
 
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr, "error: %s\nusage: osg_peer SCENE PATH.json [--size WxH] [--stride K] [--frames N] [--warmup N] "
-                       "[--mode full|impostor] [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE]\n",
+                       "[--mode full|impostor] [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE] [--window] "
+                       "[--screenshot FILE.png]\n",
                why.c_str());
   std::exit(2);
 }
@@ -129,6 +133,10 @@ Args parseArgs(int argc, char** argv) {
       a.tag = value();
     } else if (k == "--csv") {
       a.csv = value();
+    } else if (k == "--window") {
+      a.window = true;
+    } else if (k == "--screenshot") {
+      a.screenshot = value();
     } else if (!k.empty() && k[0] == '-') {
       usage("unknown option " + k);
     } else {
@@ -263,10 +271,13 @@ int main(int argc, char** argv) {
 
   // ---- a headless viewer: a pbuffer of the frame's size ----
   osg::ref_ptr<osg::GraphicsContext::Traits> traits = new osg::GraphicsContext::Traits;
+  traits->readDISPLAY();
+  traits->setUndefinedScreenDetailsToDefaultScreen();
   traits->width = args.width;
   traits->height = args.height;
-  traits->pbuffer = true;
-  traits->doubleBuffer = false;
+  traits->pbuffer = !args.window;
+  traits->windowDecoration = false;
+  traits->doubleBuffer = true;
   traits->red = traits->green = traits->blue = traits->alpha = 8;
   traits->depth = 24;
   osg::ref_ptr<osg::GraphicsContext> gc = osg::GraphicsContext::createGraphicsContext(traits);
@@ -333,6 +344,19 @@ int main(int argc, char** argv) {
               percentile(times, 50), percentile(times, 95), percentile(times, 99),
               times.empty() ? 0.0 : *std::max_element(times.begin(), times.end()), mean,
               times.empty() ? 0.0 : times.front());
+  if (!args.screenshot.empty()) {
+    // The last frame, read back (after the timing): evidence that the peer drew the city.
+    gc->makeCurrent();
+    farfield::image::ColorImage image(args.width, args.height);
+    glReadBuffer(buffer);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    std::vector<unsigned char> rows(size_t(args.width) * size_t(args.height) * 4);
+    glReadPixels(0, 0, args.width, args.height, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
+    for (int y = 0; y < args.height; ++y)
+      std::memcpy(&image.at(0, y), &rows[size_t(args.height - 1 - y) * size_t(args.width) * 4], size_t(args.width) * 4);
+    gc->releaseContext();
+    farfield::image::writePng(args.screenshot, image);
+  }
   if (!args.csv.empty()) {
     std::ofstream csv(args.csv);
     csv << "frame,path_frame,wall_ms\n";
