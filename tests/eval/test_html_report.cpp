@@ -180,6 +180,10 @@ TEST(HtmlReport, PageOfARealRunIsSelfContainedAndStatesTheVerdict) {
   EXPECT_NE(page.find("t_max 0.001 ms met on <b>0 of 3</b> frames"), std::string::npos);
   EXPECT_NE(page.find("error bound 1 px met on <b>3 of 3</b> frames"), std::string::npos);
   EXPECT_NE(page.find("farfield bench builtin:cubes --modes culled"), std::string::npos);
+  // The verdict's mode (culled, the GPU-driven frame) states what it asks of the machine: no synchronisation.
+  EXPECT_NE(page.find("Farfield's own CPU time"), std::string::npos);
+  EXPECT_NE(page.find("0.00 CPU-GPU synchronisations a frame"), std::string::npos);
+  EXPECT_NE(page.find("<th>own CPU median ms</th>"), std::string::npos);
   // Baselines first; culled draws exactly what full geometry draws.
   ASSERT_NE(page.find("<tr><td>culled</td>"), std::string::npos);
   EXPECT_LT(page.find("<tr><td>full</td>"), page.find("<tr><td>culled</td>"));

@@ -105,6 +105,11 @@ std::string base64(const std::string& bytes) {
   return out;
 }
 
+std::optional<double> kilobytes(std::optional<double> bytes) {
+  if (bytes) return *bytes / 1024.0;
+  return std::nullopt;
+}
+
 std::string htmlEscape(const std::string& text) {
   std::string out;
   out.reserve(text.size());
@@ -197,7 +202,19 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
   if (v.database_bytes) h << "<p>database " << megabytes(*v.database_bytes) << "</p>\n";
   h << "<p>speedup <b>" << format("%.2fx", v.speedup_vs_full) << "</b> over full geometry";
   if (v.speedup_vs_culled) h << ", " << format("%.2fx", *v.speedup_vs_culled) << " over view-frustum culling";
-  h << " (median frame time)</p>\n</div>\n";
+  h << " (median frame time)</p>\n";
+  {
+    // What the verdict's mode asks of the machine per frame (null in runs before GL calls were counted).
+    const nlohmann::json& mode = modes[v.mode];
+    const std::string at = where + ": modes." + v.mode;
+    const std::optional<double> cpu = optionalNumber(mode, "cpu_median_ms", at);
+    const std::optional<double> syncs = optionalNumber(mode, "mean_syncs", at);
+    if (cpu && syncs)
+      h << "<p>Farfield's own CPU time " << format("%.3f", *cpu) << " ms a frame (median), "
+        << format("%.0f", number(mode, "mean_draw_calls", at)) << " draw calls and " << format("%.2f", *syncs)
+        << " CPU-GPU synchronisations a frame</p>\n";
+  }
+  h << "</div>\n";
 
   auto text = [&](const char* key) {
     const auto it = bench.find(key);
@@ -212,7 +229,8 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
 
   // Every mode.
   h << "<h2>Modes</h2>\n<table><tr><th>mode</th><th>median ms</th><th>p95 ms</th><th>p99 ms</th><th>max ms</th>"
-       "<th>triangles</th><th>draw calls</th><th>speedup</th><th>PSNR dB</th><th>cracks</th>"
+       "<th>GPU median ms</th><th>own CPU median ms</th><th>triangles</th><th>draw calls</th><th>GL calls</th>"
+       "<th>uploaded KB</th><th>syncs</th><th>speedup</th><th>PSNR dB</th><th>cracks</th>"
        "<th>parallax p99 px</th><th>over bound</th><th>over t_max</th></tr>\n";
   // Baselines first, then the rest by name.
   std::vector<std::string> order;
@@ -232,8 +250,13 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
     h << "<tr><td>" << htmlEscape(name) << "</td><td>" << format("%.2f", number(mode, "median_ms", at)) << "</td><td>"
       << format("%.2f", number(mode, "p95_ms", at)) << "</td><td>" << format("%.2f", number(mode, "p99_ms", at))
       << "</td><td>" << format("%.2f", number(mode, "max_ms", at)) << "</td><td>"
+      << cell(optionalNumber(mode, "gpu_median_ms", at), "%.2f") << "</td><td>"
+      << cell(optionalNumber(mode, "cpu_median_ms", at), "%.3f") << "</td><td>"
       << format("%.0f", number(mode, "mean_triangles", at)) << "</td><td>"
       << format("%.0f", number(mode, "mean_draw_calls", at)) << "</td><td>"
+      << cell(optionalNumber(mode, "mean_gl_calls", at), "%.0f") << "</td><td>"
+      << cell(kilobytes(optionalNumber(mode, "mean_upload_bytes", at)), "%.1f") << "</td><td>"
+      << cell(optionalNumber(mode, "mean_syncs", at), "%.2f") << "</td><td>"
       << format("%.2fx", number(mode, "speedup_vs_full", at)) << "</td><td>"
       << (psnr && *psnr >= psnr_cap ? std::string("identical") : cell(psnr, "%.2f")) << "</td><td>"
       << (cracks ? format("%.3f%%", *cracks * 100.0) : std::string("n/a")) << "</td><td>"
