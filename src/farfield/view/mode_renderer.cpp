@@ -2,12 +2,46 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
-#include "farfield/core/timer.h"
 #include "farfield/core/log.h"
 #include "farfield/eval/city_on_terrain_mode.h"
 #include "farfield/eval/terrain_modes.h"
 
 namespace farfield::view {
+
+class ModeRenderer::PlanFrame final : public eval::Mode {
+ public:
+  explicit PlanFrame(ModeRenderer& owner) : owner_(owner) {}
+  std::string name() const override { return owner_.mode_; }
+  bool replan = true;
+  bool tint = false;
+  void frame(eval::FrameContext& frame) override {
+    ModeRenderer& o = owner_;
+    if (replan) {
+      const runtime::FramePlan& plan = o.walkthrough_->plan(frame.camera(), [&] { frame.beginOwnPass(); });
+      o.last_plan_ = &plan;
+      o.last_items_.assign(plan.items.begin(), plan.items.end());
+      o.last_kinds_ = itemKinds(plan, o.gpu_scene_, uint32_t(o.scene_.objects.size() + 1));
+      if (plan.geometry_version != o.geometry_version_) {
+        o.geometry_->culler().setObjects(plan.geometry_objects);
+        o.geometry_version_ = plan.geometry_version;
+      }
+      if (plan.report.updates > 0) frame.addStats(plan.report.update_stats);
+    }
+    o.geometry_->draw(frame);
+    if (tint) {
+      o.tinted_ = tintedItems(o.last_items_, o.last_kinds_, o.tint_materials_);
+      frame.items() = o.tinted_;
+    } else {
+      frame.items() = o.last_items_;
+    }
+  }
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
+    return owner_.geometry_->lateFrameStats(path_frame);
+  }
+
+ private:
+  ModeRenderer& owner_;
+};
 
 ModeRenderer::ModeRenderer(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const scene::Bvh& bvh,
                            gpu::Renderer& renderer, gpu::RenderTarget& target, ModeSettings settings)
@@ -33,6 +67,8 @@ ModeRenderer::ModeRenderer(const scene::Scene& scene, const gpu::GpuScene& gpu_s
 ModeRenderer::~ModeRenderer() {
   // The terrain's GPU buffers go while the context is current (the run outlives the modes otherwise).
   eval_mode_.reset();
+  plan_frame_.reset();
+  geometry_.reset();
   if (!settings_.terrain.empty()) eval::currentTerrainRun().reset();
 }
 
@@ -45,11 +81,16 @@ void ModeRenderer::select(const std::string& mode) {
     options.gpu_budget_bytes = settings_.gpu_budget_bytes;
     options.width = target_.width();
     options.height = target_.height();
+    options.geometry_items = false;  // the plan's objects, drawn by the GPU-driven frame
     if (!settings_.terrain.empty())
       FF_WARN("mode " << mode << " draws the city without the terrain (full and culled draw it under the city)");
     auto walkthrough = std::make_unique<runtime::Walkthrough>(scene_, gpu_scene_, bvh_, renderer_, options);
     walkthrough_ = std::move(walkthrough);
     eval_mode_.reset();
+    if (!geometry_) geometry_.emplace(context_, gpu::GpuCullOptions{});
+    geometry_version_ = ~uint64_t(0);
+    geometry_->culler().resetHistory();
+    plan_frame_ = std::make_unique<PlanFrame>(*this);
   } else {
     if (mode != "full" && mode != "culled")
       throw Error("mode '" + mode + "'", "unknown; the viewer draws full, culled and the database's representations "
@@ -63,6 +104,7 @@ void ModeRenderer::select(const std::string& mode) {
   }
   mode_ = mode;
   last_items_.clear();
+  last_plan_ = nullptr;
 }
 
 ViewFrame ModeRenderer::render(const Camera& camera, size_t frame_index, bool tint) {
@@ -76,31 +118,26 @@ ViewFrame ModeRenderer::render(const Camera& camera, size_t frame_index, bool ti
     frame.draw_calls = record.draw_calls;
     return frame;
   }
-  Stopwatch clock;
-  const runtime::FramePlan& plan = walkthrough_->plan(camera);
-  last_items_.assign(plan.items.begin(), plan.items.end());
-  last_kinds_ = itemKinds(plan, gpu_scene_, uint32_t(scene_.objects.size() + 1));
-  const gpu::FrameStats stats = draw(camera, tint);
-  frame.cpu_ms = clock.milliseconds();
-  frame.gpu_ms = stats.gpu_ms;
-  frame.triangles = stats.triangles + plan.report.update_stats.triangles;
-  frame.draw_calls = stats.draw_calls + plan.report.update_stats.draw_calls;
-  frame.plan = &plan;
-  frame.decisions = countDecisions(plan);
+  plan_frame_->replan = true;
+  plan_frame_->tint = tint;
+  const eval::FrameRecord record = runner_.run(*plan_frame_, camera, frame_index);
+  frame.cpu_ms = record.wall_ms;
+  frame.gpu_ms = record.gpu_ms;
+  frame.triangles = record.triangles;
+  frame.draw_calls = record.draw_calls;
+  frame.plan = last_plan_;
+  frame.decisions = countDecisions(*last_plan_);
   return frame;
 }
 
-gpu::FrameStats ModeRenderer::draw(const Camera& camera, bool tint) {
-  if (!tint) return renderer_.render(camera, last_items_, target_);
-  const std::vector<gpu::DrawItem> tinted = tintedItems(last_items_, last_kinds_, tint_materials_);
-  return renderer_.render(camera, tinted, target_);
-}
-
 void ModeRenderer::redraw(const Camera& camera, size_t frame_index, bool tint) {
-  if (eval_mode_)
+  if (eval_mode_) {
     runner_.run(*eval_mode_, camera, frame_index);
-  else
-    draw(camera, tint);
+    return;
+  }
+  plan_frame_->replan = false;
+  plan_frame_->tint = tint;
+  runner_.run(*plan_frame_, camera, frame_index);
 }
 
 }  // namespace farfield::view

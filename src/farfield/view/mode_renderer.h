@@ -1,7 +1,8 @@
 // The viewer's frames: one mode at a time, switchable while running, drawn into one render target with the shared
 // renderer. full and culled are eval's built-in modes run through eval::FrameRunner; the database's representations
 // (local, visible, smi, mmi, mmi-dynamic, placed) go through the runtime's product API, runtime::Walkthrough, whose
-// plan (items, per-layer decisions, report) the panels show. No second renderer.
+// plan (items, per-layer decisions, report) the panels show, its geometry drawn by the GPU-driven frame (the plan's
+// objects through the run's arena: gpu::GpuCuller) and its impostors by the renderer, timed by the same FrameRunner.
 #pragma once
 
 #include <array>
@@ -12,6 +13,7 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/eval/frame_runner.h"
+#include "farfield/eval/gpu_culled_mode.h"
 #include "farfield/eval/mode.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
@@ -76,11 +78,19 @@ class ModeRenderer {
   std::string mode_;
   std::unique_ptr<eval::Mode> eval_mode_;
   std::unique_ptr<runtime::Walkthrough> walkthrough_;
-  gpu::FrameStats draw(const Camera& camera, bool tint);
+  // A walkthrough's frame as a mode of the runner: plans (or not, for a redraw), then the plan's geometry objects on
+  // the GPU and its items (tinted or not) in the main pass.
+  class PlanFrame;
+  friend class PlanFrame;
+  std::unique_ptr<PlanFrame> plan_frame_;
+  std::optional<eval::GpuCullRun> geometry_;  // the walkthrough modes' GPU-driven geometry
+  uint64_t geometry_version_ = ~uint64_t(0);
 
-  std::vector<gpu::DrawItem> last_items_;  // the walkthrough's last plan, untinted
+  const runtime::FramePlan* last_plan_ = nullptr;
+  std::vector<gpu::DrawItem> last_items_;  // the walkthrough's last plan, untinted (its impostors)
   std::vector<size_t> last_kinds_;         // and the kinds of its items
   std::vector<gpu::GpuMaterial> tint_materials_;
+  std::vector<gpu::DrawItem> tinted_;
 };
 
 }  // namespace farfield::view
