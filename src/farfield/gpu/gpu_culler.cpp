@@ -58,6 +58,7 @@ struct GpuCuller::Impl {
 
   GLuint enabled = 0, visibility = 0, stats = 0, group_first = 0, object_frame = 0, work = 0, drawn = 0;
   GLuint drawn_list = 0;  // the instances drawn in this frame (the history pass's work list)
+  GLuint part_visible = 0, instance_part = 0;  // per part: visible last frame, in view; per instance: its part
   // Per phase: the commands, and the number written per group (buffers of their own: bound whole, no offset
   // alignment to respect).
   std::array<GLuint, 2> commands{}, counts{};
@@ -110,7 +111,7 @@ struct GpuCuller::Impl {
   ~Impl() {
     const GLuint buffers[] = {enabled,     visibility,  stats,     group_first, object_frame,
                               commands[0], commands[1], counts[0], counts[1],   work,        drawn,
-                              drawn_list};
+                              drawn_list,  part_visible, instance_part};
     glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
     if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
     for (Slot& s : ring) {
@@ -136,6 +137,7 @@ struct GpuCuller::Impl {
     std::array<int, 2 * kMaxLevels> sizes{};
     for (size_t k = 0; k < level_size.size(); ++k) sizes[2 * k] = level_size[k][0], sizes[2 * k + 1] = level_size[k][1];
     glProgramUniform2iv(cull.handle(), cl.level_size, GLsizei(level_size.size()), sizes.data());
+    glProgramUniform2iv(parts.handle(), part_l.level_size, GLsizei(level_size.size()), sizes.data());
     if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
     pyramid_texture = 0;
     if (level_size.size() < 2) return;
@@ -171,6 +173,12 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   // The work list: the dispatch of the cluster stages (x, y, z) and its length, then the instances.
   im.work = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
   im.drawn_list = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
+  im.part_visible = createBuffer(arena.parts().size() * sizeof(uint32_t), nullptr);
+  glClearNamedBufferData(im.part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  std::vector<uint32_t> part_of(std::max<size_t>(im.instances, 1), 0);
+  for (uint32_t p = 0; p < arena.parts().size(); ++p)
+    for (uint32_t k = 0; k < arena.parts()[p].instance_count; ++k) part_of[arena.parts()[p].first_instance + k] = p;
+  im.instance_part = createBuffer(part_of.size() * sizeof(uint32_t), part_of.data());
   for (GLuint& c : im.commands) {
     c = createBuffer(size_t(im.instances) * kCommandBytes, nullptr);
     glClearNamedBufferData(c, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -240,6 +248,7 @@ void GpuCuller::setObjects(std::span<const uint32_t> ids) {
 
 void GpuCuller::resetHistory() {
   glClearNamedBufferData(impl_->visibility, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  glClearNamedBufferData(impl_->part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 }
 
 FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMode mode, const LightSettings& light) {
@@ -264,7 +273,11 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glProgramUniform1i(c, im.cl.levels, int(im.level_size.size()));
   glProgramUniform1ui(c, im.cl.frame, uint32_t(frame + 1));
   const GLuint pp = im.parts.handle();
+  glProgramUniformMatrix4fv(pp, im.part_l.view_proj, 1, GL_FALSE, glm::value_ptr(view_proj));
   glProgramUniform4fv(pp, im.part_l.planes, 6, glm::value_ptr(frustum.planes[0]));
+  glProgramUniform2i(pp, im.part_l.viewport, target.width(), target.height());
+  glProgramUniform1f(pp, im.part_l.margin, options_.occlusion_margin);
+  glProgramUniform1i(pp, im.part_l.levels, int(im.level_size.size()));
   glProgramUniform1ui(pp, im.part_l.count, uint32_t(arena_.parts().size()));
   const GLuint e = im.emit.handle();
   glProgramUniform1i(e, im.emit_l.compact, indirect_count_ ? 1 : 0);
@@ -296,21 +309,32 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.work);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, im.drawn);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, im.drawn_list);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 15, im.part_visible);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 16, im.instance_part);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, im.stats);
   for (GLuint buffer : {im.counts[0], im.counts[1], im.stats})
     glClearNamedBufferData(buffer, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   for (GLuint list : {im.work, im.drawn_list})
     glClearNamedBufferSubData(list, GL_R32UI, 0, 4 * sizeof(uint32_t), GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
-  // The parts in view put their clusters on the work list; its length becomes the cluster stages' dispatch.
+  // A phase's work list: the parts it takes put their clusters on it (PARTS, by phase), and its length becomes the
+  // cluster stages' dispatch (ARGS).
   const GLuint part_groups = (uint32_t(arena_.parts().size()) + kWorkGroup - 1) / kWorkGroup;
-  glUseProgram(pp);
-  glDispatchCompute(std::min(part_groups, kMaxGroupsX), (part_groups + kMaxGroupsX - 1) / kMaxGroupsX, 1);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-  glUseProgram(im.args.handle());
-  glDispatchCompute(1, 1, 1);
-  glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-  glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.work);
+  auto listParts = [&](int phase) {
+    glClearNamedBufferSubData(im.work, GL_R32UI, 0, 4 * sizeof(uint32_t), GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    glProgramUniform1i(pp, im.part_l.phase, phase);
+    glUseProgram(pp);
+    glBindTextureUnit(2, target.depthTexture().handle());
+    glBindTextureUnit(3, im.pyramid_texture);
+    glDispatchCompute(std::min(part_groups, kMaxGroupsX), (part_groups + kMaxGroupsX - 1) / kMaxGroupsX, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glBindTextureUnit(2, 0);
+    glBindTextureUnit(3, 0);
+    glUseProgram(im.args.handle());
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.work);
+  };
 
   // The depth pyramid of what the target holds now (DepthPyramid::build on the GPU).
   auto buildPyramid = [&]() {
@@ -394,17 +418,22 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   };
 
   if (!options_.occlusion) {
+    listParts(2);
     cullPhase(2, 1);
     drawPhase(1);
   } else {
+    listParts(0);
     cullPhase(0, 0);
     drawPhase(0);
     buildPyramid();
+    listParts(1);
     cullPhase(1, 1);
     drawPhase(1);
     if (options_.refine_history) {
-      // The drawn instances become the work list: their dispatch, then the test against the final depth.
+      // The drawn instances become the work list: their dispatch, then the test against the final depth, which
+      // also decides the parts' visibility (cleared first).
       buildPyramid();
+      glClearNamedBufferData(im.part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.drawn_list);
       glUseProgram(im.args.handle());
       glDispatchCompute(1, 1, 1);

@@ -1,7 +1,9 @@
 #version 450 core
 // Farfield cluster culling (gpu/gpu_culler.h), in stages compiled from this one file (FF_STAGE_*):
-//   PARTS (one invocation per object part): parts of objects in this frame's plan whose box meets the frustum put
-//     their cluster instances on the work list; the others are culled whole;
+//   PARTS (one invocation per object part), by phase: 0 (early) parts of objects in this frame's plan whose box meets
+//     the frustum are in view, and those visible in the last frame put their cluster instances on the work list;
+//     1 (late) parts in view whose box the depth pyramid does not hide put theirs; 2 (no occlusion) every part in
+//     view puts its instances; the others are culled whole;
 //   ARGS (one invocation): the length of the list bound as the work list as the indirect dispatch of the next stages;
 //   CLUSTERS (one per work list entry): an instance is in view when its sphere and box meet the frustum and its normal
 //     cone does not turn every triangle away from the eye; then, by phase,
@@ -67,6 +69,11 @@ layout(std430, binding = 11) readonly buffer Parts { Part parts[]; };
 layout(std430, binding = 12) buffer Work { uvec4 dispatch_args; uint work[]; };  // dispatch_args.w: list length
 layout(std430, binding = 13) buffer Drawn { uint drawn_flag[]; };            // per instance: drawn in this phase
 layout(std430, binding = 14) buffer DrawnList { uvec4 drawn_args; uint drawn_list[]; };  // instances drawn this frame
+// Per part: bit 0 visible in the last frame (a cluster of it visible in its final depth), bit 1 in view this frame,
+// bit 2 on this frame's early list (its clusters visible in the last frame drawn early: a cluster's own flag alone
+// may be older than its part's, from a frame before the part was hidden).
+layout(std430, binding = 15) buffer PartVisible { uint part_visible[]; };
+layout(std430, binding = 16) readonly buffer InstancePart { uint instance_part[]; };
 
 layout(binding = 2) uniform sampler2D u_depth;    // pyramid level 0: the frame's depth
 layout(binding = 3) uniform sampler2D u_pyramid;  // levels 1.. in its mip levels 0..
@@ -113,35 +120,6 @@ bool boxInFrustum(vec3 lo, vec3 hi, mat4 model) {
   return true;
 }
 
-#if defined(FF_STAGE_PARTS)
-void main() {
-  beginStats();
-  const uint i = invocation();
-  if (i < u_count) {
-    const Part part = parts[i];
-    const uint object = part.info.x, count = part.info.z;
-    if (enabled[object] != 0u && count > 0u) {
-      atomicAdd(s_stats[kInPlan], count);
-      const bool affine = (objects[object].info.y & 1u) != 0u;
-      if (!affine || boxInFrustum(part.box_lo.xyz, part.box_hi.xyz, objects[object].model)) {
-        const uint base = atomicAdd(dispatch_args.w, count);
-        for (uint k = 0u; k < count; ++k) work[base + k] = part.info.y + k;
-      } else {
-        atomicAdd(s_stats[kFrustum], count);
-      }
-    }
-  }
-  endStats();
-}
-
-#elif defined(FF_STAGE_ARGS)
-void main() {
-  const uint groups = (dispatch_args.w + 63u) / 64u;
-  const uint x = min(groups, 65535u);
-  dispatch_args.xyz = uvec3(x, x == 0u ? 0u : (groups + x - 1u) / x, 1u);
-}
-
-#elif defined(FF_STAGE_CLUSTERS)
 float levelTexel(int k, ivec2 p) {
   return k == 0 ? texelFetch(u_depth, p, 0).r : texelFetch(u_pyramid, p, k - 1).r;
 }
@@ -178,6 +156,55 @@ bool hidden(vec3 lo, vec3 hi, mat4 mvp) {
 }
 
 
+#if defined(FF_STAGE_PARTS)
+// Appends the part's instances to the work list.
+void appendPart(Part part) {
+  const uint base = atomicAdd(dispatch_args.w, part.info.z);
+  for (uint k = 0u; k < part.info.z; ++k) work[base + k] = part.info.y + k;
+}
+
+void main() {
+  beginStats();
+  const uint i = invocation();
+  if (i < u_count) {
+    const Part part = parts[i];
+    const uint object = part.info.x, count = part.info.z;
+    const bool affine = (objects[object].info.y & 1u) != 0u;
+    if (u_phase == 0 || u_phase == 2) {
+      // The frame's first look at the part: in the plan and in the frustum; the early list takes those visible in the
+      // last frame, the only phase (2) all of them.
+      bool in_view = enabled[object] != 0u && count > 0u;
+      if (in_view) atomicAdd(s_stats[kInPlan], count);
+      if (in_view && affine && !boxInFrustum(part.box_lo.xyz, part.box_hi.xyz, objects[object].model)) {
+        in_view = false;
+        atomicAdd(s_stats[kFrustum], count);
+      }
+      const bool early = in_view && u_phase == 0 && (part_visible[i] & 1u) != 0u;
+      part_visible[i] = (part_visible[i] & 1u) | (in_view ? 2u : 0u) | (early ? 4u : 0u);
+      if (early || (in_view && u_phase == 2)) appendPart(part);
+    } else {
+      // The late list: parts in view whose box the early phase's depth does not hide. A part of which a cluster was
+      // drawn early is never hidden (that cluster's depth is inside its box).
+      const uint state = part_visible[i];
+      if ((state & 2u) != 0u) {
+        const bool occluded = affine && hidden(part.box_lo.xyz, part.box_hi.xyz, u_view_proj * objects[object].model);
+        part_visible[i] = (state & 6u) | (occluded ? 0u : 1u);
+        if (occluded) atomicAdd(s_stats[kOccluded], count);
+        else appendPart(part);
+      }
+    }
+  }
+  endStats();
+}
+
+#elif defined(FF_STAGE_ARGS)
+void main() {
+  const uint groups = (dispatch_args.w + 63u) / 64u;
+  const uint x = min(groups, 65535u);
+  dispatch_args.xyz = uvec3(x, x == 0u ? 0u : (groups + x - 1u) / x, 1u);
+}
+
+#elif defined(FF_STAGE_CLUSTERS)
 void main() {
   beginStats();
   const uint w = invocation();
@@ -212,14 +239,18 @@ void main() {
     }
     bool drawn = false;
     if (u_phase == 3) {
-      // The history for the next frame: visible in this frame's final depth.
-      visible[i] = in_view && !(affine && hidden(c.box_lo.xyz, c.box_hi.xyz, u_view_proj * model)) ? 1u : 0u;
+      // The history for the next frame: visible in this frame's final depth (the parts' bits cleared before).
+      const bool now_visible = in_view && !(affine && hidden(c.box_lo.xyz, c.box_hi.xyz, u_view_proj * model));
+      visible[i] = now_visible ? 1u : 0u;
+      if (now_visible) atomicOr(part_visible[instance_part[i]], 1u);
     } else if (u_phase == 0) {
       drawn = in_view && visible[i] != 0u;
     } else if (u_phase == 1) {
       const bool occluded = in_view && affine && hidden(c.box_lo.xyz, c.box_hi.xyz, u_view_proj * model);
       const bool now_visible = in_view && !occluded;
-      drawn = now_visible && visible[i] == 0u;
+      // What the early phase drew: a cluster visible in the last frame of a part on the early list.
+      const bool early = (part_visible[instance_part[i]] & 4u) != 0u && visible[i] != 0u;
+      drawn = now_visible && !(early && in_view);
       visible[i] = now_visible ? 1u : 0u;
       if (occluded) atomicAdd(s_stats[kOccluded], 1u);
     } else {
