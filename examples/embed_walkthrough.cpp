@@ -4,19 +4,21 @@
 //
 // CITY.glb and its DATABASE come from `farfield gen city` (or an importer) and `farfield bake --pipeline
 // pvs,near-far,mmi`; PATH.json from `farfield path street`. Each frame: the camera goes in, a FramePlan comes out
-// (the draw items and, per layer, impostor or geometry and why), the engine draws the items. The program prints
-// what the walkthrough decided and kept, and writes the last frame.
+// (the objects drawn as geometry, the impostors' draw items and, per layer, impostor or geometry and why); the
+// GPU-driven frame (gpu::GpuCuller over the scene's arena) culls and draws the geometry's clusters with no CPU-GPU
+// round trip, and the renderer draws the impostors on top. The program prints what the walkthrough decided and what
+// the GPU drew (read frames later, never waited for), and writes the last frame.
+#include <algorithm>
 #include <cstdio>
 #include <cstdint>
 #include <exception>
-#include <span>
 #include <string>
 #include <variant>
 
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gpu/context.h"
-#include "farfield/gpu/occlusion_culler.h"
+#include "farfield/gpu/gpu_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/image/png_io.h"
@@ -42,28 +44,37 @@ int main(int argc, char** argv) {
     gpu::RenderTarget target(width, height);
     const gen::CameraPath path = gen::loadCameraPath(argv[3]);
 
-    // Farfield's side: the walkthrough over the database, with the user's error bound.
+    // Farfield's side: the walkthrough over the database, with the user's error bound, planning the geometry as
+    // objects for the GPU-driven frame (geometry_items = true would give draw items culled on the CPU instead).
     runtime::WalkthroughOptions options;
     options.database = argv[2];
     if (argc > 4) options.error_px = std::stod(argv[4]);
+    options.geometry_items = false;
     runtime::Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
     std::printf("error bound: %.2f px\n", walkthrough.errorBoundPx());
+    const gpu::SceneArena arena(scene);  // every mesh in shared buffers, cut into clusters
+    gpu::GpuCuller culler(arena);
 
     size_t impostor_layers = 0, geometry_layers = 0;
-    uint64_t hidden_triangles = 0;
-    gpu::OcclusionCuller occlusion;  // optional: drops the plan's geometry hidden behind its nearest items (exact)
+    uint64_t version = ~uint64_t(0), gpu_frames = 0, gpu_triangles = 0, gpu_hidden = 0;
     for (size_t f = 0; f < path.frames.size(); ++f) {
       const Camera camera = path.camera(f, width, height);
       const runtime::FramePlan& plan = walkthrough.plan(camera);
-      // The engine draws the plan: its geometry items (the first geometry_items, with their bounds) through the
-      // occlusion culler, which draws the nearest of them at once, then the rest of the geometry and the impostors.
+      // The engine draws the plan: the geometry's objects through the GPU culler (only a change of the list is
+      // sent), then the impostors with the renderer. Nothing here waits for the GPU.
+      if (plan.geometry_version != version) {
+        culler.setObjects(plan.geometry_objects);
+        version = plan.geometry_version;
+      }
       target.bind();
       target.clear(renderer.light().sky_color);
-      const std::span<const gpu::DrawItem> items(plan.items);
-      hidden_triangles += occlusion
-                              .draw(renderer, camera, items.first(plan.geometry_items), plan.geometry_bounds, target,
-                                    items.subspan(plan.geometry_items))
-                              .hidden_triangles;
+      culler.draw(camera, target, gpu::RenderMode::Shaded, renderer.light());
+      renderer.draw(camera, plan.items, target);
+      for (const gpu::GpuCullStats& s : culler.finishedStats()) {  // earlier frames', as the GPU finishes them
+        ++gpu_frames;
+        gpu_triangles += s.triangles;
+        gpu_hidden += s.occlusion_culled;
+      }
       for (const runtime::LayerDecision& d : plan.layers) {
         impostor_layers += std::holds_alternative<runtime::LayerAsImpostor>(d) ? 1 : 0;
         geometry_layers += std::holds_alternative<runtime::LayerAsGeometry>(d) ? 1 : 0;
@@ -74,8 +85,10 @@ int main(int argc, char** argv) {
                     plan.report.bound_px, static_cast<unsigned long long>(plan.report.geometry_triangles),
                     static_cast<unsigned long long>(plan.report.impostor_triangles));
     }
-    std::printf("layers drawn as impostors %zu times, as geometry %zu times; %llu geometry triangles hidden\n",
-                impostor_layers, geometry_layers, static_cast<unsigned long long>(hidden_triangles));
+    std::printf("layers drawn as impostors %zu times, as geometry %zu times\n", impostor_layers, geometry_layers);
+    std::printf("GPU: %llu frames counted, %.0f geometry triangles and %.0f hidden clusters a frame\n",
+                static_cast<unsigned long long>(gpu_frames), double(gpu_triangles) / double(std::max<uint64_t>(gpu_frames, 1)),
+                double(gpu_hidden) / double(std::max<uint64_t>(gpu_frames, 1)));
     if (argc > 5) image::writePng(argv[5], target.readColor());
     return 0;
   } catch (const std::exception& e) {
