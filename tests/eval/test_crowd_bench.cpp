@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "farfield/core/error.h"
 #include "farfield/eval/crowd_bench.h"
@@ -14,28 +16,39 @@ using namespace farfield;
 
 namespace {
 
-eval::CrowdBenchOptions tinyOptions() {
-  eval::CrowdBenchOptions o;
-  o.blocks = 10;
-  o.detail = 0;
-  o.agent_counts = {60};
-  o.paths = {"pedestrian"};
-  o.frames = 3;
-  o.frame_step = 10;
-  o.width = o.height = 64;
-  o.models = {(test::sharedDataDir() / "models" / "CesiumMan.glb").string(),
-              (test::sharedDataDir() / "models" / "Fox.glb").string()};
-  o.runtime.grid.azimuths = 8;
-  o.runtime.grid.elevations = 2;
-  o.runtime.frames = 2;
-  o.runtime.palette_poses = 4;
-  o.samples = 0;
-  return o;
-}
+// The bench runs on the real models beside the repository: every test is skipped without them.
+class CrowdBench : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+    FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+    models_ = {man_glb.string(), fox_glb.string()};
+  }
+
+  eval::CrowdBenchOptions tinyOptions() const {
+    eval::CrowdBenchOptions o;
+    o.blocks = 10;
+    o.detail = 0;
+    o.agent_counts = {60};
+    o.paths = {"pedestrian"};
+    o.frames = 3;
+    o.frame_step = 10;
+    o.width = o.height = 64;
+    o.models = models_;
+    o.runtime.grid.azimuths = 8;
+    o.runtime.grid.elevations = 2;
+    o.runtime.frames = 2;
+    o.runtime.palette_poses = 4;
+    o.samples = 0;
+    return o;
+  }
+
+  std::vector<std::string> models_;
+};
 
 }  // namespace
 
-TEST(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgainstIt) {
+TEST_F(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgainstIt) {
   eval::CrowdBenchOptions o = tinyOptions();
   o.out_dir = test::scratchDir("crowd_bench").string();
   const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), o);
@@ -61,7 +74,7 @@ TEST(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgains
 
 // With the agents hidden behind the city left out, every mode's agents are those in view less the hidden ones, and
 // crowd-geometry still draws exactly what the (unculled) reference draws.
-TEST(CrowdBench, AgentsCulledBehindTheCityLeaveTheGeometryFrameExact) {
+TEST_F(CrowdBench, AgentsCulledBehindTheCityLeaveTheGeometryFrameExact) {
   eval::CrowdBenchOptions o = tinyOptions();
   o.agent_occlusion = true;
   o.out_dir = test::scratchDir("crowd_bench_occlusion").string();
@@ -78,7 +91,7 @@ TEST(CrowdBench, AgentsCulledBehindTheCityLeaveTheGeometryFrameExact) {
 
 // --compare-skinning adds the palette-skinned policies; they draw the baked reference's frames to rounding (the
 // geometry mode's crowd pixels well above the impostors' PSNR) and the same agents as their baked counterparts.
-TEST(CrowdBench, PaletteSkinningDrawsTheBakedPosesFrames) {
+TEST_F(CrowdBench, PaletteSkinningDrawsTheBakedPosesFrames) {
   eval::CrowdBenchOptions o = tinyOptions();
   o.compare_skinning = true;
   o.timing_passes = 2;
@@ -99,7 +112,7 @@ TEST(CrowdBench, PaletteSkinningDrawsTheBakedPosesFrames) {
   for (const eval::CrowdModeResult& m : run.modes) EXPECT_GT(m.wall.median, 0.0) << m.name;
 }
 
-TEST(CrowdBench, BadOptionsAreErrors) {
+TEST_F(CrowdBench, BadOptionsAreErrors) {
   eval::CrowdBenchOptions o = tinyOptions();
   o.frames = 1;
   EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);

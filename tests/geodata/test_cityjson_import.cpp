@@ -198,8 +198,8 @@ TEST(CityJsonImport, BadFilesNameTheFile) {
 }
 
 TEST(CityJsonImport, Delft) {
-  const std::string path = (farfield::test::sharedDataDir() / "city" / "delft.city.json").string();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  FF_SHARED_FILE_OR_SKIP(json, "city/delft.city.json");
+  const std::string path = json.string();
   const CityJsonScene c = importCityJson(path);
   const auto& st = c.stats;
 

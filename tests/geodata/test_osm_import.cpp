@@ -263,8 +263,8 @@ TEST(OsmImport, PbfTruncatedAndCorrupt) {
 }
 
 TEST(OsmImport, Monaco) {
-  const std::string path = (farfield::test::sharedDataDir() / "city" / "monaco-2016.osm.pbf").string();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  FF_SHARED_FILE_OR_SKIP(pbf, "city/monaco-2016.osm.pbf");
+  const std::string path = pbf.string();
   farfield::Stopwatch clock;
   const OsmCity c = importOsm(path);
   const double seconds = clock.seconds();
@@ -304,8 +304,8 @@ TEST(OsmImport, Monaco) {
 TEST(OsmImport, MonacoBuildingBlocksBruteForce) {
   // Per building: the recorded block is the smallest face holding the footprint's centroid, checked by brute force
   // over every face on a sample of buildings; buildings in no block are in none of the faces.
-  const std::string path = (farfield::test::sharedDataDir() / "city" / "monaco-2016.osm.pbf").string();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  FF_SHARED_FILE_OR_SKIP(pbf, "city/monaco-2016.osm.pbf");
+  const std::string path = pbf.string();
   OsmImportOptions options;
   options.objects = farfield::gen::ObjectGrouping::Buildings;
   options.ground = false;
@@ -335,8 +335,8 @@ TEST(OsmImport, MonacoBuildingBlocksBruteForce) {
 TEST(OsmImport, MonacoTruncated) {
   // The real file cut at 99% (in its ways: the nodes fill the first ~97%): what was read before the cut is
   // imported and the break is reported.
-  const std::string path = (farfield::test::sharedDataDir() / "city" / "monaco-2016.osm.pbf").string();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  FF_SHARED_FILE_OR_SKIP(pbf, "city/monaco-2016.osm.pbf");
+  const std::string path = pbf.string();
   const std::string bytes = readBytes(path);
   const std::string cut = (farfield::test::scratchDir("geodata_monaco_cut") / "monaco_cut.osm.pbf").string();
   writeBytes(cut, bytes.substr(0, bytes.size() * 99 / 100));

@@ -42,8 +42,8 @@ Compare compare(const image::ColorImage& a, const image::IdImage& ia, const imag
 }
 
 TEST_P(CrowdSkinningGl, InstancedGpuSkinningEqualsCpuSkinning) {
-  const scene::SkinnedModel man =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  const scene::SkinnedModel man = scene::importSkinnedModel(man_glb.string());
   const scene::Animation* walk = &man.animations[0];
   std::vector<std::vector<Mat4>> poses;
   for (int p = 0; p < 4; ++p) poses.push_back(scene::jointMatrices(man, walk, walk->start + 0.23f * float(p)));
@@ -120,8 +120,8 @@ TEST_P(CrowdSkinningGl, InstancedGpuSkinningEqualsCpuSkinning) {
 
 // A model whose texture is transparent is cut out (nothing drawn); an opaque one is drawn without the cut-out test.
 TEST_F(CrowdRendererGlCutout, ATransparentTextureIsCutOutAndAnOpaqueOneDrawsWithoutTheTest) {
-  scene::SkinnedModel man =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  scene::SkinnedModel man = scene::importSkinnedModel(man_glb.string());
   ASSERT_TRUE(man.texture);
   const std::vector<std::vector<Mat4>> poses{scene::jointMatrices(man, &man.animations[0], man.animations[0].start)};
   CrowdRenderer crowd;

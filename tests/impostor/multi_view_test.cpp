@@ -119,8 +119,8 @@ Coverage compareAgents(const gpu::RenderTarget& a, const gpu::RenderTarget& b) {
 // for texture detail resampled twice (atlas texels of 8 mm against pixels of 14 mm) and silhouette pixels; with an
 // outfit of strong, distinct colour-region tints, both tinted alike (and not like another outfit).
 TEST_F(MultiViewGl, ImpostorSeenFromACaptureViewReproducesTheGeometry) {
-  const scene::SkinnedModel man =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  const scene::SkinnedModel man = scene::importSkinnedModel(man_glb.string());
   const scene::Animation* walk = &man.animations[0];
   std::vector<std::vector<Mat4>> poses;
   for (int p = 0; p < 2; ++p) poses.push_back(scene::jointMatrices(man, walk, walk->start + 0.4f * float(p)));

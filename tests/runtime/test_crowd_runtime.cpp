@@ -31,10 +31,6 @@ class CrowdRuntimeGl : public ::testing::Test {
   void SetUp() override { gpu::sharedHeadlessContext(); }
 };
 
-scene::SkinnedModel loadFox() {
-  return scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
-}
-
 // A small atlas (8 x 3 views up to 45 degrees, 4 frames, 2 cm texels) over a palette of `poses`.
 CrowdRuntimeOptions smallAtlas(int poses) {
   CrowdRuntimeOptions o;
@@ -53,10 +49,6 @@ bool same(const image::ColorImage& a, const image::ColorImage& b) {
                     });
 }
 
-scene::SkinnedModel loadMan() {
-  return scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
-}
-
 CrowdModelOptions manOptions() {
   CrowdModelOptions mo;
   mo.facing_deg = 0.0f;
@@ -70,7 +62,8 @@ CrowdModelOptions foxOptions() {
 }
 
 TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
-  const scene::SkinnedModel fox = loadFox();
+  FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+  const scene::SkinnedModel fox = scene::importSkinnedModel(fox_glb.string());
   const CrowdModelOptions mo = foxOptions();
   CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), smallAtlas(8));
   EXPECT_GT(rt.atlasBytes(), 0u);
@@ -119,7 +112,8 @@ TEST_F(CrowdRuntimeGl, MixedDrawsGeometryNearImpostorsFarAndCullsWhatIsBehind) {
 // their triangles fit and the rest as impostors, whatever the agents' order. Brute force: the frame equals the one
 // drawn by Geometry for the nearest agents and Impostor for the others, and differs from the opposite assignment.
 TEST_F(CrowdRuntimeGl, AGeometryBudgetDrawsTheNearestAgentsAsGeometry) {
-  const scene::SkinnedModel fox = loadFox();
+  FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+  const scene::SkinnedModel fox = scene::importSkinnedModel(fox_glb.string());
   const CrowdModelOptions mo = foxOptions();
   CrowdRuntimeOptions options = smallAtlas(8);
   const uint64_t fox_triangles = fox.mesh.triangleCount();
@@ -177,7 +171,8 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetDrawsTheNearestAgentsAsGeometry) {
 // the next frame's budget is the milliseconds over the measured time per triangle; the skinned triangles drawn never
 // exceed the frame's budget.
 TEST_F(CrowdRuntimeGl, AGeometryBudgetInMillisecondsFollowsTheMeasuredTimePerTriangle) {
-  const scene::SkinnedModel man = loadMan();
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  const scene::SkinnedModel man = scene::importSkinnedModel(man_glb.string());
   const CrowdModelOptions mo = manOptions();
   CrowdRuntimeOptions options = smallAtlas(8);
   options.geometry_ms = 1000.0;  // every agent fits once the cost is measured
@@ -216,7 +211,8 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetInMillisecondsFollowsTheMeasuredTimePerTri
 // agents never take finer levels, the baseline policy draws the mesh, and a coarse level covers the mesh's pixels in
 // the mesh's colour regions.
 TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) {
-  const scene::SkinnedModel man = loadMan();
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  const scene::SkinnedModel man = scene::importSkinnedModel(man_glb.string());
   const CrowdModelOptions mo = manOptions();
   CrowdRuntimeOptions options = smallAtlas(8);
   options.error_px = 0.001;  // the switch beyond every agent here: all geometry
@@ -318,7 +314,8 @@ TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) 
 // choice keeps within the budget (brute force over every choice of levels at least as coarse as the bound's, and
 // impostors).
 TEST_F(CrowdRuntimeGl, AGeometryBudgetTakesTheLeastErrorOnScreenFirst) {
-  const scene::SkinnedModel man = loadMan();
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  const scene::SkinnedModel man = scene::importSkinnedModel(man_glb.string());
   const CrowdModelOptions mo = manOptions();
   CrowdRuntimeOptions options = smallAtlas(8);
   options.error_px = 0.005;  // the switch beyond every agent here: all inside it
@@ -427,7 +424,8 @@ TEST_F(CrowdRuntimeGl, AGeometryBudgetTakesTheLeastErrorOnScreenFirst) {
 // agents in front of it, or beside it, are drawn; the culling holds for one call only. Brute force: each agent is
 // hidden if, drawn alone over the wall, it leaves the wall's frame unchanged.
 TEST_F(CrowdRuntimeGl, AgentsBehindTheCityAreLeftOutAndTheFrameIsUnchanged) {
-  const scene::SkinnedModel fox = loadFox();
+  FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+  const scene::SkinnedModel fox = scene::importSkinnedModel(fox_glb.string());
   const CrowdModelOptions mo = foxOptions();
   CrowdRuntime rt(std::span(&fox, 1), std::span(&mo, 1), smallAtlas(4));
   // A wall 10 m ahead, 4 m wide, from 2 m below the agents' feet (no ground here: the agents' bounding boxes reach
@@ -487,7 +485,8 @@ TEST_F(CrowdRuntimeGl, AgentsBehindTheCityAreLeftOutAndTheFrameIsUnchanged) {
 // Agents at any heading and between capture views: the impostor covers nearly the pixels the geometry covers
 // (a telephoto camera, so that the agent is large on screen).
 TEST_F(CrowdRuntimeGl, ImpostorCoversTheGeometryAtAnyHeading) {
-  const scene::SkinnedModel fox = loadFox();
+  FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+  const scene::SkinnedModel fox = scene::importSkinnedModel(fox_glb.string());
   CrowdRuntimeOptions o;
   o.palette_poses = 4;
   o.frames = 4;
@@ -527,7 +526,8 @@ TEST_F(CrowdRuntimeGl, ImpostorCoversTheGeometryAtAnyHeading) {
 // With the atlas chosen from the bound, the bake uses the bound's views, texel and frames, and at the bound's
 // camera every impostor promise (texel, view, frame) holds from the bound's distance on: the switch is no farther.
 TEST_F(CrowdRuntimeGl, AtlasFromTheBoundIsWhatTheBakeUsesAndKeepsTheBound) {
-  const scene::SkinnedModel fox = loadFox();
+  FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+  const scene::SkinnedModel fox = scene::importSkinnedModel(fox_glb.string());
   CrowdRuntimeOptions o;
   o.palette_poses = 16;
   o.atlas_from_bound = true;
@@ -584,7 +584,8 @@ TEST_F(CrowdRuntimeGl, AtlasFromTheBoundIsWhatTheBakeUsesAndKeepsTheBound) {
 // Turning an agent through one azimuth step of the view grid: showing the nearest view, the image jumps once at the
 // midpoint; blending the four views around the direction spreads that change over the turn.
 TEST_F(CrowdRuntimeGl, BlendedViewsChangeSmoothlyWhereTheNearestViewJumps) {
-  const scene::SkinnedModel fox = loadFox();
+  FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+  const scene::SkinnedModel fox = scene::importSkinnedModel(fox_glb.string());
   CrowdRuntimeOptions o;
   o.palette_poses = 4;
   o.frames = 4;

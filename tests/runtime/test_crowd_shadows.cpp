@@ -138,8 +138,8 @@ void rasterise(const Vec2& a, const Vec2& b, const Vec2& c, int w, int h, std::v
 }
 
 TEST_F(CrowdShadowsGl, AnAgentDarkensTheGroundWhereItsSilhouetteFallsAlongTheLight) {
-  const scene::SkinnedModel man =
-      scene::importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  const scene::SkinnedModel man = scene::importSkinnedModel(man_glb.string());
   CrowdRuntimeOptions o;
   o.palette_poses = 4;
   o.frames = 4;

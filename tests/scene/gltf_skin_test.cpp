@@ -150,13 +150,15 @@ TEST(GltfSkin, TruncatedBufferIsAnError) {
 }
 
 TEST(GltfSkin, ReadsTheRealModels) {
-  const SkinnedModel man = importSkinnedModel((farfield::test::sharedDataDir() / "models/CesiumMan.glb").string());
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+  const SkinnedModel man = importSkinnedModel(man_glb.string());
   EXPECT_EQ(man.mesh.triangleCount(), 4672u);
   EXPECT_EQ(man.skeleton.joints.size(), 19u);
   ASSERT_FALSE(man.animations.empty());
   EXPECT_GT(man.animations[0].duration, 0.5f);
   EXPECT_TRUE(man.texture);
-  const SkinnedModel fox = importSkinnedModel((farfield::test::sharedDataDir() / "models/Fox.glb").string());
+  const SkinnedModel fox = importSkinnedModel(fox_glb.string());
   EXPECT_EQ(fox.mesh.triangleCount(), 576u);
   EXPECT_EQ(fox.animations.size(), 3u);
   EXPECT_NE(fox.animations[size_t(fox.findAnimation("walk"))].name.find("Walk"), std::string::npos);
@@ -175,7 +177,7 @@ namespace {
 // Every truncation of a real skinned model (and a flipped byte in its JSON chunk) is a clear error naming the file,
 // or a model that passes validation; never a crash.
 TEST(GltfSkin, TruncatedAndCorruptedRealModelsFailCleanly) {
-  const std::filesystem::path src = farfield::test::sharedDataDir() / "models/Fox.glb";
+  FF_SHARED_FILE_OR_SKIP(src, "models/Fox.glb");
   std::ifstream in(src, std::ios::binary);
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(bytes.size(), 1000u);

@@ -69,9 +69,11 @@ TEST(SkinRegions, ValidationRejectsRegionsOutOfRangeOrMiscounted) {
 }
 
 TEST(SkinRegions, RealModelsGetSeveralRegionsDeterministically) {
-  for (const char* file : {"models/CesiumMan.glb", "models/Fox.glb"}) {
-    const std::string path = (farfield::test::sharedDataDir() / file).string();
-    const SkinnedModel a = importSkinnedModel(path), b = importSkinnedModel(path);
+  FF_SHARED_FILE_OR_SKIP(man_glb, "models/CesiumMan.glb");
+  FF_SHARED_FILE_OR_SKIP(fox_glb, "models/Fox.glb");
+  for (const std::filesystem::path& glb : {man_glb, fox_glb}) {
+    const std::string file = glb.filename().string();
+    const SkinnedModel a = importSkinnedModel(glb.string()), b = importSkinnedModel(glb.string());
     ASSERT_EQ(a.regions.size(), a.mesh.triangleCount()) << file;
     EXPECT_EQ(a.regions, b.regions) << file;
     std::vector<bool> seen(kColorRegions, false);

@@ -2,9 +2,20 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
+
 namespace farfield::test {
 
-std::filesystem::path sharedDataDir() { return std::filesystem::path(FF_SOURCE_DIR) / ".." / "shared" / "data"; }
+std::filesystem::path sharedDataDir() {
+  const char* dir = std::getenv("FF_SHARED_DATA");
+  if (dir && *dir) return std::filesystem::path(dir);
+  return std::filesystem::path(FF_SOURCE_DIR) / ".." / "shared" / "data";
+}
+
+std::string missingSharedFile(const std::string& relative) {
+  return "needs ../shared/data/" + relative + " (real data beside the repository; absent in this checkout: no " +
+         (sharedDataDir() / relative).string() + ")";
+}
 
 std::filesystem::path testDataDir() { return std::filesystem::path(FF_TEST_DATA_DIR); }
 

@@ -24,13 +24,9 @@ namespace {
 
 using test::writeRaster;
 
-std::string demPath() {
-  return (farfield::test::sharedDataDir() / "terrain" / "bigtujunga_srtm30m_utm11.tif").string();
-}
-
 TEST(Dem, BigTujungaLoadsWithSizeRangeAndNodataOfTheFile) {
-  const std::string path = demPath();
-  ASSERT_TRUE(std::filesystem::exists(path)) << path;
+  FF_SHARED_FILE_OR_SKIP(tif, "terrain/bigtujunga_srtm30m_utm11.tif");
+  const std::string path = tif.string();
   const Heightfield hf = loadDem(path);
   EXPECT_EQ(hf.width, 1197);
   EXPECT_EQ(hf.height, 643);
