@@ -62,33 +62,39 @@ TEST(DynamicModesGl, RunOnAForestCloseToTheFullFrames) {
   EXPECT_THROW(createMode("billboard", bare.context)->prepare(bare.context), Error);
 }
 
-// The billboard mode's geometry is occlusion-culled like the culled mode's: exact, so its frames equal the frames
-// drawn without it, from eyes among the trees where near trunks and crowns hide others.
+// The billboard mode's geometry is occlusion-culled like the culled mode's, on the GPU (the default) or the CPU: exact,
+// so its frames equal the frames drawn without it, from eyes among the trees where near trunks and crowns hide others.
 TEST(DynamicModesGl, BillboardOcclusionCullingLeavesTheFrameAsItWas) {
   registerImpostorModes();
   const scene::Scene forest = smallForest(60, 6);
   gpu::sharedHeadlessContext().makeCurrent();
-  ModeRunResources on(forest, 160, 96, {{"error_px", "2"}});
-  ModeRunResources off(forest, 160, 96, {{"error_px", "2"}, {"occlusion", "off"}});
-  std::unique_ptr<Mode> with = createMode("billboard", on.context), without = createMode("billboard", off.context);
-  with->prepare(on.context);
-  without->prepare(off.context);
-  FrameRunner run_on(on.renderer, on.target), run_off(off.renderer, off.target);
-  for (size_t k = 0; k < 4; ++k) {
-    Camera cam;
-    cam.width = 160;
-    cam.height = 96;
-    cam.eye = Vec3(-30.0f + 12.0f * float(k), -20.0f, 3.0f);
-    cam.at = Vec3(0, 20, 3);
-    run_on.run(*with, cam, k);
-    run_off.run(*without, cam, k);
-    EXPECT_EQ(on.target.readColor().pixels(), off.target.readColor().pixels()) << "frame " << k;
+  for (const char* geometry : {"gpu", "cpu"}) {
+    SCOPED_TRACE(geometry);
+    ModeRunResources on(forest, 160, 96, {{"error_px", "2"}, {"geometry", geometry}});
+    ModeRunResources off(forest, 160, 96, {{"error_px", "2"}, {"geometry", geometry}, {"occlusion", "off"}});
+    std::unique_ptr<Mode> with = createMode("billboard", on.context), without = createMode("billboard", off.context);
+    with->prepare(on.context);
+    without->prepare(off.context);
+    FrameRunner run_on(on.renderer, on.target), run_off(off.renderer, off.target);
+    for (size_t k = 0; k < 4; ++k) {
+      Camera cam;
+      cam.width = 160;
+      cam.height = 96;
+      cam.eye = Vec3(-30.0f + 12.0f * float(k), -20.0f, 3.0f);
+      cam.at = Vec3(0, 20, 3);
+      run_on.run(*with, cam, k);
+      run_off.run(*without, cam, k);
+      EXPECT_EQ(on.target.readColor().pixels(), off.target.readColor().pixels()) << "frame " << k;
+    }
+    const std::map<std::string, double> info = with->info();
+    const std::string key = std::string(geometry) == "gpu" ? "gpu_occlusion_culled" : "occlusion_hidden_items_per_frame";
+    ASSERT_TRUE(info.count(key)) << key;
+    EXPECT_GT(info.at(key), 0.0);  // not vacuous: something was behind the near trees
+    EXPECT_EQ(with->info().at("geometry_gpu"), std::string(geometry) == "gpu" ? 1.0 : 0.0);
+    if (std::string(geometry) == "cpu") EXPECT_FALSE(without->info().count(key));
+    else EXPECT_EQ(without->info().at(key), 0.0);
+    std::printf("billboard occlusion (%s): %.1f hidden a frame\n", geometry, info.at(key));
   }
-  const std::map<std::string, double> info = with->info();
-  ASSERT_TRUE(info.count("occlusion_hidden_items_per_frame"));
-  EXPECT_GT(info.at("occlusion_hidden_items_per_frame"), 0.0);  // not vacuous: something was behind the near trees
-  EXPECT_FALSE(without->info().count("occlusion_hidden_items_per_frame"));
-  std::printf("billboard occlusion: %.1f items hidden a frame\n", info.at("occlusion_hidden_items_per_frame"));
 }
 
 }  // namespace

@@ -56,13 +56,14 @@ BillboardMode::BillboardMode(const ModeContext& context) {
   options_.views = intOption(context, "billboard_views", 8, 1, 64);
   options_.texels = intOption(context, "billboard_texels", 32, 4, 2048);
   options_.elevation = options_.kind == impostor::BillboardKind::Spherical ? 0.15 : 0.0;
-  if (switchOption(context, "occlusion", true)) occlusion_.emplace(occluderShareOption(context, name()));
+  geometry_draw_.emplace(context, name());
 }
 
 void BillboardMode::prepare(const ModeContext& context) {
   Stopwatch clock;
   gpu_scene_ = context.gpu_scene;
   bvh_ = context.bvh;
+  geometry_draw_->prepare(context);
   const scene::Scene& scene = *context.scene;
   tree_of_object_.assign(scene.objects.size() + 1, 0);
   std::vector<impostor::Billboard> boards;
@@ -92,14 +93,7 @@ void BillboardMode::frame(FrameContext& frame) {
     if (b && batch_->shape(b - 1).errorAngle(cam.eye) <= theta) boards_.push_back(b - 1);
     else geometry_.push_back(id);
   }
-  if (!geometry_.empty() && !occlusion_) {
-    gpu_scene_->appendDrawItems(geometry_, frame.items(), cam);
-  } else if (!geometry_.empty()) {  // the culled mode's occlusion pass
-    candidates_.clear();
-    bounds_.clear();
-    gpu_scene_->appendDrawItems(geometry_, candidates_, cam, &bounds_);
-    occlusion_->run(frame, candidates_, bounds_);
-  }
+  geometry_draw_->submitObjects(frame, geometry_);
   const size_t bytes = boards_.empty() ? 0 : batch_->build(boards_, cam.eye, frame.items());
   ++frames_;
   billboards_drawn_ += boards_.size();
@@ -109,7 +103,7 @@ void BillboardMode::frame(FrameContext& frame) {
 
 std::map<std::string, double> BillboardMode::info() const {
   const double f = double(std::max<size_t>(frames_, 1));
-  std::map<std::string, double> out = occlusion_ ? occlusion_->info() : std::map<std::string, double>{};
+  std::map<std::string, double> out = geometry_draw_->info();
   out.merge(std::map<std::string, double>{{"error_bound_px", error_px_},
           {"billboards", double(tree_ids_.size())},
           {"views", double(options_.views)},

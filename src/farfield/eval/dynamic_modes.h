@@ -39,6 +39,7 @@
 #include "farfield/impostor/dynamic.h"
 #include "farfield/impostor/warp.h"
 #include "farfield/eval/occlusion_pass.h"
+#include "farfield/eval/plan_geometry.h"
 #include "farfield/runtime/image_cache.h"
 
 namespace farfield::eval {
@@ -52,6 +53,9 @@ class BillboardMode final : public Mode {
   std::string name() const override { return "billboard"; }
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
+    return geometry_draw_->lateFrameStats(path_frame);
+  }
   std::map<std::string, double> info() const override;
 
  private:
@@ -63,9 +67,7 @@ class BillboardMode final : public Mode {
   std::vector<uint32_t> tree_ids_;
   std::unique_ptr<impostor::BillboardBatch> batch_;
   std::vector<uint32_t> visible_, geometry_, boards_;
-  std::optional<OcclusionPass> occlusion_;  // the geometry occlusion-culled (--mode-option occlusion=on)
-  std::vector<gpu::DrawItem> candidates_;
-  std::vector<Box3> bounds_;
+  std::optional<PlanGeometry> geometry_draw_;  // the geometry on the GPU or the CPU (--mode-option geometry, occlusion)
   double prepare_s_ = 0.0;
   size_t frames_ = 0, billboards_drawn_ = 0, trees_as_geometry_ = 0, uploaded_bytes_ = 0;
 };

@@ -16,7 +16,27 @@ PlanGeometry::PlanGeometry(const ModeContext& context, const std::string& mode_n
 }
 
 void PlanGeometry::prepare(const ModeContext& context) {
+  gpu_scene_ = context.gpu_scene;
   if (gpu_) run_.emplace(context, gpu_options_);
+}
+
+void PlanGeometry::submitObjects(FrameContext& frame, std::span<const uint32_t> ids) {
+  if (gpu_) {
+    run_->culler().setObjects(ids);
+    ++uploads_;
+    run_->draw(frame);
+    return;
+  }
+  // GpuScene::appendDrawItems takes an empty list as "all objects".
+  if (ids.empty()) return;
+  if (!occlusion_) {
+    gpu_scene_->appendDrawItems(ids, frame.items(), frame.camera());
+    return;
+  }
+  candidates_.clear();
+  bounds_.clear();
+  gpu_scene_->appendDrawItems(ids, candidates_, frame.camera(), &bounds_);
+  occlusion_->run(frame, candidates_, bounds_);
 }
 
 void PlanGeometry::submit(FrameContext& frame, const runtime::FramePlan& plan) {

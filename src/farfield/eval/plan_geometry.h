@@ -10,7 +10,9 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "farfield/eval/gpu_culled_mode.h"
 #include "farfield/eval/mode.h"
@@ -30,6 +32,10 @@ class PlanGeometry {
   void prepare(const ModeContext& context);
   // Draws the plan's geometry now and queues its impostors in the frame's main pass.
   void submit(FrameContext& frame, const runtime::FramePlan& plan);
+  // Draws these objects (ids, ascending) as geometry now, for a mode that chooses its objects itself: on the GPU
+  // the list's difference with the last one goes up (work in the size of the lists), on the CPU their clusters in
+  // view are culled (and occlusion-culled) into draw items. An empty list draws nothing.
+  void submitObjects(FrameContext& frame, std::span<const uint32_t> ids);
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame);
   // The occlusion pass's or the GPU run's numbers, and geometry_gpu (1 or 0), geometry_uploads (plan changes sent).
   std::map<std::string, double> info() const;
@@ -39,6 +45,9 @@ class PlanGeometry {
   gpu::GpuCullOptions gpu_options_;
   std::optional<GpuCullRun> run_;
   std::optional<OcclusionPass> occlusion_;
+  const gpu::GpuScene* gpu_scene_ = nullptr;
+  std::vector<gpu::DrawItem> candidates_;
+  std::vector<Box3> bounds_;
   uint64_t version_ = ~uint64_t(0);
   size_t uploads_ = 0;
 };
