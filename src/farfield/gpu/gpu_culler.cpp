@@ -355,7 +355,8 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     glBindTextureUnit(2, 0);
   };
 
-  auto cullPhase = [&](int phase, int commands) {
+  // The cluster stage over the bound work list, in a phase.
+  auto testClusters = [&](int phase) {
     glProgramUniform1i(c, im.cl.phase, phase);
     glUseProgram(c);
     // Units 2 and 3: the depth and the pyramid, unbound again before anything draws into the depth.
@@ -365,6 +366,10 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);
+  };
+
+  auto cullPhase = [&](int phase, int commands) {
+    testClusters(phase);
     // Runs of drawn clusters into commands.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, im.commands[size_t(commands)]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, im.counts[size_t(commands)]);
@@ -439,14 +444,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
       glDispatchCompute(1, 1, 1);
       glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
       glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.drawn_list);
-      glProgramUniform1i(c, im.cl.phase, 3);
-      glUseProgram(c);
-      glBindTextureUnit(2, target.depthTexture().handle());
-      glBindTextureUnit(3, im.pyramid_texture);
-      glDispatchComputeIndirect(0);
-      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-      glBindTextureUnit(2, 0);
-      glBindTextureUnit(3, 0);
+      testClusters(3);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.work);
     }
   }

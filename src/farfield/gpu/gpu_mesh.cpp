@@ -10,23 +10,9 @@
 #include "farfield/core/error.h"
 
 namespace farfield::gpu {
-namespace {
 
-// One interleaved vertex: 32 bytes, so a vertex fetch touches one cache line at most.
-struct Vertex {
-  float position[3];
-  float normal[3];
-  float uv[2];
-};
-static_assert(sizeof(Vertex) == 32);
-
-}  // namespace
-
-GpuMesh::GpuMesh(const scene::Mesh& mesh) {
+void checkDrawableMesh(const scene::Mesh& mesh) {
   const size_t n = mesh.positions.size();
-  // Wrong-length attributes or out-of-range indices would make the GPU read outside the buffers: reject them here,
-  // where the mesh is still in hand. Missing (empty) normals and uvs are filled with zeros; a zero normal makes the
-  // fragment shader fall back to the face normal.
   if (!mesh.normals.empty() && mesh.normals.size() != n)
     throw Error("mesh", std::to_string(mesh.normals.size()) + " normals for " + std::to_string(n) + " positions");
   if (!mesh.uvs.empty() && mesh.uvs.size() != n)
@@ -37,19 +23,27 @@ GpuMesh::GpuMesh(const scene::Mesh& mesh) {
     if (mesh.indices[i] >= n)
       throw Error("mesh", "index " + std::to_string(i) + " is " + std::to_string(mesh.indices[i]) + ", only " +
                               std::to_string(n) + " vertices");
+}
+
+GpuVertex gpuVertex(const scene::Mesh& mesh, size_t v) {
+  const Vec3& p = mesh.positions[v];
+  const Vec3 normal = mesh.normals.empty() ? Vec3(0.0f) : mesh.normals[v];
+  const Vec2 uv = mesh.uvs.empty() ? Vec2(0.0f) : mesh.uvs[v];
+  return {{p.x, p.y, p.z}, {normal.x, normal.y, normal.z}, {uv.x, uv.y}};
+}
+
+GpuMesh::GpuMesh(const scene::Mesh& mesh) {
+  // Wrong-length attributes or out-of-range indices would make the GPU read outside the buffers: reject them here,
+  // where the mesh is still in hand.
+  checkDrawableMesh(mesh);
+  const size_t n = mesh.positions.size();
   for (const Vec3& p : mesh.positions) bounds_.expand(p);
   index_count_ = uint32_t(mesh.indices.size());
   if (n == 0 || index_count_ == 0) return;
 
-  std::vector<Vertex> vertices(n);
-  for (size_t i = 0; i < n; ++i) {
-    Vertex& v = vertices[i];
-    const Vec3& p = mesh.positions[i];
-    const Vec3 normal = mesh.normals.empty() ? Vec3(0.0f) : mesh.normals[i];
-    const Vec2 uv = mesh.uvs.empty() ? Vec2(0.0f) : mesh.uvs[i];
-    v = {{p.x, p.y, p.z}, {normal.x, normal.y, normal.z}, {uv.x, uv.y}};
-  }
-  const size_t vertex_bytes = vertices.size() * sizeof(Vertex);
+  std::vector<GpuVertex> vertices(n);
+  for (size_t i = 0; i < n; ++i) vertices[i] = gpuVertex(mesh, i);
+  const size_t vertex_bytes = vertices.size() * sizeof(GpuVertex);
   const size_t index_bytes = mesh.indices.size() * sizeof(uint32_t);
   glCreateBuffers(1, &vbo_);
   glNamedBufferStorage(vbo_, GLsizeiptr(vertex_bytes), vertices.data(), 0);
@@ -58,9 +52,9 @@ GpuMesh::GpuMesh(const scene::Mesh& mesh) {
   bytes_ = vertex_bytes + index_bytes;
 
   glCreateVertexArrays(1, &vao_);
-  glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(Vertex));
+  glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(GpuVertex));
   glVertexArrayElementBuffer(vao_, ibo_);
-  const GLuint offsets[3] = {offsetof(Vertex, position), offsetof(Vertex, normal), offsetof(Vertex, uv)};
+  const GLuint offsets[3] = {offsetof(GpuVertex, position), offsetof(GpuVertex, normal), offsetof(GpuVertex, uv)};
   const GLint sizes[3] = {3, 3, 2};
   for (GLuint attribute = 0; attribute < 3; ++attribute) {
     glEnableVertexArrayAttrib(vao_, attribute);

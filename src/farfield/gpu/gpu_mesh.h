@@ -1,12 +1,28 @@
 // Mesh on the GPU: one vertex buffer (interleaved position, normal, uv), one index buffer, one vertex array.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "farfield/core/bounds.h"
 #include "farfield/scene/mesh.h"
 
 namespace farfield::gpu {
+
+// One interleaved vertex as the GPU meshes hold it (GpuMesh, SceneArena): 32 bytes, so a vertex fetch touches one
+// cache line at most. Missing normals and uvs are zeros (a zero normal makes the fragment shader use the face's).
+struct GpuVertex {
+  float position[3];
+  float normal[3];
+  float uv[2];
+};
+static_assert(sizeof(GpuVertex) == 32);
+
+// Throws farfield::Error ("mesh", ...) for attributes of the wrong length or indices that are not whole triangles or
+// refer past the positions: what would make the GPU read outside the buffers.
+void checkDrawableMesh(const scene::Mesh& mesh);
+// Vertex v of the mesh as a GpuVertex.
+GpuVertex gpuVertex(const scene::Mesh& mesh, size_t v);
 
 class GpuMesh {
  public:

@@ -14,18 +14,12 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/gpu/gpu_mesh.h"
 #include "farfield/gpu/mesh_clusters.h"
 #include "farfield/gpu/texture.h"
 
 namespace farfield::gpu {
 namespace {
-
-struct Vertex {  // as gpu_mesh.cpp's: the same attributes at the same locations
-  float position[3];
-  float normal[3];
-  float uv[2];
-};
-static_assert(sizeof(Vertex) == 32);
 
 // std430 records of the shaders (gpu_cull.comp.glsl, arena.vert.glsl).
 struct GpuCluster {
@@ -85,20 +79,6 @@ GpuObject gpuObject(const scene::Object& object) {
   return g;
 }
 
-void checkMesh(const scene::Mesh& mesh) {
-  const size_t n = mesh.positions.size();
-  if (!mesh.normals.empty() && mesh.normals.size() != n)
-    throw Error("mesh", std::to_string(mesh.normals.size()) + " normals for " + std::to_string(n) + " positions");
-  if (!mesh.uvs.empty() && mesh.uvs.size() != n)
-    throw Error("mesh", std::to_string(mesh.uvs.size()) + " uvs for " + std::to_string(n) + " positions");
-  if (mesh.indices.size() % 3 != 0)
-    throw Error("mesh", std::to_string(mesh.indices.size()) + " indices, expected a multiple of 3");
-  for (size_t i = 0; i < mesh.indices.size(); ++i)
-    if (mesh.indices[i] >= n)
-      throw Error("mesh", "index " + std::to_string(i) + " is " + std::to_string(mesh.indices[i]) + ", only " +
-                              std::to_string(n) + " vertices");
-}
-
 GLuint makeBuffer(const void* data, size_t bytes, size_t& total) {
   GLuint buffer = 0;
   glCreateBuffers(1, &buffer);
@@ -125,7 +105,7 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
   FF_CHECK(options.max_triangles >= 4 && options.max_triangles <= 512 && options.max_triangles % 4 == 0);
 
   // ---- meshes: clusters, vertices and indices ----
-  std::vector<Vertex> vertices;
+  std::vector<GpuVertex> vertices;
   std::vector<uint32_t> indices;
   mesh_clusters_.reserve(scene.meshes.size());
   std::vector<meshopt_Meshlet> meshlets;
@@ -136,7 +116,7 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const scene::Mesh& mesh = scene.meshes[m];
     try {
-      checkMesh(mesh);
+      checkDrawableMesh(mesh);
     } catch (const Error& e) {
       throw Error("scene mesh " + std::to_string(m), e.what());
     }
@@ -204,10 +184,7 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
     vertices.resize(vertices.size() + used);
     for (size_t v = 0; v < vertex_count; ++v) {
       if (remap[v] == ~0u) continue;
-      const Vec3& p = mesh.positions[v];
-      const Vec3 n = mesh.normals.empty() ? Vec3(0.0f) : mesh.normals[v];
-      const Vec2 uv = mesh.uvs.empty() ? Vec2(0.0f) : mesh.uvs[v];
-      vertices[base_vertex + remap[v]] = {{p.x, p.y, p.z}, {n.x, n.y, n.z}, {uv.x, uv.y}};
+      vertices[base_vertex + remap[v]] = gpuVertex(mesh, v);
     }
     for (size_t c = 0; c < count; ++c) {
       const meshopt_Meshlet& ml = meshlets[c];
@@ -360,7 +337,7 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
   for (uint32_t i = 0; i < identity.size(); ++i) identity[i] = i;
   vertex_count_ = vertices.size();
   index_count_ = indices.size();
-  vertex_buffer_ = makeBuffer(vertices.data(), vertices.size() * sizeof(Vertex), gpu_bytes_);
+  vertex_buffer_ = makeBuffer(vertices.data(), vertices.size() * sizeof(GpuVertex), gpu_bytes_);
   index_buffer_ = makeBuffer(indices.data(), indices.size() * sizeof(uint32_t), gpu_bytes_);
   instance_ids_ = makeBuffer(identity.data(), identity.size() * sizeof(uint32_t), gpu_bytes_);
   buffers_.clusters = makeBuffer(gpu_clusters.data(), gpu_clusters.size() * sizeof(GpuCluster), gpu_bytes_);
@@ -371,9 +348,9 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
 
   GLuint vao = 0;
   glCreateVertexArrays(1, &vao);
-  glVertexArrayVertexBuffer(vao, 0, vertex_buffer_, 0, sizeof(Vertex));
+  glVertexArrayVertexBuffer(vao, 0, vertex_buffer_, 0, sizeof(GpuVertex));
   glVertexArrayElementBuffer(vao, index_buffer_);
-  const GLuint offsets[3] = {offsetof(Vertex, position), offsetof(Vertex, normal), offsetof(Vertex, uv)};
+  const GLuint offsets[3] = {offsetof(GpuVertex, position), offsetof(GpuVertex, normal), offsetof(GpuVertex, uv)};
   const GLint sizes[3] = {3, 3, 2};
   for (GLuint attribute = 0; attribute < 3; ++attribute) {
     glEnableVertexArrayAttrib(vao, attribute);
@@ -404,9 +381,9 @@ std::vector<uint32_t> SceneArena::readIndices() const {
 }
 
 std::vector<Vec3> SceneArena::readVertexPositions() const {
-  std::vector<Vertex> vertices(vertex_count_);
+  std::vector<GpuVertex> vertices(vertex_count_);
   if (vertex_count_)
-    glGetNamedBufferSubData(vertex_buffer_, 0, GLsizeiptr(vertex_count_ * sizeof(Vertex)), vertices.data());
+    glGetNamedBufferSubData(vertex_buffer_, 0, GLsizeiptr(vertex_count_ * sizeof(GpuVertex)), vertices.data());
   std::vector<Vec3> positions(vertex_count_);
   for (size_t i = 0; i < vertex_count_; ++i)
     positions[i] = Vec3(vertices[i].position[0], vertices[i].position[1], vertices[i].position[2]);
