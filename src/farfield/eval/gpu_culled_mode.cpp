@@ -23,7 +23,7 @@ gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string
 }
 
 GpuCullRun::GpuCullRun(const ModeContext& context, const gpu::GpuCullOptions& options)
-    : culler_(std::make_unique<gpu::GpuCuller>(context.arena(), options)) {}
+    : culler_(std::make_unique<gpu::GpuCuller>(context.arena(), options)), arena_build_s_(context.arena_slot->build_s) {}
 
 void GpuCullRun::draw(FrameContext& frame) {
   gpu::RenderTarget& target = frame.beginOwnPass();
@@ -62,6 +62,7 @@ std::map<std::string, double> GpuCullRun::info() const {
   out["arena_instances"] = double(arena.instances().size());
   out["arena_material_groups"] = double(arena.groups().size());
   out["arena_gpu_bytes"] = double(arena.gpuBytes());
+  out["arena_build_s"] = arena_build_s_;
   out["indirect_count"] = culler_->indirectCount() ? 1.0 : 0.0;
   if (frames_ > 0.0) {
     out["gpu_clusters_drawn_early"] = early_ / frames_;

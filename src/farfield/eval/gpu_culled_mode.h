@@ -34,7 +34,8 @@ class GpuCullRun {
   void draw(FrameContext& frame);
   // Triangles and objects of the last frame drawn for this path frame, once the GPU has finished it.
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame);
-  // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, indirect_count (1 or 0), and per frame
+  // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, arena_build_s (making the arena, once a
+  // run), indirect_count (1 or 0), and per frame
   // (means over the frames whose statistics came back): gpu_clusters_drawn_early, gpu_clusters_drawn_late,
   // gpu_frustum_culled, gpu_cone_culled, gpu_occlusion_culled, gpu_draw_commands (indirect draws after merging runs
   // of clusters), gpu_triangles.
@@ -48,6 +49,7 @@ class GpuCullRun {
   std::map<size_t, gpu::GpuCullStats> latest_;  // per path frame, the last statistics that came back
   double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0, commands_ = 0.0;
   double triangles_ = 0.0;
+  double arena_build_s_ = 0.0;
 };
 
 class GpuCulledMode final : public Mode {

@@ -6,6 +6,7 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/core/timer.h"
 #include "farfield/eval/gpu_culled_mode.h"
 #include "farfield/eval/occlusion_pass.h"
 
@@ -27,7 +28,11 @@ const std::string& ModeContext::requireOption(const std::string& key, const std:
 
 const gpu::SceneArena& ModeContext::arena() const {
   FF_CHECK_MSG(scene != nullptr, "ModeContext::arena() needs the scene");
-  if (!arena_slot->arena) arena_slot->arena = std::make_unique<gpu::SceneArena>(*scene);
+  if (!arena_slot->arena) {
+    Stopwatch clock;
+    arena_slot->arena = std::make_unique<gpu::SceneArena>(*scene);
+    arena_slot->build_s = clock.seconds();
+  }
   return *arena_slot->arena;
 }
 

@@ -51,6 +51,7 @@ struct ModeContext {
   const gpu::SceneArena& arena() const;
   struct ArenaSlot {
     std::unique_ptr<gpu::SceneArena> arena;
+    double build_s = 0.0;  // how long making it took
   };
   std::shared_ptr<ArenaSlot> arena_slot = std::make_shared<ArenaSlot>();
 
