@@ -1,10 +1,12 @@
 #include "farfield/gpu/scene_arena.h"
 
 #include <epoxy/gl.h>
-#include <meshoptimizer.h>
 
 #include <algorithm>
-#include <array>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -14,8 +16,8 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/gpu/arena_mesh.h"
 #include "farfield/gpu/gpu_mesh.h"
-#include "farfield/gpu/mesh_clusters.h"
 #include "farfield/gpu/texture.h"
 
 namespace farfield::gpu {
@@ -104,111 +106,45 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
   FF_CHECK(options.max_vertices >= 3 && options.max_vertices <= 255);
   FF_CHECK(options.max_triangles >= 4 && options.max_triangles <= 512 && options.max_triangles % 4 == 0);
 
-  // ---- meshes: clusters, vertices and indices ----
+  // ---- meshes: clusters, vertices and indices, cut on worker threads, then laid end to end ----
+  std::vector<ArenaMesh> cut(scene.meshes.size());
+  {
+    std::atomic<size_t> next{0};
+    std::exception_ptr failure;
+    std::mutex failure_mutex;
+    auto work = [&] {
+      for (size_t m = next++; m < cut.size(); m = next++) {
+        try {
+          cut[m] = clusterArenaMesh(scene.meshes[m], options);
+        } catch (const Error& e) {
+          const std::lock_guard<std::mutex> lock(failure_mutex);
+          if (!failure) failure = std::make_exception_ptr(Error("scene mesh " + std::to_string(m), e.what()));
+          next = cut.size();
+        }
+      }
+    };
+    const size_t threads = std::clamp<size_t>(std::thread::hardware_concurrency(), 1, 16);
+    std::vector<std::thread> pool;
+    for (size_t t = 1; t < threads && t < cut.size(); ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+  }
   std::vector<GpuVertex> vertices;
   std::vector<uint32_t> indices;
   mesh_clusters_.reserve(scene.meshes.size());
-  std::vector<meshopt_Meshlet> meshlets;
-  std::vector<unsigned int> meshlet_vertices;
-  std::vector<unsigned char> meshlet_triangles;
-  std::vector<uint32_t> local;  // a mesh's indices in cluster order
-  std::vector<unsigned int> remap;
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    const scene::Mesh& mesh = scene.meshes[m];
-    try {
-      checkDrawableMesh(mesh);
-    } catch (const Error& e) {
-      throw Error("scene mesh " + std::to_string(m), e.what());
-    }
+  for (ArenaMesh& mesh : cut) {
     const uint32_t first_cluster = uint32_t(clusters_.size());
-    if (mesh.indices.empty() || mesh.positions.empty()) {
-      mesh_clusters_.emplace_back(first_cluster, 0);
-      continue;
-    }
-    const float* positions = &mesh.positions[0].x;
-    const size_t vertex_count = mesh.positions.size();
-    // The triangles by facing class (small classes and triangles without area pooled last), each class cut into
-    // clusters by meshoptimizer.
-    const size_t triangle_count = mesh.indices.size() / 3;
-    std::array<std::vector<uint32_t>, kNoFacing + 2> by_class;
-    for (size_t t = 0; t < triangle_count; ++t) {
-      const uint32_t* tri = &mesh.indices[3 * t];
-      const int c = options.min_facing_triangles > 0
-                        ? facingClass(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]])
-                        : kNoFacing;
-      by_class[size_t(c)].insert(by_class[size_t(c)].end(), tri, tri + 3);
-    }
-    for (int c = 0; c < kNoFacing; ++c)
-      if (by_class[size_t(c)].size() / 3 < options.min_facing_triangles) {
-        auto& pool = by_class[kNoFacing + 1];
-        pool.insert(pool.end(), by_class[size_t(c)].begin(), by_class[size_t(c)].end());
-        by_class[size_t(c)].clear();
-      }
-    by_class[kNoFacing + 1].insert(by_class[kNoFacing + 1].end(), by_class[kNoFacing].begin(),
-                                   by_class[kNoFacing].end());
-    by_class[kNoFacing].clear();
-    size_t count = 0;
-    meshlets.clear();
-    meshlet_vertices.clear();
-    meshlet_triangles.clear();
-    for (const std::vector<uint32_t>& part : by_class) {
-      if (part.empty()) continue;
-      const size_t bound = meshopt_buildMeshletsBound(part.size(), options.max_vertices, options.max_triangles);
-      meshlets.resize(count + bound);
-      const size_t vertex_base = meshlet_vertices.size(), triangle_base = meshlet_triangles.size();
-      meshlet_vertices.resize(vertex_base + bound * options.max_vertices);
-      meshlet_triangles.resize(triangle_base + bound * options.max_triangles * 3);
-      const size_t made = meshopt_buildMeshlets(&meshlets[count], &meshlet_vertices[vertex_base],
-                                                &meshlet_triangles[triangle_base], part.data(), part.size(), positions,
-                                                vertex_count, sizeof(Vec3), options.max_vertices,
-                                                options.max_triangles, options.cone_weight);
-      for (size_t k = count; k < count + made; ++k) {
-        meshlets[k].vertex_offset += uint32_t(vertex_base);
-        meshlets[k].triangle_offset += uint32_t(triangle_base);
-      }
-      count += made;
-    }
-    // The clusters' triangles as the mesh's own indices, cluster after cluster; then the vertices renumbered in the
-    // order those first use them (meshopt_optimizeVertexFetchRemap), so that a cluster's vertices lie together.
-    local.clear();
-    std::vector<std::pair<uint32_t, uint32_t>> ranges;  // per cluster: first, count in `local`
-    for (size_t c = 0; c < count; ++c) {
-      const meshopt_Meshlet& ml = meshlets[c];
-      ranges.emplace_back(uint32_t(local.size()), ml.triangle_count * 3);
-      for (uint32_t t = 0; t < ml.triangle_count * 3; ++t)
-        local.push_back(meshlet_vertices[ml.vertex_offset + meshlet_triangles[ml.triangle_offset + t]]);
-    }
-    remap.resize(vertex_count);
-    const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), local.data(), local.size(), vertex_count);
-    const uint32_t base_vertex = uint32_t(vertices.size());
-    vertices.resize(vertices.size() + used);
-    for (size_t v = 0; v < vertex_count; ++v) {
-      if (remap[v] == ~0u) continue;
-      vertices[base_vertex + remap[v]] = gpuVertex(mesh, v);
-    }
-    for (size_t c = 0; c < count; ++c) {
-      const meshopt_Meshlet& ml = meshlets[c];
-      const meshopt_Bounds b =
-          meshopt_computeMeshletBounds(&meshlet_vertices[ml.vertex_offset], &meshlet_triangles[ml.triangle_offset],
-                                       ml.triangle_count, positions, vertex_count, sizeof(Vec3));
-      ArenaCluster cluster;
-      cluster.center = Vec3(b.center[0], b.center[1], b.center[2]);
-      cluster.radius = b.radius;
-      cluster.cone_apex = Vec3(b.cone_apex[0], b.cone_apex[1], b.cone_apex[2]);
-      cluster.cone_axis = Vec3(b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]);
-      cluster.cone_cutoff = b.cone_cutoff;
-      for (uint32_t v = 0; v < ml.vertex_count; ++v) cluster.bounds.expand(mesh.positions[meshlet_vertices[ml.vertex_offset + v]]);
-      // The sphere must hold the box's vertices whatever meshoptimizer's rounding: grow it to their farthest.
-      for (uint32_t v = 0; v < ml.vertex_count; ++v)
-        cluster.radius = std::max(cluster.radius,
-                                  glm::length(mesh.positions[meshlet_vertices[ml.vertex_offset + v]] - cluster.center));
-      cluster.first_index = uint32_t(indices.size());
-      cluster.index_count = ranges[c].second;
+    const uint32_t base_vertex = uint32_t(vertices.size()), base_index = uint32_t(indices.size());
+    vertices.insert(vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
+    indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
+    for (ArenaCluster cluster : mesh.clusters) {
+      cluster.first_index += base_index;
       cluster.base_vertex = base_vertex;
-      for (uint32_t i = 0; i < ranges[c].second; ++i) indices.push_back(remap[local[ranges[c].first + i]]);
       clusters_.push_back(cluster);
     }
-    mesh_clusters_.emplace_back(first_cluster, uint32_t(count));
+    mesh_clusters_.emplace_back(first_cluster, uint32_t(mesh.clusters.size()));
+    mesh = ArenaMesh{};  // its memory back before the next one is copied
   }
 
   // ---- textures: one array per image size, one layer per distinct image ----

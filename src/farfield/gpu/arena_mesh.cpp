@@ -1,0 +1,107 @@
+#include "farfield/gpu/arena_mesh.h"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <array>
+#include <utility>
+
+#include "farfield/gpu/mesh_clusters.h"
+
+namespace farfield::gpu {
+
+ArenaMesh clusterArenaMesh(const scene::Mesh& mesh, const ArenaOptions& options) {
+  ArenaMesh out;
+  checkDrawableMesh(mesh);
+  if (mesh.indices.empty() || mesh.positions.empty()) return out;
+  std::vector<meshopt_Meshlet> meshlets;
+  std::vector<unsigned int> meshlet_vertices;
+  std::vector<unsigned char> meshlet_triangles;
+  std::vector<uint32_t> local;  // the mesh's indices in cluster order
+  std::vector<unsigned int> remap;
+  const float* positions = &mesh.positions[0].x;
+  const size_t vertex_count = mesh.positions.size();
+  // The triangles by facing class (small classes and triangles without area pooled last), each class cut into
+  // clusters by meshoptimizer.
+  const size_t triangle_count = mesh.indices.size() / 3;
+  std::array<std::vector<uint32_t>, kNoFacing + 2> by_class;
+  for (size_t t = 0; t < triangle_count; ++t) {
+    const uint32_t* tri = &mesh.indices[3 * t];
+    const int c = options.min_facing_triangles > 0
+                      ? facingClass(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]])
+                      : kNoFacing;
+    by_class[size_t(c)].insert(by_class[size_t(c)].end(), tri, tri + 3);
+  }
+  for (int c = 0; c < kNoFacing; ++c)
+    if (by_class[size_t(c)].size() / 3 < options.min_facing_triangles) {
+      auto& pool = by_class[kNoFacing + 1];
+      pool.insert(pool.end(), by_class[size_t(c)].begin(), by_class[size_t(c)].end());
+      by_class[size_t(c)].clear();
+    }
+  by_class[kNoFacing + 1].insert(by_class[kNoFacing + 1].end(), by_class[kNoFacing].begin(),
+                                 by_class[kNoFacing].end());
+  by_class[kNoFacing].clear();
+  size_t count = 0;
+  meshlets.clear();
+  meshlet_vertices.clear();
+  meshlet_triangles.clear();
+  for (const std::vector<uint32_t>& part : by_class) {
+    if (part.empty()) continue;
+    const size_t bound = meshopt_buildMeshletsBound(part.size(), options.max_vertices, options.max_triangles);
+    meshlets.resize(count + bound);
+    const size_t vertex_base = meshlet_vertices.size(), triangle_base = meshlet_triangles.size();
+    meshlet_vertices.resize(vertex_base + bound * options.max_vertices);
+    meshlet_triangles.resize(triangle_base + bound * options.max_triangles * 3);
+    const size_t made = meshopt_buildMeshlets(&meshlets[count], &meshlet_vertices[vertex_base],
+                                              &meshlet_triangles[triangle_base], part.data(), part.size(), positions,
+                                              vertex_count, sizeof(Vec3), options.max_vertices,
+                                              options.max_triangles, options.cone_weight);
+    for (size_t k = count; k < count + made; ++k) {
+      meshlets[k].vertex_offset += uint32_t(vertex_base);
+      meshlets[k].triangle_offset += uint32_t(triangle_base);
+    }
+    count += made;
+  }
+  // The clusters' triangles as the mesh's own indices, cluster after cluster; then the vertices renumbered in the
+  // order those first use them (meshopt_optimizeVertexFetchRemap), so that a cluster's vertices lie together.
+  local.clear();
+  std::vector<std::pair<uint32_t, uint32_t>> ranges;  // per cluster: first, count in `local`
+  for (size_t c = 0; c < count; ++c) {
+    const meshopt_Meshlet& ml = meshlets[c];
+    ranges.emplace_back(uint32_t(local.size()), ml.triangle_count * 3);
+    for (uint32_t t = 0; t < ml.triangle_count * 3; ++t)
+      local.push_back(meshlet_vertices[ml.vertex_offset + meshlet_triangles[ml.triangle_offset + t]]);
+  }
+  remap.resize(vertex_count);
+  const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), local.data(), local.size(), vertex_count);
+  out.vertices.resize(used);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    if (remap[v] == ~0u) continue;
+    out.vertices[remap[v]] = gpuVertex(mesh, v);
+  }
+  for (size_t c = 0; c < count; ++c) {
+    const meshopt_Meshlet& ml = meshlets[c];
+    const meshopt_Bounds b =
+        meshopt_computeMeshletBounds(&meshlet_vertices[ml.vertex_offset], &meshlet_triangles[ml.triangle_offset],
+                                     ml.triangle_count, positions, vertex_count, sizeof(Vec3));
+    ArenaCluster cluster;
+    cluster.center = Vec3(b.center[0], b.center[1], b.center[2]);
+    cluster.radius = b.radius;
+    cluster.cone_apex = Vec3(b.cone_apex[0], b.cone_apex[1], b.cone_apex[2]);
+    cluster.cone_axis = Vec3(b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]);
+    cluster.cone_cutoff = b.cone_cutoff;
+    // The box of its vertices, and a sphere that holds them whatever meshoptimizer's rounding.
+    for (uint32_t v = 0; v < ml.vertex_count; ++v) {
+      const Vec3& p = mesh.positions[meshlet_vertices[ml.vertex_offset + v]];
+      cluster.bounds.expand(p);
+      cluster.radius = std::max(cluster.radius, glm::length(p - cluster.center));
+    }
+    cluster.first_index = uint32_t(out.indices.size());
+    cluster.index_count = ranges[c].second;
+    for (uint32_t i = 0; i < ranges[c].second; ++i) out.indices.push_back(remap[local[ranges[c].first + i]]);
+    out.clusters.push_back(cluster);
+  }
+  return out;
+}
+
+}  // namespace farfield::gpu
