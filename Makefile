@@ -11,7 +11,7 @@ CMAKE_FLAGS ?=
 # Xvfb resets when its last client disconnects, and a test connecting during the reset fails to open the display.
 XVFB        := $(shell if [ -z "$$DISPLAY" ] && command -v xvfb-run >/dev/null 2>&1; then echo "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset'"; fi)
 
-.PHONY: all deps configure build build-cli demo test test-asan fuzz bench clean
+.PHONY: all deps configure build build-cli demo test test-asan fuzz bench dist clean
 
 all: build
 
@@ -50,6 +50,12 @@ fuzz: deps
 
 bench: build
 	@bash scripts/bench.sh $(BUILD)/bin out/bench
+
+# The release tarball for a machine without Debian's development packages (a bare GPU node): the tool, the shared
+# libraries it loads but glibc, libstdc++ and the GL dispatch, PROJ's and GDAL's data, in out/dist
+# (scripts/make_dist.sh; scripts/check_dist.sh proves one on a minimal Debian 12).
+dist: build-cli
+	@bash scripts/make_dist.sh $(BUILD)/bin/farfield out/dist
 
 clean:
 	rm -rf build out

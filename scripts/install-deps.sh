@@ -18,6 +18,8 @@ packages=(
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev python3 python3-matplotlib python3-numpy
   # sharded bakes: a one-node Slurm for the tests and benchmarks (scripts/slurm/local-cluster.sh)
   slurm-wlm munge
+  # the release tarball of `make dist` (scripts/make_dist.sh): RUNPATHs of the tool and its bundled libraries
+  patchelf
 )
 
 # node and npm run the Khronos glTF validator in the tests (npm only for tools that exist nowhere else); a node

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Release tarball for a machine without Debian's development packages (a bare GPU node): `make dist`, or
+#   scripts/make_dist.sh BINARY [OUT_DIR]        (OUT_DIR defaults to out/dist)
+# writes OUT_DIR/farfield-<version>-linux-x86_64.tar.xz holding farfield-<version>/
+#   bin/farfield                the stripped tool, RUNPATH $ORIGIN/../lib
+#   lib/                        every shared library ldd lists for it, under its SONAME, each with RUNPATH $ORIGIN (so
+#                               that the libraries' own dependencies come from lib/ too, not only the tool's), except
+#                               glibc's, libstdc++, libgcc_s and the GL dispatch libraries that a GPU driver provides
+#   share/proj, share/gdal      PROJ's proj.db and GDAL's data; the tool points PROJ_DATA/PROJ_LIB and GDAL_DATA at them
+#                               when they are unset (apps/farfield/main.cpp)
+#   share/farfield/             tools/plot_bench.py, tools/plot_terrain.py, README.md
+#   share/doc/PACKAGE/copyright of every bundled library's Debian package
+# The target machine needs glibc, libstdc++ and libglvnd (libEGL, libOpenGL) of at least Debian 12's versions and an
+# EGL driver. Needs patchelf (scripts/install-deps.sh). scripts/check_dist.sh proves a tarball on a minimal Debian 12.
+set -euo pipefail
+
+BIN=${1:?usage: make_dist.sh BINARY [OUT_DIR]}
+OUT_DIR=${2:-out/dist}
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+command -v patchelf >/dev/null || { echo "make_dist: patchelf is missing (apt-get install patchelf)" >&2; exit 1; }
+[ -x "$BIN" ] || { echo "make_dist: no executable $BIN" >&2; exit 1; }
+
+version=$("$BIN" --version | awk '{print $NF}')
+[[ $version =~ ^[0-9]+\.[0-9]+\.[0-9]+ ]] || { echo "make_dist: unexpected version '$version'" >&2; exit 1; }
+name=farfield-$version
+tarball=$OUT_DIR/$name-linux-x86_64.tar.xz
+
+# Left out: glibc (libc, libm, libdl, libpthread, librt, libresolv, the loader), the C++ runtime, and the GL dispatch
+# libraries, which must be the GPU machine's own so that its driver is found.
+skip='^(libc|libm|libdl|libpthread|librt|libresolv|ld-linux-x86-64|libstdc\+\+|libgcc_s|libEGL|libGL|libGLX|libOpenGL|libGLdispatch|libGLESv2|libvulkan)\.so'
+
+mkdir -p "$OUT_DIR"
+stage=$(mktemp -d "$OUT_DIR/.stage.XXXXXX")
+trap 'rm -rf "$stage"' EXIT
+pkg=$stage/$name
+mkdir -p "$pkg/bin" "$pkg/lib" "$pkg/share/farfield" "$pkg/share/doc"
+
+cp "$BIN" "$pkg/bin/farfield"
+strip "$pkg/bin/farfield"
+# shellcheck disable=SC2016  # $ORIGIN is for the loader, not the shell
+patchelf --set-rpath '$ORIGIN/../lib' "$pkg/bin/farfield"
+
+# The Debian package that holds a library: dpkg knows each file under the path it was packaged with, which after the
+# /usr merge may be /lib/... or /usr/lib/..., of the file or of its symlink.
+package_of() {
+  local lib=$1 real c p
+  real=$(readlink -f "$lib")
+  for c in "$lib" "$real" "${lib#/usr}" "/usr${lib#/usr}" "${real#/usr}" "/usr${real#/usr}"; do
+    p=$(dpkg -S "$c" 2>/dev/null | head -1 | cut -d: -f1) && [ -n "$p" ] && { echo "$p"; return; }
+  done
+  return 1
+}
+
+missing=$(ldd "$BIN" | awk '/not found/ {print $1}')
+[ -z "$missing" ] || { echo "make_dist: ldd finds no ${missing//$'\n'/ }" >&2; exit 1; }
+count=0
+declare -A packages=()
+while read -r needed path; do
+  [[ $needed =~ $skip ]] && continue
+  soname=$(patchelf --print-soname "$path" 2>/dev/null || true)
+  soname=${soname:-$needed}
+  cp -L "$path" "$pkg/lib/$soname"
+  chmod u+w "$pkg/lib/$soname"
+  # shellcheck disable=SC2016
+  patchelf --set-rpath '$ORIGIN' "$pkg/lib/$soname"
+  count=$((count + 1))
+  p=$(package_of "$path") || { echo "make_dist: no Debian package owns $path" >&2; exit 1; }
+  packages[$p]=1
+done < <(ldd "$BIN" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}')
+[ "$count" -gt 0 ] || { echo "make_dist: ldd listed no libraries for $BIN" >&2; exit 1; }
+
+# Data the libraries read at run time, with their packages' copyright files.
+for dir in proj gdal; do
+  [ -d "/usr/share/$dir" ] || { echo "make_dist: /usr/share/$dir is missing" >&2; exit 1; }
+  cp -rL "/usr/share/$dir" "$pkg/share/$dir"
+  for f in "/usr/share/$dir"/*; do
+    p=$(dpkg -S "$f" 2>/dev/null | head -1 | cut -d: -f1 || true)
+    [ -z "$p" ] || packages[$p]=1
+  done
+done
+[ -f "$pkg/share/proj/proj.db" ] || { echo "make_dist: no proj.db in /usr/share/proj" >&2; exit 1; }
+
+for p in "${!packages[@]}"; do
+  mkdir -p "$pkg/share/doc/$p"
+  cp -L "/usr/share/doc/$p/copyright" "$pkg/share/doc/$p/copyright" ||
+    { echo "make_dist: no copyright file for $p" >&2; exit 1; }
+done
+
+cp "$ROOT/tools/plot_bench.py" "$ROOT/tools/plot_terrain.py" "$ROOT/README.md" "$pkg/share/farfield/"
+
+rm -f "$tarball"
+tar -C "$stage" --sort=name --owner=0 --group=0 --numeric-owner -cf - "$name" | xz -9 -T2 >"$tarball.tmp"
+mv "$tarball.tmp" "$tarball"
+echo "make_dist: $tarball"
+bytes=$(stat -c %s "$tarball")
+echo "make_dist: $(awk -v b="$bytes" 'BEGIN {printf "%.1f MB (%.1f MiB)", b / 1e6, b / 1048576}'), unpacked" \
+  "$(du -sm "$pkg" | cut -f1) MiB; $count libraries in lib/ (copyrights of ${#packages[@]} Debian packages)," \
+  "PROJ's and GDAL's data in share/"
