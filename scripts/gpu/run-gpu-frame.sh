@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The GPU-driven frame on a GPU machine without Debian's development packages, in one command (the device tool's
-# machine: docs/BENCHMARKS.md, "The GPU-driven frame"). Same layout as ../shared/gpu/run-benchmarks.sh: in the current
-# folder .gpu/ff.tar.xz (the release build bundled by ../shared/gpu/bundle.sh) and .gl/*.deb (libglvnd, unpacked into
-# / first unless SKIP_GL is set). Writes OUT/<stage>.tgz (bench.json, frames.csv, cull checks, logs; no images) and
+# machine: docs/BENCHMARKS.md, "The GPU-driven frame"). In the current folder: .gpu/farfield-*.tar.xz (`make dist`;
+# or .gpu/ff.tar.xz from ../shared/gpu/bundle.sh) and .gl/*.deb (libglvnd, unpacked into / first unless SKIP_GL is
+# set). Writes OUT/<stage>.tgz (bench.json, frames.csv, cull checks, logs; no images) and
 # OUT/log.txt; prints a summary per stage.
 #
 # Stages (STAGES, default "smoke heldout big demo check"):
@@ -18,7 +18,13 @@ OUTD=${OUT:-/tmp/out}
 mkdir -p "$OUTD"
 exec > >(tee -a "$OUTD/log.txt") 2>&1
 [ -n "${SKIP_GL:-}" ] || { for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig; }
-mkdir -p /tmp/ff && tar -C /tmp -xJf .gpu/ff.tar.xz
+mkdir -p /tmp/ff
+dist=$(ls .gpu/farfield-*.tar.xz 2>/dev/null | head -1)
+if [ -n "$dist" ]; then
+  tar -C /tmp/ff --strip-components=1 -xJf "$dist"  # make dist: bin/farfield finds its lib/ by its RUNPATH
+else
+  tar -C /tmp -xJf .gpu/ff.tar.xz
+fi
 export LD_LIBRARY_PATH=/tmp/ff/lib:/usr/local/nvidia/lib64:/usr/local/nvidia/lib
 [ -f /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json ] &&
   export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
