@@ -3,7 +3,8 @@
 //                      [--azimuths A] [--elevations E] [--octahedral N] [--error-px PX] [--atlas-from-bound] [--bound-switch M]
 //                      [--blend-views] [--outfits N] [--no-shadows] [--shadow-map N] [--shadow-distance M]
 //                      [--agent-occlusion] [--impostor-shadows]
-// Animated crowds with multi-view impostors on a generated city: eval::runCrowdBench (eval/crowd_bench.h).
+// Animated crowds with multi-view impostors on a generated city: eval::runCrowdBench (eval/crowd_bench.h). Without
+// --models the crowd is the built-in figures (eval::builtinCrowdModels).
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -26,7 +27,7 @@ struct CrowdArgs {
   std::string agents = "1000,10000";
   std::string paths = "pedestrian,elevated";
   std::string size = "512x512";
-  std::string models = "../shared/data/models/CesiumMan.glb,../shared/data/models/Fox.glb";
+  std::string models;  // empty: the built-in figures
   int octahedral = 0;
   bool palette_skinning = false;
 };
@@ -86,8 +87,9 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
   bench->add_option("--city-seed", o.city_seed, "City seed")->capture_default_str();
   bench->add_option("--crowd-seed", o.crowd_seed, "Crowd seed")->capture_default_str();
   bench->add_option("--path-seed", o.path_seed, "Street walk seed")->capture_default_str();
-  bench->add_option("--models", a->models, "Skinned glTF models, comma-separated (first two: heights 1.75, 0.8 m)")
-      ->capture_default_str();
+  bench->add_option("--models", a->models,
+                    "Skinned glTF models, comma-separated (first two: heights 1.75, 0.8 m, as the shared CesiumMan "
+                    "and Fox); default: the built-in figures, a walker and a four-legged one, no file read");
   bench->add_option("--texel", o.runtime.texel_m, "Atlas texel size, metres")->capture_default_str();
   bench->add_option("--cycle-frames", o.runtime.frames, "Impostor frames per walk cycle")->capture_default_str();
   bench->add_option("--azimuths", o.runtime.grid.azimuths, "Impostor views around")->capture_default_str();

@@ -22,7 +22,7 @@ struct ViewArgs {
   std::string size = "1280x720";
   std::string screenshot_at;
   bool walk = false;
-  std::string crowd_models = "../shared/data/models/CesiumMan.glb,../shared/data/models/Fox.glb";
+  std::string crowd_models;  // empty: the built-in figures
 };
 
 std::vector<size_t> parseFrameList(const std::string& option, const std::string& text) {
@@ -89,8 +89,9 @@ const RegisterCommand reg("view", [](CLI::App& app) {
   cmd->add_option("--crowd", o.crowd.agents,
                   "Agents walking the sidewalks of the street graph, drawn over every mode as crowd-mixed (0: none)")
       ->capture_default_str();
-  cmd->add_option("--crowd-models", args->crowd_models, "Skinned glTF models of the crowd, comma-separated")
-      ->capture_default_str();
+  cmd->add_option("--crowd-models", args->crowd_models,
+                  "Skinned glTF models of the crowd, comma-separated (heights 1.75, 0.8 m, as the shared CesiumMan "
+                  "and Fox); default: the built-in figures, a walker and a four-legged one, no file read");
   cmd->add_option("--crowd-seed", o.crowd.seed, "Crowd seed")->capture_default_str();
   cmd->add_option("--crowd-error-px", o.crowd.error_px, "The crowd impostors' error bound (pixels)")
       ->capture_default_str();

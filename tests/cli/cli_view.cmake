@@ -22,8 +22,11 @@ expect_error("no-such-scene.glb" view ${WORK}/no-such-scene.glb ${script})
 expect_error("nopath.json" view builtin:cubes --replay ${WORK}/nopath.json --exit)
 expect_error("--terrain-scale" view builtin:cubes --terrain fractal:129:5 --terrain-scale 0 ${script})
 expect_error("no-such-model.glb" view builtin:cubes --crowd 10 --crowd-models ${WORK}/no-such-model.glb ${script})
-# The crowd's model is real data beside the repository (../shared/data, or $ENV{FF_SHARED_DATA} as for the C++ tests).
-# Without it the crowd's frame is not checked; the argument checks, which only look for the file, take a stand-in.
+expect_error("--crowd-models" view builtin:cubes --crowd 10 --crowd-models a.glb,b.glb,c.glb ${script})
+expect_error("--crowd-error-px" view builtin:cubes --crowd 10 --crowd-error-px 0 ${script})
+# The shared CesiumMan is real data beside the repository (../shared/data, or $ENV{FF_SHARED_DATA} as for the C++
+# tests). Without it its crowd's frame is not checked; the argument checks, which only look for the file, take a
+# stand-in. The built-in figures (no --crowd-models) need no file and are always checked.
 set(shared_data ${SOURCE_DIR}/../shared/data)
 if(NOT "$ENV{FF_SHARED_DATA}" STREQUAL "")
   set(shared_data $ENV{FF_SHARED_DATA})
@@ -85,12 +88,18 @@ expect_error("gen city --terrain" view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc
              --terrain-scale 2)
 
 # A crowd on the city's sidewalks, drawn over the mode's frame: the frame differs from the city alone where agents
-# stand; a scene without a street graph is refused naming --crowd.
+# stand, with the built-in figures (the default: what a clone without ../shared has) and with the shared CesiumMan
+# where it is present; a scene without a street graph is refused naming --crowd.
+run_ok(${FARFIELD} gen city --blocks 12 --seed 3 --detail 0 -o ${WORK}/cc.glb)
+run_ok(${FARFIELD} path street ${WORK}/cc.streets.json --frames 3 -o ${WORK}/cc_walk.json)
+set(cc_script --mode culled --replay ${WORK}/cc_walk.json --screenshot-at 2 --exit --size 160x120)
+run_ok(${FARFIELD} view ${WORK}/cc.glb ${cc_script} -o ${WORK}/cc_alone)
+run_ok(${FARFIELD} view ${WORK}/cc.glb ${cc_script} -o ${WORK}/cc_builtin --crowd 400 --crowd-ms 5)
+run_ok(${FARFIELD} diff ${WORK}/cc_alone/frame_2.png ${WORK}/cc_builtin/frame_2.png)
+if(LAST_OUT MATCHES "identical")
+  message(FATAL_ERROR "farfield view --crowd (built-in figures) drew the same frame as without the crowd:\n${LAST_OUT}")
+endif()
 if(EXISTS ${man})
-  run_ok(${FARFIELD} gen city --blocks 12 --seed 3 --detail 0 -o ${WORK}/cc.glb)
-  run_ok(${FARFIELD} path street ${WORK}/cc.streets.json --frames 3 -o ${WORK}/cc_walk.json)
-  set(cc_script --mode culled --replay ${WORK}/cc_walk.json --screenshot-at 2 --exit --size 160x120)
-  run_ok(${FARFIELD} view ${WORK}/cc.glb ${cc_script} -o ${WORK}/cc_alone)
   run_ok(${FARFIELD} view ${WORK}/cc.glb ${cc_script} -o ${WORK}/cc_crowd --crowd 400 --crowd-models ${man}
          --crowd-ms 5)
   run_ok(${FARFIELD} diff ${WORK}/cc_alone/frame_2.png ${WORK}/cc_crowd/frame_2.png)
@@ -98,8 +107,7 @@ if(EXISTS ${man})
     message(FATAL_ERROR "farfield view --crowd drew the same frame as without the crowd:\n${LAST_OUT}")
   endif()
 else()
-  message(STATUS "not checked: the crowd's frame, which needs ../shared/data/models/CesiumMan.glb (real data beside "
-                 "the repository; absent in this checkout: no ${man})")
+  message(STATUS "not checked: the shared CesiumMan's crowd frame, which needs ../shared/data/models/CesiumMan.glb "
+                 "(real data beside the repository; absent in this checkout: no ${man})")
 endif()
-expect_error("--crowd: needs the city's street graph" view builtin:cubes ${script} --crowd 10
-             --crowd-models ${model_arg})
+expect_error("--crowd: needs the city's street graph" view builtin:cubes ${script} --crowd 10)

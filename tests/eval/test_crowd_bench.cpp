@@ -1,6 +1,6 @@
-// The crowd bench end to end on a tiny city and crowd: crowd-geometry draws what the reference draws (identical
-// frames), the impostor modes differ from it and draw impostors, speedups are relative to crowd-geometry, and the
-// report files are written; bad options are errors.
+// The crowd bench end to end on a tiny city and crowd, on the built-in figures and on the shared glTF models:
+// crowd-geometry draws what the reference draws (identical frames), the impostor modes differ from it and draw
+// impostors, speedups are relative to crowd-geometry, and the report files are written; bad options are errors.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -16,7 +16,26 @@ using namespace farfield;
 
 namespace {
 
-// The bench runs on the real models beside the repository: every test is skipped without them.
+// A tiny bench: a 10-block city, 60 agents, 3 frames of 64 x 64, a small atlas; `models` empty: the built-in figures.
+eval::CrowdBenchOptions tinyBench(const std::vector<std::string>& models) {
+  eval::CrowdBenchOptions o;
+  o.blocks = 10;
+  o.detail = 0;
+  o.agent_counts = {60};
+  o.paths = {"pedestrian"};
+  o.frames = 3;
+  o.frame_step = 10;
+  o.width = o.height = 64;
+  o.models = models;
+  o.runtime.grid.azimuths = 8;
+  o.runtime.grid.elevations = 2;
+  o.runtime.frames = 2;
+  o.runtime.palette_poses = 4;
+  o.samples = 0;
+  return o;
+}
+
+// The bench on the real models beside the repository: every test is skipped without them.
 class CrowdBench : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -25,28 +44,66 @@ class CrowdBench : public ::testing::Test {
     models_ = {man_glb.string(), fox_glb.string()};
   }
 
-  eval::CrowdBenchOptions tinyOptions() const {
-    eval::CrowdBenchOptions o;
-    o.blocks = 10;
-    o.detail = 0;
-    o.agent_counts = {60};
-    o.paths = {"pedestrian"};
-    o.frames = 3;
-    o.frame_step = 10;
-    o.width = o.height = 64;
-    o.models = models_;
-    o.runtime.grid.azimuths = 8;
-    o.runtime.grid.elevations = 2;
-    o.runtime.frames = 2;
-    o.runtime.palette_poses = 4;
-    o.samples = 0;
-    return o;
-  }
+  eval::CrowdBenchOptions tinyOptions() const { return tinyBench(models_); }
 
   std::vector<std::string> models_;
 };
 
 }  // namespace
+
+// Without model files the bench runs on the built-in figures, reading nothing beside the repository (run with
+// FF_SHARED_DATA=/nonexistent, as a clone has it): the walker and the four-legged one are both drawn, crowd-geometry
+// equals the reference and the impostors, baked from the figures, stand where the reference's agents stand.
+TEST(CrowdBenchBuiltin, RunsOnTheBuiltInFiguresWithoutFiles) {
+  eval::CrowdBenchOptions o = tinyBench({});
+  o.width = o.height = 160;  // agents large enough to compare their pixels
+  o.agent_counts = {300};
+  o.out_dir = test::scratchDir("crowd_bench_builtin").string();
+  const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), o);
+  EXPECT_EQ(r.model_names, (std::vector<std::string>{"builtin:walker", "builtin:quadruped"}));
+  ASSERT_EQ(r.model_triangles.size(), 2u);
+  for (uint64_t t : r.model_triangles) {
+    EXPECT_GT(t, 100u);
+    EXPECT_LT(t, 600u);
+  }
+  for (bool cutout : r.model_cutout) EXPECT_FALSE(cutout) << "the palette texture is opaque";
+  ASSERT_EQ(r.runs.size(), 1u);
+  const eval::CrowdRun& run = r.runs[0];
+  ASSERT_EQ(run.modes.size(), 3u);
+  EXPECT_GT(run.modes[0].in_view, 0.0);
+  EXPECT_GT(run.modes[0].crowd_pixels_mean, 0.0) << "agents must cover pixels";
+  EXPECT_GE(run.modes[0].psnr_min, 99.0);
+  EXPECT_EQ(run.modes[0].bad_share_mean, 0.0);
+  EXPECT_DOUBLE_EQ(run.modes[1].impostor_agents, run.modes[1].in_view);
+  EXPECT_GT(run.modes[1].crowd_pixels_mean, 0.0);
+  // The impostors resemble the figures: crowd-impostor's crowd pixels are mostly within 8/255 of the reference's.
+  EXPECT_GT(run.modes[1].psnr_mean, 12.0);
+  EXPECT_LT(run.modes[1].psnr_mean, 99.0);
+  EXPECT_NE(r.markdown.find("builtin:walker"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(o.out_dir) / "crowd.json"));
+}
+
+TEST(CrowdBenchBuiltin, BadOptionsAreErrors) {
+  eval::CrowdBenchOptions o = tinyBench({});
+  o.frames = 1;
+  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
+  // Files need one height, facing and share each (checked before any is read).
+  o = tinyBench({"a.glb", "b.glb", "c.glb"});
+  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
+  o = tinyBench({"no-such-model.glb"});
+  try {
+    eval::runCrowdBench(gpu::sharedHeadlessContext(), o);
+    ADD_FAILURE() << "a missing model file must be an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no-such-model.glb"), std::string::npos) << e.what();
+  }
+  o = tinyBench({});
+  o.paths = {"sideways"};
+  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
+  o = tinyBench({});
+  o.timing_passes = 0;
+  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
+}
 
 TEST_F(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgainstIt) {
   eval::CrowdBenchOptions o = tinyOptions();
@@ -110,19 +167,4 @@ TEST_F(CrowdBench, PaletteSkinningDrawsTheBakedPosesFrames) {
   EXPECT_NE(r.markdown.find("skinning: baked poses"), std::string::npos);
   EXPECT_NE(r.markdown.find("fastest of 2 passes"), std::string::npos);
   for (const eval::CrowdModeResult& m : run.modes) EXPECT_GT(m.wall.median, 0.0) << m.name;
-}
-
-TEST_F(CrowdBench, BadOptionsAreErrors) {
-  eval::CrowdBenchOptions o = tinyOptions();
-  o.frames = 1;
-  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
-  o = tinyOptions();
-  o.models.clear();
-  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
-  o = tinyOptions();
-  o.paths = {"sideways"};
-  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
-  o = tinyOptions();
-  o.timing_passes = 0;
-  EXPECT_THROW(eval::runCrowdBench(gpu::sharedHeadlessContext(), o), Error);
 }

@@ -244,7 +244,6 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
 }  // namespace
 
 CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& options) {
-  if (options.models.empty()) throw Error("crowd bench", "no models given");
   if (options.model_heights.size() < options.models.size() || options.model_shares.size() < options.models.size() ||
       options.model_facing_deg.size() < options.models.size())
     throw Error("crowd bench", "one height, facing and share per model (at most " +
@@ -256,7 +255,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
   CrowdBenchResult result;
   result.renderer = context.description();
 
-  CrowdModels crowd_models = loadCrowdModels(options.models, options.model_heights, options.model_facing_deg);
+  CrowdModels crowd_models =
+      crowdModels(options.models, options.model_heights, options.model_facing_deg, options.model_shares);
   const std::vector<scene::SkinnedModel>& models = crowd_models.models;
   const std::vector<runtime::CrowdModelOptions>& model_options = crowd_models.options;
   result.model_names = crowd_models.names;
@@ -319,7 +319,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       gen::CrowdOptions cro;
       cro.agents = count;
       cro.seed = options.crowd_seed;
-      cro.model_shares.assign(options.model_shares.begin(), options.model_shares.begin() + long(models.size()));
+      cro.model_shares = crowd_models.shares;
       cro.outfits = options.outfits;
       const gen::Crowd crowd = gen::generateCrowd(city.streets, cro);
       FF_INFO("crowd bench: " << count << " agents, " << path_name << " path");

@@ -32,8 +32,11 @@ struct CrowdBenchOptions {
   int timing_passes = 1;
   int width = 512;
   int height = 512;
-  std::vector<std::string> models;  // glTF files; default ../shared/data/models CesiumMan.glb and Fox.glb
-  std::vector<float> model_heights = kCrowdModelHeights;  // per model; the defaults are the shared models'
+  // Skinned glTF files; empty (the default): the built-in figures, a walker and a four-legged one, with their own
+  // heights, facings and shares (eval::builtinCrowdModels), so that the bench reads no file.
+  std::vector<std::string> models;
+  // Per file (used with `models` only); the defaults are the shared models' (CesiumMan, Fox).
+  std::vector<float> model_heights = kCrowdModelHeights;
   std::vector<float> model_facing_deg = kCrowdModelFacingDeg;
   std::vector<float> model_shares = kCrowdModelShares;
   runtime::CrowdRuntimeOptions runtime;  // its bound_focal_px is set from the frame size (60 degrees)

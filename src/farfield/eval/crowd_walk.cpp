@@ -1,11 +1,14 @@
 #include "farfield/eval/crowd_walk.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
 #include "farfield/eval/crowd_metrics.h"
+#include "farfield/gen/quadruped_figure.h"
+#include "farfield/gen/walker_figure.h"
 #include "farfield/scene/gltf_skin.h"
 
 namespace farfield::eval {
@@ -13,12 +16,28 @@ namespace {
 constexpr float kNominalSpeed = 1.3f;  // m/s at which a model's walk cycle is played at its own rate
 }  // namespace
 
+CrowdModels builtinCrowdModels() {
+  CrowdModels out;
+  out.models.push_back(gen::makeWalkerFigure());
+  out.models.push_back(gen::makeQuadrupedFigure());
+  for (size_t m = 0; m < out.models.size(); ++m) {
+    runtime::CrowdModelOptions mo;
+    mo.height_m = kBuiltinCrowdModelHeights[m];
+    mo.facing_deg = kBuiltinCrowdModelFacingDeg[m];
+    out.options.push_back(mo);
+    out.names.push_back(out.models[m].name);
+    out.shares.push_back(kBuiltinCrowdModelShares[m]);
+  }
+  return out;
+}
+
 CrowdModels loadCrowdModels(std::span<const std::string> files, std::span<const float> heights,
-                            std::span<const float> facing_deg) {
+                            std::span<const float> facing_deg, std::span<const float> shares) {
   if (files.empty()) throw Error("crowd", "no skinned models given");
-  if (heights.size() < files.size() || facing_deg.size() < files.size())
-    throw Error("crowd", "one height and facing per model (at most " +
-                             std::to_string(std::min(heights.size(), facing_deg.size())) + " models)");
+  const size_t most = std::min({heights.size(), facing_deg.size(), shares.size()});
+  if (most < files.size())
+    throw Error("crowd", "one height, facing and share per model (at most " + std::to_string(most) + " models, " +
+                             std::to_string(files.size()) + " given)");
   CrowdModels out;
   for (size_t m = 0; m < files.size(); ++m) {
     scene::SkinImportStats stats;
@@ -29,8 +48,15 @@ CrowdModels loadCrowdModels(std::span<const std::string> files, std::span<const 
     mo.facing_deg = facing_deg[m];
     out.options.push_back(mo);
     out.names.push_back(std::filesystem::path(files[m]).filename().string());
+    out.shares.push_back(shares[m]);
   }
   return out;
+}
+
+CrowdModels crowdModels(std::span<const std::string> files, std::span<const float> heights,
+                        std::span<const float> facing_deg, std::span<const float> shares) {
+  if (files.empty()) return builtinCrowdModels();
+  return loadCrowdModels(files, heights, facing_deg, shares);
 }
 
 std::vector<runtime::CrowdAgentState> crowdAgentStates(const gen::Crowd& crowd, const runtime::CrowdRuntime& rt,

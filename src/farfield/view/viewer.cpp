@@ -422,8 +422,9 @@ void checkViewerOptions(const ViewerOptions& o) {
   if (o.exit_at_end && o.replay.empty() && o.screenshot_at.empty())
     throw Error("--exit", "needs --replay or --screenshot-at (otherwise nothing would be shown)");
   if (o.crowd.agents > 0) {
-    if (o.crowd.models.empty() || o.crowd.models.size() > 2)
-      throw Error("--crowd-models", "one or two skinned glTF files (heights 1.75 m and 0.8 m)");
+    if (o.crowd.models.size() > 2)
+      throw Error("--crowd-models", "one or two skinned glTF files (heights 1.75 m and 0.8 m), or none: the built-in "
+                                    "figures");
     for (const std::string& f : o.crowd.models)
       if (!fs::exists(f)) throw Error(f, "no such file (--crowd-models)");
     if (!(o.crowd.error_px > 0.0) || !std::isfinite(o.crowd.error_px))

@@ -1,7 +1,6 @@
 #include "farfield/view/viewer_crowd.h"
 
 #include <cmath>
-#include <cstddef>
 #include <utility>
 
 #include "farfield/core/timer.h"
@@ -11,12 +10,12 @@ namespace farfield::view {
 ViewerCrowd::ViewerCrowd(const urban::StreetGraph& streets, std::function<float(float, float)> ground_height,
                          const ViewerCrowdOptions& options, int height_px)
     : options_(options) {
-  models_ = eval::loadCrowdModels(options.models, eval::kCrowdModelHeights, eval::kCrowdModelFacingDeg);
+  models_ = eval::crowdModels(options.models, eval::kCrowdModelHeights, eval::kCrowdModelFacingDeg,
+                              eval::kCrowdModelShares);
   gen::CrowdOptions co;
   co.agents = options.agents;
   co.seed = options.seed;
-  co.model_shares.assign(eval::kCrowdModelShares.begin(),
-                         eval::kCrowdModelShares.begin() + std::ptrdiff_t(models_.models.size()));
+  co.model_shares = models_.shares;
   co.ground_height = std::move(ground_height);
   crowd_ = gen::generateCrowd(streets, co);
   runtime::CrowdRuntimeOptions ro;

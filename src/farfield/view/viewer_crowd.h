@@ -21,7 +21,9 @@ namespace farfield::view {
 
 struct ViewerCrowdOptions {
   size_t agents = 0;                // 0: no crowd
-  std::vector<std::string> models;  // skinned glTF files (CesiumMan 1.75 m, Fox 0.8 m: the first two heights)
+  // Skinned glTF files (CesiumMan 1.75 m, Fox 0.8 m: the first two heights); empty: the built-in figures, a walker
+  // and a four-legged one (eval::builtinCrowdModels), no file read.
+  std::vector<std::string> models;
   uint64_t seed = 2;
   double error_px = 1.0;            // the impostors' bound (crowd-mixed's switch)
   double lod_px = 0.0;              // skinned levels of detail within this many pixels (0: the mesh; seconds to build)
@@ -38,7 +40,7 @@ struct ViewerCrowdFrame {
 
 class ViewerCrowd {
  public:
-  // Loads the models, places the agents on the streets' sidewalks over ground_height and bakes the impostor atlases
+  // Loads the models (or makes the built-in figures), places the agents on the streets' sidewalks over ground_height and bakes the impostor atlases
   // for frames of height_px pixels at the camera's field of view. Needs the OpenGL context current. Throws
   // farfield::Error naming a bad model file, or a street graph without sidewalks.
   ViewerCrowd(const urban::StreetGraph& streets, std::function<float(float, float)> ground_height,
