@@ -24,10 +24,7 @@ constexpr int kMaxLevels = 16;
 enum Variant { kPlain = 0, kTextured = 1, kItems = 2, kVariants = 3 };
 
 GLuint createBuffer(size_t bytes, const void* data, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT) {
-  GLuint buffer = 0;
-  glCreateBuffers(1, &buffer);
-  glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), data, flags);
-  return buffer;
+  return createStorageBuffer(bytes, data, flags);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <exception>
 #include <mutex>
@@ -82,16 +83,25 @@ GpuObject gpuObject(const scene::Object& object) {
 }
 
 GLuint makeBuffer(const void* data, size_t bytes, size_t& total) {
-  GLuint buffer = 0;
-  glCreateBuffers(1, &buffer);
-  // An empty buffer still gets a name and 16 bytes, so bindings stay valid for a scene without triangles.
-  glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes ? data : nullptr,
-                       GL_DYNAMIC_STORAGE_BIT);
   total += bytes;
-  return buffer;
+  return createStorageBuffer(bytes, data, GL_DYNAMIC_STORAGE_BIT);
 }
 
 }  // namespace
+
+uint32_t createStorageBuffer(size_t bytes, const void* data, uint32_t flags) {
+  // An empty buffer still gets a name and 16 bytes, so bindings stay valid for a scene without triangles; fewer
+  // bytes than that are copied into a zeroed block first (the driver reads all 16 from `data`).
+  std::array<uint8_t, 16> small{};
+  if (data && bytes < small.size()) {
+    std::memcpy(small.data(), data, bytes);
+    data = small.data();
+  }
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, small.size())), data, GLbitfield(flags));
+  return buffer;
+}
 
 bool coneRejects(const ArenaCluster& cluster, const Vec3& eye) {
   if (!(cluster.cone_cutoff < 1.0f)) return false;

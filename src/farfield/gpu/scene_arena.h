@@ -73,6 +73,10 @@ struct MaterialGroup {
   uint64_t triangles = 0;
 };
 
+// A GL buffer of `bytes` (at least 16, so that an empty one can still be bound) with `data` (bytes of it, or none)
+// and the glNamedBufferStorage flags; for the arena's and the culler's storage buffers. Returns its name.
+uint32_t createStorageBuffer(size_t bytes, const void* data, uint32_t flags);
+
 // The eye test of a cluster's normal cone, as the culling shader makes it (both in the mesh's own space): true when
 // every triangle of the cluster faces away from the eye, with a margin for the GPU's rounding of nearly edge-on ones.
 bool coneRejects(const ArenaCluster& cluster, const Vec3& eye);
