@@ -51,16 +51,22 @@ GpuMesh::GpuMesh(const scene::Mesh& mesh) {
   glNamedBufferStorage(ibo_, GLsizeiptr(index_bytes), mesh.indices.data(), 0);
   bytes_ = vertex_bytes + index_bytes;
 
-  glCreateVertexArrays(1, &vao_);
-  glVertexArrayVertexBuffer(vao_, 0, vbo_, 0, sizeof(GpuVertex));
-  glVertexArrayElementBuffer(vao_, ibo_);
+  vao_ = makeVertexArray(vbo_, ibo_);
+}
+
+uint32_t makeVertexArray(uint32_t vertex_buffer, uint32_t index_buffer) {
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  glVertexArrayVertexBuffer(vao, 0, vertex_buffer, 0, sizeof(GpuVertex));
+  glVertexArrayElementBuffer(vao, index_buffer);
   const GLuint offsets[3] = {offsetof(GpuVertex, position), offsetof(GpuVertex, normal), offsetof(GpuVertex, uv)};
   const GLint sizes[3] = {3, 3, 2};
   for (GLuint attribute = 0; attribute < 3; ++attribute) {
-    glEnableVertexArrayAttrib(vao_, attribute);
-    glVertexArrayAttribFormat(vao_, attribute, sizes[attribute], GL_FLOAT, GL_FALSE, offsets[attribute]);
-    glVertexArrayAttribBinding(vao_, attribute, 0);
+    glEnableVertexArrayAttrib(vao, attribute);
+    glVertexArrayAttribFormat(vao, attribute, sizes[attribute], GL_FLOAT, GL_FALSE, offsets[attribute]);
+    glVertexArrayAttribBinding(vao, attribute, 0);
   }
+  return vao;
 }
 
 GpuMesh::~GpuMesh() {

@@ -23,6 +23,9 @@ static_assert(sizeof(GpuVertex) == 32);
 void checkDrawableMesh(const scene::Mesh& mesh);
 // Vertex v of the mesh as a GpuVertex.
 GpuVertex gpuVertex(const scene::Mesh& mesh, size_t v);
+// A new vertex array reading GpuVertex records (attributes 0 position, 1 normal, 2 uv, binding 0) from
+// vertex_buffer, with index_buffer as its element buffer. The caller owns (and deletes) it.
+uint32_t makeVertexArray(uint32_t vertex_buffer, uint32_t index_buffer);
 
 class GpuMesh {
  public:

@@ -292,17 +292,7 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
   buffers_.objects = makeBuffer(nullptr, scene.objects.size() * sizeof(GpuObject), gpu_bytes_);
   uploadObjects(0, uint32_t(scene.objects.size()));
 
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  glVertexArrayVertexBuffer(vao, 0, vertex_buffer_, 0, sizeof(GpuVertex));
-  glVertexArrayElementBuffer(vao, index_buffer_);
-  const GLuint offsets[3] = {offsetof(GpuVertex, position), offsetof(GpuVertex, normal), offsetof(GpuVertex, uv)};
-  const GLint sizes[3] = {3, 3, 2};
-  for (GLuint attribute = 0; attribute < 3; ++attribute) {
-    glEnableVertexArrayAttrib(vao, attribute);
-    glVertexArrayAttribFormat(vao, attribute, sizes[attribute], GL_FLOAT, GL_FALSE, offsets[attribute]);
-    glVertexArrayAttribBinding(vao, attribute, 0);
-  }
+  const GLuint vao = makeVertexArray(vertex_buffer_, index_buffer_);
   // The instance index: one value per instance from 0, 1, 2, ...; a draw's baseInstance picks its instance.
   glVertexArrayVertexBuffer(vao, 1, instance_ids_, 0, sizeof(uint32_t));
   glVertexArrayBindingDivisor(vao, 1, 1);
