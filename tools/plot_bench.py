@@ -20,7 +20,8 @@ import sys
 def read_frames(path):
     """Rows of frames.csv grouped by mode, in file order: {mode: {"frame": [...], "wall_ms": [...], ...}}."""
     numeric = ["frame", "path_frame", "wall_ms", "gpu_ms", "triangles", "draw_calls", "objects",
-               "psnr_db", "ssim", "bad_pixel_share", "parallax_p99_px", "popping"]
+               "psnr_db", "ssim", "bad_pixel_share", "parallax_p99_px", "popping", "governor_level", "predicted_ms",
+               "corrected_ms", "bound_scale"]
     modes = {}
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
@@ -76,13 +77,16 @@ def main(argv):
         print("plot_bench.py: %s has no frames" % csv_path, file=sys.stderr)
         return 2
 
-    threshold, cap, bounds = 8, 99, {}
+    threshold, cap, bounds, t_max = 8, 99, {}, None
     try:
         import json
         with open(os.path.join(out_dir, "bench.json")) as f:
             info = json.load(f)
         threshold = info.get("bad_pixel_threshold", threshold)
         cap = info.get("psnr_cap_db", cap)
+        for m in (info.get("modes") or {}).values():
+            if isinstance(m, dict) and isinstance(m.get("t_max_ms"), (int, float)):
+                t_max = float(m["t_max_ms"])
         for name, m in (info.get("modes") or {}).items():
             if isinstance(m, dict) and isinstance(m.get("error_bound_px"), (int, float)):
                 bounds[name] = float(m["error_bound_px"])
@@ -174,6 +178,34 @@ def main(argv):
         fig.savefig(os.path.join(out_dir, "popping.png"), dpi=110)
         plt.close(fig)
         written.append("popping.png")
+
+    governed = {name: s for name, s in modes.items() if has_values(s["governor_level"])}
+    if governed:
+        # The governor's loop: measured time against what it expected (the corrected prediction), and its level.
+        fig, (ax_t, ax_l) = plt.subplots(2, 1, figsize=(10, 6.0), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+        for i, (name, s) in enumerate(modes.items()):
+            if name not in governed:
+                continue
+            color = colors[i % len(colors)]
+            ax_t.plot(x_of(s), s["wall_ms"], label=name + " measured", color=color, linewidth=1.2)
+            ax_t.plot(x_of(s), s["corrected_ms"], label=name + " expected (corrected prediction)", color=color,
+                      linewidth=0.8, linestyle="--")
+            ax_l.step(x_of(s), s["governor_level"], where="mid", label=name, color=color, linewidth=1.2)
+        if t_max is not None:
+            ax_t.axhline(t_max, color="black", linewidth=0.8, linestyle=":", label="t_max %g ms" % t_max)
+        ax_t.set_ylabel("frame time (ms)")
+        ax_t.set_title("Frame governor: measured and expected frame time, and the level it chose")
+        ax_t.set_ylim(bottom=0)
+        ax_t.grid(True, alpha=0.3)
+        ax_t.legend(fontsize="small")
+        ax_l.set_xlabel("camera path frame")
+        ax_l.set_ylabel("level (0 = full)")
+        ax_l.yaxis.set_major_locator(MaxNLocator(integer=True))
+        ax_l.grid(True, alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out_dir, "governor.png"), dpi=110)
+        plt.close(fig)
+        written.append("governor.png")
 
     for name in written:
         print("wrote %s" % os.path.join(out_dir, name))

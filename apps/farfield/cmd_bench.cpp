@@ -175,6 +175,10 @@ void runBenchCommand(const BenchArgs& args) {
     for (const eval::ModeResult& m : result.modes)
       std::printf(" %s %zu/%zu;", m.name.c_str(), m.frames_over_tmax, m.frames.size());
     std::printf("\n");
+    for (const eval::ModeResult& m : result.modes)
+      if (m.governed)
+        std::printf("%s: %zu of %zu frames relaxed (drawn at a coarser level), the bound kept up to %.2fx\n",
+                    m.name.c_str(), m.frames_relaxed, m.frames.size(), m.bound_scale_max);
   }
   std::printf("\nwrote %s/{bench.json,bench.md,frames.csv}", args.out_dir.c_str());
   for (const std::string& p : result.plots) std::printf(", %s", p.c_str());

@@ -160,6 +160,22 @@ TEST(BenchBound, FramesOverTheGivenBound) {
   EXPECT_EQ(m.frames_checked, 4u);
 }
 
+TEST(BenchBound, AGovernedFrameIsCheckedAgainstTheBoundItKept) {
+  ModeResult m = madeUpFrames({1.5, 1.5, 2.5});
+  for (FrameRecord& f : m.frames) f.governor_level = 0;
+  m.frames[1].governor_level = m.frames[2].governor_level = 1;
+  m.frames[1].bound_scale = m.frames[2].bound_scale = 2.0;  // drawn at half the resolution: a 2 px bound kept
+  summarizeModeResult(m, 1.0);
+  EXPECT_EQ(m.over_bound, (std::vector<int>{1, 0, 1}));
+  EXPECT_TRUE(m.governed);
+  EXPECT_EQ(m.frames_relaxed, 2u);
+  EXPECT_DOUBLE_EQ(m.bound_scale_max, 2.0);
+  ModeResult plain = madeUpFrames({0.5});
+  summarizeModeResult(plain, 1.0);
+  EXPECT_FALSE(plain.governed);
+  EXPECT_EQ(plain.frames_relaxed, 0u);
+}
+
 TEST(BenchBound, TheModesOwnBoundUnlessOneIsGiven) {
   ModeResult m = madeUpFrames({0.5, 2.0, 0.1});
   m.info["error_bound_px"] = 0.25;
@@ -359,14 +375,17 @@ TEST(Bench, CsvMarkdownAndSampleFrames) {
   ASSERT_EQ(csv.size(), 1u + 3u * 2u);
   EXPECT_EQ(csv[0].rfind("frame,path_frame,mode,order,wall_ms,gpu_ms,triangles", 0), 0u);
   EXPECT_NE(csv[0].find(",parallax_p99_px,over_bound,popping"), std::string::npos) << csv[0];
-  EXPECT_NE(csv[0].find(",popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,syncs"), std::string::npos) << csv[0];
+  EXPECT_NE(csv[0].find(",popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,syncs,governor_level,predicted_ms,"
+                        "corrected_ms,bound_scale"),
+            std::string::npos)
+      << csv[0];
   const auto field = [](const std::string& line, size_t k) {
     size_t start = 0;
     for (size_t i = 0; i < k; ++i) start = line.find(',', start) + 1;
     return line.substr(start, line.find(',', start) - start);
   };
   for (size_t i = 1; i < csv.size(); ++i) {
-    EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 20) << csv[i];
+    EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 24) << csv[i];
     // The GL counters are on in the bench: every frame has its calls counted, and culled waits for nothing.
     EXPECT_GT(std::stoul(field(csv[i], 17)), 0u) << csv[i];
     if (csv[i].find(",culled,") != std::string::npos) {

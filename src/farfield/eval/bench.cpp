@@ -163,6 +163,7 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
   gpu::Renderer& renderer = run.renderer;
   gpu::RenderTarget& target = run.target;
   ModeContext& mode_context = run.context;
+  mode_context.t_max_ms = options.t_max_ms;
   gpu::RenderTarget reference_target;
   if (options.reference) reference_target = gpu::RenderTarget(options.width, options.height);
 
@@ -289,6 +290,15 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
 
 void summarizeModeResult(ModeResult& m, std::optional<double> error_px) {
   summarizeFrames(m);
+  m.governed = false;
+  m.frames_relaxed = 0;
+  m.bound_scale_max = 1.0;
+  for (const FrameRecord& f : m.frames) {
+    if (f.governor_level < 0) continue;
+    m.governed = true;
+    m.frames_relaxed += f.bound_scale > 1.0;
+    m.bound_scale_max = std::max(m.bound_scale_max, f.bound_scale);
+  }
   m.has_errors = !m.errors.empty();
   m.psnr_db_mean = m.psnr_db_min = m.ssim_mean = m.bad_pixel_share_mean = m.crack_share_mean = 0.0;
   m.parallax_px_mean = m.parallax_px_max = 0.0;
@@ -337,7 +347,8 @@ void summarizeModeResult(ModeResult& m, std::optional<double> error_px) {
   if (m.error_bound_px) {
     for (size_t k = 0; k < m.frames.size() && k < m.parallax_px.size(); ++k) {
       if (std::isnan(m.parallax_px[k])) continue;
-      m.over_bound[k] = m.parallax_px[k] > *m.error_bound_px ? 1 : 0;
+      // A governed frame is checked against the bound it kept (FrameRecord::bound_scale; 1 when not relaxed).
+      m.over_bound[k] = m.parallax_px[k] > *m.error_bound_px * m.frames[k].bound_scale ? 1 : 0;
       m.frames_over_bound += size_t(m.over_bound[k]);
       ++m.frames_checked;
     }

@@ -22,6 +22,7 @@
 //                       "frames_over_bound", "frames_checked_against_bound", "popping_mean", "popping_p99",
 //                       "popping_max", "info": {...}}, ...},
 //    "allocator": {"applied": bool, "description": "..."}}
+// Governed modes add "frames_relaxed" and "bound_scale_max" (null for other modes); bench.md lists them below the table.
 // speedup_vs_full = median_ms(full) / median_ms(mode). PSNR of identical frames is infinite; it is stored capped at
 // kPsnrCapDb (per frame, before the mean and min). Without a reference the error keys are null.
 //
@@ -118,6 +119,11 @@ struct ModeResult {
   size_t frames_checked = 0;
   // Frames whose wall time exceeds BenchOptions::t_max_ms (0 without it).
   size_t frames_over_tmax = 0;
+  // A governed mode (FrameRecord::governor_level >= 0 on a frame): frames drawn with a relaxed bound
+  // (bound_scale > 1) and the largest bound_scale; over_bound checks each frame against the bound it kept.
+  bool governed = false;
+  size_t frames_relaxed = 0;
+  double bound_scale_max = 1.0;
   // Popping (eval/temporal_error.h): per frame, with a reference, NaN for the first measured frame. The summary is
   // over the frames that have a value.
   std::vector<double> popping;
@@ -179,15 +185,16 @@ void writeBenchJson(const BenchResult& result, const std::string& file);
 void writeBenchMarkdown(const BenchResult& result, const std::string& file);
 // One row per frame per mode: frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,
 // psnr_db,ssim,bad_pixel_share,parallax_p99_px,over_bound,popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,
-// syncs (error columns empty without a reference; over_bound is 1 or 0, "-" without a bound, empty when not measured;
-// popping is empty for the first frame; the last six empty where GL calls were not counted).
+// syncs,governor_level,predicted_ms,corrected_ms,bound_scale (error columns empty without a reference; over_bound is 1
+// or 0, "-" without a bound, empty when not measured; popping is empty for the first frame; cpu_ms..syncs empty where
+// GL calls were not counted; the last four empty for a mode without a governor).
 void writeFramesCsv(const BenchResult& result, const std::string& file);
 // bench.json, bench.md and frames.csv into out_dir (created if missing).
 void writeBenchOutputs(const BenchResult& result, const std::string& out_dir);
 
 // Runs `PYTHON SCRIPT OUT_DIR` (tools/plot_bench.py) to draw frame_time.png, error.png, parallax.png and
-// popping.png (the last three with a reference) from frames.csv. PYTHON is the first of: the given interpreter,
-// $FF_PYTHON, python3, /usr/bin/python3 that can import matplotlib.
+// popping.png (the last three with a reference), and governor.png (with a governed mode), from frames.csv. PYTHON is
+// the first of: the given interpreter, $FF_PYTHON, python3, /usr/bin/python3 that can import matplotlib.
 // Returns the plots written (relative to out_dir); warns (never throws) when none could be drawn.
 std::vector<std::string> runPlotScript(const std::string& out_dir, const std::string& script,
                                        const std::string& python = "");

@@ -209,6 +209,9 @@ void writeBenchJson(const BenchResult& r, const std::string& file) {
     e["frames_checked_against_bound"] = m.frames_checked;
     e["t_max_ms"] = r.t_max_ms ? Json(*r.t_max_ms) : Json(nullptr);
     e["frames_over_tmax"] = r.t_max_ms ? Json(m.frames_over_tmax) : Json(nullptr);
+    // Governed modes (eval/governed_mode.h): frames drawn at a coarser level and the largest bound kept.
+    e["frames_relaxed"] = m.governed ? Json(m.frames_relaxed) : Json(nullptr);
+    e["bound_scale_max"] = m.governed ? Json(m.bound_scale_max) : Json(nullptr);
     e["repeats"] = r.repeats;
     Json info = Json::object();
     for (const auto& [key, value] : m.info) info[key] = value;
@@ -230,14 +233,30 @@ void writeBenchJson(const BenchResult& r, const std::string& file) {
   writeText(file, j.dump(2) + "\n");
 }
 
+// One line per governed mode: the budget, the frames over it, the frames relaxed and the largest bound kept.
+std::string governorLines(const BenchResult& r) {
+  std::string out;
+  for (const ModeResult& m : r.modes) {
+    if (!m.governed) continue;
+    out += "\n- " + m.name + ": t_max " + (r.t_max_ms ? fmt("%.2f", *r.t_max_ms) : std::string("-")) + " ms, " +
+           std::to_string(m.frames_over_tmax) + " of " + std::to_string(m.frames.size()) + " frames over it; " +
+           std::to_string(m.frames_relaxed) + " frames relaxed (drawn at a coarser level), the bound kept up to " +
+           fmt("%.2f", m.bound_scale_max) + "x the promised one" +
+           (m.error_bound_px ? " (" + fmt("%.2f", *m.error_bound_px * m.bound_scale_max) + " px)" : std::string()) +
+           "\n";
+  }
+  return out;
+}
+
 void writeBenchMarkdown(const BenchResult& r, const std::string& file) {
-  writeText(file, "# Walkthrough benchmark\n\n" + markdownHeader(r) + "\n" + markdownTable(r));
+  writeText(file, "# Walkthrough benchmark\n\n" + markdownHeader(r) + "\n" + markdownTable(r) + governorLines(r));
 }
 
 void writeFramesCsv(const BenchResult& r, const std::string& file) {
   std::ostringstream out;
   out << "frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,psnr_db,ssim,bad_pixel_share,"
-         "parallax_p99_px,over_bound,popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,syncs\n";
+         "parallax_p99_px,over_bound,popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,syncs,governor_level,"
+         "predicted_ms,corrected_ms,bound_scale\n";
   char line[512];
   for (size_t k = 0; k < r.frame_indices.size(); ++k) {
     for (const ModeResult& m : r.modes) {
@@ -265,10 +284,17 @@ void writeFramesCsv(const BenchResult& r, const std::string& file) {
       out << (std::isnan(pop) ? std::string() : fmt("%.4f", pop)) << ",";
       // The GL counters: empty where they were not installed.
       if (f.counted)
-        std::snprintf(line, sizeof(line), "%.4f,%.4f,%llu,%u,%llu,%u\n", f.cpu_ms, f.driver_ms,
+        std::snprintf(line, sizeof(line), "%.4f,%.4f,%llu,%u,%llu,%u,", f.cpu_ms, f.driver_ms,
                       (unsigned long long)f.gl_calls, f.dispatches, (unsigned long long)f.upload_bytes, f.syncs);
       else
-        std::snprintf(line, sizeof(line), ",,,,,\n");
+        std::snprintf(line, sizeof(line), ",,,,,,");
+      out << line;
+      // The governor's decision: empty for a mode without one.
+      if (f.governor_level >= 0)
+        std::snprintf(line, sizeof(line), "%d,%.4f,%.4f,%.4f\n", f.governor_level, f.predicted_ms, f.corrected_ms,
+                      f.bound_scale);
+      else
+        std::snprintf(line, sizeof(line), ",,,\n");
       out << line;
     }
   }
@@ -297,7 +323,7 @@ std::vector<std::string> runPlotScript(const std::string& out_dir, const std::st
     if (!c.empty() && std::find(candidates.begin(), candidates.end(), c) == candidates.end())
       candidates.push_back(c);
   // The script's own names; removed first so that a failed run cannot pass off stale plots as new.
-  const std::vector<std::string> names{"frame_time.png", "error.png", "parallax.png", "popping.png"};
+  const std::vector<std::string> names{"frame_time.png", "error.png", "parallax.png", "popping.png", "governor.png"};
   for (const std::string& n : names) fs::remove(fs::path(out_dir) / n);
   // Probe quietly for an interpreter with matplotlib (python3 on PATH may be a virtual environment without it,
   // while the system one has it), then run the script once with the first that has it.

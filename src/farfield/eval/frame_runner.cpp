@@ -105,6 +105,13 @@ FrameRecord FrameRunner::run(Mode& mode, const Camera& camera, size_t path_frame
     record.driver_ms = used.driver_ms;
   }
   record.cpu_ms = std::max(0.0, record.wall_ms - used.driver_ms - used.measure_ms);
+  mode.frameMeasured(path_frame, record.wall_ms);
+  if (const std::optional<FrameGovernance> g = mode.governance(path_frame)) {
+    record.governor_level = int(g->level);
+    record.predicted_ms = g->predicted_ms;
+    record.corrected_ms = g->corrected_ms;
+    record.bound_scale = g->bound_scale;
+  }
   return record;
 }
 

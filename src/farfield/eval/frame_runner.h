@@ -33,6 +33,12 @@ struct FrameRecord {
   uint64_t upload_bytes = 0;  // buffer, texture and uniform data sent from the CPU
   uint32_t syncs = 0;         // CPU-GPU synchronisations (calls that waited for the GPU)
   bool counted = false;       // whether the GL counters above were installed
+  // A governed mode's decision (Mode::governance): its level (-1: no governor), the cost model's prediction and its
+  // correction, and the error bound the frame kept as a multiple of the promised one.
+  int governor_level = -1;
+  double predicted_ms = 0.0;
+  double corrected_ms = 0.0;
+  double bound_scale = 1.0;
 };
 
 // The camera of path frame i at the given size; throws farfield::Error naming the frame when it is unusable

@@ -8,6 +8,7 @@
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
 #include "farfield/eval/gpu_culled_mode.h"
+#include "farfield/eval/governed_mode.h"
 #include "farfield/eval/occlusion_pass.h"
 
 namespace farfield::eval {
@@ -166,6 +167,10 @@ Registry& registry() {
     reg->entries["culled"] = {"the GPU-driven frame: the scene's clusters culled by compute shaders (frustum, normal "
                               "cones, two-phase hierarchical-Z occlusion), one multi-draw per material group",
                               [](const ModeContext& c) { return std::make_unique<GpuCulledMode>(c); }};
+    reg->entries["governed"] = {"another mode (--mode-option governed=MODE, default culled) under a frame governor "
+                                "that keeps --tmax in a closed loop, coarsening the render resolution before a frame "
+                                "would exceed it; every coarsened frame reported with the bound it kept",
+                                [](const ModeContext& c) { return std::make_unique<GovernedMode>(c); }};
     reg->entries["culled-cpu"] = {"clusters in the view frustum (BVH), not facing away, not hidden behind the nearest "
                                   "ones (culled on the CPU, the occluders' depth read back)",
                                   [](const ModeContext& c) { return std::make_unique<CulledMode>(c, true); }};

@@ -39,6 +39,8 @@ struct ModeContext {
   gpu::Renderer* renderer = nullptr;         // the renderer the harness draws with
   int width = 0;                             // frame size, pixels
   int height = 0;
+  // The run's frame budget (ms; `--tmax`), unset without one: the governed modes (eval/governed_mode.h) keep it.
+  std::optional<double> t_max_ms;
   // Free-form options of the run ("--mode-option key=value"), e.g. {"impostor_dir": "baked/city"}. A mode reads
   // the keys it knows; keys are shared by all modes of a run.
   std::map<std::string, std::string> options;
@@ -130,6 +132,14 @@ class FrameContext {
   gpu::FrameStats pass_stats_;
 };
 
+// What a frame governor decided for one frame of a mode (eval/governed_mode.h, runtime/frame_governor.h).
+struct FrameGovernance {
+  size_t level = 0;           // 0 = the mode's own frame; higher = coarser
+  double predicted_ms = 0.0;  // the cost model's prediction of the frame at that level
+  double corrected_ms = 0.0;  // ... corrected by the measured times of earlier frames
+  double bound_scale = 1.0;   // the error bound kept / the promised bound (1: not relaxed)
+};
+
 class Mode {
  public:
   virtual ~Mode() = default;
@@ -146,6 +156,11 @@ class Mode {
   // triangles and objects only then): the harness asks after it has waited for the frame and adds them to what the
   // frame's passes reported. None by default.
   virtual std::optional<gpu::FrameStats> lateFrameStats(size_t /*path_frame*/) { return std::nullopt; }
+  // The harness's measured wall time of the frame just drawn (after its wait; outside the timed part). A mode that
+  // closes a loop on its frame time (a governor) takes it; in an engine it would come from a timer query read late.
+  virtual void frameMeasured(size_t /*path_frame*/, double /*wall_ms*/) {}
+  // What a governor decided for the frame just drawn; none for modes without one.
+  virtual std::optional<FrameGovernance> governance(size_t /*path_frame*/) const { return std::nullopt; }
 };
 
 // Makes a mode; cheap (heavy work belongs in prepare()). May throw farfield::Error for bad options.

@@ -1,0 +1,105 @@
+// "governed": another mode's frame under a frame governor (runtime/frame_governor.h) that keeps the run's t_max
+// (`--tmax`) in a closed loop, every coarsened frame reported with the error bound it kept.
+//
+// The coarser levels are lower render resolutions (scale s per side: the frame rendered at s x the size and scaled
+// up, colour bilinear, ids and depth nearest), the last resort of the order (a larger placement bound and
+// simplified geometry come before it and are not levels yet). A frame at scale s keeps the bound / s: a mode that
+// checks its bound in pixels of its camera (the walkthrough) does so at the smaller size, and a pixel there is 1 / s
+// pixels of the frame.
+//
+// The prediction: a cost model (gpu/cost_model.h: base, per million triangles, per million pixels) fitted on the
+// governed mode's own frames. On its first frame (the bench's untimed warm-up; an engine's first frame) the mode draws
+// that view at every level a few times, each waited for and timed: the calibration, and the one frame with waits.
+// Then every measured frame is a sample (its triangles, read late, and its pixels), and the model is refitted over
+// the calibration and the last samples every 16 frames. A frame is predicted from the triangles of the last frame
+// whose statistics came back and the pixels of each level. Measured times reach the governor `governor_lag` frames
+// late (as a timer query read late would).
+//
+// Options (--mode-option): governed=MODE (the mode governed; default culled), governor_scales=1,0.84,... (the
+// levels' resolution scales, 1 first, decreasing, each in [0.25, 1]), governor_lag (frames, default 2),
+// governor_aim, governor_refine_below, governor_refine_after, governor_window (runtime::GovernorOptions),
+// governor_calibration_repeats (default 3). Needs --tmax.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/eval/mode.h"
+#include "farfield/gpu/cost_model.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/runtime/frame_governor.h"
+
+namespace farfield::eval {
+
+class GovernedMode final : public Mode {
+ public:
+  explicit GovernedMode(const ModeContext& context);
+  std::string name() const override { return "governed"; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override;
+  void frameMeasured(size_t path_frame, double wall_ms) override;
+  std::optional<FrameGovernance> governance(size_t path_frame) const override;
+  // The governed mode's info, and governor_*: levels, frames per level, relaxed frames, coarsenings, refinements,
+  // measured frames over t_max, the model's coefficients, calibration time, and the quantiles (p50, p95) of
+  // measured / predicted and measured / corrected over the measured frames.
+  std::map<std::string, double> info() const override;
+
+ private:
+  struct Level {
+    double scale = 1.0;
+    int width = 0, height = 0;
+    gpu::RenderTarget target;
+  };
+  struct Sample {
+    double triangles = 0.0;
+    double pixels = 0.0;
+    double ms = 0.0;
+  };
+  Camera levelCamera(const Camera& camera, size_t level) const;
+  // Draws the governed mode's frame at `level` into that level's own target; returns what it drew.
+  gpu::FrameStats drawLevel(const Camera& camera, size_t path_frame, size_t level);
+  void calibrate(const Camera& camera, size_t path_frame);
+  void refit();
+  void deliverMeasurements();
+
+  std::unique_ptr<Mode> inner_;
+  std::string inner_name_;
+  std::vector<double> scales_;
+  std::vector<Level> levels_;
+  runtime::GovernorOptions governor_options_;
+  std::unique_ptr<runtime::FrameGovernor> governor_;
+  size_t lag_ = 2;
+  int calibration_repeats_ = 3;
+  gpu::Renderer* renderer_ = nullptr;
+  gpu::RenderTarget finish_target_;  // 1 x 1: the calibration's waits (Renderer::render's glFinish)
+  std::vector<gpu::DrawItem> items_;
+
+  gpu::CostModel model_;
+  std::vector<Sample> calibration_;
+  std::vector<Sample> recent_;  // the last measured frames (a ring of kRecent)
+  size_t recent_next_ = 0;
+  size_t since_refit_ = 0;
+  double calibration_s_ = 0.0;
+  double last_triangles_ = 0.0;  // of the last frame whose statistics came back
+
+  // Per decided frame until its measurement is delivered: governor frame, path frame, decision, pixels, triangles.
+  struct InFlight {
+    uint64_t frame = 0;
+    size_t path_frame = 0;
+    runtime::GovernorDecision decision;
+    double pixels = 0.0;
+    double triangles = -1.0;  // -1 until the statistics come back
+    double measured_ms = -1.0;
+  };
+  std::vector<InFlight> in_flight_;
+  uint64_t next_frame_ = 0;
+  std::optional<FrameGovernance> last_;
+  std::vector<double> ratio_, corrected_ratio_;  // measured / predicted, measured / corrected
+};
+
+}  // namespace farfield::eval

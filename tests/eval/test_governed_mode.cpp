@@ -1,0 +1,141 @@
+// The governed mode: a budget no frame can keep puts every frame at the coarsest level, and that frame is the scene
+// rendered at the level's size and scaled up (checked against a full-geometry render at that size, scaled up on the
+// CPU); a budget every frame keeps leaves the frame itself. Budgets far from any frame's time make the decisions
+// independent of the machine's speed.
+#include "farfield/eval/governed_mode.h"
+
+#include <gtest/gtest.h>
+
+#include "eval/eval_test_scenes.h"
+#include "farfield/core/error.h"
+#include "farfield/eval/frame_runner.h"
+#include "farfield/gpu/context.h"
+#include "farfield/scene/builtin.h"
+#include "farfield/scene/bvh.h"
+
+namespace farfield::eval {
+namespace {
+
+constexpr int kSize = 64;
+
+struct Harness {
+  scene::Scene scene = scene::builtinScene("cubes");
+  std::unique_ptr<gpu::GpuScene> gpu_scene;
+  std::unique_ptr<scene::Bvh> bvh;
+  std::unique_ptr<gpu::Renderer> renderer;
+  std::unique_ptr<gpu::RenderTarget> target;
+  ModeContext context;
+
+  explicit Harness(std::optional<double> t_max_ms) {
+    gpu::sharedHeadlessContext().makeCurrent();
+    gpu_scene = std::make_unique<gpu::GpuScene>(scene);
+    bvh = std::make_unique<scene::Bvh>(scene);
+    renderer = std::make_unique<gpu::Renderer>();
+    target = std::make_unique<gpu::RenderTarget>(kSize, kSize);
+    context.scene = &scene;
+    context.gpu_scene = gpu_scene.get();
+    context.bvh = bvh.get();
+    context.renderer = renderer.get();
+    context.width = context.height = kSize;
+    context.t_max_ms = t_max_ms;
+    context.options["governor_scales"] = "1,0.5";
+  }
+  std::unique_ptr<Mode> make(const std::string& name) {
+    auto mode = createMode(name, context);
+    mode->prepare(context);
+    return mode;
+  }
+  // Full geometry at size x size, its ids scaled up to kSize x kSize by nearest sampling as a blit samples: the
+  // destination pixel x reads source pixel floor((x + 0.5) * size / kSize).
+  image::IdImage referenceIds(const Camera& camera, int size) {
+    Camera small = camera;
+    small.width = small.height = size;
+    gpu::RenderTarget t(size, size);
+    renderer->render(small, gpu_scene->drawItems(), t);
+    const image::IdImage ids = t.readIds();
+    image::IdImage out(kSize, kSize);
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x)
+        out.at(x, y) = ids.at(int((x + 0.5) * size / kSize), int((y + 0.5) * size / kSize));
+    return out;
+  }
+};
+
+size_t differingPixels(const image::IdImage& a, const image::IdImage& b) {
+  size_t n = 0;
+  for (size_t i = 0; i < a.pixelCount(); ++i) n += a.pixels()[i] != b.pixels()[i];
+  return n;
+}
+
+size_t objectPixels(const image::IdImage& a) {
+  size_t n = 0;
+  for (uint32_t id : a.pixels()) n += id != 0;
+  return n;
+}
+
+TEST(GovernedMode, ABudgetNoFrameKeepsDrawsTheCoarsestLevelScaledUp) {
+  Harness h(1e-6);  // a nanosecond: every prediction is over it
+  auto governed = h.make("governed");
+  FrameRunner runner(*h.renderer, *h.target);
+  const gen::CameraPath path = test::sideWalkPath(4);
+  runner.run(*governed, pathCamera(path, 0, kSize, kSize), 0);  // warm-up: the calibration
+  for (size_t i = 0; i < path.frames.size(); ++i) {
+    SCOPED_TRACE("path frame " + std::to_string(i));
+    const Camera camera = pathCamera(path, i, kSize, kSize);
+    const FrameRecord f = runner.run(*governed, camera, i);
+    EXPECT_EQ(f.governor_level, 1);
+    EXPECT_DOUBLE_EQ(f.bound_scale, 2.0);  // half the resolution: the bound kept is twice the promised one
+    EXPECT_GT(f.corrected_ms, 1e-6);
+    EXPECT_EQ(f.syncs, 0u);
+    const image::IdImage ids = h.target->readIds();
+    const image::IdImage half = h.referenceIds(camera, kSize / 2);
+    const image::IdImage same = h.referenceIds(camera, kSize);
+    EXPECT_GT(objectPixels(ids), 200u);
+    EXPECT_LE(differingPixels(ids, half), ids.pixelCount() / 200) << "not the half-size frame scaled up";
+    EXPECT_GT(differingPixels(ids, same), differingPixels(ids, half));  // and not the full-size frame
+  }
+  const std::map<std::string, double> info = governed->info();
+  EXPECT_EQ(info.at("governor_level_1_frames"), 5.0);  // the warm-up and the 4 frames
+  EXPECT_EQ(info.at("governor_relaxed_frames"), 5.0);
+  EXPECT_GT(info.at("governor_calibration_s"), 0.0);
+}
+
+TEST(GovernedMode, ABudgetEveryFrameKeepsLeavesTheFrameItself) {
+  Harness h(1e9);
+  auto governed = h.make("governed");
+  auto culled = h.make("culled");
+  FrameRunner runner(*h.renderer, *h.target);
+  const gen::CameraPath path = test::sideWalkPath(4);
+  runner.run(*governed, pathCamera(path, 0, kSize, kSize), 0);
+  runner.run(*culled, pathCamera(path, 0, kSize, kSize), 0);
+  for (size_t i = 0; i < path.frames.size(); ++i) {
+    SCOPED_TRACE("path frame " + std::to_string(i));
+    const Camera camera = pathCamera(path, i, kSize, kSize);
+    const FrameRecord g = runner.run(*governed, camera, i);
+    const image::IdImage governed_ids = h.target->readIds();
+    const FrameRecord c = runner.run(*culled, camera, i);
+    EXPECT_EQ(g.governor_level, 0);
+    EXPECT_DOUBLE_EQ(g.bound_scale, 1.0);
+    EXPECT_EQ(c.governor_level, -1);  // no governor
+    EXPECT_EQ(differingPixels(governed_ids, h.target->readIds()), 0u);
+    EXPECT_EQ(g.syncs, 0u);
+  }
+}
+
+TEST(GovernedMode, BadOptionsAreClearErrors) {
+  Harness h(std::nullopt);
+  EXPECT_THROW(createMode("governed", h.context), Error);  // no --tmax
+  h.context.t_max_ms = 10.0;
+  h.context.options["governor_scales"] = "0.5,1";
+  EXPECT_THROW(createMode("governed", h.context), Error);
+  h.context.options["governor_scales"] = "1,0.1";
+  EXPECT_THROW(createMode("governed", h.context), Error);
+  h.context.options["governor_scales"] = "1,0.5";
+  h.context.options["governed"] = "governed";
+  EXPECT_THROW(createMode("governed", h.context), Error);
+  h.context.options["governed"] = "no-such-mode";
+  EXPECT_THROW(createMode("governed", h.context), Error);
+}
+
+}  // namespace
+}  // namespace farfield::eval
