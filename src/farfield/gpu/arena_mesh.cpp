@@ -7,26 +7,23 @@
 #include <utility>
 
 #include "farfield/gpu/mesh_clusters.h"
+#include "farfield/gpu/surface_deviation.h"
 
 namespace farfield::gpu {
 
-ArenaMesh clusterArenaMesh(const scene::Mesh& mesh, const ArenaOptions& options) {
-  ArenaMesh out;
-  checkDrawableMesh(mesh);
-  if (mesh.indices.empty() || mesh.positions.empty()) return out;
-  std::vector<meshopt_Meshlet> meshlets;
-  std::vector<unsigned int> meshlet_vertices;
-  std::vector<unsigned char> meshlet_triangles;
-  std::vector<uint32_t> local;  // the mesh's indices in cluster order
-  std::vector<unsigned int> remap;
+namespace {
+
+// Meshlets of one index list: its triangles split by facing class (small classes and triangles without area pooled
+// last), each class cut by meshoptimizer. Appends to the three meshlet arrays.
+void buildMeshlets(const scene::Mesh& mesh, const std::vector<uint32_t>& indices, const ArenaOptions& options,
+                   std::vector<meshopt_Meshlet>& meshlets, std::vector<unsigned int>& meshlet_vertices,
+                   std::vector<unsigned char>& meshlet_triangles) {
   const float* positions = &mesh.positions[0].x;
   const size_t vertex_count = mesh.positions.size();
-  // The triangles by facing class (small classes and triangles without area pooled last), each class cut into
-  // clusters by meshoptimizer.
-  const size_t triangle_count = mesh.indices.size() / 3;
+  const size_t triangle_count = indices.size() / 3;
   std::array<std::vector<uint32_t>, kNoFacing + 2> by_class;
   for (size_t t = 0; t < triangle_count; ++t) {
-    const uint32_t* tri = &mesh.indices[3 * t];
+    const uint32_t* tri = &indices[3 * t];
     const int c = options.min_facing_triangles > 0
                       ? facingClass(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]])
                       : kNoFacing;
@@ -41,10 +38,7 @@ ArenaMesh clusterArenaMesh(const scene::Mesh& mesh, const ArenaOptions& options)
   by_class[kNoFacing + 1].insert(by_class[kNoFacing + 1].end(), by_class[kNoFacing].begin(),
                                  by_class[kNoFacing].end());
   by_class[kNoFacing].clear();
-  size_t count = 0;
-  meshlets.clear();
-  meshlet_vertices.clear();
-  meshlet_triangles.clear();
+  size_t count = meshlets.size();
   for (const std::vector<uint32_t>& part : by_class) {
     if (part.empty()) continue;
     const size_t bound = meshopt_buildMeshletsBound(part.size(), options.max_vertices, options.max_triangles);
@@ -61,10 +55,54 @@ ArenaMesh clusterArenaMesh(const scene::Mesh& mesh, const ArenaOptions& options)
       meshlets[k].triangle_offset += uint32_t(triangle_base);
     }
     count += made;
+    meshlets.resize(count);
   }
+}
+
+}  // namespace
+
+float simplifiedMesh(const scene::Mesh& mesh, const ArenaOptions& options, std::vector<uint32_t>& out) {
+  out.clear();
+  const size_t triangles = mesh.indices.size() / 3;
+  if (!(options.lod_ratio > 0.0f) || triangles < options.lod_min_triangles || mesh.positions.empty()) return 0.0f;
+  const float* positions = &mesh.positions[0].x;
+  const size_t target = std::max<size_t>(3, size_t(double(mesh.indices.size()) * options.lod_ratio) / 3 * 3);
+  out.resize(mesh.indices.size());
+  float relative = 0.0f;
+  out.resize(meshopt_simplify(out.data(), mesh.indices.data(), mesh.indices.size(), positions, mesh.positions.size(),
+                              sizeof(Vec3), target, options.lod_max_error, 0, &relative));
+  // Worth a level only when it removes a good share of the triangles.
+  if (out.empty() || out.size() > mesh.indices.size() * 3 / 4) {
+    out.clear();
+    return 0.0f;
+  }
+  (void)relative;  // meshoptimizer's own estimate is smaller than the real deviation (2-4x on the tests' meshes)
+  return float(surfaceDeviation(mesh.positions, mesh.indices, out));
+}
+
+ArenaMesh clusterArenaMesh(const scene::Mesh& mesh, const ArenaOptions& options) {
+  ArenaMesh out;
+  checkDrawableMesh(mesh);
+  if (mesh.indices.empty() || mesh.positions.empty()) return out;
+  std::vector<meshopt_Meshlet> meshlets;
+  std::vector<unsigned int> meshlet_vertices;
+  std::vector<unsigned char> meshlet_triangles;
+  const float* positions = &mesh.positions[0].x;
+  const size_t vertex_count = mesh.positions.size();
+  buildMeshlets(mesh, mesh.indices, options, meshlets, meshlet_vertices, meshlet_triangles);
+  const size_t full_count = meshlets.size();
+  // The simplified level: its clusters after the full ones, over the same vertices (meshopt_simplify keeps a subset).
+  std::vector<uint32_t> simplified;
+  const float lod_error = simplifiedMesh(mesh, options, simplified);
+  if (!simplified.empty()) {
+    buildMeshlets(mesh, simplified, options, meshlets, meshlet_vertices, meshlet_triangles);
+    out.lod_clusters = uint32_t(meshlets.size() - full_count);
+    out.lod_error = lod_error;
+  }
+  const size_t count = meshlets.size();
   // The clusters' triangles as the mesh's own indices, cluster after cluster; then the vertices renumbered in the
   // order those first use them (meshopt_optimizeVertexFetchRemap), so that a cluster's vertices lie together.
-  local.clear();
+  std::vector<uint32_t> local;  // the mesh's indices in cluster order
   std::vector<std::pair<uint32_t, uint32_t>> ranges;  // per cluster: first, count in `local`
   for (size_t c = 0; c < count; ++c) {
     const meshopt_Meshlet& ml = meshlets[c];
@@ -72,7 +110,7 @@ ArenaMesh clusterArenaMesh(const scene::Mesh& mesh, const ArenaOptions& options)
     for (uint32_t t = 0; t < ml.triangle_count * 3; ++t)
       local.push_back(meshlet_vertices[ml.vertex_offset + meshlet_triangles[ml.triangle_offset + t]]);
   }
-  remap.resize(vertex_count);
+  std::vector<unsigned int> remap(vertex_count);
   const size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), local.data(), local.size(), vertex_count);
   out.vertices.resize(used);
   for (size_t v = 0; v < vertex_count; ++v) {

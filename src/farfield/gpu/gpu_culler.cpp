@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -42,7 +43,8 @@ struct GpuCuller::Impl {
       Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1\n#define FF_ITEM_BUFFER 1")};
 
   struct CullLocations {
-    int view_proj, planes, eye, viewport, phase, compact, cone, count, levels, level_size, margin, frame;
+    int view_proj, planes, eye, viewport, phase, compact, cone, count, levels, level_size, margin, frame, lod_px,
+        lod_scale;
   };
   CullLocations cl{}, part_l{}, emit_l{};
   struct PyramidLocations {
@@ -88,7 +90,8 @@ struct GpuCuller::Impl {
             glGetUniformLocation(c, "u_phase"),     glGetUniformLocation(c, "u_compact"),
             glGetUniformLocation(c, "u_cone"),      glGetUniformLocation(c, "u_count"),
             glGetUniformLocation(c, "u_levels"),    glGetUniformLocation(c, "u_level_size"),
-            glGetUniformLocation(c, "u_margin"),    glGetUniformLocation(c, "u_frame")};
+            glGetUniformLocation(c, "u_margin"),    glGetUniformLocation(c, "u_frame"),
+            glGetUniformLocation(c, "u_lod_px"),    glGetUniformLocation(c, "u_lod_scale")};
   }
 
   Impl() {
@@ -174,7 +177,8 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   glClearNamedBufferData(im.part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   std::vector<uint32_t> part_of(std::max<size_t>(im.instances, 1), 0);
   for (uint32_t p = 0; p < arena.parts().size(); ++p)
-    for (uint32_t k = 0; k < arena.parts()[p].instance_count; ++k) part_of[arena.parts()[p].first_instance + k] = p;
+    for (uint32_t k = 0; k < arena.parts()[p].instance_count + arena.parts()[p].lod_instance_count; ++k)
+      part_of[arena.parts()[p].first_instance + k] = p;
   im.instance_part = createBuffer(part_of.size() * sizeof(uint32_t), part_of.data());
   for (GLuint& c : im.commands) {
     c = createBuffer(size_t(im.instances) * kCommandBytes, nullptr);
@@ -243,6 +247,11 @@ void GpuCuller::setObjects(std::span<const uint32_t> ids) {
   std::swap(im.enabled_ids, im.next_ids);
 }
 
+void GpuCuller::setLodErrorPx(float px) {
+  FF_CHECK(px >= 0.0f && std::isfinite(px));
+  options_.lod_error_px = px;
+}
+
 void GpuCuller::resetHistory() {
   glClearNamedBufferData(impl_->visibility, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   glClearNamedBufferData(impl_->part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -276,6 +285,11 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glProgramUniform1f(pp, im.part_l.margin, options_.occlusion_margin);
   glProgramUniform1i(pp, im.part_l.levels, int(im.level_size.size()));
   glProgramUniform1ui(pp, im.part_l.count, uint32_t(arena_.parts().size()));
+  glProgramUniform3fv(pp, im.part_l.eye, 1, glm::value_ptr(camera.eye));
+  glProgramUniform1f(pp, im.part_l.lod_px, options_.lod_error_px);
+  // Pixels per unit of error at distance 1 (partLodErrorPx's pixels_per_unit).
+  glProgramUniform1f(pp, im.part_l.lod_scale,
+                     float(double(target.height()) / (2.0 * std::tan(0.5 * double(camera.fov_y)))));
   const GLuint e = im.emit.handle();
   glProgramUniform1i(e, im.emit_l.compact, indirect_count_ ? 1 : 0);
   glProgramUniform1ui(e, im.emit_l.count, im.instances);

@@ -40,6 +40,9 @@ struct GpuCullOptions {
   // Relative depth margin of the occlusion test (DepthPyramid::hides). A negative one hides boxes that are in front
   // of the stored depth: the tests break the test with it and check that frames then differ.
   float occlusion_margin = 1e-5f;
+  // The simplified levels (ArenaOptions::lod_ratio): a part whose level's error projects to at most this many pixels
+  // of the target (partLodErrorPx) is drawn with it; 0: always the full level. GpuCuller::setLodErrorPx changes it.
+  float lod_error_px = 0.0f;
 };
 
 // One frame's statistics, read when the GPU has finished it.
@@ -70,6 +73,8 @@ class GpuCuller {
   // farfield::Error for an id out of range.
   void setObjects(std::span<const uint32_t> ids);
   void setAllObjects();
+  // The simplified levels' error bound in pixels (GpuCullOptions::lod_error_px) from the next frame on; >= 0.
+  void setLodErrorPx(float px);
   // Forgets the last frame's visibility (a camera cut): the next frame draws in its second phase only.
   void resetHistory();
 

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <string>
 #include <unordered_map>
@@ -49,6 +50,7 @@ struct GpuMaterial {
 constexpr uint32_t kObjectAffine = 1;  // the shader may cull it (a projective transform is always drawn)
 constexpr uint8_t kMirrored = 1, kSimilarity = 2, kAffine = 4;
 constexpr uint32_t kConeTestBit = 1u << 31;
+constexpr uint32_t kLodBit = 1u << 30;  // an instance of a simplified level (gpu_cull.comp.glsl, continues)
 
 uint8_t transformKind(const Mat4& m) {
   uint8_t kind = 0;
@@ -112,6 +114,19 @@ bool coneRejects(const ArenaCluster& cluster, const Vec3& eye) {
   return glm::dot(d / length, cluster.cone_axis) >= cluster.cone_cutoff + 1e-3f;
 }
 
+double partLodErrorPx(const ArenaPart& part, const Mat4& model, const Vec3& eye, double pixels_per_unit) {
+  const double inf = std::numeric_limits<double>::infinity();
+  if (part.lod_instance_count == 0 || part.bounds.empty()) return inf;
+  if (!(model[0][3] == 0.0f && model[1][3] == 0.0f && model[2][3] == 0.0f && model[3][3] == 1.0f)) return inf;
+  const Mat3 linear(model);
+  const double scale = std::max({glm::length(linear[0]), glm::length(linear[1]), glm::length(linear[2])});
+  const Vec3 centre = Vec3(model * Vec4(part.bounds.center(), 1.0f));
+  const double radius = scale * 0.5 * double(glm::length(part.bounds.hi - part.bounds.lo));
+  const double distance = double(glm::length(centre - eye)) - radius;
+  if (!(distance > 0.0)) return inf;
+  return double(part.lod_error) * scale * pixels_per_unit / distance;
+}
+
 SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) : scene_(&scene) {
   FF_CHECK(options.max_vertices >= 3 && options.max_vertices <= 255);
   FF_CHECK(options.max_triangles >= 4 && options.max_triangles <= 512 && options.max_triangles % 4 == 0);
@@ -153,7 +168,8 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
       cluster.base_vertex = base_vertex;
       clusters_.push_back(cluster);
     }
-    mesh_clusters_.emplace_back(first_cluster, uint32_t(mesh.clusters.size()));
+    mesh_clusters_.emplace_back(first_cluster, uint32_t(mesh.clusters.size()) - mesh.lod_clusters);
+    mesh_lod_.emplace_back(mesh.lod_clusters, mesh.lod_error);
     mesh = ArenaMesh{};  // its memory back before the next one is copied
   }
 
@@ -195,6 +211,7 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
     ArenaInstance instance;
     std::tuple<int, bool, bool> key;
     uint32_t part;
+    bool lod;  // of the part's simplified level (after its full level's, in the same group)
   };
   std::vector<Pending> pending;
   for (size_t o = 0; o < scene.objects.size(); ++o) {
@@ -211,18 +228,20 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
       const auto key = std::make_tuple(material_array[part.material], material.double_sided, bool(kind & kMirrored));
       group_of.emplace(key, 0);
       const auto [first, n] = mesh_clusters_[part.mesh];
+      const auto [lod_n, lod_error] = mesh_lod_[part.mesh];
       const uint32_t part_index = uint32_t(parts_.size());
       ArenaPart arena_part;
       arena_part.object = uint32_t(o);
+      arena_part.lod_error = lod_error;
       for (uint32_t c = first; c < first + n; ++c) arena_part.bounds.expand(clusters_[c].bounds);
       parts_.push_back(arena_part);
-      for (uint32_t c = first; c < first + n; ++c) {
+      for (uint32_t c = first; c < first + n + lod_n; ++c) {
         ArenaInstance instance;
         instance.cluster = c;
         instance.object = uint32_t(o);
         instance.material = part.material;
         instance.cone_test = !material.double_sided && (kind & kSimilarity) && clusters_[c].cone_cutoff < 1.0f;
-        pending.push_back({instance, key, part_index});
+        pending.push_back({instance, key, part_index, c >= first + n});
       }
     }
   }
@@ -245,14 +264,20 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
     MaterialGroup& g = groups_[in.group];
     if (g.instance_count == 0) g.first_instance = uint32_t(instances_.size());
     ++g.instance_count;
-    g.triangles += clusters_[in.cluster].index_count / 3;
-    triangles_ += clusters_[in.cluster].index_count / 3;
     ArenaPart& part = parts_[p.part];
-    if (part.instance_count == 0) part.first_instance = uint32_t(instances_.size());
-    ++part.instance_count;
+    if (p.lod) {
+      lod_triangles_ += clusters_[in.cluster].index_count / 3;
+      ++part.lod_instance_count;
+    } else {
+      g.triangles += clusters_[in.cluster].index_count / 3;
+      triangles_ += clusters_[in.cluster].index_count / 3;
+      if (part.instance_count == 0) part.first_instance = uint32_t(instances_.size());
+      ++part.instance_count;
+    }
     instances_.push_back(in);
     gpu_instances.insert(gpu_instances.end(),
-                         {in.cluster, in.object, in.material, in.group | (in.cone_test ? kConeTestBit : 0u)});
+                         {in.cluster, in.object, in.material,
+                          in.group | (in.cone_test ? kConeTestBit : 0u) | (p.lod ? kLodBit : 0u)});
   }
 
   // ---- GPU buffers ----
@@ -267,16 +292,17 @@ SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) :
          {a.bounds.hi.x, a.bounds.hi.y, a.bounds.hi.z, 0.0f},
          {a.first_index, a.index_count, a.base_vertex, 0u}};
   }
-  // Parts: object, first instance, count, 0; box lo; box hi (gpu_cull.comp.glsl's Part).
+  // Parts: object, first instance, count, simplified level's count; box lo, simplified level's error; box hi
+  // (gpu_cull.comp.glsl's Part).
   std::vector<float> gpu_parts;
   gpu_parts.reserve(12 * parts_.size());
   for (const ArenaPart& part : parts_) {
-    const uint32_t info[4] = {part.object, part.first_instance, part.instance_count, 0u};
+    const uint32_t info[4] = {part.object, part.first_instance, part.instance_count, part.lod_instance_count};
     float words[4];
     std::memcpy(words, info, sizeof(info));
     const Box3 b = part.bounds.empty() ? Box3::fromPoints(Vec3(0.0f), Vec3(0.0f)) : part.bounds;
-    gpu_parts.insert(gpu_parts.end(), {words[0], words[1], words[2], words[3], b.lo.x, b.lo.y, b.lo.z, 0.0f, b.hi.x,
-                                       b.hi.y, b.hi.z, 0.0f});
+    gpu_parts.insert(gpu_parts.end(), {words[0], words[1], words[2], words[3], b.lo.x, b.lo.y, b.lo.z,
+                                       part.lod_error, b.hi.x, b.hi.y, b.hi.z, 0.0f});
   }
   buffers_.parts = makeBuffer(gpu_parts.data(), gpu_parts.size() * sizeof(float), gpu_bytes_);
   std::vector<uint32_t> identity(std::max<size_t>(instances_.size(), 1));

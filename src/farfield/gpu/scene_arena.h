@@ -29,6 +29,11 @@ struct ArenaOptions {
   // a few dozen triangles is then one cluster (a cluster per wall would cost more draws than its back walls save),
   // and a detailed facade's clusters have cones narrow enough to be culled from behind. 0: no split.
   uint32_t min_facing_triangles = 32;
+  // A simplified level per mesh (gpu/arena_mesh.h, simplifiedMesh), which the culler draws for a part whose error
+  // projects under GpuCuller::setLodErrorPx: meshopt_simplify towards this share of the triangles (0: no level) ...
+  float lod_ratio = 0.25f;
+  float lod_max_error = 0.02f;        // ... within this share of the mesh's extent ...
+  uint32_t lod_min_triangles = 256;   // ... for meshes of at least this many triangles.
 };
 
 // One cluster of a mesh, in the mesh's own space.
@@ -61,7 +66,17 @@ struct ArenaPart {
   uint32_t first_instance = 0;
   uint32_t instance_count = 0;
   Box3 bounds;  // its mesh's, in the object's own space
+  // Its simplified level: instances [first_instance + instance_count, + lod_instance_count), within lod_error (the
+  // mesh's units) of the full surface; 0 instances: none.
+  uint32_t lod_instance_count = 0;
+  float lod_error = 0.0f;
 };
+
+// The error in pixels of drawing a part's simplified level for a camera: lod_error scaled by the object's largest
+// axis scale, projected at the distance from the eye to the nearest point of the part's bounding sphere
+// (pixels_per_unit = target height / (2 tan(fov_y / 2))); infinite for a part without a level, an eye inside the
+// sphere or a transform that is not affine. The culling shader makes the same test (gpu_cull.comp.glsl).
+double partLodErrorPx(const ArenaPart& part, const Mat4& model, const Vec3& eye, double pixels_per_unit);
 
 // Instances that one multi-draw draws: same texture array, same face culling, same winding.
 struct MaterialGroup {
@@ -92,12 +107,15 @@ class SceneArena {
 
   const scene::Scene& scene() const { return *scene_; }
   std::span<const ArenaCluster> clusters() const { return clusters_; }
-  // Clusters of scene mesh m: clusters()[meshClusters(m).first, + second).
+  // Clusters of scene mesh m: clusters()[meshClusters(m).first, + second); its simplified level's follow them
+  // (meshLodClusters(m): count, error), none where the count is 0.
   std::pair<uint32_t, uint32_t> meshClusters(uint32_t mesh) const { return mesh_clusters_.at(mesh); }
+  std::pair<uint32_t, float> meshLodClusters(uint32_t mesh) const { return mesh_lod_.at(mesh); }
   std::span<const ArenaInstance> instances() const { return instances_; }
   std::span<const ArenaPart> parts() const { return parts_; }
   std::span<const MaterialGroup> groups() const { return groups_; }
-  uint64_t triangleCount() const { return triangles_; }
+  uint64_t triangleCount() const { return triangles_; }       // of the full levels
+  uint64_t lodTriangleCount() const { return lod_triangles_; }  // of the simplified levels
   size_t gpuBytes() const { return gpu_bytes_; }
 
   // Re-uploads the transforms of these objects (ids, 1-based) after the scene's objects changed them. A change of
@@ -125,11 +143,12 @@ class SceneArena {
   const scene::Scene* scene_;
   std::vector<ArenaCluster> clusters_;
   std::vector<std::pair<uint32_t, uint32_t>> mesh_clusters_;
+  std::vector<std::pair<uint32_t, float>> mesh_lod_;
   std::vector<ArenaInstance> instances_;
   std::vector<ArenaPart> parts_;
   std::vector<MaterialGroup> groups_;
   std::vector<uint8_t> object_kind_;  // per object: bit 0 mirrored, bit 1 keeps angles (similarity)
-  uint64_t triangles_ = 0;
+  uint64_t triangles_ = 0, lod_triangles_ = 0;
   size_t gpu_bytes_ = 0;
   Buffers buffers_;
   uint32_t vertex_buffer_ = 0, index_buffer_ = 0, instance_ids_ = 0;

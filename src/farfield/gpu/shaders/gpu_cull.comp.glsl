@@ -50,8 +50,8 @@ struct Command {
   uint base_instance;
 };
 struct Part {
-  uvec4 info;  // object, first instance, instance count
-  vec4 box_lo;  // of its mesh, in the object's own space
+  uvec4 info;   // object, first instance, instance count, simplified level's instance count (after the full ones)
+  vec4 box_lo;  // of its mesh, in the object's own space; w: the simplified level's error (mesh units)
   vec4 box_hi;
 };
 
@@ -90,6 +90,8 @@ uniform int u_levels;
 uniform ivec2 u_level_size[16];
 uniform float u_margin;  // relative depth margin of the occlusion test
 uniform uint u_frame;    // this frame's number + 1 (object_frame starts at 0)
+uniform float u_lod_px;     // PARTS: the simplified levels' bound in pixels (0: never)
+uniform float u_lod_scale;  // PARTS: pixels per unit of error at distance 1
 
 // Statistics (gpu_culler.cpp, GpuCullStats): summed in shared memory, added once per work group.
 const int kInPlan = 0, kDrawnEarly = 1, kDrawnLate = 2, kTrianglesEarly = 3, kTrianglesLate = 4, kFrustum = 5,
@@ -157,10 +159,25 @@ bool hidden(vec3 lo, vec3 hi, mat4 mvp) {
 
 
 #if defined(FF_STAGE_PARTS)
-// Appends the part's instances to the work list.
-void appendPart(Part part) {
-  const uint base = atomicAdd(dispatch_args.w, part.info.z);
-  for (uint k = 0u; k < part.info.z; ++k) work[base + k] = part.info.y + k;
+// The instances this frame draws the part with: its simplified level's when that level's error, at the distance from
+// the eye to the part's bounding sphere, projects to at most u_lod_px (partLodErrorPx, scene_arena.cpp), else the
+// full level's. The same in every phase of a frame.
+uvec2 partRange(Part part, bool affine, uint object) {
+  const uvec2 full = uvec2(part.info.y, part.info.z);
+  if (!(u_lod_px > 0.0) || part.info.w == 0u || !affine) return full;
+  const mat4 model = objects[object].model;
+  const float scale = objects[object].misc.x;
+  const vec3 centre = (model * vec4(0.5 * (part.box_lo.xyz + part.box_hi.xyz), 1.0)).xyz;
+  const float radius = scale * 0.5 * length(part.box_hi.xyz - part.box_lo.xyz);
+  const float distance = length(centre - u_eye) - radius;
+  if (!(distance > 0.0) || part.box_lo.w * scale * u_lod_scale > u_lod_px * distance) return full;
+  return uvec2(part.info.y + part.info.z, part.info.w);
+}
+
+// Appends the instances [range.x, + range.y) to the work list.
+void appendPart(uvec2 range) {
+  const uint base = atomicAdd(dispatch_args.w, range.y);
+  for (uint k = 0u; k < range.y; ++k) work[base + k] = range.x + k;
 }
 
 void main() {
@@ -168,8 +185,10 @@ void main() {
   const uint i = invocation();
   if (i < u_count) {
     const Part part = parts[i];
-    const uint object = part.info.x, count = part.info.z;
+    const uint object = part.info.x;
     const bool affine = (objects[object].info.y & 1u) != 0u;
+    const uvec2 range = partRange(part, affine, object);
+    const uint count = range.y;
     if (u_phase == 0 || u_phase == 2) {
       // The frame's first look at the part: in the plan and in the frustum; the early list takes those visible in the
       // last frame, the only phase (2) all of them.
@@ -181,7 +200,7 @@ void main() {
       }
       const bool early = in_view && u_phase == 0 && (part_visible[i] & 1u) != 0u;
       part_visible[i] = (part_visible[i] & 1u) | (in_view ? 2u : 0u) | (early ? 4u : 0u);
-      if (early || (in_view && u_phase == 2)) appendPart(part);
+      if (early || (in_view && u_phase == 2)) appendPart(range);
     } else {
       // The late list: parts in view whose box the early phase's depth does not hide. A part of which a cluster was
       // drawn early is never hidden (that cluster's depth is inside its box).
@@ -190,7 +209,7 @@ void main() {
         const bool occluded = affine && hidden(part.box_lo.xyz, part.box_hi.xyz, u_view_proj * objects[object].model);
         part_visible[i] = (state & 6u) | (occluded ? 0u : 1u);
         if (occluded) atomicAdd(s_stats[kOccluded], count);
-        else appendPart(part);
+        else appendPart(range);
       }
     }
   }
@@ -271,11 +290,12 @@ void main() {
 
 #elif defined(FF_STAGE_EMIT)
 
-// Whether instance b continues instance a in one draw: the same object, material and group, and b's indices right
-// after a's over the same vertices (consecutive clusters of one part). Both are then on the work list together.
+// Whether instance b continues instance a in one draw: the same object, material, group and level (bit 30: the
+// simplified level's), and b's indices right after a's over the same vertices (consecutive clusters of one part's
+// level). Both are then on the work list together.
 bool continues(uint a, uint b) {
   const uvec4 ia = instances[a], ib = instances[b];
-  if (ia.y != ib.y || ia.z != ib.z || (ia.w & 0xffffu) != (ib.w & 0xffffu)) return false;
+  if (ia.y != ib.y || ia.z != ib.z || (ia.w & 0x4000ffffu) != (ib.w & 0x4000ffffu)) return false;
   const uvec4 ra = clusters[ia.x].range, rb = clusters[ib.x].range;
   return ra.z == rb.z && ra.x + ra.y == rb.x;
 }
