@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "eval/eval_test_scenes.h"
+#include "eval/mode_harness.h"
 #include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
 #include "farfield/image/metrics.h"
@@ -17,31 +18,8 @@ namespace {
 constexpr int kSize = 64;
 
 // Everything a mode needs over builtin:cubes, on the shared headless context.
-struct Harness {
-  scene::Scene scene = scene::builtinScene("cubes");
-  std::unique_ptr<gpu::GpuScene> gpu_scene;
-  std::unique_ptr<scene::Bvh> bvh;
-  std::unique_ptr<gpu::Renderer> renderer;
-  std::unique_ptr<gpu::RenderTarget> target;
-  ModeContext context;
-
-  Harness() {
-    gpu::sharedHeadlessContext().makeCurrent();
-    gpu_scene = std::make_unique<gpu::GpuScene>(scene);
-    bvh = std::make_unique<scene::Bvh>(scene);
-    renderer = std::make_unique<gpu::Renderer>();
-    target = std::make_unique<gpu::RenderTarget>(kSize, kSize);
-    context.scene = &scene;
-    context.gpu_scene = gpu_scene.get();
-    context.bvh = bvh.get();
-    context.renderer = renderer.get();
-    context.width = context.height = kSize;
-  }
-  std::unique_ptr<Mode> make(const std::string& name) {
-    auto mode = createMode(name, context);
-    mode->prepare(context);
-    return mode;
-  }
+struct Harness : test::ModeHarness {
+  Harness() : ModeHarness(kSize) {}
 };
 
 // Triangles of the objects whose world bounds intersect the camera's frustum: brute force over all objects.

@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include "eval/eval_test_scenes.h"
+#include "eval/mode_harness.h"
 #include "farfield/core/error.h"
 #include "farfield/eval/frame_runner.h"
+#include "farfield/eval/parallax_error.h"
 #include "farfield/gpu/context.h"
 #include "farfield/scene/builtin.h"
 #include "farfield/scene/bvh.h"
@@ -18,32 +20,11 @@ namespace {
 
 constexpr int kSize = 64;
 
-struct Harness {
-  scene::Scene scene = scene::builtinScene("cubes");
-  std::unique_ptr<gpu::GpuScene> gpu_scene;
-  std::unique_ptr<scene::Bvh> bvh;
-  std::unique_ptr<gpu::Renderer> renderer;
-  std::unique_ptr<gpu::RenderTarget> target;
-  ModeContext context;
-
-  explicit Harness(std::optional<double> t_max_ms) {
-    gpu::sharedHeadlessContext().makeCurrent();
-    gpu_scene = std::make_unique<gpu::GpuScene>(scene);
-    bvh = std::make_unique<scene::Bvh>(scene);
-    renderer = std::make_unique<gpu::Renderer>();
-    target = std::make_unique<gpu::RenderTarget>(kSize, kSize);
-    context.scene = &scene;
-    context.gpu_scene = gpu_scene.get();
-    context.bvh = bvh.get();
-    context.renderer = renderer.get();
-    context.width = context.height = kSize;
+struct Harness : test::ModeHarness {
+  explicit Harness(std::optional<double> t_max_ms) : ModeHarness(kSize) {
     context.t_max_ms = t_max_ms;
     context.options["governor_scales"] = "1,0.5";
-  }
-  std::unique_ptr<Mode> make(const std::string& name) {
-    auto mode = createMode(name, context);
-    mode->prepare(context);
-    return mode;
+    context.options["governor_lod_px"] = "0";  // resolution levels only (builtin:cubes has nothing to simplify)
   }
   // Full geometry at size x size, its ids scaled up to kSize x kSize by nearest sampling as a blit samples: the
   // destination pixel x reads source pixel floor((x + 0.5) * size / kSize).
@@ -120,6 +101,49 @@ TEST(GovernedMode, ABudgetEveryFrameKeepsLeavesTheFrameItself) {
     EXPECT_EQ(differingPixels(governed_ids, h.target->readIds()), 0u);
     EXPECT_EQ(g.syncs, 0u);
   }
+}
+
+// Spheres of 8,192 triangles in a row going away from the eye: the far ones are simplified under a few pixels.
+scene::Scene spheres() {
+  scene::Scene scene;
+  scene.addMaterial(scene::Material{});
+  const uint32_t mesh = scene.addMesh(scene::makeSphere(3.0f, 128, 64));
+  for (int i = 0; i < 8; ++i) {
+    scene::Object object;
+    object.parts.push_back({mesh, 0});
+    object.transform = glm::translate(Mat4(1.0f), Vec3(float(i % 2) * 8.0f - 4.0f, 15.0f + 20.0f * float(i), 0.0f));
+    scene.addObject(std::move(object));
+  }
+  return scene;
+}
+
+TEST(GovernedMode, SimplifiedGeometryDrawsFewerTrianglesWithinItsBound) {
+  constexpr int kBig = 256;
+  test::ModeHarness h(kBig, spheres());
+  auto culled = h.make("culled");
+  ASSERT_TRUE(culled->setGeometryErrorPx(0.0));
+  FrameRunner runner(*h.renderer, *h.target);
+  gen::PathFrame f;
+  f.eye = Vec3(0.0f, 0.0f, 2.0f);
+  f.at = Vec3(0.0f, 100.0f, 0.0f);
+  f.up = Vec3(0.0f, 0.0f, 1.0f);
+  f.fov_y = float(degToRad(40.0));
+  gen::CameraPath path;
+  path.frames = {f, f};
+  const Camera camera = pathCamera(path, 0, kBig, kBig);
+  std::vector<uint64_t> triangles;
+  std::vector<image::IdImage> ids;
+  for (double px : {0.0, 2.0}) {
+    ASSERT_TRUE(culled->setGeometryErrorPx(px));
+    runner.run(*culled, camera, 0);
+    triangles.push_back(runner.run(*culled, camera, 1).triangles);
+    ids.push_back(h.target->readIds());
+  }
+  EXPECT_LT(triangles[1], triangles[0] * 3 / 4) << triangles[0] << " -> " << triangles[1];
+  const double parallax = frameParallaxPx(ids[0], ids[1], h.scene.objects.size());
+  EXPECT_LE(parallax, 2.0);
+  // A mode that does not draw through the arena says so.
+  EXPECT_FALSE(h.make("culled-cpu")->setGeometryErrorPx(1.0));
 }
 
 TEST(GovernedMode, BadOptionsAreClearErrors) {

@@ -32,6 +32,23 @@ std::vector<double> parseScales(const std::string& text) {
   return scales;
 }
 
+// "0,1,2,4": the simplified levels' bounds in pixels, 0 first, increasing.
+std::vector<double> parseLodPx(const std::string& text) {
+  const char* key = "--mode-option governor_lod_px";
+  std::vector<double> px;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(v) || v < 0.0 || v > 64.0)
+      throw Error(key, "'" + item + "' is not a number of pixels in [0, 64]");
+    if (!px.empty() && !(v > px.back())) throw Error(key, "the bounds must increase");
+    px.push_back(v);
+  }
+  if (px.empty() || px.front() != 0.0) throw Error(key, "the first bound must be 0 (full detail)");
+  return px;
+}
+
 }  // namespace
 
 GovernedMode::GovernedMode(const ModeContext& context) {
@@ -39,6 +56,8 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   if (inner_name_ == "governed") throw Error("--mode-option governed", "cannot govern itself");
   inner_ = createMode(inner_name_, context);
   scales_ = parseScales(context.option("governor_scales", "1,0.84,0.71,0.59,0.5"));
+  lod_px_ = parseLodPx(context.option("governor_lod_px", "0,1,2,4"));
+  error_px_ = positiveOption(context, "governor_error_px", error_px_);
   if (!context.t_max_ms) throw Error("mode 'governed'", "needs a frame budget: --tmax MS");
   governor_options_.t_max_ms = *context.t_max_ms;
   governor_options_.aim = numberOption(context, "governor_aim", governor_options_.aim, 0.05, 1.0);
@@ -54,17 +73,26 @@ void GovernedMode::prepare(const ModeContext& context) {
   inner_->prepare(context);
   renderer_ = context.renderer;
   finish_target_ = gpu::RenderTarget(1, 1);
+  full_target_ = gpu::RenderTarget(context.width, context.height);
+  // The simplified levels first (at full resolution), where the governed mode draws through the arena; then the
+  // lower resolutions, with the coarsest simplified level.
+  if (!inner_->setGeometryErrorPx(0.0)) lod_px_ = {0.0};
+  std::vector<std::pair<double, double>> plan;  // scale, lod px
+  for (double px : lod_px_) plan.emplace_back(1.0, px);
+  for (size_t i = 1; i < scales_.size(); ++i) plan.emplace_back(scales_[i], lod_px_.back());
   std::vector<runtime::GovernorLevel> levels;
-  for (double s : scales_) {
+  for (const auto& [s, px] : plan) {
     Level level;
     level.scale = s;
+    level.lod_px = px;
     level.width = std::max(1, int(std::lround(context.width * s)));
     level.height = std::max(1, int(std::lround(context.height * s)));
-    level.target = gpu::RenderTarget(level.width, level.height);
+    if (s < 1.0) level.target = gpu::RenderTarget(level.width, level.height);
     levels_.push_back(std::move(level));
-    char name[32];
-    std::snprintf(name, sizeof(name), "%.2fx resolution", s);
-    levels.push_back({name, 1.0 / s});
+    char name[64];
+    std::snprintf(name, sizeof(name), "%.2fx resolution, simplified to %g px", s, px);
+    // The bound kept: the simplified geometry's or the promised one, whichever is larger, in pixels of the frame.
+    levels.push_back({name, std::max(1.0, px / error_px_) / s});
   }
   governor_ = std::make_unique<runtime::FrameGovernor>(std::move(levels), governor_options_);
 }
@@ -79,17 +107,19 @@ Camera GovernedMode::levelCamera(const Camera& camera, size_t level) const {
 gpu::FrameStats GovernedMode::drawLevel(const Camera& camera, size_t path_frame, size_t level) {
   Level& l = levels_[level];
   const Camera c = levelCamera(camera, level);
-  FrameContext inner(c, path_frame, *renderer_, l.target, items_);
+  gpu::RenderTarget& target = l.scale < 1.0 ? l.target : full_target_;
+  inner_->setGeometryErrorPx(l.lod_px);
+  FrameContext inner(c, path_frame, *renderer_, target, items_);
   inner_->frame(inner);
   gpu::FrameStats stats;
   if (!inner.drewPasses()) {
-    l.target.bind();
-    l.target.clear(renderer_->light().sky_color);
-    stats = renderer_->draw(c, inner.mainItems(), l.target);
+    target.bind();
+    target.clear(renderer_->light().sky_color);
+    stats = renderer_->draw(c, inner.mainItems(), target);
   } else {
     stats = inner.passStats();
     if (!inner.mainItems().empty()) {
-      const gpu::FrameStats main = renderer_->draw(c, inner.mainItems(), l.target);
+      const gpu::FrameStats main = renderer_->draw(c, inner.mainItems(), target);
       stats.triangles += main.triangles;
       stats.draw_calls += main.draw_calls;
       stats.objects += main.objects;
@@ -102,7 +132,9 @@ void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {
   Stopwatch total;
   Camera tiny = camera;
   tiny.width = tiny.height = 1;
-  // One untimed round first (targets, pyramids and caches made), then `repeats` timed rounds over the levels.
+  // One untimed round first (targets, pyramids and caches made), then `repeats` timed rounds over the levels. The
+  // triangles each level draws of this view, relative to the full level's, predict a level's triangles from another's.
+  std::vector<double> triangles_of(levels_.size(), 0.0);
   for (int round = 0; round <= calibration_repeats_; ++round) {
     for (size_t level = 0; level < levels_.size(); ++level) {
       Stopwatch clock;
@@ -114,9 +146,14 @@ void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {
         triangles += double(late->triangles);
       if (round > 0)
         calibration_.push_back({triangles, double(levels_[level].width) * levels_[level].height, ms});
-      last_triangles_ = triangles;
+      triangles_of[level] = triangles;
     }
   }
+  for (size_t level = 0; level < levels_.size(); ++level)
+    levels_[level].triangle_share =
+        triangles_of[0] > 0.0 ? std::clamp(triangles_of[level] / triangles_of[0], 0.01, 1.0) : 1.0;
+  last_triangles_ = triangles_of[0];
+  last_level_ = 0;
   refit();
   calibration_s_ = total.seconds();
 }
@@ -170,10 +207,13 @@ void GovernedMode::frame(FrameContext& frame) {
   const bool calibrating = calibration_.empty();
   if (calibrating) calibrate(frame.camera(), frame.pathFrame());
   deliverMeasurements();
+  // The next frame's triangles at each level: the last known frame's, moved from its level to each by the shares
+  // the calibration measured.
   std::vector<double> predicted(levels_.size());
+  const double full_triangles = last_triangles_ / levels_[last_level_].triangle_share;
   for (size_t level = 0; level < levels_.size(); ++level)
-    predicted[level] =
-        model_.predict(last_triangles_, 0.0, double(levels_[level].width) * double(levels_[level].height));
+    predicted[level] = model_.predict(full_triangles * levels_[level].triangle_share, 0.0,
+                                      double(levels_[level].width) * double(levels_[level].height));
   const runtime::GovernorDecision decision = governor_->decide(next_frame_, predicted);
   const Level& level = levels_[decision.level];
   // The calibrating frame's time is the calibration's: it is not a measurement of the frame.
@@ -182,8 +222,9 @@ void GovernedMode::frame(FrameContext& frame) {
   ++next_frame_;
   last_ = FrameGovernance{decision.level, decision.predicted_ms, decision.corrected_ms, decision.bound_scale};
 
-  if (decision.level == 0) {
-    inner_->frame(frame);  // the frame itself, drawn as the governed mode draws it
+  if (level.scale == 1.0) {
+    inner_->setGeometryErrorPx(level.lod_px);
+    inner_->frame(frame);  // the frame itself, drawn as the governed mode draws it (simplified where the level says)
     return;
   }
   gpu::RenderTarget& out = frame.beginOwnPass();
@@ -199,6 +240,7 @@ std::optional<gpu::FrameStats> GovernedMode::lateFrameStats(size_t path_frame) {
     // frame's whole count, and a mode without late statistics is modelled by pixels alone.
     it->triangles = late ? double(late->triangles) : 0.0;
     last_triangles_ = it->triangles;
+    last_level_ = it->decision.level;
     break;
   }
   return late;
@@ -224,6 +266,8 @@ std::map<std::string, double> GovernedMode::info() const {
   info["governor_levels"] = double(levels_.size());
   for (size_t i = 0; i < levels_.size(); ++i) {
     info["governor_level_" + std::to_string(i) + "_scale"] = levels_[i].scale;
+    info["governor_level_" + std::to_string(i) + "_lod_px"] = levels_[i].lod_px;
+    info["governor_level_" + std::to_string(i) + "_triangle_share"] = levels_[i].triangle_share;
     info["governor_level_" + std::to_string(i) + "_frames"] = double(s.frames_at_level[i]);
   }
   info["governor_frames"] = double(s.frames);

@@ -1,22 +1,27 @@
 // "governed": another mode's frame under a frame governor (runtime/frame_governor.h) that keeps the run's t_max
 // (`--tmax`) in a closed loop, every coarsened frame reported with the error bound it kept.
 //
-// The coarser levels are lower render resolutions (scale s per side: the frame rendered at s x the size and scaled
-// up, colour bilinear, ids and depth nearest), the last resort of the order (a larger placement bound and
-// simplified geometry come before it and are not levels yet). A frame at scale s keeps the bound / s: a mode that
-// checks its bound in pixels of its camera (the walkthrough) does so at the smaller size, and a pixel there is 1 / s
-// pixels of the frame.
+// The coarser levels, in order: the arena's simplified geometry (gpu/scene_arena.h: meshopt_simplify per mesh, drawn
+// for a part whose error projects under the level's pixels; for modes that draw through the arena), then lower render
+// resolutions (scale s per side: the frame rendered at s x the size and scaled up, colour bilinear, ids and depth
+// nearest) with the coarsest simplified geometry, the last resort. A level keeps the bound max(promised, simplified
+// px) / s: a mode that checks its bound in pixels of its camera (the walkthrough) does so at the smaller size, and a
+// pixel there is 1 / s pixels of the frame. (Impostors placed for a larger bound, first in the order, are not
+// a level yet.)
 //
 // The prediction: a cost model (gpu/cost_model.h: base, per million triangles, per million pixels) fitted on the
 // governed mode's own frames. On its first frame (the bench's untimed warm-up; an engine's first frame) the mode draws
 // that view at every level a few times, each waited for and timed: the calibration, and the one frame with waits.
 // Then every measured frame is a sample (its triangles, read late, and its pixels), and the model is refitted over
-// the calibration and the last samples every 16 frames. A frame is predicted from the triangles of the last frame
-// whose statistics came back and the pixels of each level. Measured times reach the governor `governor_lag` frames
+// the calibration and the last samples every 16 frames. A frame is predicted at each level from the triangles of the
+// last frame whose statistics came back, moved to that level by the share of triangles each level drew at the
+// calibration's view, and the level's pixels. Measured times reach the governor `governor_lag` frames
 // late (as a timer query read late would).
 //
-// Options (--mode-option): governed=MODE (the mode governed; default culled), governor_scales=1,0.84,... (the
-// levels' resolution scales, 1 first, decreasing, each in [0.25, 1]), governor_lag (frames, default 2),
+// Options (--mode-option): governed=MODE (the mode governed; default culled), governor_lod_px=0,1,2,4 (the simplified
+// levels' bounds, 0 first, increasing), governor_error_px (the promised bound, default 1 px: bound scales are relative
+// to it), governor_scales=1,0.84,... (the resolution scales, 1 first, decreasing, each in [0.25, 1]), governor_lag
+// (frames, default 2),
 // governor_aim, governor_refine_below, governor_refine_after, governor_window (runtime::GovernorOptions),
 // governor_calibration_repeats (default 3). Needs --tmax.
 #pragma once
@@ -52,8 +57,10 @@ class GovernedMode final : public Mode {
  private:
   struct Level {
     double scale = 1.0;
+    double lod_px = 0.0;          // the simplified geometry's bound (Mode::setGeometryErrorPx), 0: full detail
+    double triangle_share = 1.0;  // its triangles / the full level's, at the calibration's view
     int width = 0, height = 0;
-    gpu::RenderTarget target;
+    gpu::RenderTarget target;     // scale < 1: where it is drawn before being scaled up
   };
   struct Sample {
     double triangles = 0.0;
@@ -70,6 +77,9 @@ class GovernedMode final : public Mode {
   std::unique_ptr<Mode> inner_;
   std::string inner_name_;
   std::vector<double> scales_;
+  std::vector<double> lod_px_;
+  double error_px_ = 1.0;  // the promised bound the levels' bound scales are relative to
+  gpu::RenderTarget full_target_;  // the calibration's full-size frames
   std::vector<Level> levels_;
   runtime::GovernorOptions governor_options_;
   std::unique_ptr<runtime::FrameGovernor> governor_;
@@ -85,7 +95,8 @@ class GovernedMode final : public Mode {
   size_t recent_next_ = 0;
   size_t since_refit_ = 0;
   double calibration_s_ = 0.0;
-  double last_triangles_ = 0.0;  // of the last frame whose statistics came back
+  double last_triangles_ = 0.0;  // of the last frame whose statistics came back ...
+  size_t last_level_ = 0;        // ... drawn at this level
 
   // Per decided frame until its measurement is delivered: governor frame, path frame, decision, pixels, triangles.
   struct InFlight {

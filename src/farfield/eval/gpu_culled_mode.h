@@ -60,6 +60,11 @@ class GpuCulledMode final : public Mode {
   void frame(FrameContext& frame) override { run_->draw(frame); }
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override { return run_->lateFrameStats(path_frame); }
   std::map<std::string, double> info() const override { return run_ ? run_->info() : std::map<std::string, double>{}; }
+  bool setGeometryErrorPx(double px) override {
+    if (!run_) return false;
+    run_->culler().setLodErrorPx(float(px));
+    return true;
+  }
 
  private:
   gpu::GpuCullOptions options_;

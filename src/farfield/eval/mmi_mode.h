@@ -64,6 +64,7 @@ class MmiMode final : public Mode {
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
     return geometry_->lateFrameStats(path_frame);
   }
+  bool setGeometryErrorPx(double px) override { return geometry_ && geometry_->setGeometryErrorPx(px); }
   std::map<std::string, double> info() const override;
 
  private:

@@ -159,6 +159,10 @@ class Mode {
   // The harness's measured wall time of the frame just drawn (after its wait; outside the timed part). A mode that
   // closes a loop on its frame time (a governor) takes it; in an engine it would come from a timer query read late.
   virtual void frameMeasured(size_t /*path_frame*/, double /*wall_ms*/) {}
+  // Lets the mode draw its geometry with the arena's simplified levels where their error projects to at most `px`
+  // pixels (gpu::GpuCuller::setLodErrorPx; 0: full detail) from the next frame on. Returns false for a mode that
+  // cannot (its geometry is not drawn through the arena), which then draws as before.
+  virtual bool setGeometryErrorPx(double /*px*/) { return false; }
   // What a governor decided for the frame just drawn; none for modes without one.
   virtual std::optional<FrameGovernance> governance(size_t /*path_frame*/) const { return std::nullopt; }
 };

@@ -37,6 +37,12 @@ class PlanGeometry {
   // view are culled (and occlusion-culled) into draw items. An empty list draws nothing.
   void submitObjects(FrameContext& frame, std::span<const uint32_t> ids);
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame);
+  // The GPU run's simplified levels (Mode::setGeometryErrorPx); false on the CPU path.
+  bool setGeometryErrorPx(double px) {
+    if (!run_) return false;
+    run_->culler().setLodErrorPx(float(px));
+    return true;
+  }
   // The occlusion pass's or the GPU run's numbers, and geometry_gpu (1 or 0), geometry_uploads (plan changes sent).
   std::map<std::string, double> info() const;
 
