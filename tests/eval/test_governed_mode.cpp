@@ -120,6 +120,7 @@ scene::Scene spheres() {
 TEST(GovernedMode, SimplifiedGeometryDrawsFewerTrianglesWithinItsBound) {
   constexpr int kBig = 256;
   test::ModeHarness h(kBig, spheres());
+  h.context.arena_slot->simplified_levels = true;  // as a governed mode asks
   auto culled = h.make("culled");
   ASSERT_TRUE(culled->setGeometryErrorPx(0.0));
   FrameRunner runner(*h.renderer, *h.target);

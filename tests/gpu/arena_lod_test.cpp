@@ -64,6 +64,7 @@ double twoSidedError(const scene::Mesh& mesh, const std::vector<uint32_t>& simpl
 
 TEST(ArenaLod, TheStatedErrorBoundsTheBruteForceDistanceBothWays) {
   ArenaOptions options;
+  options.lod_ratio = 0.25f;
   for (const scene::Mesh& mesh : {scene::makeSphere(5.0f, 48, 24), hills(48)}) {
     std::vector<uint32_t> simplified;
     const float error = simplifiedMesh(mesh, options, simplified);
@@ -96,7 +97,9 @@ TEST_F(GpuTest, APartDrawnSimplifiedMovesNoVertexByMoreThanTheBound) {
                        glm::scale(Mat4(1.0f), Vec3(s));
     scene.addObject(std::move(object));
   }
-  const SceneArena arena(scene);
+  ArenaOptions options;
+  options.lod_ratio = 0.25f;
+  const SceneArena arena(scene, options);
   const std::vector<uint32_t> indices = arena.readIndices();
   const std::vector<Vec3> positions = arena.readVertexPositions();
   const auto [first, count] = arena.meshClusters(hill_mesh);

@@ -54,6 +54,7 @@ std::vector<double> parseLodPx(const std::string& text) {
 GovernedMode::GovernedMode(const ModeContext& context) {
   inner_name_ = context.option("governed", "culled");
   if (inner_name_ == "governed") throw Error("--mode-option governed", "cannot govern itself");
+  context.arena_slot->simplified_levels = true;  // before any mode of the run makes the arena (in prepare)
   inner_ = createMode(inner_name_, context);
   scales_ = parseScales(context.option("governor_scales", "1,0.84,0.71,0.59,0.5"));
   lod_px_ = parseLodPx(context.option("governor_lod_px", "0,1,2,4"));

@@ -31,7 +31,9 @@ const gpu::SceneArena& ModeContext::arena() const {
   FF_CHECK_MSG(scene != nullptr, "ModeContext::arena() needs the scene");
   if (!arena_slot->arena) {
     Stopwatch clock;
-    arena_slot->arena = std::make_unique<gpu::SceneArena>(*scene);
+    gpu::ArenaOptions options;
+    options.lod_ratio = arena_slot->simplified_levels ? 0.25f : 0.0f;
+    arena_slot->arena = std::make_unique<gpu::SceneArena>(*scene, options);
     arena_slot->build_s = clock.seconds();
   }
   return *arena_slot->arena;

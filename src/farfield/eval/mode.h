@@ -54,6 +54,9 @@ struct ModeContext {
   struct ArenaSlot {
     std::unique_ptr<gpu::SceneArena> arena;
     double build_s = 0.0;  // how long making it took
+    // Whether it is made with simplified levels (gpu::ArenaOptions::lod_ratio): a mode that draws them (governed)
+    // asks before the run's modes are prepared; they cost build time (measuring each level's deviation).
+    bool simplified_levels = false;
   };
   std::shared_ptr<ArenaSlot> arena_slot = std::make_shared<ArenaSlot>();
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <utility>
 
 #include "farfield/gpu/mesh_clusters.h"
@@ -66,11 +67,46 @@ float simplifiedMesh(const scene::Mesh& mesh, const ArenaOptions& options, std::
   const size_t triangles = mesh.indices.size() / 3;
   if (!(options.lod_ratio > 0.0f) || triangles < options.lod_min_triangles || mesh.positions.empty()) return 0.0f;
   const float* positions = &mesh.positions[0].x;
+  const size_t vertex_count = mesh.positions.size();
   const size_t target = std::max<size_t>(3, size_t(double(mesh.indices.size()) * options.lod_ratio) / 3 * 3);
+  // Simplified over positions alone: flat-shaded meshes (a building's walls) repeat each corner once per face with its
+  // own normal, and over those vertices every face is an island that nothing can collapse. The shadow index buffer
+  // names each position by one vertex; each corner of a simplified triangle then takes, among the vertices at its
+  // position, the one whose normal is closest to the triangle's own (its face's normal and texture coordinates).
+  std::vector<uint32_t> shadow(mesh.indices.size());
+  meshopt_generateShadowIndexBuffer(shadow.data(), mesh.indices.data(), mesh.indices.size(), positions, vertex_count,
+                                    sizeof(Vec3), sizeof(Vec3));
   out.resize(mesh.indices.size());
   float relative = 0.0f;
-  out.resize(meshopt_simplify(out.data(), mesh.indices.data(), mesh.indices.size(), positions, mesh.positions.size(),
-                              sizeof(Vec3), target, options.lod_max_error, 0, &relative));
+  out.resize(meshopt_simplify(out.data(), shadow.data(), shadow.size(), positions, vertex_count, sizeof(Vec3), target,
+                              options.lod_max_error, 0, &relative));
+  // Where edge collapses cannot get far (facades of many small boxes: windows, ledges, each an island), the sloppy
+  // simplifier merges vertices over a grid, across islands.
+  if (out.size() > mesh.indices.size() * 3 / 4) {
+    out.resize(mesh.indices.size());
+    out.resize(meshopt_simplifySloppy(out.data(), shadow.data(), shadow.size(), positions, vertex_count, sizeof(Vec3),
+                                      target, options.lod_max_error, &relative));
+  }
+  if (!mesh.normals.empty() && !out.empty()) {
+    std::vector<std::vector<uint32_t>> at_position(vertex_count);  // shadow vertex -> the vertices at its position
+    for (size_t i = 0; i < mesh.indices.size(); ++i) {
+      std::vector<uint32_t>& same = at_position[shadow[i]];
+      if (std::find(same.begin(), same.end(), mesh.indices[i]) == same.end()) same.push_back(mesh.indices[i]);
+    }
+    for (size_t t = 0; t + 2 < out.size(); t += 3) {
+      const Vec3 n = glm::cross(mesh.positions[out[t + 1]] - mesh.positions[out[t]],
+                                mesh.positions[out[t + 2]] - mesh.positions[out[t]]);
+      for (size_t k = t; k < t + 3; ++k) {
+        uint32_t best = out[k];
+        float best_dot = -std::numeric_limits<float>::infinity();
+        for (uint32_t v : at_position[out[k]]) {
+          const float d = glm::dot(mesh.normals[v], n);
+          if (d > best_dot) best_dot = d, best = v;
+        }
+        out[k] = best;
+      }
+    }
+  }
   // Worth a level only when it removes a good share of the triangles.
   if (out.empty() || out.size() > mesh.indices.size() * 3 / 4) {
     out.clear();

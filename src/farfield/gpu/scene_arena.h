@@ -30,8 +30,9 @@ struct ArenaOptions {
   // and a detailed facade's clusters have cones narrow enough to be culled from behind. 0: no split.
   uint32_t min_facing_triangles = 32;
   // A simplified level per mesh (gpu/arena_mesh.h, simplifiedMesh), which the culler draws for a part whose error
-  // projects under GpuCuller::setLodErrorPx: meshopt_simplify towards this share of the triangles (0: no level) ...
-  float lod_ratio = 0.25f;
+  // projects under GpuCuller::setLodErrorPx: meshopt_simplify towards this share of the triangles (0: no level; the
+  // governed modes ask for 0.25: measuring each level's deviation about doubles the arena's build time) ...
+  float lod_ratio = 0.0f;
   float lod_max_error = 0.02f;        // ... within this share of the mesh's extent ...
   uint32_t lod_min_triangles = 256;   // ... for meshes of at least this many triangles.
 };

@@ -51,7 +51,13 @@ class TriangleGrid {
           for (int x = c[0] - r; x <= c[0] + r; ++x) {
             if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != r) continue;
             if (x < 0 || y < 0 || z < 0 || x >= dims_[0] || y >= dims_[1] || z >= dims_[2]) continue;
-            for (uint32_t t : cells_[index(x, y, z)]) {
+            const std::vector<uint32_t>& cell = cells_[index(x, y, z)];
+            if (cell.empty()) continue;
+            // The cell's own distance from p: none of its triangles is nearer.
+            const Vec3 lo = bounds_.lo + Vec3(float(x), float(y), float(z)) * cell_;
+            const Vec3 gap = glm::max(glm::max(lo - p, p - (lo + Vec3(cell_))), Vec3(0.0f));
+            if (double(glm::length(gap)) >= best) continue;
+            for (uint32_t t : cell) {
               const Vec3 q = closestOnTriangle(p, positions_[indices_[3 * t]], positions_[indices_[3 * t + 1]],
                                                positions_[indices_[3 * t + 2]]);
               best = std::min(best, double(glm::length(q - p)));
