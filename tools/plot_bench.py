@@ -199,6 +199,8 @@ def main(argv):
         ax_t.grid(True, alpha=0.3)
         ax_t.legend(fontsize="small")
         ax_l.set_xlabel("camera path frame")
+        top = max(max(v for v in s["governor_level"] if not math.isnan(v)) for s in governed.values())
+        ax_l.set_ylim(-0.5, top + 0.5)
         ax_l.set_ylabel("level (0 = full)")
         ax_l.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax_l.grid(True, alpha=0.3)
