@@ -140,6 +140,8 @@ void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {
     for (size_t level = 0; level < levels_.size(); ++level) {
       Stopwatch clock;
       const gpu::FrameStats drawn = drawLevel(camera, path_frame, level);
+      // A lower resolution's frame is scaled up as in a real frame (the first blit also makes the driver's state).
+      if (levels_[level].scale < 1.0) levels_[level].target.copyScaledTo(full_target_);
       renderer_->render(tiny, {}, finish_target_);  // waits for the GPU (Renderer::render's glFinish)
       const double ms = clock.milliseconds();
       double triangles = double(drawn.triangles);
