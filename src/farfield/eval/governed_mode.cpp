@@ -16,37 +16,25 @@ constexpr size_t kRecent = 120;     // measured frames the model is refitted ove
 constexpr size_t kRefitEvery = 16;  // measured frames between refits
 constexpr size_t kMaxInFlight = 64;
 
-std::vector<double> parseScales(const std::string& text) {
-  const char* key = "--mode-option governor_scales";
-  std::vector<double> scales;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) {
-    char* end = nullptr;
-    const double s = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(s) || s < 0.25 || s > 1.0)
-      throw Error(key, "'" + item + "' is not a scale in [0.25, 1]");
-    if (!scales.empty() && !(s < scales.back())) throw Error(key, "the scales must decrease");
-    scales.push_back(s);
-  }
-  if (scales.empty() || scales.front() != 1.0) throw Error(key, "the first scale must be 1 (the frame itself)");
-  return scales;
-}
-
-// "0,1,2,4": the simplified levels' bounds in pixels, 0 first, increasing.
-std::vector<double> parseLodPx(const std::string& text) {
-  const char* key = "--mode-option governor_lod_px";
-  std::vector<double> px;
+// A comma-separated list of numbers in [lo, hi] for --mode-option KEY, the first equal to `first`, each after it
+// beyond the one before in the list's direction (`increasing` or decreasing); `what` names an item in errors.
+std::vector<double> parseLevelList(const std::string& text, const std::string& key, double lo, double hi,
+                                   double first, bool increasing, const std::string& what) {
+  const std::string where = "--mode-option " + key;
+  std::vector<double> values;
   std::stringstream in(text);
   for (std::string item; std::getline(in, item, ',');) {
     char* end = nullptr;
     const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(v) || v < 0.0 || v > 64.0)
-      throw Error(key, "'" + item + "' is not a number of pixels in [0, 64]");
-    if (!px.empty() && !(v > px.back())) throw Error(key, "the bounds must increase");
-    px.push_back(v);
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi)
+      throw Error(where, "'" + item + "' is not " + what);
+    if (!values.empty() && !(increasing ? v > values.back() : v < values.back()))
+      throw Error(where, std::string("the values must ") + (increasing ? "increase" : "decrease"));
+    values.push_back(v);
   }
-  if (px.empty() || px.front() != 0.0) throw Error(key, "the first bound must be 0 (full detail)");
-  return px;
+  if (values.empty() || values.front() != first)
+    throw Error(where, "the first value must be " + std::to_string(int(first)));
+  return values;
 }
 
 }  // namespace
@@ -56,8 +44,11 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   if (inner_name_ == "governed") throw Error("--mode-option governed", "cannot govern itself");
   context.arena_slot->simplified_levels = true;  // before any mode of the run makes the arena (in prepare)
   inner_ = createMode(inner_name_, context);
-  scales_ = parseScales(context.option("governor_scales", "1,0.84,0.71,0.59,0.5"));
-  lod_px_ = parseLodPx(context.option("governor_lod_px", "0,1,2,4"));
+  // Resolution scales, 1 (the frame itself) first, decreasing; the simplified levels' bounds, 0 (full detail) first.
+  scales_ = parseLevelList(context.option("governor_scales", "1,0.84,0.71,0.59,0.5"), "governor_scales", 0.25, 1.0,
+                           1.0, false, "a scale in [0.25, 1]");
+  lod_px_ = parseLevelList(context.option("governor_lod_px", "0,1,2,4"), "governor_lod_px", 0.0, 64.0, 0.0, true,
+                           "a number of pixels in [0, 64]");
   error_px_ = positiveOption(context, "governor_error_px", error_px_);
   if (!context.t_max_ms) throw Error("mode 'governed'", "needs a frame budget: --tmax MS");
   governor_options_.t_max_ms = *context.t_max_ms;
