@@ -1,6 +1,6 @@
 // farfield calibrate SCENE -o profile.json [--size WxH] [--fov DEG] [--views N] [--repeats N]
 //                    [--view-min X,Y,Z --view-max X,Y,Z] [--seed S] [--margin-quantile Q] [--csv FILE]
-//                    [--fill-term] [--visibility-cache FILE]
+//                    [--fill-term] [--visibility-cache FILE] [--cpu-frames]
 // Fits the frame-time cost model on this machine and validates it on random views of the view space
 // (eval/calibration.h); writes the cost profile that placement bounds frame times with.
 #include <cstdio>
@@ -134,8 +134,12 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
                   "Safety factor and margin = this quantile of measured/predicted and measured - predicted (1 = the maximum)")->capture_default_str();
   cmd->add_option("--csv", args->csv, "Per-view predicted and measured times");
   cmd->add_option("--visibility-cache", args->visibility_cache,
-                  "Time placed frames: the visible sets `farfield place --visibility-cache` saved, occlusion-culled, "
-                  "counted over whole objects as placement counts them (the view space defaults to the cache's)");
+                  "Time placed frames: the visible sets `farfield place --visibility-cache` saved, drawn as the "
+                  "walkthrough draws them, counted over whole objects as placement counts them (the view space "
+                  "defaults to the cache's)");
+  cmd->add_flag("!--cpu-frames", args->options.gpu_frames,
+                "Time the CPU-culled frames of before (occlusion culler or frustum-culled clusters) instead of the "
+                "runtime's GPU-driven ones");
   cmd->add_flag("--fill-term", args->options.fill_term,
                 "Fit the estimated-fill term too, counted up to a cap chosen on the fitting views (with "
                 "--visibility-cache: the tightest model placement can bound; see docs/BENCHMARKS.md)");

@@ -230,7 +230,8 @@ TEST(CalibrationTest, PlacedFramesCountTheVisibleSetAsPlacementDoes) {
   const CalibrateResult r = calibrate(gpu::sharedHeadlessContext(), scene, o);
   EXPECT_EQ(asked, 28u);
   const FillLens lens = FillLens::of(o.width, o.height, degToRad(double(o.fov_deg)));
-  EXPECT_NE(r.profile.validation["frames"].get<std::string>().find("placed"), std::string::npos);
+  EXPECT_NE(r.profile.validation["frames"].get<std::string>().find("visible set"), std::string::npos);
+  EXPECT_NE(r.profile.validation["frames"].get<std::string>().find("runtime (GPU-driven)"), std::string::npos);
   gpu::sharedHeadlessContext().makeCurrent();
   const gpu::GpuScene gpu_scene(scene);
   const std::vector<gpu::ObjectDrawCost> cost = gpu_scene.objectDrawCosts();

@@ -15,6 +15,7 @@
 #include "farfield/eval/frame_stats.h"
 #include "farfield/eval/mode.h"
 #include "farfield/eval/occlusion_pass.h"
+#include "farfield/eval/plan_geometry.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/scene/bvh.h"
@@ -43,6 +44,23 @@ class PlacedGeometry final : public Mode {
   OcclusionPass occlusion_;
   std::vector<gpu::DrawItem> items_;
   std::vector<Box3> bounds_;
+};
+
+// The runtime's own geometry pass over a list of objects: the GPU-driven frame (eval/plan_geometry.h, gpu::GpuCuller)
+// that the walkthrough's plans draw through, each view drawn once untimed first so that the culler's last-frame
+// visibility is the view's own (a walkthrough's consecutive frames see nearly the same) and no object list is sent.
+class RuntimeGeometry final : public Mode {
+ public:
+  explicit RuntimeGeometry(const ModeContext& context) : geometry_(context, "calibrate") { geometry_.prepare(context); }
+  std::string name() const override { return "runtime-geometry"; }
+  void frame(FrameContext& frame) override { geometry_.submitObjects(frame, ids); }
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
+    return geometry_.lateFrameStats(path_frame);
+  }
+  std::vector<uint32_t> ids;  // the next frame's objects, ascending
+
+ private:
+  PlanGeometry geometry_;
 };
 
 }  // namespace
@@ -159,9 +177,22 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   std::vector<uint32_t> ids;
   std::vector<gpu::DrawItem> items;
   const bool placed = bool(options.visible_set);
+  // The runtime's frames are counted as placement counts a view: whole objects.
+  const bool whole_objects = placed || options.gpu_frames;
   const std::vector<gpu::ObjectDrawCost> object_cost =
-      placed ? gpu_scene.objectDrawCosts() : std::vector<gpu::ObjectDrawCost>{};
+      whole_objects ? gpu_scene.objectDrawCosts() : std::vector<gpu::ObjectDrawCost>{};
   PlacedGeometry placed_geometry(gpu_scene);
+  ModeContext mode_context;  // holds the arena the runtime's frames draw (alive as long as they are)
+  std::optional<RuntimeGeometry> runtime_geometry;
+  if (options.gpu_frames) {
+    mode_context.scene = &scene;
+    mode_context.gpu_scene = &gpu_scene;
+    mode_context.bvh = &bvh;
+    mode_context.renderer = &renderer;
+    mode_context.width = options.width;
+    mode_context.height = options.height;
+    runtime_geometry.emplace(mode_context);
+  }
   FrameRunner runner(renderer, target);
   // A view's workload, counted once: the objects it draws (returned in `view_ids`) and their triangles, draw calls and
   // estimated fill, as the model counts them.
@@ -178,6 +209,8 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
                               std::back_inserter(kept));
         view_ids.swap(kept);
       }
+    }
+    if (whole_objects) {
       for (uint32_t id : view_ids) {
         check.triangles += object_cost[id].triangles;
         check.draw_calls += object_cost[id].draws;
@@ -197,8 +230,14 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     if (!region) check.region_fill = check.fill;
     return check;
   };
-  // One timed render of a view's objects: placed frames through the occlusion culler, else frustum-culled clusters.
+  // One timed render of a view's objects: the runtime's GPU-driven frame (after an untimed one of the same view), or
+  // on the CPU path placed frames through the occlusion culler, else frustum-culled clusters.
   const auto render = [&](const Camera& camera, const std::vector<uint32_t>& view_ids) {
+    if (runtime_geometry) {
+      runtime_geometry->ids = view_ids;
+      runner.run(*runtime_geometry, camera, 0);
+      return runner.run(*runtime_geometry, camera, 0).wall_ms;
+    }
     if (placed) {
       placed_geometry.ids = view_ids;
       return runner.run(placed_geometry, camera, 0).wall_ms;
@@ -298,8 +337,12 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   result.wall_s = wall.seconds();
   profile.validation = {{"views", result.checks.size()},
                         {"fill_term", options.fill_term},
-                        {"frames", placed ? "placed: visible set of the eye's region, occlusion-culled; whole objects"
-                                          : "frustum-culled full geometry"},
+                        {"frames", options.gpu_frames
+                                       ? (placed ? "runtime (GPU-driven): visible set of the eye's region; whole objects"
+                                                 : "runtime (GPU-driven): objects in the frustum; whole objects")
+                                       : (placed ? "placed: visible set of the eye's region, occlusion-culled; whole "
+                                                   "objects"
+                                                 : "frustum-culled full geometry")},
                         {"repeats", options.repeats},
                         {"seed", options.seed},
                         {"view_space", {{"lo", {space.lo.x, space.lo.y, space.lo.z}}, {"hi", {space.hi.x, space.hi.y, space.hi.z}}}},

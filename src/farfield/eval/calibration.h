@@ -49,6 +49,12 @@ struct CalibrateOptions {
   // Placement bounds a region's fill from its nearest point, so the fill cap is chosen for those sums
   // (fitWithFillCap's bounded fills): each fitting view's objects counted from its region.
   std::function<std::optional<Box3>(const Vec3& eye)> region_of;
+  // The frames timed: the runtime's own, GPU-driven (eval/plan_geometry.h: the objects culled per cluster by
+  // gpu::GpuCuller, as the walkthrough draws its plans and `culled` draws the scene), each view drawn once untimed
+  // first; false: the CPU-culled frames of before (the visible set through the occlusion culler, or frustum-culled
+  // clusters). Either way the views' workloads are counted as placement counts them, over whole objects, except the
+  // CPU path without visible_set (its clusters).
+  bool gpu_frames = true;
   uint32_t seed = 1;
   float near_plane = 0.5f;
   float far_plane = 20000.0f;
