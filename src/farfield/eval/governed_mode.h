@@ -9,8 +9,9 @@
 // pixel there is 1 / s pixels of the frame. (Impostors placed for a larger bound, first in the order, are not
 // a level yet.)
 //
-// The prediction: a cost model (gpu/cost_model.h: base, per million triangles, per million pixels) fitted on the
-// governed mode's own frames. On its first frame (the bench's untimed warm-up; an engine's first frame) the mode draws
+// The prediction and the loop are runtime::GovernorLoop's (runtime/governor_loop.h); this mode draws, times and
+// reports. The prediction: a cost model (gpu/cost_model.h: base, per million triangles, per million pixels) fitted on
+// the governed mode's own frames. On its first frame (the bench's untimed warm-up; an engine's first frame) the mode draws
 // that view at every level a few times, each waited for and timed: the calibration, and the one frame with waits.
 // Then every measured frame is a sample (its triangles, read late, and its pixels), and the model is refitted over
 // the calibration and the last samples every 16 frames. A frame is predicted at each level from the triangles of the
@@ -34,9 +35,8 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/eval/mode.h"
-#include "farfield/gpu/cost_model.h"
 #include "farfield/gpu/render_target.h"
-#include "farfield/runtime/frame_governor.h"
+#include "farfield/runtime/governor_loop.h"
 
 namespace farfield::eval {
 
@@ -57,60 +57,33 @@ class GovernedMode final : public Mode {
  private:
   struct Level {
     double scale = 1.0;
-    double lod_px = 0.0;          // the simplified geometry's bound (Mode::setGeometryErrorPx), 0: full detail
-    double triangle_share = 1.0;  // its triangles / the full level's, at the calibration's view
+    double lod_px = 0.0;       // the simplified geometry's bound (Mode::setGeometryErrorPx), 0: full detail
     int width = 0, height = 0;
-    gpu::RenderTarget target;     // scale < 1: where it is drawn before being scaled up
-  };
-  struct Sample {
-    double triangles = 0.0;
-    double pixels = 0.0;
-    double ms = 0.0;
+    gpu::RenderTarget target;  // scale < 1: where it is drawn before being scaled up
   };
   Camera levelCamera(const Camera& camera, size_t level) const;
-  // Draws the governed mode's frame at `level` into that level's own target; returns what it drew.
+  // Draws the governed mode's frame at `level` into that level's own target (or the calibration's full-size one).
   gpu::FrameStats drawLevel(const Camera& camera, size_t path_frame, size_t level);
   void calibrate(const Camera& camera, size_t path_frame);
-  void refit();
-  void deliverMeasurements();
 
   std::unique_ptr<Mode> inner_;
   std::string inner_name_;
   std::vector<double> scales_;
   std::vector<double> lod_px_;
   double error_px_ = 1.0;  // the promised bound the levels' bound scales are relative to
-  gpu::RenderTarget full_target_;  // the calibration's full-size frames
   std::vector<Level> levels_;
-  runtime::GovernorOptions governor_options_;
-  std::unique_ptr<runtime::FrameGovernor> governor_;
-  size_t lag_ = 2;
+  runtime::GovernorLoopOptions loop_options_;
+  std::unique_ptr<runtime::GovernorLoop> loop_;
   int calibration_repeats_ = 3;
+  double calibration_s_ = 0.0;
   gpu::Renderer* renderer_ = nullptr;
   gpu::RenderTarget finish_target_;  // 1 x 1: the calibration's waits (Renderer::render's glFinish)
+  gpu::RenderTarget full_target_;    // the calibration's full-size frames
   std::vector<gpu::DrawItem> items_;
-
-  gpu::CostModel model_;
-  std::vector<Sample> calibration_;
-  std::vector<Sample> recent_;  // the last measured frames (a ring of kRecent)
-  size_t recent_next_ = 0;
-  size_t since_refit_ = 0;
-  double calibration_s_ = 0.0;
-  double last_triangles_ = 0.0;  // of the last frame whose statistics came back ...
-  size_t last_level_ = 0;        // ... drawn at this level
-
-  // Per decided frame until its measurement is delivered: governor frame, path frame, decision, pixels, triangles.
-  struct InFlight {
-    uint64_t frame = 0;
-    size_t path_frame = 0;
-    runtime::GovernorDecision decision;
-    double pixels = 0.0;
-    double triangles = -1.0;  // -1 until the statistics come back
-    double measured_ms = -1.0;
-  };
-  std::vector<InFlight> in_flight_;
   uint64_t next_frame_ = 0;
+  std::optional<uint64_t> last_frame_;  // the loop's number of the last frame drawn (none: it calibrated)
+  size_t last_path_frame_ = 0;
   std::optional<FrameGovernance> last_;
-  std::vector<double> ratio_, corrected_ratio_;  // measured / predicted, measured / corrected
 };
 
 }  // namespace farfield::eval
