@@ -19,6 +19,7 @@ gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string
   options.occlusion = onOff(context, "gpu_occlusion", options.occlusion, mode_name);
   options.cone = onOff(context, "gpu_cones", options.cone, mode_name);
   options.compact = onOff(context, "gpu_compact", options.compact, mode_name);
+  options.refine_history = onOff(context, "gpu_refine_history", options.refine_history, mode_name);
   return options;
 }
 

@@ -6,7 +6,8 @@
 //
 // Options (--mode-option), shared by every mode that draws through the arena: gpu_occlusion=on|off (the pyramid test;
 // off: frustum and cones only), gpu_cones=on|off, gpu_compact=on|off (compacted command lists with
-// glMultiDrawElementsIndirectCount where the driver has it).
+// glMultiDrawElementsIndirectCount where the driver has it), gpu_refine_history=on|off (GpuCullOptions::
+// refine_history: the next frame's early list from a pyramid of this frame's final depth).
 #pragma once
 
 #include <map>
@@ -20,8 +21,8 @@
 
 namespace farfield::eval {
 
-// The GpuCuller options of a run's --mode-option keys (gpu_occlusion, gpu_cones, gpu_compact: on or off); throws
-// farfield::Error naming the key for another value.
+// The GpuCuller options of a run's --mode-option keys (gpu_occlusion, gpu_cones, gpu_compact, gpu_refine_history: on
+// or off); throws farfield::Error naming the key for another value.
 gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string& mode_name);
 
 // A GpuCuller over the run's arena drawing into bench frames, its statistics read late and kept per path frame.
