@@ -92,9 +92,11 @@ TEST_F(GpuTest, APartDrawnSimplifiedMovesNoVertexByMoreThanTheBound) {
   for (int i = 0; i < 12; ++i) {
     scene::Object object;
     object.parts.push_back({hill_mesh, 0});
+    // Uniform scales, and every third object stretched unevenly and turned (no similarity: the stretch bounds).
     const float s = 0.5f + 1.5f * u(rng);
+    const Vec3 scale = i % 3 == 2 ? Vec3(s, 0.6f * s, 1.3f * s) : Vec3(s);
     object.transform = glm::translate(Mat4(1.0f), Vec3(300.0f * u(rng), 300.0f * u(rng), 0.0f)) *
-                       glm::scale(Mat4(1.0f), Vec3(s));
+                       glm::rotate(Mat4(1.0f), 6.0f * u(rng), Vec3(0.0f, 0.0f, 1.0f)) * glm::scale(Mat4(1.0f), scale);
     scene.addObject(std::move(object));
   }
   ArenaOptions options;
@@ -113,9 +115,14 @@ TEST_F(GpuTest, APartDrawnSimplifiedMovesNoVertexByMoreThanTheBound) {
     for (uint32_t i = 0; i < cluster.index_count; ++i)
       out.push_back(cluster.base_vertex + indices[cluster.first_index + i]);
   }
-  // Each full vertex's distance to the simplified surface (mesh units), once.
-  std::vector<double> deviation;
-  for (uint32_t v : full) deviation.push_back(distanceToSurface(positions[v], positions, simple));
+  // Per object, each full vertex's distance to the simplified surface in the world, once.
+  std::vector<std::vector<double>> deviation(scene.objects.size());
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    std::vector<Vec3> world(positions.size());
+    for (size_t v = 0; v < positions.size(); ++v)
+      world[v] = Vec3(scene.objects[o].transform * Vec4(positions[v], 1.0f));
+    for (uint32_t v : full) deviation[o].push_back(distanceToSurface(world[v], world, simple));
+  }
   const double pixels_per_unit = 360.0 / (2.0 * std::tan(0.5 * degToRad(60.0)));
   size_t simplified_parts = 0, full_parts = 0;
   for (int trial = 0; trial < 20; ++trial) {
@@ -130,11 +137,10 @@ TEST_F(GpuTest, APartDrawnSimplifiedMovesNoVertexByMoreThanTheBound) {
         }
         ++simplified_parts;
         // Every full vertex: its distance to the simplified surface, in the world, projected at its own distance.
-        const float scale = glm::length(Vec3(model[0]));
         double worst = 0.0;
         for (size_t k = 0; k < full.size(); ++k) {
           const Vec3 world = Vec3(model * Vec4(positions[full[k]], 1.0f));
-          worst = std::max(worst, deviation[k] * scale * pixels_per_unit / double(glm::length(world - eye)));
+          worst = std::max(worst, deviation[part.object][k] * pixels_per_unit / double(glm::length(world - eye)));
         }
         EXPECT_LE(worst, bound_px * 1.0001) << "trial " << trial;
       }

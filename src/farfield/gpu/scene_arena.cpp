@@ -38,7 +38,7 @@ static_assert(sizeof(GpuCluster) == 96);
 struct GpuObject {
   float model[16];
   float normal[16];   // the inverse transpose of the model's 3x3 part, in the first three columns
-  float misc[4];      // x: largest scale of the model's axes
+  float misc[4];      // x: largest scale of the model's axes; y, z: objectStretch (the least and most it stretches)
   uint32_t info[4];   // object id, flags (kObjectAffine)
 };
 static_assert(sizeof(GpuObject) == 160);
@@ -79,6 +79,9 @@ GpuObject gpuObject(const scene::Object& object) {
   const Mat4 normal4(normal);
   std::copy(glm::value_ptr(normal4), glm::value_ptr(normal4) + 16, g.normal);
   g.misc[0] = std::max({glm::length(linear[0]), glm::length(linear[1]), glm::length(linear[2])});
+  const auto [least, most] = objectStretch(m);
+  g.misc[1] = float(least);
+  g.misc[2] = float(most);
   g.info[0] = object.id;
   g.info[1] = (transformKind(m) & kAffine) ? kObjectAffine : 0u;
   return g;
@@ -114,17 +117,37 @@ bool coneRejects(const ArenaCluster& cluster, const Vec3& eye) {
   return glm::dot(d / length, cluster.cone_axis) >= cluster.cone_cutoff + 1e-3f;
 }
 
+std::pair<double, double> objectStretch(const Mat4& model) {
+  const Mat3 linear(model);
+  const double det = double(glm::determinant(linear));
+  if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return {0.0, 0.0};
+  if (transformKind(model) & kSimilarity) {
+    const double s = double(glm::length(linear[0]));
+    return {s, s};
+  }
+  const auto frobenius = [](const Mat3& m) {
+    double sum = 0.0;
+    for (int c = 0; c < 3; ++c) sum += double(glm::dot(m[c], m[c]));
+    return std::sqrt(sum);
+  };
+  // The spectral norm is at most the Frobenius norm: |L v| <= |L|_F |v|, and |v| <= |L^-1|_F |L v|.
+  return {1.0 / frobenius(glm::inverse(linear)), frobenius(linear)};
+}
+
 double partLodErrorPx(const ArenaPart& part, const Mat4& model, const Vec3& eye, double pixels_per_unit) {
   const double inf = std::numeric_limits<double>::infinity();
   if (part.lod_instance_count == 0 || part.bounds.empty()) return inf;
   if (!(model[0][3] == 0.0f && model[1][3] == 0.0f && model[2][3] == 0.0f && model[3][3] == 1.0f)) return inf;
+  const auto [least, most] = objectStretch(model);
+  if (!(least > 0.0)) return inf;
+  // The eye in the object's own space, and its distance to the part's box there; the world distance to any point of
+  // the part is at least that times the least stretch, and the error at most the level's times the most.
   const Mat3 linear(model);
-  const double scale = std::max({glm::length(linear[0]), glm::length(linear[1]), glm::length(linear[2])});
-  const Vec3 centre = Vec3(model * Vec4(part.bounds.center(), 1.0f));
-  const double radius = scale * 0.5 * double(glm::length(part.bounds.hi - part.bounds.lo));
-  const double distance = double(glm::length(centre - eye)) - radius;
+  const Vec3 local = glm::inverse(linear) * (eye - Vec3(model[3]));
+  const Vec3 gap = glm::max(glm::max(part.bounds.lo - local, local - part.bounds.hi), Vec3(0.0f));
+  const double distance = double(glm::length(gap)) * least;
   if (!(distance > 0.0)) return inf;
-  return double(part.lod_error) * scale * pixels_per_unit / distance;
+  return double(part.lod_error) * most * pixels_per_unit / distance;
 }
 
 SceneArena::SceneArena(const scene::Scene& scene, const ArenaOptions& options) : scene_(&scene) {

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "farfield/core/bounds.h"
@@ -73,10 +74,15 @@ struct ArenaPart {
   float lod_error = 0.0f;
 };
 
-// The error in pixels of drawing a part's simplified level for a camera: lod_error scaled by the object's largest
-// axis scale, projected at the distance from the eye to the nearest point of the part's bounding sphere
-// (pixels_per_unit = target height / (2 tan(fov_y / 2))); infinite for a part without a level, an eye inside the
-// sphere or a transform that is not affine. The culling shader makes the same test (gpu_cull.comp.glsl).
+// Bounds of how much an object's transform stretches lengths: at least `first`, at most `second` (the scale of a
+// similarity; otherwise 1 / |L^-1|_F and |L|_F of its linear part L). {0, 0} for a singular transform.
+std::pair<double, double> objectStretch(const Mat4& model);
+
+// The error in pixels of drawing a part's simplified level for a camera: lod_error stretched by the most the object's
+// transform stretches, projected at the distance from the eye to the part's box (in the object's space, times the
+// least the transform stretches; pixels_per_unit = target height / (2 tan(fov_y / 2))). An upper bound of how far any
+// point of the level is drawn from the full level. Infinite for a part without a level, an eye inside its box or a
+// transform that is not affine or is singular. The culling shader makes the same test (gpu_cull.comp.glsl).
 double partLodErrorPx(const ArenaPart& part, const Mat4& model, const Vec3& eye, double pixels_per_unit);
 
 // Instances that one multi-draw draws: same texture array, same face culling, same winding.

@@ -39,7 +39,7 @@ struct Cluster {
 struct Object {
   mat4 model;
   mat4 normal_matrix;
-  vec4 misc;   // x: largest axis scale
+  vec4 misc;   // x: largest axis scale; y, z: the least and the most it stretches lengths (objectStretch)
   uvec4 info;  // id, flags (1: affine)
 };
 struct Command {
@@ -160,17 +160,18 @@ bool hidden(vec3 lo, vec3 hi, mat4 mvp) {
 
 #if defined(FF_STAGE_PARTS)
 // The instances this frame draws the part with: its simplified level's when that level's error, at the distance from
-// the eye to the part's bounding sphere, projects to at most u_lod_px (partLodErrorPx, scene_arena.cpp), else the
-// full level's. The same in every phase of a frame.
+// the eye to the part's box, projects to at most u_lod_px (partLodErrorPx, scene_arena.cpp), else the full level's.
+// The same in every phase of a frame.
 uvec2 partRange(Part part, bool affine, uint object) {
   const uvec2 full = uvec2(part.info.y, part.info.z);
-  if (!(u_lod_px > 0.0) || part.info.w == 0u || !affine) return full;
+  const float least = objects[object].misc.y, most = objects[object].misc.z;
+  if (!(u_lod_px > 0.0) || part.info.w == 0u || !affine || !(least > 0.0)) return full;
   const mat4 model = objects[object].model;
-  const float scale = objects[object].misc.x;
-  const vec3 centre = (model * vec4(0.5 * (part.box_lo.xyz + part.box_hi.xyz), 1.0)).xyz;
-  const float radius = scale * 0.5 * length(part.box_hi.xyz - part.box_lo.xyz);
-  const float distance = length(centre - u_eye) - radius;
-  if (!(distance > 0.0) || part.box_lo.w * scale * u_lod_scale > u_lod_px * distance) return full;
+  // The eye in the object's space: the inverse of the linear part is the transpose of the normal matrix.
+  const vec3 local = transpose(mat3(objects[object].normal_matrix)) * (u_eye - model[3].xyz);
+  const vec3 gap = max(max(part.box_lo.xyz - local, local - part.box_hi.xyz), vec3(0.0));
+  const float distance = length(gap) * least;
+  if (!(distance > 0.0) || part.box_lo.w * most * u_lod_scale > u_lod_px * distance) return full;
   return uvec2(part.info.y + part.info.z, part.info.w);
 }
 
