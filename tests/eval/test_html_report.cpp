@@ -97,6 +97,17 @@ TEST(HtmlReport, VerdictCountsBothPromisesOfTheChosenMode) {
   kept["modes"]["mmi"]["frames_checked_against_bound"] = 9;
   EXPECT_FALSE(readVerdict(kept, "bench.json", {}).kept());
 
+  EXPECT_FALSE(v.frames_relaxed.has_value());  // not a governed mode
+  nlohmann::json governed = run;
+  governed["modes"]["mmi"]["frames_relaxed"] = 4;
+  governed["modes"]["mmi"]["bound_scale_max"] = 2.0;
+  const Verdict g = readVerdict(governed, "bench.json", {});
+  ASSERT_TRUE(g.frames_relaxed.has_value());
+  EXPECT_EQ(*g.frames_relaxed, 4u);
+  EXPECT_DOUBLE_EQ(g.bound_scale_max, 2.0);
+  governed["modes"]["mmi"]["bound_scale_max"] = "two";
+  EXPECT_THROW(readVerdict(governed, "bench.json", {}), Error);
+
   HtmlReportOptions culled;
   culled.mode = "culled";
   const Verdict c = readVerdict(run, "bench.json", culled);

@@ -162,6 +162,10 @@ Verdict readVerdict(const nlohmann::json& bench, const std::string& where, const
     v.frames_over_bound = size_t(number(mode, "frames_over_bound", at));
     v.frames_checked_against_bound = size_t(number(mode, "frames_checked_against_bound", at));
   }
+  if (const auto relaxed = mode.find("frames_relaxed"); relaxed != mode.end() && !relaxed->is_null()) {
+    v.frames_relaxed = size_t(number(mode, "frames_relaxed", at));
+    v.bound_scale_max = number(mode, "bound_scale_max", at);
+  }
   v.speedup_vs_full = number(mode, "speedup_vs_full", at);
   if (const auto culled = modes.find("culled"); culled != modes.end() && v.mode != "culled")
     v.speedup_vs_culled = number(*culled, "median_ms", where + ": modes.culled") / number(mode, "median_ms", at);
@@ -199,6 +203,15 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
       << "</b> frames (parallax p99 against the full-geometry reference)</p>\n";
   else
     h << "<p>no error bound for this mode</p>\n";
+  if (v.frames_relaxed)
+    h << "<p>frame governor: <b>" << *v.frames_relaxed << " of " << v.frames
+      << "</b> frames relaxed (drawn at a coarser level)"
+      << (*v.frames_relaxed > 0
+              ? ", the bound kept up to " + format("%.3g", v.bound_scale_max) + "x the promised one" +
+                    (v.bound_px ? " (" + format("%.3g", *v.bound_px * v.bound_scale_max) + " px)" : std::string()) +
+                    ", each frame checked against the bound it kept"
+              : std::string())
+      << "</p>\n";
   if (v.database_bytes) h << "<p>database " << megabytes(*v.database_bytes) << "</p>\n";
   h << "<p>speedup <b>" << format("%.2fx", v.speedup_vs_full) << "</b> over full geometry";
   if (v.speedup_vs_culled) h << ", " << format("%.2fx", *v.speedup_vs_culled) << " over view-frustum culling";

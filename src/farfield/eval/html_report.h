@@ -35,6 +35,10 @@ struct Verdict {
   double speedup_vs_full = 0.0;      // median frame time of the baseline over the mode's
   std::optional<double> speedup_vs_culled;
   std::optional<uint64_t> database_bytes;
+  // A governed mode (bench.json "frames_relaxed" not null): frames drawn at a coarser level, and the largest bound
+  // kept as a multiple of the promised one. The bound check above is against the bound each frame kept.
+  std::optional<size_t> frames_relaxed;
+  double bound_scale_max = 1.0;
 
   // Both promises that were checked held on every frame (and the bound was checked on every frame).
   bool kept() const;
