@@ -18,8 +18,9 @@ packages=(
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev python3 python3-matplotlib python3-numpy
   # sharded bakes: a one-node Slurm for the tests and benchmarks (scripts/slurm/local-cluster.sh)
   slurm-wlm munge
-  # the release tarball of `make dist` (scripts/make_dist.sh): RUNPATHs of the tool and its bundled libraries
-  patchelf
+  # the release tarball of `make dist` (scripts/make_dist.sh): RUNPATHs of the tool and its bundled libraries, and the
+  # X11 extensions GLFW opens with dlopen for `farfield view` (bundled too: ldd does not list them)
+  patchelf libxcursor1 libxrandr2 libxinerama1 libxi6 libxxf86vm1
 )
 
 # node and npm run the Khronos glTF validator in the tests (npm only for tools that exist nowhere else); a node

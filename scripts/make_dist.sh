@@ -3,9 +3,10 @@
 #   scripts/make_dist.sh BINARY [OUT_DIR]        (OUT_DIR defaults to out/dist)
 # writes OUT_DIR/farfield-<version>-linux-x86_64.tar.xz holding farfield-<version>/
 #   bin/farfield                the stripped tool, RUNPATH $ORIGIN/../lib
-#   lib/                        every shared library ldd lists for it, under its SONAME, each with RUNPATH $ORIGIN (so
-#                               that the libraries' own dependencies come from lib/ too, not only the tool's), except
-#                               glibc's, libstdc++, libgcc_s and the GL dispatch libraries that a GPU driver provides
+#   lib/                        every shared library ldd lists for it, and the X11 extensions GLFW opens with dlopen
+#                               (with theirs), under its SONAME, each with RUNPATH $ORIGIN (so that the libraries' own
+#                               dependencies come from lib/ too, not only the tool's), except glibc's, libstdc++,
+#                               libgcc_s and the GL dispatch libraries that a GPU driver provides
 #   share/proj, share/gdal      PROJ's proj.db and GDAL's data; the tool points PROJ_DATA/PROJ_LIB and GDAL_DATA at them
 #                               when they are unset (apps/farfield/main.cpp)
 #   share/farfield/             tools/plot_bench.py, tools/plot_terrain.py, README.md
@@ -53,6 +54,22 @@ package_of() {
 
 missing=$(ldd "$BIN" | awk '/not found/ {print $1}')
 [ -z "$missing" ] || { echo "make_dist: ldd finds no ${missing//$'\n'/ }" >&2; exit 1; }
+# GLFW opens the X11 extensions with dlopen when `farfield view` makes a window: ldd does not list them, so they and
+# their own libraries are added by name.
+dlopened=()
+for d in libXcursor.so.1 libXrandr.so.2 libXinerama.so.1 libXi.so.6 libXxf86vm.so.1; do
+  path=$("$(command -v ldconfig || echo /sbin/ldconfig)" -p | awk -v n="$d" '$1 == n && /x86-64/ {print $NF; exit}')
+  [ -n "$path" ] || { echo "make_dist: $d (an X11 extension GLFW opens) is missing" >&2; exit 1; }
+  dlopened+=("$path")
+done
+# "needed path" lines of every library to bundle, each once.
+libraries() {
+  ldd "$BIN" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}'
+  for path in "${dlopened[@]}"; do
+    echo "$(basename "$path") $path"
+    ldd "$path" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}'
+  done
+}
 count=0
 declare -A packages=()
 while read -r needed path; do
@@ -66,7 +83,7 @@ while read -r needed path; do
   count=$((count + 1))
   p=$(package_of "$path") || { echo "make_dist: no Debian package owns $path" >&2; exit 1; }
   packages[$p]=1
-done < <(ldd "$BIN" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}')
+done < <(libraries | sort -u -k1,1)
 [ "$count" -gt 0 ] || { echo "make_dist: ldd listed no libraries for $BIN" >&2; exit 1; }
 
 # Data the libraries read at run time, with their packages' copyright files.
