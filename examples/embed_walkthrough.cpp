@@ -1,6 +1,6 @@
 // Embedding Farfield's walkthrough in a render loop, the way an engine does (no benchmark harness, no CLI):
 //
-//   embed_walkthrough CITY.glb DATABASE PATH.json [ERROR_PX] [OUT.png]
+//   embed_walkthrough CITY.glb DATABASE PATH.json [ERROR_PX] [OUT.png] [T_MAX_MS]
 //
 // CITY.glb and its DATABASE come from `farfield gen city` (or an importer) and `farfield bake --pipeline
 // pvs,near-far,mmi`; PATH.json from `farfield path street`. Each frame: the camera goes in, a FramePlan comes out
@@ -8,20 +8,29 @@
 // GPU-driven frame (gpu::GpuCuller over the scene's arena) culls and draws the geometry's clusters with no CPU-GPU
 // round trip, and the renderer draws the impostors on top. The program prints what the walkthrough decided and what
 // the GPU drew (read frames later, never waited for), and writes the last frame.
+//
+// With T_MAX_MS, a frame governor keeps that budget (runtime/governor_loop.h): the arena gets simplified levels, the
+// first view is drawn at each level with waits (the engine's loading frame: the calibration), and then each frame's
+// level is chosen before it is drawn from the model and the GPU times of earlier frames, read two frames late.
 #include <algorithm>
 #include <cstdio>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "farfield/core/error.h"
 #include "farfield/gen/camera_path.h"
 #include "farfield/gpu/context.h"
+#include "farfield/core/timer.h"
 #include "farfield/gpu/gpu_culler.h"
+#include "farfield/gpu/gpu_timer.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/image/png_io.h"
+#include "farfield/runtime/governor_loop.h"
 #include "farfield/runtime/walkthrough.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/scene/import.h"
@@ -29,7 +38,7 @@
 int main(int argc, char** argv) {
   using namespace farfield;
   if (argc < 4) {
-    std::fprintf(stderr, "usage: %s CITY.glb DATABASE PATH.json [ERROR_PX] [OUT.png]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s CITY.glb DATABASE PATH.json [ERROR_PX] [OUT.png] [T_MAX_MS]\n", argv[0]);
     return 2;
   }
   try {
@@ -52,25 +61,79 @@ int main(int argc, char** argv) {
     options.geometry_items = false;
     runtime::Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
     std::printf("error bound: %.2f px\n", walkthrough.errorBoundPx());
-    const gpu::SceneArena arena(scene);  // every mesh in shared buffers, cut into clusters
+    // Every mesh in shared buffers, cut into clusters; with a budget, simplified levels too.
+    const double t_max_ms = argc > 6 ? std::stod(argv[6]) : 0.0;
+    gpu::ArenaOptions arena_options;
+    arena_options.lod_ratio = t_max_ms > 0.0 ? 0.25f : 0.0f;
+    const gpu::SceneArena arena(scene, arena_options);
     gpu::GpuCuller culler(arena);
+
+    // The frame governor's levels: the simplified geometry under 0, 1, 2 and 4 pixels, each keeping max(bound, px).
+    const std::vector<float> lod_px{0.0f, 1.0f, 2.0f, 4.0f};
+    std::unique_ptr<runtime::GovernorLoop> governor;
+    if (t_max_ms > 0.0) {
+      std::vector<runtime::LoopLevel> levels;
+      for (float px : lod_px)
+        levels.push_back({{"simplified to " + std::to_string(px) + " px",
+                           std::max(1.0, double(px) / std::max(walkthrough.errorBoundPx(), 1e-9))},
+                          double(width) * double(height)});
+      runtime::GovernorLoopOptions loop;
+      loop.governor.t_max_ms = t_max_ms;
+      governor = std::make_unique<runtime::GovernorLoop>(std::move(levels), loop);
+    }
+    const auto drawFrame = [&](const Camera& camera, const runtime::FramePlan& plan) {
+      target.bind();
+      target.clear(renderer.light().sky_color);
+      culler.draw(camera, target, gpu::RenderMode::Shaded, renderer.light());
+      renderer.draw(camera, plan.items, target);
+    };
+    if (governor) {
+      // The calibration: the first view at every level, each waited for (the public wait: a 1 x 1 render).
+      const Camera camera = path.camera(0, width, height);
+      const runtime::FramePlan& plan = walkthrough.plan(camera);
+      culler.setObjects(plan.geometry_objects);
+      Camera tiny = camera;
+      tiny.width = tiny.height = 1;
+      gpu::RenderTarget tiny_target(1, 1);
+      for (int round = 0; round <= 3; ++round)
+        for (size_t level = 0; level < lod_px.size(); ++level) {
+          culler.setLodErrorPx(lod_px[level]);
+          Stopwatch clock;
+          drawFrame(camera, plan);
+          renderer.render(tiny, {}, tiny_target);
+          const double ms = clock.milliseconds();
+          const std::vector<gpu::GpuCullStats> stats = culler.finishedStats();
+          if (round > 0 && !stats.empty()) governor->calibrationSample(level, double(stats.back().triangles), ms);
+        }
+      governor->finishCalibration();
+      culler.resetHistory();
+    }
+    const uint64_t first_culler_frame = culler.frames();
+    gpu::GpuTimer timers[3];  // a frame's GPU time is read two frames later
+    size_t relaxed = 0;
 
     size_t impostor_layers = 0, geometry_layers = 0;
     uint64_t version = ~uint64_t(0), gpu_frames = 0, gpu_triangles = 0, gpu_hidden = 0;
     for (size_t f = 0; f < path.frames.size(); ++f) {
       const Camera camera = path.camera(f, width, height);
       const runtime::FramePlan& plan = walkthrough.plan(camera);
+      if (governor) {
+        if (f >= 2) governor->frameMeasured(f - 2, timers[(f - 2) % 3].elapsedMs());
+        const runtime::GovernorDecision decision = governor->decide(f);
+        culler.setLodErrorPx(lod_px[decision.level]);
+        relaxed += decision.relaxed ? 1 : 0;
+        timers[f % 3].begin();
+      }
       // The engine draws the plan: the geometry's objects through the GPU culler (only a change of the list is
       // sent), then the impostors with the renderer. Nothing here waits for the GPU.
       if (plan.geometry_version != version) {
         culler.setObjects(plan.geometry_objects);
         version = plan.geometry_version;
       }
-      target.bind();
-      target.clear(renderer.light().sky_color);
-      culler.draw(camera, target, gpu::RenderMode::Shaded, renderer.light());
-      renderer.draw(camera, plan.items, target);
+      drawFrame(camera, plan);
+      if (governor) timers[f % 3].end();
       for (const gpu::GpuCullStats& s : culler.finishedStats()) {  // earlier frames', as the GPU finishes them
+        if (governor && s.frame >= first_culler_frame) governor->frameTriangles(s.frame - first_culler_frame, double(s.triangles));
         ++gpu_frames;
         gpu_triangles += s.triangles;
         gpu_hidden += s.occlusion_culled;
@@ -89,6 +152,12 @@ int main(int argc, char** argv) {
     std::printf("GPU: %llu frames counted, %.0f geometry triangles and %.0f hidden clusters a frame\n",
                 static_cast<unsigned long long>(gpu_frames), double(gpu_triangles) / double(std::max<uint64_t>(gpu_frames, 1)),
                 double(gpu_hidden) / double(std::max<uint64_t>(gpu_frames, 1)));
+    if (governor) {
+      const runtime::FrameGovernor::Statistics& s = governor->governor().statistics();
+      std::printf("governor: t_max %.2f ms, frames per level", t_max_ms);
+      for (size_t level = 0; level < lod_px.size(); ++level) std::printf(" %zu", s.frames_at_level[level]);
+      std::printf(", relaxed %zu of %zu, measured over t_max %zu\n", relaxed, path.frames.size(), s.measured_over);
+    }
     if (argc > 5) image::writePng(argv[5], target.readColor());
     return 0;
   } catch (const std::exception& e) {
