@@ -147,6 +147,26 @@ TEST(GovernedMode, SimplifiedGeometryDrawsFewerTrianglesWithinItsBound) {
   EXPECT_FALSE(h.make("culled-cpu")->setGeometryErrorPx(1.0));
 }
 
+TEST(GovernedMode, ImpostorBoundsComeFirstAndTheCoarsestLevelKeepsTheLargestOfEveryBound) {
+  Harness h(1e-6);
+  h.context.options["governor_impostor_px"] = "4,8";  // levels 1 and 2: the mode again under 4 and 8 px
+  h.context.options["governor_lod_px"] = "0,2";
+  auto governed = h.make("governed");
+  FrameRunner runner(*h.renderer, *h.target);
+  const gen::CameraPath path = test::sideWalkPath(2);
+  runner.run(*governed, pathCamera(path, 0, kSize, kSize), 0);
+  const FrameRecord f = runner.run(*governed, pathCamera(path, 1, kSize, kSize), 1);
+  const std::map<std::string, double> info = governed->info();
+  // Full, impostors under 4 and 8 px, 2 px geometry (with 8 px impostors), then half resolution (with both).
+  ASSERT_EQ(info.at("governor_levels"), 5.0);
+  EXPECT_EQ(info.at("governor_level_1_impostor_px"), 4.0);
+  EXPECT_EQ(info.at("governor_level_2_impostor_px"), 8.0);
+  EXPECT_EQ(info.at("governor_level_3_lod_px"), 2.0);
+  EXPECT_EQ(info.at("governor_level_3_impostor_px"), 8.0);
+  EXPECT_EQ(f.governor_level, 4);
+  EXPECT_DOUBLE_EQ(f.bound_scale, 16.0);  // max(1 px promised, 8 px impostors, 2 px geometry) at half resolution
+}
+
 TEST(GovernedMode, BadOptionsAreClearErrors) {
   Harness h(std::nullopt);
   EXPECT_THROW(createMode("governed", h.context), Error);  // no --tmax
@@ -159,6 +179,11 @@ TEST(GovernedMode, BadOptionsAreClearErrors) {
   h.context.options["governed"] = "governed";
   EXPECT_THROW(createMode("governed", h.context), Error);
   h.context.options["governed"] = "no-such-mode";
+  EXPECT_THROW(createMode("governed", h.context), Error);
+  h.context.options.erase("governed");
+  h.context.options["governor_impostor_px"] = "4,2";  // must increase
+  EXPECT_THROW(createMode("governed", h.context), Error);
+  h.context.options["governor_impostor_px"] = "0";  // a bound of no pixels
   EXPECT_THROW(createMode("governed", h.context), Error);
 }
 

@@ -39,7 +39,22 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   inner_name_ = context.option("governed", "culled");
   if (inner_name_ == "governed") throw Error("--mode-option governed", "cannot govern itself");
   context.arena_slot->simplified_levels = true;  // before any mode of the run makes the arena (in prepare)
-  inner_ = createMode(inner_name_, context);
+  inners_.push_back(createMode(inner_name_, context));
+  // Impostors accepted under larger bounds: the governed mode again, its walkthrough's bound (error_px) set to each.
+  const std::string impostor_px = context.option("governor_impostor_px");
+  if (!impostor_px.empty()) {
+    impostor_px_ = parseLevelList("0," + impostor_px, "governor_impostor_px", 0.0, 64.0, 0.0, true,
+                                  "a number of pixels in (0, 64]");
+    impostor_px_.erase(impostor_px_.begin());
+    for (double px : impostor_px_) {
+      ModeContext coarser = context;  // shares the run's arena and the record of options read
+      char value[32];
+      std::snprintf(value, sizeof(value), "%g", px);
+      coarser.options["error_px"] = value;
+      contexts_.push_back(coarser);
+      inners_.push_back(createMode(inner_name_, coarser));
+    }
+  }
   // Resolution scales, 1 (the frame itself) first, decreasing; the simplified levels' bounds, 0 (full detail) first.
   scales_ = parseLevelList(context.option("governor_scales", "1,0.84,0.71,0.59,0.5"), "governor_scales", 0.25, 1.0,
                            1.0, false, "a scale in [0.25, 1]");
@@ -58,28 +73,42 @@ GovernedMode::GovernedMode(const ModeContext& context) {
 }
 
 void GovernedMode::prepare(const ModeContext& context) {
-  inner_->prepare(context);
+  inners_[0]->prepare(context);
+  for (size_t k = 1; k < inners_.size(); ++k) inners_[k]->prepare(contexts_[k - 1]);
   renderer_ = context.renderer;
   finish_target_ = gpu::RenderTarget(1, 1);
   full_target_ = gpu::RenderTarget(context.width, context.height);
-  // The simplified levels first (at full resolution), where the governed mode draws through the arena; then the
-  // lower resolutions, with the coarsest simplified level.
-  if (!inner_->setGeometryErrorPx(0.0)) lod_px_ = {0.0};
-  std::vector<std::pair<double, double>> plan;  // scale, lod px
-  for (double px : lod_px_) plan.emplace_back(1.0, px);
-  for (size_t i = 1; i < scales_.size(); ++i) plan.emplace_back(scales_[i], lod_px_.back());
+  // The levels, in the order: impostors under larger bounds (governor_impostor_px), then the simplified levels
+  // (at full resolution, with the coarsest impostor bound), where the governed mode draws through the arena; then the
+  // lower resolutions, with the coarsest of both.
+  for (const auto& inner : inners_)
+    if (!inner->setGeometryErrorPx(0.0)) lod_px_ = {0.0};
+  struct Plan {
+    size_t inner;
+    double scale, lod_px, impostor_px;
+  };
+  std::vector<Plan> plan;
+  plan.push_back({0, 1.0, 0.0, 0.0});
+  for (size_t k = 0; k < impostor_px_.size(); ++k) plan.push_back({k + 1, 1.0, 0.0, impostor_px_[k]});
+  const size_t last = inners_.size() - 1;
+  const double last_px = impostor_px_.empty() ? 0.0 : impostor_px_.back();
+  for (size_t i = 1; i < lod_px_.size(); ++i) plan.push_back({last, 1.0, lod_px_[i], last_px});
+  for (size_t i = 1; i < scales_.size(); ++i) plan.push_back({last, scales_[i], lod_px_.back(), last_px});
   std::vector<runtime::LoopLevel> levels;
-  for (const auto& [s, px] : plan) {
+  for (const auto& [inner, s, px, ipx] : plan) {
     Level level;
+    level.inner = inner;
     level.scale = s;
     level.lod_px = px;
     level.width = std::max(1, int(std::lround(context.width * s)));
     level.height = std::max(1, int(std::lround(context.height * s)));
     if (s < 1.0) level.target = gpu::RenderTarget(level.width, level.height);
-    char name[64];
-    std::snprintf(name, sizeof(name), "%.2fx resolution, simplified to %g px", s, px);
-    // The bound kept: the simplified geometry's or the promised one, whichever is larger, in pixels of the frame.
-    levels.push_back({{name, std::max(1.0, px / error_px_) / s}, double(level.width) * double(level.height)});
+    char name[96];
+    std::snprintf(name, sizeof(name), "%.2fx resolution, simplified to %g px, impostors under %g px", s, px, ipx);
+    // The bound kept: the impostors', the simplified geometry's or the promised one, whichever is larger, in pixels
+    // of the frame.
+    levels.push_back({{name, std::max({1.0, px / error_px_, ipx / error_px_}) / s},
+                      double(level.width) * double(level.height)});
     levels_.push_back(std::move(level));
   }
   loop_ = std::make_unique<runtime::GovernorLoop>(std::move(levels), loop_options_);
@@ -96,9 +125,10 @@ gpu::FrameStats GovernedMode::drawLevel(const Camera& camera, size_t path_frame,
   Level& l = levels_[level];
   const Camera c = levelCamera(camera, level);
   gpu::RenderTarget& target = l.scale < 1.0 ? l.target : full_target_;
-  inner_->setGeometryErrorPx(l.lod_px);
+  Mode& mode = *inners_[l.inner];
+  mode.setGeometryErrorPx(l.lod_px);
   FrameContext inner(c, path_frame, *renderer_, target, items_);
-  inner_->frame(inner);
+  mode.frame(inner);
   gpu::FrameStats stats;
   if (!inner.drewPasses()) {
     target.bind();
@@ -130,7 +160,7 @@ void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {
       renderer_->render(tiny, {}, finish_target_);  // waits for the GPU (Renderer::render's glFinish)
       const double ms = clock.milliseconds();
       double triangles = double(drawn.triangles);
-      if (const std::optional<gpu::FrameStats> late = inner_->lateFrameStats(path_frame))
+      if (const std::optional<gpu::FrameStats> late = inners_[levels_[level].inner]->lateFrameStats(path_frame))
         triangles += double(late->triangles);
       if (round > 0) loop_->calibrationSample(level, triangles, ms);
     }
@@ -150,9 +180,11 @@ void GovernedMode::frame(FrameContext& frame) {
   last_ = FrameGovernance{decision.level, decision.predicted_ms, decision.corrected_ms, decision.bound_scale};
 
   const Level& level = levels_[decision.level];
+  last_inner_ = level.inner;
   if (level.scale == 1.0) {
-    inner_->setGeometryErrorPx(level.lod_px);
-    inner_->frame(frame);  // the frame itself, drawn as the governed mode draws it (simplified where the level says)
+    // The frame itself, drawn as the governed mode draws it (simplified and under the bound the level says).
+    inners_[level.inner]->setGeometryErrorPx(level.lod_px);
+    inners_[level.inner]->frame(frame);
     return;
   }
   gpu::RenderTarget& out = frame.beginOwnPass();
@@ -161,7 +193,7 @@ void GovernedMode::frame(FrameContext& frame) {
 }
 
 std::optional<gpu::FrameStats> GovernedMode::lateFrameStats(size_t path_frame) {
-  std::optional<gpu::FrameStats> late = inner_->lateFrameStats(path_frame);
+  std::optional<gpu::FrameStats> late = inners_[last_inner_]->lateFrameStats(path_frame);
   // The late triangles are the GPU-driven frame's whole count; a mode without late statistics is modelled by its
   // pixels alone (0 triangles).
   if (last_frame_ && path_frame == last_path_frame_) loop_->frameTriangles(*last_frame_, late ? double(late->triangles) : 0.0);
@@ -169,14 +201,14 @@ std::optional<gpu::FrameStats> GovernedMode::lateFrameStats(size_t path_frame) {
 }
 
 void GovernedMode::frameMeasured(size_t path_frame, double wall_ms) {
-  inner_->frameMeasured(path_frame, wall_ms);
+  inners_[last_inner_]->frameMeasured(path_frame, wall_ms);
   if (last_frame_ && path_frame == last_path_frame_) loop_->frameMeasured(*last_frame_, wall_ms);
 }
 
 std::optional<FrameGovernance> GovernedMode::governance(size_t /*path_frame*/) const { return last_; }
 
 std::map<std::string, double> GovernedMode::info() const {
-  std::map<std::string, double> info = inner_->info();
+  std::map<std::string, double> info = inners_[0]->info();
   if (!loop_) return info;
   const runtime::FrameGovernor::Statistics& s = loop_->governor().statistics();
   const gpu::CostModel& model = loop_->model();
@@ -185,6 +217,8 @@ std::map<std::string, double> GovernedMode::info() const {
   for (size_t i = 0; i < levels_.size(); ++i) {
     info["governor_level_" + std::to_string(i) + "_scale"] = levels_[i].scale;
     info["governor_level_" + std::to_string(i) + "_lod_px"] = levels_[i].lod_px;
+    info["governor_level_" + std::to_string(i) + "_impostor_px"] =
+        levels_[i].inner == 0 ? 0.0 : impostor_px_[levels_[i].inner - 1];
     info["governor_level_" + std::to_string(i) + "_triangle_share"] = loop_->triangleShare(i);
     info["governor_level_" + std::to_string(i) + "_frames"] = double(s.frames_at_level[i]);
   }

@@ -1,13 +1,14 @@
 // "governed": another mode's frame under a frame governor (runtime/frame_governor.h) that keeps the run's t_max
 // (`--tmax`) in a closed loop, every coarsened frame reported with the error bound it kept.
 //
-// The coarser levels, in order: the arena's simplified geometry (gpu/scene_arena.h: meshopt_simplify per mesh, drawn
-// for a part whose error projects under the level's pixels; for modes that draw through the arena), then lower render
-// resolutions (scale s per side: the frame rendered at s x the size and scaled up, colour bilinear, ids and depth
-// nearest) with the coarsest simplified geometry, the last resort. A level keeps the bound max(promised, simplified
-// px) / s: a mode that checks its bound in pixels of its camera (the walkthrough) does so at the smaller size, and a
-// pixel there is 1 / s pixels of the frame. (Impostors placed for a larger bound, first in the order, are not
-// a level yet.)
+// The coarser levels, in order: impostors accepted under larger bounds (governor_impostor_px=4,8: the governed mode
+// again with its walkthrough's bound, --mode-option error_px, set to each, so that more of its database's impostors
+// hold the eye; for modes over an impostor database; not a placement made for that bound), the arena's simplified
+// geometry (gpu/scene_arena.h: meshopt_simplify per mesh, drawn for a part whose error projects under the level's
+// pixels; for modes that draw through the arena), then lower render resolutions (scale s per side: the frame rendered
+// at s x the size and scaled up, colour bilinear, ids and depth nearest) with the coarsest of both, the last resort.
+// A level keeps the bound max(promised, impostors' px, simplified px) / s: a mode that checks its bound in pixels of
+// its camera (the walkthrough) does so at the smaller size, and a pixel there is 1 / s pixels of the frame.
 //
 // The prediction and the loop are runtime::GovernorLoop's (runtime/governor_loop.h); this mode draws, times and
 // reports. The prediction: a cost model (gpu/cost_model.h: base, per million triangles, per million pixels) fitted on
@@ -19,7 +20,8 @@
 // calibration's view, and the level's pixels. Measured times reach the governor `governor_lag` frames
 // late (as a timer query read late would).
 //
-// Options (--mode-option): governed=MODE (the mode governed; default culled), governor_lod_px=0,1,2,4 (the simplified
+// Options (--mode-option): governed=MODE (the mode governed; default culled), governor_impostor_px (none by default),
+// governor_lod_px=0,1,2,4 (the simplified
 // levels' bounds, 0 first, increasing), governor_error_px (the promised bound, default 1 px: bound scales are relative
 // to it), governor_scales=1,0.84,... (the resolution scales, 1 first, decreasing, each in [0.25, 1]), governor_lag
 // (frames, default 2),
@@ -56,6 +58,7 @@ class GovernedMode final : public Mode {
 
  private:
   struct Level {
+    size_t inner = 0;          // inners_[inner] draws it
     double scale = 1.0;
     double lod_px = 0.0;       // the simplified geometry's bound (Mode::setGeometryErrorPx), 0: full detail
     int width = 0, height = 0;
@@ -66,7 +69,11 @@ class GovernedMode final : public Mode {
   gpu::FrameStats drawLevel(const Camera& camera, size_t path_frame, size_t level);
   void calibrate(const Camera& camera, size_t path_frame);
 
-  std::unique_ptr<Mode> inner_;
+  // The governed mode, and again under each of impostor_px_ (their contexts in contexts_, kept for their lifetime).
+  std::vector<std::unique_ptr<Mode>> inners_;
+  std::vector<ModeContext> contexts_;
+  std::vector<double> impostor_px_;
+  size_t last_inner_ = 0;
   std::string inner_name_;
   std::vector<double> scales_;
   std::vector<double> lod_px_;
