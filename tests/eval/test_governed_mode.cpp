@@ -170,6 +170,9 @@ TEST(GovernedMode, ImpostorBoundsComeFirstAndTheCoarsestLevelKeepsTheLargestOfEv
 TEST(GovernedMode, BadOptionsAreClearErrors) {
   Harness h(std::nullopt);
   EXPECT_THROW(createMode("governed", h.context), Error);  // no --tmax
+  h.context.options["governor_t_max_ms"] = "12";           // ... or the option
+  EXPECT_NO_THROW(createMode("governed", h.context));
+  h.context.options.erase("governor_t_max_ms");
   h.context.t_max_ms = 10.0;
   h.context.options["governor_scales"] = "0.5,1";
   EXPECT_THROW(createMode("governed", h.context), Error);

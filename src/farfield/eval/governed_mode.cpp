@@ -61,9 +61,11 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   lod_px_ = parseLevelList(context.option("governor_lod_px", "0,1,2,4"), "governor_lod_px", 0.0, 64.0, 0.0, true,
                            "a number of pixels in [0, 64]");
   error_px_ = positiveOption(context, "governor_error_px", error_px_);
-  if (!context.t_max_ms) throw Error("mode 'governed'", "needs a frame budget: --tmax MS");
+  // The budget: --mode-option governor_t_max_ms (for commands without --tmax: walk), else the run's --tmax.
+  const double t_max = numberOption(context, "governor_t_max_ms", context.t_max_ms.value_or(0.0), 0.0);
+  if (!(t_max > 0.0)) throw Error("mode 'governed'", "needs a frame budget: --tmax MS (or --mode-option governor_t_max_ms=MS)");
   runtime::GovernorOptions& g = loop_options_.governor;
-  g.t_max_ms = *context.t_max_ms;
+  g.t_max_ms = t_max;
   g.aim = numberOption(context, "governor_aim", g.aim, 0.05, 1.0);
   g.refine_below = numberOption(context, "governor_refine_below", g.refine_below, 0.05, g.aim);
   g.refine_after = countOption(context, "governor_refine_after", g.refine_after);

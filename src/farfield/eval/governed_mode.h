@@ -26,7 +26,8 @@
 // to it), governor_scales=1,0.84,... (the resolution scales, 1 first, decreasing, each in [0.25, 1]), governor_lag
 // (frames, default 2),
 // governor_aim, governor_refine_below, governor_refine_after, governor_window (runtime::GovernorOptions),
-// governor_calibration_repeats (default 3). Needs --tmax.
+// governor_calibration_repeats (default 3), governor_t_max_ms (the budget where the command has no --tmax, e.g. walk;
+// it wins over --tmax). Needs one of them.
 #pragma once
 
 #include <map>
