@@ -3,6 +3,7 @@
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <atomic>
 #if defined(__x86_64__) || defined(__i386__)
 #include <x86intrin.h>
@@ -23,8 +24,10 @@ GlCounters& GlCounters::operator-=(const GlCounters& o) {
   dispatches -= o.dispatches;
   syncs -= o.syncs;
   upload_bytes -= o.upload_bytes;
-  driver_ms -= o.driver_ms;
-  measure_ms -= o.measure_ms;
+  // Times are tick counts converted with a tick rate estimated anew at each read: two reads of an unchanged count may
+  // differ by a few nanoseconds either way, and no time between two reads is negative.
+  driver_ms = std::max(0.0, driver_ms - o.driver_ms);
+  measure_ms = std::max(0.0, measure_ms - o.measure_ms);
   return *this;
 }
 

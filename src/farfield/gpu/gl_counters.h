@@ -37,6 +37,7 @@ struct GlCounters {
   double driver_ms = 0.0;     // time inside GL calls
   double measure_ms = 0.0;    // time inside GlMeasurement scopes (their GL calls are not counted)
 
+  // The counts and times since `o` (an earlier read); times are never negative (see the .cpp).
   GlCounters& operator-=(const GlCounters& o);
   friend GlCounters operator-(GlCounters a, const GlCounters& b) { return a -= b; }
 };
