@@ -14,7 +14,6 @@
 #include "farfield/eval/frame_runner.h"
 #include "farfield/eval/frame_stats.h"
 #include "farfield/eval/mode.h"
-#include "farfield/eval/occlusion_pass.h"
 #include "farfield/eval/plan_geometry.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
@@ -24,31 +23,8 @@ namespace farfield::eval {
 
 namespace {
 
-// The placed walkthrough's geometry pass over a list of objects: their clusters in the frustum, occlusion-culled
-// (eval/occlusion_pass.h), as submitPlan draws a plan's geometry.
-class PlacedGeometry final : public Mode {
- public:
-  explicit PlacedGeometry(const gpu::GpuScene& scene) : scene_(scene) {}
-  std::string name() const override { return "placed-geometry"; }
-  void frame(FrameContext& frame) override {
-    if (ids.empty()) return;  // an empty list would mean every object to appendDrawItems
-    items_.clear();
-    bounds_.clear();
-    scene_.appendDrawItems(ids, items_, frame.camera(), &bounds_);
-    occlusion_.run(frame, items_, bounds_);
-  }
-  std::vector<uint32_t> ids;  // the next frame's objects, ascending
-
- private:
-  const gpu::GpuScene& scene_;
-  OcclusionPass occlusion_;
-  std::vector<gpu::DrawItem> items_;
-  std::vector<Box3> bounds_;
-};
-
-// The runtime's own geometry pass over a list of objects: the GPU-driven frame (eval/plan_geometry.h, gpu::GpuCuller)
-// that the walkthrough's plans draw through, each view drawn once untimed first so that the culler's last-frame
-// visibility is the view's own (a walkthrough's consecutive frames see nearly the same) and no object list is sent.
+// The geometry pass over a list of objects, as the walkthrough draws a plan's geometry (eval/plan_geometry.h): on the
+// GPU (gpu::GpuCuller), or on the CPU (clusters in the frustum, occlusion-culled or not) as the context's options say.
 class RuntimeGeometry final : public Mode {
  public:
   explicit RuntimeGeometry(const ModeContext& context) : geometry_(context, "calibrate") { geometry_.prepare(context); }
@@ -181,18 +157,18 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   const bool whole_objects = placed || options.gpu_frames;
   const std::vector<gpu::ObjectDrawCost> object_cost =
       whole_objects ? gpu_scene.objectDrawCosts() : std::vector<gpu::ObjectDrawCost>{};
-  PlacedGeometry placed_geometry(gpu_scene);
-  ModeContext mode_context;  // holds the arena the runtime's frames draw (alive as long as they are)
-  std::optional<RuntimeGeometry> runtime_geometry;
-  if (options.gpu_frames) {
-    mode_context.scene = &scene;
-    mode_context.gpu_scene = &gpu_scene;
-    mode_context.bvh = &bvh;
-    mode_context.renderer = &renderer;
-    mode_context.width = options.width;
-    mode_context.height = options.height;
-    runtime_geometry.emplace(mode_context);
-  }
+  // The frames timed: the runtime's GPU-driven ones, or the CPU-culled ones of before (placed frames occlusion-culled,
+  // the others frustum-culled clusters). The context holds the arena the GPU frames draw (alive as long as they are).
+  ModeContext mode_context;
+  mode_context.scene = &scene;
+  mode_context.gpu_scene = &gpu_scene;
+  mode_context.bvh = &bvh;
+  mode_context.renderer = &renderer;
+  mode_context.width = options.width;
+  mode_context.height = options.height;
+  mode_context.options = {{"geometry", options.gpu_frames ? "gpu" : "cpu"},
+                          {"occlusion", options.gpu_frames || placed ? "on" : "off"}};
+  RuntimeGeometry geometry(mode_context);
   FrameRunner runner(renderer, target);
   // A view's workload, counted once: the objects it draws (returned in `view_ids`) and their triangles, draw calls and
   // estimated fill, as the model counts them.
@@ -230,21 +206,13 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     if (!region) check.region_fill = check.fill;
     return check;
   };
-  // One timed render of a view's objects: the runtime's GPU-driven frame (after an untimed one of the same view), or
-  // on the CPU path placed frames through the occlusion culler, else frustum-culled clusters.
+  // One timed render of a view's objects. A GPU-driven one after an untimed one of the same view, so that the
+  // culler's last-frame visibility is the view's own (a walkthrough's consecutive frames see nearly the same) and no
+  // object list is sent in the timed one.
   const auto render = [&](const Camera& camera, const std::vector<uint32_t>& view_ids) {
-    if (runtime_geometry) {
-      runtime_geometry->ids = view_ids;
-      runner.run(*runtime_geometry, camera, 0);
-      return runner.run(*runtime_geometry, camera, 0).wall_ms;
-    }
-    if (placed) {
-      placed_geometry.ids = view_ids;
-      return runner.run(placed_geometry, camera, 0).wall_ms;
-    }
-    items.clear();
-    if (!view_ids.empty()) gpu_scene.appendDrawItems(view_ids, items, camera);
-    return renderer.render(camera, items, target).wall_ms;
+    geometry.ids = view_ids;
+    if (options.gpu_frames) runner.run(geometry, camera, 0);
+    return runner.run(geometry, camera, 0).wall_ms;
   };
   // Every view rendered once, then again in further passes over all of them, the fastest render kept: a view's
   // renders are a pass apart (seconds), so a slow spell of the machine does not slow all of them. The fitting and the

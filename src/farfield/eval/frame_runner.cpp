@@ -56,24 +56,9 @@ FrameRecord FrameRunner::run(Mode& mode, const Camera& camera, size_t path_frame
   Stopwatch clock;
   FrameContext frame(camera, path_frame, renderer_, target_, items_, &timer_);
   mode.frame(frame);
-  if (!frame.drewPasses()) {
-    // The common case: one pass. Clear and draw as Renderer::render does (its GPU time covers the clear and the
-    // draws), the wait below.
-    target_.bind();  // before the query starts (see Renderer::render)
-    timer_.begin();
-    target_.clear(renderer_.light().sky_color);
-    stats = renderer_.draw(camera, frame.mainItems(), target_);
-  } else {
-    // The mode drew passes of its own onto the cleared target (FrameContext started timer_ with the first one);
-    // the main pass goes on top.
-    stats = frame.passStats();
-    if (!frame.mainItems().empty()) {
-      const gpu::FrameStats main = renderer_.draw(camera, frame.mainItems(), target_);
-      stats.triangles += main.triangles;
-      stats.draw_calls += main.draw_calls;
-      stats.objects += main.objects;
-    }
-  }
+  // The main pass: on the target the mode's passes drew (FrameContext started timer_ with the first one), else on the
+  // target cleared now (the timer started with the clear, as Renderer::render's GPU time covers it); the wait below.
+  stats = frame.drawMainPass();
   {
     // The wait for the frame is the measurement's. Only the gpu module calls OpenGL, and its public way to wait is
     // Renderer::render, which clears its target first: render nothing into a 1x1 target of our own, whose glFinish

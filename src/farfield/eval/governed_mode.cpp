@@ -131,21 +131,7 @@ gpu::FrameStats GovernedMode::drawLevel(const Camera& camera, size_t path_frame,
   mode.setGeometryErrorPx(l.lod_px);
   FrameContext inner(c, path_frame, *renderer_, target, items_);
   mode.frame(inner);
-  gpu::FrameStats stats;
-  if (!inner.drewPasses()) {
-    target.bind();
-    target.clear(renderer_->light().sky_color);
-    stats = renderer_->draw(c, inner.mainItems(), target);
-  } else {
-    stats = inner.passStats();
-    if (!inner.mainItems().empty()) {
-      const gpu::FrameStats main = renderer_->draw(c, inner.mainItems(), target);
-      stats.triangles += main.triangles;
-      stats.draw_calls += main.draw_calls;
-      stats.objects += main.objects;
-    }
-  }
-  return stats;
+  return inner.drawMainPass();
 }
 
 void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {

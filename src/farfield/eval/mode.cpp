@@ -78,6 +78,21 @@ gpu::FrameStats FrameContext::drawPass(std::span<const gpu::DrawItem> items, gpu
   return stats;
 }
 
+gpu::FrameStats FrameContext::drawMainPass() {
+  if (!drew_passes_) {
+    target_.bind();  // before the timer's query starts (see Renderer::render)
+    clearOnce();
+  }
+  gpu::FrameStats stats = pass_stats_;
+  if (!mainItems().empty()) {
+    const gpu::FrameStats main = renderer_.draw(camera_, mainItems(), target_);
+    stats.triangles += main.triangles;
+    stats.draw_calls += main.draw_calls;
+    stats.objects += main.objects;
+  }
+  return stats;
+}
+
 gpu::RenderTarget& FrameContext::beginOwnPass() {
   clearOnce();
   return target_;

@@ -116,9 +116,9 @@ class FrameContext {
   gpu::RenderTarget& beginOwnPass();
   void addStats(const gpu::FrameStats& stats);
 
-  // Harness side: whether the mode drew into the frame's target itself, and the sums of what it reported.
-  bool drewPasses() const { return drew_passes_; }
-  const gpu::FrameStats& passStats() const { return pass_stats_; }
+  // Harness side, after Mode::frame(): the main pass. The target is cleared first (and the timer started) when the
+  // mode drew no pass of its own; the main items are drawn on top. Returns what the passes and the main pass drew.
+  gpu::FrameStats drawMainPass();
 
  private:
   void clearOnce();
