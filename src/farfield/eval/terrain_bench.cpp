@@ -363,6 +363,19 @@ void runQuality(Experiment& x) {
         image::writePng((dir / (tag + "_g_diff_high_" + name + ".png")).string(), absDifference(high_image, img));
       }
     }
+    for (const std::string& name : o.modes) {  // the CDLOD terrain on the GPU at each threshold
+      if (!measure || (name != "high-gpu" && name != "low-gpu")) continue;
+      target.clear(x.run->sky);
+      x.run->gpuLod().draw(camera, name == "high-gpu" ? o.high_error : o.low_error, target);
+      const image::ColorImage img = target.readColor();
+      row.psnr[name] = std::min(image::psnr(high_image, img), kPsnrCapDb);
+      if (views.count(pf)) {
+        const std::string tag = "view" + std::to_string(1 + std::distance(views.begin(), views.find(pf)));
+        const fs::path dir = x.figures / "fig06";
+        image::writePng((dir / (tag + "_f_" + name + ".png")).string(), img);
+        image::writePng((dir / (tag + "_g_diff_high_" + name + ".png")).string(), absDifference(high_image, img));
+      }
+    }
     if (measure) x.result.quality.push_back(std::move(row));
     progress.advance();
   }

@@ -48,6 +48,15 @@ gpu::TerrainRenderer& TerrainRun::gpuRenderer() {
   return *renderer;
 }
 
+terrain::GpuLodTerrain& TerrainRun::gpuLod(int patch_cells) {
+  if (!gpu_lod_) {
+    terrain::CdlodOptions options;
+    options.patch_cells = patch_cells;
+    gpu_lod_ = std::make_unique<terrain::GpuLodTerrain>(data->hf, data->texture, options);
+  }
+  return *gpu_lod_;
+}
+
 std::shared_ptr<TerrainRun>& currentTerrainRun() {
   static std::shared_ptr<TerrainRun> run;
   return run;
@@ -67,6 +76,33 @@ void LodMode::frame(FrameContext& frame) {
 
 std::map<std::string, double> LodMode::info() const {
   return {{"pixel_error", high_ ? run_->high_error : run_->low_error}};
+}
+
+void GpuLodMode::prepare(const ModeContext& context) {
+  run_ = terrainRunFor(context, name_);
+  const int patch = intOption(context, "patch_cells", 16, 2, 128);
+  if ((patch & (patch - 1)) != 0)
+    throw Error("--mode-option patch_cells", "must be a power of two, got " + std::to_string(patch));
+  run_->gpuLod(patch);
+  frames_ = nodes_ = 0;
+}
+
+void GpuLodMode::frame(FrameContext& frame) {
+  gpu::RenderTarget& target = frame.beginOwnPass();
+  const terrain::GpuLodFrame drawn =
+      run_->gpuLod().draw(frame.camera(), high_ ? run_->high_error : run_->low_error, target);
+  frame.addStats(drawn.draw);
+  ++frames_;
+  nodes_ += drawn.nodes;
+}
+
+std::map<std::string, double> GpuLodMode::info() const {
+  terrain::GpuLodTerrain& lod = run_->gpuLod();
+  return {{"pixel_error", high_ ? run_->high_error : run_->low_error},
+          {"patch_cells", double(lod.lod().patchCells())},
+          {"levels", double(lod.lod().levels())},
+          {"nodes_mean", frames_ ? double(nodes_) / double(frames_) : 0.0},
+          {"gpu_bytes", double(lod.gpuBytes())}};
 }
 
 TiledLodMode::~TiledLodMode() {
@@ -246,6 +282,10 @@ std::map<std::string, double> TileSpriteMode::info() const {
 void registerTerrainModes() {
   registerMode("high", "terrain: high-resolution quadtree LOD (--mode-option terrain=DEM)",
                [](const ModeContext&) { return std::make_unique<LodMode>("high", true); });
+  registerMode("high-gpu", "terrain: CDLOD on the GPU at the high threshold (--mode-option terrain=DEM)",
+               [](const ModeContext&) { return std::make_unique<GpuLodMode>("high-gpu", true); });
+  registerMode("low-gpu", "terrain: CDLOD on the GPU at the low threshold (--mode-option terrain=DEM)",
+               [](const ModeContext&) { return std::make_unique<GpuLodMode>("low-gpu", false); });
   registerMode("high-tiles",
                "terrain: the high LOD built per tile from tiles paged under a budget (--mode-option terrain=DEM, "
                "tile_blocks=N, tile_budget_mb=MB)",

@@ -20,6 +20,7 @@
 #include "farfield/core/math.h"
 #include "farfield/eval/mode.h"
 #include "farfield/gpu/terrain_renderer.h"
+#include "farfield/terrain/gpu_lod.h"
 #include "farfield/terrain/lod_sprite.h"
 #include "farfield/terrain/paged_terrain.h"
 #include "farfield/terrain/quadtree_lod.h"
@@ -50,6 +51,12 @@ struct TerrainRun {
   std::map<std::string, std::vector<SpriteLog>> logs;  // sprite mode name -> frames of its last pass
 
   gpu::TerrainRenderer& gpuRenderer();
+  // The CDLOD terrain on the GPU (terrain/gpu_lod.h), made by the first call (needs a current context) with that
+  // call's patch size.
+  terrain::GpuLodTerrain& gpuLod(int patch_cells = 16);
+
+ private:
+  std::unique_ptr<terrain::GpuLodTerrain> gpu_lod_;
 };
 
 // The run the terrain modes use; null when none is set (the first terrain mode then loads one from its options).
@@ -82,6 +89,25 @@ class LodMode : public Mode {
   bool high_;
   std::shared_ptr<TerrainRun> run_;
   terrain::LodMesh mesh_;
+};
+
+// `high-gpu` and `low-gpu`: the CDLOD terrain (terrain/cdlod.h) at the run's high and low thresholds, selected on the
+// CPU and drawn as one instanced draw whose vertex shader fetches heights and morphs between levels. Mode option:
+// patch_cells=P (quads per patch side, a power of two, default 16). info(): pixel_error, patch_cells, levels,
+// nodes_mean (drawn per frame), gpu_bytes.
+class GpuLodMode : public Mode {
+ public:
+  GpuLodMode(std::string name, bool high) : name_(std::move(name)), high_(high) {}
+  std::string name() const override { return name_; }
+  void prepare(const ModeContext& context) override;
+  void frame(FrameContext& frame) override;
+  std::map<std::string, double> info() const override;
+
+ private:
+  std::string name_;
+  bool high_;
+  std::shared_ptr<TerrainRun> run_;
+  size_t frames_ = 0, nodes_ = 0;
 };
 
 // `high-tiles`: the high LOD built per tile from a tile cache of the run's terrain paged under a budget

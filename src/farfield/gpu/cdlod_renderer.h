@@ -1,0 +1,82 @@
+// The GPU half of the CDLOD terrain (terrain/cdlod.h, Strugar 2009): one static grid patch of P x P quads drawn as
+// instances of one draw, a node per instance; the vertex shader places each patch vertex on the grid, fetches its
+// height from a texture of the whole grid (R32F, one texel per grid point), and morphs it towards the next coarser
+// level by its distance from the eye and the morph range of the nodes of the next level it lies in (a buffer of the
+// ranges of every node, uploaded when they change: when the image height, field of view or bound change). Per frame
+// the CPU uploads the selected nodes (16 bytes each); nothing is read back and nothing waits.
+//
+// Conventions as for TerrainRenderer: reversed Z, counter-clockwise front faces seen from above, unlit, the original
+// texture at uv = world_xy * uv_scale + uv_offset, object id 1 to attachment 1; no clear, no wait.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/program.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/gpu/renderer.h"
+#include "farfield/gpu/texture.h"
+#include "farfield/image/image.h"
+
+namespace farfield::gpu {
+
+// One drawn node: the grid point of its corner and its level (a vertex every 2^level grid points).
+struct CdlodInstance {
+  int32_t x0 = 0, y0 = 0;
+  int32_t level = 0;
+  int32_t unused = 0;
+};
+
+class CdlodRenderer {
+ public:
+  static constexpr int kMaxLevels = 25;
+  // Needs a current context. heights: width x height grid points, row-major, row 0 the south edge (terrain/
+  // heightfield.h); cell: metres between grid points along x and y; patch_cells: P. Throws farfield::Error for an
+  // empty or mismatched grid, a grid larger than the driver's textures, or an empty texture.
+  CdlodRenderer(int width, int height, std::span<const float> heights, Vec2 cell, int patch_cells,
+                const image::ColorImage& texture, Vec2 uv_scale, Vec2 uv_offset);
+  ~CdlodRenderer();
+  CdlodRenderer(const CdlodRenderer&) = delete;
+  CdlodRenderer& operator=(const CdlodRenderer&) = delete;
+
+  // The node grid of each level: its first index in the range buffer and its node counts along x and y (levels
+  // 0..top, at most kMaxLevels). Throws farfield::Error for more levels or mismatched arrays.
+  void setLevels(std::span<const int> offsets, std::span<const IVec2> counts);
+  // The morph range (start, end) of every node, indexed as setLevels says (a node's range applies to the vertices of
+  // the level below inside it; no morph where end is not above start), kept in one of kRangeSlots slots (one per
+  // bound in use: ranges depend on it). Uploaded once; call again when they change.
+  static constexpr int kRangeSlots = 4;
+  void setRanges(std::span<const Vec2> ranges, int slot = 0);
+  // Draws the nodes with a slot's ranges. Throws farfield::Error before setLevels, or for a slot never set.
+  FrameStats draw(const Camera& camera, RenderTarget& target, std::span<const CdlodInstance> nodes, int slot = 0);
+
+  // As TerrainRenderer::setDepthBias.
+  void setDepthBias(float slope_factor, float units) {
+    bias_factor_ = slope_factor;
+    bias_units_ = units;
+  }
+  int patchCells() const { return patch_cells_; }
+  size_t trianglesPerNode() const { return size_t(2) * size_t(patch_cells_) * size_t(patch_cells_); }
+  size_t gpuBytes() const;
+
+ private:
+  int width_, height_, patch_cells_;
+  Vec2 cell_;
+  uint32_t vao_ = 0, ibo_ = 0, nodes_ = 0;
+  uint32_t ranges_[kRangeSlots] = {};
+  size_t range_bytes_[kRangeSlots] = {};
+  size_t node_capacity_ = 0;
+  int top_ = -1;
+  std::vector<int> level_offset_;
+  std::vector<IVec2> level_count_;
+  size_t index_count_ = 0;
+  Texture heights_;
+  Texture texture_;
+  Program program_;
+  Vec2 uv_scale_, uv_offset_;
+  float bias_factor_ = 0.0f, bias_units_ = 0.0f;
+};
+
+}  // namespace farfield::gpu

@@ -1,0 +1,58 @@
+#version 450 core
+// Farfield CDLOD terrain vertex shader (gpu/cdlod_renderer.h; the arithmetic of terrain/cdlod.cpp's
+// CdlodTerrain::vertex, which the tests compare): patch vertex (i, j) from gl_VertexID, its node from the instance.
+
+layout(std430, binding = 0) readonly buffer Nodes { ivec4 nodes[]; };  // x0, y0, level, unused
+layout(std430, binding = 1) readonly buffer Ranges { vec2 ranges[]; };  // per node: morph start and end
+layout(binding = 1) uniform sampler2D u_heights;                        // R32F, a texel per grid point
+
+uniform mat4 u_view_proj;
+uniform vec3 u_eye;
+uniform vec2 u_cell;      // metres per grid step
+uniform ivec2 u_last;     // the last grid point: (width - 1, height - 1)
+uniform int u_patch;      // quads per patch side
+uniform int u_top;                // the top level (never morphs)
+uniform int u_level_offset[25];   // per level: index of node (0, 0) in `ranges`
+uniform ivec2 u_level_count[25];  // per level: nodes along x and y
+uniform vec2 u_uv_scale;
+uniform vec2 u_uv_offset;
+
+out vec2 v_uv;
+
+float heightAt(vec2 g) {
+  g = clamp(g, vec2(0.0), vec2(u_last));
+  ivec2 p0 = min(ivec2(floor(g)), u_last);
+  ivec2 p1 = min(p0 + 1, u_last);
+  vec2 f = g - vec2(p0);
+  float a = texelFetch(u_heights, p0, 0).r * (1.0 - f.x) + texelFetch(u_heights, ivec2(p1.x, p0.y), 0).r * f.x;
+  float b = texelFetch(u_heights, ivec2(p0.x, p1.y), 0).r * (1.0 - f.x) + texelFetch(u_heights, p1, 0).r * f.x;
+  return a * (1.0 - f.y) + b * f.y;
+}
+
+void main() {
+  ivec4 node = nodes[gl_InstanceID];
+  int i = gl_VertexID % (u_patch + 1), j = gl_VertexID / (u_patch + 1);
+  int s = 1 << node.z;
+  ivec2 g = node.xy + ivec2(i, j) * s;
+  ivec2 c = min(g, u_last);
+  vec3 unmorphed = vec3(vec2(c) * u_cell, texelFetch(u_heights, c, 0).r);
+  float d = length(u_eye - unmorphed);
+  float k = 0.0;
+  if (node.z < u_top) {
+    // The range: the largest over the next level's nodes the vertex lies in (two or four on their borders).
+    int up = node.z + 1, cells = u_patch << up;
+    ivec2 count = u_level_count[up];
+    ivec2 hi = min(c / cells, count - 1);
+    ivec2 lo = min(ivec2(c.x % cells == 0 && c.x > 0 ? c.x / cells - 1 : hi.x,
+                         c.y % cells == 0 && c.y > 0 ? c.y / cells - 1 : hi.y), count - 1);
+    int base = u_level_offset[up];
+    vec2 m = max(max(ranges[base + lo.x + lo.y * count.x], ranges[base + hi.x + lo.y * count.x]),
+                 max(ranges[base + lo.x + hi.y * count.x], ranges[base + hi.x + hi.y * count.x]));
+    if (m.y > m.x) k = clamp((d - m.x) / (m.y - m.x), 0.0, 1.0);
+  }
+  vec2 gm = vec2(g) - vec2(float(i & 1), float(j & 1)) * (float(s) * k);
+  gm = min(gm, vec2(u_last));
+  vec3 world = vec3(gm * u_cell, heightAt(gm));
+  v_uv = world.xy * u_uv_scale + u_uv_offset;
+  gl_Position = u_view_proj * vec4(world, 1.0);
+}

@@ -1,0 +1,71 @@
+#include "farfield/terrain/gpu_lod.h"
+
+#include <vector>
+
+#include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_texture.h"
+
+namespace farfield::terrain {
+namespace {
+
+Vec2 uvScale(const Heightfield& hf) {
+  Vec2 scale, offset;
+  texCoordTransform(hf, scale, offset);
+  return scale;
+}
+
+Vec2 uvOffset(const Heightfield& hf) {
+  Vec2 scale, offset;
+  texCoordTransform(hf, scale, offset);
+  return offset;
+}
+
+}  // namespace
+
+GpuLodTerrain::GpuLodTerrain(const Heightfield& hf, const image::ColorImage& texture, const CdlodOptions& options)
+    : lod_(hf, options),
+      renderer_(hf.width, hf.height, hf.heights, Vec2(float(hf.cell_x), float(hf.cell_y)), options.patch_cells,
+                texture, uvScale(hf), uvOffset(hf)) {
+  std::vector<int> offsets;
+  std::vector<IVec2> counts;
+  for (int l = 0; l <= lod_.topLevel(); ++l) {
+    offsets.push_back(int(lod_.levelOffset(l)));
+    counts.emplace_back(lod_.nodesX(l), lod_.nodesY(l));
+  }
+  renderer_.setLevels(offsets, counts);
+}
+
+GpuLodFrame GpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull) {
+  // The slot whose ranges were made for this bound, else the least recently used one.
+  const double scale = QuadtreeLod::pixelsPerRadian(camera) / double(pixel_error);
+  int slot = 0;
+  for (int s = 0; s < gpu::CdlodRenderer::kRangeSlots; ++s) {
+    if (selections_[s].ranges.scale == scale) {
+      slot = s;
+      break;
+    }
+    if (used_[s] < used_[slot]) slot = s;
+  }
+  used_[slot] = ++frame_;
+  last_ = slot;
+  CdlodSelection& selection = selections_[slot];
+  lod_.select(camera, pixel_error, cull, selection);
+  if (selection.ranges_changed) {
+    std::vector<Vec2> ranges;
+    ranges.reserve(selection.ranges.node.size());
+    for (const Vec3& r : selection.ranges.node) ranges.emplace_back(r.x, r.y);
+    renderer_.setRanges(ranges, slot);
+  }
+  instances_.clear();
+  const int p = lod_.patchCells();
+  for (const CdlodNode& n : selection.nodes)
+    instances_.push_back({int32_t(n.x * (p << n.level)), int32_t(n.y * (p << n.level)), int32_t(n.level), 0});
+  GpuLodFrame frame;
+  frame.draw = renderer_.draw(camera, target, instances_, slot);
+  frame.nodes = selection.nodes.size();
+  frame.nodes_visited = selection.visited;
+  frame.nodes_culled = selection.culled;
+  return frame;
+}
+
+}  // namespace farfield::terrain

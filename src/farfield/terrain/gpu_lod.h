@@ -1,0 +1,51 @@
+// The CDLOD terrain on the GPU (terrain/cdlod.h's selection, gpu/cdlod_renderer.h's instanced patch): the terrain
+// module's frame for `high-gpu` and `low-gpu`. Per frame: the selection over the node tree on the CPU (a few hundred
+// nodes), an upload of 16 bytes a drawn node, one instanced draw; no per-frame triangle list, no wait.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/cdlod_renderer.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/image/image.h"
+#include "farfield/terrain/cdlod.h"
+#include "farfield/terrain/heightfield.h"
+
+namespace farfield::terrain {
+
+struct GpuLodFrame {
+  gpu::FrameStats draw;     // triangles (every drawn node's patch, degenerate ones included), one draw call
+  size_t nodes = 0;         // drawn
+  size_t nodes_visited = 0; // tested by the selection
+  size_t nodes_culled = 0;  // left out by the frustum
+};
+
+class GpuLodTerrain {
+ public:
+  // Needs a current context; hf must outlive this. texture: the terrain's original texture, placed as
+  // texCoordTransform (terrain_texture.h) places it. Throws farfield::Error as CdlodTerrain and CdlodRenderer do.
+  GpuLodTerrain(const Heightfield& hf, const image::ColorImage& texture, const CdlodOptions& options = {});
+
+  // Selects and draws the terrain for the camera under the bound (pixels) into the bound target (not cleared).
+  GpuLodFrame draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull = true);
+
+  const CdlodTerrain& lod() const { return lod_; }
+  const CdlodSelection& lastSelection() const { return selections_[last_]; }
+  gpu::CdlodRenderer& renderer() { return renderer_; }
+  size_t gpuBytes() const { return renderer_.gpuBytes(); }
+
+ private:
+  CdlodTerrain lod_;
+  gpu::CdlodRenderer renderer_;
+  // One selection (with its ranges) per bound in use, each drawn with its own range slot; the least recently used
+  // is remade for a new bound.
+  CdlodSelection selections_[gpu::CdlodRenderer::kRangeSlots];
+  uint64_t used_[gpu::CdlodRenderer::kRangeSlots] = {};
+  uint64_t frame_ = 0;
+  int last_ = 0;
+  std::vector<gpu::CdlodInstance> instances_;
+};
+
+}  // namespace farfield::terrain
