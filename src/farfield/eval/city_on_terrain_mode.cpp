@@ -50,8 +50,8 @@ void checkGroundLiesOnTerrain(const scene::Scene& scene, const scene::Object& gr
 
 CityOnTerrainMode::CityOnTerrainMode(std::string terrain, std::string city)
     : terrain_(std::move(terrain)), city_(std::move(city)) {
-  if (terrain_ != "high" && terrain_ != "lod-sprite")
-    throw Error("mode " + name(), "the terrain technique must be high or lod-sprite");
+  if (terrain_ != "high" && terrain_ != "high-gpu" && terrain_ != "lod-sprite")
+    throw Error("mode " + name(), "the terrain technique must be high, high-gpu or lod-sprite");
 }
 
 void CityOnTerrainMode::prepare(const ModeContext& context) {
@@ -73,6 +73,7 @@ void CityOnTerrainMode::prepare(const ModeContext& context) {
     break;
   }
   gpu::TerrainRenderer& renderer = run_->gpuRenderer();
+  if (terrain_ == "high-gpu") run_->gpuLod();
   if (terrain_ == "lod-sprite") {
     // LOD-sprite's per-frame choice needs this machine's terrain costs (terrain bench calibrates them on its path).
     if (!run_->cost) run_->cost = terrain::calibrateTerrainCost(*data.lod, renderer, calibrationViews(context));
@@ -133,6 +134,17 @@ void CityOnTerrainMode::frame(FrameContext& frame) {
   renderer.setDepthBias(kDepthBiasSlopes, kDepthBiasSlopes);
   if (sprite_) {
     stats = sprite_->render(camera, target);
+  } else if (terrain_ == "high-gpu") {
+    // The hole: the same grid rectangle as the CPU LOD's, in world x, y; fragments strictly inside are left out.
+    gpu::CdlodRenderer& cdlod = run_->gpuLod().renderer();
+    const terrain::Heightfield& hf = run_->data->hf;
+    if (!hole_.empty())
+      cdlod.setHole(Vec2(float(hole_.x0 * hf.cell_x), float(hole_.y0 * hf.cell_y)),
+                    Vec2(float(hole_.x1 * hf.cell_x), float(hole_.y1 * hf.cell_y)));
+    cdlod.setDepthBias(kDepthBiasSlopes, kDepthBiasSlopes);
+    stats = run_->gpuLod().draw(camera, run_->high_error, target).draw;
+    cdlod.setDepthBias(0.0f, 0.0f);
+    cdlod.clearHole();
   } else {
     stats = terrain::renderLodFrame(*run_->data->lod, renderer, camera,
                                     terrain::LodSettings{run_->high_error, true, false}, target, mesh_, hole_);
@@ -163,7 +175,7 @@ std::map<std::string, double> CityOnTerrainMode::info() const {
 }
 
 void registerCityOnTerrainModes() {
-  for (const char* terrain : {"high", "lod-sprite"})
+  for (const char* terrain : {"high", "high-gpu", "lod-sprite"})
     for (const char* city : {"culled", "dynamic-shade"}) {
       const std::string t = terrain, c = city;
       registerMode("terrain-" + t + "+" + c,

@@ -70,6 +70,13 @@ void CdlodRenderer::setLevels(std::span<const int> offsets, std::span<const IVec
   top_ = int(offsets.size()) - 1;
 }
 
+void CdlodRenderer::setHole(Vec2 lo, Vec2 hi) {
+  if (!hole_program_.handle())
+    hole_program_ = Program::fromEmbedded("cdlod.vert.glsl", "terrain.frag.glsl", "#define FF_HOLE 1");
+  hole_ = true;
+  hole_rect_ = Vec4(lo, hi);
+}
+
 void CdlodRenderer::setRanges(std::span<const Vec2> ranges, int slot) {
   if (ranges.empty()) throw Error("CDLOD renderer", "no node ranges");
   if (slot < 0 || slot >= kRangeSlots) throw Error("CDLOD renderer", "no range slot " + std::to_string(slot));
@@ -95,19 +102,21 @@ FrameStats CdlodRenderer::draw(const Camera& camera, RenderTarget& target, std::
   glNamedBufferSubData(nodes_, 0, GLsizeiptr(bytes), nodes.data());
 
   target.bindForOpaquePass();
-  program_.use();
-  program_.set("u_view_proj", camera.viewProjection());
-  program_.set("u_eye", camera.eye);
-  glUniform2fv(program_.uniformLocation("u_cell"), 1, glm::value_ptr(cell_));
-  glUniform2i(program_.uniformLocation("u_last"), width_ - 1, height_ - 1);
-  program_.set("u_patch", patch_cells_);
-  program_.set("u_top", top_);
-  glUniform1iv(program_.uniformLocation("u_level_offset[0]"), GLsizei(level_offset_.size()), level_offset_.data());
-  glUniform2iv(program_.uniformLocation("u_level_count[0]"), GLsizei(level_count_.size()),
+  Program& program = hole_ ? hole_program_ : program_;
+  program.use();
+  program.set("u_view_proj", camera.viewProjection());
+  program.set("u_eye", camera.eye);
+  glUniform2fv(program.uniformLocation("u_cell"), 1, glm::value_ptr(cell_));
+  glUniform2i(program.uniformLocation("u_last"), width_ - 1, height_ - 1);
+  program.set("u_patch", patch_cells_);
+  program.set("u_top", top_);
+  glUniform1iv(program.uniformLocation("u_level_offset[0]"), GLsizei(level_offset_.size()), level_offset_.data());
+  glUniform2iv(program.uniformLocation("u_level_count[0]"), GLsizei(level_count_.size()),
                glm::value_ptr(level_count_[0]));
-  glUniform2fv(program_.uniformLocation("u_uv_scale"), 1, glm::value_ptr(uv_scale_));
-  glUniform2fv(program_.uniformLocation("u_uv_offset"), 1, glm::value_ptr(uv_offset_));
-  program_.set("u_object_id", uint32_t(1));
+  glUniform2fv(program.uniformLocation("u_uv_scale"), 1, glm::value_ptr(uv_scale_));
+  glUniform2fv(program.uniformLocation("u_uv_offset"), 1, glm::value_ptr(uv_offset_));
+  program.set("u_object_id", uint32_t(1));
+  if (hole_) program.set("u_hole", hole_rect_);
   texture_.bind(0);
   heights_.bind(1);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, nodes_);

@@ -57,6 +57,10 @@ class CdlodRenderer {
     bias_factor_ = slope_factor;
     bias_units_ = units;
   }
+  // Leaves out the ground inside a rectangle of world x, y (lo, hi), which someone else draws (a city's ground);
+  // clearHole draws it all again. Applies to the draws that follow.
+  void setHole(Vec2 lo, Vec2 hi);
+  void clearHole() { hole_ = false; }
   int patchCells() const { return patch_cells_; }
   size_t trianglesPerNode() const { return size_t(2) * size_t(patch_cells_) * size_t(patch_cells_); }
   size_t gpuBytes() const;
@@ -75,6 +79,9 @@ class CdlodRenderer {
   Texture heights_;
   Texture texture_;
   Program program_;
+  Program hole_program_;  // made by the first setHole
+  bool hole_ = false;
+  Vec4 hole_rect_{0.0f};
   Vec2 uv_scale_, uv_offset_;
   float bias_factor_ = 0.0f, bias_units_ = 0.0f;
 };

@@ -18,6 +18,7 @@ uniform vec2 u_uv_scale;
 uniform vec2 u_uv_offset;
 
 out vec2 v_uv;
+out vec2 v_world_xy;  // for the fragment shader's hole (terrain.frag.glsl with FF_HOLE)
 
 float heightAt(vec2 g) {
   g = clamp(g, vec2(0.0), vec2(u_last));
@@ -35,11 +36,12 @@ void main() {
   int s = 1 << node.z;
   ivec2 g = node.xy + ivec2(i, j) * s;
   ivec2 c = min(g, u_last);
-  vec3 unmorphed = vec3(vec2(c) * u_cell, texelFetch(u_heights, c, 0).r);
-  float d = length(u_eye - unmorphed);
+  float h0 = texelFetch(u_heights, c, 0).r;
+  ivec2 odd = ivec2(i & 1, j & 1);
   float k = 0.0;
-  if (node.z < u_top) {
+  if (node.z < u_top && (odd.x | odd.y) != 0) {  // even vertices never move
     // The range: the largest over the next level's nodes the vertex lies in (two or four on their borders).
+    float d = length(u_eye - vec3(vec2(c) * u_cell, h0));
     int up = node.z + 1, cells = u_patch << up;
     ivec2 count = u_level_count[up];
     ivec2 hi = min(c / cells, count - 1);
@@ -50,9 +52,11 @@ void main() {
                  max(ranges[base + lo.x + hi.y * count.x], ranges[base + hi.x + hi.y * count.x]));
     if (m.y > m.x) k = clamp((d - m.x) / (m.y - m.x), 0.0, 1.0);
   }
-  vec2 gm = vec2(g) - vec2(float(i & 1), float(j & 1)) * (float(s) * k);
+  vec2 gm = vec2(g) - vec2(odd) * (float(s) * k);
   gm = min(gm, vec2(u_last));
-  vec3 world = vec3(gm * u_cell, heightAt(gm));
+  // Unmoved (k = 0, or an even vertex): the grid point's height, which the bilinear interpolation gives exactly.
+  vec3 world = vec3(gm * u_cell, k > 0.0 ? heightAt(gm) : h0);
   v_uv = world.xy * u_uv_scale + u_uv_offset;
+  v_world_xy = world.xy;
   gl_Position = u_view_proj * vec4(world, 1.0);
 }

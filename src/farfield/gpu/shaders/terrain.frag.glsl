@@ -2,6 +2,7 @@
 // Farfield terrain fragment shader (gpu/terrain_renderer.h), unlit: the original texture, or with FF_SPRITE the
 // sprite (an earlier frame) projected through the sprite camera: the clip position is interpolated perspective-
 // correctly and divided per fragment, so a point of the surface samples the sprite where the sprite camera saw it.
+// With FF_HOLE (the CDLOD terrain, gpu/cdlod_renderer.h), fragments inside a rectangle of world x, y are left out.
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uint o_id;
@@ -13,8 +14,16 @@ in vec4 v_sprite_clip;
 #else
 in vec2 v_uv;
 #endif
+#ifdef FF_HOLE
+// A rectangle of the ground (world x, y: lo, hi) drawn by someone else (a city), left out.
+in vec2 v_world_xy;
+uniform vec4 u_hole;
+#endif
 
 void main() {
+#ifdef FF_HOLE
+  if (all(greaterThan(v_world_xy, u_hole.xy)) && all(lessThan(v_world_xy, u_hole.zw))) discard;
+#endif
 #ifdef FF_SPRITE
   vec2 st = v_sprite_clip.xy / v_sprite_clip.w * 0.5 + 0.5;
   o_color = vec4(texture(u_texture, st).rgb, 1.0);
