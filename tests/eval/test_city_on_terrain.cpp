@@ -174,13 +174,10 @@ TEST(CityOnTerrainGL, TheGpuTerrainFrameIsTheNearerOfTheCityAndTheTerrain) {
   CityOnTerrainMode composite("high-gpu", "culled");
   composite.prepare(res.context);
   TerrainRun& run = *currentTerrainRun();
-  const terrain::GridRect h = composite.hole();
-  const double cx = run.data->hf.cell_x, cy = run.data->hf.cell_y;
   expectTheNearerOfBoth(res, composite, camera, [&](const Camera& moved, gpu::RenderTarget& alone) {
-    gpu::CdlodRenderer& cdlod = run.gpuLod().renderer();
-    cdlod.setHole(Vec2(float(h.x0 * cx), float(h.y0 * cy)), Vec2(float(h.x1 * cx), float(h.y1 * cy)));
+    run.gpuLod().setHole(composite.hole());
     run.gpuLod().draw(moved, run.high_error, alone);
-    cdlod.clearHole();
+    run.gpuLod().clearHole();
   });
   // The hole leaves out the terrain under the city (the check above cannot tell: the city's ground wins there).
   gpu::RenderTarget alone(camera.width, camera.height);
@@ -188,9 +185,9 @@ TEST(CityOnTerrainGL, TheGpuTerrainFrameIsTheNearerOfTheCityAndTheTerrain) {
   run.gpuLod().draw(composite.terrainCamera(camera), run.high_error, alone);
   gpu::RenderTarget alone_hole(camera.width, camera.height);
   alone_hole.clear(res.renderer.light().sky_color);
-  run.gpuLod().renderer().setHole(Vec2(float(h.x0 * cx), float(h.y0 * cy)), Vec2(float(h.x1 * cx), float(h.y1 * cy)));
+  run.gpuLod().setHole(composite.hole());
   run.gpuLod().draw(composite.terrainCamera(camera), run.high_error, alone_hole);
-  run.gpuLod().renderer().clearHole();
+  run.gpuLod().clearHole();
   const image::IdImage ids = alone.readIds(), ids_hole = alone_hole.readIds();
   size_t terrain_px = 0, terrain_px_hole = 0;
   for (int y = 0; y < camera.height; ++y)

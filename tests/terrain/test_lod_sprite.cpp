@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/terrain_renderer.h"
@@ -357,6 +358,73 @@ TEST(LodSpriteGL, ChoiceSwitchesToTheSpriteWhenTheVirtualKeyframeLastsLongEnough
   EXPECT_GE(s.predicted_keyframe_ms + (age - 2.0) * s.predicted_sprite_ms, (age - 1.0) * s.predicted_high_ms);
   for (size_t f = first_sprite + 1; f < infos.size(); ++f) EXPECT_EQ(infos[f].source, SpriteSource::Kept);
   EXPECT_EQ(sprite.counters().switches, 1u);
+}
+
+}  // namespace
+}  // namespace farfield::terrain
+
+namespace farfield::terrain {
+namespace {
+
+// LodSpriteOptions::gpu_high: the high LOD is the CDLOD terrain's. Where its frames are predicted cheap, every frame
+// is the CDLOD frame, pixel for pixel; where they are expensive, the sprite path is taken and each keyframe is the
+// CDLOD terrain drawn at the keyframe's camera. Without a CDLOD cost model the choice is refused.
+TEST(LodSpriteGL, TheGpuHighLodDrawsHighFramesAndKeyframes) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  const std::vector<Camera> cameras = choicePath(scene.hf, 16);
+  LodSpriteOptions options;
+  options.sky_color = kSky;
+  options.gpu_high = &gpu_lod;
+  gpu::RenderTarget frame(128, 128), expected(128, 128);
+
+  TerrainCost cheap;  // sprite frames cost 2 draws, CDLOD frames nothing
+  cheap.frame.ms_per_draw = 3.0;
+  cheap.gpu_high = gpu::CostModel{};
+  cheap.gpu_high->base_ms = 0.5;
+  options.cost = &cheap;
+  {
+    LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+    for (size_t f = 0; f < cameras.size(); ++f) {
+      frame.clear(kSky);
+      LodSpriteFrameInfo info;
+      sprite.render(cameras[f], frame, &info);
+      EXPECT_EQ(info.path, TerrainPath::High) << "frame " << f;
+      EXPECT_DOUBLE_EQ(info.predicted_high_ms, 0.5) << "frame " << f;
+      EXPECT_EQ(info.high_triangles % (2 * 8 * 8), 0u) << "CDLOD patches";
+      expected.clear(kSky);
+      gpu_lod.draw(cameras[f], options.high_error, expected);
+      EXPECT_EQ(frame.readColor().pixels(), expected.readColor().pixels()) << "frame " << f;
+    }
+  }
+
+  TerrainCost expensive = cheap;  // now the CDLOD frames cost a lot
+  expensive.gpu_high->base_ms = 50.0;
+  expensive.frame.ms_per_draw = 0.1;
+  options.cost = &expensive;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  size_t keyframes = 0;
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    sprite.render(cameras[f], frame, &info);
+    if (info.source != SpriteSource::Fresh) continue;
+    ++keyframes;
+    EXPECT_GT(info.keyframe_triangles, 0u);
+    EXPECT_EQ(info.keyframe_triangles % (2 * 8 * 8), 0u);
+    const Camera& key = *sprite.spriteCamera();
+    gpu::RenderTarget key_expected(key.width, key.height);
+    key_expected.clear(kSky);
+    gpu_lod.draw(key, options.high_error, key_expected);
+    EXPECT_EQ(sprite.spriteTarget()->readColor().pixels(), key_expected.readColor().pixels()) << "frame " << f;
+  }
+  EXPECT_GE(keyframes, 1u);
+  EXPECT_GE(sprite.counters().frames - sprite.counters().high_frames, cameras.size() / 2);
+
+  TerrainCost without = cheap;
+  without.gpu_high.reset();
+  options.cost = &without;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, options), Error);
 }
 
 }  // namespace

@@ -48,6 +48,19 @@ TEST(TerrainCostGL, FitsOneSamplePerWorkloadAndMeasuresTheReadBack) {
   EXPECT_GT(cost.frameMs(1e5, 1, 64, 64), 0.0);
   EXPECT_GE(cost.frameMs(1e6, 1, 64, 64), cost.frameMs(1e3, 1, 64, 64));
   EXPECT_TRUE(cost.toJson()["frame"].contains("ms_per_mtriangle"));
+  EXPECT_FALSE(cost.gpu_high.has_value());
+  EXPECT_FALSE(cost.toJson().contains("gpu_high"));
+
+  // With the CDLOD terrain: its frames too, one sample per size, view and threshold.
+  GpuLodTerrain gpu_lod(hf, texture, CdlodOptions{8, 16, 0.2f});
+  TerrainCostOptions with_gpu = o;
+  with_gpu.gpu_high = &gpu_lod;
+  const TerrainCost both = calibrateTerrainCost(lod, renderer, with_gpu);
+  ASSERT_TRUE(both.gpu_high.has_value());
+  EXPECT_EQ(both.gpu_high->samples, 2u * 2u * 2u);
+  EXPECT_EQ(both.frame.samples, cost.frame.samples);
+  EXPECT_GT(both.gpuHighMs(1e5, 64, 64), 0.0);
+  EXPECT_TRUE(both.toJson().contains("gpu_high"));
 
   TerrainCostOptions bad = o;
   bad.views.clear();

@@ -135,16 +135,12 @@ void CityOnTerrainMode::frame(FrameContext& frame) {
   if (sprite_) {
     stats = sprite_->render(camera, target);
   } else if (terrain_ == "high-gpu") {
-    // The hole: the same grid rectangle as the CPU LOD's, in world x, y; fragments strictly inside are left out.
-    gpu::CdlodRenderer& cdlod = run_->gpuLod().renderer();
-    const terrain::Heightfield& hf = run_->data->hf;
-    if (!hole_.empty())
-      cdlod.setHole(Vec2(float(hole_.x0 * hf.cell_x), float(hole_.y0 * hf.cell_y)),
-                    Vec2(float(hole_.x1 * hf.cell_x), float(hole_.y1 * hf.cell_y)));
-    cdlod.setDepthBias(kDepthBiasSlopes, kDepthBiasSlopes);
-    stats = run_->gpuLod().draw(camera, run_->high_error, target).draw;
-    cdlod.setDepthBias(0.0f, 0.0f);
-    cdlod.clearHole();
+    terrain::GpuLodTerrain& lod = run_->gpuLod();
+    lod.setHole(hole_);  // the quadtree's hole, left out by the fragment shader
+    lod.renderer().setDepthBias(kDepthBiasSlopes, kDepthBiasSlopes);
+    stats = lod.draw(camera, run_->high_error, target).draw;
+    lod.renderer().setDepthBias(0.0f, 0.0f);
+    lod.clearHole();
   } else {
     stats = terrain::renderLodFrame(*run_->data->lod, renderer, camera,
                                     terrain::LodSettings{run_->high_error, true, false}, target, mesh_, hole_);

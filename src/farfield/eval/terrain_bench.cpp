@@ -11,6 +11,7 @@
 #include <fstream>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -231,7 +232,9 @@ void calibrate(Experiment& x) {
   std::vector<Camera> views;
   const size_t n = x.path.frames.size();
   for (size_t k = 0; k < 5; ++k) views.push_back(x.cameraAt(x.path, std::min(n - 1, (2 * k + 1) * n / 10)));
-  const terrain::TerrainCostOptions c = spriteCostOptions(*x.run, std::move(views), o.width, o.height);
+  const bool gpu_sprite = std::find(o.modes.begin(), o.modes.end(), "lod-sprite-gpu") != o.modes.end();
+  const terrain::TerrainCostOptions c = spriteCostOptions(*x.run, std::move(views), o.width, o.height,
+                                                          gpu_sprite ? &x.run->gpuLod() : nullptr);
   x.run->cost = terrain::calibrateTerrainCost(*x.data().lod, x.run->gpuRenderer(), c);
   x.result.cost = x.run->cost;
   const gpu::CostModel& m = x.run->cost->frame;
@@ -240,6 +243,9 @@ void calibrate(Experiment& x) {
       "z-buffer read back %.3f ms/Mpixel\n",
       m.base_ms, m.ms_per_mtriangle, m.ms_per_draw, m.ms_per_mpixel, m.r2, m.rms_error_ms,
       x.run->cost->readback_ms_per_mpixel);
+  if (const std::optional<gpu::CostModel>& g = x.run->cost->gpu_high)
+    say(o, "cost:    CDLOD frame = %.3f ms + %.3f ms/Mtriangle + %.3f ms/Mpixel (r2 %.3f, rms %.3f ms)\n", g->base_ms,
+        g->ms_per_mtriangle, g->ms_per_mpixel, g->r2, g->rms_error_ms);
 }
 
 // 1. The benchmark harness: every mode interleaved, timed, with bench.json.
@@ -290,9 +296,11 @@ void runQuality(Experiment& x) {
   std::vector<std::pair<std::string, std::unique_ptr<terrain::LodSpriteRenderer>>> sprites;
   for (const std::string& name : o.modes) {
     SpriteVariant variant;
-    if (!spriteVariantOf(name, variant)) continue;
+    bool gpu_high = false;
+    if (!spriteVariantOf(name, variant, &gpu_high)) continue;
     sprites.emplace_back(name, std::make_unique<terrain::LodSpriteRenderer>(
-                                   *data.lod, renderer, o.width, o.height, spriteOptions(*x.run, variant, o.epsilon)));
+                                   *data.lod, renderer, o.width, o.height,
+                                   spriteOptions(*x.run, variant, o.epsilon, gpu_high ? &x.run->gpuLod() : nullptr)));
   }
   std::vector<std::pair<std::string, std::unique_ptr<terrain::TileSpriteRenderer>>> tiles;
   for (const std::string& name : o.modes) {
@@ -729,6 +737,10 @@ void writeSummary(Experiment& x) {
        << " ms + " << num(c.ms_per_mtriangle, 1) << " ms/Mtriangle + " << num(c.ms_per_draw, 3) << " ms/draw + "
        << num(c.ms_per_mpixel, 2) << " ms/Mpixel (r2 " << num(c.r2, 3) << "), z-buffer read back "
        << num(r.cost->readback_ms_per_mpixel, 3) << " ms/Mpixel";
+    if (const std::optional<gpu::CostModel>& g = r.cost->gpu_high)
+      md << "; CDLOD frames (lod-sprite-gpu's high frames and keyframes): " << num(g->base_ms, 3) << " ms + "
+         << num(g->ms_per_mtriangle, 1) << " ms/Mtriangle + " << num(g->ms_per_mpixel, 2) << " ms/Mpixel (r2 "
+         << num(g->r2, 3) << ")";
     const auto& check = summary["cost_model"]["measured_over_predicted"];
     for (const char* k : {"high", "sprite_kept"})
       if (check.contains(k))

@@ -149,20 +149,24 @@ std::map<std::string, double> TiledLodMode::info() const {
           {"patch_gpu_budget_bytes", double(paged_->budget())}};
 }
 
-terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon) {
+terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon,
+                                        terrain::GpuLodTerrain* gpu_high) {
   terrain::LodSpriteOptions o;
+  o.gpu_high = gpu_high;
   o.epsilon = epsilon;
   o.high_error = run.high_error;
   o.low_error = run.low_error;
   o.sky_color = run.sky;
-  if (variant == SpriteVariant::Paper && run.cost) o.cost = &*run.cost;
+  if (variant == SpriteVariant::Paper && run.cost && (!gpu_high || run.cost->gpu_high)) o.cost = &*run.cost;
   if (variant == SpriteVariant::Predict) o.predict = true;
   if (variant == SpriteVariant::Cache) o.cache_size = 8;
   return o;
 }
 
-terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector<Camera> views, int width, int height) {
+terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector<Camera> views, int width, int height,
+                                              terrain::GpuLodTerrain* gpu_high) {
   terrain::TerrainCostOptions c;
+  c.gpu_high = gpu_high;
   c.views = std::move(views);
   const Camera key = terrain::guardBandCamera(Camera{}, width, height, terrain::LodSpriteOptions{}.keyframe_margin);
   c.keyframe_width = key.width;
@@ -171,8 +175,9 @@ terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector
   return c;
 }
 
-bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant) {
-  if (mode_name == "lod-sprite") variant = SpriteVariant::Paper;
+bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant, bool* gpu_high) {
+  if (gpu_high) *gpu_high = mode_name == "lod-sprite-gpu";
+  if (mode_name == "lod-sprite" || mode_name == "lod-sprite-gpu") variant = SpriteVariant::Paper;
   else if (mode_name == "lod-sprite-always") variant = SpriteVariant::Always;
   else if (mode_name == "lod-sprite-predict") variant = SpriteVariant::Predict;
   else if (mode_name == "lod-sprite-cache") variant = SpriteVariant::Cache;
@@ -182,7 +187,8 @@ bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant) {
 
 void SpriteMode::prepare(const ModeContext& context) {
   run_ = terrainRunFor(context, name_);
-  const terrain::LodSpriteOptions o = spriteOptions(*run_, variant_, epsilon_ > 0.0 ? epsilon_ : run_->epsilon);
+  const terrain::LodSpriteOptions o = spriteOptions(*run_, variant_, epsilon_ > 0.0 ? epsilon_ : run_->epsilon,
+                                                    gpu_high_ ? &run_->gpuLod() : nullptr);
   sprite_ = std::make_unique<terrain::LodSpriteRenderer>(*run_->data->lod, run_->gpuRenderer(), context.width,
                                                          context.height, o);
 }
@@ -296,6 +302,12 @@ void registerTerrainModes() {
                "terrain: LOD-sprite, Chen et al. 1999, choosing per frame between it and the high LOD by the calibrated "
                "cost (terrain bench; --mode-option terrain=DEM, epsilon=PX)",
                [](const ModeContext&) { return std::make_unique<SpriteMode>("lod-sprite", SpriteVariant::Paper); });
+  registerMode("lod-sprite-gpu",
+               "terrain: LOD-sprite whose keyframes and high frames are the CDLOD terrain on the GPU, choosing per frame "
+               "by the costs of those frames (terrain bench)",
+               [](const ModeContext&) {
+                 return std::make_unique<SpriteMode>("lod-sprite-gpu", SpriteVariant::Paper, 0.0, true);
+               });
   registerMode("lod-sprite-always", "terrain: LOD-sprite on every frame, the paper's technique without the choice",
                [](const ModeContext&) {
                  return std::make_unique<SpriteMode>("lod-sprite-always", SpriteVariant::Always);

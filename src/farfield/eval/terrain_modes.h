@@ -139,19 +139,25 @@ enum class SpriteVariant { Paper, Always, Predict, Cache };
 
 // The LOD-sprite options of a variant with the run's thresholds (epsilon, pixels, > 0); the one place the
 // variants are defined, shared by the modes and the terrain bench's quality pass.
-terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon);
+// gpu_high: the high-resolution LOD the sprite renderer draws (keyframes and high frames) is that CDLOD terrain
+// (LodSpriteOptions::gpu_high); with the choice, the run's cost model must then have its frames (gpu_high fitted).
+terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon,
+                                        terrain::GpuLodTerrain* gpu_high = nullptr);
 // What calibrateTerrainCost times for lod-sprite's choice on `views` (frames of width x height): the keyframe target
 // with the guard band, and LOD thresholds spread around the run's high and low ones.
-terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector<Camera> views, int width, int height);
+// gpu_high: also time that CDLOD terrain's frames (TerrainCost::gpu_high).
+terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector<Camera> views, int width, int height,
+                                              terrain::GpuLodTerrain* gpu_high = nullptr);
 // "lod-sprite" -> Paper, "lod-sprite-always" -> Always, "lod-sprite-predict" -> Predict, "lod-sprite-cache" -> Cache; false for other names.
-bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant);
+// "lod-sprite-gpu" is the Paper variant drawing its high-resolution LOD with the CDLOD terrain (gpu_high set).
+bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant, bool* gpu_high = nullptr);
 
 // `lod-sprite` and its section 5 variants. Each pass over the path (the harness's warm-up frame is one) starts
 // from scratch, so the measured pass renders its own first keyframe. epsilon 0 = the run's.
 class SpriteMode : public Mode {
  public:
-  SpriteMode(std::string name, SpriteVariant variant, double epsilon = 0.0)
-      : name_(std::move(name)), variant_(variant), epsilon_(epsilon) {}
+  SpriteMode(std::string name, SpriteVariant variant, double epsilon = 0.0, bool gpu_high = false)
+      : name_(std::move(name)), variant_(variant), epsilon_(epsilon), gpu_high_(gpu_high) {}
   std::string name() const override { return name_; }
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
@@ -165,6 +171,7 @@ class SpriteMode : public Mode {
   std::string name_;
   SpriteVariant variant_;
   double epsilon_;
+  bool gpu_high_;
   std::shared_ptr<TerrainRun> run_;
   std::unique_ptr<terrain::LodSpriteRenderer> sprite_;
   bool started_ = false;

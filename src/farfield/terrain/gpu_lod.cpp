@@ -35,6 +35,16 @@ GpuLodTerrain::GpuLodTerrain(const Heightfield& hf, const image::ColorImage& tex
   renderer_.setLevels(offsets, counts);
 }
 
+void GpuLodTerrain::setHole(const GridRect& hole) {
+  if (hole.empty()) {
+    renderer_.clearHole();
+    return;
+  }
+  const Heightfield& hf = lod_.heightfield();
+  renderer_.setHole(Vec2(float(hole.x0 * hf.cell_x), float(hole.y0 * hf.cell_y)),
+                    Vec2(float(hole.x1 * hf.cell_x), float(hole.y1 * hf.cell_y)));
+}
+
 GpuLodFrame GpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull) {
   // The slot whose ranges were made for this bound, else the least recently used one.
   const double scale = QuadtreeLod::pixelsPerRadian(camera) / double(pixel_error);

@@ -12,6 +12,7 @@
 #include "farfield/image/image.h"
 #include "farfield/terrain/cdlod.h"
 #include "farfield/terrain/heightfield.h"
+#include "farfield/terrain/quadtree_lod.h"
 
 namespace farfield::terrain {
 
@@ -30,6 +31,12 @@ class GpuLodTerrain {
 
   // Selects and draws the terrain for the camera under the bound (pixels) into the bound target (not cleared).
   GpuLodFrame draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull = true);
+
+  // Leaves out the ground of a rectangle of grid points (the quadtree LOD's hole, removeTrianglesInside: a city's
+  // ground drawn by someone else): fragments strictly inside it, in world x, y, are discarded. An empty rectangle
+  // clears it. Applies to the draws that follow.
+  void setHole(const GridRect& hole);
+  void clearHole() { renderer_.clearHole(); }
 
   const CdlodTerrain& lod() const { return lod_; }
   const CdlodSelection& lastSelection() const { return selections_[last_]; }

@@ -84,6 +84,21 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRendere
   if (!(options.keyframe_margin >= 0.0f && options.keyframe_margin <= 1.0f))
     throw Error("lod-sprite", "keyframe margin must be 0..1 (share of the frame size per side)");
   if (options.lifetime_history < 1) throw Error("lod-sprite", "lifetime history must be at least 1 sprite");
+  if (options.gpu_high && options.cost && !options.cost->gpu_high)
+    throw Error("lod-sprite", "the CDLOD high LOD needs a cost model fitted on its frames (TerrainCostOptions::gpu_high)");
+}
+
+gpu::FrameStats LodSpriteRenderer::drawHigh(const Camera& camera, gpu::RenderTarget& target, LodMesh& mesh, int slot) {
+  if (options_.gpu_high) {
+    options_.gpu_high->setHole(options_.hole);
+    const gpu::FrameStats stats = options_.gpu_high->draw(camera, options_.high_error, target).draw;
+    options_.gpu_high->clearHole();
+    return stats;
+  }
+  lod_.build(camera, LodSettings{options_.high_error, true, false}, mesh);
+  removeTrianglesInside(mesh, options_.hole, uint32_t(lod_.width()));
+  renderer_.setIndices(mesh.indices, slot);
+  return renderer_.drawTextured(camera, target, 0, mesh.triangleCount(), slot);
 }
 
 LodSpriteRenderer::~LodSpriteRenderer() = default;
@@ -156,13 +171,11 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
   k->camera = keyframeCamera(camera);
   k->view_proj = k->camera.viewProjection();
   // Figure 3, lines 1 and 5: the high-resolution mesh rendered into the sprite; then the z-buffer is kept.
-  lod_.build(k->camera, LodSettings{options_.high_error, true, false}, high_);
-  removeTrianglesInside(high_, options_.hole, uint32_t(lod_.width()));
-  renderer_.setIndices(high_.indices, 0);
   k->target.clear(options_.sky_color);
-  gpu::addDraw(stats, renderer_.drawTextured(k->camera, k->target, 0, high_.triangleCount(), 0));
-  info.keyframe_triangles += high_.triangleCount();
-  high_triangles_key_ = high_.triangleCount();
+  const gpu::FrameStats key = drawHigh(k->camera, k->target, high_, 0);
+  gpu::addDraw(stats, key);
+  info.keyframe_triangles += key.triangles;
+  high_triangles_key_ = key.triangles;
   high_latest_is_key_ = true;
   k->depth = k->target.readDepth();
   k->ready = true;
@@ -217,8 +230,17 @@ void LodSpriteRenderer::schedulePrediction(const Camera& camera) {
 
 void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info) {
   // Step 0 (the frame after the switch): the mesh; steps 1..chunks: one slice of it each; then the z-buffer.
+  // With the CDLOD terrain: step 0 draws it whole, step 1 reads the z-buffer.
   Keyframe& k = *pending_;
   const size_t chunks = pending_chunks_;
+  if (options_.gpu_high && pending_chunk_ == 0) {
+    k.target.clear(options_.sky_color);
+    const gpu::FrameStats ahead = drawHigh(k.camera, k.target, pending_mesh_, 1);
+    gpu::addDraw(stats, ahead);
+    info.ahead_triangles += ahead.triangles;
+    ++pending_chunk_;
+    return;
+  }
   if (pending_chunk_ == 0) {
     lod_.build(k.camera, LodSettings{options_.high_error, true, false}, pending_mesh_);
     removeTrianglesInside(pending_mesh_, options_.hole, uint32_t(lod_.width()));
@@ -227,13 +249,15 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     ++pending_chunk_;
     return;
   }
-  const size_t total = pending_mesh_.triangleCount();
-  const size_t per_chunk = (total + chunks - 1) / chunks;
-  const size_t first = std::min(total, (pending_chunk_ - 1) * per_chunk);
-  const size_t count = std::min(total - first, per_chunk);
-  gpu::addDraw(stats, renderer_.drawTextured(k.camera, k.target, first, count, 1));
-  info.ahead_triangles += count;
-  if (++pending_chunk_ <= chunks) return;
+  if (!options_.gpu_high) {
+    const size_t total = pending_mesh_.triangleCount();
+    const size_t per_chunk = (total + chunks - 1) / chunks;
+    const size_t first = std::min(total, (pending_chunk_ - 1) * per_chunk);
+    const size_t count = std::min(total - first, per_chunk);
+    gpu::addDraw(stats, renderer_.drawTextured(k.camera, k.target, first, count, 1));
+    info.ahead_triangles += count;
+    if (++pending_chunk_ <= chunks) return;
+  }
   k.depth = k.target.readDepth();
   k.ready = true;
   ++counters_.predicted_rendered;
@@ -253,9 +277,11 @@ PathCosts LodSpriteRenderer::predictCosts(size_t low_triangles) const {
   if (high_latest_is_key_) frame_tris = key_tris / area_ratio;
   else key_tris = frame_tris * area_ratio;
   PathCosts p;
-  p.high_ms = c.frameMs(frame_tris, 1.0, width_, height_);
+  const bool gpu = options_.gpu_high != nullptr;
+  p.high_ms = gpu ? c.gpuHighMs(frame_tris, width_, height_) : c.frameMs(frame_tris, 1.0, width_, height_);
   p.sprite_ms = c.frameMs(double(low_triangles), 2.0, width_, height_);
-  p.keyframe_ms = c.frameMs(key_tris, 1.0, key.width, key.height) + c.readbackMs(key.width, key.height) + p.sprite_ms;
+  p.keyframe_ms = (gpu ? c.gpuHighMs(key_tris, key.width, key.height) : c.frameMs(key_tris, 1.0, key.width, key.height)) +
+                  c.readbackMs(key.width, key.height) + p.sprite_ms;
   return p;
 }
 
@@ -263,10 +289,9 @@ gpu::FrameStats LodSpriteRenderer::renderHigh(const Camera& camera, gpu::RenderT
                                               LodSpriteFrameInfo& info) {
   info.path = TerrainPath::High;
   ++counters_.high_frames;
-  const gpu::FrameStats stats = renderLodFrame(lod_, renderer_, camera, LodSettings{options_.high_error, true, false},
-                                               target, high_, options_.hole);
-  info.high_triangles = high_.triangleCount();
-  high_triangles_frame_ = high_.triangleCount();
+  const gpu::FrameStats stats = drawHigh(camera, target, high_, 0);
+  info.high_triangles = stats.triangles;
+  high_triangles_frame_ = stats.triangles;
   high_latest_is_key_ = false;
   return stats;
 }

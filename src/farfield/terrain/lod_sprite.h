@@ -40,6 +40,7 @@
 #include "farfield/gpu/renderer.h"
 #include "farfield/gpu/terrain_renderer.h"
 #include "farfield/image/image.h"
+#include "farfield/terrain/gpu_lod.h"
 #include "farfield/terrain/keyframe_visibility.h"
 #include "farfield/terrain/path_choice.h"
 #include "farfield/terrain/quadtree_lod.h"
@@ -94,6 +95,11 @@ struct LodSpriteOptions {
   // Grid points whose triangles are not drawn (removeTrianglesInside; every mesh the renderer draws): ground that
   // something else draws, e.g. a city's. The error metric still counts the quadrants there.
   GridRect hole;
+  // The high-resolution LOD (keyframes, predicted keyframes, high frames) drawn by the CDLOD terrain on the GPU
+  // (gpu_lod.h) at high_error instead of the quadtree LOD; null = the quadtree LOD. With a cost model, the high
+  // frames and keyframes are then predicted by its gpu_high model (calibrateTerrainCost with gpu_high), which it must
+  // have. A predicted keyframe is drawn whole in one frame (no slices). Must outlive the renderer.
+  GpuLodTerrain* gpu_high = nullptr;
 };
 
 enum class SpriteSource : uint8_t {
@@ -194,6 +200,9 @@ class LodSpriteRenderer {
   Vec3 anchor_eye_{0.0f};
   uint64_t anchor_since_ = 0;
   std::deque<uint64_t> lifetimes_;
+  // The high-resolution LOD of options_.hole for a camera into a target (bound, not cleared): the CDLOD terrain's or
+  // the quadtree's (mesh: its scratch, slot: the renderer's index slot); returns the draw's counts.
+  gpu::FrameStats drawHigh(const Camera& camera, gpu::RenderTarget& target, LodMesh& mesh, int slot);
   uint64_t high_triangles_frame_ = 0;  // last high-LOD triangle counts seen at the frame's and the keyframe's camera
   uint64_t high_triangles_key_ = 0;
   bool high_latest_is_key_ = false;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
 #include "farfield/gpu/render_target.h"
@@ -15,14 +16,21 @@ double TerrainCost::frameMs(double triangles, double draw_calls, int width, int 
   return frame.predict(triangles, draw_calls, double(width) * double(height)) * safety_factor;
 }
 
+double TerrainCost::gpuHighMs(double triangles, int width, int height) const {
+  FF_CHECK_MSG(gpu_high.has_value(), "no CDLOD frame model was fitted");
+  return gpu_high->predict(triangles, 1.0, double(width) * double(height)) * safety_factor;
+}
+
 double TerrainCost::readbackMs(int width, int height) const {
   return readback_ms_per_mpixel * double(width) * double(height) * 1e-6 * safety_factor;
 }
 
 nlohmann::json TerrainCost::toJson() const {
-  return {{"frame", frame.toJson()},
-          {"readback_ms_per_mpixel", readback_ms_per_mpixel},
-          {"safety_factor", safety_factor}};
+  nlohmann::json j = {{"frame", frame.toJson()},
+                      {"readback_ms_per_mpixel", readback_ms_per_mpixel},
+                      {"safety_factor", safety_factor}};
+  if (gpu_high) j["gpu_high"] = gpu_high->toJson();
+  return j;
 }
 
 namespace {
@@ -50,7 +58,7 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
   const int kw = options.keyframe_width > 0 ? options.keyframe_width : fw;
   const int kh = options.keyframe_height > 0 ? options.keyframe_height : fh;
 
-  std::vector<gpu::CostSample> samples;
+  std::vector<gpu::CostSample> samples, gpu_samples;
   std::vector<double> readback_ms;
   LodMesh mesh;
   const Vec4 sky{0.6f, 0.7f, 0.9f, 1.0f};
@@ -101,6 +109,24 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
           }
           samples.push_back({triangles, double(sprite_calls + 1), double(w) * double(h), median(times)});
         }
+      if (options.gpu_high) {
+        // The CDLOD frames at each threshold (one untimed warm-up draw first: llvmpipe compiles at the first draw).
+        target.clear(sky);
+        options.gpu_high->draw(camera, options.pixel_errors.front(), target);
+        renderer.finish();
+        for (const float tau : options.pixel_errors) {
+          std::vector<double> times;
+          double triangles = 0.0;
+          for (int r = 0; r < options.repeats; ++r) {
+            Stopwatch clock;
+            target.clear(sky);
+            triangles = double(options.gpu_high->draw(camera, tau, target).draw.triangles);
+            renderer.finish();
+            times.push_back(clock.milliseconds());
+          }
+          gpu_samples.push_back({triangles, 1.0, double(w) * double(h), median(times)});
+        }
+      }
       if (size) {
         for (int r = 0; r < options.repeats; ++r) {
           Stopwatch clock;
@@ -112,6 +138,7 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
   }
   TerrainCost cost;
   cost.frame = gpu::CostModel::fit(samples);
+  if (!gpu_samples.empty()) cost.gpu_high = gpu::CostModel::fit(gpu_samples);
   cost.readback_ms_per_mpixel = median(readback_ms) / (double(kw) * double(kh) * 1e-6);
   return cost;
 }

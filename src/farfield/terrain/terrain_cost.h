@@ -8,6 +8,7 @@
 // of its own, linear in the keyframe's pixels.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -15,6 +16,7 @@
 #include "farfield/core/camera.h"
 #include "farfield/gpu/cost_model.h"
 #include "farfield/gpu/terrain_renderer.h"
+#include "farfield/terrain/gpu_lod.h"
 #include "farfield/terrain/quadtree_lod.h"
 
 namespace farfield::terrain {
@@ -23,11 +25,17 @@ struct TerrainCost {
   gpu::CostModel frame;                   // LOD build + draw + finish of a frame
   double readback_ms_per_mpixel = 0.0;    // z-buffer read back, per million keyframe pixels (>= 0)
   double safety_factor = 1.0;             // predictions are multiplied by it (>= 1)
+  // With TerrainCostOptions::gpu_high: frames of the high LOD drawn by the CDLOD terrain on the GPU (gpu_lod.h):
+  // selection, node upload, one instanced draw, finish. Its triangles cost differently from the CPU LOD's (no mesh
+  // built, every vertex shaded by the patch), so they have a model of their own.
+  std::optional<gpu::CostModel> gpu_high;
 
   // A frame of `triangles` in `draw_calls` calls into a width x height target, ms.
   double frameMs(double triangles, double draw_calls, int width, int height) const;
+  // A CDLOD frame of `triangles` (its patches') into a width x height target, ms; needs gpu_high.
+  double gpuHighMs(double triangles, int width, int height) const;
   double readbackMs(int width, int height) const;
-  // {"frame": CostModel::toJson(), "readback_ms_per_mpixel", "safety_factor"}.
+  // {"frame": CostModel::toJson(), "readback_ms_per_mpixel", "safety_factor"} and "gpu_high" when fitted.
   nlohmann::json toJson() const;
 };
 
@@ -41,6 +49,8 @@ struct TerrainCostOptions {
   // tile with a sprite, and with only 1 and 2 calls timed its fit swung from 0 to 0.7 ms a call between runs.
   std::vector<int> sprite_calls{0, 1, 15};
   int repeats = 3;            // timed renders per workload (median kept; one untimed warm-up per view and size)
+  // Also time its frames at each threshold and size (TerrainCost::gpu_high); null = not. Must hold the same terrain.
+  GpuLodTerrain* gpu_high = nullptr;
 };
 
 // Times the LOD meshes of the views at each threshold, drawn with the original texture and, in sprite_calls + 1 draw
