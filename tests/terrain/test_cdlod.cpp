@@ -247,6 +247,22 @@ TEST(Cdlod, NoCrackAlongSharedEdgesAndTheGridCoveredOnce) {
     EXPECT_LT(crack, 1e-4) << "tau " << tau;
     EXPECT_EQ(step, 1) << "neighbours of different levels seen, never more than one apart";
   }
+  // A terrain half rough, half nearly flat: neighbouring nodes' ranges differ by orders of magnitude, so levels
+  // change along the seam, where only the ranges taken as the largest over a vertex's nodes (and the dilated ends
+  // of the selection) keep the borders joined.
+  Heightfield mixed = hf;
+  for (int j = 0; j < mixed.height; ++j)
+    for (int i = 0; i < mixed.width / 2; ++i) mixed.at(i, j) = 200.0f + 0.01f * (mixed.at(i, j) - 200.0f);
+  const CdlodTerrain mixed_lod(mixed, CdlodOptions{8, 16, 0.3f});
+  EXPECT_LT(mixed_lod.nodeError({1, 0, 0}) * 20.0f, mixed_lod.nodeError({1, mixed_lod.nodesX(1) - 1, 0}));
+  for (const Camera& c : {camera, cameraAt(Vec3(2560, 600, hf.maxHeight() + 60), Vec3(2560, 4000, hf.minHeight()))}) {
+    CdlodSelection sel;
+    mixed_lod.select(c, 1.0f, false, sel);
+    int step = 0;
+    EXPECT_LT(worstCrack(mixed_lod, c, sel, &step), 1e-4);
+    EXPECT_LE(step, 1);
+    EXPECT_LE(checkSurface(mixed_lod, c, sel).worst_px, 1.001 + 1e-4);
+  }
   // Without morphing, a level's odd vertices on an edge next to a coarser node leave a crack: the check sees it.
   const CdlodTerrain unmorphed(hf, CdlodOptions{8, 16, 0.0f});
   CdlodSelection sel;
