@@ -5,15 +5,19 @@
 # set). Writes OUT/<stage>.tgz (bench.json, frames.csv, cull checks, logs; no images) and
 # OUT/log.txt; prints a summary per stage.
 #
-# Stages (STAGES, default "smoke heldout big demo check"):
+# Stages (STAGES, default "smoke heldout big demo check terrain"):
 #   smoke    a small city, one bench; stops everything unless the NVIDIA driver drew it
 #   heldout  a 400-block detail-3 city (about 17 M triangles) and a 300-frame car drive at 1920x1080: frustum,
 #            culled-cpu and culled (the GPU-driven frame), GPU time from timer queries, own CPU time, syncs
 #   big      the 100,000-block city (detail 0) at 1920x1080, 150 frames: the same modes
 #   demo     the default city at 640x360 (make demo's): the same modes
 #   check    farfield cull-check on the held-out city at 1920x1080 (GPU-culled frames against frustum-culled ones)
+#   terrain  the terrain LODs at 1920x1080, 600-frame flythroughs: the quadtree LOD (high, low, lod-sprite) against
+#            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu) on the shared DEM (.gpu/data/terrain/*.tif, when
+#            carried) and on the 8,193^2 fractal
 set -uo pipefail
-STAGES=${STAGES:-smoke heldout big demo check}
+STAGES=${STAGES:-smoke heldout big demo check terrain}
+DATA=$PWD/.gpu/data
 OUTD=${OUT:-/tmp/out}
 mkdir -p "$OUTD"
 exec > >(tee -a "$OUTD/log.txt") 2>&1
@@ -119,5 +123,21 @@ if [[ " $STAGES " == *" check "* ]]; then
   echo "rc $?"
   tail -6 $H/check.txt
   keep check $H/check $H/check.txt
+fi
+if [[ " $STAGES " == *" terrain "* ]]; then
+  T=terrain
+  mkdir -p $T
+  tmodes=high,high-gpu,low,low-gpu,lod-sprite,lod-sprite-gpu
+  dem=$(ls "$DATA"/terrain/*.tif 2>/dev/null | head -1)
+  for spec in ${dem:+"$dem"} fractal:8193:7; do
+    name=$(basename "$spec" .tif | tr ':' '-')
+    say "terrain: $spec, 1920x1080"
+    timeout 900 $FF terrain bench "$spec" --modes $tmodes --frames 600 --size 1920x1080 --no-sweeps --no-section5 \
+      --no-plots -o $T/$name > $T/$name.txt 2>&1
+    echo "rc $?"
+    grep -E "^cost:" $T/$name.txt
+    summ $T/$name/bench.json
+  done
+  keep terrain $T/*/bench.json $T/*/terrain.json $T/*/terrain.md $T/*/frames.csv $T/*.txt
 fi
 say "done"
