@@ -10,8 +10,10 @@
 
 #include "farfield/core/error.h"
 #include "farfield/terrain/cdlod.h"
+#include "farfield/terrain/cdlod_tiles.h"
 #include "farfield/terrain/fractal.h"
 #include "farfield/terrain/quadtree_lod.h"
+#include "terrain/tiled_test_terrain.h"
 
 namespace farfield::terrain {
 namespace {
@@ -332,6 +334,44 @@ TEST(Cdlod, SurfaceContinuousWhileTheEyeMoves) {
   // it by a small part of that.
   EXPECT_GT(popping, 4.0 * smooth) << "morphed " << smooth << " m, unmorphed " << popping << " m";
   EXPECT_LT(smooth, 0.25 * morphed.levelError(2));
+}
+
+// Node data read tile by tile from a tile cache: the nodes inside a tile exactly the whole grid's, the coarser ones
+// height ranges exact and errors bounded from above (by at most the largest error inside a tile); a selection made
+// with them keeps the bound on the drawn surface, with no crack.
+TEST(Cdlod, NodeDataFromATileCache) {
+  const Heightfield hf = test::tiledTestFractal();
+  const TileCache cache(test::writeTestCache(hf, "cdlod_tiles"));  // blocks of 16, tiles of 64 cells
+  const CdlodOptions options{8, 16, 0.3f};
+  const CdlodTerrain exact(hf, options);
+  const CdlodTerrain tiled = cdlodFromTileCache(cache, options);
+  const int lt = cdlodTileLevel(cache.layout(), options);
+  ASSERT_EQ(lt, 3);  // 64-cell nodes fill a tile
+  ASSERT_EQ(tiled.topLevel(), exact.topLevel());
+  ASSERT_GT(tiled.topLevel(), lt);
+  EXPECT_FALSE(tiled.hasHeights());
+  for (int l = 0; l <= exact.topLevel(); ++l)
+    for (int y = 0; y < exact.nodesY(l); ++y)
+      for (int x = 0; x < exact.nodesX(l); ++x) {
+        const CdlodNode n{l, x, y};
+        ASSERT_EQ(tiled.nodeHeights(n), exact.nodeHeights(n)) << l << " " << x << " " << y;
+        if (l <= lt) {
+          ASSERT_EQ(tiled.nodeError(n), exact.nodeError(n)) << l << " " << x << " " << y;
+        } else {
+          EXPECT_GE(tiled.nodeError(n), exact.nodeError(n) - 1e-3f) << l << " " << x << " " << y;
+          EXPECT_LE(tiled.nodeError(n), exact.nodeError(n) + exact.levelError(lt) + 1e-3f);
+        }
+      }
+  const Camera camera = cameraAt(Vec3(300, 200, hf.maxHeight() + 80), Vec3(4000, 4500, hf.minHeight()));
+  for (float tau : {1.0f, 4.0f}) {
+    CdlodSelection sel;
+    tiled.select(camera, tau, false, sel);
+    // The vertices as the whole grid's terrain computes them, with the tiled data's ranges.
+    EXPECT_LE(checkSurface(exact, camera, sel).worst_px, tau * 1.001 + 1e-4);
+    int step = 0;
+    EXPECT_LT(worstCrack(exact, camera, sel, &step), 1e-4);
+  }
+  EXPECT_THROW(cdlodFromTileCache(cache, CdlodOptions{128, 16, 0.3f}), Error);  // a patch larger than a tile
 }
 
 TEST(Cdlod, BadInputIsAnError) {

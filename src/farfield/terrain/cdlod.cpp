@@ -23,11 +23,10 @@ float boxDistance(const Box3& box, const Vec3& p) {
 
 }  // namespace
 
-CdlodTerrain::CdlodTerrain(const Heightfield& hf, const CdlodOptions& options) : hf_(&hf), options_(options) {
-  const std::string what = "CDLOD terrain (" + hf.source + ")";
-  if (hf.width < 2 || hf.height < 2 || hf.heights.size() != size_t(hf.width) * size_t(hf.height))
-    throw Error(what, "needs a grid of at least 2 x 2 points, got " + std::to_string(hf.width) + " x " +
-                          std::to_string(hf.height));
+int CdlodTerrain::topLevelFor(const CdlodGrid& grid, const CdlodOptions& options, const std::string& what) {
+  if (grid.width < 2 || grid.height < 2)
+    throw Error(what, "needs a grid of at least 2 x 2 points, got " + std::to_string(grid.width) + " x " +
+                          std::to_string(grid.height));
   if (!isPowerOfTwo(options.patch_cells) || options.patch_cells < 2)
     throw Error(what, "patch size must be a power of two >= 2, got " + std::to_string(options.patch_cells));
   if (!(options.morph_fraction >= 0.0f) || !std::isfinite(options.morph_fraction))
@@ -36,25 +35,61 @@ CdlodTerrain::CdlodTerrain(const Heightfield& hf, const CdlodOptions& options) :
     throw Error(what, "max_level must be in 0..24, got " + std::to_string(options.max_level));
   // The top level: 2^top divides both cell counts (so that the border is a vertex of every level), and above it a
   // single node would already cover the grid.
-  top_ = 0;
-  while (top_ < options.max_level) {
-    const int s = 1 << (top_ + 1);
-    if ((hf.width - 1) % s != 0 || (hf.height - 1) % s != 0) break;
-    if (int64_t(options.patch_cells) * (s / 2) >= int64_t(std::max(hf.width, hf.height) - 1)) break;
-    ++top_;
+  int top = 0;
+  while (top < options.max_level) {
+    const int s = 1 << (top + 1);
+    if ((grid.width - 1) % s != 0 || (grid.height - 1) % s != 0) break;
+    if (int64_t(options.patch_cells) * (s / 2) >= int64_t(std::max(grid.width, grid.height) - 1)) break;
+    ++top;
   }
+  return top;
+}
+
+CdlodTerrain::CdlodTerrain(const Heightfield& hf, const CdlodOptions& options)
+    : hf_(&hf), grid_{hf.width, hf.height, hf.cell_x, hf.cell_y}, options_(options) {
+  if (hf.heights.size() != size_t(std::max(hf.width, 0)) * size_t(std::max(hf.height, 0)))
+    throw Error("CDLOD terrain (" + hf.source + ")", "the grid's heights do not match its size");
+  top_ = topLevelFor(grid_, options, "CDLOD terrain (" + hf.source + ")");
   computeBoxes();
   computeErrors();
 }
 
+CdlodTerrain::CdlodTerrain(const CdlodGrid& grid, const CdlodOptions& options, std::vector<Vec2> heights,
+                           std::vector<float> errors)
+    : grid_(grid), options_(options) {
+  top_ = topLevelFor(grid_, options);
+  box_offset_.assign(size_t(top_) + 1, 0);
+  size_t total = 0;
+  for (int l = 0; l <= top_; ++l) {
+    box_offset_[size_t(l)] = total;
+    total += size_t(nodesX(l)) * size_t(nodesY(l));
+  }
+  if (heights.size() != total || errors.size() != total)
+    throw Error("CDLOD terrain", "node data for " + std::to_string(heights.size()) + " and " +
+                                     std::to_string(errors.size()) + " nodes, the grid has " + std::to_string(total));
+  boxes_ = std::move(heights);
+  node_error_ = std::move(errors);
+  error_.assign(size_t(top_) + 1, 0.0f);
+  for (int l = 0; l <= top_; ++l) {
+    for (int y = 0; y < nodesY(l); ++y)
+      for (int x = 0; x < nodesX(l); ++x) error_[size_t(l)] = std::max(error_[size_t(l)], nodeError({l, x, y}));
+    if (l > 0) error_[size_t(l)] = std::max(error_[size_t(l)], error_[size_t(l) - 1]);
+  }
+}
+
+const Heightfield& CdlodTerrain::heightfield() const {
+  FF_CHECK_MSG(hf_ != nullptr, "a CDLOD terrain made from node data has no heights");
+  return *hf_;
+}
+
 int CdlodTerrain::nodesX(int level) const {
   const int64_t cells = int64_t(options_.patch_cells) << level;
-  return int((int64_t(hf_->width - 1) + cells - 1) / cells);
+  return int((int64_t(grid_.width - 1) + cells - 1) / cells);
 }
 
 int CdlodTerrain::nodesY(int level) const {
   const int64_t cells = int64_t(options_.patch_cells) << level;
-  return int((int64_t(hf_->height - 1) + cells - 1) / cells);
+  return int((int64_t(grid_.height - 1) + cells - 1) / cells);
 }
 
 size_t CdlodTerrain::nodeIndex(const CdlodNode& node) const {
@@ -64,9 +99,9 @@ size_t CdlodTerrain::nodeIndex(const CdlodNode& node) const {
 Box3 CdlodTerrain::nodeBox(const CdlodNode& node) const {
   const int64_t cells = int64_t(options_.patch_cells) << node.level;
   const int64_t x0 = node.x * cells, y0 = node.y * cells;
-  const int64_t x1 = std::min<int64_t>(x0 + cells, hf_->width - 1), y1 = std::min<int64_t>(y0 + cells, hf_->height - 1);
+  const int64_t x1 = std::min<int64_t>(x0 + cells, grid_.width - 1), y1 = std::min<int64_t>(y0 + cells, grid_.height - 1);
   const Vec2 h = boxes_[nodeIndex(node)];
-  const float cx = float(hf_->cell_x), cy = float(hf_->cell_y);
+  const float cx = float(grid_.cell_x), cy = float(grid_.cell_y);
   Box3 box;
   box.lo = Vec3(float(x0) * cx, float(y0) * cy, h.x);
   box.hi = Vec3(float(x1) * cx, float(y1) * cy, h.y);
@@ -208,7 +243,7 @@ void CdlodTerrain::selectNode(const CdlodNode& node, const Vec3& eye, const Frus
 }
 
 float CdlodTerrain::heightAt(float gx, float gy) const {
-  const Heightfield& hf = *hf_;
+  const Heightfield& hf = heightfield();
   gx = std::clamp(gx, 0.0f, float(hf.width - 1));
   gy = std::clamp(gy, 0.0f, float(hf.height - 1));
   const int x0 = std::min(int(std::floor(gx)), hf.width - 1), y0 = std::min(int(std::floor(gy)), hf.height - 1);
@@ -224,8 +259,8 @@ float CdlodTerrain::morphFactor(const CdlodNode& node, int i, int j, const Cdlod
   if (node.level >= top_) return 0.0f;
   const int s = 1 << node.level;
   const int64_t cells = int64_t(options_.patch_cells) << node.level;
-  const int gx = int(std::min<int64_t>(node.x * cells + int64_t(i) * s, hf_->width - 1));
-  const int gy = int(std::min<int64_t>(node.y * cells + int64_t(j) * s, hf_->height - 1));
+  const int gx = int(std::min<int64_t>(node.x * cells + int64_t(i) * s, grid_.width - 1));
+  const int gy = int(std::min<int64_t>(node.y * cells + int64_t(j) * s, grid_.height - 1));
   // The range: the largest over the nodes of the next level the vertex lies in (as the shader computes it).
   const int up = node.level + 1, up_cells = options_.patch_cells << up;
   const int hx = std::min(gx / up_cells, nodesX(up) - 1), hy = std::min(gy / up_cells, nodesY(up) - 1);
@@ -235,7 +270,7 @@ float CdlodTerrain::morphFactor(const CdlodNode& node, int i, int j, const Cdlod
   for (int qy : {ly, hy})
     for (int qx : {lx, hx}) range = glm::max(range, Vec2(ranges.node[nodeIndex({up, qx, qy})]));
   if (!(range.y > range.x)) return 0.0f;
-  const Vec3 p(float(gx) * float(hf_->cell_x), float(gy) * float(hf_->cell_y), hf_->at(gx, gy));
+  const Vec3 p(float(gx) * float(grid_.cell_x), float(gy) * float(grid_.cell_y), heightfield().at(gx, gy));
   return std::clamp((glm::length(eye - p) - range.x) / (range.y - range.x), 0.0f, 1.0f);
 }
 
@@ -246,9 +281,9 @@ Vec3 CdlodTerrain::vertex(const CdlodNode& node, int i, int j, const CdlodRanges
   const float k = morphFactor(node, i, j, ranges, eye);
   float mx = float(node.x * cells + int64_t(i) * s) - ((i & 1) ? float(s) * k : 0.0f);
   float my = float(node.y * cells + int64_t(j) * s) - ((j & 1) ? float(s) * k : 0.0f);
-  mx = std::min(mx, float(hf_->width - 1));
-  my = std::min(my, float(hf_->height - 1));
-  return Vec3(mx * float(hf_->cell_x), my * float(hf_->cell_y), heightAt(mx, my));
+  mx = std::min(mx, float(grid_.width - 1));
+  my = std::min(my, float(grid_.height - 1));
+  return Vec3(mx * float(grid_.cell_x), my * float(grid_.cell_y), heightAt(mx, my));
 }
 
 }  // namespace farfield::terrain

@@ -39,6 +39,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "farfield/core/bounds.h"
@@ -52,6 +53,12 @@ struct CdlodOptions {
   int patch_cells = 16;         // P: quads per patch side, a power of two >= 2
   int max_level = 16;           // the top level is at most this (and as 2^L divides the grid's cell counts)
   float morph_fraction = 0.2f;  // width of the morph range, relative to its start (>= 0; 0: no morphing, pops)
+};
+
+// The grid a CDLOD terrain covers: points and cell sizes (heightfield.h's frame).
+struct CdlodGrid {
+  int width = 0, height = 0;
+  double cell_x = 1.0, cell_y = 1.0;
 };
 
 struct CdlodNode {
@@ -79,8 +86,20 @@ class CdlodTerrain {
   // Keeps a reference to hf, which must outlive this. Throws farfield::Error for a grid smaller than 2 x 2, a patch
   // size that is not a power of two >= 2, or a negative morph fraction.
   explicit CdlodTerrain(const Heightfield& hf, const CdlodOptions& options = {});
+  // Node data made elsewhere (cdlod_tiles.h: from a tile cache, the grid never held whole): per node in nodeIndex
+  // order, its height range (min, max) and its error E(N) (or an upper bound of it: the ranges then keep the bound
+  // with room to spare). No heights: vertex(), morphFactor() and heightAt() need the other constructor. Throws
+  // farfield::Error for arrays that do not match the grid's node counts, or as the other constructor.
+  CdlodTerrain(const CdlodGrid& grid, const CdlodOptions& options, std::vector<Vec2> heights,
+               std::vector<float> errors);
 
-  const Heightfield& heightfield() const { return *hf_; }
+  // The top level for a grid (see the file comment); throws farfield::Error (naming `what`) for bad options.
+  static int topLevelFor(const CdlodGrid& grid, const CdlodOptions& options,
+                         const std::string& what = "CDLOD terrain");
+
+  const CdlodGrid& grid() const { return grid_; }
+  bool hasHeights() const { return hf_ != nullptr; }
+  const Heightfield& heightfield() const;
   const CdlodOptions& options() const { return options_; }
   int patchCells() const { return options_.patch_cells; }
   int topLevel() const { return top_; }
@@ -95,6 +114,7 @@ class CdlodTerrain {
   size_t levelOffset(int level) const { return box_offset_[size_t(level)]; }
   size_t nodeCount() const { return boxes_.size(); }
   float nodeError(const CdlodNode& node) const { return node_error_[nodeIndex(node)]; }  // E(N), metres
+  Vec2 nodeHeights(const CdlodNode& node) const { return boxes_[nodeIndex(node)]; }      // (min, max), metres
   float levelError(int level) const { return error_[size_t(level)]; }  // largest E(N) of the level and finer ones
   // The node's box: its grid area clamped to the grid, heights over that area.
   Box3 nodeBox(const CdlodNode& node) const;
@@ -119,7 +139,8 @@ class CdlodTerrain {
   void computeErrors();
   void selectNode(const CdlodNode& node, const Vec3& eye, const Frustum* frustum, CdlodSelection& out) const;
 
-  const Heightfield* hf_;
+  const Heightfield* hf_ = nullptr;
+  CdlodGrid grid_;
   CdlodOptions options_;
   int top_ = 0;
   std::vector<float> error_;       // per level

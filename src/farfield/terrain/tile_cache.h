@@ -102,6 +102,8 @@ class TileCache {
 
   // Reads tile (tx, ty) at `step` (a power of two, 1 .. block / 2). Throws farfield::Error naming the file.
   TileGrid read(int tx, int ty, int step) const;
+  // The same tile's heights alone (TileGrid::error and radius left empty): a third of the reading.
+  TileGrid readHeights(int tx, int ty, int step) const { return readPlanes(tx, ty, step, 1); }
   // The whole grid at every step-th point (a power of two, 1 .. block / 2), read tile by tile: what a flythrough or
   // a map is planned on without holding the grid. cell = step * the grid's cell; source "<file> at step N".
   Heightfield overview(int step) const;
