@@ -225,6 +225,10 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
   tiles->add_option("--prefetch-frames", to.prefetch_frames, "With --render: load tiles this many frames ahead of the "
                                                              "camera's motion on a worker thread (0 = on demand)")
       ->capture_default_str();
+  tiles->add_flag("--gpu-lod", to.gpu_lod,
+                  "With --render: draw with the CDLOD terrain paged from the cache (pages of full-resolution heights "
+                  "under --gpu-budget-mb, an overview for far nodes) instead of the quadtree LOD per tile");
+  tiles->add_option("--patch-cells", to.patch_cells, "With --gpu-lod: quads per CDLOD patch side (a power of two)");
   tiles->callback([t] { runTiles(t->first, t->second); });
 });
 

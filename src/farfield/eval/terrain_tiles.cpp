@@ -25,6 +25,7 @@
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_data.h"
 #include "farfield/terrain/tile_cache.h"
+#include "farfield/terrain/paged_gpu_lod.h"
 #include "farfield/terrain/tile_pager.h"
 #include "farfield/terrain/tile_sprites.h"
 #include "farfield/terrain/tiled_lod.h"
@@ -138,14 +139,27 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   size_t rss_peak = rss_after_drop;
   // Drawing: a context, a target, and the patches paged under their budget.
   std::unique_ptr<gpu::RenderTarget> target;
+  double cdlod_prepare_seconds = 0.0;
   std::unique_ptr<terrain::PagedTerrainRenderer> paged;
+  std::unique_ptr<terrain::PagedGpuLodTerrain> cdlod;
+  if (o.gpu_lod && !o.render) throw Error("--gpu-lod", "draws frames: needs --render");
   if (o.render) {
     if (!(o.gpu_budget_mb > 0.0)) throw Error("--gpu-budget-mb", "must be positive");
     gpu::sharedHeadlessContext().makeCurrent();
     target = std::make_unique<gpu::RenderTarget>(o.width, o.height);
     if (o.prefetch_frames < 0) throw Error("--prefetch-frames", "must be 0 or more");
-    paged = std::make_unique<terrain::PagedTerrainRenderer>(pager, size_t(o.gpu_budget_mb * 1024.0 * 1024.0),
-                                                            o.prefetch_frames);
+    if (o.gpu_lod) {
+      const Stopwatch prepare;
+      terrain::PagedGpuLodOptions po;
+      po.lod.patch_cells = o.patch_cells;
+      po.gpu_budget_bytes = size_t(o.gpu_budget_mb * 1024.0 * 1024.0);
+      po.prefetch_frames = o.prefetch_frames;
+      cdlod = std::make_unique<terrain::PagedGpuLodTerrain>(cache, po);
+      cdlod_prepare_seconds = prepare.seconds();
+    } else {
+      paged = std::make_unique<terrain::PagedTerrainRenderer>(pager, size_t(o.gpu_budget_mb * 1024.0 * 1024.0),
+                                                              o.prefetch_frames);
+    }
     fs::create_directories(out / "frames");
   }
   std::unique_ptr<terrain::TileSprites> tile_sprites;
@@ -155,7 +169,22 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   for (size_t f = 0; f < path.frames.size(); ++f) {
     const Camera camera = path.camera(f, o.width, o.height, clip.near_plane, clip.far_plane);
     FrameRow row;
-    if (paged) {
+    if (cdlod) {
+      // The CDLOD frame: the selection, the pages it needs (read at once if missing), the draw, to the GPU's end.
+      target->clear(kSky);
+      const Stopwatch draw;
+      const terrain::PagedGpuLodFrame cf = cdlod->draw(camera, o.pixel_error, *target);
+      cdlod->finish();
+      row.frame_ms = row.ms = draw.milliseconds();
+      row.triangles = row.drawn_triangles = cf.draw.triangles;
+      row.patch_loads = cf.page_loads;
+      row.gpu_bytes = cdlod->stats().pages * (cdlod->gpuBytes() / std::max(1, cdlod->pageLayers()));
+      if (o.sample_stride > 0 && f % o.sample_stride == 0) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%05zu.png", f);
+        image::writePng((out / "frames" / name).string(), target->readColor());
+      }
+    } else if (paged) {
       // The frame as a renderer draws it: the LOD per tile, the tiles read (or taken from the prefetch), the
       // patches made, the draw, to the GPU's end.
       target->clear(kSky);
@@ -283,7 +312,52 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     j["whole_keyframe_triangles"] = sprite.whole_triangles;
   }
   std::string render_md;
-  if (paged) {
+  if (cdlod) {
+    std::vector<double> fms;
+    size_t drawn_max = 0, drawn_sum = 0;
+    for (const FrameRow& r : rows) {
+      fms.push_back(r.frame_ms);
+      drawn_max = std::max(drawn_max, r.drawn_triangles);
+      drawn_sum += r.drawn_triangles;
+    }
+    std::sort(fms.begin(), fms.end());
+    double fsum = 0.0;
+    for (double v : fms) fsum += v;
+    const terrain::PagedGpuLodStats& cs = cdlod->stats();
+    size_t over_twice = 0;
+    for (double v : fms) over_twice += v > 2.0 * fms[fms.size() / 2] ? 1 : 0;
+    j["render"] = {{"lod", "cdlod"},
+                   {"frame_ms_mean", fsum / double(fms.size())},
+                   {"frame_ms_median", fms[fms.size() / 2]},
+                   {"frame_ms_p99", fms[std::min(fms.size() - 1, fms.size() * 99 / 100)]},
+                   {"frame_ms_max", fms.back()},
+                   {"frames_over_twice_the_median", over_twice},
+                   {"triangles_mean", double(drawn_sum) / double(rows.size())},
+                   {"triangles_max", drawn_max},
+                   {"prepare_seconds", cdlod_prepare_seconds},
+                   {"overview_step", cdlod->overviewStep()},
+                   {"page_layers", cdlod->pageLayers()},
+                   {"pages_peak", cs.peak_pages},
+                   {"page_loads_waited_for", cs.page_loads},
+                   {"pages_prefetched", cs.prefetched},
+                   {"prefetch_hits", cs.prefetch_hits},
+                   {"page_evictions", cs.evictions},
+                   {"page_seconds", cs.load_seconds},
+                   {"gpu_bytes", cdlod->gpuBytes()},
+                   {"prefetch_frames", o.prefetch_frames}};
+    char line[640];
+    std::snprintf(line, sizeof line,
+                  "\ndrawn by the CDLOD terrain paged from the cache: frame %.2f ms mean, %.2f median, %.2f p99, "
+                  "%.2f max (selection, pages waited for, draw, to the GPU's end); %zu frames over twice the "
+                  "median; %.0f triangles mean, %zu max; pages: %d layers (%.0f MiB), %zu held at most, %zu read "
+                  "in frames, %zu read ahead %d frames (%zu used), %zu evictions, %.1f s reading; node data and "
+                  "overview made in %.1f s\n",
+                  fsum / double(fms.size()), fms[fms.size() / 2], double(j["render"]["frame_ms_p99"]), fms.back(),
+                  over_twice, double(drawn_sum) / double(rows.size()), drawn_max, cdlod->pageLayers(),
+                  mib(cdlod->gpuBytes()), cs.peak_pages, cs.page_loads, cs.prefetched, o.prefetch_frames,
+                  cs.prefetch_hits, cs.evictions, cs.load_seconds, cdlod_prepare_seconds);
+    render_md = line;
+  } else if (paged) {
     std::vector<double> fms;
     size_t drawn_max = 0, drawn_sum = 0;
     for (const FrameRow& r : rows) {

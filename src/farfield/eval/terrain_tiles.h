@@ -40,6 +40,10 @@ struct TerrainTilesOptions {
   double gpu_budget_mb = 256;
   int prefetch_frames = 32;  // with render: tiles loaded ahead along the camera's motion (0 = every tile on demand)
   size_t sample_stride = 100;
+  // With render: draw with the CDLOD terrain paged from the cache (terrain/paged_gpu_lod.h: pages of full-resolution
+  // heights and colours under gpu_budget_mb, an overview for the far nodes) instead of the quadtree LOD per tile.
+  bool gpu_lod = false;
+  int patch_cells = 16;
 };
 
 struct TerrainTilesResult {

@@ -33,8 +33,46 @@ CdlodRenderer::CdlodRenderer(int width, int height, std::span<const float> heigh
   glTextureSubImage2D(heights_.handle(), 0, 0, 0, width, height, GL_RED, GL_FLOAT, heights.data());
   texture_ = Texture::fromImage(texture, true);
   texture_.setClampToEdge();
-  program_ = Program::fromEmbedded("cdlod.vert.glsl", "terrain.frag.glsl");
+  makePatch();
+}
 
+CdlodRenderer::CdlodRenderer(int width, int height, Vec2 cell, int patch_cells, const CdlodOverview& overview,
+                             CdlodPages& pages)
+    : width_(width), height_(height), patch_cells_(patch_cells), cell_(cell), uv_scale_(1.0f), uv_offset_(0.0f) {
+  if (width < 2 || height < 2) throw Error("CDLOD renderer", "a grid needs at least 2 x 2 points");
+  if (patch_cells < 2 || patch_cells > 254) throw Error("CDLOD renderer", "patch size must be in 2..254");
+  if (overview.step < 1 || (width - 1) % overview.step != 0 || (height - 1) % overview.step != 0 ||
+      overview.width != (width - 1) / overview.step + 1 || overview.height != (height - 1) / overview.step + 1 ||
+      overview.heights.size() != size_t(overview.width) * size_t(overview.height) || !overview.colour ||
+      overview.colour->width() != overview.width || overview.colour->height() != overview.height)
+    throw Error("CDLOD renderer", "the overview must hold every " + std::to_string(overview.step) +
+                                      "th point of the " + std::to_string(width) + " x " + std::to_string(height) +
+                                      " grid, with a texel per point");
+  pages_ = &pages;
+  overview_step_ = overview.step;
+  heights_ = Texture(overview.width, overview.height, TextureFormat::R32F, false);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glTextureSubImage2D(heights_.handle(), 0, 0, 0, overview.width, overview.height, GL_RED, GL_FLOAT,
+                      overview.heights.data());
+  texture_ = Texture::fromImage(*overview.colour, true);
+  texture_.setClampToEdge();
+  makePatch();
+}
+
+Program& CdlodRenderer::program(bool hole) {
+  Program& p = hole ? hole_program_ : program_;
+  if (!p.handle()) {
+    std::string defines;
+    if (pages_) defines += "#define FF_PAGED 1\n";
+    if (hole) defines += "#define FF_HOLE 1\n";
+    p = Program::fromEmbedded("cdlod.vert.glsl", "terrain.frag.glsl", defines);
+  }
+  return p;
+}
+
+void CdlodRenderer::makePatch() {
+  const int patch_cells = patch_cells_;
   // The patch: (P + 1)^2 vertices named by gl_VertexID, each cell split along its (0,0)-(1,1) diagonal.
   std::vector<uint16_t> indices;
   const int row = patch_cells + 1;
@@ -71,8 +109,7 @@ void CdlodRenderer::setLevels(std::span<const int> offsets, std::span<const IVec
 }
 
 void CdlodRenderer::setHole(Vec2 lo, Vec2 hi) {
-  if (!hole_program_.handle())
-    hole_program_ = Program::fromEmbedded("cdlod.vert.glsl", "terrain.frag.glsl", "#define FF_HOLE 1");
+  program(true);
   hole_ = true;
   hole_rect_ = Vec4(lo, hi);
 }
@@ -102,7 +139,7 @@ FrameStats CdlodRenderer::draw(const Camera& camera, RenderTarget& target, std::
   glNamedBufferSubData(nodes_, 0, GLsizeiptr(bytes), nodes.data());
 
   target.bindForOpaquePass();
-  Program& program = hole_ ? hole_program_ : program_;
+  Program& program = this->program(hole_);
   program.use();
   program.set("u_view_proj", camera.viewProjection());
   program.set("u_eye", camera.eye);
@@ -119,6 +156,11 @@ FrameStats CdlodRenderer::draw(const Camera& camera, RenderTarget& target, std::
   if (hole_) program.set("u_hole", hole_rect_);
   texture_.bind(0);
   heights_.bind(1);
+  if (pages_) {
+    program.set("u_page_cells", pages_->pageCells());
+    program.set("u_overview_step", overview_step_);
+    pages_->bind(2, 3);
+  }
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, nodes_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ranges_[slot]);
   const bool bias = bias_factor_ != 0.0f || bias_units_ != 0.0f;
@@ -136,6 +178,8 @@ FrameStats CdlodRenderer::draw(const Camera& camera, RenderTarget& target, std::
   stats.wall_ms = wall.milliseconds();
   return stats;
 }
+
+void CdlodRenderer::finish() { glFinish(); }
 
 size_t CdlodRenderer::gpuBytes() const {
   size_t bytes = heights_.byteSize() + texture_.byteSize() + index_count_ * sizeof(uint16_t) + node_capacity_;

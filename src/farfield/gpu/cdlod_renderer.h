@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "farfield/core/camera.h"
+#include "farfield/gpu/cdlod_pages.h"
 #include "farfield/gpu/program.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
@@ -22,11 +23,20 @@
 
 namespace farfield::gpu {
 
-// One drawn node: the grid point of its corner and its level (a vertex every 2^level grid points).
+// One drawn node: the grid point of its corner and its level (a vertex every 2^level grid points); with pages, the
+// page layer holding its tile (-1: the overview).
 struct CdlodInstance {
   int32_t x0 = 0, y0 = 0;
   int32_t level = 0;
-  int32_t unused = 0;
+  int32_t layer = -1;
+};
+
+// A paged terrain's overview (every step-th grid point), always held, for the nodes that do not read a page.
+struct CdlodOverview {
+  int step = 1;
+  int width = 0, height = 0;         // its points
+  std::span<const float> heights;    // width x height, row-major, row 0 south
+  const image::ColorImage* colour = nullptr;  // the original texture at its points (width x height texels)
 };
 
 class CdlodRenderer {
@@ -37,6 +47,10 @@ class CdlodRenderer {
   // empty or mismatched grid, a grid larger than the driver's textures, or an empty texture.
   CdlodRenderer(int width, int height, std::span<const float> heights, Vec2 cell, int patch_cells,
                 const image::ColorImage& texture, Vec2 uv_scale, Vec2 uv_offset);
+  // A terrain paged in tiles: heights and colours from `pages` for the nodes whose instance names a layer, from the
+  // overview for the others (whose vertices must lie on it). pages must outlive the renderer. Throws farfield::Error
+  // for an overview that does not cover the grid at its step.
+  CdlodRenderer(int width, int height, Vec2 cell, int patch_cells, const CdlodOverview& overview, CdlodPages& pages);
   ~CdlodRenderer();
   CdlodRenderer(const CdlodRenderer&) = delete;
   CdlodRenderer& operator=(const CdlodRenderer&) = delete;
@@ -61,6 +75,8 @@ class CdlodRenderer {
   // clearHole draws it all again. Applies to the draws that follow.
   void setHole(Vec2 lo, Vec2 hi);
   void clearHole() { hole_ = false; }
+  // Waits until every command issued so far has completed (glFinish): the end of a timed terrain frame.
+  void finish();
   int patchCells() const { return patch_cells_; }
   size_t trianglesPerNode() const { return size_t(2) * size_t(patch_cells_) * size_t(patch_cells_); }
   size_t gpuBytes() const;
@@ -78,6 +94,11 @@ class CdlodRenderer {
   size_t index_count_ = 0;
   Texture heights_;
   Texture texture_;
+  Program& program(bool hole);
+  void makePatch();
+
+  CdlodPages* pages_ = nullptr;
+  int overview_step_ = 1;
   Program program_;
   Program hole_program_;  // made by the first setHole
   bool hole_ = false;

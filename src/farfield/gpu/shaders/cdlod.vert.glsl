@@ -1,10 +1,19 @@
 #version 450 core
 // Farfield CDLOD terrain vertex shader (gpu/cdlod_renderer.h; the arithmetic of terrain/cdlod.cpp's
 // CdlodTerrain::vertex, which the tests compare): patch vertex (i, j) from gl_VertexID, its node from the instance.
+// With FF_PAGED (a terrain paged in tiles): a node whose instance names a page layer (w >= 0) reads its tile's page,
+// (S + 1)^2 grid points from the tile's first; the others read the overview, every u_overview_step-th grid point
+// (their vertices lie on it).
 
-layout(std430, binding = 0) readonly buffer Nodes { ivec4 nodes[]; };  // x0, y0, level, unused
+layout(std430, binding = 0) readonly buffer Nodes { ivec4 nodes[]; };  // x0, y0, level, page layer (FF_PAGED)
 layout(std430, binding = 1) readonly buffer Ranges { vec2 ranges[]; };  // per node: morph start and end
 layout(binding = 1) uniform sampler2D u_heights;                        // R32F, a texel per grid point
+#ifdef FF_PAGED
+layout(binding = 2) uniform sampler2DArray u_pages;  // R32F pages, (S + 1)^2 texels each
+uniform int u_page_cells;                             // S
+uniform int u_overview_step;                          // u_heights holds every u_overview_step-th grid point
+flat out int v_layer;
+#endif
 
 uniform mat4 u_view_proj;
 uniform vec3 u_eye;
@@ -20,15 +29,34 @@ uniform vec2 u_uv_offset;
 out vec2 v_uv;
 out vec2 v_world_xy;  // for the fragment shader's hole (terrain.frag.glsl with FF_HOLE)
 
-float heightAt(vec2 g) {
-  g = clamp(g, vec2(0.0), vec2(u_last));
-  ivec2 p0 = min(ivec2(floor(g)), u_last);
-  ivec2 p1 = min(p0 + 1, u_last);
+float bilinear(vec2 g, ivec2 last, int layer) {
+  g = clamp(g, vec2(0.0), vec2(last));
+  ivec2 p0 = min(ivec2(floor(g)), last);
+  ivec2 p1 = min(p0 + 1, last);
   vec2 f = g - vec2(p0);
+#ifdef FF_PAGED
+  if (layer >= 0) {
+    float a = texelFetch(u_pages, ivec3(p0, layer), 0).r * (1.0 - f.x) +
+              texelFetch(u_pages, ivec3(p1.x, p0.y, layer), 0).r * f.x;
+    float b = texelFetch(u_pages, ivec3(p0.x, p1.y, layer), 0).r * (1.0 - f.x) +
+              texelFetch(u_pages, ivec3(p1, layer), 0).r * f.x;
+    return a * (1.0 - f.y) + b * f.y;
+  }
+#endif
   float a = texelFetch(u_heights, p0, 0).r * (1.0 - f.x) + texelFetch(u_heights, ivec2(p1.x, p0.y), 0).r * f.x;
   float b = texelFetch(u_heights, ivec2(p0.x, p1.y), 0).r * (1.0 - f.x) + texelFetch(u_heights, p1, 0).r * f.x;
   return a * (1.0 - f.y) + b * f.y;
 }
+
+#ifdef FF_PAGED
+// Grid coordinates into the node's source: its page (from the tile's first point) or the overview.
+vec2 sourceCoord(vec2 g, ivec2 tile_origin, int layer) {
+  return layer >= 0 ? g - vec2(tile_origin) : g / float(u_overview_step);
+}
+ivec2 sourceLast(int layer) {
+  return layer >= 0 ? ivec2(u_page_cells) : textureSize(u_heights, 0) - 1;
+}
+#endif
 
 void main() {
   ivec4 node = nodes[gl_InstanceID];
@@ -36,7 +64,17 @@ void main() {
   int s = 1 << node.z;
   ivec2 g = node.xy + ivec2(i, j) * s;
   ivec2 c = min(g, u_last);
+#ifdef FF_PAGED
+  int layer = node.w;
+  ivec2 tile_origin = (node.xy / u_page_cells) * u_page_cells;
+  ivec2 last = sourceLast(layer);
+  float h0 = bilinear(sourceCoord(vec2(c), tile_origin, layer), last, layer);
+  v_layer = layer;
+#else
+  int layer = -1;
+  ivec2 last = u_last;
   float h0 = texelFetch(u_heights, c, 0).r;
+#endif
   ivec2 odd = ivec2(i & 1, j & 1);
   float k = 0.0;
   if (node.z < u_top && (odd.x | odd.y) != 0) {  // even vertices never move
@@ -55,8 +93,14 @@ void main() {
   vec2 gm = vec2(g) - vec2(odd) * (float(s) * k);
   gm = min(gm, vec2(u_last));
   // Unmoved (k = 0, or an even vertex): the grid point's height, which the bilinear interpolation gives exactly.
-  vec3 world = vec3(gm * u_cell, k > 0.0 ? heightAt(gm) : h0);
+#ifdef FF_PAGED
+  vec2 source = sourceCoord(gm, tile_origin, layer);
+  vec3 world = vec3(gm * u_cell, k > 0.0 ? bilinear(source, last, layer) : h0);
+  v_uv = (source + 0.5) / vec2(last + 1);  // texel centres on the source's points
+#else
+  vec3 world = vec3(gm * u_cell, k > 0.0 ? bilinear(gm, last, layer) : h0);
   v_uv = world.xy * u_uv_scale + u_uv_offset;
+#endif
   v_world_xy = world.xy;
   gl_Position = u_view_proj * vec4(world, 1.0);
 }

@@ -14,6 +14,11 @@ in vec4 v_sprite_clip;
 #else
 in vec2 v_uv;
 #endif
+#ifdef FF_PAGED
+// A paged CDLOD terrain (gpu/cdlod_pages.h): fragments of nodes read from a page take its colour layer.
+flat in int v_layer;
+layout(binding = 3) uniform sampler2DArray u_page_colours;
+#endif
 #ifdef FF_HOLE
 // A rectangle of the ground (world x, y: lo, hi) drawn by someone else (a city), left out.
 in vec2 v_world_xy;
@@ -27,6 +32,9 @@ void main() {
 #ifdef FF_SPRITE
   vec2 st = v_sprite_clip.xy / v_sprite_clip.w * 0.5 + 0.5;
   o_color = vec4(texture(u_texture, st).rgb, 1.0);
+#elif defined(FF_PAGED)
+  o_color = vec4((v_layer >= 0 ? texture(u_page_colours, vec3(v_uv, float(v_layer))) : texture(u_texture, v_uv)).rgb,
+                 1.0);
 #else
   o_color = vec4(texture(u_texture, v_uv).rgb, 1.0);
 #endif

@@ -1,0 +1,253 @@
+#include "farfield/terrain/paged_gpu_lod.h"
+
+#include <algorithm>
+#include <string>
+
+#include "farfield/core/error.h"
+#include "farfield/core/timer.h"
+#include "farfield/terrain/cdlod_tiles.h"
+#include "farfield/terrain/terrain_texture.h"
+
+namespace farfield::terrain {
+namespace {
+
+int defaultOverviewStep(const TileCache& cache, const CdlodOptions& lod) {
+  const int tile_level = cdlodTileLevel(cache.layout(), lod);
+  int step = 1;
+  while (step * 2 <= 16 && step * 2 <= cache.layout().block / 2 && step * 2 <= (1 << (tile_level + 1))) step *= 2;
+  return step;
+}
+
+}  // namespace
+
+PagedGpuLodTerrain::PagedGpuLodTerrain(const TileCache& cache, const PagedGpuLodOptions& options)
+    : cache_(cache), options_(options), lod_(cdlodFromTileCache(cache, options.lod)) {
+  const TileLayout& l = cache.layout();
+  overview_step_ = options.overview_step > 0 ? options.overview_step : defaultOverviewStep(cache, options.lod);
+  fine_levels_ = 0;
+  while ((1 << fine_levels_) < overview_step_) ++fine_levels_;
+  if ((1 << fine_levels_) != overview_step_ || overview_step_ > l.block / 2 ||
+      fine_levels_ > cdlodTileLevel(l, options.lod) + 1 || fine_levels_ > lod_.topLevel())
+    throw Error(cache.path(), "overview step " + std::to_string(overview_step_) +
+                                  ": needs a power of two up to half a block whose nodes fit in a tile");
+  if (options.prefetch_frames < 0) throw Error("paged CDLOD terrain", "prefetch frames must be 0 or more");
+  overview_ = cache.overview(overview_step_);
+  TextureOptions to;
+  to.ramp_lo = cache.minHeight();
+  to.ramp_hi = cache.maxHeight();
+  to.step = overview_step_;
+  overview_colour_ = terrainTexture(overview_, to);
+  const int page_cells = l.tile_blocks * l.block;
+  const size_t layer_bytes = gpu::CdlodPages(page_cells, 1).layerBytes();
+  const int layers = int(std::min<size_t>(options.gpu_budget_bytes / layer_bytes, 2048));
+  if (layers < 1)
+    throw Error("paged CDLOD terrain", "a GPU budget of " + std::to_string(options.gpu_budget_bytes >> 20) +
+                                           " MiB holds no page of " + std::to_string(layer_bytes >> 20) + " MiB");
+  pages_ = std::make_unique<gpu::CdlodPages>(page_cells, layers);
+  for (int k = layers - 1; k >= 0; --k) free_layers_.push_back(k);
+  gpu::CdlodOverview ov;
+  ov.step = overview_step_;
+  ov.width = overview_.width;
+  ov.height = overview_.height;
+  ov.heights = overview_.heights;
+  ov.colour = &overview_colour_;
+  renderer_ = std::make_unique<gpu::CdlodRenderer>(l.width, l.height, Vec2(float(l.cell_x), float(l.cell_y)),
+                                                   options.lod.patch_cells, ov, *pages_);
+  std::vector<int> offsets;
+  std::vector<IVec2> counts;
+  for (int level = 0; level <= lod_.topLevel(); ++level) {
+    offsets.push_back(int(lod_.levelOffset(level)));
+    counts.emplace_back(lod_.nodesX(level), lod_.nodesY(level));
+  }
+  renderer_->setLevels(offsets, counts);
+  worker_ = std::thread([this] { work(); });
+}
+
+PagedGpuLodTerrain::~PagedGpuLodTerrain() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+size_t PagedGpuLodTerrain::gpuBytes() const { return renderer_->gpuBytes() + pages_->bytes(); }
+
+PagedGpuLodTerrain::Page PagedGpuLodTerrain::makePage(int tx, int ty) const {
+  const Stopwatch clock;
+  const TileLayout& l = cache_.layout();
+  const TileGrid g = cache_.readHeights(tx, ty, 1);
+  // The tile's own points in g.hf: blocks [x0, x1) of its stored blocks, their last points included.
+  const int x0 = g.blocks.x0 * l.block, y0 = g.blocks.y0 * l.block;
+  const int x1 = g.blocks.x1 * l.block, y1 = g.blocks.y1 * l.block;
+  const int n = l.tile_blocks * l.block + 1;
+  Page page;
+  page.heights.resize(size_t(n) * size_t(n));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      page.heights[size_t(i) + size_t(j) * size_t(n)] = g.hf.at(std::min(x0 + i, x1), std::min(y0 + j, y1));
+  // Its colours: the original texture's texels at its points, made with a point of margin for the slopes at its
+  // edges (as the whole grid's texture sees them).
+  const int mx0 = std::max(x0 - 1, 0), my0 = std::max(y0 - 1, 0);
+  const int mx1 = std::min(x1 + 1, g.hf.width - 1), my1 = std::min(y1 + 1, g.hf.height - 1);
+  const Heightfield part = g.hf.crop(mx0, my0, mx1 - mx0 + 1, my1 - my0 + 1);
+  TextureOptions to;
+  to.ramp_lo = cache_.minHeight();
+  to.ramp_hi = cache_.maxHeight();
+  to.origin = g.origin + IVec2(mx0, my0);
+  const image::ColorImage texels = terrainTexture(part, to);
+  page.colour = image::ColorImage(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) page.colour.at(i, j) = texels.at(std::min(x0 + i, x1) - mx0, std::min(y0 + j, y1) - my0);
+  page.seconds = clock.seconds();
+  return page;
+}
+
+PagedGpuLodTerrain::TileKey PagedGpuLodTerrain::tileOf(const CdlodNode& node) const {
+  const int cells = lod_.patchCells() << node.level;
+  const int tile = cache_.layout().tile_blocks * cache_.layout().block;
+  return {node.x * cells / tile, node.y * cells / tile};
+}
+
+void PagedGpuLodTerrain::work() {
+  for (;;) {
+    TileKey tile;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      if (stop_) return;
+      tile = queue_.front();
+      queue_.pop_front();
+    }
+    Page page = makePage(tile.first, tile.second);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      worker_seconds_ += page.seconds;
+      ++prefetched_;
+      ready_[tile] = std::move(page);
+      in_flight_.erase(tile);
+    }
+    done_.notify_all();
+  }
+}
+
+int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKey>& needed, size_t& loads) {
+  auto held = layer_of_.find(tile);
+  if (held != layer_of_.end()) {
+    lru_.remove(tile);
+    lru_.push_front(tile);
+    return held->second;
+  }
+  // Its data: ready from the worker, still in flight (wait for it), or read now.
+  std::optional<Page> page;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    // Still queued: the worker has not started it, so it is read here. Being read: wait for it.
+    const auto queued = std::find(queue_.begin(), queue_.end(), tile);
+    if (queued != queue_.end()) {
+      queue_.erase(queued);
+      in_flight_.erase(tile);
+    }
+    done_.wait(lock, [&] { return !in_flight_.count(tile); });
+    auto r = ready_.find(tile);
+    if (r != ready_.end()) {
+      page = std::move(r->second);
+      ready_.erase(r);
+      ++stats_.prefetch_hits;
+    }
+  }
+  if (!page) {
+    page = makePage(tile.first, tile.second);
+    stats_.load_seconds += page->seconds;
+    ++stats_.page_loads;
+    ++loads;
+  }
+  int layer = -1;
+  if (!free_layers_.empty()) {
+    layer = free_layers_.back();
+    free_layers_.pop_back();
+  } else {
+    // The least recently used page this frame does not need.
+    for (auto it = lru_.rbegin(); it != lru_.rend(); ++it)
+      if (!needed.count(*it)) {
+        layer = layer_of_.at(*it);
+        layer_of_.erase(*it);
+        lru_.erase(std::next(it).base());
+        ++stats_.evictions;
+        break;
+      }
+  }
+  FF_CHECK(layer >= 0);  // draw() checked that the frame's pages fit
+  pages_->upload(layer, page->heights, page->colour);
+  layer_of_[tile] = layer;
+  lru_.push_front(tile);
+  stats_.pages = layer_of_.size();
+  stats_.peak_pages = std::max(stats_.peak_pages, stats_.pages);
+  return layer;
+}
+
+PagedGpuLodFrame PagedGpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target) {
+  lod_.select(camera, pixel_error, true, selection_);
+  if (selection_.ranges_changed) {
+    std::vector<Vec2> ranges;
+    ranges.reserve(selection_.ranges.node.size());
+    for (const Vec3& r : selection_.ranges.node) ranges.emplace_back(r.x, r.y);
+    renderer_->setRanges(ranges);
+  }
+  std::set<TileKey> needed;
+  for (const CdlodNode& n : selection_.nodes)
+    if (n.level < fine_levels_) needed.insert(tileOf(n));
+  if (needed.size() > size_t(pages_->layers()))
+    throw Error("paged CDLOD terrain", "this view needs " + std::to_string(needed.size()) + " pages; the GPU budget holds " +
+                                           std::to_string(pages_->layers()) + ": raise it");
+  PagedGpuLodFrame frame;
+  instances_.clear();
+  const int p = lod_.patchCells();
+  for (const CdlodNode& n : selection_.nodes) {
+    const int layer = n.level < fine_levels_ ? residentLayer(tileOf(n), needed, frame.page_loads) : -1;
+    frame.paged_nodes += layer >= 0 ? 1 : 0;
+    instances_.push_back({int32_t(n.x * (p << n.level)), int32_t(n.y * (p << n.level)), int32_t(n.level), layer});
+  }
+  frame.draw = renderer_->draw(camera, target, instances_);
+  frame.nodes = selection_.nodes.size();
+  frame.pages_needed = needed.size();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stats_.prefetched = prefetched_;
+    stats_.load_seconds += worker_seconds_;
+    worker_seconds_ = 0.0;
+  }
+  if (options_.prefetch_frames > 0) prefetchAhead(camera, pixel_error);
+  last_camera_ = camera;
+  return frame;
+}
+
+void PagedGpuLodTerrain::prefetchAhead(const Camera& camera, float pixel_error) {
+  if (!last_camera_) return;
+  const Vec3 eye_step = camera.eye - last_camera_->eye, at_step = camera.at - last_camera_->at;
+  if (glm::length(eye_step) < 1e-6f && glm::length(at_step) < 1e-6f) return;
+  std::set<TileKey> wanted;
+  CdlodSelection& ahead = ahead_;  // its ranges are remade only when the bound or the camera model change
+  for (const float frames : {0.5f * float(options_.prefetch_frames), float(options_.prefetch_frames)}) {
+    Camera c = camera;
+    c.eye += eye_step * frames;
+    c.at += at_step * frames;
+    lod_.select(c, pixel_error, true, ahead);
+    for (const CdlodNode& n : ahead.nodes)
+      if (n.level < fine_levels_) wanted.insert(tileOf(n));
+  }
+  size_t room = size_t(pages_->layers());
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const TileKey& t : wanted) {
+      if (layer_of_.count(t) || in_flight_.count(t) || ready_.count(t)) continue;
+      if (in_flight_.size() + ready_.size() >= room) break;  // no more read ahead than the pages could take
+      queue_.push_back(t);
+      in_flight_.insert(t);
+    }
+  }
+  wake_.notify_all();
+}
+
+}  // namespace farfield::terrain

@@ -1,0 +1,127 @@
+// The CDLOD terrain (cdlod.h) paged from a tile cache (tile_cache.h) to the GPU: for terrains larger than memory or
+// than the driver's textures (a 16,385^2 grid is 1 GB of heights and exceeds llvmpipe's 16,384-texel limit).
+//
+// The node data come from the cache tile by tile (cdlod_tiles.h). The nodes of the finest levels (below F) read their
+// tile's page: the tile's own points at full resolution and its original-texture texels, in a layer of texture
+// arrays held under a GPU budget (gpu/cdlod_pages.h), the least recently used evicted first. The coarser nodes, whose
+// vertices lie every 2^F points, read the overview (every 2^F-th point and a texel each), always held. Per frame: the
+// selection, the pages it needs (read at once if missing: the frame waits, counted), one instanced draw. After each
+// frame the pages the camera will need half and all of prefetch_frames frames ahead, moving as it last moved, are
+// read on a worker thread, so that a steady flight rarely waits.
+//
+// The same tree, ranges and pages give the same frame whatever the budget (the pixels do not depend on what was
+// evicted: tested). Against the whole grid's CDLOD (gpu_lod.h) the frames differ where coarse nodes morph (the
+// overview is sampled between their vertices) and in the coarse nodes' colours (a texel per overview point).
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <list>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/gpu/cdlod_pages.h"
+#include "farfield/gpu/cdlod_renderer.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/terrain/cdlod.h"
+#include "farfield/terrain/tile_cache.h"
+
+namespace farfield::terrain {
+
+struct PagedGpuLodOptions {
+  CdlodOptions lod;
+  size_t gpu_budget_bytes = size_t(256) << 20;  // the pages' layers (heights and colours with mipmaps)
+  int prefetch_frames = 32;  // pages read ahead along the camera's motion (0: only what a frame needs, at once)
+  int overview_step = 0;     // 2^F; 0 = the largest power of two up to 16 that the cache and its tiles allow
+};
+
+struct PagedGpuLodStats {
+  size_t page_loads = 0;     // pages read by draw() itself: the frame waited
+  size_t prefetched = 0;     // pages read by the worker
+  size_t prefetch_hits = 0;  // of them, taken into a frame
+  size_t evictions = 0;
+  size_t pages = 0;          // held now
+  size_t peak_pages = 0;
+  double load_seconds = 0.0;  // reading tiles and making their colours (both threads)
+};
+
+struct PagedGpuLodFrame {
+  gpu::FrameStats draw;
+  size_t nodes = 0;         // drawn
+  size_t paged_nodes = 0;   // of them, reading a page
+  size_t pages_needed = 0;  // distinct pages the frame read
+  size_t page_loads = 0;    // read in this frame (waited for)
+};
+
+class PagedGpuLodTerrain {
+ public:
+  // Needs a current context; cache must outlive this. Reads the cache's node data (every tile once) and overview.
+  // Throws farfield::Error when the budget holds no page, or as cdlodFromTileCache does.
+  PagedGpuLodTerrain(const TileCache& cache, const PagedGpuLodOptions& options = {});
+  ~PagedGpuLodTerrain();
+  PagedGpuLodTerrain(const PagedGpuLodTerrain&) = delete;
+  PagedGpuLodTerrain& operator=(const PagedGpuLodTerrain&) = delete;
+
+  // Draws the terrain for the camera under the bound (pixels) into the bound target (not cleared; no wait). Throws
+  // farfield::Error when the frame needs more pages than the budget holds.
+  PagedGpuLodFrame draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target);
+
+  // Waits for the GPU (glFinish): the end of a timed frame.
+  void finish() { renderer_->finish(); }
+
+  const CdlodTerrain& lod() const { return lod_; }
+  const PagedGpuLodStats& stats() const { return stats_; }
+  int fineLevels() const { return fine_levels_; }
+  int overviewStep() const { return overview_step_; }
+  int pageLayers() const { return pages_->layers(); }
+  size_t gpuBytes() const;
+
+ private:
+  struct Page {
+    std::vector<float> heights;
+    image::ColorImage colour;
+    double seconds = 0.0;
+  };
+  using TileKey = std::pair<int, int>;
+  Page makePage(int tx, int ty) const;
+  TileKey tileOf(const CdlodNode& node) const;
+  int residentLayer(const TileKey& tile, const std::set<TileKey>& needed, size_t& loads);
+  void prefetchAhead(const Camera& camera, float pixel_error);
+  void work();
+
+  const TileCache& cache_;
+  PagedGpuLodOptions options_;
+  CdlodTerrain lod_;
+  int overview_step_ = 1, fine_levels_ = 0;
+  Heightfield overview_;
+  image::ColorImage overview_colour_;
+  std::unique_ptr<gpu::CdlodPages> pages_;
+  std::unique_ptr<gpu::CdlodRenderer> renderer_;
+  CdlodSelection selection_, ahead_;
+  std::vector<gpu::CdlodInstance> instances_;
+  PagedGpuLodStats stats_;
+  std::map<TileKey, int> layer_of_;  // resident tiles
+  std::list<TileKey> lru_;           // most recently used first
+  std::vector<int> free_layers_;
+  std::optional<Camera> last_camera_;
+  // Shared with the worker, under mutex_.
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  std::deque<TileKey> queue_;
+  std::set<TileKey> in_flight_;
+  std::map<TileKey, Page> ready_;
+  size_t prefetched_ = 0;
+  double worker_seconds_ = 0.0;
+  bool stop_ = false;
+  std::thread worker_;
+};
+
+}  // namespace farfield::terrain
