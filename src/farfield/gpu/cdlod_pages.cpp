@@ -64,21 +64,27 @@ CdlodPages::~CdlodPages() {
   if (colours_) glDeleteTextures(1, &colours_);
 }
 
-void CdlodPages::upload(int layer, std::span<const float> heights, const image::ColorImage& colour) {
+std::vector<image::ColorImage> CdlodPages::colourMips(image::ColorImage level0) {
+  std::vector<image::ColorImage> levels;
+  levels.push_back(std::move(level0));
+  while (levels.back().width() > 1 || levels.back().height() > 1) levels.push_back(halve(levels.back()));
+  return levels;
+}
+
+void CdlodPages::upload(int layer, std::span<const float> heights, std::span<const image::ColorImage> colour) {
   const int n = page_cells_ + 1;
   if (layer < 0 || layer >= layers_) throw Error("CDLOD pages", "no layer " + std::to_string(layer));
-  if (heights.size() != size_t(n) * size_t(n) || colour.width() != n || colour.height() != n)
-    throw Error("CDLOD pages", "a page is " + std::to_string(n) + " x " + std::to_string(n) + " points");
+  if (heights.size() != size_t(n) * size_t(n) || colour.size() != size_t(levels_) || colour[0].width() != n ||
+      colour[0].height() != n)
+    throw Error("CDLOD pages", "a page is " + std::to_string(n) + " x " + std::to_string(n) + " points with " +
+                                   std::to_string(levels_) + " colour levels");
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
   glTextureSubImage3D(heights_, 0, 0, 0, layer, n, n, 1, GL_RED, GL_FLOAT, heights.data());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  image::ColorImage level = colour;
-  for (int l = 0; l < levels_; ++l) {
-    if (l > 0) level = halve(level);
-    glTextureSubImage3D(colours_, l, 0, 0, layer, level.width(), level.height(), 1, GL_RGBA, GL_UNSIGNED_BYTE,
-                        level.data());
-  }
+  for (int l = 0; l < levels_; ++l)
+    glTextureSubImage3D(colours_, l, 0, 0, layer, colour[size_t(l)].width(), colour[size_t(l)].height(), 1, GL_RGBA,
+                        GL_UNSIGNED_BYTE, colour[size_t(l)].data());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
 }
 

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "farfield/image/image.h"
 
@@ -21,9 +22,11 @@ class CdlodPages {
   CdlodPages(const CdlodPages&) = delete;
   CdlodPages& operator=(const CdlodPages&) = delete;
 
-  // Fills a layer: heights, (S + 1)^2 row-major from the tile's first point; colour, (S + 1)^2 texels likewise.
-  // Throws farfield::Error for a layer out of range or data of another size.
-  void upload(int layer, std::span<const float> heights, const image::ColorImage& colour);
+  // Fills a layer: heights, (S + 1)^2 row-major from the tile's first point; colour, its mip chain (colourMips: level
+  // 0 is (S + 1)^2 texels likewise). Throws farfield::Error for a layer out of range or data of another size.
+  void upload(int layer, std::span<const float> heights, std::span<const image::ColorImage> colour);
+  // The mip chain of a page's colour, made on the CPU (by a loading thread: no GL).
+  static std::vector<image::ColorImage> colourMips(image::ColorImage level0);
   // Binds the height array to a texture unit and the colour array to another.
   void bind(int height_unit, int colour_unit) const;
 

@@ -97,9 +97,10 @@ PagedGpuLodTerrain::Page PagedGpuLodTerrain::makePage(int tx, int ty) const {
   to.ramp_hi = cache_.maxHeight();
   to.origin = g.origin + IVec2(mx0, my0);
   const image::ColorImage texels = terrainTexture(part, to);
-  page.colour = image::ColorImage(n, n);
+  image::ColorImage colour(n, n);
   for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) page.colour.at(i, j) = texels.at(std::min(x0 + i, x1) - mx0, std::min(y0 + j, y1) - my0);
+    for (int i = 0; i < n; ++i) colour.at(i, j) = texels.at(std::min(x0 + i, x1) - mx0, std::min(y0 + j, y1) - my0);
+  page.colour = gpu::CdlodPages::colourMips(std::move(colour));
   page.seconds = clock.seconds();
   return page;
 }

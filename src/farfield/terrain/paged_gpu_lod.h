@@ -87,7 +87,7 @@ class PagedGpuLodTerrain {
  private:
   struct Page {
     std::vector<float> heights;
-    image::ColorImage colour;
+    std::vector<image::ColorImage> colour;  // mip chain
     double seconds = 0.0;
   };
   using TileKey = std::pair<int, int>;
