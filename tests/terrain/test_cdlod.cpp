@@ -13,6 +13,7 @@
 #include "farfield/terrain/cdlod_tiles.h"
 #include "farfield/terrain/fractal.h"
 #include "farfield/terrain/quadtree_lod.h"
+#include "terrain/terrain_gl_scene.h"
 #include "terrain/tiled_test_terrain.h"
 
 namespace farfield::terrain {
@@ -27,16 +28,7 @@ Heightfield fractal(int size, uint64_t seed, double relief = 400.0) {
   return fractalTerrain(o);
 }
 
-Camera cameraAt(Vec3 eye, Vec3 at, int size = 256) {
-  Camera c;
-  c.eye = eye;
-  c.at = at;
-  c.width = c.height = size;
-  c.fov_y = float(degToRad(60.0));
-  c.near_plane = 1.0f;
-  c.far_plane = 100000.0f;
-  return c;
-}
+Camera cameraAt(Vec3 eye, Vec3 at) { return test::makeCamera(eye, at, 256); }
 
 // The drawn (morphed) triangles of one node, in world coordinates.
 std::vector<std::array<Vec3, 3>> nodeTriangles(const CdlodTerrain& t, const CdlodNode& n, const CdlodRanges& r,

@@ -64,45 +64,41 @@ std::shared_ptr<TerrainRun>& currentTerrainRun() {
 
 void LodMode::prepare(const ModeContext& context) {
   run_ = terrainRunFor(context, name_);
-  run_->gpuRenderer();
+  frames_ = nodes_ = 0;
+  if (!gpu_) {
+    run_->gpuRenderer();
+    return;
+  }
+  const int patch = intOption(context, "patch_cells", 16, 2, 128);
+  if ((patch & (patch - 1)) != 0)
+    throw Error("--mode-option patch_cells", "must be a power of two, got " + std::to_string(patch));
+  run_->gpuLod(patch);
 }
 
 void LodMode::frame(FrameContext& frame) {
   gpu::RenderTarget& target = frame.beginOwnPass();
   const float error = high_ ? run_->high_error : run_->low_error;
+  if (gpu_) {
+    const terrain::GpuLodFrame drawn = run_->gpuLod().draw(frame.camera(), error, target);
+    frame.addStats(drawn.draw);
+    ++frames_;
+    nodes_ += drawn.nodes;
+    return;
+  }
   frame.addStats(terrain::renderLodFrame(*run_->data->lod, run_->gpuRenderer(), frame.camera(),
                                          terrain::LodSettings{error, true, false}, target, mesh_));
 }
 
 std::map<std::string, double> LodMode::info() const {
-  return {{"pixel_error", high_ ? run_->high_error : run_->low_error}};
-}
-
-void GpuLodMode::prepare(const ModeContext& context) {
-  run_ = terrainRunFor(context, name_);
-  const int patch = intOption(context, "patch_cells", 16, 2, 128);
-  if ((patch & (patch - 1)) != 0)
-    throw Error("--mode-option patch_cells", "must be a power of two, got " + std::to_string(patch));
-  run_->gpuLod(patch);
-  frames_ = nodes_ = 0;
-}
-
-void GpuLodMode::frame(FrameContext& frame) {
-  gpu::RenderTarget& target = frame.beginOwnPass();
-  const terrain::GpuLodFrame drawn =
-      run_->gpuLod().draw(frame.camera(), high_ ? run_->high_error : run_->low_error, target);
-  frame.addStats(drawn.draw);
-  ++frames_;
-  nodes_ += drawn.nodes;
-}
-
-std::map<std::string, double> GpuLodMode::info() const {
-  terrain::GpuLodTerrain& lod = run_->gpuLod();
-  return {{"pixel_error", high_ ? run_->high_error : run_->low_error},
-          {"patch_cells", double(lod.lod().patchCells())},
-          {"levels", double(lod.lod().levels())},
-          {"nodes_mean", frames_ ? double(nodes_) / double(frames_) : 0.0},
-          {"gpu_bytes", double(lod.gpuBytes())}};
+  std::map<std::string, double> out{{"pixel_error", high_ ? run_->high_error : run_->low_error}};
+  if (gpu_) {
+    terrain::GpuLodTerrain& lod = run_->gpuLod();
+    out["patch_cells"] = double(lod.lod().patchCells());
+    out["levels"] = double(lod.lod().levels());
+    out["nodes_mean"] = frames_ ? double(nodes_) / double(frames_) : 0.0;
+    out["gpu_bytes"] = double(lod.gpuBytes());
+  }
+  return out;
 }
 
 TiledLodMode::~TiledLodMode() {
@@ -289,9 +285,9 @@ void registerTerrainModes() {
   registerMode("high", "terrain: high-resolution quadtree LOD (--mode-option terrain=DEM)",
                [](const ModeContext&) { return std::make_unique<LodMode>("high", true); });
   registerMode("high-gpu", "terrain: CDLOD on the GPU at the high threshold (--mode-option terrain=DEM)",
-               [](const ModeContext&) { return std::make_unique<GpuLodMode>("high-gpu", true); });
+               [](const ModeContext&) { return std::make_unique<LodMode>("high-gpu", true, true); });
   registerMode("low-gpu", "terrain: CDLOD on the GPU at the low threshold (--mode-option terrain=DEM)",
-               [](const ModeContext&) { return std::make_unique<GpuLodMode>("low-gpu", false); });
+               [](const ModeContext&) { return std::make_unique<LodMode>("low-gpu", false, true); });
   registerMode("high-tiles",
                "terrain: the high LOD built per tile from tiles paged under a budget (--mode-option terrain=DEM, "
                "tile_blocks=N, tile_budget_mb=MB)",

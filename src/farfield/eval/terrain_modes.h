@@ -75,10 +75,13 @@ class ScopedTerrainRun {
   ScopedTerrainRun& operator=(const ScopedTerrainRun&) = delete;
 };
 
-// `high` and `low`: the LOD mesh with the original texture.
+// `high` and `low`: the LOD mesh with the original texture. With gpu, `high-gpu` and `low-gpu`: the CDLOD terrain
+// (terrain/cdlod.h) at the same thresholds, selected on the CPU and drawn as one instanced draw whose vertex shader
+// fetches heights and morphs between levels; mode option patch_cells=P (quads per patch side, a power of two,
+// default 16). info(): pixel_error, and with gpu patch_cells, levels, nodes_mean (drawn per frame), gpu_bytes.
 class LodMode : public Mode {
  public:
-  LodMode(std::string name, bool high) : name_(std::move(name)), high_(high) {}
+  LodMode(std::string name, bool high, bool gpu = false) : name_(std::move(name)), high_(high), gpu_(gpu) {}
   std::string name() const override { return name_; }
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
@@ -86,27 +89,9 @@ class LodMode : public Mode {
 
  private:
   std::string name_;
-  bool high_;
+  bool high_, gpu_;
   std::shared_ptr<TerrainRun> run_;
   terrain::LodMesh mesh_;
-};
-
-// `high-gpu` and `low-gpu`: the CDLOD terrain (terrain/cdlod.h) at the run's high and low thresholds, selected on the
-// CPU and drawn as one instanced draw whose vertex shader fetches heights and morphs between levels. Mode option:
-// patch_cells=P (quads per patch side, a power of two, default 16). info(): pixel_error, patch_cells, levels,
-// nodes_mean (drawn per frame), gpu_bytes.
-class GpuLodMode : public Mode {
- public:
-  GpuLodMode(std::string name, bool high) : name_(std::move(name)), high_(high) {}
-  std::string name() const override { return name_; }
-  void prepare(const ModeContext& context) override;
-  void frame(FrameContext& frame) override;
-  std::map<std::string, double> info() const override;
-
- private:
-  std::string name_;
-  bool high_;
-  std::shared_ptr<TerrainRun> run_;
   size_t frames_ = 0, nodes_ = 0;
 };
 

@@ -33,6 +33,19 @@
 
 namespace farfield::eval::terrain_experiment {
 
+// A renderer, a target and the harness's frame runner, with a mode context for them: the timed loops below.
+struct TimedLoop {
+  gpu::Renderer renderer;
+  gpu::RenderTarget target;
+  FrameRunner runner;
+  ModeContext context;
+  TimedLoop(int width, int height) : target(width, height), runner(renderer, target) {
+    context.renderer = &renderer;
+    context.width = width;
+    context.height = height;
+  }
+};
+
 // 4. Sweeps. Figures 12 and 13 (keyframe fraction against frame count and threshold) from the keyframe decisions
 // alone (no rendering needed: they depend on the viewpoints and the low-resolution meshes only); Figure 14
 // (speedup against threshold) timed: lod-sprite at each threshold over the same frames, interleaved, against
@@ -66,13 +79,9 @@ void runSweeps(Experiment& x) {
   const std::vector<Camera> cameras = x.measuredCameras();
   const std::vector<size_t>& indices = x.result.bench.frame_indices;
   // Timed sweep with the harness's frame runner and its frame-time definition.
-  gpu::Renderer renderer;
-  gpu::RenderTarget target(o.width, o.height);
-  FrameRunner runner(renderer, target);
-  ModeContext mc;
-  mc.renderer = &renderer;
-  mc.width = o.width;
-  mc.height = o.height;
+  TimedLoop loop(o.width, o.height);
+  FrameRunner& runner = loop.runner;
+  const ModeContext& mc = loop.context;
   // High resolution runs in the same interleaved loop, so that every ratio is measured over the same minutes (the
   // load of a shared machine drifts between the harness run and this one).
   std::vector<std::unique_ptr<SpriteMode>> modes;
@@ -149,13 +158,9 @@ void runBackAndForth(Experiment& x) {
       terrainCameraPath(terrain::backAndForth(viewpoints, std::min(first, n - length), length, 2), "back-and-forth");
   say(o, "section 5: back and forth over path frames %zu..%zu (%zu frames)\n", std::min(first, n - length),
       std::min(first, n - length) + length - 1, bf.frames.size());
-  gpu::Renderer renderer;
-  gpu::RenderTarget target(o.width, o.height);
-  FrameRunner runner(renderer, target);
-  ModeContext mc;
-  mc.renderer = &renderer;
-  mc.width = o.width;
-  mc.height = o.height;
+  TimedLoop loop(o.width, o.height);
+  FrameRunner& runner = loop.runner;
+  const ModeContext& mc = loop.context;
   std::vector<std::unique_ptr<Mode>> modes;
   modes.push_back(std::make_unique<LodMode>("high", true));
   modes.push_back(std::make_unique<SpriteMode>("lod-sprite", SpriteVariant::Paper));

@@ -312,17 +312,18 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     j["whole_keyframe_triangles"] = sprite.whole_triangles;
   }
   std::string render_md;
+  // The drawn frames' times (sorted) and triangles, for either renderer's summary.
+  std::vector<double> fms;
+  size_t drawn_max = 0, drawn_sum = 0;
+  double fsum = 0.0;
+  for (const FrameRow& r : rows) {
+    fms.push_back(r.frame_ms);
+    fsum += r.frame_ms;
+    drawn_max = std::max(drawn_max, r.drawn_triangles);
+    drawn_sum += r.drawn_triangles;
+  }
+  std::sort(fms.begin(), fms.end());
   if (cdlod) {
-    std::vector<double> fms;
-    size_t drawn_max = 0, drawn_sum = 0;
-    for (const FrameRow& r : rows) {
-      fms.push_back(r.frame_ms);
-      drawn_max = std::max(drawn_max, r.drawn_triangles);
-      drawn_sum += r.drawn_triangles;
-    }
-    std::sort(fms.begin(), fms.end());
-    double fsum = 0.0;
-    for (double v : fms) fsum += v;
     const terrain::PagedGpuLodStats& cs = cdlod->stats();
     size_t over_twice = 0;
     for (double v : fms) over_twice += v > 2.0 * fms[fms.size() / 2] ? 1 : 0;
@@ -358,16 +359,6 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                   cs.prefetch_hits, cs.evictions, cs.load_seconds, cdlod_prepare_seconds);
     render_md = line;
   } else if (paged) {
-    std::vector<double> fms;
-    size_t drawn_max = 0, drawn_sum = 0;
-    for (const FrameRow& r : rows) {
-      fms.push_back(r.frame_ms);
-      drawn_max = std::max(drawn_max, r.drawn_triangles);
-      drawn_sum += r.drawn_triangles;
-    }
-    std::sort(fms.begin(), fms.end());
-    double fsum = 0.0;
-    for (double v : fms) fsum += v;
     const terrain::PagedTerrainStats& ps = paged->stats();
     // What drawing the whole grid would hold on the GPU: every point's position and a texel a point with mipmaps.
     const size_t whole_gpu = size_t(grid_w) * size_t(grid_h) * (sizeof(Vec3) + 4 * 4 / 3);
