@@ -265,7 +265,7 @@ const Entry kEntries[] = {
     FF_HOOK_UNIFORM(glUniform1i, 4), FF_HOOK_UNIFORM(glUniform1ui, 4),
     FF_HOOK_UNIFORM(glUniform1f, 4), FF_HOOK_UNIFORM(glUniform2f, 8),
     FF_HOOK_UNIFORM(glUniform2i, 8), FF_HOOK_UNIFORM(glUniform2fv, 8, 1),
-    FF_HOOK_UNIFORM(glUniform1iv, 4, 1), FF_HOOK_UNIFORM(glUniform2iv, 8, 1),
+    FF_HOOK_UNIFORM(glUniform1iv, 4, 1), FF_HOOK_UNIFORM(glUniform2iv, 8, 1), FF_HOOK_UNIFORM(glUniform1fv, 4, 1),
     FF_HOOK_UNIFORM(glUniform3fv, 12, 1), FF_HOOK_UNIFORM(glUniform4fv, 16, 1),
     FF_HOOK_UNIFORM(glUniform4f, 16), FF_HOOK_UNIFORM(glUniformMatrix3fv, 36, 1),
     FF_HOOK_UNIFORM(glUniformMatrix4fv, 64, 1), FF_HOOK_UNIFORM(glProgramUniform1f, 4),

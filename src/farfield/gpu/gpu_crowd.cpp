@@ -1,0 +1,151 @@
+#include "farfield/gpu/gpu_crowd.h"
+
+#include <epoxy/gl.h>
+#include <glm/gtc/type_ptr.hpp>
+
+#include <algorithm>
+#include <string>
+
+#include "farfield/core/check.h"
+#include "farfield/core/error.h"
+
+namespace farfield::gpu {
+namespace {
+
+struct AgentRecord {
+  uint32_t route, model, outfit, id;
+  float start, speed, direction, phase;
+};
+struct RouteRecord {
+  uint32_t first, count;
+  float length, unused;
+};
+struct ModelRecord {
+  Vec4 sphere;
+  Vec4 lists;
+};
+
+uint32_t makeBuffer(const void* data, size_t bytes, size_t& total) {
+  uint32_t b = 0;
+  glCreateBuffers(1, &b);
+  glNamedBufferStorage(b, GLsizeiptr(std::max<size_t>(bytes, 16)), data, 0);
+  total += bytes;
+  return b;
+}
+
+template <class T>
+std::vector<T> readBuffer(uint32_t buffer, size_t offset, size_t count) {
+  std::vector<T> out(count);
+  if (count) glGetNamedBufferSubData(buffer, GLintptr(offset), GLsizeiptr(count * sizeof(T)), out.data());
+  return out;
+}
+
+}  // namespace
+
+GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCrowdAgent> agents,
+                   std::span<const GpuCrowdModel> models)
+    : agents_(agents.size()), models_(models.size()) {
+  const char* what = "GPU crowd";
+  if (agents.empty()) throw Error(what, "no agents");
+  if (models.empty() || models.size() > size_t(kMaxModels))
+    throw Error(what, std::to_string(models.size()) + " models (1.." + std::to_string(kMaxModels) + ")");
+  std::vector<RouteRecord> route_records;
+  std::vector<Vec4> points;
+  for (size_t r = 0; r < routes.size(); ++r) {
+    const GpuCrowdRoute& route = routes[r];
+    if (route.loop.size() < 2 || route.distance.size() != route.loop.size() ||
+        (!route.ground.empty() && route.ground.size() != route.loop.size()) || !(route.length > 0.0f))
+      throw Error(what, "route " + std::to_string(r) + ": needs 2 or more points, an arc length and a ground height "
+                                                         "(or none) at each, and a positive length");
+    route_records.push_back({uint32_t(points.size()), uint32_t(route.loop.size()), route.length, 0.0f});
+    for (size_t k = 0; k < route.loop.size(); ++k)
+      points.emplace_back(route.loop[k], route.distance[k], route.ground.empty() ? 0.0f : route.ground[k]);
+  }
+  std::vector<AgentRecord> agent_records;
+  agent_records.reserve(agents.size());
+  for (size_t i = 0; i < agents.size(); ++i) {
+    const GpuCrowdAgent& a = agents[i];
+    if (a.route >= routes.size() || a.model >= models.size())
+      throw Error(what, "agent " + std::to_string(i) + " names route " + std::to_string(a.route) + " and model " +
+                            std::to_string(a.model) + " (" + std::to_string(routes.size()) + " routes, " +
+                            std::to_string(models.size()) + " models)");
+    agent_records.push_back({a.route, a.model, a.outfit, a.id, a.start, a.speed, a.direction, a.phase});
+  }
+  std::vector<ModelRecord> model_records;
+  for (size_t m = 0; m < models.size(); ++m) {
+    const GpuCrowdModel& mo = models[m];
+    if (!(mo.stride_m > 0.0f) || !(mo.radius > 0.0f)) throw Error(what, "model " + std::to_string(m) + ": stride and radius must be positive");
+    model_records.push_back({Vec4(mo.centre, mo.radius), Vec4(float(2 * m), mo.stride_m, 0.0f, 0.0f)});
+    initial_commands_.push_back({mo.geometry_indices, 0, 0, 0, 0});
+    initial_commands_.push_back({mo.impostor_indices, 0, 0, 0, 0});
+  }
+  agent_buf_ = makeBuffer(agent_records.data(), agent_records.size() * sizeof(AgentRecord), bytes_);
+  routes_ = makeBuffer(route_records.data(), route_records.size() * sizeof(RouteRecord), bytes_);
+  points_ = makeBuffer(points.data(), points.size() * sizeof(Vec4), bytes_);
+  poses_ = makeBuffer(nullptr, agents.size() * sizeof(Vec4), bytes_);
+  phases_ = makeBuffer(nullptr, agents.size() * sizeof(float), bytes_);
+  model_buf_ = makeBuffer(model_records.data(), model_records.size() * sizeof(ModelRecord), bytes_);
+  commands_ = makeBuffer(initial_commands_.data(), initial_commands_.size() * sizeof(GpuCrowdCommand), bytes_);
+  initial_ = makeBuffer(initial_commands_.data(), initial_commands_.size() * sizeof(GpuCrowdCommand), bytes_);
+  lists_ = makeBuffer(nullptr, initial_commands_.size() * agents.size() * sizeof(uint32_t), bytes_);
+  simulate_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_SIMULATE 1\n");
+  classify_ = Program::computeFromEmbedded("crowd_sim.comp.glsl");
+}
+
+GpuCrowd::~GpuCrowd() {
+  for (uint32_t b : {agent_buf_, routes_, points_, poses_, phases_, model_buf_, commands_, initial_, lists_})
+    if (b) glDeleteBuffers(1, &b);
+}
+
+void GpuCrowd::simulate(float t) {
+  simulate_.use();
+  simulate_.set("u_agents", uint32_t(agents_));
+  simulate_.set("u_time", t);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, agent_buf_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, routes_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, points_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, poses_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, phases_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, model_buf_);
+  glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> switch_m) {
+  if (switch_m.size() != models_)
+    throw Error("GPU crowd", std::to_string(switch_m.size()) + " switch distances for " + std::to_string(models_) +
+                                 " models");
+  camera.validate("GPU crowd camera");
+  // The instance counts back to 0: the commands copied from their initial values on the GPU's side (no upload).
+  glCopyNamedBufferSubData(initial_, commands_, 0, 0, GLsizeiptr(initial_commands_.size() * sizeof(GpuCrowdCommand)));
+  const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  float switches[kMaxModels] = {};
+  for (size_t m = 0; m < models_; ++m) switches[m] = switch_m[m];
+  classify_.use();
+  classify_.set("u_agents", uint32_t(agents_));
+  classify_.set("u_eye", camera.eye);
+  classify_.set("u_capacity", uint32_t(agents_));
+  glUniform4fv(classify_.uniformLocation("u_planes[0]"), 6, glm::value_ptr(frustum.planes[0]));
+  glUniform1fv(classify_.uniformLocation("u_switch[0]"), kMaxModels, switches);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, agent_buf_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, poses_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, model_buf_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, commands_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, lists_);
+  glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+}
+
+std::vector<Vec4> GpuCrowd::readPoses() const { return readBuffer<Vec4>(poses_, 0, agents_); }
+std::vector<float> GpuCrowd::readPhases() const { return readBuffer<float>(phases_, 0, agents_); }
+std::vector<GpuCrowdCommand> GpuCrowd::readCommands() const {
+  return readBuffer<GpuCrowdCommand>(commands_, 0, initial_commands_.size());
+}
+std::vector<uint32_t> GpuCrowd::readList(size_t list) const {
+  FF_CHECK(list < initial_commands_.size());
+  const size_t n = readCommands()[list].instance_count;
+  return readBuffer<uint32_t>(lists_, list * agents_ * sizeof(uint32_t), n);
+}
+size_t GpuCrowd::gpuBytes() const { return bytes_; }
+
+}  // namespace farfield::gpu

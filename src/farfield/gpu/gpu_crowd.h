@@ -1,0 +1,94 @@
+// A crowd simulated, culled and classified on the GPU (issue 45, first part): the agents, their sidewalk loops and
+// their models live in GPU buffers, uploaded once. Per frame, two compute dispatches and no upload but a few
+// uniforms: the first advances every agent to time t along its loop (gen::agentPose's arithmetic, in
+// crowd_sim.comp.glsl) and its walk-cycle phase; the second culls each agent against the camera's frustum and
+// classifies it by its model's switch distance (geometry nearer, impostor farther: the switch the CPU runtime takes
+// from Dobbyn's texel rule and the view error bound, runtime::CrowdRuntime::switchDistances), appending its index to
+// one of two lists per model. Each list has an indirect draw command whose instance count the pass increments, so the
+// lists are drawn with glMultiDrawElementsIndirect and nothing is read back.
+//
+// Plain data in (no gen or runtime types): eval converts a gen::Crowd (eval/gpu_crowd_input.h).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "farfield/core/camera.h"
+#include "farfield/core/math.h"
+#include "farfield/gpu/program.h"
+
+namespace farfield::gpu {
+
+struct GpuCrowdRoute {
+  std::vector<Vec2> loop;       // the sidewalk loop's points, counter-clockwise
+  std::vector<float> distance;  // arc length at each point (distance[0] = 0)
+  std::vector<float> ground;    // ground height at each point (empty: 0)
+  float length = 0.0f;
+};
+
+struct GpuCrowdAgent {
+  uint32_t route = 0, model = 0, outfit = 0, id = 0;
+  float start = 0.0f, speed = 1.2f;
+  float direction = 1.0f;  // +1 counter-clockwise, -1 clockwise
+  float phase = 0.0f;      // animation phase at t = 0
+};
+
+struct GpuCrowdModel {
+  Vec3 centre{0.0f, 0.0f, 0.9f};  // bounding sphere in agent space (feet at the origin, z up)
+  float radius = 1.0f;
+  float stride_m = 1.3f;          // metres walked over one animation cycle
+  uint32_t geometry_indices = 0;  // index counts of the lists' draw commands (geometry, impostor)
+  uint32_t impostor_indices = 6;
+};
+
+// The indirect draw command of a list (GL's DrawElementsIndirectCommand).
+struct GpuCrowdCommand {
+  uint32_t count = 0, instance_count = 0, first_index = 0;
+  int32_t base_vertex = 0;
+  uint32_t base_instance = 0;
+};
+
+class GpuCrowd {
+ public:
+  static constexpr int kMaxModels = 16;
+  // Needs a current context. Throws farfield::Error for no agents, an agent naming a missing route or model, a route
+  // of fewer than 2 points or mismatched arrays, more than kMaxModels models.
+  GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCrowdAgent> agents,
+           std::span<const GpuCrowdModel> models);
+  ~GpuCrowd();
+  GpuCrowd(const GpuCrowd&) = delete;
+  GpuCrowd& operator=(const GpuCrowd&) = delete;
+
+  // Every agent's pose and phase at time t (seconds): one dispatch.
+  void simulate(float t);
+  // The agents in the camera's frustum into the lists, by switch distance per model (metres; one per model): the
+  // commands' instance counts reset (a copy between GPU buffers) and one dispatch. Call after simulate.
+  void cullAndClassify(const Camera& camera, std::span<const float> switch_m);
+
+  size_t agentCount() const { return agents_; }
+  size_t modelCount() const { return models_; }
+  // List of model m: 2m (geometry) and 2m + 1 (impostors); its agent indices start at list * agentCount() in the
+  // list buffer; its command at list in the command buffer.
+  uint32_t poseBuffer() const { return poses_; }    // vec4 per agent: feet x, y, z, heading
+  uint32_t phaseBuffer() const { return phases_; }  // float per agent
+  uint32_t listBuffer() const { return lists_; }
+  uint32_t commandBuffer() const { return commands_; }
+
+  // Reads back (waits for the GPU; tests and checks, never a frame): poses, phases, the lists' agents, commands.
+  std::vector<Vec4> readPoses() const;
+  std::vector<float> readPhases() const;
+  std::vector<GpuCrowdCommand> readCommands() const;
+  std::vector<uint32_t> readList(size_t list) const;
+  size_t gpuBytes() const;
+
+ private:
+  size_t agents_ = 0, models_ = 0;
+  uint32_t agent_buf_ = 0, routes_ = 0, points_ = 0, poses_ = 0, phases_ = 0, model_buf_ = 0, commands_ = 0,
+           initial_ = 0, lists_ = 0;
+  size_t bytes_ = 0;
+  std::vector<GpuCrowdCommand> initial_commands_;
+  Program simulate_, classify_;
+};
+
+}  // namespace farfield::gpu

@@ -1,0 +1,86 @@
+#version 450 core
+// Farfield GPU crowd (gpu/gpu_crowd.h; issue 45): with FF_SIMULATE, each agent's pose at time u_time along its
+// sidewalk loop (the arithmetic of gen::agentPose; the ground's height interpolated between the loop's points) and
+// its animation phase (the distance walked over its model's stride, as eval's crowdAgentStates); otherwise, each agent culled by the camera's frustum (a sphere
+// about its feet) and classified by its model's switch distance, its index appended to its model's geometry or
+// impostor list, whose indirect draw command counts it.
+
+layout(local_size_x = 64) in;
+
+struct Agent {
+  uint route, model, outfit, id;
+  float start, speed, direction, phase;
+};
+struct Route {
+  uint first, count;  // loop points points[first .. first + count)
+  float len, unused;
+};
+struct Model {
+  vec4 sphere;        // centre (agent space, x y about the feet, z up) and radius
+  vec4 lists;         // x: this model's first list (geometry; impostors x + 1), y: stride (metres a walk cycle)
+};
+struct Command {
+  uint count, instance_count, first_index;
+  int base_vertex;
+  uint base_instance;
+};
+
+layout(std430, binding = 0) readonly buffer Agents { Agent agents[]; };
+layout(std430, binding = 1) readonly buffer Routes { Route routes[]; };
+layout(std430, binding = 2) readonly buffer Points { vec4 points[]; };  // x, y, arc length at the point, z (ground)
+layout(std430, binding = 3) buffer Poses { vec4 poses[]; };            // per agent: feet x y z, heading
+layout(std430, binding = 4) buffer Phases { float phases[]; };         // per agent: animation phase [0, 1)
+layout(std430, binding = 5) readonly buffer Models { Model models[]; };
+layout(std430, binding = 6) buffer Commands { Command commands[]; };   // per list
+layout(std430, binding = 7) buffer Lists { uint lists[]; };            // per list, u_capacity agent indices
+
+uniform uint u_agents;
+uniform float u_time;
+uniform vec4 u_planes[6];      // frustum planes (dot(xyz, p) + w >= 0 inside)
+uniform vec3 u_eye;
+uniform float u_switch[16];    // per model: geometry nearer than this (metres)
+uniform uint u_capacity;       // agents a list holds
+
+#ifdef FF_SIMULATE
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= u_agents) return;
+  Agent a = agents[i];
+  Route r = routes[a.route];
+  float walked = a.speed * u_time;
+  float s = mod(a.start + a.direction * walked, r.len);
+  if (s < 0.0) s += r.len;
+  // The segment: the last point whose arc length is at most s (binary search).
+  uint lo = 0u, hi = r.count;  // points[first + lo].z <= s < points[first + hi].z
+  while (hi - lo > 1u) {
+    uint mid = (lo + hi) / 2u;
+    if (points[r.first + mid].z <= s) lo = mid; else hi = mid;
+  }
+  vec4 p0 = points[r.first + lo], p1 = points[r.first + (lo + 1u) % r.count];
+  vec2 d = p1.xy - p0.xy;
+  float len = length(d);
+  vec2 dir = len > 0.0 ? d / len : vec2(1.0, 0.0);
+  float along = clamp(s - p0.z, 0.0, len);
+  vec2 p = p0.xy + dir * along;
+  float z = len > 0.0 ? mix(p0.w, p1.w, along / len) : p0.w;
+  vec2 walk = dir * a.direction;
+  poses[i] = vec4(p, z, atan(walk.y, walk.x));
+  phases[i] = fract(a.phase + walked / models[a.model].lists.y);
+}
+#else
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= u_agents) return;
+  Agent a = agents[i];
+  Model m = models[a.model];
+  vec4 pose = poses[i];
+  // A sphere that holds the model in any heading: about the feet, raised by the centre's height.
+  vec3 c = pose.xyz + vec3(0.0, 0.0, m.sphere.z);
+  float radius = m.sphere.w + length(m.sphere.xy);
+  for (int k = 0; k < 6; ++k)
+    if (dot(u_planes[k].xyz, c) + u_planes[k].w < -radius) return;
+  uint list = uint(m.lists.x) + (distance(u_eye, c) < u_switch[a.model] ? 0u : 1u);
+  uint slot = atomicAdd(commands[list].instance_count, 1u);
+  lists[list * u_capacity + slot] = i;
+}
+#endif
