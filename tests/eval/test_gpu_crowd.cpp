@@ -4,16 +4,21 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <random>
 #include <set>
 #include <vector>
 
 #include "farfield/core/error.h"
+#include "farfield/eval/crowd_metrics.h"
+#include "farfield/eval/crowd_walk.h"
 #include "farfield/eval/gpu_crowd_input.h"
 #include "farfield/gen/street_network.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/gl_counters.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/runtime/crowd_runtime.h"
 
 namespace farfield::eval {
 namespace {
@@ -108,12 +113,15 @@ TEST(GpuCrowdGL, CullingAndClassificationEqualACpuBruteForce) {
     }
     // The CPU brute force, on the GPU's poses: the same sphere, planes and switch, in double precision.
     const std::vector<Vec4> poses = gc.readPoses();
-    const Frustum f = Frustum::fromMatrix(c.viewProjection());
+    Frustum f = Frustum::fromMatrix(c.viewProjection());
+    for (Vec4& p : f.planes) p /= glm::length(Vec3(p));
     std::vector<std::set<uint32_t>> expected(2 * models.size()), near_threshold(2 * models.size());
     for (size_t i = 0; i < crowd.agents.size(); ++i) {
       const gpu::GpuCrowdModel& m = models[crowd.agents[i].model];
-      const DVec3 centre = DVec3(Vec3(poses[i])) + DVec3(0.0, 0.0, m.centre.z);
-      const double radius = double(m.radius) + glm::length(DVec2(m.centre.x, m.centre.y));
+      const double h = poses[i].w;  // the model's centre turned by the heading, about the feet
+      const DVec3 centre = DVec3(Vec3(poses[i])) + DVec3(std::cos(h) * m.centre.x - std::sin(h) * m.centre.y,
+                                                          std::sin(h) * m.centre.x + std::cos(h) * m.centre.y, m.centre.z);
+      const double radius = m.radius;
       bool inside = true, borderline = false;
       for (const Vec4& p : f.planes) {
         const double d = glm::dot(DVec3(Vec3(p)), centre) + double(p.w) + radius;
@@ -133,7 +141,7 @@ TEST(GpuCrowdGL, CullingAndClassificationEqualACpuBruteForce) {
     const std::vector<gpu::GpuCrowdCommand> commands = gc.readCommands();
     for (size_t list = 0; list < expected.size(); ++list) {
       const std::vector<uint32_t> got = gc.readList(list);
-      EXPECT_EQ(commands[list].count, list % 2 ? 6u : models[list / 2].geometry_indices);
+      EXPECT_EQ(commands[list].count, list % 2 ? 4u : models[list / 2].geometry_indices);
       EXPECT_EQ(size_t(commands[list].instance_count), got.size());
       std::set<uint32_t> got_set(got.begin(), got.end());
       EXPECT_EQ(got_set.size(), got.size()) << "an agent listed twice";
@@ -144,6 +152,69 @@ TEST(GpuCrowdGL, CullingAndClassificationEqualACpuBruteForce) {
   }
   EXPECT_GT(geometry, 0u);  // the cameras saw both kinds
   EXPECT_GT(impostors, 0u);
+}
+
+// The frame drawn from the GPU crowd (simulated, culled and classified on the GPU, indirect draws) against the CPU
+// path's frame (gen::agentPose per agent, runtime::CrowdRuntime::draw) on the same camera, for each policy.
+TEST(GpuCrowdGL, FramesEqualTheCpuPathsOnTheCrowdsPixels) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  const CrowdModels models = builtinCrowdModels();
+  runtime::CrowdRuntime rt(models.models, models.options, runtime::CrowdRuntimeOptions{});
+  gen::StreetNetworkOptions so;
+  so.blocks = 12;
+  so.seed = 3;
+  const urban::StreetGraph streets = gen::generateStreetNetwork(so);
+  gen::CrowdOptions co;
+  co.agents = 3000;
+  co.seed = 21;
+  co.model_shares = models.shares;
+  const gen::Crowd crowd = gen::generateCrowd(streets, co);
+  gpu::GpuCrowd gc(gpuCrowdRoutes(crowd), gpuCrowdAgents(crowd, kCrowdIdBit), rt.gpuCrowdModels(kCrowdNominalSpeed));
+  const float t = 7.5f;
+  const std::vector<runtime::CrowdAgentState> states = crowdAgentStates(crowd, rt, t);
+  gc.simulate(t);
+  Camera camera;
+  const gen::AgentPose some = gen::agentPose(crowd, 0, t);
+  camera.eye = some.position + Vec3(-7.0f, -5.0f, 2.5f);
+  camera.at = some.position + Vec3(10.0f, 8.0f, 0.5f);
+  camera.width = 320;
+  camera.height = 200;
+  camera.near_plane = 0.3f;
+  camera.far_plane = 3000.0f;
+  const gpu::LightSettings light;
+  for (runtime::CrowdPolicy policy :
+       {runtime::CrowdPolicy::Impostor, runtime::CrowdPolicy::Geometry, runtime::CrowdPolicy::Mixed}) {
+    gpu::RenderTarget cpu(camera.width, camera.height), gpu_path(camera.width, camera.height);
+    cpu.clear(Vec4(0.5f, 0.6f, 0.7f, 1.0f));
+    cpu.bindForOpaquePass();
+    const runtime::CrowdFrameStats cs = rt.draw(camera, states, policy, light);
+    gpu_path.clear(Vec4(0.5f, 0.6f, 0.7f, 1.0f));
+    gpu_path.bindForOpaquePass();
+    const runtime::CrowdFrameStats gs = rt.drawGpu(camera, gc, policy, light);
+    EXPECT_EQ(gs.draw.draw_calls, 2u * rt.modelCount());
+    const image::IdImage a = cpu.readIds(), b = gpu_path.readIds();
+    const image::ColorImage ca = cpu.readColor(), cb = gpu_path.readColor();
+    size_t crowd_px = 0, same_id = 0, same_colour = 0;
+    for (int y = 0; y < camera.height; ++y)
+      for (int x = 0; x < camera.width; ++x) {
+        if (!(a.at(x, y) & kCrowdIdBit) && !(b.at(x, y) & kCrowdIdBit)) continue;
+        ++crowd_px;
+        same_id += a.at(x, y) == b.at(x, y) ? 1 : 0;
+        same_colour += glm::all(glm::lessThanEqual(glm::abs(glm::ivec4(ca.at(x, y)) - glm::ivec4(cb.at(x, y))),
+                                                   glm::ivec4(2)))
+                           ? 1
+                           : 0;
+      }
+    std::printf("policy %d: %zu crowd pixels, %zu same agent, %zu same colour; CPU drew %zu geometry, %zu impostors\n",
+                int(policy), crowd_px, same_id, same_colour, cs.geometry, cs.impostors);
+    EXPECT_GT(crowd_px, 500u);
+    if (policy == runtime::CrowdPolicy::Mixed) {  // the camera sees agents of both kinds
+      EXPECT_GT(cs.geometry, 0u);
+      EXPECT_GT(cs.impostors, 0u);
+    }
+    EXPECT_GE(double(same_id), 0.995 * double(crowd_px));
+    EXPECT_GE(double(same_colour), 0.99 * double(crowd_px));
+  }
 }
 
 TEST(GpuCrowdGL, BadInputIsAnError) {

@@ -12,9 +12,6 @@
 #include "farfield/scene/gltf_skin.h"
 
 namespace farfield::eval {
-namespace {
-constexpr float kNominalSpeed = 1.3f;  // m/s at which a model's walk cycle is played at its own rate
-}  // namespace
 
 CrowdModels builtinCrowdModels() {
   CrowdModels out;
@@ -69,7 +66,7 @@ std::vector<runtime::CrowdAgentState> crowdAgentStates(const gen::Crowd& crowd, 
     s.model = a.model;
     s.position = p.position;
     s.heading = p.heading;
-    const float stride = kNominalSpeed * rt.cycleSeconds(a.model);
+    const float stride = kCrowdNominalSpeed * rt.cycleSeconds(a.model);
     const float phase = a.phase + p.walked / stride;
     s.phase = phase - std::floor(phase);
     s.tint = a.tint;

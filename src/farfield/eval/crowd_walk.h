@@ -19,6 +19,8 @@ namespace farfield::eval {
 // The defaults for glTF files given as the crowd's models (--models, --crowd-models), by model index: those of the
 // shared models (../shared/data/models CesiumMan.glb, Fox.glb): heights in metres, the turn bringing each front to
 // +x (CesiumMan walks along +x once Z up; the Fox faces glTF's +z, -y), shares of agents.
+// m/s at which a model's walk cycle is played at its own rate (crowdAgentStates' phase; the GPU crowd's stride).
+inline constexpr float kCrowdNominalSpeed = 1.3f;
 inline const std::vector<float> kCrowdModelHeights{1.75f, 0.8f};
 inline const std::vector<float> kCrowdModelFacingDeg{0.0f, 90.0f};
 inline const std::vector<float> kCrowdModelShares{0.7f, 0.3f};

@@ -17,12 +17,13 @@ std::vector<gpu::GpuCrowdRoute> gpuCrowdRoutes(const gen::Crowd& crowd) {
   return routes;
 }
 
-std::vector<gpu::GpuCrowdAgent> gpuCrowdAgents(const gen::Crowd& crowd) {
+std::vector<gpu::GpuCrowdAgent> gpuCrowdAgents(const gen::Crowd& crowd, uint32_t id_bits) {
   std::vector<gpu::GpuCrowdAgent> agents;
   agents.reserve(crowd.agents.size());
   for (size_t i = 0; i < crowd.agents.size(); ++i) {
     const gen::CrowdAgent& a = crowd.agents[i];
-    agents.push_back({a.route, a.model, a.outfit, uint32_t(i), a.start, a.speed, float(a.direction), a.phase});
+    agents.push_back(
+        {a.route, a.model, a.outfit, id_bits | uint32_t(i), a.start, a.speed, float(a.direction), a.phase, a.tint});
   }
   return agents;
 }

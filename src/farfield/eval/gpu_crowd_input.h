@@ -10,7 +10,7 @@
 namespace farfield::eval {
 
 std::vector<gpu::GpuCrowdRoute> gpuCrowdRoutes(const gen::Crowd& crowd);
-// Agent i keeps i as its id.
-std::vector<gpu::GpuCrowdAgent> gpuCrowdAgents(const gen::Crowd& crowd);
+// Agent i's object id is id_bits | i (eval's crowdAgentStates: kCrowdIdBit | i).
+std::vector<gpu::GpuCrowdAgent> gpuCrowdAgents(const gen::Crowd& crowd, uint32_t id_bits = 0);
 
 }  // namespace farfield::eval

@@ -329,6 +329,21 @@ FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtla
   const AtlasLayout& l = atlas.layout_;
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < uint32_t(l.frames) && a.view < uint32_t(l.azimuths * l.elevations));
   uploadAgents(agents);
+  useImpostors(camera, atlas, light, blend_views);
+  glBindVertexArray(empty_vao_);
+  glDisable(GL_CULL_FACE);
+  glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(agents.size()));
+  glEnable(GL_CULL_FACE);
+  glBindVertexArray(0);
+  stats.draw_calls = 1;
+  stats.triangles = 2 * agents.size();
+  stats.objects = uint32_t(agents.size());
+  return stats;
+}
+
+const Program& CrowdRenderer::useImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas,
+                                           const LightSettings& light, bool blend_views) {
+  const AtlasLayout& l = atlas.layout_;
   const Program& p = blend_views ? impostor_blend_ : impostor_;
   p.use();
   p.set("u_view_proj", camera.viewProjection());
@@ -339,14 +354,47 @@ FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtla
   p.set("u_octahedral", l.octahedral ? 1 : 0);
   bindAtlas(p, atlas);
   setLight(p, light);
+  return p;
+}
+
+FrameStats CrowdRenderer::drawSkinnedIndirect(const Camera& camera, const SkinnedGpuModel& model, uint32_t agents,
+                                              size_t offset, size_t bytes, uint32_t commands, size_t command_offset,
+                                              const LightSettings& light) {
+  FrameStats stats;
+  if (model.indexCount() == 0 || bytes == 0) return stats;
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
+  const Program& p = program(skinned_, model);
+  p.use();
+  p.set("u_view_proj", camera.viewProjection());
+  p.set("u_outfits", outfits_);
+  bindModel(p, model);
+  setLight(p, light);
+  p.set("u_first_triangle", model.levels_[0].first_triangle);
+  glEnable(GL_CULL_FACE);
+  glBindVertexArray(model.vao_);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
+  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, reinterpret_cast<const void*>(command_offset), 1, 0);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+  glBindVertexArray(0);
+  stats.draw_calls = 1;
+  return stats;
+}
+
+FrameStats CrowdRenderer::drawImpostorsIndirect(const Camera& camera, const ImpostorAtlasGpu& atlas, uint32_t agents,
+                                                size_t offset, size_t bytes, uint32_t commands,
+                                                size_t command_offset, const LightSettings& light) {
+  FrameStats stats;
+  if (bytes == 0) return stats;
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
+  useImpostors(camera, atlas, light, false);
   glBindVertexArray(empty_vao_);
   glDisable(GL_CULL_FACE);
-  glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(agents.size()));
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
+  glMultiDrawArraysIndirect(GL_TRIANGLE_STRIP, reinterpret_cast<const void*>(command_offset), 1, 0);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
   glEnable(GL_CULL_FACE);
   glBindVertexArray(0);
   stats.draw_calls = 1;
-  stats.triangles = 2 * agents.size();
-  stats.objects = uint32_t(agents.size());
   return stats;
 }
 

@@ -145,6 +145,15 @@ class CrowdRenderer {
   // elevation) instead of showing `view`.
   FrameStats drawImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas, std::span<const CrowdAgentGpu> agents,
                            const LightSettings& light, bool blend_views = false);
+  // The same draws for agents whose records the GPU wrote (gpu_crowd.h): `bytes` of records at `offset` of the
+  // storage buffer `agents`, drawn by the indirect command at `command_offset` of `commands` (its instance count
+  // written on the GPU: skinned, a DrawElementsIndirectCommand over the mesh; impostors, a DrawArraysIndirectCommand
+  // of 4 vertices). No upload and no wait; the stats count the draw call alone (the agents are known on the GPU).
+  FrameStats drawSkinnedIndirect(const Camera& camera, const SkinnedGpuModel& model, uint32_t agents, size_t offset,
+                                 size_t bytes, uint32_t commands, size_t command_offset, const LightSettings& light);
+  FrameStats drawImpostorsIndirect(const Camera& camera, const ImpostorAtlasGpu& atlas, uint32_t agents,
+                                   size_t offset, size_t bytes, uint32_t commands, size_t command_offset,
+                                   const LightSettings& light);
   // Renders pose `pose` of the model (agent at the origin, heading 0) into `layer` of the atlas, one cell per view;
   // clears the layer first. Leaves the default framebuffer state to the caller (rebind your target after).
   void capture(const SkinnedGpuModel& model, uint32_t pose, ImpostorAtlasGpu& atlas, int layer,
@@ -173,6 +182,9 @@ class CrowdRenderer {
   // One instanced draw of the model's level for `count` agents (program, model and agents bound), and its counts.
   FrameStats drawAgents(const Program& p, const SkinnedGpuModel& model, size_t count, size_t level) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
+  // drawImpostors' and drawImpostorsIndirect's program, uniforms and atlas.
+  const Program& useImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas, const LightSettings& light,
+                              bool blend_views);
   // The skinned programs by skinning ([0] Palette, [1] BakedPoses) and, for drawing, cut-out ([0] none, [1] cut out):
   // the model's (program()). The bake always cuts out.
   const Program& program(const Program (&programs)[2][2], const SkinnedGpuModel& model) const;

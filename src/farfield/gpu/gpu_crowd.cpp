@@ -15,6 +15,7 @@ namespace {
 struct AgentRecord {
   uint32_t route, model, outfit, id;
   float start, speed, direction, phase;
+  Vec4 tint;
 };
 struct RouteRecord {
   uint32_t first, count;
@@ -23,6 +24,12 @@ struct RouteRecord {
 struct ModelRecord {
   Vec4 sphere;
   Vec4 lists;
+  uint32_t counts[4];
+  Vec4 grid;
+};
+struct ListRecord {  // gpu::CrowdAgentGpu
+  Vec4 pos_heading, tint;
+  uint32_t index, view, object_id, outfit;
 };
 
 uint32_t makeBuffer(const void* data, size_t bytes, size_t& total) {
@@ -69,15 +76,19 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
       throw Error(what, "agent " + std::to_string(i) + " names route " + std::to_string(a.route) + " and model " +
                             std::to_string(a.model) + " (" + std::to_string(routes.size()) + " routes, " +
                             std::to_string(models.size()) + " models)");
-    agent_records.push_back({a.route, a.model, a.outfit, a.id, a.start, a.speed, a.direction, a.phase});
+    agent_records.push_back({a.route, a.model, a.outfit, a.id, a.start, a.speed, a.direction, a.phase, a.tint});
   }
   std::vector<ModelRecord> model_records;
   for (size_t m = 0; m < models.size(); ++m) {
     const GpuCrowdModel& mo = models[m];
-    if (!(mo.stride_m > 0.0f) || !(mo.radius > 0.0f)) throw Error(what, "model " + std::to_string(m) + ": stride and radius must be positive");
-    model_records.push_back({Vec4(mo.centre, mo.radius), Vec4(float(2 * m), mo.stride_m, 0.0f, 0.0f)});
-    initial_commands_.push_back({mo.geometry_indices, 0, 0, 0, 0});
-    initial_commands_.push_back({mo.impostor_indices, 0, 0, 0, 0});
+    if (!(mo.stride_m > 0.0f) || !(mo.radius > 0.0f) || mo.palette_poses < 1 || mo.frames < 1 || mo.azimuths < 1 ||
+        mo.elevations < 1)
+      throw Error(what, "model " + std::to_string(m) + ": stride, radius, poses, frames and views must be positive");
+    model_records.push_back({Vec4(mo.centre, mo.radius), Vec4(float(2 * m), mo.stride_m, 0.0f, 0.0f),
+                             {mo.palette_poses, mo.frames, mo.azimuths, mo.elevations},
+                             Vec4(mo.max_elevation, 0.0f, 0.0f, 0.0f)});
+    initial_commands_.push_back({mo.geometry_indices, 0, mo.geometry_first_index, 0, 0});
+    initial_commands_.push_back({4, 0, 0, 0, 0});  // count 4, instances, first 0, base instance 0
   }
   agent_buf_ = makeBuffer(agent_records.data(), agent_records.size() * sizeof(AgentRecord), bytes_);
   routes_ = makeBuffer(route_records.data(), route_records.size() * sizeof(RouteRecord), bytes_);
@@ -87,7 +98,8 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
   model_buf_ = makeBuffer(model_records.data(), model_records.size() * sizeof(ModelRecord), bytes_);
   commands_ = makeBuffer(initial_commands_.data(), initial_commands_.size() * sizeof(GpuCrowdCommand), bytes_);
   initial_ = makeBuffer(initial_commands_.data(), initial_commands_.size() * sizeof(GpuCrowdCommand), bytes_);
-  lists_ = makeBuffer(nullptr, initial_commands_.size() * agents.size() * sizeof(uint32_t), bytes_);
+  capacity_ = (agents.size() + 63) / 64 * 64;  // 64 records = 3,072 bytes: list offsets aligned for binding
+  lists_ = makeBuffer(nullptr, initial_commands_.size() * capacity_ * sizeof(ListRecord), bytes_);
   simulate_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_SIMULATE 1\n");
   classify_ = Program::computeFromEmbedded("crowd_sim.comp.glsl");
 }
@@ -101,6 +113,7 @@ void GpuCrowd::simulate(float t) {
   simulate_.use();
   simulate_.set("u_agents", uint32_t(agents_));
   simulate_.set("u_time", t);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, phases_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, agent_buf_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, routes_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, points_);
@@ -118,17 +131,19 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
   camera.validate("GPU crowd camera");
   // The instance counts back to 0: the commands copied from their initial values on the GPU's side (no upload).
   glCopyNamedBufferSubData(initial_, commands_, 0, 0, GLsizeiptr(initial_commands_.size() * sizeof(GpuCrowdCommand)));
-  const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  for (Vec4& p : frustum.planes) p /= std::max(glm::length(Vec3(p)), 1e-20f);  // distances in metres
   float switches[kMaxModels] = {};
   for (size_t m = 0; m < models_; ++m) switches[m] = switch_m[m];
   classify_.use();
   classify_.set("u_agents", uint32_t(agents_));
   classify_.set("u_eye", camera.eye);
-  classify_.set("u_capacity", uint32_t(agents_));
+  classify_.set("u_capacity", uint32_t(capacity_));
   glUniform4fv(classify_.uniformLocation("u_planes[0]"), 6, glm::value_ptr(frustum.planes[0]));
   glUniform1fv(classify_.uniformLocation("u_switch[0]"), kMaxModels, switches);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, agent_buf_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, poses_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, phases_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, model_buf_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, commands_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, lists_);
@@ -144,7 +159,9 @@ std::vector<GpuCrowdCommand> GpuCrowd::readCommands() const {
 std::vector<uint32_t> GpuCrowd::readList(size_t list) const {
   FF_CHECK(list < initial_commands_.size());
   const size_t n = readCommands()[list].instance_count;
-  return readBuffer<uint32_t>(lists_, list * agents_ * sizeof(uint32_t), n);
+  std::vector<uint32_t> ids;
+  for (const ListRecord& r : readBuffer<ListRecord>(lists_, listOffset(list), n)) ids.push_back(r.object_id);
+  return ids;
 }
 size_t GpuCrowd::gpuBytes() const { return bytes_; }
 

@@ -28,18 +28,26 @@ struct GpuCrowdRoute {
 };
 
 struct GpuCrowdAgent {
-  uint32_t route = 0, model = 0, outfit = 0, id = 0;
+  uint32_t route = 0, model = 0, outfit = 0;
+  uint32_t id = 0;         // its object id (the id buffer's)
   float start = 0.0f, speed = 1.2f;
   float direction = 1.0f;  // +1 counter-clockwise, -1 clockwise
   float phase = 0.0f;      // animation phase at t = 0
+  Vec4 tint{1.0f};
 };
 
 struct GpuCrowdModel {
-  Vec3 centre{0.0f, 0.0f, 0.9f};  // bounding sphere in agent space (feet at the origin, z up)
-  float radius = 1.0f;
+  Vec3 centre{0.0f, 0.0f, 0.9f};  // bounding sphere in agent space (feet at the origin, facing +x, z up), turned
+  float radius = 1.0f;            // with the agent's heading (runtime::CrowdRuntime's)
   float stride_m = 1.3f;          // metres walked over one animation cycle
-  uint32_t geometry_indices = 0;  // index counts of the lists' draw commands (geometry, impostor)
-  uint32_t impostor_indices = 6;
+  uint32_t palette_poses = 64;    // geometry records: the palette pose nearest the phase
+  uint32_t frames = 16;           // impostor records: the atlas frame nearest the phase, and the view nearest the
+  uint32_t azimuths = 32;         // eye's direction on an azimuths x elevations grid up to max_elevation (not
+  uint32_t elevations = 8;        // octahedral: impostor::nearestView)
+  float max_elevation = 1.5707964f;
+  // The lists' draw commands: the geometry's indexed draw (index count and first index of the mesh), the
+  // impostors' 4-vertex strip (a DrawArraysIndirectCommand in the same 20-byte slot).
+  uint32_t geometry_indices = 0, geometry_first_index = 0;
 };
 
 // The indirect draw command of a list (GL's DrawElementsIndirectCommand).
@@ -68,8 +76,10 @@ class GpuCrowd {
 
   size_t agentCount() const { return agents_; }
   size_t modelCount() const { return models_; }
-  // List of model m: 2m (geometry) and 2m + 1 (impostors); its agent indices start at list * agentCount() in the
-  // list buffer; its command at list in the command buffer.
+  // List of model m: 2m (geometry) and 2m + 1 (impostors); its records (gpu::CrowdAgentGpu, crowd_renderer.h) start
+  // at listOffset(list) bytes of the list buffer; its command at list * sizeof(GpuCrowdCommand) of the command buffer.
+  size_t listOffset(size_t list) const { return list * capacity_ * 48; }
+  size_t listBytes() const { return capacity_ * 48; }
   uint32_t poseBuffer() const { return poses_; }    // vec4 per agent: feet x, y, z, heading
   uint32_t phaseBuffer() const { return phases_; }  // float per agent
   uint32_t listBuffer() const { return lists_; }
@@ -79,11 +89,12 @@ class GpuCrowd {
   std::vector<Vec4> readPoses() const;
   std::vector<float> readPhases() const;
   std::vector<GpuCrowdCommand> readCommands() const;
+  // The object ids of a list's agents, in list order.
   std::vector<uint32_t> readList(size_t list) const;
   size_t gpuBytes() const;
 
  private:
-  size_t agents_ = 0, models_ = 0;
+  size_t agents_ = 0, models_ = 0, capacity_ = 0;  // capacity: records a list holds (agents, rounded up to 64)
   uint32_t agent_buf_ = 0, routes_ = 0, points_ = 0, poses_ = 0, phases_ = 0, model_buf_ = 0, commands_ = 0,
            initial_ = 0, lists_ = 0;
   size_t bytes_ = 0;

@@ -365,6 +365,54 @@ CrowdFrameStats CrowdRuntime::draw(const Camera& camera, std::span<const CrowdAg
   return drawLists(camera, light, stats);
 }
 
+std::vector<gpu::GpuCrowdModel> CrowdRuntime::gpuCrowdModels(float nominal_speed) const {
+  std::vector<gpu::GpuCrowdModel> out;
+  for (const Model& m : models_) {
+    const impostor::ViewGrid& grid = m.impostor->grid;
+    if (grid.octahedral) throw Error("crowd runtime", "the GPU crowd does not take octahedral atlases yet");
+    gpu::GpuCrowdModel g;
+    g.centre = m.centre;
+    g.radius = m.radius;
+    g.stride_m = nominal_speed * m.cycle_s;
+    g.palette_poses = uint32_t(options_.palette_poses);
+    g.frames = uint32_t(m.choice.frames);
+    g.azimuths = uint32_t(grid.azimuths);
+    g.elevations = uint32_t(grid.elevations);
+    g.max_elevation = grid.max_elevation;
+    g.geometry_indices = m.gpu->indexCount();
+    g.geometry_first_index = 0;
+    out.push_back(g);
+  }
+  return out;
+}
+
+CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
+                                      const gpu::LightSettings& light) {
+  if (crowd.modelCount() != models_.size())
+    throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
+                                     std::to_string(models_.size()));
+  std::vector<float> switches(models_.size());
+  for (size_t m = 0; m < models_.size(); ++m)
+    switches[m] = policy == CrowdPolicy::Geometry ? std::numeric_limits<float>::max()
+                  : policy == CrowdPolicy::Impostor ? -1.0f
+                                                    : float(switchDistances(m, camera).both());
+  crowd.cullAndClassify(camera, switches);
+  CrowdFrameStats stats;
+  const size_t command = sizeof(gpu::GpuCrowdCommand);
+  for (size_t m = 0; m < models_.size(); ++m) {
+    stats.draw.draw_calls +=
+        renderer_.drawSkinnedIndirect(camera, *models_[m].gpu, crowd.listBuffer(), crowd.listOffset(2 * m),
+                                      crowd.listBytes(), crowd.commandBuffer(), 2 * m * command, light)
+            .draw_calls;
+    stats.draw.draw_calls +=
+        renderer_.drawImpostorsIndirect(camera, *models_[m].impostor->atlas, crowd.listBuffer(),
+                                        crowd.listOffset(2 * m + 1), crowd.listBytes(), crowd.commandBuffer(),
+                                        (2 * m + 1) * command, light)
+            .draw_calls;
+  }
+  return stats;
+}
+
 void CrowdRuntime::castShadows(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                                const gpu::LightSettings& light, const CrowdShadowOptions& shadows,
                                CrowdFrameStats& stats) {

@@ -13,6 +13,7 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/gpu/crowd_renderer.h"
+#include "farfield/gpu/gpu_crowd.h"
 #include "farfield/gpu/gpu_timer.h"
 #include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/render_target.h"
@@ -155,6 +156,18 @@ class CrowdRuntime {
   CrowdFrameStats drawShadowed(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdPolicy policy,
                                const gpu::LightSettings& light, const gpu::RenderTarget& target,
                                const CrowdShadowOptions& shadows = {});
+
+  // The runtime's models as the GPU crowd's (gpu/gpu_crowd.h; issue 45): bounding spheres, strides (the walk cycle
+  // played at its own rate at nominal_speed m/s), palette poses, atlas frames and view grids, the meshes' index
+  // ranges. Throws farfield::Error for an octahedral atlas (its nearest view is not on the GPU yet).
+  std::vector<gpu::GpuCrowdModel> gpuCrowdModels(float nominal_speed) const;
+  // The crowd's frame from a GPU crowd of these models simulated to the frame's time (GpuCrowd::simulate): culled
+  // and classified on the GPU by the policy (Mixed: switchDistances), drawn by one indirect draw per model and
+  // representation, the meshes at level 0. No readback and no per-agent upload. Not on this path yet: geometry
+  // budgets, levels of detail, blended views, occlusion culling and shadows (the CPU path's draw and drawShadowed);
+  // the stats count draw calls only (the agents are counted on the GPU).
+  CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
+                          const gpu::LightSettings& light);
 
   // Occlusion culling of the next draw or drawShadowed call (that call only): agents whose bounding box lies behind
   // `target`'s current depth (the city, drawn first) over the box's whole footprint are left out (gpu::DepthPyramid;

@@ -10,14 +10,23 @@ layout(local_size_x = 64) in;
 struct Agent {
   uint route, model, outfit, id;
   float start, speed, direction, phase;
+  vec4 tint;
 };
 struct Route {
   uint first, count;  // loop points points[first .. first + count)
   float len, unused;
 };
 struct Model {
-  vec4 sphere;        // centre (agent space, x y about the feet, z up) and radius
+  vec4 sphere;        // centre (agent space: feet at the origin, facing +x, z up) and radius
   vec4 lists;         // x: this model's first list (geometry; impostors x + 1), y: stride (metres a walk cycle)
+  uvec4 counts;       // palette poses, atlas frames, azimuths, elevations
+  vec4 grid;          // x: the views' largest elevation (radians)
+};
+// An agent as the crowd renderer's shaders read it (gpu::CrowdAgentGpu, 48 bytes).
+struct Record {
+  vec4 pos_heading;
+  vec4 tint;
+  uvec4 misc;         // index (pose or frame), view, object id, outfit
 };
 struct Command {
   uint count, instance_count, first_index;
@@ -32,7 +41,7 @@ layout(std430, binding = 3) buffer Poses { vec4 poses[]; };            // per ag
 layout(std430, binding = 4) buffer Phases { float phases[]; };         // per agent: animation phase [0, 1)
 layout(std430, binding = 5) readonly buffer Models { Model models[]; };
 layout(std430, binding = 6) buffer Commands { Command commands[]; };   // per list
-layout(std430, binding = 7) buffer Lists { uint lists[]; };            // per list, u_capacity agent indices
+layout(std430, binding = 7) buffer Lists { Record lists[]; };          // per list, u_capacity agents
 
 uniform uint u_agents;
 uniform float u_time;
@@ -68,19 +77,60 @@ void main() {
   phases[i] = fract(a.phase + walked / models[a.model].lists.y);
 }
 #else
+const float kTwoPi = 6.28318530717958647692;
+
+// runtime/crowd_runtime.cpp's turn(): v turned by `heading` about +z.
+vec3 turn(float heading, vec3 v) {
+  float c = cos(heading), s = sin(heading);
+  return vec3(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
+}
+
+// The runtime's cycleIndex: the nearest of `count` poses or frames over one cycle.
+uint cycleIndex(float phase, uint count) { return uint(floor((phase - floor(phase)) * float(count) + 0.5)) % count; }
+
+vec3 viewDirection(Model m, uint cell) {
+  float az = kTwoPi * float(cell % m.counts.z) / float(m.counts.z);
+  float el = m.grid.x * float(cell / m.counts.z) / float(m.counts.w);
+  return vec3(cos(el) * cos(az), cos(el) * sin(az), sin(el));
+}
+
+// impostor::nearestView for an azimuth x elevation grid (not octahedral).
+uint nearestView(Model m, vec3 to_camera) {
+  vec3 d = normalize(to_camera);
+  float az = atan(d.y, d.x);
+  if (az < 0.0) az += kTwoPi;
+  uint ai = uint(floor(az / kTwoPi * float(m.counts.z) + 0.5)) % m.counts.z;
+  float el = asin(clamp(d.z, -1.0, 1.0));
+  float step = m.grid.x / float(m.counts.w);
+  int below = clamp(int(floor(el / step)), 0, int(m.counts.w) - 1);
+  int above = min(below + 1, int(m.counts.w) - 1);
+  uint a = uint(below) * m.counts.z + ai, b = uint(above) * m.counts.z + ai;
+  return dot(viewDirection(m, a), d) >= dot(viewDirection(m, b), d) ? a : b;
+}
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= u_agents) return;
   Agent a = agents[i];
   Model m = models[a.model];
   vec4 pose = poses[i];
-  // A sphere that holds the model in any heading: about the feet, raised by the centre's height.
-  vec3 c = pose.xyz + vec3(0.0, 0.0, m.sphere.z);
-  float radius = m.sphere.w + length(m.sphere.xy);
+  // The runtime's bounding sphere: the model's centre turned by the heading, about the feet (normalised planes).
+  vec3 c = pose.xyz + turn(pose.w, m.sphere.xyz);
   for (int k = 0; k < 6; ++k)
-    if (dot(u_planes[k].xyz, c) + u_planes[k].w < -radius) return;
-  uint list = uint(m.lists.x) + (distance(u_eye, c) < u_switch[a.model] ? 0u : 1u);
+    if (dot(u_planes[k].xyz, c) + u_planes[k].w < -m.sphere.w) return;
+  bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
+  uint list = uint(m.lists.x) + (impostor ? 1u : 0u);
   uint slot = atomicAdd(commands[list].instance_count, 1u);
-  lists[list * u_capacity + slot] = i;
+  Record r;
+  r.pos_heading = pose;
+  r.tint = a.tint;
+  uint index = cycleIndex(phases[i], impostor ? m.counts.y : m.counts.x);
+  uint view = 0u;
+  if (impostor) {
+    vec3 local = turn(-pose.w, u_eye - c);  // the eye in agent space
+    view = nearestView(m, length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0));
+  }
+  r.misc = uvec4(index, view, a.id, a.outfit);
+  lists[list * u_capacity + slot] = r;
 }
 #endif
