@@ -123,6 +123,9 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
   bench->add_flag("--compare-skinning", o.compare_skinning,
                   "Also crowd-geometry-palette and crowd-mixed-palette: the same policies with joint matrices blended "
                   "per vertex, timed on the same frames");
+  bench->add_flag("--gpu-crowd", o.gpu_crowd,
+                  "Also crowd-geometry-gpu, crowd-impostor-gpu and crowd-mixed-gpu: the crowd simulated, culled, "
+                  "classified and drawn on the GPU (no shadows yet)");
   bench->add_option("--skinned-lod", o.runtime.geometry_lod_px,
                     "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels "
                     "(0: the mesh)")

@@ -14,6 +14,8 @@
 #include "farfield/core/log.h"
 #include "farfield/core/timer.h"
 #include "farfield/eval/crowd_metrics.h"
+#include "farfield/eval/gpu_crowd_input.h"
+#include "farfield/gpu/gpu_crowd.h"
 #include "farfield/eval/crowd_walk.h"
 #include "farfield/eval/frame_runner.h"
 #include "farfield/eval/mode.h"
@@ -33,15 +35,21 @@ struct ModeSpec {
   std::string name;
   runtime::CrowdPolicy policy;
   bool palette = false;  // drawn by the palette-skinning runtime (CrowdBenchOptions::compare_skinning)
+  bool gpu = false;      // the GPU crowd (CrowdBenchOptions::gpu_crowd)
 };
 
-std::vector<ModeSpec> modeSpecs(bool compare_skinning) {
+std::vector<ModeSpec> modeSpecs(bool compare_skinning, bool gpu_crowd) {
   std::vector<ModeSpec> specs{{"crowd-geometry", runtime::CrowdPolicy::Geometry},
                               {"crowd-impostor", runtime::CrowdPolicy::Impostor},
                               {"crowd-mixed", runtime::CrowdPolicy::Mixed}};
   if (compare_skinning) {
     specs.push_back({"crowd-geometry-palette", runtime::CrowdPolicy::Geometry, true});
     specs.push_back({"crowd-mixed-palette", runtime::CrowdPolicy::Mixed, true});
+  }
+  if (gpu_crowd) {
+    specs.push_back({"crowd-geometry-gpu", runtime::CrowdPolicy::Geometry, false, true});
+    specs.push_back({"crowd-impostor-gpu", runtime::CrowdPolicy::Impostor, false, true});
+    specs.push_back({"crowd-mixed-gpu", runtime::CrowdPolicy::Mixed, false, true});
   }
   return specs;
 }
@@ -308,7 +316,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
     for (size_t m = 0; m < rt.modelCount(); ++m) result.switch_m.push_back(rt.switchDistances(m, c).both());
   }
   if (!options.out_dir.empty()) fs::create_directories(fs::path(options.out_dir) / "frames");
-  const std::vector<ModeSpec> specs = modeSpecs(options.compare_skinning);
+  const std::vector<ModeSpec> specs = modeSpecs(options.compare_skinning, options.gpu_crowd);
   const gpu::LightSettings light = renderer.light();
 
   for (const std::string& path_name : options.paths) {
@@ -322,6 +330,10 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       cro.model_shares = crowd_models.shares;
       cro.outfits = options.outfits;
       const gen::Crowd crowd = gen::generateCrowd(city.streets, cro);
+      std::unique_ptr<gpu::GpuCrowd> gpu_crowd;
+      if (options.gpu_crowd)
+        gpu_crowd = std::make_unique<gpu::GpuCrowd>(gpuCrowdRoutes(crowd), gpuCrowdAgents(crowd, kCrowdIdBit),
+                                                    rt.gpuCrowdModels(kCrowdNominalSpeed));
       FF_INFO("crowd bench: " << count << " agents, " << path_name << " path");
       CrowdRun run;
       run.agents = count;
@@ -342,8 +354,10 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       gpu::OcclusionCuller city_culler;
       const size_t sample_every = options.samples > 0 ? std::max<size_t>(1, options.frames / size_t(options.samples)) : 0;
       // Path frame k's camera, agents and city items.
+      float frame_time = 0.0f;  // the path frame's time, seconds (the GPU crowd's simulation)
       auto setUpFrame = [&](size_t k, size_t& pf, Camera& camera, std::vector<runtime::CrowdAgentState>& states) {
         pf = std::min(k * options.frame_step, path.frames.size() - 1);
+        frame_time = float(pf) / path.fps;
         camera = pathCamera(path, pf, options.width, options.height);
         states = crowdAgentStates(crowd, rt, float(pf) / path.fps);
         ids.clear();
@@ -369,11 +383,25 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         rt.finish();
         const double city_ms = clock.milliseconds();
         runtime::CrowdRuntime& mode_rt = specs[m].palette && rt_palette ? *rt_palette : rt;
-        if (options.agent_occlusion) mode_rt.cullBehind(target);
-        out.stats = drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
+        if (specs[m].gpu) {
+          gpu_crowd->simulate(frame_time);
+          out.stats = rt.drawGpu(camera, *gpu_crowd, specs[m].policy, light);
+        } else {
+          if (options.agent_occlusion) mode_rt.cullBehind(target);
+          out.stats = drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
+        }
         mode_rt.finish();
         out.total = clock.milliseconds();
         out.crowd = out.total - city_ms;
+        if (specs[m].gpu) {  // the lists' sizes, read after the timed frame
+          const std::vector<gpu::GpuCrowdCommand> commands = gpu_crowd->readCommands();
+          for (size_t list = 0; list < commands.size(); ++list) {
+            (list % 2 ? out.stats.impostors : out.stats.geometry) += commands[list].instance_count;
+            if (list % 2 == 0) out.stats.draw.triangles += uint64_t(commands[list].instance_count) * rt.modelTriangles(list / 2);
+            else out.stats.draw.triangles += 2 * uint64_t(commands[list].instance_count);
+          }
+          out.stats.in_view = out.stats.geometry + out.stats.impostors;
+        }
         if (options.runtime.geometry_ms > 0.0 && specs[m].policy == runtime::CrowdPolicy::Mixed &&
             out.stats.geometry > 0)
           out.skinned = mode_rt.collectGeometryMs();

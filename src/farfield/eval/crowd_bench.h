@@ -52,6 +52,10 @@ struct CrowdBenchOptions {
   // Adds crowd-geometry-palette and crowd-mixed-palette: the same policies through a second runtime whose skinned
   // agents blend joint matrices (gpu::Skinning::Palette), timed in the same process on the same frames as the others.
   bool compare_skinning = false;
+  // Adds crowd-geometry-gpu, crowd-impostor-gpu and crowd-mixed-gpu: the crowd simulated, culled, classified and
+  // drawn on the GPU (gpu/gpu_crowd.h, runtime::CrowdRuntime::drawGpu; its simulation inside the crowd pass's time),
+  // without shadows, occlusion culling or budgets yet.
+  bool gpu_crowd = false;
   std::string out_dir;
   int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)
 };
