@@ -106,6 +106,9 @@ const RegisterCommand reg("view", [](CLI::App& app) {
                   "the smaller holds)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--crowd-gpu", o.crowd.gpu,
+                "The crowd simulated, culled, classified and drawn on the GPU (crowd-mixed-gpu: no shadows, "
+                "occlusion culling or budgets yet)");
   cmd->callback([args] { runViewCommand(*args); });
 });
 

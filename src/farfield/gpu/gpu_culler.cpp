@@ -431,6 +431,10 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     if (!culling) glEnable(GL_CULL_FACE);
     if (mirrored) glFrontFace(GL_CCW);
     glBindVertexArray(0);
+    // Left bound, the count buffer turned later plain indirect draws of other renderers into nothing on Mesa
+    // (the GPU crowd's, drawn after this frame's city).
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    if (indirect_count_) glBindBuffer(GL_PARAMETER_BUFFER_ARB, 0);
   };
 
   if (!options_.occlusion) {

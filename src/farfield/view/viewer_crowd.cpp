@@ -4,6 +4,8 @@
 #include <utility>
 
 #include "farfield/core/timer.h"
+#include "farfield/eval/crowd_metrics.h"
+#include "farfield/eval/gpu_crowd_input.h"
 
 namespace farfield::view {
 
@@ -26,6 +28,10 @@ ViewerCrowd::ViewerCrowd(const urban::StreetGraph& streets, std::function<float(
   ro.bound_focal_px = double(height_px) / (2.0 * std::tan(double(Camera{}.fov_y) / 2.0));
   ro.region_tints = crowd_.region_tints;
   rt_ = std::make_unique<runtime::CrowdRuntime>(models_.models, models_.options, ro);
+  if (options.gpu)
+    gpu_crowd_ = std::make_unique<gpu::GpuCrowd>(eval::gpuCrowdRoutes(crowd_),
+                                                 eval::gpuCrowdAgents(crowd_, eval::kCrowdIdBit),
+                                                 rt_->gpuCrowdModels(eval::kCrowdNominalSpeed));
 }
 
 ViewerCrowd::~ViewerCrowd() = default;
@@ -33,6 +39,15 @@ ViewerCrowd::~ViewerCrowd() = default;
 ViewerCrowdFrame ViewerCrowd::draw(const Camera& camera, float t, const gpu::LightSettings& light,
                                    const gpu::RenderTarget& target) {
   const Stopwatch clock;
+  if (gpu_crowd_) {
+    target.bindForOpaquePass();
+    gpu_crowd_->simulate(t);
+    ViewerCrowdFrame frame;
+    frame.stats = rt_->drawGpu(camera, *gpu_crowd_, runtime::CrowdPolicy::Mixed, light);
+    rt_->finish();
+    frame.ms = clock.milliseconds();
+    return frame;
+  }
   const std::vector<runtime::CrowdAgentState> states = eval::crowdAgentStates(crowd_, *rt_, t);
   runtime::CrowdShadowOptions shadow;
   shadow.impostor_casters = true;

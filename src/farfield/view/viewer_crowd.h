@@ -1,7 +1,7 @@
 // The viewer's crowd: agents walking the city's sidewalks (gen::generateCrowd on the street graph, standing on the
 // scene's ground), drawn by the crowd runtime after the mode's frame as crowd-mixed draws them (skinned near,
 // multi-view impostors far, their shadows on the city). The same models, runtime and per-frame states as
-// `farfield crowd bench` (eval/crowd_walk.h).
+// `farfield crowd bench` (eval/crowd_walk.h); or, with ViewerCrowdOptions::gpu, the GPU crowd's (crowd-mixed-gpu).
 #pragma once
 
 #include <functional>
@@ -30,6 +30,9 @@ struct ViewerCrowdOptions {
   uint64_t max_triangles = 20000;   // skinned triangles a frame (0: no budget)
   double geometry_ms = 0.0;         // skinned drawing a frame in ms, at the measured time per triangle (0: none)
   bool shadows = true;
+  // The crowd simulated, culled, classified and drawn on the GPU (gpu/gpu_crowd.h, CrowdRuntime::drawGpu): no
+  // per-agent work on the CPU; without shadows, occlusion culling, budgets or levels of detail yet.
+  bool gpu = false;
 };
 
 // What one crowd frame drew and took.
@@ -60,6 +63,7 @@ class ViewerCrowd {
   eval::CrowdModels models_;
   gen::Crowd crowd_;
   std::unique_ptr<runtime::CrowdRuntime> rt_;
+  std::unique_ptr<gpu::GpuCrowd> gpu_crowd_;  // with options.gpu
 };
 
 }  // namespace farfield::view
