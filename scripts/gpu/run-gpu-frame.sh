@@ -12,11 +12,13 @@
 #   big      the 100,000-block city (detail 0) at 1920x1080, 150 frames: the same modes
 #   demo     the default city at 640x360 (make demo's): the same modes
 #   check    farfield cull-check on the held-out city at 1920x1080 (GPU-culled frames against frustum-culled ones)
+#   crowd    the crowd bench at 1920x1080 with the GPU crowd beside the CPU path (--gpu-crowd), 10,000 to 1,000,000
+#            agents, no shadows (the GPU path has none yet)
 #   terrain  the terrain LODs at 1920x1080, 600-frame flythroughs: the quadtree LOD (high, low, lod-sprite) against
 #            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu) on the shared DEM (.gpu/data/terrain/*.tif, when
 #            carried) and on the 8,193^2 fractal
 set -uo pipefail
-STAGES=${STAGES:-smoke heldout big demo check terrain}
+STAGES=${STAGES:-smoke heldout big demo check terrain crowd}
 DATA=$PWD/.gpu/data
 OUTD=${OUT:-/tmp/out}
 mkdir -p "$OUTD"
@@ -139,5 +141,15 @@ if [[ " $STAGES " == *" terrain "* ]]; then
     summ $T/$name/bench.json
   done
   keep terrain $T/*/bench.json $T/*/terrain.json $T/*/terrain.md $T/*/frames.csv $T/*.txt
+fi
+if [[ " $STAGES " == *" crowd "* ]]; then
+  say "crowd: 10,000 to 1,000,000 agents, CPU and GPU paths, 1920x1080"
+  C=crowd
+  mkdir -p $C
+  timeout 900 $FF crowd bench -o $C/bench --agents 10000,100000,1000000 --frames 6 --gpu-crowd --no-shadows \
+    --size 1920x1080 > $C/bench.txt 2>&1
+  echo "rc $?"
+  grep -E "^\| [0-9]" $C/bench/crowd.md | head -40
+  keep crowd $C/bench/crowd.json $C/bench/crowd.md $C/bench.txt
 fi
 say "done"
