@@ -95,6 +95,31 @@ TEST(TerrainTilesGL, ADemFileIsStreamedAndDrawnFromPagedPatches) {
   EXPECT_GT(s["process_peak_rss"].get<size_t>(), 0u);
 }
 
+// --render --gpu-lod: the CDLOD terrain paged from the same cache draws every frame, under its GPU budget, and reports
+// its pages.
+TEST(TerrainTilesGL, TheCdlodTerrainIsDrawnFromPagesOfTheCache) {
+  TerrainTilesOptions o = smallRun("terrain_tiles_cdlod");
+  o.check_stride = 0;
+  o.sprite_tile_cells = 0;
+  o.render = true;
+  o.gpu_lod = true;
+  o.gpu_budget_mb = 2.0;
+  o.sample_stride = 10;
+  runTerrainTiles(o);
+  std::ifstream in(std::filesystem::path(o.out_dir) / "tiles.json");
+  const nlohmann::json r = nlohmann::json::parse(in)["render"];
+  EXPECT_EQ(r["lod"].get<std::string>(), "cdlod");
+  EXPECT_GT(r["triangles_mean"].get<double>(), 100.0);
+  EXPECT_GE(r["page_layers"].get<int>(), 1);
+  EXPECT_LE(r["pages_peak"].get<size_t>(), size_t(r["page_layers"].get<int>()));
+  EXPECT_GT(r["page_loads_waited_for"].get<size_t>() + r["pages_prefetched"].get<size_t>(), 0u);
+  EXPECT_LE(r["gpu_bytes"].get<size_t>(), size_t(3) << 20);  // 2 MiB of pages, the overview and the patch
+  for (const char* f : {"frame_00000.png", "frame_00010.png", "frame_00020.png"})
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(o.out_dir) / "frames" / f)) << f;
+  o.render = false;
+  test::expectErrorMentions([&] { runTerrainTiles(o); }, {"--gpu-lod", "--render"});
+}
+
 TEST(TerrainTiles, BadOptionsAreRefused) {
   TerrainTilesOptions o = smallRun("terrain_tiles_bad");
   o.frames = 1;
