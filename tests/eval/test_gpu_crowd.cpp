@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <span>
 #include <vector>
 
 #include "farfield/core/error.h"
@@ -19,6 +20,7 @@
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/runtime/crowd_runtime.h"
+#include "runtime/grey_quad.h"
 
 namespace farfield::eval {
 namespace {
@@ -214,6 +216,74 @@ TEST(GpuCrowdGL, FramesEqualTheCpuPathsOnTheCrowdsPixels) {
     }
     EXPECT_GE(double(same_id), 0.995 * double(crowd_px));
     EXPECT_GE(double(same_colour), 0.99 * double(crowd_px));
+  }
+}
+
+// Occlusion on the GPU (GpuCrowd::occludeBehind): behind a wall drawn first, the agents the CPU runtime's exact
+// test (cullBehind: the depth read back) leaves out are left out, and the frame is unchanged, pixel for pixel and
+// id for id.
+TEST(GpuCrowdGL, AgentsBehindAWallAreLeftOutAsTheCpuTestLeavesThemOut) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  const CrowdModels models = builtinCrowdModels();
+  runtime::CrowdRuntime rt(models.models, models.options, runtime::CrowdRuntimeOptions{});
+  gen::StreetNetworkOptions so;
+  so.blocks = 12;
+  so.seed = 3;
+  const urban::StreetGraph streets = gen::generateStreetNetwork(so);
+  gen::CrowdOptions co;
+  co.agents = 3000;
+  co.seed = 21;
+  co.model_shares = models.shares;
+  const gen::Crowd crowd = gen::generateCrowd(streets, co);
+  gpu::GpuCrowd gc(gpuCrowdRoutes(crowd), gpuCrowdAgents(crowd, kCrowdIdBit), rt.gpuCrowdModels(kCrowdNominalSpeed));
+  const float t = 7.5f;
+  const std::vector<runtime::CrowdAgentState> states = crowdAgentStates(crowd, rt, t);
+  gc.simulate(t);
+  const gen::AgentPose some = gen::agentPose(crowd, 0, t);
+  Camera camera;
+  camera.eye = some.position + Vec3(-7.0f, -5.0f, 2.5f);
+  camera.at = some.position + Vec3(10.0f, 8.0f, 0.5f);
+  camera.width = 320;
+  camera.height = 200;
+  camera.near_plane = 0.3f;
+  camera.far_plane = 3000.0f;
+  // A wall 14 m along the view, 16 m wide and 6 m tall, facing the camera, hiding the agents behind its middle.
+  const Vec3 f = glm::normalize(Vec3(camera.at.x - camera.eye.x, camera.at.y - camera.eye.y, 0.0f));
+  const Vec3 side(-f.y, f.x, 0.0f);
+  const Vec3 mid = Vec3(camera.eye.x, camera.eye.y, some.position.z) + 14.0f * f;
+  const test::GreyQuad wall({mid + 8.0f * side - Vec3(0, 0, 1), mid - 8.0f * side - Vec3(0, 0, 1),
+                             mid - 8.0f * side + Vec3(0, 0, 5), mid + 8.0f * side + Vec3(0, 0, 5)},
+                            -f, 0.5f);
+  gpu::Renderer renderer;
+  const gpu::LightSettings light = renderer.light();
+  gpu::RenderTarget target(camera.width, camera.height);
+  for (runtime::CrowdPolicy policy : {runtime::CrowdPolicy::Impostor, runtime::CrowdPolicy::Mixed}) {
+    auto gpuFrame = [&](bool occlude) {
+      renderer.render(camera, std::span(&wall.item, 1), target);
+      target.bindForOpaquePass();
+      rt.drawGpu(camera, gc, policy, light, occlude ? &target : nullptr);
+      rt.finish();
+      return std::make_pair(target.readColor(), target.readIds());
+    };
+    const auto with = gpuFrame(true);
+    const gpu::GpuCrowd::Counts culled = gc.readCounts();
+    const auto without = gpuFrame(false);
+    const gpu::GpuCrowd::Counts plain = gc.readCounts();
+    EXPECT_EQ(with.first.pixels(), without.first.pixels());
+    EXPECT_EQ(with.second.pixels(), without.second.pixels());
+    EXPECT_EQ(plain.occluded, 0u);
+    EXPECT_EQ(culled.in_view, plain.in_view);
+    // The CPU runtime's test on the same frame: the depth read back.
+    renderer.render(camera, std::span(&wall.item, 1), target);
+    target.bindForOpaquePass();
+    rt.cullBehind(target);
+    const runtime::CrowdFrameStats cpu = rt.draw(camera, states, policy, light);
+    rt.finish();
+    std::printf("policy %d: %u in view, %u left out on the GPU, %zu on the CPU\n", int(policy), culled.in_view,
+                culled.occluded, cpu.occluded);
+    EXPECT_GT(culled.occluded, 20u);
+    EXPECT_EQ(culled.in_view, uint32_t(cpu.in_view));
+    EXPECT_NEAR(double(culled.occluded), double(cpu.occluded), 0.01 * double(cpu.occluded) + 1.0);
   }
 }
 

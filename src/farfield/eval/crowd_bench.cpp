@@ -385,7 +385,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         runtime::CrowdRuntime& mode_rt = specs[m].palette && rt_palette ? *rt_palette : rt;
         if (specs[m].gpu) {
           gpu_crowd->simulate(frame_time);
-          out.stats = rt.drawGpu(camera, *gpu_crowd, specs[m].policy, light);
+          out.stats = rt.drawGpu(camera, *gpu_crowd, specs[m].policy, light, options.agent_occlusion ? &target : nullptr);
         } else {
           if (options.agent_occlusion) mode_rt.cullBehind(target);
           out.stats = drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
@@ -400,7 +400,9 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
             if (list % 2 == 0) out.stats.draw.triangles += uint64_t(commands[list].instance_count) * rt.modelTriangles(list / 2);
             else out.stats.draw.triangles += 2 * uint64_t(commands[list].instance_count);
           }
-          out.stats.in_view = out.stats.geometry + out.stats.impostors;
+          const gpu::GpuCrowd::Counts counts = gpu_crowd->readCounts();
+          out.stats.in_view = counts.in_view;
+          out.stats.occluded = counts.occluded;
         }
         if (options.runtime.geometry_ms > 0.0 && specs[m].policy == runtime::CrowdPolicy::Mixed &&
             out.stats.geometry > 0)

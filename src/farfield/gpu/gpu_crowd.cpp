@@ -100,12 +100,13 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
   initial_ = makeBuffer(initial_commands_.data(), initial_commands_.size() * sizeof(GpuCrowdCommand), bytes_);
   capacity_ = (agents.size() + 63) / 64 * 64;  // 64 records = 3,072 bytes: list offsets aligned for binding
   lists_ = makeBuffer(nullptr, initial_commands_.size() * capacity_ * sizeof(ListRecord), bytes_);
+  counts_ = makeBuffer(nullptr, 2 * sizeof(uint32_t), bytes_);
   simulate_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_SIMULATE 1\n");
   classify_ = Program::computeFromEmbedded("crowd_sim.comp.glsl");
 }
 
 GpuCrowd::~GpuCrowd() {
-  for (uint32_t b : {agent_buf_, routes_, points_, poses_, phases_, model_buf_, commands_, initial_, lists_})
+  for (uint32_t b : {agent_buf_, routes_, points_, poses_, phases_, model_buf_, commands_, initial_, lists_, counts_})
     if (b) glDeleteBuffers(1, &b);
 }
 
@@ -124,6 +125,17 @@ void GpuCrowd::simulate(float t) {
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
+void GpuCrowd::occludeBehind(const RenderTarget& target) {
+  if (!pyramid_) pyramid_ = std::make_unique<GpuDepthPyramid>();
+  pyramid_->build(target);
+  occlude_next_ = true;
+}
+
+GpuCrowd::Counts GpuCrowd::readCounts() const {
+  const std::vector<uint32_t> c = readBuffer<uint32_t>(counts_, 0, 2);
+  return {c[0], c[1]};
+}
+
 void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> switch_m) {
   if (switch_m.size() != models_)
     throw Error("GPU crowd", std::to_string(switch_m.size()) + " switch distances for " + std::to_string(models_) +
@@ -131,6 +143,7 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
   camera.validate("GPU crowd camera");
   // The instance counts back to 0: the commands copied from their initial values on the GPU's side (no upload).
   glCopyNamedBufferSubData(initial_, commands_, 0, 0, GLsizeiptr(initial_commands_.size() * sizeof(GpuCrowdCommand)));
+  glClearNamedBufferData(counts_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
   for (Vec4& p : frustum.planes) p /= std::max(glm::length(Vec3(p)), 1e-20f);  // distances in metres
   float switches[kMaxModels] = {};
@@ -147,8 +160,25 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, model_buf_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, commands_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, lists_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, counts_);
+  const bool occlude = occlude_next_;
+  occlude_next_ = false;
+  classify_.set("u_occlusion", occlude ? 1 : 0);
+  if (occlude) {
+    if (pyramid_->levelSizes()[0] != camera.width || pyramid_->levelSizes()[1] != camera.height)
+      throw Error("GPU crowd", "occludeBehind's target is not the camera's size");
+    classify_.set("u_view_proj", camera.viewProjection());
+    classify_.set("u_levels", pyramid_->levels());
+    const std::vector<int> sizes = pyramid_->levelSizes();
+    glUniform2iv(classify_.uniformLocation("u_level_size[0]"), GLsizei(pyramid_->levels()), sizes.data());
+    pyramid_->bind(2, 3);
+  }
   glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+  if (occlude) {
+    glBindTextureUnit(2, 0);
+    glBindTextureUnit(3, 0);
+  }
 }
 
 std::vector<Vec4> GpuCrowd::readPoses() const { return readBuffer<Vec4>(poses_, 0, agents_); }

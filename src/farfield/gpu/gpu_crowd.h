@@ -11,12 +11,15 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "farfield/core/camera.h"
 #include "farfield/core/math.h"
+#include "farfield/gpu/gpu_depth_pyramid.h"
 #include "farfield/gpu/program.h"
+#include "farfield/gpu/render_target.h"
 
 namespace farfield::gpu {
 
@@ -74,6 +77,18 @@ class GpuCrowd {
   // commands' instance counts reset (a copy between GPU buffers) and one dispatch. Call after simulate.
   void cullAndClassify(const Camera& camera, std::span<const float> switch_m);
 
+  // Occlusion culling of the next cullAndClassify (that call only): agents whose bounding box lies behind `target`'s
+  // current depth (the city, drawn first) over the box's whole footprint are left out, by the test of the CPU runtime's
+  // cullBehind (gpu::projectBox, DepthPyramid::hides) on a depth pyramid built on the GPU: no readback. The target
+  // must be the next camera's size.
+  void occludeBehind(const RenderTarget& target);
+  // After cullAndClassify (waits for the GPU; tests and counts, never inside a frame): agents in view, and of them
+  // left out by occlusion.
+  struct Counts {
+    uint32_t in_view = 0, occluded = 0;
+  };
+  Counts readCounts() const;
+
   size_t agentCount() const { return agents_; }
   size_t modelCount() const { return models_; }
   // List of model m: 2m (geometry) and 2m + 1 (impostors); its records (gpu::CrowdAgentGpu, crowd_renderer.h) start
@@ -96,7 +111,9 @@ class GpuCrowd {
  private:
   size_t agents_ = 0, models_ = 0, capacity_ = 0;  // capacity: records a list holds (agents, rounded up to 64)
   uint32_t agent_buf_ = 0, routes_ = 0, points_ = 0, poses_ = 0, phases_ = 0, model_buf_ = 0, commands_ = 0,
-           initial_ = 0, lists_ = 0;
+           initial_ = 0, lists_ = 0, counts_ = 0;
+  std::unique_ptr<GpuDepthPyramid> pyramid_;  // made by the first occludeBehind
+  bool occlude_next_ = false;
   size_t bytes_ = 0;
   std::vector<GpuCrowdCommand> initial_commands_;
   Program simulate_, classify_;

@@ -387,7 +387,7 @@ std::vector<gpu::GpuCrowdModel> CrowdRuntime::gpuCrowdModels(float nominal_speed
 }
 
 CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
-                                      const gpu::LightSettings& light) {
+                                      const gpu::LightSettings& light, const gpu::RenderTarget* occluders) {
   if (crowd.modelCount() != models_.size())
     throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
                                      std::to_string(models_.size()));
@@ -396,6 +396,10 @@ CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd
     switches[m] = policy == CrowdPolicy::Geometry ? std::numeric_limits<float>::max()
                   : policy == CrowdPolicy::Impostor ? -1.0f
                                                     : float(switchDistances(m, camera).both());
+  if (occluders) {
+    crowd.occludeBehind(*occluders);
+    occluders->bindForOpaquePass();  // the pyramid's compute left the draw state to us
+  }
   crowd.cullAndClassify(camera, switches);
   CrowdFrameStats stats;
   const size_t command = sizeof(gpu::GpuCrowdCommand);

@@ -163,11 +163,13 @@ class CrowdRuntime {
   std::vector<gpu::GpuCrowdModel> gpuCrowdModels(float nominal_speed) const;
   // The crowd's frame from a GPU crowd of these models simulated to the frame's time (GpuCrowd::simulate): culled
   // and classified on the GPU by the policy (Mixed: switchDistances), drawn by one indirect draw per model and
-  // representation, the meshes at level 0. No readback and no per-agent upload. Not on this path yet: geometry
-  // budgets, levels of detail, blended views, occlusion culling and shadows (the CPU path's draw and drawShadowed);
-  // the stats count draw calls only (the agents are counted on the GPU).
+  // representation, the meshes at level 0. With occluders (the target holding the city, the camera's size), the
+  // agents hidden behind its depth are left out first (GpuCrowd::occludeBehind, cullBehind's test). No readback and
+  // no per-agent upload. Not on this path yet: geometry budgets, levels of detail, blended views and shadows (the
+  // CPU path's draw and drawShadowed); the stats count draw calls only (the agents are counted on the GPU:
+  // GpuCrowd::readCommands, readCounts).
   CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
-                          const gpu::LightSettings& light);
+                          const gpu::LightSettings& light, const gpu::RenderTarget* occluders = nullptr);
 
   // Occlusion culling of the next draw or drawShadowed call (that call only): agents whose bounding box lies behind
   // `target`'s current depth (the city, drawn first) over the box's whole footprint are left out (gpu::DepthPyramid;

@@ -43,7 +43,7 @@ ViewerCrowdFrame ViewerCrowd::draw(const Camera& camera, float t, const gpu::Lig
     target.bindForOpaquePass();
     gpu_crowd_->simulate(t);
     ViewerCrowdFrame frame;
-    frame.stats = rt_->drawGpu(camera, *gpu_crowd_, runtime::CrowdPolicy::Mixed, light);
+    frame.stats = rt_->drawGpu(camera, *gpu_crowd_, runtime::CrowdPolicy::Mixed, light, &target);
     rt_->finish();
     frame.ms = clock.milliseconds();
     return frame;

@@ -49,6 +49,14 @@ uniform vec4 u_planes[6];      // frustum planes (dot(xyz, p) + w >= 0 inside)
 uniform vec3 u_eye;
 uniform float u_switch[16];    // per model: geometry nearer than this (metres)
 uniform uint u_capacity;       // agents a list holds
+// Occlusion (GpuCrowd::occludeBehind): the target's depth pyramid, and the camera that projects agents into it.
+layout(std430, binding = 8) buffer Stats { uint stats[]; };  // in view, of them left out behind the depth
+layout(binding = 2) uniform sampler2D u_depth;               // level 0: the target's depth
+layout(binding = 3) uniform sampler2D u_pyramid;             // levels 1.. in its mips 0..
+uniform int u_occlusion;
+uniform mat4 u_view_proj;
+uniform int u_levels;
+uniform ivec2 u_level_size[16];
 
 #ifdef FF_SIMULATE
 void main() {
@@ -108,6 +116,41 @@ uint nearestView(Model m, vec3 to_camera) {
   return dot(viewDirection(m, a), d) >= dot(viewDirection(m, b), d) ? a : b;
 }
 
+// gpu::DepthPyramid::farthest: the farthest depth over the pixels [lo, hi], from the finest level where they span at
+// most two texels each way.
+float farthest(ivec2 lo, ivec2 hi) {
+  lo = max(lo, ivec2(0));
+  hi = min(hi, u_level_size[0] - 1);
+  if (lo.x > hi.x || lo.y > hi.y) return 1.0;
+  int k = 0;
+  while (k + 1 < u_levels && ((hi.x >> k) - (lo.x >> k) > 1 || (hi.y >> k) - (lo.y >> k) > 1)) ++k;
+  float result = 1e30;
+  for (int y = lo.y >> k; y <= (hi.y >> k); ++y)
+    for (int x = lo.x >> k; x <= (hi.x >> k); ++x)
+      result = min(result, k == 0 ? texelFetch(u_depth, ivec2(x, y), 0).r : texelFetch(u_pyramid, ivec2(x, y), k - 1).r);
+  return result;
+}
+
+// gpu::projectBox and DepthPyramid::hides for the cube about the sphere (runtime::CrowdRuntime::hidden's box).
+bool hidden(vec3 c, float r) {
+  vec2 size = vec2(u_level_size[0]);
+  vec2 lo = vec2(1e30), hi = vec2(-1e30);
+  float nearest = -1e30;
+  for (int k = 0; k < 8; ++k) {
+    vec3 corner = c + r * vec3((k & 1) != 0 ? 1.0 : -1.0, (k & 2) != 0 ? 1.0 : -1.0, (k & 4) != 0 ? 1.0 : -1.0);
+    vec4 clip = u_view_proj * vec4(corner, 1.0);
+    if (!(clip.w > 1e-6)) return false;  // reaches the eye
+    vec2 p = (clip.xy / clip.w * 0.5 + 0.5) * size;
+    lo = min(lo, p);
+    hi = max(hi, p);
+    nearest = max(nearest, clip.z / clip.w);
+  }
+  ivec2 x0 = ivec2(max(ivec2(0), ivec2(floor(max(lo, vec2(-2.0)))) - 1));
+  ivec2 x1 = ivec2(min(u_level_size[0] - 1, ivec2(floor(min(hi, size + 1.0))) + 1));
+  if (x0.x > x1.x || x0.y > x1.y) return true;  // in front of the eye, no pixel centre covered
+  return nearest * (1.0 + 1e-5) + 1e-12 < farthest(x0, x1);
+}
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= u_agents) return;
@@ -118,6 +161,11 @@ void main() {
   vec3 c = pose.xyz + turn(pose.w, m.sphere.xyz);
   for (int k = 0; k < 6; ++k)
     if (dot(u_planes[k].xyz, c) + u_planes[k].w < -m.sphere.w) return;
+  atomicAdd(stats[0], 1u);
+  if (u_occlusion != 0 && hidden(c, m.sphere.w)) {
+    atomicAdd(stats[1], 1u);
+    return;
+  }
   bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
   uint list = uint(m.lists.x) + (impostor ? 1u : 0u);
   uint slot = atomicAdd(commands[list].instance_count, 1u);

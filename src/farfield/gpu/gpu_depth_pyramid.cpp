@@ -1,0 +1,61 @@
+#include "farfield/gpu/gpu_depth_pyramid.h"
+
+#include <epoxy/gl.h>
+
+#include "farfield/core/check.h"
+
+namespace farfield::gpu {
+
+GpuDepthPyramid::GpuDepthPyramid() : program_(Program::computeFromEmbedded("depth_pyramid.comp.glsl")) {}
+
+GpuDepthPyramid::~GpuDepthPyramid() {
+  if (texture_) glDeleteTextures(1, &texture_);
+}
+
+std::vector<int> GpuDepthPyramid::levelSizes() const {
+  std::vector<int> sizes;
+  for (const auto& s : level_size_) sizes.insert(sizes.end(), {s[0], s[1]});
+  return sizes;
+}
+
+void GpuDepthPyramid::build(const RenderTarget& target) {
+  depth_ = target.depthTexture().handle();
+  if (target.width() != width_ || target.height() != height_) {
+    width_ = target.width(), height_ = target.height();
+    level_size_.assign(1, {width_, height_});
+    while (level_size_.back()[0] > 1 || level_size_.back()[1] > 1)
+      level_size_.push_back({(level_size_.back()[0] + 1) / 2, (level_size_.back()[1] + 1) / 2});
+    FF_CHECK_MSG(int(level_size_.size()) <= kMaxLevels, "render target too large for the depth pyramid");
+    if (texture_) glDeleteTextures(1, &texture_);
+    texture_ = 0;
+    if (level_size_.size() >= 2) {
+      // GL's mip levels halve rounding down; levels rounding up fit in those of the next power of two.
+      int pw = 1, ph = 1;
+      while (pw < level_size_[1][0]) pw *= 2;
+      while (ph < level_size_[1][1]) ph *= 2;
+      glCreateTextures(GL_TEXTURE_2D, 1, &texture_);
+      glTextureStorage2D(texture_, GLsizei(level_size_.size()) - 1, GL_R32F, pw, ph);
+      glTextureParameteri(texture_, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+      glTextureParameteri(texture_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+  }
+  program_.use();
+  glBindTextureUnit(2, depth_);
+  for (size_t k = 1; k < level_size_.size(); ++k) {
+    program_.set("u_from_depth", k == 1 ? 1 : 0);
+    glUniform2i(program_.uniformLocation("u_src_size"), level_size_[k - 1][0], level_size_[k - 1][1]);
+    glUniform2i(program_.uniformLocation("u_dst_size"), level_size_[k][0], level_size_[k][1]);
+    glBindImageTexture(0, texture_, GLint(k == 1 ? 0 : k - 2), GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+    glBindImageTexture(1, texture_, GLint(k - 1), GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glDispatchCompute(GLuint(level_size_[k][0] + 7) / 8, GLuint(level_size_[k][1] + 7) / 8, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+  }
+  glBindTextureUnit(2, 0);
+}
+
+void GpuDepthPyramid::bind(int depth_unit, int pyramid_unit) const {
+  glBindTextureUnit(GLuint(depth_unit), depth_);
+  glBindTextureUnit(GLuint(pyramid_unit), texture_);
+}
+
+}  // namespace farfield::gpu
