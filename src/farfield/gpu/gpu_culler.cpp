@@ -10,6 +10,7 @@
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
+#include "farfield/gpu/gpu_depth_pyramid.h"
 #include "farfield/gpu/program.h"
 
 namespace farfield::gpu {
@@ -36,7 +37,6 @@ struct GpuCuller::Impl {
   Program args = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_ARGS 1");
   Program cull = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_CLUSTERS 1");
   Program emit = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_EMIT 1");
-  Program pyramid = Program::computeFromEmbedded("depth_pyramid.comp.glsl");
   std::array<Program, kVariants> draw{
       Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1"),
       Program::fromEmbedded("arena.vert.glsl", "mesh.frag.glsl", "#define FF_ARENA 1\n#define FF_TEXTURED 1"),
@@ -47,9 +47,6 @@ struct GpuCuller::Impl {
         lod_scale;
   };
   CullLocations cl{}, part_l{}, emit_l{};
-  struct PyramidLocations {
-    int src_size, dst_size, from_depth;
-  } pl{};
   struct DrawLocations {
     int view_proj, light_dir, light_color, ambient;
   };
@@ -69,10 +66,8 @@ struct GpuCuller::Impl {
   std::vector<uint32_t> enabled_ids, next_ids;
   std::vector<uint32_t> changes;
 
-  // Depth pyramid levels 1.. (level 0 is the target's depth).
-  GLuint pyramid_texture = 0;
-  int width = 0, height = 0;
-  std::vector<std::array<int, 2>> level_size;  // level 0 first
+  // The depth pyramid (level 0 is the target's depth).
+  GpuDepthPyramid pyramid;
 
   struct Slot {
     GLuint buffer = 0;
@@ -98,9 +93,6 @@ struct GpuCuller::Impl {
     cl = locate(cull);
     part_l = locate(parts);
     emit_l = locate(emit);
-    const GLuint p = pyramid.handle();
-    pl = {glGetUniformLocation(p, "u_src_size"), glGetUniformLocation(p, "u_dst_size"),
-          glGetUniformLocation(p, "u_from_depth")};
     for (int v = 0; v < kVariants; ++v) {
       const GLuint h = draw[size_t(v)].handle();
       dl[size_t(v)] = {glGetUniformLocation(h, "u_view_proj"), glGetUniformLocation(h, "u_light_dir"),
@@ -113,7 +105,6 @@ struct GpuCuller::Impl {
                               commands[0], commands[1], counts[0], counts[1],   work,        drawn,
                               drawn_list,  part_visible, instance_part};
     glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
-    if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
     for (Slot& s : ring) {
       if (s.fence) glDeleteSync(s.fence);
       if (s.buffer) {
@@ -123,35 +114,13 @@ struct GpuCuller::Impl {
     }
   }
 
-  // Pyramid levels for a width x height target: level k + 1 is ceil(level k / 2) until 1 x 1 (DepthPyramid's).
+  // Pyramid levels for a width x height target (GpuDepthPyramid), their sizes into the stages that test them.
   void sizePyramid(int w, int h) {
-    if (w == width && h == height) return;
-    width = w, height = h;
-    level_size.clear();
-    level_size.push_back({w, h});
-    while (level_size.back()[0] > 1 || level_size.back()[1] > 1) {
-      const auto [pw, ph] = level_size.back();
-      level_size.push_back({(pw + 1) / 2, (ph + 1) / 2});
-    }
-    FF_CHECK_MSG(int(level_size.size()) <= kMaxLevels, "render target too large for the depth pyramid");
-    std::array<int, 2 * kMaxLevels> sizes{};
-    for (size_t k = 0; k < level_size.size(); ++k) sizes[2 * k] = level_size[k][0], sizes[2 * k + 1] = level_size[k][1];
-    glProgramUniform2iv(cull.handle(), cl.level_size, GLsizei(level_size.size()), sizes.data());
-    glProgramUniform2iv(parts.handle(), part_l.level_size, GLsizei(level_size.size()), sizes.data());
-    if (pyramid_texture) glDeleteTextures(1, &pyramid_texture);
-    pyramid_texture = 0;
-    if (level_size.size() < 2) return;
-    // GL's mip levels halve rounding down; levels rounding up fit in those of the next power of two.
-    int pw = 1, ph = 1;
-    while (pw < level_size[1][0]) pw *= 2;
-    while (ph < level_size[1][1]) ph *= 2;
-    const int mips = int(level_size.size()) - 1;
-    glCreateTextures(GL_TEXTURE_2D, 1, &pyramid_texture);
-    glTextureStorage2D(pyramid_texture, mips, GL_R32F, pw, ph);
-    glTextureParameteri(pyramid_texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
-    glTextureParameteri(pyramid_texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTextureParameteri(pyramid_texture, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(pyramid_texture, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    if (!pyramid.resize(w, h)) return;
+    FF_CHECK_MSG(pyramid.levels() <= kMaxLevels, "render target too large for the depth pyramid");
+    const std::vector<int> sizes = pyramid.levelSizes();
+    glProgramUniform2iv(cull.handle(), cl.level_size, GLsizei(pyramid.levels()), sizes.data());
+    glProgramUniform2iv(parts.handle(), part_l.level_size, GLsizei(pyramid.levels()), sizes.data());
   }
 };
 
@@ -276,14 +245,14 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glProgramUniform2i(c, im.cl.viewport, target.width(), target.height());
   glProgramUniform1i(c, im.cl.cone, options_.cone ? 1 : 0);
   glProgramUniform1f(c, im.cl.margin, options_.occlusion_margin);
-  glProgramUniform1i(c, im.cl.levels, int(im.level_size.size()));
+  glProgramUniform1i(c, im.cl.levels, im.pyramid.levels());
   glProgramUniform1ui(c, im.cl.frame, uint32_t(frame + 1));
   const GLuint pp = im.parts.handle();
   glProgramUniformMatrix4fv(pp, im.part_l.view_proj, 1, GL_FALSE, glm::value_ptr(view_proj));
   glProgramUniform4fv(pp, im.part_l.planes, 6, glm::value_ptr(frustum.planes[0]));
   glProgramUniform2i(pp, im.part_l.viewport, target.width(), target.height());
   glProgramUniform1f(pp, im.part_l.margin, options_.occlusion_margin);
-  glProgramUniform1i(pp, im.part_l.levels, int(im.level_size.size()));
+  glProgramUniform1i(pp, im.part_l.levels, im.pyramid.levels());
   glProgramUniform1ui(pp, im.part_l.count, uint32_t(arena_.parts().size()));
   glProgramUniform3fv(pp, im.part_l.eye, 1, glm::value_ptr(camera.eye));
   glProgramUniform1f(pp, im.part_l.lod_px, options_.lod_error_px);
@@ -336,7 +305,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     glProgramUniform1i(pp, im.part_l.phase, phase);
     glUseProgram(pp);
     glBindTextureUnit(2, target.depthTexture().handle());
-    glBindTextureUnit(3, im.pyramid_texture);
+    glBindTextureUnit(3, im.pyramid.texture());
     glDispatchCompute(std::min(part_groups, kMaxGroupsX), (part_groups + kMaxGroupsX - 1) / kMaxGroupsX, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glBindTextureUnit(2, 0);
@@ -348,23 +317,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   };
 
   // The depth pyramid of what the target holds now (DepthPyramid::build on the GPU).
-  auto buildPyramid = [&]() {
-    glUseProgram(im.pyramid.handle());
-    glBindTextureUnit(2, target.depthTexture().handle());
-    const GLuint p = im.pyramid.handle();
-    for (size_t k = 1; k < im.level_size.size(); ++k) {
-      const auto [sw, sh] = im.level_size[k - 1];
-      const auto [dw, dh] = im.level_size[k];
-      glProgramUniform2i(p, im.pl.src_size, sw, sh);
-      glProgramUniform2i(p, im.pl.dst_size, dw, dh);
-      glProgramUniform1i(p, im.pl.from_depth, k == 1 ? 1 : 0);
-      glBindImageTexture(0, im.pyramid_texture, GLint(k == 1 ? 0 : k - 2), GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-      glBindImageTexture(1, im.pyramid_texture, GLint(k - 1), GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-      glDispatchCompute(GLuint(dw + 7) / 8, GLuint(dh + 7) / 8, 1);
-      glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    }
-    glBindTextureUnit(2, 0);
-  };
+  auto buildPyramid = [&]() { im.pyramid.build(target); };
 
   // The cluster stage over the bound work list, in a phase.
   auto testClusters = [&](int phase) {
@@ -372,7 +325,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     glUseProgram(c);
     // Units 2 and 3: the depth and the pyramid, unbound again before anything draws into the depth.
     glBindTextureUnit(2, target.depthTexture().handle());
-    glBindTextureUnit(3, im.pyramid_texture);
+    glBindTextureUnit(3, im.pyramid.texture());
     glDispatchComputeIndirect(0);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glBindTextureUnit(2, 0);

@@ -18,10 +18,10 @@ std::vector<int> GpuDepthPyramid::levelSizes() const {
   return sizes;
 }
 
-void GpuDepthPyramid::build(const RenderTarget& target) {
-  depth_ = target.depthTexture().handle();
-  if (target.width() != width_ || target.height() != height_) {
-    width_ = target.width(), height_ = target.height();
+bool GpuDepthPyramid::resize(int width, int height) {
+  if (width == width_ && height == height_) return false;
+  {
+    width_ = width, height_ = height;
     level_size_.assign(1, {width_, height_});
     while (level_size_.back()[0] > 1 || level_size_.back()[1] > 1)
       level_size_.push_back({(level_size_.back()[0] + 1) / 2, (level_size_.back()[1] + 1) / 2});
@@ -37,8 +37,16 @@ void GpuDepthPyramid::build(const RenderTarget& target) {
       glTextureStorage2D(texture_, GLsizei(level_size_.size()) - 1, GL_R32F, pw, ph);
       glTextureParameteri(texture_, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
       glTextureParameteri(texture_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      glTextureParameteri(texture_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(texture_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
   }
+  return true;
+}
+
+void GpuDepthPyramid::build(const RenderTarget& target) {
+  depth_ = target.depthTexture().handle();
+  resize(target.width(), target.height());
   program_.use();
   glBindTextureUnit(2, depth_);
   for (size_t k = 1; k < level_size_.size(); ++k) {
