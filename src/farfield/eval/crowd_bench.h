@@ -54,7 +54,7 @@ struct CrowdBenchOptions {
   bool compare_skinning = false;
   // Adds crowd-geometry-gpu, crowd-impostor-gpu and crowd-mixed-gpu: the crowd simulated, culled, classified and
   // drawn on the GPU (gpu/gpu_crowd.h, runtime::CrowdRuntime::drawGpu; its simulation inside the crowd pass's time),
-  // without shadows, occlusion culling or budgets yet.
+  // without shadows or budgets yet (with agent_occlusion, agents behind the city are left out on the GPU).
   bool gpu_crowd = false;
   std::string out_dir;
   int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)
