@@ -156,33 +156,49 @@ TEST(GpuCrowdGL, CullingAndClassificationEqualACpuBruteForce) {
   EXPECT_GT(impostors, 0u);
 }
 
+// The built-in figures' runtime, a crowd of 3,000 on a small street network, its GPU crowd and CPU states at one
+// time, and a camera among the agents: what the frame tests draw both ways.
+struct CrowdScene {
+  CrowdModels models = (gpu::sharedHeadlessContext().makeCurrent(), builtinCrowdModels());
+  runtime::CrowdRuntime rt{models.models, models.options, runtime::CrowdRuntimeOptions{}};
+  gen::Crowd crowd = makeCrowd(models.shares);
+  gpu::GpuCrowd gc{gpuCrowdRoutes(crowd), gpuCrowdAgents(crowd, kCrowdIdBit), rt.gpuCrowdModels(kCrowdNominalSpeed)};
+  float t = 7.5f;
+  std::vector<runtime::CrowdAgentState> states = crowdAgentStates(crowd, rt, t);
+  Camera camera = cameraAmong();
+
+  CrowdScene() { gc.simulate(t); }
+  static gen::Crowd makeCrowd(const std::vector<float>& shares) {
+    gen::StreetNetworkOptions so;
+    so.blocks = 12;
+    so.seed = 3;
+    gen::CrowdOptions co;
+    co.agents = 3000;
+    co.seed = 21;
+    co.model_shares = shares;
+    return gen::generateCrowd(gen::generateStreetNetwork(so), co);
+  }
+  Camera cameraAmong() const {
+    const gen::AgentPose some = gen::agentPose(crowd, 0, t);
+    Camera c;
+    c.eye = some.position + Vec3(-7.0f, -5.0f, 2.5f);
+    c.at = some.position + Vec3(10.0f, 8.0f, 0.5f);
+    c.width = 320;
+    c.height = 200;
+    c.near_plane = 0.3f;
+    c.far_plane = 3000.0f;
+    return c;
+  }
+};
+
 // The frame drawn from the GPU crowd (simulated, culled and classified on the GPU, indirect draws) against the CPU
 // path's frame (gen::agentPose per agent, runtime::CrowdRuntime::draw) on the same camera, for each policy.
 TEST(GpuCrowdGL, FramesEqualTheCpuPathsOnTheCrowdsPixels) {
-  gpu::sharedHeadlessContext().makeCurrent();
-  const CrowdModels models = builtinCrowdModels();
-  runtime::CrowdRuntime rt(models.models, models.options, runtime::CrowdRuntimeOptions{});
-  gen::StreetNetworkOptions so;
-  so.blocks = 12;
-  so.seed = 3;
-  const urban::StreetGraph streets = gen::generateStreetNetwork(so);
-  gen::CrowdOptions co;
-  co.agents = 3000;
-  co.seed = 21;
-  co.model_shares = models.shares;
-  const gen::Crowd crowd = gen::generateCrowd(streets, co);
-  gpu::GpuCrowd gc(gpuCrowdRoutes(crowd), gpuCrowdAgents(crowd, kCrowdIdBit), rt.gpuCrowdModels(kCrowdNominalSpeed));
-  const float t = 7.5f;
-  const std::vector<runtime::CrowdAgentState> states = crowdAgentStates(crowd, rt, t);
-  gc.simulate(t);
-  Camera camera;
-  const gen::AgentPose some = gen::agentPose(crowd, 0, t);
-  camera.eye = some.position + Vec3(-7.0f, -5.0f, 2.5f);
-  camera.at = some.position + Vec3(10.0f, 8.0f, 0.5f);
-  camera.width = 320;
-  camera.height = 200;
-  camera.near_plane = 0.3f;
-  camera.far_plane = 3000.0f;
+  CrowdScene scene;
+  runtime::CrowdRuntime& rt = scene.rt;
+  gpu::GpuCrowd& gc = scene.gc;
+  const std::vector<runtime::CrowdAgentState>& states = scene.states;
+  const Camera& camera = scene.camera;
   const gpu::LightSettings light;
   for (runtime::CrowdPolicy policy :
        {runtime::CrowdPolicy::Impostor, runtime::CrowdPolicy::Geometry, runtime::CrowdPolicy::Mixed}) {
@@ -223,30 +239,12 @@ TEST(GpuCrowdGL, FramesEqualTheCpuPathsOnTheCrowdsPixels) {
 // test (cullBehind: the depth read back) leaves out are left out, and the frame is unchanged, pixel for pixel and
 // id for id.
 TEST(GpuCrowdGL, AgentsBehindAWallAreLeftOutAsTheCpuTestLeavesThemOut) {
-  gpu::sharedHeadlessContext().makeCurrent();
-  const CrowdModels models = builtinCrowdModels();
-  runtime::CrowdRuntime rt(models.models, models.options, runtime::CrowdRuntimeOptions{});
-  gen::StreetNetworkOptions so;
-  so.blocks = 12;
-  so.seed = 3;
-  const urban::StreetGraph streets = gen::generateStreetNetwork(so);
-  gen::CrowdOptions co;
-  co.agents = 3000;
-  co.seed = 21;
-  co.model_shares = models.shares;
-  const gen::Crowd crowd = gen::generateCrowd(streets, co);
-  gpu::GpuCrowd gc(gpuCrowdRoutes(crowd), gpuCrowdAgents(crowd, kCrowdIdBit), rt.gpuCrowdModels(kCrowdNominalSpeed));
-  const float t = 7.5f;
-  const std::vector<runtime::CrowdAgentState> states = crowdAgentStates(crowd, rt, t);
-  gc.simulate(t);
-  const gen::AgentPose some = gen::agentPose(crowd, 0, t);
-  Camera camera;
-  camera.eye = some.position + Vec3(-7.0f, -5.0f, 2.5f);
-  camera.at = some.position + Vec3(10.0f, 8.0f, 0.5f);
-  camera.width = 320;
-  camera.height = 200;
-  camera.near_plane = 0.3f;
-  camera.far_plane = 3000.0f;
+  CrowdScene scene;
+  runtime::CrowdRuntime& rt = scene.rt;
+  gpu::GpuCrowd& gc = scene.gc;
+  const std::vector<runtime::CrowdAgentState>& states = scene.states;
+  const Camera& camera = scene.camera;
+  const gen::AgentPose some = gen::agentPose(scene.crowd, 0, scene.t);
   // A wall 14 m along the view, 16 m wide and 6 m tall, facing the camera, hiding the agents behind its middle.
   const Vec3 f = glm::normalize(Vec3(camera.at.x - camera.eye.x, camera.at.y - camera.eye.y, 0.0f));
   const Vec3 side(-f.y, f.x, 0.0f);

@@ -311,12 +311,7 @@ FrameStats CrowdRenderer::drawSkinned(const Camera& camera, const SkinnedGpuMode
   if (agents.empty() || model.indexCount() == 0) return {};
   for (const CrowdAgentGpu& a : agents) FF_CHECK(a.index < model.pose_count_);
   uploadAgents(agents);
-  const Program& p = program(skinned_, model);
-  p.use();
-  p.set("u_view_proj", camera.viewProjection());
-  p.set("u_outfits", outfits_);
-  bindModel(p, model);
-  setLight(p, light);
+  const Program& p = useSkinned(camera, model, light);
   glEnable(GL_CULL_FACE);
   return drawAgents(p, model, agents.size(), level);
 }
@@ -341,6 +336,17 @@ FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtla
   return stats;
 }
 
+const Program& CrowdRenderer::useSkinned(const Camera& camera, const SkinnedGpuModel& model,
+                                         const LightSettings& light) {
+  const Program& p = program(skinned_, model);
+  p.use();
+  p.set("u_view_proj", camera.viewProjection());
+  p.set("u_outfits", outfits_);
+  bindModel(p, model);
+  setLight(p, light);
+  return p;
+}
+
 const Program& CrowdRenderer::useImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas,
                                            const LightSettings& light, bool blend_views) {
   const AtlasLayout& l = atlas.layout_;
@@ -363,12 +369,7 @@ FrameStats CrowdRenderer::drawSkinnedIndirect(const Camera& camera, const Skinne
   FrameStats stats;
   if (model.indexCount() == 0 || bytes == 0) return stats;
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
-  const Program& p = program(skinned_, model);
-  p.use();
-  p.set("u_view_proj", camera.viewProjection());
-  p.set("u_outfits", outfits_);
-  bindModel(p, model);
-  setLight(p, light);
+  const Program& p = useSkinned(camera, model, light);
   p.set("u_first_triangle", model.levels_[0].first_triangle);
   glEnable(GL_CULL_FACE);
   glBindVertexArray(model.vao_);

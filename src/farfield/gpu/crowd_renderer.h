@@ -182,7 +182,8 @@ class CrowdRenderer {
   // One instanced draw of the model's level for `count` agents (program, model and agents bound), and its counts.
   FrameStats drawAgents(const Program& p, const SkinnedGpuModel& model, size_t count, size_t level) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
-  // drawImpostors' and drawImpostorsIndirect's program, uniforms and atlas.
+  // drawSkinned's and drawSkinnedIndirect's program, uniforms and model; the same for the impostor draws.
+  const Program& useSkinned(const Camera& camera, const SkinnedGpuModel& model, const LightSettings& light);
   const Program& useImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas, const LightSettings& light,
                               bool blend_views);
   // The skinned programs by skinning ([0] Palette, [1] BakedPoses) and, for drawing, cut-out ([0] none, [1] cut out):
