@@ -15,6 +15,7 @@
 #include "farfield/core/timer.h"
 #include "farfield/eval/crowd_metrics.h"
 #include "farfield/eval/gpu_crowd_input.h"
+#include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/gpu_crowd.h"
 #include "farfield/eval/crowd_walk.h"
 #include "farfield/eval/frame_runner.h"
@@ -171,13 +172,15 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
     md << "\n";
   }
   md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
-  md << "| agents | path | mode | median ms | crowd ms | speedup | crowd speedup | geometry / impostor agents | "
-        "triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) | shadow casters / receiver px off |\n";
-  md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  md << "| agents | path | mode | median ms | crowd ms | crowd own CPU ms | speedup | crowd speedup | "
+        "geometry / impostor agents | triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) | "
+        "shadow casters / receiver px off |\n";
+  md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const CrowdRun& run : result.runs)
     for (const CrowdModeResult& r : run.modes)
       md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << fmt("%.1f", r.wall.median)
-         << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.2fx", r.speedup) << " | "
+         << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.3f", r.crowd_cpu.median) << " | "
+         << fmt("%.2fx", r.speedup) << " | "
          << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
          << fmt("%.0f", r.impostor_agents)
          << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string())
@@ -189,6 +192,10 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
          << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
          << fmt("%.2f", run.reference_popping_mean) << ") | " << fmt("%.0f", r.shadow_casters) << " / "
          << fmt("%.0f", r.receiver_bad_pixels) << " |\n";
+  md << "\nThe CPU modes' agent states (poses and phases of every agent, eval::crowdAgentStates) are made before the "
+        "crowd pass, outside its time:";
+  for (const CrowdRun& run : result.runs) md << " " << fmt("%.2f", run.cpu_states_ms) << " ms (" << thousands(run.agents) << ", " << run.path << ")";
+  md << ". The crowd-*-gpu modes simulate every agent inside it.\n";
   if (options.runtime.geometry_ms > 0.0) {
     md << "\ncrowd-mixed's skinned draws against the " << fmt("%.1f", options.runtime.geometry_ms)
        << " ms budget (the frames that drew skinned agents):\n";
@@ -233,6 +240,7 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
     for (const CrowdModeResult& r : run.modes)
       j["runs"].push_back({{"agents", run.agents}, {"path", run.path}, {"mode", r.name},
                            {"median_ms", r.wall.median}, {"p95_ms", r.wall.p95}, {"crowd_median_ms", r.crowd.median},
+                           {"crowd_own_cpu_median_ms", r.crowd_cpu.median}, {"cpu_states_ms", run.cpu_states_ms},
                            {"speedup", r.speedup}, {"crowd_speedup", r.crowd_speedup}, {"psnr_db_mean", r.psnr_mean},
                            {"psnr_db_min", r.psnr_min}, {"bad_pixel_share_mean", r.bad_share_mean},
                            {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
@@ -318,6 +326,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
   if (!options.out_dir.empty()) fs::create_directories(fs::path(options.out_dir) / "frames");
   const std::vector<ModeSpec> specs = modeSpecs(options.compare_skinning, options.gpu_crowd);
   const gpu::LightSettings light = renderer.light();
+  gpu::installGlCounters();  // the crowd pass's own CPU time: its wall time less the time inside GL calls
 
   for (const std::string& path_name : options.paths) {
     if (path_name != "pedestrian" && path_name != "elevated")
@@ -338,7 +347,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       CrowdRun run;
       run.agents = count;
       run.path = path_name;
-      std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), psnr(specs.size()),
+      std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), crowd_cpu(specs.size()),
+          psnr(specs.size()),
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
           in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
           receiver_bad(specs.size()), occluded(specs.size()), over_budget(specs.size()), coarser(specs.size()),
@@ -355,11 +365,14 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       const size_t sample_every = options.samples > 0 ? std::max<size_t>(1, options.frames / size_t(options.samples)) : 0;
       // Path frame k's camera, agents and city items.
       float frame_time = 0.0f;  // the path frame's time, seconds (the GPU crowd's simulation)
+      std::vector<double> states_ms;  // per frame: making the CPU modes' agent states
       auto setUpFrame = [&](size_t k, size_t& pf, Camera& camera, std::vector<runtime::CrowdAgentState>& states) {
         pf = std::min(k * options.frame_step, path.frames.size() - 1);
         frame_time = float(pf) / path.fps;
         camera = pathCamera(path, pf, options.width, options.height);
+        const Stopwatch states_clock;
         states = crowdAgentStates(crowd, rt, float(pf) / path.fps);
+        states_ms.push_back(states_clock.milliseconds());
         ids.clear();
         items.clear();
         item_bounds.clear();
@@ -370,7 +383,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       // Mode m's frame into `target`, timed: the city as the culled mode draws it (occlusion culling is exact: the
       // reference's city pixels), then the crowd.
       struct Timed {
-        double total = 0.0, crowd = 0.0;
+        double total = 0.0, crowd = 0.0, crowd_cpu = 0.0;
         double skinned = -1.0;  // crowd-mixed's measured skinned draws under runtime.geometry_ms; -1: none
         runtime::CrowdFrameStats stats;
       };
@@ -383,6 +396,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         rt.finish();
         const double city_ms = clock.milliseconds();
         runtime::CrowdRuntime& mode_rt = specs[m].palette && rt_palette ? *rt_palette : rt;
+        const gpu::GlCounters gl_before = gpu::glCounters();
         if (specs[m].gpu) {
           gpu_crowd->simulate(frame_time);
           out.stats = rt.drawGpu(camera, *gpu_crowd, specs[m].policy, light, options.agent_occlusion ? &target : nullptr);
@@ -393,6 +407,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         mode_rt.finish();
         out.total = clock.milliseconds();
         out.crowd = out.total - city_ms;
+        out.crowd_cpu = std::max(0.0, out.crowd - (gpu::glCounters() - gl_before).driver_ms);
         if (specs[m].gpu) {  // the lists' sizes, read after the timed frame
           const std::vector<gpu::GpuCrowdCommand> commands = gpu_crowd->readCommands();
           for (size_t list = 0; list < commands.size(); ++list) {
@@ -434,6 +449,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           if (k == 0) continue;
           wall[m].push_back(timed.total);
           crowd_ms[m].push_back(timed.crowd);
+          crowd_cpu[m].push_back(timed.crowd_cpu);
           skinned[m].push_back(timed.skinned);
           geo[m].push_back(double(st.geometry));
           imp[m].push_back(double(st.impostors));
@@ -483,12 +499,14 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
             const Timed timed = drawTimed(m, camera, states);
             wall[m][k - 1] = std::min(wall[m][k - 1], timed.total);
             crowd_ms[m][k - 1] = std::min(crowd_ms[m][k - 1], timed.crowd);
+            crowd_cpu[m][k - 1] = std::min(crowd_cpu[m][k - 1], timed.crowd_cpu);
             if (timed.skinned >= 0.0)
               skinned[m][k - 1] = skinned[m][k - 1] < 0.0 ? timed.skinned : std::min(skinned[m][k - 1], timed.skinned);
           }
         }
       }
       run.reference_popping_mean = options.frames > 1 ? ref_change / double(options.frames - 1) : 0.0;
+      for (size_t k = 1; k < states_ms.size(); ++k) run.cpu_states_ms += states_ms[k] / double(states_ms.size() - 1);
       auto mean = [](const std::vector<double>& v) {
         double s = 0.0;
         for (double x : v) s += x;
@@ -499,6 +517,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.name = specs[m].name;
         r.wall = summarize(wall[m]);
         r.crowd = summarize(crowd_ms[m]);
+        r.crowd_cpu = summarize(crowd_cpu[m]);
         std::vector<double> timed_skinned;
         for (double v : skinned[m])
           if (v >= 0.0) timed_skinned.push_back(v);

@@ -64,6 +64,9 @@ struct CrowdModeResult {
   std::string name;
   FrameSummary wall;   // city + crowd, ms
   FrameSummary crowd;  // crowd pass alone, ms
+  // Farfield's own CPU time in the crowd pass: its wall time less the time inside GL calls (gpu/gl_counters.h), ms.
+  // The CPU modes' agent states (their poses and phases, CrowdRun::cpu_states_ms) are made before it.
+  FrameSummary crowd_cpu;
   double speedup = 0.0;        // median wall of crowd-geometry / this mode's
   double crowd_speedup = 0.0;  // the same on crowd time
   double psnr_mean = 0.0, psnr_min = 0.0, bad_share_mean = 0.0, crowd_pixels_mean = 0.0;
@@ -85,6 +88,7 @@ struct CrowdRun {
   size_t agents = 0;
   std::string path;
   double reference_popping_mean = 0.0;  // the reference's own frame-to-frame change on crowd pixels (MAE)
+  double cpu_states_ms = 0.0;  // mean per frame: the CPU modes' agent states (eval::crowdAgentStates), outside the pass
   std::vector<CrowdModeResult> modes;
 };
 
