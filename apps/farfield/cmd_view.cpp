@@ -86,6 +86,8 @@ const RegisterCommand reg("view", [](CLI::App& app) {
                   "made on (gen city --terrain)");
   cmd->add_option("--terrain-scale", o.terrain_scale, "Vertical scale the city was made with (gen city --terrain-scale)")
       ->capture_default_str();
+  cmd->add_flag("--terrain-gpu", o.terrain_gpu,
+                "Draw the terrain by CDLOD on the GPU (high-gpu: no per-frame CPU mesh) instead of LOD-sprite");
   cmd->add_option("--crowd", o.crowd.agents,
                   "Agents walking the sidewalks of the street graph, drawn over every mode as crowd-mixed (0: none)")
       ->capture_default_str();

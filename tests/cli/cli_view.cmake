@@ -84,6 +84,13 @@ run_ok(${FARFIELD} diff ${WORK}/tc_alone/frame_0.png ${WORK}/tc_terrain/frame_0.
 if(LAST_OUT MATCHES "identical")
   message(FATAL_ERROR "farfield view --terrain drew the same frame as without the terrain:\n${LAST_OUT}")
 endif()
+# The same terrain drawn by CDLOD on the GPU (--terrain-gpu): a terrain is drawn too, close to LOD-sprite's.
+run_ok(${FARFIELD} view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_terrain_gpu --terrain ${terrain} --terrain-scale 0.5
+       --terrain-gpu)
+run_ok(${FARFIELD} diff ${WORK}/tc_alone/frame_0.png ${WORK}/tc_terrain_gpu/frame_0.png)
+if(LAST_OUT MATCHES "identical")
+  message(FATAL_ERROR "farfield view --terrain-gpu drew the same frame as without the terrain:\n${LAST_OUT}")
+endif()
 expect_error("gen city --terrain" view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_bad --terrain ${terrain}
              --terrain-scale 2)
 

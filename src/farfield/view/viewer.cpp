@@ -101,6 +101,7 @@ class Viewer {
     settings.error_px = options_.error_px;
     settings.terrain = options_.terrain;
     settings.terrain_scale = options_.terrain_scale;
+    settings.terrain_gpu = options_.terrain_gpu;
     panel_.gpu_budget_bytes = settings.gpu_budget_bytes;
     modes_ = std::make_unique<ModeRenderer>(scene_, gpu_scene_, bvh_, renderer_, target_, settings);
     selectMode(options_.mode.empty() ? defaultMode(database_) : options_.mode);
