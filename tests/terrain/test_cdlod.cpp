@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <optional>
 #include <vector>
 
@@ -364,6 +366,46 @@ TEST(Cdlod, NodeDataFromATileCache) {
     EXPECT_LT(worstCrack(exact, camera, sel, &step), 1e-4);
   }
   EXPECT_THROW(cdlodFromTileCache(cache, CdlodOptions{128, 16, 0.3f}), Error);  // a patch larger than a tile
+}
+
+// The node data kept beside the cache: written by the first call, read back by the next (the same data), made again
+// when damaged or made for another patch size.
+TEST(Cdlod, NodeDataKeptBesideTheCache) {
+  const Heightfield hf = test::tiledTestFractal(7);
+  const std::string path = test::writeTestCache(hf, "cdlod_kept");
+  const TileCache cache(path);
+  const CdlodOptions options{8, 16, 0.3f};
+  std::filesystem::remove(path + ".cdlod");
+  bool reused = true;
+  const CdlodTerrain made = cdlodFromTileCacheKept(cache, options, &reused);
+  EXPECT_FALSE(reused);
+  ASSERT_TRUE(std::filesystem::exists(path + ".cdlod"));
+  const CdlodTerrain read = cdlodFromTileCacheKept(cache, options, &reused);
+  EXPECT_TRUE(reused);
+  for (int l = 0; l <= made.topLevel(); ++l)
+    for (int y = 0; y < made.nodesY(l); ++y)
+      for (int x = 0; x < made.nodesX(l); ++x) {
+        ASSERT_EQ(read.nodeHeights({l, x, y}), made.nodeHeights({l, x, y}));
+        ASSERT_EQ(read.nodeError({l, x, y}), made.nodeError({l, x, y}));
+      }
+  cdlodFromTileCacheKept(cache, CdlodOptions{16, 16, 0.3f}, &reused);  // another patch size: made again
+  EXPECT_FALSE(reused);
+  cdlodFromTileCacheKept(cache, options, &reused);  // rewritten for 16: made again for 8
+  EXPECT_FALSE(reused);
+  {  // a flipped byte in the node data: the checksum fails, the data are made again (the same)
+    std::fstream f(path + ".cdlod", std::ios::binary | std::ios::in | std::ios::out);
+    f.seekp(100);
+    char c = 0;
+    f.read(&c, 1);
+    f.seekp(100);
+    c = char(c ^ 0x5a);
+    f.write(&c, 1);
+  }
+  const CdlodTerrain again = cdlodFromTileCacheKept(cache, options, &reused);
+  EXPECT_FALSE(reused);
+  EXPECT_EQ(again.nodeError({1, 0, 0}), made.nodeError({1, 0, 0}));
+  cdlodFromTileCacheKept(cache, options, &reused);
+  EXPECT_TRUE(reused);
 }
 
 TEST(Cdlod, BadInputIsAnError) {

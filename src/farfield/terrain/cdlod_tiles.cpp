@@ -2,11 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "farfield/core/error.h"
+#include "farfield/core/log.h"
+
+// xxHash inlined from its header (libxxhash-dev): no library to link.
+#define XXH_INLINE_ALL
+#include <xxhash.h>
 
 namespace farfield::terrain {
 namespace {
@@ -142,6 +150,104 @@ CdlodTerrain cdlodFromTileCache(const TileCache& cache, const CdlodOptions& opti
     }
   }
   return CdlodTerrain(grid, options, std::move(heights), std::move(errors));
+}
+
+namespace {
+
+constexpr char kKeptMagic[8] = {'F', 'F', 'C', 'D', 'L', 'O', 'D', '1'};
+
+// The header of a kept file: what it was made for.
+struct KeptHeader {
+  char magic[8];
+  uint32_t version;
+  int32_t width, height, patch_cells, max_level, top;
+  uint64_t cache_bytes;
+  int64_t cache_time;
+  uint64_t nodes;
+};
+
+KeptHeader keptHeaderFor(const TileCache& cache, const CdlodOptions& options, int top, uint64_t nodes) {
+  KeptHeader h{};
+  std::memcpy(h.magic, kKeptMagic, 8);
+  h.version = 1;
+  h.width = cache.layout().width;
+  h.height = cache.layout().height;
+  h.patch_cells = options.patch_cells;
+  h.max_level = options.max_level;
+  h.top = top;
+  std::error_code ec;
+  h.cache_bytes = std::filesystem::file_size(cache.path(), ec);
+  h.cache_time = int64_t(std::filesystem::last_write_time(cache.path(), ec).time_since_epoch().count());
+  h.nodes = nodes;
+  return h;
+}
+
+}  // namespace
+
+CdlodTerrain cdlodFromTileCacheKept(const TileCache& cache, const CdlodOptions& options, bool* reused) {
+  if (reused) *reused = false;
+  const std::string kept = cache.path() + ".cdlod";
+  const TileLayout& layout = cache.layout();
+  const CdlodGrid grid{layout.width, layout.height, layout.cell_x, layout.cell_y};
+  const int top = CdlodTerrain::topLevelFor(grid, options, cache.path());
+  uint64_t nodes = 0;
+  for (int l = 0; l <= top; ++l) {
+    const int64_t cells = int64_t(options.patch_cells) << l;
+    nodes += uint64_t((grid.width - 1 + cells - 1) / cells) * uint64_t((grid.height - 1 + cells - 1) / cells);
+  }
+  const KeptHeader want = keptHeaderFor(cache, options, top, nodes);
+  const size_t body = size_t(nodes) * (sizeof(Vec2) + sizeof(float));
+  if (std::filesystem::exists(kept)) {
+    std::ifstream in(kept, std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    KeptHeader have{};
+    if (bytes.size() >= sizeof(KeptHeader)) std::memcpy(&have, bytes.data(), sizeof(KeptHeader));
+    const bool matches = bytes.size() == sizeof(KeptHeader) + body + sizeof(uint64_t) &&
+                         std::memcmp(&have, &want, sizeof(KeptHeader)) == 0;
+    uint64_t sum = 0;
+    if (matches) std::memcpy(&sum, bytes.data() + sizeof(KeptHeader) + body, sizeof(sum));
+    if (matches && sum == XXH3_64bits(bytes.data(), sizeof(KeptHeader) + body)) {
+      std::vector<Vec2> heights(nodes);
+      std::vector<float> errors(nodes);
+      std::memcpy(heights.data(), bytes.data() + sizeof(KeptHeader), nodes * sizeof(Vec2));
+      std::memcpy(errors.data(), bytes.data() + sizeof(KeptHeader) + nodes * sizeof(Vec2), nodes * sizeof(float));
+      if (reused) *reused = true;
+      return CdlodTerrain(grid, options, std::move(heights), std::move(errors));
+    }
+    if (std::memcmp(have.magic, kKeptMagic, 8) == 0 && std::memcmp(&have, &want, sizeof(KeptHeader)) == 0)
+      FF_WARN(kept << ": damaged (its checksum does not hold); made again from the tile cache");
+  }
+  CdlodTerrain lod = cdlodFromTileCache(cache, options);
+  std::string out(sizeof(KeptHeader), '\0');
+  std::memcpy(out.data(), &want, sizeof(KeptHeader));
+  for (int l = 0; l <= lod.topLevel(); ++l)
+    for (int y = 0; y < lod.nodesY(l); ++y)
+      for (int x = 0; x < lod.nodesX(l); ++x) {
+        const Vec2 h = lod.nodeHeights({l, x, y});
+        out.append(reinterpret_cast<const char*>(&h), sizeof(h));
+      }
+  for (int l = 0; l <= lod.topLevel(); ++l)
+    for (int y = 0; y < lod.nodesY(l); ++y)
+      for (int x = 0; x < lod.nodesX(l); ++x) {
+        const float e = lod.nodeError({l, x, y});
+        out.append(reinterpret_cast<const char*>(&e), sizeof(e));
+      }
+  const uint64_t sum = XXH3_64bits(out.data(), out.size());
+  out.append(reinterpret_cast<const char*>(&sum), sizeof(sum));
+  const std::string tmp = kept + ".tmp";
+  {
+    std::ofstream file(tmp, std::ios::binary | std::ios::trunc);
+    file.write(out.data(), std::streamsize(out.size()));
+    file.flush();
+    if (!file) {
+      FF_WARN(kept << ": cannot be written; the node data will be made again next time");
+      return lod;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, kept, ec);
+  if (ec) FF_WARN(kept << ": cannot be moved into place (" << ec.message() << ")");
+  return lod;
 }
 
 }  // namespace farfield::terrain

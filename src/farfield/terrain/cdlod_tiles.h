@@ -22,4 +22,10 @@ int cdlodTileLevel(const TileLayout& layout, const CdlodOptions& options);
 // as TileCache's reads and CdlodTerrain do.
 CdlodTerrain cdlodFromTileCache(const TileCache& cache, const CdlodOptions& options = {});
 
+// The same, kept beside the cache in "<cache>.cdlod" so that a run does not read every tile again: read back when it
+// was made for this cache (its size and time), grid and patch size and its checksum holds; otherwise (missing,
+// stale, or damaged: a warning naming it) made from the cache and written (a temporary file renamed over it; a
+// directory that cannot be written is a warning, not an error). `reused`: whether it was read back.
+CdlodTerrain cdlodFromTileCacheKept(const TileCache& cache, const CdlodOptions& options = {}, bool* reused = nullptr);
+
 }  // namespace farfield::terrain

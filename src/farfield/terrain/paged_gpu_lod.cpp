@@ -21,7 +21,7 @@ int defaultOverviewStep(const TileCache& cache, const CdlodOptions& lod) {
 }  // namespace
 
 PagedGpuLodTerrain::PagedGpuLodTerrain(const TileCache& cache, const PagedGpuLodOptions& options)
-    : cache_(cache), options_(options), lod_(cdlodFromTileCache(cache, options.lod)) {
+    : cache_(cache), options_(options), lod_(cdlodFromTileCacheKept(cache, options.lod)) {
   const TileLayout& l = cache.layout();
   overview_step_ = options.overview_step > 0 ? options.overview_step : defaultOverviewStep(cache, options.lod);
   fine_levels_ = 0;

@@ -1,9 +1,10 @@
 // The CDLOD terrain (cdlod.h) paged from a tile cache (tile_cache.h) to the GPU: for terrains larger than memory or
 // than the driver's textures (a 16,385^2 grid is 1 GB of heights and exceeds llvmpipe's 16,384-texel limit).
 //
-// The node data come from the cache tile by tile (cdlod_tiles.h). The nodes of the finest levels (below F) read their
-// tile's page: the tile's own points at full resolution and its original-texture texels, in a layer of texture
-// arrays held under a GPU budget (gpu/cdlod_pages.h), the least recently used evicted first. The coarser nodes, whose
+// The node data come from the cache tile by tile, or from the file kept beside it (cdlod_tiles.h). The nodes of the
+// finest levels (below F) read their tile's page: the tile's own points at full resolution and its original-texture
+// texels, in a layer of texture arrays held under a GPU budget (gpu/cdlod_pages.h), the least recently used evicted
+// first. The coarser nodes, whose
 // vertices lie every 2^F points, read the overview (every 2^F-th point and a texel each), always held. Per frame: the
 // selection, the pages it needs (read at once if missing: the frame waits, counted), one instanced draw. After each
 // frame the pages the camera will need half and all of prefetch_frames frames ahead, moving as it last moved, are
