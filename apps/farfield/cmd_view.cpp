@@ -109,8 +109,8 @@ const RegisterCommand reg("view", [](CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--crowd-gpu", o.crowd.gpu,
-                "The crowd simulated, culled (behind the city too), classified and drawn on the GPU "
-                "(crowd-mixed-gpu: no shadows or budgets yet)");
+                "The crowd simulated, culled (behind the city too), classified, drawn and shadowed on the GPU "
+                "(crowd-mixed-gpu: no budgets yet)");
   cmd->callback([args] { runViewCommand(*args); });
 });
 

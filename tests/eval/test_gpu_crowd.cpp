@@ -285,6 +285,56 @@ TEST(GpuCrowdGL, AgentsBehindAWallAreLeftOutAsTheCpuTestLeavesThemOut) {
   }
 }
 
+// Shadows on the GPU path (drawGpuShadowed): the agents darken the ground, where the CPU path's shadows fall (its
+// map is fitted to the casters it knows, the GPU path's to the receivers: their texels differ, so edges do).
+TEST(GpuCrowdGL, ShadowsFallWhereTheCpuPathsFall) {
+  CrowdScene scene;
+  const Vec3 c = scene.camera.eye;
+  const float z = gen::agentPose(scene.crowd, 0, scene.t).position.z;
+  const test::GreyQuad ground({Vec3(c.x - 300, c.y - 300, z), Vec3(c.x + 300, c.y - 300, z),
+                               Vec3(c.x + 300, c.y + 300, z), Vec3(c.x - 300, c.y + 300, z)},
+                              Vec3(0, 0, 1), 0.7f);
+  gpu::Renderer renderer;
+  gpu::LightSettings light = renderer.light();
+  gpu::RenderTarget target(scene.camera.width, scene.camera.height);
+  const runtime::CrowdShadowOptions shadows;
+  auto frame = [&](int kind) {  // 0: GPU, no shadows; 1: GPU shadowed; 2: CPU shadowed
+    renderer.render(scene.camera, std::span(&ground.item, 1), target);
+    target.bindForOpaquePass();
+    if (kind == 0) scene.rt.drawGpu(scene.camera, scene.gc, runtime::CrowdPolicy::Mixed, light);
+    if (kind == 1)
+      scene.rt.drawGpuShadowed(scene.camera, scene.gc, runtime::CrowdPolicy::Mixed, light, target, shadows);
+    if (kind == 2)
+      scene.rt.drawShadowed(scene.camera, scene.states, runtime::CrowdPolicy::Mixed, light, target, shadows);
+    scene.rt.finish();
+    return std::make_pair(target.readColor(), target.readIds());
+  };
+  const auto plain = frame(0), gpu_shadowed = frame(1);
+  const std::vector<gpu::GpuCrowdCommand> commands = scene.gc.readCommands();
+  uint32_t casters = 0;
+  for (size_t m = 0; m < scene.gc.modelCount(); ++m)
+    casters += commands[scene.gc.casterList(m, false)].instance_count + commands[scene.gc.casterList(m, true)].instance_count;
+  const auto cpu_shadowed = frame(2);
+  size_t ground_px = 0, gpu_dark = 0, cpu_dark = 0, both_dark = 0;
+  for (int y = 0; y < scene.camera.height; ++y)
+    for (int x = 0; x < scene.camera.width; ++x) {
+      if ((plain.second.at(x, y) & kCrowdIdBit) || (cpu_shadowed.second.at(x, y) & kCrowdIdBit) ||
+          plain.second.at(x, y) == 0)
+        continue;
+      ++ground_px;
+      const int base = plain.first.at(x, y).g;
+      const bool g = gpu_shadowed.first.at(x, y).g + 8 < base, k = cpu_shadowed.first.at(x, y).g + 8 < base;
+      gpu_dark += g, cpu_dark += k, both_dark += g && k;
+    }
+  std::printf("shadows: %u casters on the GPU, %zu ground pixels, %zu darkened by the GPU path, %zu by the CPU's, "
+              "%zu by both\n", casters, ground_px, gpu_dark, cpu_dark, both_dark);
+  EXPECT_GT(casters, 0u);
+  EXPECT_GT(cpu_dark, 50u);
+  EXPECT_GE(double(both_dark), 0.95 * double(cpu_dark));  // nearly every CPU shadow pixel is a GPU one
+  // The GPU path's map spans every receiver, so its texels are coarser (2.5x here) and its shadows a little wider.
+  EXPECT_GE(double(both_dark), 0.7 * double(gpu_dark));
+}
+
 TEST(GpuCrowdGL, BadInputIsAnError) {
   gpu::sharedHeadlessContext().makeCurrent();
   const gen::Crowd crowd = testCrowd(10, false);

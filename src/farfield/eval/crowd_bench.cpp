@@ -399,7 +399,11 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         const gpu::GlCounters gl_before = gpu::glCounters();
         if (specs[m].gpu) {
           gpu_crowd->simulate(frame_time);
-          out.stats = rt.drawGpu(camera, *gpu_crowd, specs[m].policy, light, options.agent_occlusion ? &target : nullptr);
+          target.bindForOpaquePass();
+          out.stats = options.shadows ? rt.drawGpuShadowed(camera, *gpu_crowd, specs[m].policy, light, target,
+                                                           options.shadow, options.agent_occlusion)
+                                      : rt.drawGpu(camera, *gpu_crowd, specs[m].policy, light,
+                                                   options.agent_occlusion ? &target : nullptr);
         } else {
           if (options.agent_occlusion) mode_rt.cullBehind(target);
           out.stats = drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
@@ -410,11 +414,14 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         out.crowd_cpu = std::max(0.0, out.crowd - (gpu::glCounters() - gl_before).driver_ms);
         if (specs[m].gpu) {  // the lists' sizes, read after the timed frame
           const std::vector<gpu::GpuCrowdCommand> commands = gpu_crowd->readCommands();
-          for (size_t list = 0; list < commands.size(); ++list) {
+          for (size_t list = 0; list < 2 * gpu_crowd->modelCount(); ++list) {  // the camera's lists
             (list % 2 ? out.stats.impostors : out.stats.geometry) += commands[list].instance_count;
             if (list % 2 == 0) out.stats.draw.triangles += uint64_t(commands[list].instance_count) * rt.modelTriangles(list / 2);
             else out.stats.draw.triangles += 2 * uint64_t(commands[list].instance_count);
           }
+          for (size_t m2 = 0; options.shadows && m2 < gpu_crowd->modelCount(); ++m2)
+            out.stats.shadow_casters += commands[gpu_crowd->casterList(m2, false)].instance_count +
+                                        commands[gpu_crowd->casterList(m2, true)].instance_count;
           const gpu::GpuCrowd::Counts counts = gpu_crowd->readCounts();
           out.stats.in_view = counts.in_view;
           out.stats.occluded = counts.occluded;

@@ -53,8 +53,8 @@ struct CrowdBenchOptions {
   // agents blend joint matrices (gpu::Skinning::Palette), timed in the same process on the same frames as the others.
   bool compare_skinning = false;
   // Adds crowd-geometry-gpu, crowd-impostor-gpu and crowd-mixed-gpu: the crowd simulated, culled, classified and
-  // drawn on the GPU (gpu/gpu_crowd.h, runtime::CrowdRuntime::drawGpu; its simulation inside the crowd pass's time),
-  // without shadows or budgets yet (with agent_occlusion, agents behind the city are left out on the GPU).
+  // drawn on the GPU (gpu/gpu_crowd.h, runtime::CrowdRuntime::drawGpu and drawGpuShadowed; its simulation inside
+  // the crowd pass's time), with shadows and agent_occlusion as the others, without budgets yet.
   bool gpu_crowd = false;
   std::string out_dir;
   int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)

@@ -475,6 +475,46 @@ FrameStats CrowdRenderer::drawImpostorDepth(const Mat4& light_view_proj, const V
   return stats;
 }
 
+FrameStats CrowdRenderer::drawSkinnedDepthIndirect(const Mat4& light_view_proj, const SkinnedGpuModel& model,
+                                                   uint32_t agents, size_t offset, size_t bytes, uint32_t commands,
+                                                   size_t command_offset) {
+  FrameStats stats;
+  if (model.indexCount() == 0 || bytes == 0) return stats;
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
+  const Program& p = program(skinned_depth_, model);
+  p.use();
+  p.set("u_view_proj", light_view_proj);
+  bindModel(p, model);
+  p.set("u_first_triangle", model.levels_[0].first_triangle);
+  glBindVertexArray(model.vao_);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
+  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, reinterpret_cast<const void*>(command_offset), 1, 0);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+  glBindVertexArray(0);
+  stats.draw_calls = 1;
+  return stats;
+}
+
+FrameStats CrowdRenderer::drawImpostorDepthIndirect(const Mat4& light_view_proj, const Vec3& to_light,
+                                                    const ImpostorAtlasGpu& atlas, uint32_t agents, size_t offset,
+                                                    size_t bytes, uint32_t commands, size_t command_offset) {
+  FrameStats stats;
+  if (bytes == 0) return stats;
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
+  impostor_depth_.use();
+  impostor_depth_.set("u_view_proj", light_view_proj);
+  impostor_depth_.set("u_eye", Vec3(0.0f));
+  impostor_depth_.set("u_fixed_dir", glm::normalize(to_light));
+  bindAtlas(impostor_depth_, atlas);
+  glBindVertexArray(empty_vao_);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
+  glMultiDrawArraysIndirect(GL_TRIANGLE_STRIP, reinterpret_cast<const void*>(command_offset), 1, 0);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+  glBindVertexArray(0);
+  stats.draw_calls = 1;
+  return stats;
+}
+
 void CrowdRenderer::finish() const { glFinish(); }
 
 }  // namespace farfield::gpu

@@ -154,6 +154,12 @@ class CrowdRenderer {
   FrameStats drawImpostorsIndirect(const Camera& camera, const ImpostorAtlasGpu& atlas, uint32_t agents,
                                    size_t offset, size_t bytes, uint32_t commands, size_t command_offset,
                                    const LightSettings& light);
+  // The shadow casters' depth-only draws for GPU-written records, as drawSkinnedIndirect and drawImpostorsIndirect.
+  FrameStats drawSkinnedDepthIndirect(const Mat4& light_view_proj, const SkinnedGpuModel& model, uint32_t agents,
+                                      size_t offset, size_t bytes, uint32_t commands, size_t command_offset);
+  FrameStats drawImpostorDepthIndirect(const Mat4& light_view_proj, const Vec3& to_light,
+                                       const ImpostorAtlasGpu& atlas, uint32_t agents, size_t offset, size_t bytes,
+                                       uint32_t commands, size_t command_offset);
   // Renders pose `pose` of the model (agent at the origin, heading 0) into `layer` of the atlas, one cell per view;
   // clears the layer first. Leaves the default framebuffer state to the caller (rebind your target after).
   void capture(const SkinnedGpuModel& model, uint32_t pose, ImpostorAtlasGpu& atlas, int layer,

@@ -90,6 +90,8 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
     initial_commands_.push_back({mo.geometry_indices, 0, mo.geometry_first_index, 0, 0});
     initial_commands_.push_back({4, 0, 0, 0, 0});  // count 4, instances, first 0, base instance 0
   }
+  // The casters' lists after the camera's, alike.
+  for (size_t k = 0, n = initial_commands_.size(); k < n; ++k) initial_commands_.push_back(initial_commands_[k]);
   agent_buf_ = makeBuffer(agent_records.data(), agent_records.size() * sizeof(AgentRecord), bytes_);
   routes_ = makeBuffer(route_records.data(), route_records.size() * sizeof(RouteRecord), bytes_);
   points_ = makeBuffer(points.data(), points.size() * sizeof(Vec4), bytes_);
@@ -103,6 +105,7 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
   counts_ = makeBuffer(nullptr, 2 * sizeof(uint32_t), bytes_);
   simulate_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_SIMULATE 1\n");
   classify_ = Program::computeFromEmbedded("crowd_sim.comp.glsl");
+  casters_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_CASTERS 1\n");
 }
 
 GpuCrowd::~GpuCrowd() {
@@ -129,6 +132,36 @@ void GpuCrowd::occludeBehind(const RenderTarget& target) {
   if (!pyramid_) pyramid_ = std::make_unique<GpuDepthPyramid>();
   pyramid_->build(target);
   occlude_next_ = true;
+}
+
+void GpuCrowd::castShadows(const Camera& camera, std::span<const float> switch_m, const Mat4& light_view_proj,
+                           float side_m, float depth_range_m, const Vec3& to_light) {
+  if (switch_m.size() != models_)
+    throw Error("GPU crowd", std::to_string(switch_m.size()) + " switch distances for " + std::to_string(models_) +
+                                 " models");
+  if (!(side_m > 0.0f) || !(depth_range_m > 0.0f)) throw Error("GPU crowd", "an empty shadow map box");
+  const size_t half = initial_commands_.size() / 2;  // the casters' commands, reset from their initial values
+  glCopyNamedBufferSubData(initial_, commands_, GLintptr(half * sizeof(GpuCrowdCommand)),
+                           GLintptr(half * sizeof(GpuCrowdCommand)), GLsizeiptr(half * sizeof(GpuCrowdCommand)));
+  float switches[kMaxModels] = {};
+  for (size_t m = 0; m < models_; ++m) switches[m] = switch_m[m];
+  casters_.use();
+  casters_.set("u_agents", uint32_t(agents_));
+  casters_.set("u_eye", camera.eye);
+  casters_.set("u_capacity", uint32_t(capacity_));
+  casters_.set("u_first_list", uint32_t(2 * models_));
+  casters_.set("u_light_view_proj", light_view_proj);
+  casters_.set("u_to_light", glm::normalize(to_light));
+  glUniform2f(casters_.uniformLocation("u_light_scale"), 2.0f / side_m, 1.0f / depth_range_m);
+  glUniform1fv(casters_.uniformLocation("u_switch[0]"), kMaxModels, switches);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, agent_buf_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, poses_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, phases_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, model_buf_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, commands_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, lists_);
+  glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
 }
 
 GpuCrowd::Counts GpuCrowd::readCounts() const {

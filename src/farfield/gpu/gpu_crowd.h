@@ -77,6 +77,15 @@ class GpuCrowd {
   // commands' instance counts reset (a copy between GPU buffers) and one dispatch. Call after simulate.
   void cullAndClassify(const Camera& camera, std::span<const float> switch_m);
 
+  // The shadow casters of a map (after simulate and cullAndClassify): every agent whose sphere reaches into the map's
+  // box (light_view_proj: orthographic, x and y to [-1, 1] over side_m metres, z to [0, 1] over depth_range_m), in
+  // the representation the switch distances give it (as cullAndClassify), impostors with their view towards the
+  // light (to_light: unit, towards it); into the caster lists, whose counts alone are reset. One dispatch.
+  void castShadows(const Camera& camera, std::span<const float> switch_m, const Mat4& light_view_proj, float side_m,
+                   float depth_range_m, const Vec3& to_light);
+  // Lists: the camera's, 2m (geometry) and 2m + 1 (impostors); the casters', casterList(m, impostor).
+  size_t casterList(size_t m, bool impostor) const { return 2 * models_ + 2 * m + (impostor ? 1 : 0); }
+
   // Occlusion culling of the next cullAndClassify (that call only): agents whose bounding box lies behind `target`'s
   // current depth (the city, drawn first) over the box's whole footprint are left out, by the test of the CPU runtime's
   // cullBehind (gpu::projectBox, DepthPyramid::hides) on a depth pyramid built on the GPU: no readback. The target
@@ -116,7 +125,7 @@ class GpuCrowd {
   bool occlude_next_ = false;
   size_t bytes_ = 0;
   std::vector<GpuCrowdCommand> initial_commands_;
-  Program simulate_, classify_;
+  Program simulate_, classify_, casters_;
 };
 
 }  // namespace farfield::gpu

@@ -386,21 +386,17 @@ std::vector<gpu::GpuCrowdModel> CrowdRuntime::gpuCrowdModels(float nominal_speed
   return out;
 }
 
-CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
-                                      const gpu::LightSettings& light, const gpu::RenderTarget* occluders) {
-  if (crowd.modelCount() != models_.size())
-    throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
-                                     std::to_string(models_.size()));
+std::vector<float> CrowdRuntime::gpuSwitches(const Camera& camera, CrowdPolicy policy) const {
   std::vector<float> switches(models_.size());
   for (size_t m = 0; m < models_.size(); ++m)
     switches[m] = policy == CrowdPolicy::Geometry ? std::numeric_limits<float>::max()
                   : policy == CrowdPolicy::Impostor ? -1.0f
                                                     : float(switchDistances(m, camera).both());
-  if (occluders) {
-    crowd.occludeBehind(*occluders);
-    occluders->bindForOpaquePass();  // the pyramid's compute left the draw state to us
-  }
-  crowd.cullAndClassify(camera, switches);
+  return switches;
+}
+
+CrowdFrameStats CrowdRuntime::drawGpuLists(const Camera& camera, gpu::GpuCrowd& crowd,
+                                           const gpu::LightSettings& light) {
   CrowdFrameStats stats;
   const size_t command = sizeof(gpu::GpuCrowdCommand);
   for (size_t m = 0; m < models_.size(); ++m) {
@@ -414,6 +410,57 @@ CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd
                                         (2 * m + 1) * command, light)
             .draw_calls;
   }
+  return stats;
+}
+
+CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
+                                      const gpu::LightSettings& light, const gpu::RenderTarget* occluders) {
+  if (crowd.modelCount() != models_.size())
+    throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
+                                     std::to_string(models_.size()));
+  if (occluders) {
+    crowd.occludeBehind(*occluders);
+    occluders->bindForOpaquePass();  // the pyramid's compute left the draw state to us
+  }
+  crowd.cullAndClassify(camera, gpuSwitches(camera, policy));
+  return drawGpuLists(camera, crowd, light);
+}
+
+CrowdFrameStats CrowdRuntime::drawGpuShadowed(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
+                                              const gpu::LightSettings& light, const gpu::RenderTarget& target,
+                                              const CrowdShadowOptions& shadows, bool occlude) {
+  if (crowd.modelCount() != models_.size())
+    throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
+                                     std::to_string(models_.size()));
+  const std::vector<float> switches = gpuSwitches(camera, policy);
+  if (occlude) crowd.occludeBehind(target);
+  crowd.cullAndClassify(camera, switches);
+  // The map over the receivers, grown by what a caster standing on one reaches (its sphere about its feet).
+  float reach = 0.0f;
+  for (const Model& m : models_) reach = std::max(reach, glm::length(m.centre) + 2.0f * m.radius);
+  const ShadowFit fit = fitShadowReceivers(camera, light.direction, shadows.distance_m, shadows.map_size, reach);
+  if (!shadow_map_ || shadow_map_->size() != shadows.map_size)
+    shadow_map_ = std::make_unique<gpu::ShadowMap>(shadows.map_size);
+  const Vec3 to_light = -glm::normalize(light.direction);
+  crowd.castShadows(camera, switches, fit.projection.view_proj, fit.projection.texel_m * float(shadows.map_size),
+                    fit.projection.depth_range_m, to_light);
+  shadow_map_->bindForCasters();
+  const size_t command = sizeof(gpu::GpuCrowdCommand);
+  for (size_t m = 0; m < models_.size(); ++m) {
+    const size_t g = crowd.casterList(m, false), i = crowd.casterList(m, true);
+    renderer_.drawSkinnedDepthIndirect(fit.projection.view_proj, *models_[m].gpu, crowd.listBuffer(),
+                                       crowd.listOffset(g), crowd.listBytes(), crowd.commandBuffer(), g * command);
+    renderer_.drawImpostorDepthIndirect(fit.projection.view_proj, to_light, *models_[m].impostor->atlas,
+                                        crowd.listBuffer(), crowd.listOffset(i), crowd.listBytes(),
+                                        crowd.commandBuffer(), i * command);
+  }
+  target.bindForOpaquePass();
+  CrowdFrameStats stats = drawGpuLists(camera, crowd, light);
+  stats.shadow_texel_m = fit.projection.texel_m;
+  if (!receiver_) receiver_ = std::make_unique<gpu::ShadowReceiver>();
+  receiver_->apply(camera, *shadow_map_, fit.projection, target, light, shadows.agent_id_mask, shadows.bias_m,
+                   shadows.distance_m, fit.screen_rects);
+  target.bindForOpaquePass();
   return stats;
 }
 

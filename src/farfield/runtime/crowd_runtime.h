@@ -170,6 +170,14 @@ class CrowdRuntime {
   // GpuCrowd::readCommands, readCounts).
   CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                           const gpu::LightSettings& light, const gpu::RenderTarget* occluders = nullptr);
+  // As drawGpu into `target` (holding the city), with the agents' shadows: the map fitted to the receivers the
+  // camera sees within shadows.distance_m (runtime::fitShadowReceivers: the casters are known on the GPU only), the
+  // agents whose spheres reach into it cast in the representation the policy gives them (GpuCrowd::castShadows), and
+  // the target's receivers are darkened (gpu::ShadowReceiver). occlude: agents behind the target's depth left out
+  // (their shadows still cast). shadows.impostor_casters is not on this path.
+  CrowdFrameStats drawGpuShadowed(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
+                                  const gpu::LightSettings& light, const gpu::RenderTarget& target,
+                                  const CrowdShadowOptions& shadows = {}, bool occlude = false);
 
   // Occlusion culling of the next draw or drawShadowed call (that call only): agents whose bounding box lies behind
   // `target`'s current depth (the city, drawn first) over the box's whole footprint are left out (gpu::DepthPyramid;
@@ -212,6 +220,10 @@ class CrowdRuntime {
     CrowdAtlasChoice choice;
     std::vector<double> level_m{0.0};  // per level of detail: its distance to the mesh (agent metres)
   };
+  // The GPU path's switch distances per model for a policy.
+  std::vector<float> gpuSwitches(const Camera& camera, CrowdPolicy policy) const;
+  // The GPU path's camera lists, drawn.
+  CrowdFrameStats drawGpuLists(const Camera& camera, gpu::GpuCrowd& crowd, const gpu::LightSettings& light);
   // Agents' GPU records by model and representation (culled with the camera's frustum unless null).
   struct Lists {
     std::vector<std::vector<std::vector<gpu::CrowdAgentGpu>>> geometry;  // per model, per level of detail

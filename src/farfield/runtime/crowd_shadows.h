@@ -36,4 +36,10 @@ struct ShadowFit {
 ShadowFit fitShadow(const Camera& camera, const Vec3& light_dir, std::span<const CasterSphere> spheres,
                     float distance_m, int map_size, float drop_m = 1.0f);
 
+// The map for casters the CPU does not know (the GPU crowd's): the receivers' light-space bounds grown by reach_m on
+// every side (casters standing on a receiver reach no farther: the agents' height and radius), and the whole frame as
+// the receivers' screen region. No caster list. Throws as fitShadow.
+ShadowFit fitShadowReceivers(const Camera& camera, const Vec3& light_dir, float distance_m, int map_size,
+                             float reach_m);
+
 }  // namespace farfield::runtime

@@ -43,7 +43,9 @@ ViewerCrowdFrame ViewerCrowd::draw(const Camera& camera, float t, const gpu::Lig
     target.bindForOpaquePass();
     gpu_crowd_->simulate(t);
     ViewerCrowdFrame frame;
-    frame.stats = rt_->drawGpu(camera, *gpu_crowd_, runtime::CrowdPolicy::Mixed, light, &target);
+    frame.stats = options_.shadows ? rt_->drawGpuShadowed(camera, *gpu_crowd_, runtime::CrowdPolicy::Mixed, light,
+                                                          target, runtime::CrowdShadowOptions{}, true)
+                                   : rt_->drawGpu(camera, *gpu_crowd_, runtime::CrowdPolicy::Mixed, light, &target);
     rt_->finish();
     frame.ms = clock.milliseconds();
     return frame;

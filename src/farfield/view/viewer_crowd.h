@@ -30,8 +30,8 @@ struct ViewerCrowdOptions {
   uint64_t max_triangles = 20000;   // skinned triangles a frame (0: no budget)
   double geometry_ms = 0.0;         // skinned drawing a frame in ms, at the measured time per triangle (0: none)
   bool shadows = true;
-  // The crowd simulated, culled (frustum, and behind the mode's frame on the GPU), classified and drawn on the GPU
-  // (gpu/gpu_crowd.h, CrowdRuntime::drawGpu): no per-agent work on the CPU; without shadows, budgets or levels of
+  // The crowd simulated, culled (frustum, and behind the mode's frame), classified, drawn and shadowed on the GPU
+  // (gpu/gpu_crowd.h, CrowdRuntime::drawGpuShadowed): no per-agent work on the CPU; without budgets or levels of
   // detail yet.
   bool gpu = false;
 };

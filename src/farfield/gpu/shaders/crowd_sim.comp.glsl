@@ -57,34 +57,13 @@ uniform int u_occlusion;
 uniform mat4 u_view_proj;
 uniform int u_levels;
 uniform ivec2 u_level_size[16];
+// Shadow casters (GpuCrowd::castShadows): the map's orthographic view-projection, its scale (x: 2 / side, per metre
+// across the light; y: 1 / depth range), the direction towards the light, and where the casters' lists start.
+uniform mat4 u_light_view_proj;
+uniform vec2 u_light_scale;
+uniform vec3 u_to_light;
+uniform uint u_first_list;
 
-#ifdef FF_SIMULATE
-void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i >= u_agents) return;
-  Agent a = agents[i];
-  Route r = routes[a.route];
-  float walked = a.speed * u_time;
-  float s = mod(a.start + a.direction * walked, r.len);
-  if (s < 0.0) s += r.len;
-  // The segment: the last point whose arc length is at most s (binary search).
-  uint lo = 0u, hi = r.count;  // points[first + lo].z <= s < points[first + hi].z
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (points[r.first + mid].z <= s) lo = mid; else hi = mid;
-  }
-  vec4 p0 = points[r.first + lo], p1 = points[r.first + (lo + 1u) % r.count];
-  vec2 d = p1.xy - p0.xy;
-  float len = length(d);
-  vec2 dir = len > 0.0 ? d / len : vec2(1.0, 0.0);
-  float along = clamp(s - p0.z, 0.0, len);
-  vec2 p = p0.xy + dir * along;
-  float z = len > 0.0 ? mix(p0.w, p1.w, along / len) : p0.w;
-  vec2 walk = dir * a.direction;
-  poses[i] = vec4(p, z, atan(walk.y, walk.x));
-  phases[i] = fract(a.phase + walked / models[a.model].lists.y);
-}
-#else
 const float kTwoPi = 6.28318530717958647692;
 
 // runtime/crowd_runtime.cpp's turn(): v turned by `heading` about +z.
@@ -151,6 +130,59 @@ bool hidden(vec3 c, float r) {
   return nearest * (1.0 + 1e-5) + 1e-12 < farthest(x0, x1);
 }
 
+#if defined(FF_SIMULATE)
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= u_agents) return;
+  Agent a = agents[i];
+  Route r = routes[a.route];
+  float walked = a.speed * u_time;
+  float s = mod(a.start + a.direction * walked, r.len);
+  if (s < 0.0) s += r.len;
+  // The segment: the last point whose arc length is at most s (binary search).
+  uint lo = 0u, hi = r.count;  // points[first + lo].z <= s < points[first + hi].z
+  while (hi - lo > 1u) {
+    uint mid = (lo + hi) / 2u;
+    if (points[r.first + mid].z <= s) lo = mid; else hi = mid;
+  }
+  vec4 p0 = points[r.first + lo], p1 = points[r.first + (lo + 1u) % r.count];
+  vec2 d = p1.xy - p0.xy;
+  float len = length(d);
+  vec2 dir = len > 0.0 ? d / len : vec2(1.0, 0.0);
+  float along = clamp(s - p0.z, 0.0, len);
+  vec2 p = p0.xy + dir * along;
+  float z = len > 0.0 ? mix(p0.w, p1.w, along / len) : p0.w;
+  vec2 walk = dir * a.direction;
+  poses[i] = vec4(p, z, atan(walk.y, walk.x));
+  phases[i] = fract(a.phase + walked / models[a.model].lists.y);
+}
+#elif defined(FF_CASTERS)
+// FF_CASTERS: the agents whose sphere reaches into the shadow map's box cast, in the representation the camera's
+// switch gives them (runtime::CrowdRuntime's rule without a budget); impostors show their view towards the light.
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= u_agents) return;
+  Agent a = agents[i];
+  Model m = models[a.model];
+  vec4 pose = poses[i];
+  vec3 c = pose.xyz + turn(pose.w, m.sphere.xyz);
+  float r = m.sphere.w;
+  vec4 p = u_light_view_proj * vec4(c, 1.0);  // orthographic: w = 1
+  if (abs(p.x) > 1.0 + r * u_light_scale.x || abs(p.y) > 1.0 + r * u_light_scale.x || p.z < -r * u_light_scale.y ||
+      p.z > 1.0 + r * u_light_scale.y)
+    return;
+  bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
+  uint list = u_first_list + uint(m.lists.x) + (impostor ? 1u : 0u);
+  uint slot = atomicAdd(commands[list].instance_count, 1u);
+  Record rec;
+  rec.pos_heading = pose;
+  rec.tint = a.tint;
+  uint index = cycleIndex(phases[i], impostor ? m.counts.y : m.counts.x);
+  uint view = impostor ? nearestView(m, turn(-pose.w, u_to_light)) : 0u;
+  rec.misc = uvec4(index, view, a.id, a.outfit);
+  lists[list * u_capacity + slot] = rec;
+}
+#else
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= u_agents) return;
