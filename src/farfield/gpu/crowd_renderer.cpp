@@ -336,6 +336,16 @@ FrameStats CrowdRenderer::drawImpostors(const Camera& camera, const ImpostorAtla
   return stats;
 }
 
+void CrowdRenderer::drawIndirect(uint32_t vao, uint32_t commands, size_t command_offset, bool indexed) const {
+  glBindVertexArray(vao);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
+  const void* offset = reinterpret_cast<const void*>(command_offset);
+  if (indexed) glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, offset, 1, 0);
+  else glMultiDrawArraysIndirect(GL_TRIANGLE_STRIP, offset, 1, 0);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+  glBindVertexArray(0);
+}
+
 const Program& CrowdRenderer::useSkinned(const Camera& camera, const SkinnedGpuModel& model,
                                          const LightSettings& light) {
   const Program& p = program(skinned_, model);
@@ -372,11 +382,7 @@ FrameStats CrowdRenderer::drawSkinnedIndirect(const Camera& camera, const Skinne
   const Program& p = useSkinned(camera, model, light);
   p.set("u_first_triangle", model.levels_[0].first_triangle);
   glEnable(GL_CULL_FACE);
-  glBindVertexArray(model.vao_);
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
-  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, reinterpret_cast<const void*>(command_offset), 1, 0);
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
-  glBindVertexArray(0);
+  drawIndirect(model.vao_, commands, command_offset, true);
   stats.draw_calls = 1;
   return stats;
 }
@@ -388,13 +394,9 @@ FrameStats CrowdRenderer::drawImpostorsIndirect(const Camera& camera, const Impo
   if (bytes == 0) return stats;
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
   useImpostors(camera, atlas, light, false);
-  glBindVertexArray(empty_vao_);
   glDisable(GL_CULL_FACE);
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
-  glMultiDrawArraysIndirect(GL_TRIANGLE_STRIP, reinterpret_cast<const void*>(command_offset), 1, 0);
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+  drawIndirect(empty_vao_, commands, command_offset, false);
   glEnable(GL_CULL_FACE);
-  glBindVertexArray(0);
   stats.draw_calls = 1;
   return stats;
 }
@@ -486,11 +488,7 @@ FrameStats CrowdRenderer::drawSkinnedDepthIndirect(const Mat4& light_view_proj, 
   p.set("u_view_proj", light_view_proj);
   bindModel(p, model);
   p.set("u_first_triangle", model.levels_[0].first_triangle);
-  glBindVertexArray(model.vao_);
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
-  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, reinterpret_cast<const void*>(command_offset), 1, 0);
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
-  glBindVertexArray(0);
+  drawIndirect(model.vao_, commands, command_offset, true);
   stats.draw_calls = 1;
   return stats;
 }
@@ -506,11 +504,7 @@ FrameStats CrowdRenderer::drawImpostorDepthIndirect(const Mat4& light_view_proj,
   impostor_depth_.set("u_eye", Vec3(0.0f));
   impostor_depth_.set("u_fixed_dir", glm::normalize(to_light));
   bindAtlas(impostor_depth_, atlas);
-  glBindVertexArray(empty_vao_);
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
-  glMultiDrawArraysIndirect(GL_TRIANGLE_STRIP, reinterpret_cast<const void*>(command_offset), 1, 0);
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
-  glBindVertexArray(0);
+  drawIndirect(empty_vao_, commands, command_offset, false);
   stats.draw_calls = 1;
   return stats;
 }

@@ -188,6 +188,8 @@ class CrowdRenderer {
   // One instanced draw of the model's level for `count` agents (program, model and agents bound), and its counts.
   FrameStats drawAgents(const Program& p, const SkinnedGpuModel& model, size_t count, size_t level) const;
   void bindAtlas(const Program& p, const ImpostorAtlasGpu& atlas) const;
+  // One indirect draw of the command at command_offset of `commands` over `vao`: the indexed mesh or a 4-vertex strip.
+  void drawIndirect(uint32_t vao, uint32_t commands, size_t command_offset, bool indexed) const;
   // drawSkinned's and drawSkinnedIndirect's program, uniforms and model; the same for the impostor draws.
   const Program& useSkinned(const Camera& camera, const SkinnedGpuModel& model, const LightSettings& light);
   const Program& useImpostors(const Camera& camera, const ImpostorAtlasGpu& atlas, const LightSettings& light,

@@ -4,6 +4,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <iterator>
 #include <string>
 
 #include "farfield/core/check.h"
@@ -113,17 +114,27 @@ GpuCrowd::~GpuCrowd() {
     if (b) glDeleteBuffers(1, &b);
 }
 
+void GpuCrowd::bindBuffers() const {
+  const uint32_t buffers[] = {agent_buf_, routes_, points_, poses_, phases_, model_buf_, commands_, lists_, counts_};
+  for (GLuint b = 0; b < GLuint(std::size(buffers)); ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, buffers[b]);
+}
+
+void GpuCrowd::usePass(const Program& pass, const Camera& camera, std::span<const float> switch_m) const {
+  float switches[kMaxModels] = {};
+  for (size_t m = 0; m < models_; ++m) switches[m] = switch_m[m];
+  pass.use();
+  pass.set("u_agents", uint32_t(agents_));
+  pass.set("u_eye", camera.eye);
+  pass.set("u_capacity", uint32_t(capacity_));
+  glUniform1fv(pass.uniformLocation("u_switch[0]"), kMaxModels, switches);
+  bindBuffers();
+}
+
 void GpuCrowd::simulate(float t) {
   simulate_.use();
   simulate_.set("u_agents", uint32_t(agents_));
   simulate_.set("u_time", t);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, phases_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, agent_buf_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, routes_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, points_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, poses_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, phases_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, model_buf_);
+  bindBuffers();
   glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
@@ -143,23 +154,11 @@ void GpuCrowd::castShadows(const Camera& camera, std::span<const float> switch_m
   const size_t half = initial_commands_.size() / 2;  // the casters' commands, reset from their initial values
   glCopyNamedBufferSubData(initial_, commands_, GLintptr(half * sizeof(GpuCrowdCommand)),
                            GLintptr(half * sizeof(GpuCrowdCommand)), GLsizeiptr(half * sizeof(GpuCrowdCommand)));
-  float switches[kMaxModels] = {};
-  for (size_t m = 0; m < models_; ++m) switches[m] = switch_m[m];
-  casters_.use();
-  casters_.set("u_agents", uint32_t(agents_));
-  casters_.set("u_eye", camera.eye);
-  casters_.set("u_capacity", uint32_t(capacity_));
+  usePass(casters_, camera, switch_m);
   casters_.set("u_first_list", uint32_t(2 * models_));
   casters_.set("u_light_view_proj", light_view_proj);
   casters_.set("u_to_light", glm::normalize(to_light));
   glUniform2f(casters_.uniformLocation("u_light_scale"), 2.0f / side_m, 1.0f / depth_range_m);
-  glUniform1fv(casters_.uniformLocation("u_switch[0]"), kMaxModels, switches);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, agent_buf_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, poses_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, phases_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, model_buf_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, commands_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, lists_);
   glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
 }
@@ -179,21 +178,8 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
   glClearNamedBufferData(counts_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
   for (Vec4& p : frustum.planes) p /= std::max(glm::length(Vec3(p)), 1e-20f);  // distances in metres
-  float switches[kMaxModels] = {};
-  for (size_t m = 0; m < models_; ++m) switches[m] = switch_m[m];
-  classify_.use();
-  classify_.set("u_agents", uint32_t(agents_));
-  classify_.set("u_eye", camera.eye);
-  classify_.set("u_capacity", uint32_t(capacity_));
+  usePass(classify_, camera, switch_m);
   glUniform4fv(classify_.uniformLocation("u_planes[0]"), 6, glm::value_ptr(frustum.planes[0]));
-  glUniform1fv(classify_.uniformLocation("u_switch[0]"), kMaxModels, switches);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, agent_buf_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, poses_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, phases_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, model_buf_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, commands_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, lists_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, counts_);
   const bool occlude = occlude_next_;
   occlude_next_ = false;
   classify_.set("u_occlusion", occlude ? 1 : 0);

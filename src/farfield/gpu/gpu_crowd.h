@@ -118,6 +118,10 @@ class GpuCrowd {
   size_t gpuBytes() const;
 
  private:
+  // Every buffer at its binding (crowd_sim.comp.glsl's layout); a classifying pass's program, uniforms and buffers.
+  void bindBuffers() const;
+  void usePass(const Program& pass, const Camera& camera, std::span<const float> switch_m) const;
+
   size_t agents_ = 0, models_ = 0, capacity_ = 0;  // capacity: records a list holds (agents, rounded up to 64)
   uint32_t agent_buf_ = 0, routes_ = 0, points_ = 0, poses_ = 0, phases_ = 0, model_buf_ = 0, commands_ = 0,
            initial_ = 0, lists_ = 0, counts_ = 0;

@@ -130,6 +130,24 @@ bool hidden(vec3 c, float r) {
   return nearest * (1.0 + 1e-5) + 1e-12 < farthest(x0, x1);
 }
 
+#ifndef FF_SIMULATE
+// Agent i into its model's geometry or impostor list after `first_list` (the camera's switch decides), as the
+// renderer's record: the palette pose or the atlas frame nearest its phase, and for an impostor the view nearest
+// `view_dir` (agent space).
+void append(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 c, vec3 view_dir) {
+  bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
+  uint list = first_list + uint(m.lists.x) + (impostor ? 1u : 0u);
+  uint slot = atomicAdd(commands[list].instance_count, 1u);
+  Record r;
+  r.pos_heading = pose;
+  r.tint = a.tint;
+  uint index = cycleIndex(phases[i], impostor ? m.counts.y : m.counts.x);
+  uint view = impostor ? nearestView(m, view_dir) : 0u;
+  r.misc = uvec4(index, view, a.id, a.outfit);
+  lists[list * u_capacity + slot] = r;
+}
+#endif
+
 #if defined(FF_SIMULATE)
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -171,16 +189,7 @@ void main() {
   if (abs(p.x) > 1.0 + r * u_light_scale.x || abs(p.y) > 1.0 + r * u_light_scale.x || p.z < -r * u_light_scale.y ||
       p.z > 1.0 + r * u_light_scale.y)
     return;
-  bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
-  uint list = u_first_list + uint(m.lists.x) + (impostor ? 1u : 0u);
-  uint slot = atomicAdd(commands[list].instance_count, 1u);
-  Record rec;
-  rec.pos_heading = pose;
-  rec.tint = a.tint;
-  uint index = cycleIndex(phases[i], impostor ? m.counts.y : m.counts.x);
-  uint view = impostor ? nearestView(m, turn(-pose.w, u_to_light)) : 0u;
-  rec.misc = uvec4(index, view, a.id, a.outfit);
-  lists[list * u_capacity + slot] = rec;
+  append(u_first_list, i, a, m, pose, c, turn(-pose.w, u_to_light));
 }
 #else
 void main() {
@@ -198,19 +207,7 @@ void main() {
     atomicAdd(stats[1], 1u);
     return;
   }
-  bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
-  uint list = uint(m.lists.x) + (impostor ? 1u : 0u);
-  uint slot = atomicAdd(commands[list].instance_count, 1u);
-  Record r;
-  r.pos_heading = pose;
-  r.tint = a.tint;
-  uint index = cycleIndex(phases[i], impostor ? m.counts.y : m.counts.x);
-  uint view = 0u;
-  if (impostor) {
-    vec3 local = turn(-pose.w, u_eye - c);  // the eye in agent space
-    view = nearestView(m, length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0));
-  }
-  r.misc = uvec4(index, view, a.id, a.outfit);
-  lists[list * u_capacity + slot] = r;
+  vec3 local = turn(-pose.w, u_eye - c);  // the eye in agent space
+  append(0u, i, a, m, pose, c, length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0));
 }
 #endif
