@@ -178,7 +178,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
       row.frame_ms = row.ms = draw.milliseconds();
       row.triangles = row.drawn_triangles = cf.draw.triangles;
       row.patch_loads = cf.page_loads;
-      row.gpu_bytes = cdlod->stats().pages * (cdlod->gpuBytes() / std::max(1, cdlod->pageLayers()));
+      row.gpu_bytes = cdlod->stats().pages * cdlod->pageBytes();  // the pages held
       if (o.sample_stride > 0 && f % o.sample_stride == 0) {
         char name[32];
         std::snprintf(name, sizeof name, "frame_%05zu.png", f);

@@ -386,7 +386,11 @@ std::vector<gpu::GpuCrowdModel> CrowdRuntime::gpuCrowdModels(float nominal_speed
   return out;
 }
 
-std::vector<float> CrowdRuntime::gpuSwitches(const Camera& camera, CrowdPolicy policy) const {
+std::vector<float> CrowdRuntime::gpuSwitches(const gpu::GpuCrowd& crowd, const Camera& camera,
+                                             CrowdPolicy policy) const {
+  if (crowd.modelCount() != models_.size())
+    throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
+                                     std::to_string(models_.size()));
   std::vector<float> switches(models_.size());
   for (size_t m = 0; m < models_.size(); ++m)
     switches[m] = policy == CrowdPolicy::Geometry ? std::numeric_limits<float>::max()
@@ -415,24 +419,19 @@ CrowdFrameStats CrowdRuntime::drawGpuLists(const Camera& camera, gpu::GpuCrowd& 
 
 CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                                       const gpu::LightSettings& light, const gpu::RenderTarget* occluders) {
-  if (crowd.modelCount() != models_.size())
-    throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
-                                     std::to_string(models_.size()));
+  const std::vector<float> switches = gpuSwitches(crowd, camera, policy);
   if (occluders) {
     crowd.occludeBehind(*occluders);
     occluders->bindForOpaquePass();  // the pyramid's compute left the draw state to us
   }
-  crowd.cullAndClassify(camera, gpuSwitches(camera, policy));
+  crowd.cullAndClassify(camera, switches);
   return drawGpuLists(camera, crowd, light);
 }
 
 CrowdFrameStats CrowdRuntime::drawGpuShadowed(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                                               const gpu::LightSettings& light, const gpu::RenderTarget& target,
                                               const CrowdShadowOptions& shadows, bool occlude) {
-  if (crowd.modelCount() != models_.size())
-    throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
-                                     std::to_string(models_.size()));
-  const std::vector<float> switches = gpuSwitches(camera, policy);
+  const std::vector<float> switches = gpuSwitches(crowd, camera, policy);
   if (occlude) crowd.occludeBehind(target);
   crowd.cullAndClassify(camera, switches);
   // The map over the receivers, grown by what a caster standing on one reaches (its sphere about its feet).

@@ -220,8 +220,8 @@ class CrowdRuntime {
     CrowdAtlasChoice choice;
     std::vector<double> level_m{0.0};  // per level of detail: its distance to the mesh (agent metres)
   };
-  // The GPU path's switch distances per model for a policy.
-  std::vector<float> gpuSwitches(const Camera& camera, CrowdPolicy policy) const;
+  // The GPU path's switch distances per model for a policy; throws farfield::Error for a crowd of other models.
+  std::vector<float> gpuSwitches(const gpu::GpuCrowd& crowd, const Camera& camera, CrowdPolicy policy) const;
   // The GPU path's camera lists, drawn.
   CrowdFrameStats drawGpuLists(const Camera& camera, gpu::GpuCrowd& crowd, const gpu::LightSettings& light);
   // Agents' GPU records by model and representation (culled with the camera's frustum unless null).

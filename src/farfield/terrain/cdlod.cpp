@@ -50,31 +50,51 @@ CdlodTerrain::CdlodTerrain(const Heightfield& hf, const CdlodOptions& options)
   if (hf.heights.size() != size_t(std::max(hf.width, 0)) * size_t(std::max(hf.height, 0)))
     throw Error("CDLOD terrain (" + hf.source + ")", "the grid's heights do not match its size");
   top_ = topLevelFor(grid_, options, "CDLOD terrain (" + hf.source + ")");
+  layOut();
   computeBoxes();
   computeErrors();
 }
 
-CdlodTerrain::CdlodTerrain(const CdlodGrid& grid, const CdlodOptions& options, std::vector<Vec2> heights,
-                           std::vector<float> errors)
-    : grid_(grid), options_(options) {
-  top_ = topLevelFor(grid_, options);
+size_t CdlodTerrain::nodeCountFor(const CdlodGrid& grid, const CdlodOptions& options) {
+  const int top = topLevelFor(grid, options);
+  size_t total = 0;
+  for (int l = 0; l <= top; ++l) {
+    const int64_t cells = int64_t(options.patch_cells) << l;
+    total += size_t((grid.width - 1 + cells - 1) / cells) * size_t((grid.height - 1 + cells - 1) / cells);
+  }
+  return total;
+}
+
+void CdlodTerrain::layOut() {
   box_offset_.assign(size_t(top_) + 1, 0);
   size_t total = 0;
   for (int l = 0; l <= top_; ++l) {
     box_offset_[size_t(l)] = total;
     total += size_t(nodesX(l)) * size_t(nodesY(l));
   }
-  if (heights.size() != total || errors.size() != total)
-    throw Error("CDLOD terrain", "node data for " + std::to_string(heights.size()) + " and " +
-                                     std::to_string(errors.size()) + " nodes, the grid has " + std::to_string(total));
-  boxes_ = std::move(heights);
-  node_error_ = std::move(errors);
+}
+
+void CdlodTerrain::computeLevelErrors() {
   error_.assign(size_t(top_) + 1, 0.0f);
   for (int l = 0; l <= top_; ++l) {
     for (int y = 0; y < nodesY(l); ++y)
       for (int x = 0; x < nodesX(l); ++x) error_[size_t(l)] = std::max(error_[size_t(l)], nodeError({l, x, y}));
     if (l > 0) error_[size_t(l)] = std::max(error_[size_t(l)], error_[size_t(l) - 1]);
   }
+}
+
+CdlodTerrain::CdlodTerrain(const CdlodGrid& grid, const CdlodOptions& options, std::vector<Vec2> heights,
+                           std::vector<float> errors)
+    : grid_(grid), options_(options) {
+  top_ = topLevelFor(grid_, options);
+  layOut();
+  const size_t total = box_offset_.back() + size_t(nodesX(top_)) * size_t(nodesY(top_));
+  if (heights.size() != total || errors.size() != total)
+    throw Error("CDLOD terrain", "node data for " + std::to_string(heights.size()) + " and " +
+                                     std::to_string(errors.size()) + " nodes, the grid has " + std::to_string(total));
+  boxes_ = std::move(heights);
+  node_error_ = std::move(errors);
+  computeLevelErrors();
 }
 
 const Heightfield& CdlodTerrain::heightfield() const {
@@ -110,13 +130,7 @@ Box3 CdlodTerrain::nodeBox(const CdlodNode& node) const {
 
 void CdlodTerrain::computeBoxes() {
   const Heightfield& hf = *hf_;
-  box_offset_.assign(size_t(top_) + 1, 0);
-  size_t total = 0;
-  for (int l = 0; l <= top_; ++l) {
-    box_offset_[size_t(l)] = total;
-    total += size_t(nodesX(l)) * size_t(nodesY(l));
-  }
-  boxes_.assign(total, Vec2(kInf, -kInf));
+  boxes_.assign(nodeCountFor(grid_, options_), Vec2(kInf, -kInf));
   // Level 0 from the grid (each node's points, its border included), the others from their children.
   const int p = options_.patch_cells;
   for (int y = 0; y < nodesY(0); ++y)
@@ -145,34 +159,17 @@ void CdlodTerrain::computeBoxes() {
 
 void CdlodTerrain::computeErrors() {
   const Heightfield& hf = *hf_;
-  error_.assign(size_t(top_) + 1, 0.0f);
   node_error_.assign(boxes_.size(), 0.0f);
-  const int p = options_.patch_cells;
+  auto h = [&](int i, int j) { return hf.clampedAt(i, j); };
   for (int l = 1; l <= top_; ++l) {
-    const int s = 1 << l, cells = p << l;
-    const double inv = 1.0 / s;
+    const int cells = options_.patch_cells << l;
     for (int y = 0; y < nodesY(l); ++y)
-      for (int x = 0; x < nodesX(l); ++x) {
-        double worst = 0.0;
-        for (int j = y * cells; j <= std::min((y + 1) * cells, hf.height - 1); ++j) {
-          const int cy = j / s * s;
-          const double v = (j - cy) * inv;
-          for (int i = x * cells; i <= std::min((x + 1) * cells, hf.width - 1); ++i) {
-            const int cx = i / s * s;
-            if (i == cx && j == cy) continue;  // a vertex of the level
-            const double u = (i - cx) * inv;
-            const double h00 = hf.at(cx, cy), h10 = hf.clampedAt(cx + s, cy), h01 = hf.clampedAt(cx, cy + s),
-                         h11 = hf.clampedAt(cx + s, cy + s);
-            // The cell's triangles split along its (0,0)-(1,1) diagonal.
-            const double mesh = u >= v ? h00 + u * (h10 - h00) + v * (h11 - h10) : h00 + v * (h01 - h00) + u * (h11 - h01);
-            worst = std::max(worst, std::abs(mesh - double(hf.at(i, j))));
-          }
-        }
-        node_error_[nodeIndex({l, x, y})] = float(worst);
-        error_[size_t(l)] = std::max(error_[size_t(l)], float(worst));
-      }
-    error_[size_t(l)] = std::max(error_[size_t(l)], error_[size_t(l) - 1]);
+      for (int x = 0; x < nodesX(l); ++x)
+        node_error_[nodeIndex({l, x, y})] =
+            float(levelMeshError(h, x * cells, y * cells, std::min((x + 1) * cells, hf.width - 1),
+                                 std::min((y + 1) * cells, hf.height - 1), 1 << l));
   }
+  computeLevelErrors();
 }
 
 size_t CdlodTerrain::bytes() const {

@@ -38,6 +38,8 @@
 // coarser level's mesh (the (odd, odd) cell of each 2 x 2 block keeps its diagonal; the others collapse).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -93,6 +95,8 @@ class CdlodTerrain {
   CdlodTerrain(const CdlodGrid& grid, const CdlodOptions& options, std::vector<Vec2> heights,
                std::vector<float> errors);
 
+  // Nodes of every level for a grid (the length of the node data).
+  static size_t nodeCountFor(const CdlodGrid& grid, const CdlodOptions& options);
   // The top level for a grid (see the file comment); throws farfield::Error (naming `what`) for bad options.
   static int topLevelFor(const CdlodGrid& grid, const CdlodOptions& options,
                          const std::string& what = "CDLOD terrain");
@@ -135,8 +139,10 @@ class CdlodTerrain {
   float heightAt(float gx, float gy) const;
 
  private:
+  void layOut();  // top_ set: the per-level offsets of the node data
   void computeBoxes();
   void computeErrors();
+  void computeLevelErrors();  // error_ from node_error_
   void selectNode(const CdlodNode& node, const Vec3& eye, const Frustum* frustum, CdlodSelection& out) const;
 
   const Heightfield* hf_ = nullptr;
@@ -149,5 +155,28 @@ class CdlodTerrain {
   std::vector<size_t> box_offset_;
   std::vector<Vec2> boxes_;
 };
+
+// The largest vertical distance between the grid points h(i, j) of [x0, x1] x [y0, y1] (every stride-th one from
+// (x0, y0)) and the mesh of level spacing s over them, its cells split along their (0,0)-(1,1) diagonal: a node's
+// E(N) with stride 1. h(i, j) gives the grid's height, clamped to the grid. (With a stride that is a multiple of a
+// finer level's spacing, the finer mesh's vertices: cdlod_tiles.h's bound.)
+template <class Height>
+double levelMeshError(const Height& h, int x0, int y0, int x1, int y1, int s, int stride = 1) {
+  const double inv = 1.0 / s;
+  double worst = 0.0;
+  for (int j = y0; j <= y1; j += stride) {
+    const int cy = j / s * s;
+    const double v = (j - cy) * inv;
+    for (int i = x0; i <= x1; i += stride) {
+      const int cx = i / s * s;
+      if (i == cx && j == cy) continue;  // a vertex of the level
+      const double u = (i - cx) * inv;
+      const double h00 = h(cx, cy), h10 = h(cx + s, cy), h01 = h(cx, cy + s), h11 = h(cx + s, cy + s);
+      const double mesh = u >= v ? h00 + u * (h10 - h00) + v * (h11 - h10) : h00 + v * (h01 - h00) + u * (h11 - h01);
+      worst = std::max(worst, std::abs(mesh - double(h(i, j))));
+    }
+  }
+  return worst;
+}
 
 }  // namespace farfield::terrain

@@ -45,6 +45,18 @@ void GpuLodTerrain::setHole(const GridRect& hole) {
                     Vec2(float(hole.x1 * hf.cell_x), float(hole.y1 * hf.cell_y)));
 }
 
+void uploadRanges(const CdlodSelection& selection, gpu::CdlodRenderer& renderer, int slot) {
+  std::vector<Vec2> ranges;
+  ranges.reserve(selection.ranges.node.size());
+  for (const Vec3& r : selection.ranges.node) ranges.emplace_back(r.x, r.y);
+  renderer.setRanges(ranges, slot);
+}
+
+gpu::CdlodInstance cdlodInstance(const CdlodNode& node, int patch_cells, int layer) {
+  const int cells = patch_cells << node.level;
+  return {int32_t(node.x * cells), int32_t(node.y * cells), int32_t(node.level), int32_t(layer)};
+}
+
 GpuLodFrame GpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull) {
   // The slot whose ranges were made for this bound, else the least recently used one.
   const double scale = QuadtreeLod::pixelsPerRadian(camera) / double(pixel_error);
@@ -60,16 +72,9 @@ GpuLodFrame GpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::Re
   last_ = slot;
   CdlodSelection& selection = selections_[slot];
   lod_.select(camera, pixel_error, cull, selection);
-  if (selection.ranges_changed) {
-    std::vector<Vec2> ranges;
-    ranges.reserve(selection.ranges.node.size());
-    for (const Vec3& r : selection.ranges.node) ranges.emplace_back(r.x, r.y);
-    renderer_.setRanges(ranges, slot);
-  }
+  if (selection.ranges_changed) uploadRanges(selection, renderer_, slot);
   instances_.clear();
-  const int p = lod_.patchCells();
-  for (const CdlodNode& n : selection.nodes)
-    instances_.push_back({int32_t(n.x * (p << n.level)), int32_t(n.y * (p << n.level)), int32_t(n.level), 0});
+  for (const CdlodNode& n : selection.nodes) instances_.push_back(cdlodInstance(n, lod_.patchCells()));
   GpuLodFrame frame;
   frame.draw = renderer_.draw(camera, target, instances_, slot);
   frame.nodes = selection.nodes.size();

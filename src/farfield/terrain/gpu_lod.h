@@ -23,6 +23,11 @@ struct GpuLodFrame {
   size_t nodes_culled = 0;  // left out by the frustum
 };
 
+// A selection's morph ranges into a renderer's range slot (when select() remade them).
+void uploadRanges(const CdlodSelection& selection, gpu::CdlodRenderer& renderer, int slot = 0);
+// A selected node as the renderer's instance: its corner grid point, its level and its page layer (-1: none).
+gpu::CdlodInstance cdlodInstance(const CdlodNode& node, int patch_cells, int layer = -1);
+
 class GpuLodTerrain {
  public:
   // Needs a current context; hf must outlive this. texture: the terrain's original texture, placed as

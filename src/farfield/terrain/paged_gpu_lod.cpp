@@ -6,6 +6,7 @@
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
 #include "farfield/terrain/cdlod_tiles.h"
+#include "farfield/terrain/gpu_lod.h"
 #include "farfield/terrain/terrain_texture.h"
 
 namespace farfield::terrain {
@@ -190,12 +191,7 @@ int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKe
 
 PagedGpuLodFrame PagedGpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target) {
   lod_.select(camera, pixel_error, true, selection_);
-  if (selection_.ranges_changed) {
-    std::vector<Vec2> ranges;
-    ranges.reserve(selection_.ranges.node.size());
-    for (const Vec3& r : selection_.ranges.node) ranges.emplace_back(r.x, r.y);
-    renderer_->setRanges(ranges);
-  }
+  if (selection_.ranges_changed) uploadRanges(selection_, *renderer_);
   std::set<TileKey> needed;
   for (const CdlodNode& n : selection_.nodes)
     if (n.level < fine_levels_) needed.insert(tileOf(n));
@@ -203,12 +199,13 @@ PagedGpuLodFrame PagedGpuLodTerrain::draw(const Camera& camera, float pixel_erro
     throw Error("paged CDLOD terrain", "this view needs " + std::to_string(needed.size()) + " pages; the GPU budget holds " +
                                            std::to_string(pages_->layers()) + ": raise it");
   PagedGpuLodFrame frame;
+  std::map<TileKey, int> layers;  // each page the frame reads, made resident once
+  for (const TileKey& t : needed) layers[t] = residentLayer(t, needed, frame.page_loads);
   instances_.clear();
-  const int p = lod_.patchCells();
   for (const CdlodNode& n : selection_.nodes) {
-    const int layer = n.level < fine_levels_ ? residentLayer(tileOf(n), needed, frame.page_loads) : -1;
+    const int layer = n.level < fine_levels_ ? layers.at(tileOf(n)) : -1;
     frame.paged_nodes += layer >= 0 ? 1 : 0;
-    instances_.push_back({int32_t(n.x * (p << n.level)), int32_t(n.y * (p << n.level)), int32_t(n.level), layer});
+    instances_.push_back(cdlodInstance(n, lod_.patchCells(), layer));
   }
   frame.draw = renderer_->draw(camera, target, instances_);
   frame.nodes = selection_.nodes.size();

@@ -83,6 +83,7 @@ class PagedGpuLodTerrain {
   int fineLevels() const { return fine_levels_; }
   int overviewStep() const { return overview_step_; }
   int pageLayers() const { return pages_->layers(); }
+  size_t pageBytes() const { return pages_->layerBytes(); }  // one page's GPU bytes
   size_t gpuBytes() const;
 
  private:
