@@ -205,7 +205,11 @@ TEST(CityOnTerrainGL, TheLodSpriteTerrainChoosesPerFrameByCostsMeasuredAtPrepare
   CityOnTerrainMode mode("lod-sprite", "culled");
   mode.prepare(res.context);
   ASSERT_TRUE(currentTerrainRun()->cost.has_value());
-  EXPECT_GT(currentTerrainRun()->cost->frame.r2, 0.0);
+  // Fitted from frames timed at prepare (the fit's r2 is left alone: on a frame this small the times are noise, and a
+  // fit to the mean alone has r2 0).
+  const gpu::CostModel& fitted = currentTerrainRun()->cost->frame;
+  EXPECT_GE(fitted.samples, 5u);
+  EXPECT_GT(fitted.predict(1000.0, 1.0, 96.0 * 64.0), 0.0) << "a frame takes time";
   FrameRunner runner(res.renderer, res.target);
   const Box3 b = city.scene.bounds();
   for (size_t f = 0; f < 4; ++f) {
