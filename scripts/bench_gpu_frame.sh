@@ -41,7 +41,7 @@ path() {
 # ---- the benchmark: frustum, culled-cpu and culled (full added as the baseline) ----
 for s in $SCENES; do
   case $s in
-    demo) city demo 400 2 1 --objects buildings; path demo 1 car ;;          # make demo's city and drive
+    demo) city demo 400 2 1 --objects buildings; path demo 1 car ;;          # make demo's city and drive until 2026-12-05
     heldout-d3) city heldout-d3 400 3 97 --objects buildings; path heldout-d3 5 car ;;
     small-d0) city small-d0 400 0 3; path small-d0 41 car ;;               # the big city's kind, 400 blocks
     big-d0) city big-d0 100000 0 3; path big-d0 41 car ;;

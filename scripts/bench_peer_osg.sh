@@ -6,7 +6,7 @@
 #
 #   scripts/bench_peer_osg.sh [FARFIELD] [OUT] [SCENE PATH]
 #
-# Without SCENE and PATH it makes the demo's city and drive (400 blocks, detail 2, seed 1). Environment: SIZE
+# Without SCENE and PATH it makes the demo's city and drive of before 2026-12-05 (400 blocks, detail 2, seed 1). Environment: SIZE
 # (640x360), STRIDE (5), IMPOSTORS ("100:4 200:8": osgSim::Impostor threshold in metres and pixel error),
 # OSG_BUILD (build/osg-peer: where the peer is built). OpenSceneGraph draws into a GLX window: without a display the
 # peer runs under xvfb-run (Mesa's llvmpipe; on a GPU machine give it an X server of the GPU). The last frame of each

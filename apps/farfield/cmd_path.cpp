@@ -3,10 +3,13 @@
 // farfield path flyover SCENE [--frames N] [--fps F] [--altitude M] [--fov DEG] -o FILE
 // farfield path views SCENE [--frames N] [--seed S] [--view-min X,Y,Z --view-max X,Y,Z] [--fov DEG] -o FILE
 // farfield path orbit SCENE [--frames N] [--fps F] [--radius-scale K] [--elevation DEG] [--fov DEG] -o FILE
+// farfield path cut PATH.json --from A [--to B] -o FILE
 // Writes a camera path (JSON, see farfield/gen/camera_path.h) for the walkthrough benchmark.
+#include <cstddef>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "city_terrain.h"
 #include "cli_util.h"
@@ -38,6 +41,7 @@ struct PathArgs {
   float radius_scale = 1.2f;
   float elevation_deg = 25.0f;
   std::string view_min, view_max;
+  size_t from = 0, to = 0;  // cut: frames [from, to] (to 0: the last)
 };
 
 void writeAndReport(const gen::CameraPath& path, const std::string& output, const std::string& what) {
@@ -123,8 +127,20 @@ void runViews(const PathArgs& args) {
   writeAndReport(path, args.output, "random views");
 }
 
+// Frames [from, to] of a path (to 0: through the last), e.g. the stretch of a run that shows something.
+void runCut(const PathArgs& args) {
+  gen::CameraPath path = gen::loadCameraPath(args.input);
+  const size_t last = args.to == 0 ? path.frames.size() - 1 : args.to;
+  if (path.frames.empty() || args.from > last || last >= path.frames.size())
+    throw Error(args.input, "cannot cut frames " + std::to_string(args.from) + "-" + std::to_string(last) +
+                                " from a path of " + std::to_string(path.frames.size()) + " frames");
+  path.frames = std::vector<gen::PathFrame>(path.frames.begin() + std::ptrdiff_t(args.from),
+                                            path.frames.begin() + std::ptrdiff_t(last) + 1);
+  writeAndReport(path, args.output, path.kind + ", frames " + std::to_string(args.from) + "-" + std::to_string(last));
+}
+
 const RegisterCommand reg("path", [](CLI::App& app) {
-  auto* cmd = app.add_subcommand("path", "Write a camera path: a street walk, random views, a flyover or an orbit.");
+  auto* cmd = app.add_subcommand("path", "Write a camera path: a street walk, random views, a flyover or an orbit, or a cut of one.");
   cmd->require_subcommand(1);
 
   auto street = std::make_shared<PathArgs>();
@@ -166,6 +182,14 @@ const RegisterCommand reg("path", [](CLI::App& app) {
       ->check(CLI::PositiveNumber);
   o->add_option("--elevation", orb->elevation_deg, "Elevation angle, degrees")->check(CLI::Range(-89.0, 89.0));
   o->callback([orb] { runOrbit(*orb); });
+
+  auto cut = std::make_shared<PathArgs>();
+  auto* c = cmd->add_subcommand("cut", "Frames FROM to TO of a camera path (e.g. the stretch of a run to look at).");
+  c->add_option("path", cut->input, "Camera path (.json)")->required();
+  c->add_option("--from", cut->from, "First frame kept (0-based)")->required();
+  c->add_option("--to", cut->to, "Last frame kept (default: the path's last)");
+  c->add_option("-o,--output", cut->output, "Output camera path (.json)")->required();
+  c->callback([cut] { runCut(*cut); });
 });
 
 }  // namespace

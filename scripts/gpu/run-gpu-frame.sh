@@ -10,7 +10,7 @@
 #   heldout  a 400-block detail-3 city (about 17 M triangles) and a 300-frame car drive at 1920x1080: frustum,
 #            culled-cpu and culled (the GPU-driven frame), GPU time from timer queries, own CPU time, syncs
 #   big      the 100,000-block city (detail 0) at 1920x1080, 150 frames: the same modes
-#   demo     the default city at 640x360 (make demo's): the same modes
+#   demo     the 400-block detail-2 city at 640x360 (make demo's until 2026-12-05): the same modes
 #   check    farfield cull-check on the held-out city at 1920x1080 (GPU-culled frames against frustum-culled ones)
 #   crowd    the crowd bench at 1920x1080 with the GPU crowd beside the CPU path (--gpu-crowd), 10,000 to 1,000,000
 #            agents, no shadows (the GPU path has none yet)

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <random>
+#include <set>
 #include <span>
 #include <variant>
 
@@ -350,14 +351,18 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
   runtime::Walkthrough walkthrough(city.scene, gpu_scene, bvh, renderer, wo);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  size_t guarded = 0, drawn = 0;
-  for (int k = 0; k < 400; ++k) {
+  const auto randomCamera = [&]() {  // in the view space, any heading, level
     Camera camera;
     camera.eye = index.view_space.lo + (index.view_space.hi - index.view_space.lo) * Vec3(u(rng), u(rng), u(rng));
     const float yaw = float(2.0 * kPi) * u(rng);
     camera.at = camera.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
     camera.width = camera.height = 128;
     camera.fov_y = float(degToRad(45.0));
+    return camera;
+  };
+  size_t guarded = 0, drawn = 0;
+  for (int k = 0; k < 400; ++k) {
+    const Camera camera = randomCamera();
     const runtime::FramePlan& plan = walkthrough.plan(camera);
     uint64_t triangles = 0;
     for (const gpu::DrawItem& item : plan.items) triangles += item.triangleCount();
@@ -381,6 +386,41 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
   std::printf("fill charged: %zu CPVs over t_max at the bound, %zu after the fallback (%zu coarser impostors); %zu "
               "guarded views, %zu impostors drawn\n",
               r.unsolved_at_bound, r.unsolved_cpvs, r.fallback_impostors, guarded, drawn);
+
+  // Without coarser_impostors the walkthrough keeps its bound: the impostors placed under a coarser one are left to
+  // geometry, the others drawn as before; raising its bound to theirs takes them again (a governor's coarser level).
+  ASSERT_GT(r.fallback_impostors, 0u) << "the check below needs coarser impostors";
+  runtime::WalkthroughOptions strict_options = wo, raised_options = wo;
+  strict_options.coarser_impostors = raised_options.coarser_impostors = false;
+  raised_options.error_px = options.error_px * 4.0;  // the coarsest fallback bound
+  runtime::Walkthrough free_walk(city.scene, gpu_scene, bvh, renderer, wo);
+  runtime::Walkthrough strict(city.scene, gpu_scene, bvh, renderer, strict_options);
+  runtime::Walkthrough raised(city.scene, gpu_scene, bvh, renderer, raised_options);
+  const auto coarseOf = [&](uint32_t id) { return index.find(id)->bound.pixels > options.error_px * (1.0 + 1e-9); };
+  size_t coarse_drawn = 0, coarse_raised = 0;
+  rng.seed(5);
+  for (int k = 0; k < 400; ++k) {
+    const Camera camera = randomCamera();
+    std::set<uint32_t> as_impostor, strict_impostor;
+    for (const runtime::LayerDecision& d : free_walk.plan(camera).layers)
+      if (const auto* i = std::get_if<runtime::ClusterAsImpostor>(&d)) as_impostor.insert(i->impostor);
+    for (const runtime::LayerDecision& d : strict.plan(camera).layers) {
+      if (const auto* i = std::get_if<runtime::ClusterAsImpostor>(&d)) {
+        EXPECT_FALSE(coarseOf(i->impostor)) << "view " << k << ": impostor " << i->impostor;
+        strict_impostor.insert(i->impostor);
+      }
+    }
+    for (uint32_t id : as_impostor) {
+      coarse_drawn += coarseOf(id) ? 1 : 0;
+      EXPECT_EQ(strict_impostor.count(id), coarseOf(id) ? 0u : 1u) << "view " << k << ": impostor " << id;
+    }
+    for (const runtime::LayerDecision& d : raised.plan(camera).layers)
+      if (const auto* i = std::get_if<runtime::ClusterAsImpostor>(&d)) coarse_raised += coarseOf(i->impostor) ? 1 : 0;
+  }
+  EXPECT_GT(coarse_drawn, 0u) << "no view drew a coarser impostor: the check is vacuous";
+  EXPECT_GE(coarse_raised, coarse_drawn);
+  // Every coarser impostor of the eye's CPV is left to geometry, at least those the free walkthrough drew.
+  EXPECT_GE(strict.statistics().at("coarser_impostors_left_to_geometry"), double(coarse_drawn));
 }
 
 // --visibility-only: every minimum-size region of the view space's partition is sampled into the cache (the regions

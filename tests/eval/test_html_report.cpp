@@ -117,6 +117,50 @@ TEST(HtmlReport, VerdictCountsBothPromisesOfTheChosenMode) {
   EXPECT_TRUE(c.kept());
 }
 
+// A placement database's impostors (its placement.json summary) and the frames that drew them (the mode's info).
+TEST(HtmlReport, VerdictStatesTheImpostorsPlacedAndTheFramesTheyServed) {
+  const fs::path dir = test::scratchDir("html_report_placement");
+  writeText(dir / "placement.json", R"({"summary": {"impostors": 7, "memory_bytes": 2500000.0}})");
+  nlohmann::json run = madeUpRun();
+  run["modes"]["mmi"]["info"] = {{"frames_with_impostors", 6.0}, {"impostor_stretch_first_frame", 4.0},
+                                 {"impostor_stretch_last_frame", 12.0}, {"impostor_stretch_frames", 5.0}};
+  HtmlReportOptions options;
+  options.database = dir.string();
+  const Verdict v = readVerdict(run, "bench.json", options);
+  ASSERT_TRUE(v.impostors_placed.has_value());
+  EXPECT_EQ(*v.impostors_placed, 7u);
+  EXPECT_DOUBLE_EQ(v.impostor_gpu_bytes, 2.5e6);
+  ASSERT_TRUE(v.frames_with_impostors.has_value());
+  EXPECT_EQ(*v.frames_with_impostors, 6u);
+  ASSERT_TRUE(v.impostor_stretch.has_value());
+  EXPECT_EQ(v.impostor_stretch->first, 4u);
+  EXPECT_EQ(v.impostor_stretch->second, 12u);
+
+  // The page says so on its first screen.
+  for (auto& [name, mode] : run["modes"].items())
+    for (const char* k : {"p95_ms", "p99_ms", "max_ms", "mean_triangles", "mean_draw_calls"}) mode[k] = 1.0;
+  writeText(dir / "bench.json", run.dump());
+  const std::string page = htmlReport(dir, options);
+  EXPECT_NE(page.find("7 layered impostors</b> placed (2.5 MB on the GPU), drawn in <b>6 of 10</b> frames "
+                      "(longest stretch: path frames 4-12)"),
+            std::string::npos);
+
+  // None placed: said plainly. Without a placement (a pipeline store) or without the mode's info: not stated.
+  writeText(dir / "placement.json", R"({"summary": {"impostors": 0, "memory_bytes": 0}})");
+  EXPECT_NE(htmlReport(dir, options).find("<b>none placed</b>"), std::string::npos);
+  fs::remove(dir / "placement.json");
+  EXPECT_FALSE(readVerdict(run, "bench.json", options).impostors_placed.has_value());
+  EXPECT_FALSE(readVerdict(madeUpRun(), "bench.json", {}).frames_with_impostors.has_value());
+  // A placement.json without its summary names the file.
+  writeText(dir / "placement.json", R"({"impostors": []})");
+  try {
+    readVerdict(run, "bench.json", options);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("placement.json"), std::string::npos) << e.what();
+  }
+}
+
 TEST(HtmlReport, BadRunsNameTheFileAndWhatIsWrong) {
   HtmlReportOptions missing;
   missing.mode = "placed";

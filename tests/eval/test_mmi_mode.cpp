@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <string>
+#include <variant>
 
 #include "farfield/bake/bake.h"
 #include "farfield/bake/pipeline.h"
@@ -22,6 +24,7 @@
 #include "farfield/eval/mmi_mode.h"
 #include "farfield/store/impostor_store.h"
 #include "farfield/urban/cells.h"
+#include "farfield/gpu/renderer.h"
 #include "support/test_support.h"
 
 namespace fs = std::filesystem;
@@ -293,6 +296,61 @@ TEST_F(MmiModeTest, WhereNoImpostorIsValidTheObjectsAreDrawnAsGeometry) {
   // At the bake's bound the same store draws impostors (the check above is not vacuous).
   EXPECT_GT(loose.mode("mmi")->info.at("mean_impostor_triangles"), 0.0);
   EXPECT_EQ(loose.mode("mmi")->info.at("error_bound_px"), pipelineOptions().error_px);
+
+  // The frames that drew an impostor: none at the strict bound (and no stretch); at the bake's, the frames whose plan
+  // drew one, their longest stretch a run of consecutive path frames (every frame measured here).
+  for (const char* name : {"smi", "mmi"}) {
+    EXPECT_EQ(strict.mode(name)->info.at("frames_with_impostors"), 0.0) << name;
+    EXPECT_EQ(strict.mode(name)->info.count("impostor_stretch_first_frame"), 0u) << name;
+  }
+  const std::map<std::string, double>& info = loose.mode("mmi")->info;
+  const double with = info.at("frames_with_impostors"), stretch = info.at("impostor_stretch_frames");
+  EXPECT_GT(with, 0.0);
+  EXPECT_LE(with, double(s.path.frames.size()));
+  EXPECT_GE(stretch, 1.0);
+  EXPECT_LE(stretch, with);
+  EXPECT_EQ(info.at("impostor_stretch_last_frame") - info.at("impostor_stretch_first_frame") + 1.0, stretch);
+  // Against the walkthrough itself, frame by frame: the frames whose plan holds an impostor layer.
+  {
+    gpu::sharedHeadlessContext().makeCurrent();
+    const scene::Scene& scene = s.city.scene;
+    const gpu::GpuScene gpu_scene(scene);
+    const scene::Bvh bvh(scene);
+    gpu::Renderer renderer;
+    runtime::WalkthroughOptions o;
+    o.database = s.store;
+    o.representation = runtime::Representation::Mmi;
+    runtime::Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, o);
+    size_t expected = 0;
+    for (size_t f = 0; f < s.path.frames.size(); ++f) {
+      const runtime::FramePlan& plan = walkthrough.plan(s.path.camera(f, kFrameSize, kFrameSize));
+      expected += std::any_of(plan.layers.begin(), plan.layers.end(), [](const runtime::LayerDecision& d) {
+                    return std::holds_alternative<runtime::LayerAsImpostor>(d);
+                  })
+                      ? 1
+                      : 0;
+    }
+    EXPECT_EQ(with, double(expected));
+  }
+}
+
+// Governed over mmi with a budget no frame keeps: every frame at the coarsest level, drawn by the inner mode whose bound
+// is the largest impostor level's, at half the resolution. The frames that drew an impostor are the governed frames'
+// (not those of the inner mode at the promised bound, which draws only the calibration): at least as many as mmi's at
+// the promised bound, since a larger bound and larger pixels only widen where an impostor is valid.
+TEST_F(MmiModeTest, GovernedFramesCountTheImpostorsOfTheLevelThatDrewThem) {
+  const MmiCity& s = mmiCity();
+  const BenchResult r = runModes(s.path, {"mmi", "governed"}, s.store,
+                                 {{"governed", "mmi"}, {"governor_t_max_ms", "0.001"}, {"governor_impostor_px", "8"}});
+  const ModeResult* mmi = r.mode("mmi");
+  const ModeResult* governed = r.mode("governed");
+  ASSERT_TRUE(mmi && governed);
+  const double levels = governed->info.at("governor_levels");
+  EXPECT_EQ(governed->info.at("governor_level_" + std::to_string(int(levels) - 1) + "_frames"),
+            governed->info.at("governor_frames"));  // every frame, the warm-up's too
+  EXPECT_GE(mmi->info.at("frames_with_impostors"), 2.0);
+  EXPECT_GE(governed->info.at("frames_with_impostors"), mmi->info.at("frames_with_impostors"));
+  EXPECT_LE(governed->info.at("frames_with_impostors"), double(s.path.frames.size()));
 }
 
 // `bake --online single,mmi`: the store holds the PVS and the split; the mode runs the stage it draws (mmi or single,

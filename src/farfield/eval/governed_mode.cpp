@@ -173,11 +173,12 @@ void GovernedMode::frame(FrameContext& frame) {
     // The frame itself, drawn as the governed mode draws it (simplified and under the bound the level says).
     inners_[level.inner]->setGeometryErrorPx(level.lod_px);
     inners_[level.inner]->frame(frame);
-    return;
+  } else {
+    gpu::RenderTarget& out = frame.beginOwnPass();
+    frame.addStats(drawLevel(frame.camera(), frame.pathFrame(), decision.level));
+    level.target.copyScaledTo(out);
   }
-  gpu::RenderTarget& out = frame.beginOwnPass();
-  frame.addStats(drawLevel(frame.camera(), frame.pathFrame(), decision.level));
-  level.target.copyScaledTo(out);
+  if (const std::optional<bool> drew = inners_[level.inner]->drewImpostors()) impostor_frames_[frame.pathFrame()] = *drew;
 }
 
 std::optional<gpu::FrameStats> GovernedMode::lateFrameStats(size_t path_frame) {
@@ -197,6 +198,8 @@ std::optional<FrameGovernance> GovernedMode::governance(size_t /*path_frame*/) c
 
 std::map<std::string, double> GovernedMode::info() const {
   std::map<std::string, double> info = inners_[0]->info();
+  // The frames that drew an impostor are the governed frames', whichever level (and inner mode) drew them.
+  if (!impostor_frames_.empty()) addImpostorFrames(impostor_frames_, info);
   if (!loop_) return info;
   const runtime::FrameGovernor::Statistics& s = loop_->governor().statistics();
   const gpu::CostModel& model = loop_->model();

@@ -75,6 +75,7 @@ class GovernedMode final : public Mode {
   std::vector<ModeContext> contexts_;
   std::vector<double> impostor_px_;
   size_t last_inner_ = 0;
+  std::map<size_t, bool> impostor_frames_;  // per path frame: the governed frame drew an impostor
   std::string inner_name_;
   std::vector<double> scales_;
   std::vector<double> lod_px_;

@@ -169,7 +169,27 @@ Verdict readVerdict(const nlohmann::json& bench, const std::string& where, const
   v.speedup_vs_full = number(mode, "speedup_vs_full", at);
   if (const auto culled = modes.find("culled"); culled != modes.end() && v.mode != "culled")
     v.speedup_vs_culled = number(*culled, "median_ms", where + ": modes.culled") / number(mode, "median_ms", at);
-  if (!options.database.empty()) v.database_bytes = directoryBytes(options.database);
+  if (!options.database.empty()) {
+    v.database_bytes = directoryBytes(options.database);
+    const fs::path placement = fs::path(options.database) / "placement.json";
+    if (fs::exists(placement)) {
+      try {
+        const nlohmann::json summary = nlohmann::json::parse(readFileBytes(placement)).at("summary");
+        v.impostors_placed = summary.at("impostors").get<size_t>();
+        v.impostor_gpu_bytes = summary.at("memory_bytes").get<double>();
+      } catch (const nlohmann::json::exception& e) {
+        throw Error(placement.string(), std::string("no impostor count and memory in its summary: ") + e.what());
+      }
+    }
+  }
+  if (const auto info = mode.find("info"); info != mode.end() && info->is_object()) {
+    const std::string info_at = at + ".info";
+    if (const std::optional<double> with = optionalNumber(*info, "frames_with_impostors", info_at))
+      v.frames_with_impostors = size_t(*with);
+    const std::optional<double> first = optionalNumber(*info, "impostor_stretch_first_frame", info_at);
+    const std::optional<double> last = optionalNumber(*info, "impostor_stretch_last_frame", info_at);
+    if (first && last) v.impostor_stretch = std::make_pair(size_t(*first), size_t(*last));
+  }
   return v;
 }
 
@@ -213,6 +233,21 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
               : std::string())
       << "</p>\n";
   if (v.database_bytes) h << "<p>database " << megabytes(*v.database_bytes) << "</p>\n";
+  if (v.impostors_placed) {
+    if (*v.impostors_placed == 0) {
+      h << "<p>impostors: <b>none placed</b> (no view was predicted over t_max): every frame is geometry</p>\n";
+    } else {
+      h << "<p>impostors: <b>" << *v.impostors_placed << " layered impostors</b> placed ("
+        << megabytes(uint64_t(v.impostor_gpu_bytes)) << " on the GPU)";
+      if (v.frames_with_impostors) {
+        h << ", drawn in <b>" << *v.frames_with_impostors << " of " << v.frames << "</b> frames";
+        if (v.impostor_stretch)
+          h << " (longest stretch: path frames " << v.impostor_stretch->first << "-" << v.impostor_stretch->second
+            << ")";
+      }
+      h << "</p>\n";
+    }
+  }
   h << "<p>speedup <b>" << format("%.2fx", v.speedup_vs_full) << "</b> over full geometry";
   if (v.speedup_vs_culled) h << ", " << format("%.2fx", *v.speedup_vs_culled) << " over view-frustum culling";
   h << " (median frame time)</p>\n";

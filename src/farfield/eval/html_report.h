@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -39,13 +40,22 @@ struct Verdict {
   // kept as a multiple of the promised one. The bound check above is against the bound each frame kept.
   std::optional<size_t> frames_relaxed;
   double bound_scale_max = 1.0;
+  // A placement database (`farfield place`: placement.json in HtmlReportOptions::database): the layered impostors it
+  // holds and their GPU bytes; none for another database.
+  std::optional<size_t> impostors_placed;
+  double impostor_gpu_bytes = 0.0;
+  // The mode's measured frames that drew an impostor, and their longest stretch (path frames, first and last), from
+  // the mode's info (frames_with_impostors, impostor_stretch_*: eval/mmi_mode.h); none when the mode does not say.
+  std::optional<size_t> frames_with_impostors;
+  std::optional<std::pair<size_t, size_t>> impostor_stretch;
 
   // Both promises that were checked held on every frame (and the bound was checked on every frame).
   bool kept() const;
 };
 
 // The verdict of a bench.json (already parsed; `where` names it in errors). Throws farfield::Error naming `where`
-// for a run without the mode asked for, without modes, or with fields of the wrong type.
+// for a run without the mode asked for, without modes, or with fields of the wrong type, and naming the database's
+// placement.json when it is malformed.
 Verdict readVerdict(const nlohmann::json& bench, const std::string& where, const HtmlReportOptions& options);
 
 // Total bytes of the regular files under `directory` (recursively); throws farfield::Error naming it when it is

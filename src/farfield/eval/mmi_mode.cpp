@@ -1,7 +1,9 @@
 // The Table 1 modes of Decoret et al. 1999 over a pipeline store: option parsing and the Walkthrough they adapt.
 #include "farfield/eval/mmi_mode.h"
 
+#include <algorithm>
 #include <cmath>
+#include <variant>
 #include <stdexcept>
 
 #include "farfield/core/error.h"
@@ -51,6 +53,7 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
   o.min_lifetime_frames = numberOption(context, "dynamic_min_lifetime", o.min_lifetime_frames, 0.0);
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);
   o.layer_tiles = switchOption(context, "layer_tiles", true);
+  o.coarser_impostors = switchOption(context, "coarser_impostors", true);
   geometry_.emplace(context, runtime::representationName(representation));
   geometry_->configure(o);
 }
@@ -69,12 +72,17 @@ void MmiMode::frame(FrameContext& frame) {
   const runtime::FramePlan& plan = walkthrough_->plan(frame.camera(), [&] { frame.beginOwnPass(); });
   geometry_->submit(frame, plan);
   if (plan.report.updates > 0) frame.addStats(plan.report.update_stats);
+  last_drew_impostors_ = std::any_of(plan.layers.begin(), plan.layers.end(), [](const runtime::LayerDecision& d) {
+    return !std::holds_alternative<runtime::LayerAsGeometry>(d) && !std::holds_alternative<runtime::ClusterAsGeometry>(d);
+  });
+  impostor_frames_[frame.pathFrame()] = last_drew_impostors_;
 }
 
 std::map<std::string, double> MmiMode::info() const {
   // The walkthrough reports its bound (error_bound_px) for the representations that draw impostors only.
   std::map<std::string, double> info = walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
   info.merge(geometry_->info());
+  addImpostorFrames(impostor_frames_, info);
   return info;
 }
 

@@ -23,12 +23,17 @@
 //   cell_lookup=street|nearest  as for the depth-mesh mode
 //   error_px=PX             the error bound in pixels of this walk's frames (default: the bake's --error-px); the
 //                           bound's angle follows from the frame size and field of view (core/error_bound.h)
+//   coarser_impostors=on|off  placed: impostors placed under a coarser bound (place --fallback-bounds) drawn, held
+//                           to their own bound (default on), or their objects drawn as geometry (off: every frame
+//                           keeps error_px; the governed mode's impostor levels raise it to take them)
 //   geometry=gpu|cpu        the plan's geometry culled and drawn on the GPU through the run's arena (default; as
 //                           the culled mode, gpu_occlusion, gpu_cones, gpu_compact apply) or culled per cluster on
 //                           the CPU (eval/plan_geometry.h)
 //   occlusion=on|off        the plan's geometry occlusion-culled (exact: the same frame; default on); on the CPU
 //                           path against the depth of its nearest items, occluder_share=S the triangle share drawn
 //                           first (0.1)
+//
+// info() adds to the walkthrough's statistics the path frames that drew an impostor (eval::addImpostorFrames).
 //   mmi-dynamic only:
 //   frame_budget_ms=MS      the desired frame time (default 33.3: 30 Hz)
 //   dynamic_error_px=PX     a layer is refreshed when its error angle exceeds PX pixels (default 2)
@@ -66,11 +71,14 @@ class MmiMode final : public Mode {
   }
   bool setGeometryErrorPx(double px) override { return geometry_ && geometry_->setGeometryErrorPx(px); }
   std::map<std::string, double> info() const override;
+  std::optional<bool> drewImpostors() const override { return last_drew_impostors_; }
 
  private:
   runtime::WalkthroughOptions options_;
   std::unique_ptr<runtime::Walkthrough> walkthrough_;
   std::optional<PlanGeometry> geometry_;  // how the plans' geometry is drawn (--mode-option geometry, occlusion)
+  std::map<size_t, bool> impostor_frames_;  // per path frame: an impostor drawn (addImpostorFrames)
+  bool last_drew_impostors_ = false;
 };
 
 }  // namespace farfield::eval

@@ -265,4 +265,25 @@ ModeRunResources::ModeRunResources(const scene::Scene& scene, int width, int hei
   context.options = std::move(options);
 }
 
+void addImpostorFrames(const std::map<size_t, bool>& frames, std::map<std::string, double>& info) {
+  size_t with = 0, run = 0, best = 0, run_first = 0, best_first = 0, best_last = 0;
+  for (const auto& [path_frame, impostor] : frames) {
+    if (!impostor) {
+      run = 0;
+      continue;
+    }
+    ++with;
+    if (run == 0) run_first = path_frame;
+    if (++run > best) best = run, best_first = run_first, best_last = path_frame;
+  }
+  info["frames_with_impostors"] = double(with);
+  for (const char* key : {"impostor_stretch_first_frame", "impostor_stretch_last_frame", "impostor_stretch_frames"})
+    info.erase(key);
+  if (best > 0) {
+    info["impostor_stretch_first_frame"] = double(best_first);
+    info["impostor_stretch_last_frame"] = double(best_last);
+    info["impostor_stretch_frames"] = double(best);
+  }
+}
+
 }  // namespace farfield::eval

@@ -168,7 +168,15 @@ class Mode {
   virtual bool setGeometryErrorPx(double /*px*/) { return false; }
   // What a governor decided for the frame just drawn; none for modes without one.
   virtual std::optional<FrameGovernance> governance(size_t /*path_frame*/) const { return std::nullopt; }
+  // Whether the frame just drawn drew an impostor; none for modes that draw none by design.
+  virtual std::optional<bool> drewImpostors() const { return std::nullopt; }
 };
+
+// The measured path frames that drew an impostor (per path frame: whether the frame drew one) into a mode's info():
+// frames_with_impostors, and the longest stretch of consecutive measured frames that all did
+// (impostor_stretch_first_frame, impostor_stretch_last_frame: path frames; impostor_stretch_frames: measured frames
+// in it; none without such a frame).
+void addImpostorFrames(const std::map<size_t, bool>& frames, std::map<std::string, double>& info);
 
 // Makes a mode; cheap (heavy work belongs in prepare()). May throw farfield::Error for bad options.
 using ModeFactory = std::function<std::unique_ptr<Mode>(const ModeContext& context)>;

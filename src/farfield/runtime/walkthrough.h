@@ -87,6 +87,10 @@ struct WalkthroughOptions {
   std::string cell_lookup;                     // "street" or "nearest"; "" = the database's
   bool layer_tiles = true;                     // Placed: layers drawn as their tiles (false: whole quads, the same
                                                // image with every texel shaded; for comparisons)
+  // Placed: impostors placed under a coarser bound than error_px (`place --fallback-bounds`) are drawn, held to their
+  // own bound and counted (true), or their objects drawn as geometry so that every frame keeps error_px (false: a
+  // frame governor then takes them as a coarser level by raising error_px).
+  bool coarser_impostors = true;
   // true: the plan's geometry as draw items culled per cluster on the CPU (FramePlan::items, geometry_items);
   // false: as the objects a GPU-driven frame culls itself (FramePlan::geometry_objects, gpu::GpuCuller), the items
   // then holding the impostors only.

@@ -71,8 +71,25 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
     const store::StoredCpv& c = p.index.cpvs[*cpv];
     report.cpv = *cpv;
     report.cpv_t_after_ms = c.t_after;
+    // An impostor of the CPV not drawn: its objects in view are geometry (reported with their triangles).
+    const auto leaveToGeometry = [&](uint32_t id, const store::StoredPlacedImpostor& record) {
+      ClusterAsGeometry g{id, 0};
+      for (uint32_t o : record.objects)
+        if (std::binary_search(ids_.begin(), ids_.end(), o)) g.triangles += object_triangles_[o];
+      plan.layers.push_back(g);
+      ++report.layers_as_geometry;
+    };
     for (uint32_t id : c.impostors) {
       const store::StoredPlacedImpostor& record = *p.index.find(id);
+      // A fallback impostor (placed under a coarser bound for a CPV the bound could not bring under t_max, see
+      // bake::PlaceOptions::fallback_bound_factors) is held to its own bound, and counted; or, without
+      // coarser_impostors, left to geometry (and not loaded).
+      const bool coarse = record.bound.pixels > options_.error_px * (1.0 + 1e-9);
+      if (coarse && !options_.coarser_impostors) {
+        leaveToGeometry(id, record);
+        ++p.stats.coarse_left_to_geometry;
+        continue;
+      }
       auto it = p.resident.find(id);
       if (it == p.resident.end()) {
         Stopwatch timer;
@@ -96,10 +113,7 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
       }
       // The impostor keeps this frame's bound where the eye is in its shaft and its plan's error fits the frame's
       // pixel (a camera narrower or larger than the placement's frames has smaller pixels).
-      // A fallback impostor (placed under a coarser bound for a CPV the bound could not bring under t_max, see
-      // bake::PlaceOptions::fallback_bound_factors) is held to its own bound, and counted.
       const double radius = frameRadius(camera, record.box);
-      const bool coarse = record.bound.pixels > options_.error_px * (1.0 + 1e-9);
       const double theta = coarse ? ErrorBound::forCamera(record.bound.pixels, camera).angleWithin(radius)
                                   : bound.angleWithin(radius);
       if (record.shaft.contains(camera.eye) && it->second.error_rad <= theta) {
@@ -108,11 +122,7 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
         for (uint32_t o : record.objects) p.hidden[o] = 1;
         drawn.push_back(id);
       } else {
-        ClusterAsGeometry g{id, 0};
-        for (uint32_t o : record.objects)
-          if (std::binary_search(ids_.begin(), ids_.end(), o)) g.triangles += object_triangles_[o];
-        plan.layers.push_back(g);
-        ++report.layers_as_geometry;
+        leaveToGeometry(id, record);
         ++p.stats.geometry_fallbacks;
       }
     }
@@ -163,6 +173,7 @@ std::map<std::string, double> Walkthrough::placedStatistics() const {
   out["mean_geometry_triangles"] = s.geometry_triangles / n;
   out["impostors_drawn_as_geometry"] = double(s.geometry_fallbacks);
   out["impostors_drawn_at_a_coarser_bound"] = double(s.coarse_draws);
+  out["coarser_impostors_left_to_geometry"] = double(s.coarse_left_to_geometry);
   out["impostor_loads"] = double(s.loads);
   out["impostor_load_ms_mean"] = s.loads ? s.load_ms_total / double(s.loads) : 0.0;
   out["impostor_load_ms_max"] = s.load_ms_max;

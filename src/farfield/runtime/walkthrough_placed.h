@@ -31,6 +31,7 @@ struct Walkthrough::Placed {
     uint64_t resident_bytes_max = 0;
     size_t over_gpu_budget_frames = 0;
     size_t coarse_draws = 0;  // fallback impostors drawn (placed under a coarser bound than the walkthrough's)
+    size_t coarse_left_to_geometry = 0;  // ... left to geometry (WalkthroughOptions::coarser_impostors false)
   } stats;
 };
 
