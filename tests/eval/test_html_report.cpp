@@ -120,7 +120,7 @@ TEST(HtmlReport, VerdictCountsBothPromisesOfTheChosenMode) {
 // A placement database's impostors (its placement.json summary) and the frames that drew them (the mode's info).
 TEST(HtmlReport, VerdictStatesTheImpostorsPlacedAndTheFramesTheyServed) {
   const fs::path dir = test::scratchDir("html_report_placement");
-  writeText(dir / "placement.json", R"({"summary": {"impostors": 7, "memory_bytes": 2500000.0}})");
+  writeText(dir / "placement.json", R"({"summary": {"impostors": 7, "memory_bytes": 2621440.0}})");
   nlohmann::json run = madeUpRun();
   run["modes"]["mmi"]["info"] = {{"frames_with_impostors", 6.0}, {"impostor_stretch_first_frame", 4.0},
                                  {"impostor_stretch_last_frame", 12.0}, {"impostor_stretch_frames", 5.0}};
@@ -129,7 +129,7 @@ TEST(HtmlReport, VerdictStatesTheImpostorsPlacedAndTheFramesTheyServed) {
   const Verdict v = readVerdict(run, "bench.json", options);
   ASSERT_TRUE(v.impostors_placed.has_value());
   EXPECT_EQ(*v.impostors_placed, 7u);
-  EXPECT_DOUBLE_EQ(v.impostor_gpu_bytes, 2.5e6);
+  EXPECT_DOUBLE_EQ(v.impostor_gpu_bytes, 2.5 * 1048576.0);
   ASSERT_TRUE(v.frames_with_impostors.has_value());
   EXPECT_EQ(*v.frames_with_impostors, 6u);
   ASSERT_TRUE(v.impostor_stretch.has_value());

@@ -51,7 +51,8 @@ std::string cell(const std::optional<double>& v, const char* fmt, const char* no
   return v ? format(fmt, *v) : std::string(none);
 }
 
-std::string megabytes(uint64_t bytes) { return format("%.1f MB", double(bytes) / 1e6); }
+// MB as `farfield place` and the other commands print them: 2^20 bytes.
+std::string megabytes(uint64_t bytes) { return format("%.1f MB", double(bytes) / 1048576.0); }
 
 std::string dataUri(const fs::path& png) { return "data:image/png;base64," + base64(readFileBytes(png)); }
 
