@@ -376,7 +376,7 @@ TEST(Bench, CsvMarkdownAndSampleFrames) {
   EXPECT_EQ(csv[0].rfind("frame,path_frame,mode,order,wall_ms,gpu_ms,triangles", 0), 0u);
   EXPECT_NE(csv[0].find(",parallax_p99_px,over_bound,popping"), std::string::npos) << csv[0];
   EXPECT_NE(csv[0].find(",popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,syncs,governor_level,predicted_ms,"
-                        "corrected_ms,bound_scale"),
+                        "corrected_ms,bound_scale,impostors"),
             std::string::npos)
       << csv[0];
   const auto field = [](const std::string& line, size_t k) {
@@ -385,7 +385,7 @@ TEST(Bench, CsvMarkdownAndSampleFrames) {
     return line.substr(start, line.find(',', start) - start);
   };
   for (size_t i = 1; i < csv.size(); ++i) {
-    EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 24) << csv[i];
+    EXPECT_EQ(std::count(csv[i].begin(), csv[i].end(), ','), 25) << csv[i];  // 26 columns
     // The GL counters are on in the bench: every frame has its calls counted, and culled waits for nothing.
     EXPECT_GT(std::stoul(field(csv[i], 17)), 0u) << csv[i];
     if (csv[i].find(",culled,") != std::string::npos) {

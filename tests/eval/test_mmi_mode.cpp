@@ -310,6 +310,11 @@ TEST_F(MmiModeTest, WhereNoImpostorIsValidTheObjectsAreDrawnAsGeometry) {
   EXPECT_GE(stretch, 1.0);
   EXPECT_LE(stretch, with);
   EXPECT_EQ(info.at("impostor_stretch_last_frame") - info.at("impostor_stretch_first_frame") + 1.0, stretch);
+  // Frame by frame in the bench's records (frames.csv's impostors column): the same count; none for visible.
+  size_t marked = 0;
+  for (const FrameRecord& f : loose.mode("mmi")->frames) marked += f.impostors == 1 ? 1 : 0;
+  EXPECT_EQ(double(marked), with);
+  for (const FrameRecord& f : strict.mode("mmi")->frames) EXPECT_EQ(f.impostors, 0);
   // Against the walkthrough itself, frame by frame: the frames whose plan holds an impostor layer.
   {
     gpu::sharedHeadlessContext().makeCurrent();

@@ -185,9 +185,10 @@ void writeBenchJson(const BenchResult& result, const std::string& file);
 void writeBenchMarkdown(const BenchResult& result, const std::string& file);
 // One row per frame per mode: frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,
 // psnr_db,ssim,bad_pixel_share,parallax_p99_px,over_bound,popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,
-// syncs,governor_level,predicted_ms,corrected_ms,bound_scale (error columns empty without a reference; over_bound is 1
-// or 0, "-" without a bound, empty when not measured; popping is empty for the first frame; cpu_ms..syncs empty where
-// GL calls were not counted; the last four empty for a mode without a governor).
+// syncs,governor_level,predicted_ms,corrected_ms,bound_scale,impostors (error columns empty without a reference;
+// over_bound is 1 or 0, "-" without a bound, empty when not measured; popping is empty for the first frame;
+// cpu_ms..syncs empty where GL calls were not counted; governor_level..bound_scale empty for a mode without a
+// governor; impostors 1 where the frame drew an impostor, 0 where not, empty for a mode that draws none by design).
 void writeFramesCsv(const BenchResult& result, const std::string& file);
 // bench.json, bench.md and frames.csv into out_dir (created if missing).
 void writeBenchOutputs(const BenchResult& result, const std::string& out_dir);

@@ -256,7 +256,7 @@ void writeFramesCsv(const BenchResult& r, const std::string& file) {
   std::ostringstream out;
   out << "frame,path_frame,mode,order,wall_ms,gpu_ms,triangles,draw_calls,objects,psnr_db,ssim,bad_pixel_share,"
          "parallax_p99_px,over_bound,popping,cpu_ms,driver_ms,gl_calls,dispatches,upload_bytes,syncs,governor_level,"
-         "predicted_ms,corrected_ms,bound_scale\n";
+         "predicted_ms,corrected_ms,bound_scale,impostors\n";
   char line[512];
   for (size_t k = 0; k < r.frame_indices.size(); ++k) {
     for (const ModeResult& m : r.modes) {
@@ -291,11 +291,11 @@ void writeFramesCsv(const BenchResult& r, const std::string& file) {
       out << line;
       // The governor's decision: empty for a mode without one.
       if (f.governor_level >= 0)
-        std::snprintf(line, sizeof(line), "%d,%.4f,%.4f,%.4f\n", f.governor_level, f.predicted_ms, f.corrected_ms,
+        std::snprintf(line, sizeof(line), "%d,%.4f,%.4f,%.4f,", f.governor_level, f.predicted_ms, f.corrected_ms,
                       f.bound_scale);
       else
-        std::snprintf(line, sizeof(line), ",,,\n");
-      out << line;
+        std::snprintf(line, sizeof(line), ",,,,");
+      out << line << (f.impostors >= 0 ? std::to_string(f.impostors) : std::string()) << "\n";
     }
   }
   writeText(file, out.str());

@@ -97,6 +97,7 @@ FrameRecord FrameRunner::run(Mode& mode, const Camera& camera, size_t path_frame
     record.corrected_ms = g->corrected_ms;
     record.bound_scale = g->bound_scale;
   }
+  if (const std::optional<bool> drew = mode.drewImpostors()) record.impostors = *drew ? 1 : 0;
   return record;
 }
 

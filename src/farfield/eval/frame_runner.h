@@ -39,6 +39,8 @@ struct FrameRecord {
   double predicted_ms = 0.0;
   double corrected_ms = 0.0;
   double bound_scale = 1.0;
+  // Whether the frame drew an impostor (Mode::drewImpostors): 1 or 0; -1 for a mode that draws none by design.
+  int impostors = -1;
 };
 
 // The camera of path frame i at the given size; throws farfield::Error naming the frame when it is unusable

@@ -68,15 +68,15 @@ void writeWalkCsv(const WalkResult& result, const std::string& file) {
   std::ofstream out(file);
   if (!out) throw Error(file, "cannot open for writing");
   out << "frame,path_frame,mode,wall_ms,gpu_ms,triangles,draw_calls,objects,cpu_ms,driver_ms,gl_calls,dispatches,"
-         "upload_bytes,syncs\n";
+         "upload_bytes,syncs,impostors\n";
   char line[512];
   for (size_t i = 0; i < result.frames.size(); ++i) {
     const FrameRecord& f = result.frames[i];
-    std::snprintf(line, sizeof(line), "%zu,%zu,%s,%.4f,%.4f,%llu,%u,%u,%.4f,%.4f,%llu,%u,%llu,%u\n", i, f.path_frame,
+    std::snprintf(line, sizeof(line), "%zu,%zu,%s,%.4f,%.4f,%llu,%u,%u,%.4f,%.4f,%llu,%u,%llu,%u,", i, f.path_frame,
                   result.mode.c_str(), f.wall_ms, f.gpu_ms, (unsigned long long)f.triangles, f.draw_calls, f.objects,
                   f.cpu_ms, f.driver_ms, (unsigned long long)f.gl_calls, f.dispatches,
                   (unsigned long long)f.upload_bytes, f.syncs);
-    out << line;
+    out << line << (f.impostors >= 0 ? std::to_string(f.impostors) : std::string()) << "\n";
   }
   if (!out) throw Error(file, "write failed");
 }

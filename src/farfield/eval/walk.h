@@ -48,7 +48,9 @@ struct WalkResult {
 WalkResult runWalk(gpu::Context& context, const scene::Scene& scene, const gen::CameraPath& path,
                    const WalkOptions& options);
 
-// frame,path_frame,wall_ms,gpu_ms,triangles,draw_calls,objects (one row per measured frame).
+// frame,path_frame,mode,wall_ms,gpu_ms,triangles,draw_calls,objects,cpu_ms,driver_ms,gl_calls,dispatches,
+// upload_bytes,syncs,impostors (one row per measured frame; impostors 1 or 0, empty for a mode that draws none by
+// design).
 void writeWalkCsv(const WalkResult& result, const std::string& file);
 // A few human-readable lines: mode, size, frames, median/p95/p99/max wall and GPU ms, mean triangles/draw calls.
 std::string formatWalkSummary(const WalkResult& result);
