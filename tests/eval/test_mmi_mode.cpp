@@ -339,6 +339,34 @@ TEST_F(MmiModeTest, WhereNoImpostorIsValidTheObjectsAreDrawnAsGeometry) {
   }
 }
 
+// The bench's sample frames: besides the evenly spaced ones, the first measured frame that drew an impostor, with a
+// PNG per mode (the report shows it).
+TEST_F(MmiModeTest, TheFirstFrameWithAnImpostorIsASampleFrame) {
+  const MmiCity& s = mmiCity();
+  registerImpostorModes();
+  BenchOptions options;
+  options.modes = {"visible", "mmi"};
+  options.width = options.height = kFrameSize;
+  options.samples = 1;
+  options.out_dir = test::scratchDir("mmi_mode_samples").string();
+  options.mode_options["impostor_dir"] = s.store;
+  const BenchResult r = runBench(gpu::sharedHeadlessContext(), s.city.scene, s.path, options);
+  const ModeResult* mmi = r.mode("mmi");
+  ASSERT_TRUE(mmi);
+  size_t first = s.path.frames.size();
+  for (const FrameRecord& f : mmi->frames)
+    if (f.impostors == 1) first = std::min(first, f.path_frame);
+  ASSERT_LT(first, s.path.frames.size()) << "no frame drew an impostor";
+  const auto it = std::find_if(r.samples.begin(), r.samples.end(),
+                               [&](const SampleFrame& sf) { return sf.path_frame == first; });
+  ASSERT_NE(it, r.samples.end()) << "frame " << first << " is not a sample";
+  EXPECT_LE(r.samples.size(), 2u);
+  ASSERT_EQ(it->mode_png.count("mmi"), 1u);
+  EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(options.out_dir) / it->mode_png.at("mmi")));
+  // visible draws none by design: its frames say so.
+  for (const FrameRecord& f : r.mode("visible")->frames) EXPECT_EQ(f.impostors, -1);
+}
+
 // Governed over mmi with a budget no frame keeps: every frame at the coarsest level, drawn by the inner mode whose bound
 // is the largest impostor level's, at half the resolution. The frames that drew an impostor are the governed frames'
 // (not those of the inner mode at the promised bound, which draws only the calibration): at least as many as mmi's at

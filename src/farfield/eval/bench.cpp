@@ -187,6 +187,8 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
 
   const std::set<size_t> sample_at = save_samples ? samplePositions(result.frame_indices.size(), options.samples)
                                                   : std::set<size_t>{};
+  bool impostor_sampled = false;  // a sample shows a frame in which a mode drew an impostor
+  bool impostor_modes = true;     // a mode says whether it drew impostors (known after the first frame)
   const fs::path out_dir(options.out_dir);
   // The previous measured frame of the reference and of each mode, for the popping error.
   image::ColorImage previous_reference;
@@ -202,56 +204,68 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
       reference = reference_target.readColor();
       reference_ids = reference_target.readIds();
     }
-    const bool sample = sample_at.count(k) != 0;
-    SampleFrame sample_frame;
-    sample_frame.path_frame = path_frame;
-    const std::string tag = frameTag(path_frame);
+    // A sample: an evenly spaced frame, or the first in which a mode drew an impostor (known once the modes ran, so
+    // until one has, every frame is kept until then).
+    bool sample = sample_at.count(k) != 0;
+    const bool may_sample = save_samples && impostor_modes && !impostor_sampled;
+    std::vector<image::ColorImage> frames(mode_count);
+    std::vector<image::IdImage> frame_ids(mode_count);
     for (size_t j = 0; j < mode_count; ++j) {
       const size_t m = (k + j) % mode_count;
       ModeResult& mode_result = result.modes[m];
       // The first render; the repeats are later passes over the path (below).
       mode_result.frames.push_back(runner.run(*modes[m], camera, path_frame));
       mode_result.order.push_back(int(j));
-      if (options.reference || sample) {
-        image::ColorImage frame = target.readColor();
-        image::IdImage ids;
+      if (options.reference || sample || may_sample) {
+        frames[m] = target.readColor();
         if (options.reference) {
-          image::ImageMetrics e = image::compareImages(reference, frame, options.bad_pixel_threshold);
+          image::ImageMetrics e = image::compareImages(reference, frames[m], options.bad_pixel_threshold);
           if (!(e.psnr_db < kPsnrCapDb)) e.psnr_db = kPsnrCapDb;  // +inf (identical) and above the cap
           mode_result.errors.push_back(e);
-          ids = target.readIds();
-          mode_result.crack_shares.push_back(crackShare(reference_ids, ids));
-          mode_result.parallax_px.push_back(frameParallaxPx(reference_ids, ids, scene.objects.size()));
+          frame_ids[m] = target.readIds();
+          mode_result.crack_shares.push_back(crackShare(reference_ids, frame_ids[m]));
+          mode_result.parallax_px.push_back(frameParallaxPx(reference_ids, frame_ids[m], scene.objects.size()));
           mode_result.popping.push_back(
               k == 0 ? std::numeric_limits<double>::quiet_NaN()
-                     : poppingError(previous_frame[m], frame, previous_reference, reference));
+                     : poppingError(previous_frame[m], frames[m], previous_reference, reference));
         }
-        if (sample) {
-          const std::string name = "frames/" + tag + "_" + fileSafe(mode_result.name) + ".png";
-          image::writePng((out_dir / name).string(), frame);
-          sample_frame.mode_png[mode_result.name] = name;
-          if (options.reference) {
-            const std::string diff = "frames/" + tag + "_" + fileSafe(mode_result.name) + "_diff.png";
-            image::writePng((out_dir / diff).string(), image::diffHeatmap(reference, frame));
-            sample_frame.diff_png[mode_result.name] = diff;
-            if (!std::isnan(mode_result.parallax_px.back())) {
-              // Where objects are drawn away from where the reference shows them: the parallax error per pixel.
-              const std::string par = "frames/" + tag + "_" + fileSafe(mode_result.name) + "_parallax.png";
-              image::writePng((out_dir / par).string(), parallaxHeatmap(reference_ids, ids));
-            }
-          }
-        }
-        if (options.reference) previous_frame[m] = std::move(frame);
       }
       progress.advance();
     }
+    const bool impostors = std::any_of(result.modes.begin(), result.modes.end(),
+                                       [](const ModeResult& m) { return m.frames.back().impostors == 1; });
+    if (may_sample && impostors) sample = true;
+    if (sample && impostors) impostor_sampled = true;
+    impostor_modes = std::any_of(result.modes.begin(), result.modes.end(),
+                                 [](const ModeResult& m) { return m.frames.back().impostors >= 0; });
     if (sample) {
+      SampleFrame sample_frame;
+      sample_frame.path_frame = path_frame;
+      const std::string tag = frameTag(path_frame);
+      for (size_t m = 0; m < mode_count; ++m) {
+        const ModeResult& mode_result = result.modes[m];
+        const std::string name = "frames/" + tag + "_" + fileSafe(mode_result.name) + ".png";
+        image::writePng((out_dir / name).string(), frames[m]);
+        sample_frame.mode_png[mode_result.name] = name;
+        if (options.reference) {
+          const std::string diff = "frames/" + tag + "_" + fileSafe(mode_result.name) + "_diff.png";
+          image::writePng((out_dir / diff).string(), image::diffHeatmap(reference, frames[m]));
+          sample_frame.diff_png[mode_result.name] = diff;
+          if (!std::isnan(mode_result.parallax_px.back())) {
+            // Where objects are drawn away from where the reference shows them: the parallax error per pixel.
+            const std::string par = "frames/" + tag + "_" + fileSafe(mode_result.name) + "_parallax.png";
+            image::writePng((out_dir / par).string(), parallaxHeatmap(reference_ids, frame_ids[m]));
+          }
+        }
+      }
       if (options.reference) {
         sample_frame.reference_png = "frames/" + tag + "_reference.png";
         image::writePng((out_dir / sample_frame.reference_png).string(), reference);
       }
       result.samples.push_back(std::move(sample_frame));
     }
+    if (options.reference)
+      for (size_t m = 0; m < mode_count; ++m) previous_frame[m] = std::move(frames[m]);
     if (options.reference) previous_reference = std::move(reference);
   }
   progress.finish();

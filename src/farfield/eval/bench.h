@@ -59,7 +59,9 @@ struct BenchOptions {
   size_t stride = 1;   // take every stride-th path frame
   bool reference = false;
   int bad_pixel_threshold = 8;  // 8-bit units
-  int samples = 4;              // sample frames saved under out_dir/frames (evenly spaced); 0 = none
+  // Sample frames saved under out_dir/frames, evenly spaced, and with samples > 0 also the first measured frame in which
+  // a mode drew an impostor (FrameRecord::impostors), when it is not one of them; 0 = none.
+  int samples = 4;
   std::string out_dir;          // where sample frames go; "" = none saved
   std::map<std::string, std::string> mode_options;  // ModeContext::options
   std::string scene_label;      // for the outputs, e.g. the SCENE argument

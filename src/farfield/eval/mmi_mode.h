@@ -71,7 +71,12 @@ class MmiMode final : public Mode {
   }
   bool setGeometryErrorPx(double px) override { return geometry_ && geometry_->setGeometryErrorPx(px); }
   std::map<std::string, double> info() const override;
-  std::optional<bool> drewImpostors() const override { return last_drew_impostors_; }
+  // None for local and visible, which draw geometry only.
+  std::optional<bool> drewImpostors() const override {
+    const runtime::Representation r = options_.representation;
+    if (r == runtime::Representation::Local || r == runtime::Representation::Visible) return std::nullopt;
+    return last_drew_impostors_;
+  }
 
  private:
   runtime::WalkthroughOptions options_;
