@@ -384,6 +384,13 @@ TEST_F(MmiModeTest, GovernedFramesCountTheImpostorsOfTheLevelThatDrewThem) {
   EXPECT_GE(mmi->info.at("frames_with_impostors"), 2.0);
   EXPECT_GE(governed->info.at("frames_with_impostors"), mmi->info.at("frames_with_impostors"));
   EXPECT_LE(governed->info.at("frames_with_impostors"), double(s.path.frames.size()));
+  // Frame by frame: the governed records say what the level that drew them drew.
+  size_t marked = 0;
+  for (const FrameRecord& f : governed->frames) {
+    EXPECT_GE(f.impostors, 0) << "frame " << f.path_frame;
+    marked += f.impostors == 1 ? 1 : 0;
+  }
+  EXPECT_EQ(double(marked), governed->info.at("frames_with_impostors"));
 }
 
 // `bake --online single,mmi`: the store holds the PVS and the split; the mode runs the stage it draws (mmi or single,

@@ -52,6 +52,8 @@ class GovernedMode final : public Mode {
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override;
   void frameMeasured(size_t path_frame, double wall_ms) override;
   std::optional<FrameGovernance> governance(size_t path_frame) const override;
+  // Whether the level that drew the frame just drawn drew an impostor (its inner mode's answer).
+  std::optional<bool> drewImpostors() const override { return inners_.at(last_inner_)->drewImpostors(); }
   // The governed mode's info, and governor_*: levels, frames per level, relaxed frames, coarsenings, refinements,
   // measured frames over t_max, the model's coefficients, calibration time, and the quantiles (p50, p95) of
   // measured / predicted and measured / corrected over the measured frames.
