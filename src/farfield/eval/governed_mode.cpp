@@ -178,7 +178,7 @@ void GovernedMode::frame(FrameContext& frame) {
     frame.addStats(drawLevel(frame.camera(), frame.pathFrame(), decision.level));
     level.target.copyScaledTo(out);
   }
-  if (const std::optional<bool> drew = inners_[level.inner]->drewImpostors()) impostor_frames_[frame.pathFrame()] = *drew;
+  if (const std::optional<bool> drew = drewImpostors()) impostor_frames_[frame.pathFrame()] = *drew;
 }
 
 std::optional<gpu::FrameStats> GovernedMode::lateFrameStats(size_t path_frame) {

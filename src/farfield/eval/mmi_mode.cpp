@@ -82,7 +82,7 @@ std::map<std::string, double> MmiMode::info() const {
   // The walkthrough reports its bound (error_bound_px) for the representations that draw impostors only.
   std::map<std::string, double> info = walkthrough_ ? walkthrough_->statistics() : std::map<std::string, double>{};
   info.merge(geometry_->info());
-  if (drewImpostors()) addImpostorFrames(impostor_frames_, info);
+  if (drawsImpostors()) addImpostorFrames(impostor_frames_, info);
   return info;
 }
 

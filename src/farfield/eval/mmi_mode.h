@@ -73,12 +73,14 @@ class MmiMode final : public Mode {
   std::map<std::string, double> info() const override;
   // None for local and visible, which draw geometry only.
   std::optional<bool> drewImpostors() const override {
-    const runtime::Representation r = options_.representation;
-    if (r == runtime::Representation::Local || r == runtime::Representation::Visible) return std::nullopt;
-    return last_drew_impostors_;
+    return drawsImpostors() ? std::optional<bool>(last_drew_impostors_) : std::nullopt;
   }
 
  private:
+  bool drawsImpostors() const {
+    return options_.representation != runtime::Representation::Local &&
+           options_.representation != runtime::Representation::Visible;
+  }
   runtime::WalkthroughOptions options_;
   std::unique_ptr<runtime::Walkthrough> walkthrough_;
   std::optional<PlanGeometry> geometry_;  // how the plans' geometry is drawn (--mode-option geometry, occlusion)
