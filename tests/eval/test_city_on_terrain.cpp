@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "farfield/core/error.h"
 #include "farfield/eval/frame_runner.h"
@@ -201,30 +202,39 @@ TEST(CityOnTerrainGL, TheGpuTerrainFrameIsTheNearerOfTheCityAndTheTerrain) {
 
 TEST(CityOnTerrainGL, TheLodSpriteTerrainChoosesPerFrameByCostsMeasuredAtPrepare) {
   const gen::City city = cityOnTheFractal(10, 5);
-  ModeRunResources res(city.scene, 96, 64, {{"terrain", kSpec}, {"terrain_scale", "0.5"}});
-  CityOnTerrainMode mode("lod-sprite", "culled");
-  mode.prepare(res.context);
-  ASSERT_TRUE(currentTerrainRun()->cost.has_value());
-  // Fitted from frames timed at prepare (the fit's r2 is left alone: on a frame this small the times are noise, and a
-  // fit to the mean alone has r2 0).
-  const gpu::CostModel& fitted = currentTerrainRun()->cost->frame;
-  EXPECT_GE(fitted.samples, 5u);
-  EXPECT_GT(fitted.predict(1000.0, 1.0, 96.0 * 64.0), 0.0) << "a frame takes time";
-  FrameRunner runner(res.renderer, res.target);
-  const Box3 b = city.scene.bounds();
-  for (size_t f = 0; f < 4; ++f) {
-    Camera camera;
-    camera.eye = Vec3(b.lo.x + 5.0f * float(f), b.lo.y - 50.0f, b.hi.z + 100.0f);
-    camera.at = Vec3(b.hi.x + 300.0f, b.hi.y + 300.0f, 0.0f);
-    camera.width = 96;
-    camera.height = 64;
-    camera.near_plane = 1.0f;
-    camera.far_plane = 20000.0f;
-    runner.run(mode, camera, f);
+  // lod-sprite-gpu: the same with the CDLOD terrain's frames, its sprite frames fitted too.
+  for (const char* technique : {"lod-sprite", "lod-sprite-gpu"}) {
+    SCOPED_TRACE(technique);
+    ModeRunResources res(city.scene, 96, 64, {{"terrain", kSpec}, {"terrain_scale", "0.5"}});
+    CityOnTerrainMode mode(technique, "culled");
+    mode.prepare(res.context);
+    ASSERT_TRUE(currentTerrainRun()->cost.has_value());
+    // Fitted from frames timed at prepare (the fit's r2 is left alone: on a frame this small the times are noise, and
+    // a fit to the mean alone has r2 0).
+    const terrain::TerrainCost& cost = *currentTerrainRun()->cost;
+    EXPECT_GE(cost.frame.samples, 5u);
+    EXPECT_GT(cost.frame.predict(1000.0, 1.0, 96.0 * 64.0), 0.0) << "a frame takes time";
+    if (std::string(technique) == "lod-sprite-gpu") {
+      ASSERT_TRUE(cost.gpu_high && cost.gpu_sprite);
+      EXPECT_GE(cost.gpu_sprite->samples, 5u);
+      EXPECT_GT(cost.gpuSpriteMs(1000.0, 96, 64), 0.0);
+    }
+    FrameRunner runner(res.renderer, res.target);
+    const Box3 b = city.scene.bounds();
+    for (size_t f = 0; f < 4; ++f) {
+      Camera camera;
+      camera.eye = Vec3(b.lo.x + 5.0f * float(f), b.lo.y - 50.0f, b.hi.z + 100.0f);
+      camera.at = Vec3(b.hi.x + 300.0f, b.hi.y + 300.0f, 0.0f);
+      camera.width = 96;
+      camera.height = 64;
+      camera.near_plane = 1.0f;
+      camera.far_plane = 20000.0f;
+      runner.run(mode, camera, f);
+    }
+    // With the choice, the run starts on the high LOD (no sprite lifetime is known yet); always-sprite would not.
+    EXPECT_GE(mode.info().at("terrain_high_frames"), 1.0);
+    currentTerrainRun().reset();
   }
-  // With the choice, the run starts on the high LOD (no sprite lifetime is known yet); always-sprite would not.
-  EXPECT_GE(mode.info().at("terrain_high_frames"), 1.0);
-  currentTerrainRun().reset();
 }
 
 TEST(CityOnTerrainGL, ACityMadeOnAnotherTerrainIsRefused) {

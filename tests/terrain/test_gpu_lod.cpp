@@ -3,6 +3,8 @@
 // frame at the same bound and the full-resolution grid's. Needs a GL context (llvmpipe is enough).
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -10,6 +12,8 @@
 #include "farfield/gpu/context.h"
 #include "farfield/image/metrics.h"
 #include "farfield/terrain/gpu_lod.h"
+#include "farfield/terrain/keyframe_visibility.h"
+#include "farfield/terrain/terrain_texture.h"
 #include "terrain_gl_scene.h"
 
 namespace farfield::terrain {
@@ -92,6 +96,95 @@ TEST(GpuLodGL, CloseToTheQuadtreeLodAndTheFullGrid) {
     EXPECT_LT(image::psnr(drawGpuLod(terrain, camera, 64.0f), full), vs_full);
   }
 }
+
+// LOD-sprite's sprite frame on the GPU (CdlodRenderer::setSprite): against the CPU reference of the same selection,
+// its vertices from CdlodTerrain::vertex, each tested by keyframe_visibility.h's vertexVisible against the keyframe's
+// depth read back, the triangles whose three vertices pass drawn with the sprite, the others with the texture.
+// Once with a plain magenta sprite (the frame shows which triangles took the sprite) and once with the keyframe's own
+// colour (the projection).
+TEST(GpuLodGL, SpriteFrameTakesTheSpriteWhereTheCpuVisibilityTestSays) {
+  test::Scene scene(test::testFractal());
+  GpuLodTerrain terrain(scene.hf, scene.texture, CdlodOptions{8, 16, 0.3f});
+  const Heightfield& hf = scene.hf;
+  const float top = hf.maxHeight();
+  const Camera key = makeCamera(Vec3(100, 150, top + 80), Vec3(2400, 2000, hf.minHeight()), 160);
+  gpu::RenderTarget keyframe(key.width, key.height), magenta(key.width, key.height);
+  keyframe.clear(kSky);
+  terrain.draw(key, 1.0f, keyframe);
+  magenta.clear(Vec4(1.0f, 0.0f, 1.0f, 1.0f));
+  const image::DepthImage key_depth = keyframe.readDepth();
+  const VisibilityOptions visibility;
+  Vec2 scale, offset;
+  texCoordTransform(hf, scale, offset);
+  // The frame moved away from the keyframe (sideways, lower, turned), so that part of its view is hidden there.
+  for (const Camera& camera : {makeCamera(Vec3(400, 100, top + 20), Vec3(2200, 2400, hf.minHeight()), 128),
+                               makeCamera(Vec3(160, 120, top + 60), Vec3(2300, 2100, hf.minHeight()), 128)}) {
+    for (const gpu::RenderTarget* colour : {&magenta, &keyframe}) {
+      gpu::CdlodSprite sprite;
+      sprite.colour = &colour->colorTexture();
+      sprite.depth = &keyframe.depthTexture();
+      sprite.camera = key;
+      const int handle = terrain.select(camera, 4.0f);
+      terrain.renderer().setSprite(sprite);
+      gpu::RenderTarget target(camera.width, camera.height);
+      target.clear(kSky);
+      const GpuLodFrame frame = terrain.drawSelection(camera, handle, target);
+      terrain.renderer().clearSprite();
+      EXPECT_EQ(frame.draw.draw_calls, 1u);
+      const image::ColorImage gpu_frame = target.readColor();
+
+      const CdlodTerrain& lod = terrain.lod();
+      const CdlodSelection& sel = terrain.selection(handle);
+      const int p = lod.patchCells();
+      std::vector<Vec3> positions;
+      std::vector<uint8_t> visible;
+      std::vector<uint32_t> shown, textured;
+      for (const CdlodNode& n : sel.nodes) {
+        const uint32_t base = uint32_t(positions.size());
+        for (int j = 0; j <= p; ++j)
+          for (int i = 0; i <= p; ++i) {
+            const Vec3 v = lod.vertex(n, i, j, sel.ranges, camera.eye);
+            const int gi = std::min(int(std::floor(v.x / float(hf.cell_x) + 0.5f)), hf.width - 1);
+            const int gj = std::min(int(std::floor(v.y / float(hf.cell_y) + 0.5f)), hf.height - 1);
+            positions.push_back(v);
+            visible.push_back(vertexVisible(key, key_depth, v, hf.normal(gi, gj), visibility) ? 1 : 0);
+          }
+        for (int j = 0; j < p; ++j)
+          for (int i = 0; i < p; ++i) {
+            const uint32_t c00 = base + uint32_t(i + j * (p + 1)), c10 = c00 + 1, c01 = c00 + uint32_t(p + 1),
+                           c11 = c01 + 1;
+            for (const std::array<uint32_t, 3>& t : {std::array<uint32_t, 3>{c00, c10, c11}, {c00, c11, c01}}) {
+              std::vector<uint32_t>& list = visible[t[0]] && visible[t[1]] && visible[t[2]] ? shown : textured;
+              list.insert(list.end(), t.begin(), t.end());
+            }
+          }
+      }
+      gpu::TerrainRenderer reference(positions, scene.texture, scale, offset);
+      std::vector<uint32_t> indices = shown;
+      indices.insert(indices.end(), textured.begin(), textured.end());
+      reference.setIndices(indices);
+      gpu::RenderTarget expected(camera.width, camera.height);
+      expected.clear(kSky);
+      reference.drawSprite(camera, expected, colour->colorTexture(), key.viewProjection(), 0, shown.size() / 3);
+      reference.drawTextured(camera, expected, shown.size() / 3, textured.size() / 3);
+      const image::ColorImage cpu_frame = expected.readColor();
+      const double share = double(shown.size()) / double(indices.size());
+      std::printf("eye %.0f,%.0f, %s sprite: %.0f %% of the triangles visible in the keyframe, PSNR %.1f dB\n",
+                  camera.eye.x, camera.eye.y, colour == &magenta ? "magenta" : "keyframe", 100.0 * share,
+                  image::psnr(gpu_frame, cpu_frame));
+      EXPECT_GT(share, 0.1);
+      EXPECT_LT(share, 0.98);
+      EXPECT_GT(image::psnr(gpu_frame, cpu_frame), 40.0) << "eye " << camera.eye.x;
+    }
+  }
+  gpu::CdlodSprite bad;
+  EXPECT_THROW(terrain.renderer().setSprite(bad), Error);  // no textures
+  bad.colour = bad.depth = &keyframe.depthTexture();
+  bad.camera = makeCamera(Vec3(0, 0, 500), Vec3(100, 100, 0), 64);
+  EXPECT_THROW(terrain.renderer().setSprite(bad), Error);  // another size than the camera's
+  EXPECT_THROW(terrain.selection(-1), Error);
+}
+
 
 TEST(GpuLodGL, BadInputIsAnError) {
   test::Scene scene(test::testFractal());

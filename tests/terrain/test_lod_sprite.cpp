@@ -3,12 +3,14 @@
 // section 5's keyframe cache and keyframes rendered ahead.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
 #include "farfield/core/error.h"
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/terrain_renderer.h"
 #include "farfield/image/metrics.h"
@@ -425,6 +427,76 @@ TEST(LodSpriteGL, TheGpuHighLodDrawsHighFramesAndKeyframes) {
   without.gpu_high.reset();
   options.cost = &without;
   EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, options), Error);
+}
+
+// The sprite frame on the GPU too (gpu_low): a keyframe is a CDLOD frame whose depth stays on the GPU, a sprite frame
+// is one CDLOD draw tested against it, and no frame waits for the GPU; the frames stay close to the CDLOD high
+// frames, the metric over the CDLOD mesh trips along the path, and the choice predicts sprite frames by gpu_sprite.
+TEST(LodSpriteGL, TheSpriteFrameOnTheGpuWaitsForNothing) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  const std::vector<Camera> cameras = choicePath(scene.hf, 24);
+  LodSpriteOptions options;
+  options.sky_color = kSky;
+  options.gpu_high = &gpu_lod;
+  options.gpu_low = true;
+  TerrainCost cost;  // CDLOD high frames expensive, sprite frames cheap: the sprite path once a sprite has lasted
+  cost.gpu_high = gpu::CostModel{};
+  cost.gpu_high->base_ms = 50.0;
+  cost.gpu_sprite = gpu::CostModel{};
+  cost.gpu_sprite->base_ms = 0.25;
+  options.cost = &cost;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const bool counting = gpu::installGlCounters();
+  gpu::RenderTarget frame(128, 128), expected(128, 128);
+  double worst_psnr = 1e9;
+  size_t sprite_frames = 0;
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    const gpu::GlCounters before = gpu::glCounters();
+    const gpu::FrameStats stats = sprite.render(cameras[f], frame, &info);
+    const gpu::GlCounters used = gpu::glCounters() - before;
+    EXPECT_DOUBLE_EQ(info.predicted_sprite_ms, 0.25) << "frame " << f;
+    if (info.path == TerrainPath::Sprite) {
+      ++sprite_frames;
+      EXPECT_TRUE(sprite.spriteDepth()->empty());
+    }
+    EXPECT_EQ(stats.draw_calls, info.source == SpriteSource::Fresh ? 2u : 1u) << "frame " << f;
+    EXPECT_EQ(info.low_triangles % (2 * 8 * 8), 0u) << "CDLOD patches";
+    if (counting) {
+      EXPECT_EQ(used.syncs, 0u) << "frame " << f;
+    }
+    if (f > 0) {
+      EXPECT_GT(info.quadrants, 100u) << "frame " << f;
+    }
+    expected.clear(kSky);
+    gpu_lod.draw(cameras[f], options.high_error, expected);
+    worst_psnr = std::min(worst_psnr, image::psnr(frame.readColor(), expected.readColor()));
+  }
+  std::printf("%zu keyframes in %zu frames, %zu sprite frames; worst PSNR against the CDLOD high frame %.1f dB\n",
+              sprite.counters().fresh_keyframes, cameras.size(), sprite_frames, worst_psnr);
+  // The first keyframe is virtual (no sprite lifetime measured yet: the high frame wins); then sprites.
+  EXPECT_GE(sprite_frames, cameras.size() * 3 / 4);
+  EXPECT_GE(sprite.counters().fresh_keyframes, 2u);
+  EXPECT_LT(sprite.counters().fresh_keyframes, cameras.size() / 2);
+  EXPECT_GT(worst_psnr, 25.0);
+
+  LodSpriteOptions bad = options;
+  bad.predict = true;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);
+  bad = options;
+  bad.cache_size = 4;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);
+  bad = options;
+  bad.gpu_high = nullptr;
+  bad.cost = nullptr;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);
+  TerrainCost no_sprite_model = cost;
+  no_sprite_model.gpu_sprite.reset();
+  bad = options;
+  bad.cost = &no_sprite_model;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);
 }
 
 }  // namespace

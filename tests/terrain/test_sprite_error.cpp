@@ -4,8 +4,12 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
+#include "farfield/core/camera.h"
+#include "farfield/terrain/cdlod.h"
+#include "farfield/terrain/fractal.h"
 #include "farfield/terrain/sprite_error.h"
 
 namespace farfield::terrain {
@@ -28,6 +32,14 @@ TEST(SpriteError, FlatQuadrantByHand) {
   ASSERT_TRUE(spriteProjection(c, q, v1b, cp));
   EXPECT_NEAR(cp.x, 10.0 / 0.9, 1e-9);
   EXPECT_NEAR(cp.z, 0.0, 1e-9);
+  // A grazing ray (1 mm of descent over a kilometre) meets the plane z = 0 10 km past C: with `near`, C' is kept
+  // where the ray leaves the quadrant's box grown by its size on each side, x = 15.
+  const DVec3 v1c(-1000, 0, 10.001);
+  ASSERT_TRUE(spriteProjection(c, q, v1c, cp));
+  EXPECT_GT(cp.x, 1e6);
+  ASSERT_TRUE(spriteProjection(c, q, v1c, cp, true));
+  EXPECT_NEAR(cp.x, 15.0, 1e-6);
+  EXPECT_NEAR(cp.z, 10.001 - 1.015 * 0.001, 1e-6);
 }
 
 // Independent: the fan surface height over (x, y) (4 triangles around the mean of the corners), the first crossing
@@ -122,6 +134,56 @@ TEST(SpriteError, KeyframeDueWhenMeanSquareReachesThreshold) {
   EXPECT_NEAR(e.pixels(beta), 1.0, 1e-12);
   e.quadrants = 0;
   EXPECT_FALSE(keyframeDue(e, beta, 1.0));
+}
+
+// Equation 2 over a CDLOD mesh (the GPU sprite frame's, lod_sprite.h's gpu_low): every cell of the selection's nodes
+// of level >= 1 inside the grid is a quadrant (counted independently here), and the evenly spread sample stands for
+// the mean over every cell.
+TEST(SpriteError, CdlodSampleStandsForEveryCell) {
+  FractalOptions fo;
+  fo.size = 257;
+  fo.seed = 5;
+  fo.cell_size = 20.0;
+  fo.relief = 600.0;
+  const Heightfield hf = fractalTerrain(fo);
+  const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
+  Camera camera;
+  camera.eye = Vec3(200.0f, 300.0f, hf.maxHeight() + 300.0f);
+  camera.at = Vec3(3000.0f, 3500.0f, 0.0f);
+  camera.width = camera.height = 512;
+  camera.fov_y = float(degToRad(60.0));
+  camera.near_plane = 1.0f;
+  camera.far_plane = 50000.0f;
+  CdlodSelection selection;
+  lod.select(camera, 4.0f, true, selection);
+  const int p = lod.patchCells();
+  size_t cells = 0;
+  for (const CdlodNode& n : selection.nodes) {
+    if (n.level < 1) continue;
+    const int s = 1 << n.level;
+    for (int j = 0; j < p; ++j)
+      for (int i = 0; i < p; ++i)
+        if ((n.x * p + i + 1) * s <= hf.width - 1 && (n.y * p + j + 1) * s <= hf.height - 1) ++cells;
+  }
+  ASSERT_GT(cells, 2000u) << "the test needs a mesh larger than the sample";
+  double previous = 0.0;
+  for (const float move : {10.0f, 40.0f, 160.0f}) {
+    const Vec3 v2 = camera.eye + Vec3(move, 0.5f * move, -0.2f * move);
+    const SpriteError all = spriteError(lod, selection.nodes, camera.eye, v2, 0);
+    EXPECT_EQ(all.quadrants + all.skipped, cells);
+    const SpriteError sample = spriteError(lod, selection.nodes, camera.eye, v2, 512);
+    EXPECT_GT(sample.quadrants, 300u);
+    EXPECT_LT(sample.quadrants + sample.skipped, 512u + selection.nodes.size());
+    const double ratio = std::sqrt(sample.mean_theta_sq / all.mean_theta_sq);
+    std::printf("move %.0f m: %zu cells, error %.3f px (every cell) / %.3f px (%zu sampled), ratio %.3f\n", move,
+                cells, all.pixels(pixelAngle(camera)), sample.pixels(pixelAngle(camera)), sample.quadrants, ratio);
+    EXPECT_NEAR(ratio, 1.0, 0.2);
+    // The same sample from frame to frame, and a larger move shows a larger error.
+    EXPECT_EQ(spriteError(lod, selection.nodes, camera.eye, v2, 512).mean_theta_sq, sample.mean_theta_sq);
+    EXPECT_GT(all.mean_theta_sq, previous);
+    previous = all.mean_theta_sq;
+  }
+  EXPECT_LT(spriteError(lod, selection.nodes, camera.eye, camera.eye, 512).mean_theta_sq, 1e-20);
 }
 
 }  // namespace

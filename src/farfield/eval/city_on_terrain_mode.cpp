@@ -50,8 +50,8 @@ void checkGroundLiesOnTerrain(const scene::Scene& scene, const scene::Object& gr
 
 CityOnTerrainMode::CityOnTerrainMode(std::string terrain, std::string city)
     : terrain_(std::move(terrain)), city_(std::move(city)) {
-  if (terrain_ != "high" && terrain_ != "high-gpu" && terrain_ != "lod-sprite")
-    throw Error("mode " + name(), "the terrain technique must be high, high-gpu or lod-sprite");
+  if (terrain_ != "high" && terrain_ != "high-gpu" && terrain_ != "lod-sprite" && terrain_ != "lod-sprite-gpu")
+    throw Error("mode " + name(), "the terrain technique must be high, high-gpu, lod-sprite or lod-sprite-gpu");
 }
 
 void CityOnTerrainMode::prepare(const ModeContext& context) {
@@ -74,10 +74,16 @@ void CityOnTerrainMode::prepare(const ModeContext& context) {
   }
   gpu::TerrainRenderer& renderer = run_->gpuRenderer();
   if (terrain_ == "high-gpu") run_->gpuLod();
-  if (terrain_ == "lod-sprite") {
-    // LOD-sprite's per-frame choice needs this machine's terrain costs (terrain bench calibrates them on its path).
-    if (!run_->cost) run_->cost = terrain::calibrateTerrainCost(*data.lod, renderer, calibrationViews(context));
-    terrain::LodSpriteOptions o = spriteOptions(*run_, SpriteVariant::Paper, run_->epsilon);
+  if (terrain_ == "lod-sprite" || terrain_ == "lod-sprite-gpu") {
+    // LOD-sprite's per-frame choice needs this machine's terrain costs (terrain bench calibrates them on its path),
+    // with the CDLOD terrain's frames for lod-sprite-gpu.
+    terrain::GpuLodTerrain* gpu = terrain_ == "lod-sprite-gpu" ? &run_->gpuLod() : nullptr;
+    if (!run_->cost || (gpu && !run_->cost->gpu_sprite)) {
+      terrain::TerrainCostOptions c = calibrationViews(context);
+      c.gpu_high = gpu;
+      run_->cost = terrain::calibrateTerrainCost(*data.lod, renderer, c);
+    }
+    terrain::LodSpriteOptions o = spriteOptions(*run_, SpriteVariant::Paper, run_->epsilon, gpu);
     o.hole = hole_;
     sprite_ = std::make_unique<terrain::LodSpriteRenderer>(*data.lod, renderer, context.width, context.height, o);
   }
@@ -133,7 +139,10 @@ void CityOnTerrainMode::frame(FrameContext& frame) {
   // Where the terrain's LOD triangles reach over the city's ground near the hole's edge, the ground wins.
   renderer.setDepthBias(kDepthBiasSlopes, kDepthBiasSlopes);
   if (sprite_) {
+    terrain::GpuLodTerrain* gpu = sprite_->options().gpu_high;
+    if (gpu) gpu->renderer().setDepthBias(kDepthBiasSlopes, kDepthBiasSlopes);
     stats = sprite_->render(camera, target);
+    if (gpu) gpu->renderer().setDepthBias(0.0f, 0.0f);
   } else if (terrain_ == "high-gpu") {
     terrain::GpuLodTerrain& lod = run_->gpuLod();
     lod.setHole(hole_);  // the quadtree's hole, left out by the fragment shader
@@ -171,7 +180,7 @@ std::map<std::string, double> CityOnTerrainMode::info() const {
 }
 
 void registerCityOnTerrainModes() {
-  for (const char* terrain : {"high", "high-gpu", "lod-sprite"})
+  for (const char* terrain : {"high", "high-gpu", "lod-sprite", "lod-sprite-gpu"})
     for (const char* city : {"culled", "dynamic-shade"}) {
       const std::string t = terrain, c = city;
       registerMode("terrain-" + t + "+" + c,

@@ -1,9 +1,9 @@
 // A city and a terrain in one frame (issue 18): the city's scene drawn by a walkthrough mode ("culled",
 // "dynamic-shade", ...) over a terrain drawn by a terrain technique ("high": the 1 px quadtree LOD, "high-gpu": the
-// 1 px CDLOD on the GPU (terrain/gpu_lod.h; its hole left out by the fragment shader), or "lod-sprite":
+// 1 px CDLOD on the GPU (terrain/gpu_lod.h; its hole left out by the fragment shader), "lod-sprite":
 // Chen et al. 1999, choosing per frame between the sprite and the high LOD by this machine's terrain costs, measured
-// at prepare() from five views around the city unless the run has them), both into the frame's target, the z-buffer
-// deciding between them.
+// at prepare() from five views around the city unless the run has them, or "lod-sprite-gpu": the same drawn by the
+// CDLOD terrain, sprite frames included), both into the frame's target, the z-buffer deciding between them.
 //
 // The city must have been made on the same terrain: `farfield gen city --terrain SPEC --terrain-scale S`, then
 // `farfield bench city.glb path.json --modes terrain-lod-sprite+culled --mode-option terrain=SPEC --mode-option
@@ -13,7 +13,7 @@
 // the terrain's surface) covers the city; the terrain's triangles under it are left out (a hole of whole grid
 // cells inside the ground's rectangle), so the two do not fight for the same pixels.
 //
-// Names: "terrain-high+MODE", "terrain-high-gpu+MODE" and "terrain-lod-sprite+MODE" for MODE culled and
+// Names: "terrain-T+MODE" for T high, high-gpu, lod-sprite and lod-sprite-gpu, and MODE culled and
 // dynamic-shade (registered by
 // registerTerrainModes); the mode's own options apply. info(): the city mode's, prefixed "city_", and the terrain's.
 #pragma once
@@ -32,8 +32,8 @@ namespace farfield::eval {
 
 class CityOnTerrainMode : public Mode {
  public:
-  // terrain: "high" (the quadtree LOD), "high-gpu" (CDLOD, terrain/gpu_lod.h) or "lod-sprite"; city: a registered
-  // walkthrough mode's name.
+  // terrain: "high" (the quadtree LOD), "high-gpu" (CDLOD, terrain/gpu_lod.h), "lod-sprite" or "lod-sprite-gpu";
+  // city: a registered walkthrough mode's name.
   CityOnTerrainMode(std::string terrain, std::string city);
   std::string name() const override { return "terrain-" + terrain_ + "+" + city_; }
   void prepare(const ModeContext& context) override;

@@ -195,6 +195,9 @@ void calibrate(Experiment& x) {
   if (const std::optional<gpu::CostModel>& g = x.run->cost->gpu_high)
     say(o, "cost:    CDLOD frame = %.3f ms + %.3f ms/Mtriangle + %.3f ms/Mpixel (r2 %.3f, rms %.3f ms)\n", g->base_ms,
         g->ms_per_mtriangle, g->ms_per_mpixel, g->r2, g->rms_error_ms);
+  if (const std::optional<gpu::CostModel>& g = x.run->cost->gpu_sprite)
+    say(o, "cost:    CDLOD sprite frame = %.3f ms + %.3f ms/Mtriangle + %.3f ms/Mpixel (r2 %.3f, rms %.3f ms)\n",
+        g->base_ms, g->ms_per_mtriangle, g->ms_per_mpixel, g->r2, g->rms_error_ms);
 }
 
 // 1. The benchmark harness: every mode interleaved, timed, with bench.json.

@@ -149,11 +149,14 @@ terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant var
                                         terrain::GpuLodTerrain* gpu_high) {
   terrain::LodSpriteOptions o;
   o.gpu_high = gpu_high;
+  o.gpu_low = gpu_high != nullptr && variant != SpriteVariant::Predict && variant != SpriteVariant::Cache;
   o.epsilon = epsilon;
   o.high_error = run.high_error;
   o.low_error = run.low_error;
   o.sky_color = run.sky;
-  if (variant == SpriteVariant::Paper && run.cost && (!gpu_high || run.cost->gpu_high)) o.cost = &*run.cost;
+  if (variant == SpriteVariant::Paper && run.cost &&
+      (!gpu_high || (run.cost->gpu_high && (!o.gpu_low || run.cost->gpu_sprite))))
+    o.cost = &*run.cost;
   if (variant == SpriteVariant::Predict) o.predict = true;
   if (variant == SpriteVariant::Cache) o.cache_size = 8;
   return o;
@@ -299,8 +302,9 @@ void registerTerrainModes() {
                "cost (terrain bench; --mode-option terrain=DEM, epsilon=PX)",
                [](const ModeContext&) { return std::make_unique<SpriteMode>("lod-sprite", SpriteVariant::Paper); });
   registerMode("lod-sprite-gpu",
-               "terrain: LOD-sprite whose keyframes and high frames are the CDLOD terrain on the GPU, choosing per frame "
-               "by the costs of those frames (terrain bench)",
+               "terrain: LOD-sprite drawn by the CDLOD terrain on the GPU (keyframes, high frames, and sprite frames tested "
+               "against the keyframe's depth in the vertex shader), choosing per frame by the costs of those frames "
+               "(terrain bench)",
                [](const ModeContext&) {
                  return std::make_unique<SpriteMode>("lod-sprite-gpu", SpriteVariant::Paper, 0.0, true);
                });

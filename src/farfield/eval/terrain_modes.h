@@ -124,8 +124,9 @@ enum class SpriteVariant { Paper, Always, Predict, Cache };
 
 // The LOD-sprite options of a variant with the run's thresholds (epsilon, pixels, > 0); the one place the
 // variants are defined, shared by the modes and the terrain bench's quality pass.
-// gpu_high: the high-resolution LOD the sprite renderer draws (keyframes and high frames) is that CDLOD terrain
-// (LodSpriteOptions::gpu_high); with the choice, the run's cost model must then have its frames (gpu_high fitted).
+// gpu_high: the sprite renderer draws with that CDLOD terrain: its keyframes and high frames
+// (LodSpriteOptions::gpu_high), and for the variants without prediction or cache its sprite frames too (gpu_low);
+// with the choice, the run's cost model must then have their frames (gpu_high and gpu_sprite fitted).
 terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant variant, double epsilon,
                                         terrain::GpuLodTerrain* gpu_high = nullptr);
 // What calibrateTerrainCost times for lod-sprite's choice on `views` (frames of width x height): the keyframe target
@@ -134,7 +135,7 @@ terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant var
 terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector<Camera> views, int width, int height,
                                               terrain::GpuLodTerrain* gpu_high = nullptr);
 // "lod-sprite" -> Paper, "lod-sprite-always" -> Always, "lod-sprite-predict" -> Predict, "lod-sprite-cache" -> Cache; false for other names.
-// "lod-sprite-gpu" is the Paper variant drawing its high-resolution LOD with the CDLOD terrain (gpu_high set).
+// "lod-sprite-gpu" is the Paper variant drawn by the CDLOD terrain on the GPU: keyframes, high and sprite frames.
 bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant, bool* gpu_high = nullptr);
 
 // `lod-sprite` and its section 5 variants. Each pass over the path (the harness's warm-up frame is one) starts

@@ -172,6 +172,10 @@ void writeSummary(Experiment& x) {
       md << "; CDLOD frames (lod-sprite-gpu's high frames and keyframes): " << num(g->base_ms, 3) << " ms + "
          << num(g->ms_per_mtriangle, 1) << " ms/Mtriangle + " << num(g->ms_per_mpixel, 2) << " ms/Mpixel (r2 "
          << num(g->r2, 3) << ")";
+    if (const std::optional<gpu::CostModel>& g = r.cost->gpu_sprite)
+      md << "; CDLOD sprite frames (lod-sprite-gpu's): " << num(g->base_ms, 3) << " ms + "
+         << num(g->ms_per_mtriangle, 1) << " ms/Mtriangle + " << num(g->ms_per_mpixel, 2) << " ms/Mpixel (r2 "
+         << num(g->r2, 3) << ")";
     const auto& check = summary["cost_model"]["measured_over_predicted"];
     for (const char* k : {"high", "sprite_kept"})
       if (check.contains(k))

@@ -60,12 +60,13 @@ CdlodRenderer::CdlodRenderer(int width, int height, Vec2 cell, int patch_cells, 
   makePatch();
 }
 
-Program& CdlodRenderer::program(bool hole) {
-  Program& p = hole ? hole_program_ : program_;
+Program& CdlodRenderer::program(bool hole, bool sprite) {
+  Program& p = programs_[(hole ? 1 : 0) + (sprite ? 2 : 0)];
   if (!p.handle()) {
     std::string defines;
     if (pages_) defines += "#define FF_PAGED 1\n";
     if (hole) defines += "#define FF_HOLE 1\n";
+    if (sprite) defines += "#define FF_CDLOD_SPRITE 1\n";
     p = Program::fromEmbedded("cdlod.vert.glsl", "terrain.frag.glsl", defines);
   }
   return p;
@@ -109,9 +110,23 @@ void CdlodRenderer::setLevels(std::span<const int> offsets, std::span<const IVec
 }
 
 void CdlodRenderer::setHole(Vec2 lo, Vec2 hi) {
-  program(true);
+  program(true, false);
   hole_ = true;
   hole_rect_ = Vec4(lo, hi);
+}
+
+void CdlodRenderer::setSprite(const CdlodSprite& sprite) {
+  const char* where = "CDLOD renderer sprite";
+  if (pages_) throw Error(where, "a terrain paged in tiles has no sprite frame (its heights are not one texture)");
+  if (!sprite.colour || !sprite.depth) throw Error(where, "needs the keyframe's colour and depth textures");
+  sprite.camera.validate(where);
+  for (const Texture* t : {sprite.colour, sprite.depth})
+    if (t->width() != sprite.camera.width || t->height() != sprite.camera.height)
+      throw Error(where, "a " + std::to_string(t->width()) + " x " + std::to_string(t->height()) +
+                             " texture for a keyframe camera of " + std::to_string(sprite.camera.width) + " x " +
+                             std::to_string(sprite.camera.height));
+  sprite_ = sprite;
+  sprite_on_ = true;
 }
 
 void CdlodRenderer::setRanges(std::span<const Vec2> ranges, int slot) {
@@ -139,7 +154,7 @@ FrameStats CdlodRenderer::draw(const Camera& camera, RenderTarget& target, std::
   glNamedBufferSubData(nodes_, 0, GLsizeiptr(bytes), nodes.data());
 
   target.bindForOpaquePass();
-  Program& program = this->program(hole_);
+  Program& program = this->program(hole_, sprite_on_);
   program.use();
   program.set("u_view_proj", camera.viewProjection());
   program.set("u_eye", camera.eye);
@@ -154,6 +169,15 @@ FrameStats CdlodRenderer::draw(const Camera& camera, RenderTarget& target, std::
   glUniform2fv(program.uniformLocation("u_uv_offset"), 1, glm::value_ptr(uv_offset_));
   program.set("u_object_id", uint32_t(1));
   if (hole_) program.set("u_hole", hole_rect_);
+  if (sprite_on_) {
+    const Camera& k = sprite_.camera;
+    program.set("u_sprite_view_proj", k.viewProjection());
+    program.set("u_sprite_eye_beta", Vec4(k.eye, k.fovX() / float(k.width)));
+    glUniform2f(program.uniformLocation("u_sprite_near_far"), k.near_plane, k.far_plane);
+    program.set("u_sprite_thickness", Vec3(sprite_.thickness_m, sprite_.thickness_rel, sprite_.footprint_pixels));
+    sprite_.depth->bind(4);
+    sprite_.colour->bind(5);
+  }
   texture_.bind(0);
   heights_.bind(1);
   if (pages_) {

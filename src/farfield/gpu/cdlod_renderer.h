@@ -39,6 +39,16 @@ struct CdlodOverview {
   const image::ColorImage* colour = nullptr;  // the original texture at its points (width x height texels)
 };
 
+// A sprite for LOD-sprite's frame on the GPU (terrain/lod_sprite.h, Chen et al. 1999): a keyframe's colour and depth
+// and its camera, with equation 3's thickness (terrain/keyframe_visibility.h's VisibilityOptions). The textures must
+// have the camera's size and outlive the draws that use them.
+struct CdlodSprite {
+  const Texture* colour = nullptr;
+  const Texture* depth = nullptr;  // window depth, reversed Z (RenderTarget::depthTexture)
+  Camera camera;
+  float thickness_m = 1.0f, thickness_rel = 0.01f, footprint_pixels = 1.0f;
+};
+
 class CdlodRenderer {
  public:
   static constexpr int kMaxLevels = 25;
@@ -75,6 +85,13 @@ class CdlodRenderer {
   // clearHole draws it all again. Applies to the draws that follow.
   void setHole(Vec2 lo, Vec2 hi);
   void clearHole() { hole_ = false; }
+  // The draws that follow test each vertex against the sprite's keyframe as keyframe_visibility.h's vertexVisible
+  // does (in the vertex shader), and take the sprite, projected through its camera, over the triangles whose three
+  // vertices are visible there, the original texture elsewhere: the sprite frame in one draw, with nothing read back.
+  // clearSprite draws the original texture alone again. Throws farfield::Error for missing textures, textures of
+  // another size than the camera's, or a paged terrain (its heights are not one texture).
+  void setSprite(const CdlodSprite& sprite);
+  void clearSprite() { sprite_on_ = false; }
   // Waits until every command issued so far has completed (glFinish): the end of a timed terrain frame.
   void finish();
   int patchCells() const { return patch_cells_; }
@@ -94,14 +111,15 @@ class CdlodRenderer {
   size_t index_count_ = 0;
   Texture heights_;
   Texture texture_;
-  Program& program(bool hole);
+  Program& program(bool hole, bool sprite);
   void makePatch();
 
   CdlodPages* pages_ = nullptr;
   int overview_step_ = 1;
-  Program program_;
-  Program hole_program_;  // made by the first setHole
+  Program programs_[4];  // by hole + 2 * sprite, each made at its first use
   bool hole_ = false;
+  bool sprite_on_ = false;
+  CdlodSprite sprite_;
   Vec4 hole_rect_{0.0f};
   Vec2 uv_scale_, uv_offset_;
   float bias_factor_ = 0.0f, bias_units_ = 0.0f;

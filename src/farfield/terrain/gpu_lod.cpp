@@ -1,6 +1,9 @@
 #include "farfield/terrain/gpu_lod.h"
 
+#include <string>
 #include <vector>
+
+#include "farfield/core/error.h"
 
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_texture.h"
@@ -57,7 +60,7 @@ gpu::CdlodInstance cdlodInstance(const CdlodNode& node, int patch_cells, int lay
   return {int32_t(node.x * cells), int32_t(node.y * cells), int32_t(node.level), int32_t(layer)};
 }
 
-GpuLodFrame GpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull) {
+int GpuLodTerrain::select(const Camera& camera, float pixel_error, bool cull) {
   // The slot whose ranges were made for this bound, else the least recently used one.
   const double scale = QuadtreeLod::pixelsPerRadian(camera) / double(pixel_error);
   int slot = 0;
@@ -73,14 +76,29 @@ GpuLodFrame GpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::Re
   CdlodSelection& selection = selections_[slot];
   lod_.select(camera, pixel_error, cull, selection);
   if (selection.ranges_changed) uploadRanges(selection, renderer_, slot);
+  return slot;
+}
+
+const CdlodSelection& GpuLodTerrain::selection(int handle) const {
+  if (handle < 0 || handle >= gpu::CdlodRenderer::kRangeSlots || used_[handle] == 0)
+    throw Error("CDLOD terrain", "no selection " + std::to_string(handle));
+  return selections_[handle];
+}
+
+GpuLodFrame GpuLodTerrain::drawSelection(const Camera& camera, int handle, gpu::RenderTarget& target) {
+  const CdlodSelection& sel = selection(handle);
   instances_.clear();
-  for (const CdlodNode& n : selection.nodes) instances_.push_back(cdlodInstance(n, lod_.patchCells()));
+  for (const CdlodNode& n : sel.nodes) instances_.push_back(cdlodInstance(n, lod_.patchCells()));
   GpuLodFrame frame;
-  frame.draw = renderer_.draw(camera, target, instances_, slot);
-  frame.nodes = selection.nodes.size();
-  frame.nodes_visited = selection.visited;
-  frame.nodes_culled = selection.culled;
+  frame.draw = renderer_.draw(camera, target, instances_, handle);
+  frame.nodes = sel.nodes.size();
+  frame.nodes_visited = sel.visited;
+  frame.nodes_culled = sel.culled;
   return frame;
+}
+
+GpuLodFrame GpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull) {
+  return drawSelection(camera, select(camera, pixel_error, cull), target);
 }
 
 }  // namespace farfield::terrain

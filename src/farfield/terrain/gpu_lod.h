@@ -36,6 +36,13 @@ class GpuLodTerrain {
 
   // Selects and draws the terrain for the camera under the bound (pixels) into the bound target (not cleared).
   GpuLodFrame draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull = true);
+  // draw() in two steps, for a host that decides between them (LOD-sprite: its error metric runs over the
+  // selection): select() returns the selection's handle, valid until selections for kRangeSlots other bounds were
+  // made; drawSelection() draws it with the camera it was selected for (or one of the same image height and field
+  // of view). Throws farfield::Error for a handle never returned.
+  int select(const Camera& camera, float pixel_error, bool cull = true);
+  const CdlodSelection& selection(int handle) const;
+  GpuLodFrame drawSelection(const Camera& camera, int handle, gpu::RenderTarget& target);
 
   // Leaves out the ground of a rectangle of grid points (the quadtree LOD's hole, removeTrianglesInside: a city's
   // ground drawn by someone else): fragments strictly inside it, in world x, y, are discarded. An empty rectangle

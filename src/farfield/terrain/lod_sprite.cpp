@@ -86,6 +86,13 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRendere
   if (options.lifetime_history < 1) throw Error("lod-sprite", "lifetime history must be at least 1 sprite");
   if (options.gpu_high && options.cost && !options.cost->gpu_high)
     throw Error("lod-sprite", "the CDLOD high LOD needs a cost model fitted on its frames (TerrainCostOptions::gpu_high)");
+  if (options.gpu_low) {
+    if (!options.gpu_high) throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) needs the CDLOD terrain (gpu_high)");
+    if (options.predict || options.cache_size > 1)
+      throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) has no keyframe prediction or cache");
+    if (options.cost && !options.cost->gpu_sprite)
+      throw Error("lod-sprite", "the sprite frame on the GPU needs a cost model fitted on its frames (TerrainCost::gpu_sprite)");
+  }
 }
 
 gpu::FrameStats LodSpriteRenderer::drawHigh(const Camera& camera, gpu::RenderTarget& target, LodMesh& mesh, int slot) {
@@ -177,7 +184,7 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
   info.keyframe_triangles += key.triangles;
   high_triangles_key_ = key.triangles;
   high_latest_is_key_ = true;
-  k->depth = k->target.readDepth();
+  if (!options_.gpu_low) k->depth = k->target.readDepth();  // gpu_low: tested against on the GPU
   k->ready = true;
   ++counters_.fresh_keyframes;
   Keyframe* raw = k.get();
@@ -267,6 +274,32 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
   k.coverage_at_creation = probe_.visibleShare(probe_mesh_.indices);
 }
 
+SpriteError LodSpriteRenderer::frameError(const Vec3& v1, const Vec3& v2) const {
+  if (options_.gpu_low)
+    return spriteError(options_.gpu_high->lod(), options_.gpu_high->selection(low_handle_).nodes, v1, v2,
+                       options_.error_quadrants);
+  return spriteError(lod_, low_.quadrants, v1, v2);
+}
+
+gpu::FrameStats LodSpriteRenderer::drawSpriteFrame(const Camera& camera, gpu::RenderTarget& target,
+                                                   LodSpriteFrameInfo& info) {
+  GpuLodTerrain& terrain = *options_.gpu_high;
+  gpu::CdlodSprite sprite;
+  sprite.colour = &current_->target.colorTexture();
+  sprite.depth = &current_->target.depthTexture();
+  sprite.camera = current_->camera;
+  sprite.thickness_m = options_.visibility.thickness_m;
+  sprite.thickness_rel = options_.visibility.thickness_rel;
+  sprite.footprint_pixels = options_.visibility.footprint_pixels;
+  terrain.renderer().setSprite(sprite);
+  terrain.setHole(options_.hole);
+  const gpu::FrameStats stats = terrain.drawSelection(camera, low_handle_, target).draw;
+  terrain.clearHole();
+  terrain.renderer().clearSprite();
+  info.low_triangles = stats.triangles;
+  return stats;
+}
+
 PathCosts LodSpriteRenderer::predictCosts(size_t low_triangles) const {
   const TerrainCost& c = *options_.cost;
   const Camera key = keyframeCamera(Camera{});
@@ -279,9 +312,10 @@ PathCosts LodSpriteRenderer::predictCosts(size_t low_triangles) const {
   PathCosts p;
   const bool gpu = options_.gpu_high != nullptr;
   p.high_ms = gpu ? c.gpuHighMs(frame_tris, width_, height_) : c.frameMs(frame_tris, 1.0, width_, height_);
-  p.sprite_ms = c.frameMs(double(low_triangles), 2.0, width_, height_);
+  p.sprite_ms = options_.gpu_low ? c.gpuSpriteMs(double(low_triangles), width_, height_)
+                                 : c.frameMs(double(low_triangles), 2.0, width_, height_);
   p.keyframe_ms = (gpu ? c.gpuHighMs(key_tris, key.width, key.height) : c.frameMs(key_tris, 1.0, key.width, key.height)) +
-                  c.readbackMs(key.width, key.height) + p.sprite_ms;
+                  (options_.gpu_low ? 0.0 : c.readbackMs(key.width, key.height)) + p.sprite_ms;
   return p;
 }
 
@@ -307,17 +341,25 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   while (history_.size() > size_t(options_.predict_history)) history_.pop_front();
 
   // Figure 3, line 6 (done first: the error metric of line 3 runs over this mesh's quadrants).
-  lod_.build(camera, LodSettings{options_.low_error, true, true}, low_);
-  removeTrianglesInside(low_, options_.hole, uint32_t(lod_.width()));
-  info.quadrants = low_.quadrants.size();
+  if (options_.gpu_low) {
+    low_handle_ = options_.gpu_high->select(camera, options_.low_error);
+    const CdlodSelection& low = options_.gpu_high->selection(low_handle_);
+    low_triangles_ = low.nodes.size() * options_.gpu_high->renderer().trianglesPerNode();
+  } else {
+    lod_.build(camera, LodSettings{options_.low_error, true, true}, low_);
+    removeTrianglesInside(low_, options_.hole, uint32_t(lod_.width()));
+    info.quadrants = low_.quadrants.size();
+    low_triangles_ = low_.triangleCount();
+  }
   const double beta = pixelAngle(camera);
-  auto errorOf = [&](const Keyframe& k) { return spriteError(lod_, low_.quadrants, k.camera.eye, camera.eye); };
+  auto errorOf = [&](const Keyframe& k) { return frameError(k.camera.eye, camera.eye); };
 
   // Lines 3-5: error of the current sprite (or of the virtual keyframe the high LOD stands for); a new one when it
   // reaches the threshold.
   bool due = !anchored_;
   if (anchored_) {
-    const SpriteError e = spriteError(lod_, low_.quadrants, anchor_eye_, camera.eye);
+    const SpriteError e = frameError(anchor_eye_, camera.eye);
+    if (options_.gpu_low) info.quadrants = e.quadrants;
     info.trigger_error_px = info.error_px = e.pixels(beta);
     due = keyframeDue(e, beta, options_.epsilon);
   }
@@ -325,7 +367,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   const bool choose = options_.cost != nullptr;
   PathCosts costs;
   if (choose) {
-    costs = predictCosts(low_.triangleCount());
+    costs = predictCosts(low_triangles_);
     info.predicted_high_ms = costs.high_ms;
     info.predicted_sprite_ms = costs.sprite_ms;
     info.predicted_keyframe_ms = costs.keyframe_ms;
@@ -402,7 +444,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     current_ = chosen;
     sprite_since_ = frame_;
     info.error_px = chosen_error;
-    visibility_.reset(lod_, current_->camera, &current_->depth, options_.visibility);
+    if (!options_.gpu_low) visibility_.reset(lod_, current_->camera, &current_->depth, options_.visibility);
     if (options_.predict) schedulePrediction(camera);
   } else if (!current_ || (choose && choosePath(costs, true, 0.0) == TerrainPath::High)) {
     // A virtual keyframe still valid, or a valid sprite that costs more to draw than the high LOD.
@@ -418,6 +460,11 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   if (options_.predict && pending_ && !pending_->ready && !due) advancePrediction(stats, info);
 
   // Lines 7-11: visible triangles with the sprite, the others with the original texture.
+  if (options_.gpu_low) {
+    gpu::addDraw(stats, drawSpriteFrame(camera, target, info));
+    if (out) *out = info;
+    return stats;
+  }
   const size_t n = low_.triangleCount();
   const size_t visible = visibility_.partition(low_.indices);
   if (info.source == SpriteSource::Fresh) current_->coverage_at_creation = n ? double(visible) / double(n) : 1.0;

@@ -100,6 +100,14 @@ struct LodSpriteOptions {
   // frames and keyframes are then predicted by its gpu_high model (calibrateTerrainCost with gpu_high), which it must
   // have. A predicted keyframe is drawn whole in one frame (no slices). Must outlive the renderer.
   GpuLodTerrain* gpu_high = nullptr;
+  // With gpu_high: the sprite frame on the GPU too. Its low-resolution mesh is gpu_high's CDLOD selection at
+  // low_error; equation 2 runs over that mesh's cells (sprite_error.h, a sample of at most error_quadrants of them);
+  // equation 3 runs per vertex in the vertex shader against the keyframe's depth texture (gpu::CdlodSprite), and the
+  // frame is one draw. Nothing is read back: a keyframe's depth stays on the GPU (spriteDepth() is empty) and
+  // LodSpriteFrameInfo::visible_triangles is not counted. No prediction and no keyframe cache (their coverage test
+  // reads the keyframe's depth). With a cost model, its sprite frames are predicted by the gpu_sprite model.
+  bool gpu_low = false;
+  size_t error_quadrants = 1024;
 };
 
 enum class SpriteSource : uint8_t {
@@ -203,6 +211,12 @@ class LodSpriteRenderer {
   // The high-resolution LOD of options_.hole for a camera into a target (bound, not cleared): the CDLOD terrain's or
   // the quadtree's (mesh: its scratch, slot: the renderer's index slot); returns the draw's counts.
   gpu::FrameStats drawHigh(const Camera& camera, gpu::RenderTarget& target, LodMesh& mesh, int slot);
+  // With gpu_low: the frame's low-resolution selection (GpuLodTerrain::select's handle) and its triangles.
+  int low_handle_ = -1;
+  size_t low_triangles_ = 0;
+  // Equation 2 for the frame's low-resolution mesh, the sprite seen from v1 and the frame from v2.
+  SpriteError frameError(const Vec3& v1, const Vec3& v2) const;
+  gpu::FrameStats drawSpriteFrame(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo& info);
   uint64_t high_triangles_frame_ = 0;  // last high-LOD triangle counts seen at the frame's and the keyframe's camera
   uint64_t high_triangles_key_ = 0;
   bool high_latest_is_key_ = false;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -30,7 +31,7 @@ bool rayPlane(const DVec3& v1, const DVec3& dir, const DVec3& p0, const DVec3& p
 
 }  // namespace
 
-bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, DVec3& c_prime) {
+bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, DVec3& c_prime, bool near) {
   const size_t n = corners.size();
   if (n < 3) return false;
   const DVec3 dir = c - v1;
@@ -85,13 +86,36 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
     return true;
   }
   if (!have_fallback) return false;
+  if (!near) {
+    c_prime = v1 + fallback_t * dir;
+    return true;
+  }
+  // The fallback plane is met where it extends beyond the quadrant; a ray that grazes it meets it arbitrarily far
+  // away, even next to v1 (a cell 4 km from the eye in the CDLOD test had C' near v1, theta 3 rad: the whole of a
+  // mean over 6,400 cells). The sprite shows C on the low surface past the quadrant, which the quadrant's plane does
+  // not describe that far: C' is kept within the quadrant's neighbourhood, its xy box grown by its own size on every
+  // side (C, at t = 1, lies inside it), where the ray leaves that.
+  DVec2 lo(corners[0]), hi(corners[0]);
+  for (const DVec3& q : corners) lo = glm::min(lo, DVec2(q)), hi = glm::max(hi, DVec2(q));
+  const DVec2 size = hi - lo;
+  lo -= size;
+  hi += size;
+  double t_lo = -std::numeric_limits<double>::max(), t_hi = std::numeric_limits<double>::max();
+  for (int axis = 0; axis < 2; ++axis) {
+    if (std::abs(dir[axis]) < 1e-12) continue;
+    const double a = (lo[axis] - v1[axis]) / dir[axis], b = (hi[axis] - v1[axis]) / dir[axis];
+    t_lo = std::max(t_lo, std::min(a, b));
+    t_hi = std::min(t_hi, std::max(a, b));
+  }
+  if (t_lo <= 1.0 && 1.0 <= t_hi) fallback_t = std::clamp(fallback_t, std::max(t_lo, 0.0), t_hi);
   c_prime = v1 + fallback_t * dir;
   return true;
 }
 
-double quadrantTheta(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, const DVec3& v2, bool* ok) {
+double quadrantTheta(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, const DVec3& v2, bool* ok,
+                     bool near) {
   DVec3 c_prime;
-  const bool good = spriteProjection(c, corners, v1, c_prime);
+  const bool good = spriteProjection(c, corners, v1, c_prime, near);
   if (ok) *ok = good;
   if (!good) return 0.0;
   const DVec3 a = c - v2, b = c_prime - v2;
@@ -120,6 +144,82 @@ SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> qua
     ++e.quadrants;
   }
   e.mean_theta_sq = e.quadrants ? sum / double(e.quadrants) : 0.0;
+  return e;
+}
+
+SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
+                        size_t max_quadrants) {
+  const Heightfield& hf = lod.heightfield();
+  const int p = lod.patchCells();
+  // Per node of level >= 1: its cells inside the grid (columns x rows), and its weight for the sample's allocation.
+  struct Stratum {
+    const CdlodNode* node;
+    int columns, rows;
+    double weight;
+  };
+  std::vector<Stratum> strata;
+  strata.reserve(nodes.size());
+  size_t cells = 0;
+  double total_weight = 0.0;
+  for (const CdlodNode& n : nodes) {
+    if (n.level < 1) continue;
+    const int s = lod.spacing(n.level);
+    const int columns = std::clamp((hf.width - 1 - n.x * p * s) / s, 0, p);
+    const int rows = std::clamp((hf.height - 1 - n.y * p * s) / s, 0, p);
+    if (columns == 0 || rows == 0) continue;
+    // A cell's theta grows with its central vertex's deviation (at most the node's error E(N)) and falls with the
+    // square of its distance from the eye.
+    const Box3 box = lod.nodeBox(n);
+    const Vec3 nearest = glm::clamp(v2, box.lo, box.hi);
+    const double d = std::max(double(glm::length(v2 - nearest)), 1.0);
+    const double w = double(lod.nodeError(n)) / (d * d);
+    strata.push_back({&n, columns, rows, w * w});
+    cells += size_t(columns) * size_t(rows);
+    total_weight += w * w;
+  }
+  SpriteError e;
+  const DVec3 eye1(v1), eye2(v2);
+  auto point = [&](int i, int j) { return DVec3(hf.position(i, j)); };
+  DVec3 corners[4];
+  double weighted = 0.0, represented = 0.0;
+  for (const Stratum& st : strata) {
+    const CdlodNode& n = *st.node;
+    const size_t count = size_t(st.columns) * size_t(st.rows);
+    // Every k-th cell (k odd, so that the sample moves across the columns), from an offset fixed by the node.
+    size_t k = 1;
+    if (max_quadrants > 0 && cells > max_quadrants) {
+      const double share = total_weight > 0.0 ? st.weight / total_weight : 1.0 / double(strata.size());
+      const size_t taken = std::clamp<size_t>(size_t(std::lround(share * double(max_quadrants))), 1, count);
+      k = ((count + taken - 1) / taken) | 1;
+    }
+    uint32_t h = uint32_t(n.x) * 0x9E3779B1u ^ uint32_t(n.y) * 0x85EBCA77u ^ uint32_t(n.level) * 0xC2B2AE3Du;
+    h ^= h >> 15;
+    const int s = lod.spacing(n.level), x0 = n.x * p * s, y0 = n.y * p * s;
+    double sum = 0.0;
+    size_t used = 0;
+    for (size_t c = k > 1 ? size_t(h) % k : 0; c < count; c += k) {
+      const int cx = x0 + int(c % size_t(st.columns)) * s, cy = y0 + int(c / size_t(st.columns)) * s;
+      corners[0] = point(cx, cy);
+      corners[1] = point(cx + s, cy);
+      corners[2] = point(cx + s, cy + s);
+      corners[3] = point(cx, cy + s);
+      bool ok = false;
+      const double theta = quadrantTheta(point(cx + s / 2, cy + s / 2), corners, eye1, eye2, &ok, true);
+      if (!ok) {
+        ++e.skipped;
+        continue;
+      }
+      sum += theta * theta;
+      e.max_theta = std::max(e.max_theta, theta);
+      ++used;
+    }
+    if (used == 0) continue;
+    // The node's mean stands for all its cells.
+    weighted += sum / double(used) * double(count);
+    represented += double(count);
+    e.quadrants += used;
+  }
+  e.mean_theta_sq = represented > 0.0 ? weighted / represented : 0.0;
   return e;
 }
 

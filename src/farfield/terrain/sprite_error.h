@@ -18,16 +18,23 @@
 
 #include "farfield/core/camera.h"
 #include "farfield/core/math.h"
+#include "farfield/terrain/cdlod.h"
 #include "farfield/terrain/quadtree_lod.h"
 
 namespace farfield::terrain {
 
 // C' for one quadrant (see above); returns false (and leaves c_prime alone) when the ray is parallel to every
-// candidate plane or v1 coincides with C.
-bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, DVec3& c_prime);
+// candidate plane or v1 coincides with C. near: a fallback C' is kept within the quadrant's neighbourhood, its xy box
+// grown by its own size on every side, where the ray leaves that. A ray that grazes the fallback plane meets it
+// arbitrarily far away, even next to v1: in the CDLOD metric's test one cell 4 km from the eye had C' next to v1 and
+// theta 3 rad, the whole of the mean over 6,400 cells. The quadtree's metric (near = false) keeps the plane as the
+// paper states it, so that its figures stay comparable; with near, its test path's keyframes trip later (the first
+// at frame 16 instead of 12 on LodSprite.KeyframesRenderedAheadAreUsed's path): it has such outliers too.
+bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, DVec3& c_prime,
+                      bool near = false);
 // theta (radians) for one quadrant; 0 when spriteProjection fails (the caller counts those as skipped).
 double quadrantTheta(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, const DVec3& v2,
-                     bool* ok = nullptr);
+                     bool* ok = nullptr, bool near = false);
 
 // beta: the view angle of one pixel, horizontal field of view / image width (radians per pixel).
 double pixelAngle(const Camera& camera);
@@ -44,6 +51,19 @@ struct SpriteError {
 // Equation 2's mean over the quadrants of a low-resolution mesh (LodSettings::collect_quadrants).
 SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> quadrants, const Vec3& v1,
                         const Vec3& v2);
+// Equation 2's mean over the quadrants of a CDLOD low-resolution mesh (gpu_lod.h's selection): a cell of a drawn node
+// of level L >= 1 has its corners every 2^L grid points and its true central vertex C at the grid point in its middle
+// (cells of level 0 skip no grid point, and cells beyond the grid are degenerate: neither is a quadrant). The mesh
+// is taken unmorphed. With more than max_quadrants cells (0: no limit; a CDLOD mesh has thousands where the
+// quadtree's has hundreds), a stratified sample of about max_quadrants stands for the mean: each node is a stratum
+// whose sampled mean stands for all its cells, and the sample is spread over the nodes by (E(N) / d^2)^2, the size
+// of theta^2 there (E(N) the node's error, d its distance from v2), at least one cell each: theta^2 is heavy-tailed,
+// and the near nodes, few of the cells, hold most of the mean. A node's cells are every k-th (k odd, so that the
+// sample moves across the patch's columns) from an offset fixed by the node, so a node keeps its sample from frame to
+// frame. C' as spriteProjection with near. quadrants: the cells evaluated. Needs the terrain's heights.
+SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
+                        size_t max_quadrants = 1024);
+
 // Equation 2: true when a new keyframe is due (mean theta^2 >= (beta * epsilon)^2). No quadrants: never due.
 bool keyframeDue(const SpriteError& error, double beta, double epsilon_pixels);
 

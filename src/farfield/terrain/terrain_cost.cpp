@@ -21,6 +21,11 @@ double TerrainCost::gpuHighMs(double triangles, int width, int height) const {
   return gpu_high->predict(triangles, 1.0, double(width) * double(height)) * safety_factor;
 }
 
+double TerrainCost::gpuSpriteMs(double triangles, int width, int height) const {
+  FF_CHECK_MSG(gpu_sprite.has_value(), "no CDLOD sprite frame model was fitted");
+  return gpu_sprite->predict(triangles, 1.0, double(width) * double(height)) * safety_factor;
+}
+
 double TerrainCost::readbackMs(int width, int height) const {
   return readback_ms_per_mpixel * double(width) * double(height) * 1e-6 * safety_factor;
 }
@@ -30,6 +35,7 @@ nlohmann::json TerrainCost::toJson() const {
                       {"readback_ms_per_mpixel", readback_ms_per_mpixel},
                       {"safety_factor", safety_factor}};
   if (gpu_high) j["gpu_high"] = gpu_high->toJson();
+  if (gpu_sprite) j["gpu_sprite"] = gpu_sprite->toJson();
   return j;
 }
 
@@ -58,7 +64,7 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
   const int kw = options.keyframe_width > 0 ? options.keyframe_width : fw;
   const int kh = options.keyframe_height > 0 ? options.keyframe_height : fh;
 
-  std::vector<gpu::CostSample> samples, gpu_samples;
+  std::vector<gpu::CostSample> samples, gpu_samples, sprite_samples;
   std::vector<double> readback_ms;
   LodMesh mesh;
   const Vec4 sky{0.6f, 0.7f, 0.9f, 1.0f};
@@ -126,6 +132,31 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
           }
           gpu_samples.push_back({triangles, 1.0, double(w) * double(h), median(times)});
         }
+        // The sprite frames: this view's keyframe (the finest threshold) as the sprite, the mesh at each threshold.
+        sprite.clear(sky);
+        options.gpu_high->draw(camera, options.pixel_errors.front(), sprite);
+        gpu::CdlodSprite key;
+        key.colour = &sprite.colorTexture();
+        key.depth = &sprite.depthTexture();
+        key.camera = camera;
+        options.gpu_high->renderer().setSprite(key);
+        target.clear(sky);
+        options.gpu_high->draw(camera, options.pixel_errors.front(), target);  // untimed: the program's first draw
+        renderer.finish();
+        for (const float tau : options.pixel_errors) {
+          std::vector<double> times;
+          double triangles = 0.0;
+          for (int r = 0; r < options.repeats; ++r) {
+            Stopwatch clock;
+            target.clear(sky);
+            triangles = double(options.gpu_high->draw(camera, tau, target).draw.triangles);
+            renderer.finish();
+            times.push_back(clock.milliseconds());
+          }
+          sprite_samples.push_back({triangles, 1.0, double(w) * double(h), median(times)});
+        }
+        options.gpu_high->renderer().clearSprite();
+        sprite.clear(sky);
       }
       if (size) {
         for (int r = 0; r < options.repeats; ++r) {
@@ -139,6 +170,7 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
   TerrainCost cost;
   cost.frame = gpu::CostModel::fit(samples);
   if (!gpu_samples.empty()) cost.gpu_high = gpu::CostModel::fit(gpu_samples);
+  if (!sprite_samples.empty()) cost.gpu_sprite = gpu::CostModel::fit(sprite_samples);
   cost.readback_ms_per_mpixel = median(readback_ms) / (double(kw) * double(kh) * 1e-6);
   return cost;
 }

@@ -29,13 +29,18 @@ struct TerrainCost {
   // selection, node upload, one instanced draw, finish. Its triangles cost differently from the CPU LOD's (no mesh
   // built, every vertex shaded by the patch), so they have a model of their own.
   std::optional<gpu::CostModel> gpu_high;
+  // With gpu_high as well: CDLOD frames drawn as LOD-sprite's sprite frame on the GPU (gpu::CdlodSprite: each vertex
+  // tested against a keyframe's depth, the sprite or the original texture per triangle), in one draw.
+  std::optional<gpu::CostModel> gpu_sprite;
 
   // A frame of `triangles` in `draw_calls` calls into a width x height target, ms.
   double frameMs(double triangles, double draw_calls, int width, int height) const;
   // A CDLOD frame of `triangles` (its patches') into a width x height target, ms; needs gpu_high.
   double gpuHighMs(double triangles, int width, int height) const;
+  // A CDLOD sprite frame of `triangles` into a width x height target, ms; needs gpu_sprite.
+  double gpuSpriteMs(double triangles, int width, int height) const;
   double readbackMs(int width, int height) const;
-  // {"frame": CostModel::toJson(), "readback_ms_per_mpixel", "safety_factor"} and "gpu_high" when fitted.
+  // {"frame": CostModel::toJson(), "readback_ms_per_mpixel", "safety_factor"}, "gpu_high" and "gpu_sprite" when fitted.
   nlohmann::json toJson() const;
 };
 
@@ -49,7 +54,8 @@ struct TerrainCostOptions {
   // tile with a sprite, and with only 1 and 2 calls timed its fit swung from 0 to 0.7 ms a call between runs.
   std::vector<int> sprite_calls{0, 1, 15};
   int repeats = 3;            // timed renders per workload (median kept; one untimed warm-up per view and size)
-  // Also time its frames at each threshold and size (TerrainCost::gpu_high); null = not. Must hold the same terrain.
+  // Also time its frames at each threshold and size (TerrainCost::gpu_high), and its sprite frames with a keyframe of
+  // the view at the first threshold as the sprite (TerrainCost::gpu_sprite); null = not. Must hold the same terrain.
   GpuLodTerrain* gpu_high = nullptr;
 };
 

@@ -4,6 +4,10 @@
 // With FF_PAGED (a terrain paged in tiles): a node whose instance names a page layer (w >= 0) reads its tile's page,
 // (S + 1)^2 grid points from the tile's first; the others read the overview, every u_overview_step-th grid point
 // (their vertices lie on it).
+// With FF_CDLOD_SPRITE (LOD-sprite's frame on the GPU, terrain/lod_sprite.h): each vertex is also projected into the
+// sprite's keyframe and tested against the keyframe's depth as terrain/keyframe_visibility.h's vertexVisible does
+// (Chen et al. 1999, equation 3); v_hidden is 0 for a visible vertex and large otherwise, so that it interpolates to
+// 0 only over a triangle whose three vertices are visible (terrain.frag.glsl then takes the sprite there).
 
 layout(std430, binding = 0) readonly buffer Nodes { ivec4 nodes[]; };  // x0, y0, level, page layer (FF_PAGED)
 layout(std430, binding = 1) readonly buffer Ranges { vec2 ranges[]; };  // per node: morph start and end
@@ -27,7 +31,47 @@ uniform vec2 u_uv_scale;
 uniform vec2 u_uv_offset;
 
 out vec2 v_uv;
-out vec2 v_world_xy;  // for the fragment shader's hole (terrain.frag.glsl with FF_HOLE)
+out vec2 v_world_xy;
+#ifdef FF_CDLOD_SPRITE
+uniform mat4 u_sprite_view_proj;
+layout(binding = 4) uniform sampler2D u_sprite_depth;  // the keyframe's window depth (reversed Z), row 0 at the bottom
+uniform vec4 u_sprite_eye_beta;    // the keyframe's eye, and its view angle of one pixel (fovX / width)
+uniform vec2 u_sprite_near_far;    // the keyframe camera's near and far planes
+uniform vec3 u_sprite_thickness;   // VisibilityOptions: thickness_m, thickness_rel, footprint_pixels
+out vec4 v_sprite_clip;
+out float v_hidden;
+
+// The unit normal at grid point c from central differences, one-sided at the border (Heightfield::normal).
+vec3 gridNormal(ivec2 c) {
+  ivec2 lo = max(c - 1, ivec2(0)), hi = min(c + 1, u_last);
+  float dzdx = hi.x > lo.x ? (texelFetch(u_heights, ivec2(hi.x, c.y), 0).r -
+                              texelFetch(u_heights, ivec2(lo.x, c.y), 0).r) / (float(hi.x - lo.x) * u_cell.x) : 0.0;
+  float dzdy = hi.y > lo.y ? (texelFetch(u_heights, ivec2(c.x, hi.y), 0).r -
+                              texelFetch(u_heights, ivec2(c.x, lo.y), 0).r) / (float(hi.y - lo.y) * u_cell.y) : 0.0;
+  return normalize(vec3(-dzdx, -dzdy, 1.0));
+}
+
+// Equation 3 (keyframe_visibility.cpp's vertexVisible): inside the keyframe, on its surface within the thickness.
+bool spriteVisible(vec3 p, vec3 n, vec4 clip) {
+  if (!(clip.w > 0.0)) return false;
+  vec3 ndc = clip.xyz / clip.w;
+  ivec2 size = textureSize(u_sprite_depth, 0);
+  vec2 s = vec2((ndc.x * 0.5 + 0.5) * float(size.x), (0.5 - ndc.y * 0.5) * float(size.y));  // row 0 at the top
+  if (!(s.x >= 0.0 && s.y >= 0.0 && s.x < float(size.x) && s.y < float(size.y))) return false;
+  if (!(ndc.z >= 0.0 && ndc.z <= 1.0)) return false;
+  float key_depth = texelFetch(u_sprite_depth, ivec2(int(s.x), size.y - 1 - int(s.y)), 0).r;
+  if (!(key_depth > 0.0)) return false;  // background
+  float zn = u_sprite_near_far.x, zf = u_sprite_near_far.y;
+  float z_buffer = zn * zf / (key_depth * (zf - zn) + zn);
+  float footprint = 0.0;
+  if (u_sprite_thickness.z > 0.0) {
+    float sin_a = abs(dot(n, normalize(u_sprite_eye_beta.xyz - p)));
+    float cot_a = min(sqrt(max(1.0 - sin_a * sin_a, 0.0)) / max(sin_a, 1e-6), 20.0);
+    footprint = u_sprite_thickness.z * u_sprite_eye_beta.w * cot_a;
+  }
+  return abs(clip.w - z_buffer) < u_sprite_thickness.x + (u_sprite_thickness.y + footprint) * clip.w;
+}
+#endif  // for the fragment shader's hole (terrain.frag.glsl with FF_HOLE)
 
 float bilinear(vec2 g, ivec2 last, int layer) {
   g = clamp(g, vec2(0.0), vec2(last));
@@ -102,5 +146,10 @@ void main() {
   v_uv = world.xy * u_uv_scale + u_uv_offset;
 #endif
   v_world_xy = world.xy;
+#ifdef FF_CDLOD_SPRITE
+  v_sprite_clip = u_sprite_view_proj * vec4(world, 1.0);
+  // The normal of the grid point nearest the (possibly morphed) vertex.
+  v_hidden = spriteVisible(world, gridNormal(min(ivec2(floor(gm + 0.5)), u_last)), v_sprite_clip) ? 0.0 : 1e6;
+#endif
   gl_Position = u_view_proj * vec4(world, 1.0);
 }
