@@ -156,6 +156,99 @@ TEST(GpuCrowdGL, CullingAndClassificationEqualACpuBruteForce) {
   EXPECT_GT(impostors, 0u);
 }
 
+// Mixed's geometry budget on the GPU (GpuCrowd::setGeometryBudget) against a CPU brute force on the same poses: the
+// skinned triangles stay within the budget, the agents kept as geometry are the nearest of those inside their switch
+// (up to the distance bucket at the cut), the others inside their switch become impostors, and the frame still waits
+// for nothing.
+TEST(GpuCrowdGL, TheGeometryBudgetKeepsTheNearestAgentsAsGeometry) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  gpu::installGlCounters();
+  const gen::Crowd crowd = testCrowd(20000, false);
+  const std::vector<gpu::GpuCrowdModel> models = testModels();
+  gpu::GpuCrowd gc(gpuCrowdRoutes(crowd), gpuCrowdAgents(crowd), models);
+  const float t = 3.0f;
+  gc.simulate(t);
+  const std::vector<Vec4> start = gc.readPoses();
+  const std::vector<float> switches{45.0f, 35.0f};
+  const double bucket_m = 45.0 / gpu::GpuCrowd::kBudgetBuckets;
+  size_t tried = 0;
+  for (size_t k = 0; k < 4; ++k) {
+    // A pedestrian's eye among the agents, looking along the street.
+    const Vec4 p = start[k * 4999];
+    Camera c;
+    c.eye = Vec3(p) + Vec3(0.0f, 0.0f, 1.7f);
+    c.at = c.eye + Vec3(std::cos(p.w), std::sin(p.w), -0.05f);
+    c.width = 640;
+    c.height = 360;
+    c.near_plane = 0.5f;
+    c.far_plane = 5000.0f;
+    const uint64_t budget = 20000 + 15000 * k;
+    gc.setGeometryBudget(budget);
+    const gpu::GlCounters before = gpu::glCounters();
+    gc.simulate(t);
+    gc.cullAndClassify(c, switches);
+    const gpu::GlCounters frame = gpu::glCounters() - before;
+    if (gpu::glCountersInstalled()) {
+      EXPECT_EQ(frame.syncs, 0u) << "nothing in the frame waits for the GPU";
+      EXPECT_EQ(frame.dispatches, 4u) << "simulate, classify, the budget's scan and assignment";
+    }
+    const std::vector<Vec4> poses = gc.readPoses();
+    auto distanceOf = [&](uint32_t i) {
+      const gpu::GpuCrowdModel& m = models[crowd.agents[i].model];
+      const double h = poses[i].w;
+      const DVec3 centre = DVec3(Vec3(poses[i])) + DVec3(std::cos(h) * m.centre.x - std::sin(h) * m.centre.y,
+                                                          std::sin(h) * m.centre.x + std::cos(h) * m.centre.y, m.centre.z);
+      return glm::length(DVec3(c.eye) - centre);
+    };
+    auto trianglesOf = [&](uint32_t i) { return uint64_t(models[crowd.agents[i].model].geometry_indices / 3); };
+    // The GPU's lists (ids are the agents' indices here).
+    uint64_t kept = 0;
+    double farthest_geometry = 0.0, nearest_over = 1e30;
+    size_t over = 0;
+    std::vector<std::pair<double, uint32_t>> candidates;  // inside their switch, in view: what the budget ranks
+    for (size_t m = 0; m < models.size(); ++m) {
+      for (uint32_t i : gc.readList(2 * m)) {
+        kept += trianglesOf(i);
+        farthest_geometry = std::max(farthest_geometry, distanceOf(i));
+        candidates.emplace_back(distanceOf(i), i);
+      }
+      for (uint32_t i : gc.readList(2 * m + 1))
+        if (distanceOf(i) < switches[m] - 1e-3) {
+          ++over;
+          nearest_over = std::min(nearest_over, distanceOf(i));
+          candidates.emplace_back(distanceOf(i), i);
+        }
+    }
+    const gpu::GpuCrowd::Counts counts = gc.readCounts();
+    if (over == 0) continue;  // the budget held every candidate: nothing to rank here
+    ++tried;
+    EXPECT_LE(kept, budget);
+    EXPECT_EQ(uint64_t(counts.budget_triangles_kept), kept);
+    EXPECT_EQ(size_t(counts.over_budget), over);
+    EXPECT_LT(farthest_geometry, nearest_over + bucket_m) << "a farther agent kept its geometry";
+    // The CPU's cut: the nearest candidates whose triangles fit. The GPU keeps as much, less the agents within a
+    // bucket of the cut (they go together).
+    std::sort(candidates.begin(), candidates.end());
+    uint64_t cpu_kept = 0;
+    double cut = 1e30;
+    for (const auto& [d, i] : candidates) {
+      if (cpu_kept + trianglesOf(i) > budget) {
+        cut = d;
+        break;
+      }
+      cpu_kept += trianglesOf(i);
+    }
+    uint64_t near_cut = 0;
+    for (const auto& [d, i] : candidates)
+      if (d >= cut - 2.0 * bucket_m && d < cut) near_cut += trianglesOf(i);
+    EXPECT_GE(kept + near_cut, cpu_kept) << "trial " << k;
+    std::printf("budget %llu: %llu triangles kept (the CPU's exact cut %llu), %zu agents over it\n",
+                (unsigned long long)budget, (unsigned long long)kept, (unsigned long long)cpu_kept, over);
+  }
+  EXPECT_GE(tried, 2u) << "the test needs views where the budget binds";
+}
+
+
 // The built-in figures' runtime, a crowd of 3,000 on a small street network, its GPU crowd and CPU states at one
 // time, and a camera among the agents: what the frame tests draw both ways.
 struct CrowdScene {

@@ -425,6 +425,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           const gpu::GpuCrowd::Counts counts = gpu_crowd->readCounts();
           out.stats.in_view = counts.in_view;
           out.stats.occluded = counts.occluded;
+          out.stats.over_budget = counts.over_budget;
         }
         if (options.runtime.geometry_ms > 0.0 && specs[m].policy == runtime::CrowdPolicy::Mixed &&
             out.stats.geometry > 0)

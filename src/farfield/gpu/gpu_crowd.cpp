@@ -85,7 +85,7 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
     if (!(mo.stride_m > 0.0f) || !(mo.radius > 0.0f) || mo.palette_poses < 1 || mo.frames < 1 || mo.azimuths < 1 ||
         mo.elevations < 1)
       throw Error(what, "model " + std::to_string(m) + ": stride, radius, poses, frames and views must be positive");
-    model_records.push_back({Vec4(mo.centre, mo.radius), Vec4(float(2 * m), mo.stride_m, 0.0f, 0.0f),
+    model_records.push_back({Vec4(mo.centre, mo.radius), Vec4(float(2 * m), mo.stride_m, float(mo.geometry_indices / 3), 0.0f),
                              {mo.palette_poses, mo.frames, mo.azimuths, mo.elevations},
                              Vec4(mo.max_elevation, 0.0f, 0.0f, 0.0f)});
     initial_commands_.push_back({mo.geometry_indices, 0, mo.geometry_first_index, 0, 0});
@@ -103,19 +103,26 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
   initial_ = makeBuffer(initial_commands_.data(), initial_commands_.size() * sizeof(GpuCrowdCommand), bytes_);
   capacity_ = (agents.size() + 63) / 64 * 64;  // 64 records = 3,072 bytes: list offsets aligned for binding
   lists_ = makeBuffer(nullptr, initial_commands_.size() * capacity_ * sizeof(ListRecord), bytes_);
-  counts_ = makeBuffer(nullptr, 2 * sizeof(uint32_t), bytes_);
+  counts_ = makeBuffer(nullptr, 6 * sizeof(uint32_t), bytes_);
+  candidates_ = makeBuffer(nullptr, agents.size() * sizeof(uint32_t), bytes_);
+  const std::vector<uint32_t> zero(kBudgetBuckets, 0);
+  buckets_ = makeBuffer(zero.data(), zero.size() * sizeof(uint32_t), bytes_);
   simulate_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_SIMULATE 1\n");
   classify_ = Program::computeFromEmbedded("crowd_sim.comp.glsl");
   casters_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_CASTERS 1\n");
+  budget_scan_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_BUDGET_SCAN 1\n");
+  budget_assign_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_BUDGET_ASSIGN 1\n");
 }
 
 GpuCrowd::~GpuCrowd() {
-  for (uint32_t b : {agent_buf_, routes_, points_, poses_, phases_, model_buf_, commands_, initial_, lists_, counts_})
+  for (uint32_t b : {agent_buf_, routes_, points_, poses_, phases_, model_buf_, commands_, initial_, lists_, counts_,
+                     candidates_, buckets_})
     if (b) glDeleteBuffers(1, &b);
 }
 
 void GpuCrowd::bindBuffers() const {
-  const uint32_t buffers[] = {agent_buf_, routes_, points_, poses_, phases_, model_buf_, commands_, lists_, counts_};
+  const uint32_t buffers[] = {agent_buf_, routes_,  points_, poses_,      phases_, model_buf_,
+                              commands_,  lists_,   counts_, candidates_, buckets_};
   for (GLuint b = 0; b < GLuint(std::size(buffers)); ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, buffers[b]);
 }
 
@@ -126,6 +133,7 @@ void GpuCrowd::usePass(const Program& pass, const Camera& camera, std::span<cons
   pass.set("u_agents", uint32_t(agents_));
   pass.set("u_eye", camera.eye);
   pass.set("u_capacity", uint32_t(capacity_));
+  pass.set("u_budget", uint32_t(0));
   glUniform1fv(pass.uniformLocation("u_switch[0]"), kMaxModels, switches);
   bindBuffers();
 }
@@ -164,8 +172,14 @@ void GpuCrowd::castShadows(const Camera& camera, std::span<const float> switch_m
 }
 
 GpuCrowd::Counts GpuCrowd::readCounts() const {
-  const std::vector<uint32_t> c = readBuffer<uint32_t>(counts_, 0, 2);
-  return {c[0], c[1]};
+  const std::vector<uint32_t> c = readBuffer<uint32_t>(counts_, 0, 6);
+  Counts counts{c[0], c[1]};
+  if (budget_ > 0) {
+    counts.over_budget = c[3];
+    counts.budget_triangles_kept = c[4];
+    counts.budget_triangles_wanted = c[5];
+  }
+  return counts;
 }
 
 void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> switch_m) {
@@ -192,7 +206,27 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
     glUniform2iv(classify_.uniformLocation("u_level_size[0]"), GLsizei(pyramid_->levels()), sizes.data());
     pyramid_->bind(2, 3);
   }
+  // Under a budget: the candidates' buckets over the largest switch distance (a budget means nothing without one).
+  float largest_switch = 0.0f;
+  for (float d : switch_m)
+    if (d < 1e30f) largest_switch = std::max(largest_switch, d);
+  const bool budget = budget_ > 0 && largest_switch > 0.0f;
+  if (budget) {
+    classify_.set("u_budget", uint32_t(std::min<uint64_t>(budget_, UINT32_MAX)));
+    classify_.set("u_buckets", kBudgetBuckets);
+    classify_.set("u_buckets_per_m", float(kBudgetBuckets) / largest_switch);
+  }
   glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
+  if (budget) {
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    budget_scan_.use();
+    budget_scan_.set("u_budget", uint32_t(std::min<uint64_t>(budget_, UINT32_MAX)));
+    budget_scan_.set("u_buckets", kBudgetBuckets);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    usePass(budget_assign_, camera, switch_m);
+    glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
+  }
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
   if (occlude) {
     glBindTextureUnit(2, 0);

@@ -86,6 +86,15 @@ class GpuCrowd {
   // Lists: the camera's, 2m (geometry) and 2m + 1 (impostors); the casters', casterList(m, impostor).
   size_t casterList(size_t m, bool impostor) const { return 2 * models_ + 2 * m + (impostor ? 1 : 0); }
 
+  // A budget of skinned triangles for the cullAndClassify calls that follow (0: none, the default): of the agents in
+  // view inside their switch distance, the nearest whose models' triangles fit in it stay geometry and the others
+  // become impostors (runtime::CrowdRuntimeOptions::max_geometry_triangles' rule, impostors of the farthest), by
+  // distance buckets of 1/1024 of the largest switch distance (agents of one bucket go together, so a few triangles
+  // of the budget may stay unused): two more dispatches, no readback.
+  static constexpr uint32_t kBudgetBuckets = 1024;
+  void setGeometryBudget(uint64_t triangles) { budget_ = triangles; }
+  uint64_t geometryBudget() const { return budget_; }
+
   // Occlusion culling of the next cullAndClassify (that call only): agents whose bounding box lies behind `target`'s
   // current depth (the city, drawn first) over the box's whole footprint are left out, by the test of the CPU runtime's
   // cullBehind (gpu::projectBox, DepthPyramid::hides) on a depth pyramid built on the GPU: no readback. The target
@@ -93,8 +102,11 @@ class GpuCrowd {
   void occludeBehind(const RenderTarget& target);
   // After cullAndClassify (waits for the GPU; tests and counts, never inside a frame): agents in view, and of them
   // left out by occlusion.
+  // Under a budget: the agents inside their switch drawn as impostors for it, the skinned triangles kept, and those
+  // the agents inside their switch would have drawn.
   struct Counts {
     uint32_t in_view = 0, occluded = 0;
+    uint32_t over_budget = 0, budget_triangles_kept = 0, budget_triangles_wanted = 0;
   };
   Counts readCounts() const;
 
@@ -124,12 +136,13 @@ class GpuCrowd {
 
   size_t agents_ = 0, models_ = 0, capacity_ = 0;  // capacity: records a list holds (agents, rounded up to 64)
   uint32_t agent_buf_ = 0, routes_ = 0, points_ = 0, poses_ = 0, phases_ = 0, model_buf_ = 0, commands_ = 0,
-           initial_ = 0, lists_ = 0, counts_ = 0;
+           initial_ = 0, lists_ = 0, counts_ = 0, candidates_ = 0, buckets_ = 0;
+  uint64_t budget_ = 0;
   std::unique_ptr<GpuDepthPyramid> pyramid_;  // made by the first occludeBehind
   bool occlude_next_ = false;
   size_t bytes_ = 0;
   std::vector<GpuCrowdCommand> initial_commands_;
-  Program simulate_, classify_, casters_;
+  Program simulate_, classify_, casters_, budget_scan_, budget_assign_;
 };
 
 }  // namespace farfield::gpu

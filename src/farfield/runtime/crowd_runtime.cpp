@@ -420,18 +420,22 @@ CrowdFrameStats CrowdRuntime::drawGpuLists(const Camera& camera, gpu::GpuCrowd& 
 CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                                       const gpu::LightSettings& light, const gpu::RenderTarget* occluders) {
   const std::vector<float> switches = gpuSwitches(crowd, camera, policy);
+  crowd.setGeometryBudget(policy == CrowdPolicy::Mixed ? options_.max_geometry_triangles : 0);
   if (occluders) {
     crowd.occludeBehind(*occluders);
     occluders->bindForOpaquePass();  // the pyramid's compute left the draw state to us
   }
   crowd.cullAndClassify(camera, switches);
-  return drawGpuLists(camera, crowd, light);
+  CrowdFrameStats stats = drawGpuLists(camera, crowd, light);
+  stats.budget_triangles = crowd.geometryBudget();
+  return stats;
 }
 
 CrowdFrameStats CrowdRuntime::drawGpuShadowed(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                                               const gpu::LightSettings& light, const gpu::RenderTarget& target,
                                               const CrowdShadowOptions& shadows, bool occlude) {
   const std::vector<float> switches = gpuSwitches(crowd, camera, policy);
+  crowd.setGeometryBudget(policy == CrowdPolicy::Mixed ? options_.max_geometry_triangles : 0);
   if (occlude) crowd.occludeBehind(target);
   crowd.cullAndClassify(camera, switches);
   // The map over the receivers, grown by what a caster standing on one reaches (its sphere about its feet).
@@ -455,6 +459,7 @@ CrowdFrameStats CrowdRuntime::drawGpuShadowed(const Camera& camera, gpu::GpuCrow
   }
   target.bindForOpaquePass();
   CrowdFrameStats stats = drawGpuLists(camera, crowd, light);
+  stats.budget_triangles = crowd.geometryBudget();
   stats.shadow_texel_m = fit.projection.texel_m;
   if (!receiver_) receiver_ = std::make_unique<gpu::ShadowReceiver>();
   receiver_->apply(camera, *shadow_map_, fit.projection, target, light, shadows.agent_id_mask, shadows.bias_m,

@@ -165,16 +165,18 @@ class CrowdRuntime {
   // and classified on the GPU by the policy (Mixed: switchDistances), drawn by one indirect draw per model and
   // representation, the meshes at level 0. With occluders (the target holding the city, the camera's size), the
   // agents hidden behind its depth are left out first (GpuCrowd::occludeBehind, cullBehind's test). No readback and
-  // no per-agent upload. Not on this path yet: geometry budgets, levels of detail, blended views and shadows (the
-  // CPU path's draw and drawShadowed); the stats count draw calls only (the agents are counted on the GPU:
-  // GpuCrowd::readCommands, readCounts).
+  // no per-agent upload. Mixed's budget in triangles (max_geometry_triangles) holds here too, on the GPU
+  // (GpuCrowd::setGeometryBudget: impostors of the farthest, by distance buckets); not on this path yet: the budget
+  // in milliseconds, budget_coarsens, levels of detail and blended views. The stats count draw calls and the budget
+  // only (the agents are counted on the GPU: GpuCrowd::readCommands, readCounts).
   CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                           const gpu::LightSettings& light, const gpu::RenderTarget* occluders = nullptr);
   // As drawGpu into `target` (holding the city), with the agents' shadows: the map fitted to the receivers the
   // camera sees within shadows.distance_m (runtime::fitShadowReceivers: the casters are known on the GPU only), the
   // agents whose spheres reach into it cast in the representation the policy gives them (GpuCrowd::castShadows), and
   // the target's receivers are darkened (gpu::ShadowReceiver). occlude: agents behind the target's depth left out
-  // (their shadows still cast). shadows.impostor_casters is not on this path.
+  // (their shadows still cast). shadows.impostor_casters is not on this path, and casters take the switch distance
+  // alone (an agent turned into an impostor by the budget casts as geometry).
   CrowdFrameStats drawGpuShadowed(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                                   const gpu::LightSettings& light, const gpu::RenderTarget& target,
                                   const CrowdShadowOptions& shadows = {}, bool occlude = false);

@@ -4,6 +4,11 @@
 // its animation phase (the distance walked over its model's stride, as eval's crowdAgentStates); otherwise, each agent culled by the camera's frustum (a sphere
 // about its feet) and classified by its model's switch distance, its index appended to its model's geometry or
 // impostor list, whose indirect draw command counts it.
+// Under a geometry budget (GpuCrowd::setGeometryBudget; u_budget > 0) the classifying pass does not append the agents
+// inside their switch distance: it marks them as candidates with their distance bucket and adds their model's
+// triangles to that bucket's sum; FF_BUDGET_SCAN then finds the first bucket whose running sum passes the budget, and
+// FF_BUDGET_ASSIGN appends the candidates nearer than it as geometry and the others as impostors ("over budget"): the
+// nearest agents keep their geometry, and the skinned triangles stay within the budget.
 
 layout(local_size_x = 64) in;
 
@@ -50,7 +55,9 @@ uniform vec3 u_eye;
 uniform float u_switch[16];    // per model: geometry nearer than this (metres)
 uniform uint u_capacity;       // agents a list holds
 // Occlusion (GpuCrowd::occludeBehind): the target's depth pyramid, and the camera that projects agents into it.
-layout(std430, binding = 8) buffer Stats { uint stats[]; };  // in view, of them left out behind the depth
+// in view, of them left out behind the depth; under a budget: the first bucket over it, candidates over it, the
+// triangles kept, the triangles wanted
+layout(std430, binding = 8) buffer Stats { uint stats[]; };
 layout(binding = 2) uniform sampler2D u_depth;               // level 0: the target's depth
 layout(binding = 3) uniform sampler2D u_pyramid;             // levels 1.. in its mips 0..
 uniform int u_occlusion;
@@ -63,6 +70,13 @@ uniform mat4 u_light_view_proj;
 uniform vec2 u_light_scale;
 uniform vec3 u_to_light;
 uniform uint u_first_list;
+// The geometry budget: skinned triangles a frame (0: none), and the candidates' distance buckets.
+layout(std430, binding = 9) buffer Candidates { uint candidates[]; };  // per agent: its bucket, or kNone
+layout(std430, binding = 10) buffer Buckets { uint buckets[]; };       // per bucket: the candidates' triangles
+uniform uint u_budget;
+uniform uint u_buckets;
+uniform float u_buckets_per_m;
+const uint kNone = 0xFFFFFFFFu;
 
 const float kTwoPi = 6.28318530717958647692;
 
@@ -131,11 +145,9 @@ bool hidden(vec3 c, float r) {
 }
 
 #ifndef FF_SIMULATE
-// Agent i into its model's geometry or impostor list after `first_list` (the camera's switch decides), as the
-// renderer's record: the palette pose or the atlas frame nearest its phase, and for an impostor the view nearest
-// `view_dir` (agent space).
-void append(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 c, vec3 view_dir) {
-  bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
+// Agent i into its model's geometry or impostor list after `first_list`, as the renderer's record: the palette pose
+// or the atlas frame nearest its phase, and for an impostor the view nearest `view_dir` (agent space).
+void append(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 view_dir, bool impostor) {
   uint list = first_list + uint(m.lists.x) + (impostor ? 1u : 0u);
   uint slot = atomicAdd(commands[list].instance_count, 1u);
   Record r;
@@ -189,12 +201,48 @@ void main() {
   if (abs(p.x) > 1.0 + r * u_light_scale.x || abs(p.y) > 1.0 + r * u_light_scale.x || p.z < -r * u_light_scale.y ||
       p.z > 1.0 + r * u_light_scale.y)
     return;
-  append(u_first_list, i, a, m, pose, c, turn(-pose.w, u_to_light));
+  append(u_first_list, i, a, m, pose, turn(-pose.w, u_to_light), !(distance(u_eye, c) < u_switch[a.model]));
+}
+#elif defined(FF_BUDGET_SCAN)
+// One invocation: the first bucket whose running sum of triangles passes the budget (u_buckets: none does), the
+// triangles kept and wanted; the buckets cleared for the next frame.
+void main() {
+  if (gl_GlobalInvocationID.x != 0u) return;
+  uint kept = 0u, wanted = 0u, first_over = u_buckets;
+  for (uint b = 0u; b < u_buckets; ++b) {
+    uint t = buckets[b];
+    wanted += t;
+    if (first_over == u_buckets) {
+      if (t > u_budget - kept) first_over = b;
+      else kept += t;
+    }
+    buckets[b] = 0u;
+  }
+  stats[2] = first_over;
+  stats[4] = kept;
+  stats[5] = wanted;
+}
+#elif defined(FF_BUDGET_ASSIGN)
+// The candidates nearer than the first bucket over the budget as geometry, the others as impostors.
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= u_agents) return;
+  uint bucket = candidates[i];
+  if (bucket == kNone) return;
+  Agent a = agents[i];
+  Model m = models[a.model];
+  vec4 pose = poses[i];
+  vec3 c = pose.xyz + turn(pose.w, m.sphere.xyz);
+  bool impostor = bucket >= stats[2];
+  if (impostor) atomicAdd(stats[3], 1u);
+  vec3 local = turn(-pose.w, u_eye - c);
+  append(0u, i, a, m, pose, length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0), impostor);
 }
 #else
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= u_agents) return;
+  if (u_budget != 0u) candidates[i] = kNone;
   Agent a = agents[i];
   Model m = models[a.model];
   vec4 pose = poses[i];
@@ -207,7 +255,15 @@ void main() {
     atomicAdd(stats[1], 1u);
     return;
   }
+  float d = distance(u_eye, c);
+  bool impostor = !(d < u_switch[a.model]);
+  if (u_budget != 0u && !impostor) {  // a candidate for geometry: FF_BUDGET_ASSIGN decides
+    uint bucket = min(uint(d * u_buckets_per_m), u_buckets - 1u);
+    candidates[i] = bucket;
+    atomicAdd(buckets[bucket], uint(m.lists.z));
+    return;
+  }
   vec3 local = turn(-pose.w, u_eye - c);  // the eye in agent space
-  append(0u, i, a, m, pose, c, length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0));
+  append(0u, i, a, m, pose, length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0), impostor);
 }
 #endif
