@@ -19,6 +19,7 @@
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
+#include "farfield/image/metrics.h"
 #include "farfield/runtime/crowd_runtime.h"
 #include "runtime/grey_quad.h"
 
@@ -326,6 +327,26 @@ TEST(GpuCrowdGL, FramesEqualTheCpuPathsOnTheCrowdsPixels) {
     EXPECT_GE(double(same_id), 0.995 * double(crowd_px));
     EXPECT_GE(double(same_colour), 0.99 * double(crowd_px));
   }
+  // Blended views (the four around each impostor's direction): the same on both paths too, and not the nearest
+  // view's frame.
+  runtime::CrowdRuntimeOptions blend;
+  blend.blend_views = true;
+  runtime::CrowdRuntime blended(scene.models.models, scene.models.options, blend);
+  gpu::RenderTarget cpu(camera.width, camera.height), gpu_path(camera.width, camera.height),
+      nearest(camera.width, camera.height);
+  for (gpu::RenderTarget* t : {&cpu, &gpu_path, &nearest}) t->clear(Vec4(0.5f, 0.6f, 0.7f, 1.0f));
+  cpu.bindForOpaquePass();
+  blended.draw(camera, states, runtime::CrowdPolicy::Impostor, light);
+  gpu_path.bindForOpaquePass();
+  blended.drawGpu(camera, gc, runtime::CrowdPolicy::Impostor, light);
+  nearest.bindForOpaquePass();
+  rt.drawGpu(camera, gc, runtime::CrowdPolicy::Impostor, light);
+  const double same = image::psnr(cpu.readColor(), gpu_path.readColor());
+  const double other = image::psnr(nearest.readColor(), gpu_path.readColor());
+  std::printf("blended views: GPU path against the CPU path %.1f dB, against the nearest view's frame %.1f dB\n", same,
+              other);
+  EXPECT_GT(same, 50.0);
+  EXPECT_LT(other, same - 10.0);
 }
 
 // Occlusion on the GPU (GpuCrowd::occludeBehind): behind a wall drawn first, the agents the CPU runtime's exact

@@ -389,11 +389,12 @@ FrameStats CrowdRenderer::drawSkinnedIndirect(const Camera& camera, const Skinne
 
 FrameStats CrowdRenderer::drawImpostorsIndirect(const Camera& camera, const ImpostorAtlasGpu& atlas, uint32_t agents,
                                                 size_t offset, size_t bytes, uint32_t commands,
-                                                size_t command_offset, const LightSettings& light) {
+                                                size_t command_offset, const LightSettings& light,
+                                                bool blend_views) {
   FrameStats stats;
   if (bytes == 0) return stats;
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
-  useImpostors(camera, atlas, light, false);
+  useImpostors(camera, atlas, light, blend_views);
   glDisable(GL_CULL_FACE);
   drawIndirect(empty_vao_, commands, command_offset, false);
   glEnable(GL_CULL_FACE);

@@ -151,9 +151,10 @@ class CrowdRenderer {
   // of 4 vertices). No upload and no wait; the stats count the draw call alone (the agents are known on the GPU).
   FrameStats drawSkinnedIndirect(const Camera& camera, const SkinnedGpuModel& model, uint32_t agents, size_t offset,
                                  size_t bytes, uint32_t commands, size_t command_offset, const LightSettings& light);
+  // blend_views as drawImpostors' (the four views around each quad's direction, found in the vertex shader).
   FrameStats drawImpostorsIndirect(const Camera& camera, const ImpostorAtlasGpu& atlas, uint32_t agents,
                                    size_t offset, size_t bytes, uint32_t commands, size_t command_offset,
-                                   const LightSettings& light);
+                                   const LightSettings& light, bool blend_views = false);
   // The shadow casters' depth-only draws for GPU-written records, as drawSkinnedIndirect and drawImpostorsIndirect.
   FrameStats drawSkinnedDepthIndirect(const Mat4& light_view_proj, const SkinnedGpuModel& model, uint32_t agents,
                                       size_t offset, size_t bytes, uint32_t commands, size_t command_offset);

@@ -411,7 +411,7 @@ CrowdFrameStats CrowdRuntime::drawGpuLists(const Camera& camera, gpu::GpuCrowd& 
     stats.draw.draw_calls +=
         renderer_.drawImpostorsIndirect(camera, *models_[m].impostor->atlas, crowd.listBuffer(),
                                         crowd.listOffset(2 * m + 1), crowd.listBytes(), crowd.commandBuffer(),
-                                        (2 * m + 1) * command, light)
+                                        (2 * m + 1) * command, light, options_.blend_views)
             .draw_calls;
   }
   return stats;

@@ -166,8 +166,8 @@ class CrowdRuntime {
   // representation, the meshes at level 0. With occluders (the target holding the city, the camera's size), the
   // agents hidden behind its depth are left out first (GpuCrowd::occludeBehind, cullBehind's test). No readback and
   // no per-agent upload. Mixed's budget in triangles (max_geometry_triangles) holds here too, on the GPU
-  // (GpuCrowd::setGeometryBudget: impostors of the farthest, by distance buckets); not on this path yet: the budget
-  // in milliseconds, budget_coarsens, levels of detail and blended views. The stats count draw calls and the budget
+  // (GpuCrowd::setGeometryBudget: impostors of the farthest, by distance buckets), and so do blended views; not on
+  // this path yet: the budget in milliseconds, budget_coarsens and levels of detail. The stats count draw calls and the budget
   // only (the agents are counted on the GPU: GpuCrowd::readCommands, readCounts).
   CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                           const gpu::LightSettings& light, const gpu::RenderTarget* occluders = nullptr);
