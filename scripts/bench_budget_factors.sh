@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# The frame budget kept on the frames the runtime draws (issue 43's check), as a new user would try it: for each city
+# and path (none used by a test or tuning), this machine's frame with region visibility alone (a placement with no
+# impostor, walked over the path: median M), then for each factor f a placement under t_max = f x M and an error
+# bound, and the walkthrough benchmark of the placed impostors without the governor (the cost model alone) and under
+# it (`governed`), against full-geometry reference frames. Writes OUT/budget.md: per city, path and factor, the
+# impostors placed and their GPU memory, frames over t_max with and without the governor, frames relaxed (and to what
+# bound), the image error, and the cost model's measured / predicted quantiles on the calibration's held-out views.
+# Usage: scripts/bench_budget_factors.sh FARFIELD OUT
+# Environment: CASES (default "150:3:211:car 150:3:307:walk 200:2:419:car": blocks:detail:seed:path, path car or
+# walk), FACTORS (default "0.4 0.6 0.8"), BOUND (px, default 2), FRAMES (path frames, default 300), STRIDE (default 3).
+set -euo pipefail
+FARFIELD=${1:-build/release/bin/farfield}
+OUT=${2:-out/bench/budget}
+CASES=${CASES:-"150:3:211:car 150:3:307:walk 200:2:419:car"}
+FACTORS=${FACTORS:-"0.4 0.6 0.8"}
+BOUND=${BOUND:-2}
+FRAMES=${FRAMES:-300}
+STRIDE=${STRIDE:-3}
+SIZE=640x360
+FOV=60
+mkdir -p "$OUT"
+start=$(date +%s)
+say() { echo "== [$(( $(date +%s) - start )) s] $*"; }
+table="$OUT/budget.md"
+{
+  echo "# The frame budget at factors of the no-impostor walkthrough ($(date -u +%Y-%m-%d))"
+  echo
+  echo "scripts/bench_budget_factors.sh; $SIZE, ${FRAMES}-frame paths, every ${STRIDE}th frame measured, ${BOUND} px."
+  echo
+  echo "| city (blocks, detail, seed) | path | no-impostor median ms | model held-out measured/predicted p50, p95 | factor | t_max ms | impostors | GPU MiB | placed: median ms, frames over t_max | governed: median ms, frames over t_max, relaxed (largest bound px) | PSNR placed / governed dB | frames over the bound |"
+  echo "|---|---|---:|---|---:|---:|---:|---:|---|---|---|---|"
+} > "$table"
+for spec in $CASES; do
+  IFS=: read -r blocks detail seed kind <<< "$spec"
+  dir="$OUT/b${blocks}-d${detail}-s${seed}-${kind}"
+  mkdir -p "$dir"
+  say "city $blocks blocks, detail $detail, seed $seed; a $kind path"
+  "$FARFIELD" gen city --blocks "$blocks" --detail "$detail" --seed "$seed" --objects buildings -o "$dir/city.glb" \
+    > "$dir/gen.txt" 2>&1
+  car=()
+  [ "$kind" = car ] && car=(--car)
+  "$FARFIELD" path street "$dir/city.streets.json" --frames "$FRAMES" --seed "$seed" "${car[@]}" --fov "$FOV" \
+    -o "$dir/path.json" > "$dir/path.txt" 2>&1
+  district=(--size "$SIZE" --fov "$FOV" --around "$dir/path.json" --margin 30 --max-pitch 20 --error-px "$BOUND"
+            --visibility-cache "$dir/visibility.bin")
+  say "visible sets"
+  "$FARFIELD" place "$dir/city.glb" -o "$dir/visibility" "${district[@]}" --visibility-only > "$dir/visibility.txt" 2>&1
+  say "calibrate"
+  "$FARFIELD" calibrate "$dir/city.glb" -o "$dir/profile.json" --size "$SIZE" --fov "$FOV" --views 60 --fit-views 40 \
+    --visibility-cache "$dir/visibility.bin" > "$dir/calibrate.txt" 2>&1
+  ratios=$(python3 -c '
+import json, sys
+p = json.load(open(sys.argv[1]))
+v = p.get("validation", {})
+print("%.2f, %.2f" % (v.get("ratio_p50", float("nan")), v.get("ratio_p95", float("nan"))))' "$dir/profile.json" \
+    2>/dev/null || echo "?")
+  say "no impostor: place and walk"
+  "$FARFIELD" place "$dir/city.glb" --profile "$dir/profile.json" -o "$dir/no_impostor" --tmax 1000 "${district[@]}" \
+    --view-cells none > "$dir/no_impostor.txt" 2>&1
+  "$FARFIELD" walk "$dir/city.glb" --path "$dir/path.json" --mode placed \
+    --mode-option impostor_dir="$dir/no_impostor" --size "$SIZE" > "$dir/no_impostor_walk.txt" 2>&1
+  median=$(awk '/^wall ms:/ {print $4}' "$dir/no_impostor_walk.txt")
+  for f in $FACTORS; do
+    tmax=$(awk -v m="$median" -v f="$f" 'BEGIN {printf "%.1f", m * f}')
+    run="$dir/f$f"
+    mkdir -p "$run"
+    say "factor $f: t_max $tmax ms: place"
+    "$FARFIELD" place "$dir/city.glb" --profile "$dir/profile.json" -o "$run/placement" --tmax "$tmax" \
+      "${district[@]}" > "$run/place.txt" 2>&1
+    say "factor $f: bench placed and governed"
+    "$FARFIELD" bench "$dir/city.glb" --path "$dir/path.json" --impostors "$run/placement" \
+      --modes placed,governed --mode-option governed=placed --mode-option governor_error_px="$BOUND" \
+      --reference --size "$SIZE" --tmax "$tmax" --error-px "$BOUND" --stride "$STRIDE" -o "$run" \
+      > "$run/bench.txt" 2>&1
+    python3 - "$run" "$blocks" "$detail" "$seed" "$kind" "$median" "$ratios" "$f" "$tmax" "$BOUND" >> "$table" <<'EOF'
+import json, sys
+run, blocks, detail, seed, kind, median, ratios, f, tmax, bound = sys.argv[1:]
+placement = json.load(open(run + "/placement/placement.json"))["summary"]
+bench = json.load(open(run + "/bench.json"))
+p, g = bench["modes"]["placed"], bench["modes"]["governed"]
+frames = p.get("frames_checked_against_bound", bench.get("frames", 0))
+print(f"| {blocks}, {detail}, {seed} | {kind} | {float(median):.1f} | {ratios} | {f} | {float(tmax):.1f} | "
+      f"{placement['impostors']} | {placement['memory_bytes'] / 2**20:.1f} | "
+      f"{p['median_ms']:.1f}, {p['frames_over_tmax']} of {frames} | "
+      f"{g['median_ms']:.1f}, {g['frames_over_tmax']} of {frames}, {g['frames_relaxed']} "
+      f"({float(bound) * g['bound_scale_max']:.0f}) | {p['psnr_db_mean']:.1f} / {g['psnr_db_mean']:.1f} | "
+      f"{p['frames_over_bound']} / {g['frames_over_bound']} |")
+EOF
+  done
+done
+say "wrote $table"
+cat "$table"
