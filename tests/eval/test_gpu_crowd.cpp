@@ -52,6 +52,34 @@ std::vector<gpu::GpuCrowdModel> testModels() {
   return {a, b};
 }
 
+// A 640 x 360 camera over the test crowd.
+Camera crowdCamera(const Vec3& eye, const Vec3& at) {
+  Camera c;
+  c.eye = eye;
+  c.at = at;
+  c.width = 640;
+  c.height = 360;
+  c.near_plane = 0.5f;
+  c.far_plane = 5000.0f;
+  return c;
+}
+
+// The runtime's bounding-sphere centre of an agent at a GPU pose: the model's centre turned by the heading, about the
+// feet, in double precision.
+DVec3 agentCentre(const Vec4& pose, const gpu::GpuCrowdModel& m) {
+  const double h = pose.w;
+  return DVec3(Vec3(pose)) + DVec3(std::cos(h) * m.centre.x - std::sin(h) * m.centre.y,
+                                   std::sin(h) * m.centre.x + std::cos(h) * m.centre.y, m.centre.z);
+}
+
+// One frame of the GPU crowd, simulated to t and classified for the camera: the GL work it asked for.
+gpu::GlCounters classifyCounted(gpu::GpuCrowd& gc, float t, const Camera& c, std::span<const float> switches) {
+  const gpu::GlCounters before = gpu::glCounters();
+  gc.simulate(t);
+  gc.cullAndClassify(c, switches);
+  return gpu::glCounters() - before;
+}
+
 float angleDifference(float a, float b) {
   const float d = std::fmod(std::abs(a - b), float(2.0 * kPi));
   return std::min(d, float(2.0 * kPi) - d);
@@ -96,19 +124,11 @@ TEST(GpuCrowdGL, CullingAndClassificationEqualACpuBruteForce) {
     for (const Vec2& p : r.loop) lo = glm::min(lo, p), hi = glm::max(hi, p);
   size_t geometry = 0, impostors = 0;
   for (int trial = 0; trial < 6; ++trial) {
-    Camera c;
-    c.eye = Vec3(lo.x + u(rng) * (hi.x - lo.x), lo.y + u(rng) * (hi.y - lo.y), 1.7f + 60.0f * u(rng));
-    c.at = Vec3(lo.x + u(rng) * (hi.x - lo.x), lo.y + u(rng) * (hi.y - lo.y), 0.0f);
-    c.width = 640;
-    c.height = 360;
-    c.near_plane = 0.5f;
-    c.far_plane = 5000.0f;
+    const Vec3 eye(lo.x + u(rng) * (hi.x - lo.x), lo.y + u(rng) * (hi.y - lo.y), 1.7f + 60.0f * u(rng));
+    const Camera c = crowdCamera(eye, Vec3(lo.x + u(rng) * (hi.x - lo.x), lo.y + u(rng) * (hi.y - lo.y), 0.0f));
     const std::vector<float> switches{20.0f + 30.0f * u(rng), 10.0f + 20.0f * u(rng)};
     const float t = 10.0f * u(rng);
-    const gpu::GlCounters before = gpu::glCounters();
-    gc.simulate(t);
-    gc.cullAndClassify(c, switches);
-    const gpu::GlCounters frame = gpu::glCounters() - before;
+    const gpu::GlCounters frame = classifyCounted(gc, t, c, switches);
     if (gpu::glCountersInstalled()) {
       EXPECT_EQ(frame.syncs, 0u) << "nothing in the frame waits for the GPU";
       EXPECT_LT(frame.upload_bytes, 512u) << "only a few uniforms are sent";
@@ -121,9 +141,7 @@ TEST(GpuCrowdGL, CullingAndClassificationEqualACpuBruteForce) {
     std::vector<std::set<uint32_t>> expected(2 * models.size()), near_threshold(2 * models.size());
     for (size_t i = 0; i < crowd.agents.size(); ++i) {
       const gpu::GpuCrowdModel& m = models[crowd.agents[i].model];
-      const double h = poses[i].w;  // the model's centre turned by the heading, about the feet
-      const DVec3 centre = DVec3(Vec3(poses[i])) + DVec3(std::cos(h) * m.centre.x - std::sin(h) * m.centre.y,
-                                                          std::sin(h) * m.centre.x + std::cos(h) * m.centre.y, m.centre.z);
+      const DVec3 centre = agentCentre(poses[i], m);
       const double radius = m.radius;
       bool inside = true, borderline = false;
       for (const Vec4& p : f.planes) {
@@ -176,30 +194,18 @@ TEST(GpuCrowdGL, TheGeometryBudgetKeepsTheNearestAgentsAsGeometry) {
   for (size_t k = 0; k < 4; ++k) {
     // A pedestrian's eye among the agents, looking along the street.
     const Vec4 p = start[k * 4999];
-    Camera c;
-    c.eye = Vec3(p) + Vec3(0.0f, 0.0f, 1.7f);
-    c.at = c.eye + Vec3(std::cos(p.w), std::sin(p.w), -0.05f);
-    c.width = 640;
-    c.height = 360;
-    c.near_plane = 0.5f;
-    c.far_plane = 5000.0f;
+    const Vec3 eye = Vec3(p) + Vec3(0.0f, 0.0f, 1.7f);
+    const Camera c = crowdCamera(eye, eye + Vec3(std::cos(p.w), std::sin(p.w), -0.05f));
     const uint64_t budget = 20000 + 15000 * k;
     gc.setGeometryBudget(budget);
-    const gpu::GlCounters before = gpu::glCounters();
-    gc.simulate(t);
-    gc.cullAndClassify(c, switches);
-    const gpu::GlCounters frame = gpu::glCounters() - before;
+    const gpu::GlCounters frame = classifyCounted(gc, t, c, switches);
     if (gpu::glCountersInstalled()) {
       EXPECT_EQ(frame.syncs, 0u) << "nothing in the frame waits for the GPU";
       EXPECT_EQ(frame.dispatches, 4u) << "simulate, classify, the budget's scan and assignment";
     }
     const std::vector<Vec4> poses = gc.readPoses();
     auto distanceOf = [&](uint32_t i) {
-      const gpu::GpuCrowdModel& m = models[crowd.agents[i].model];
-      const double h = poses[i].w;
-      const DVec3 centre = DVec3(Vec3(poses[i])) + DVec3(std::cos(h) * m.centre.x - std::sin(h) * m.centre.y,
-                                                          std::sin(h) * m.centre.x + std::cos(h) * m.centre.y, m.centre.z);
-      return glm::length(DVec3(c.eye) - centre);
+      return glm::length(DVec3(c.eye) - agentCentre(poses[i], models[crowd.agents[i].model]));
     };
     auto trianglesOf = [&](uint32_t i) { return uint64_t(models[crowd.agents[i].model].geometry_indices / 3); };
     // The GPU's lists (ids are the agents' indices here).

@@ -116,22 +116,26 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
           samples.push_back({triangles, double(sprite_calls + 1), double(w) * double(h), median(times)});
         }
       if (options.gpu_high) {
-        // The CDLOD frames at each threshold (one untimed warm-up draw first: llvmpipe compiles at the first draw).
-        target.clear(sky);
-        options.gpu_high->draw(camera, options.pixel_errors.front(), target);
-        renderer.finish();
-        for (const float tau : options.pixel_errors) {
-          std::vector<double> times;
-          double triangles = 0.0;
-          for (int r = 0; r < options.repeats; ++r) {
-            Stopwatch clock;
-            target.clear(sky);
-            triangles = double(options.gpu_high->draw(camera, tau, target).draw.triangles);
-            renderer.finish();
-            times.push_back(clock.milliseconds());
+        // The CDLOD frames at each threshold into `out` (one untimed warm-up draw first: llvmpipe compiles a program
+        // at its first draw).
+        auto timeCdlod = [&](std::vector<gpu::CostSample>& out) {
+          target.clear(sky);
+          options.gpu_high->draw(camera, options.pixel_errors.front(), target);
+          renderer.finish();
+          for (const float tau : options.pixel_errors) {
+            std::vector<double> times;
+            double triangles = 0.0;
+            for (int r = 0; r < options.repeats; ++r) {
+              Stopwatch clock;
+              target.clear(sky);
+              triangles = double(options.gpu_high->draw(camera, tau, target).draw.triangles);
+              renderer.finish();
+              times.push_back(clock.milliseconds());
+            }
+            out.push_back({triangles, 1.0, double(w) * double(h), median(times)});
           }
-          gpu_samples.push_back({triangles, 1.0, double(w) * double(h), median(times)});
-        }
+        };
+        timeCdlod(gpu_samples);
         // The sprite frames: this view's keyframe (the finest threshold) as the sprite, the mesh at each threshold.
         sprite.clear(sky);
         options.gpu_high->draw(camera, options.pixel_errors.front(), sprite);
@@ -140,21 +144,7 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
         key.depth = &sprite.depthTexture();
         key.camera = camera;
         options.gpu_high->renderer().setSprite(key);
-        target.clear(sky);
-        options.gpu_high->draw(camera, options.pixel_errors.front(), target);  // untimed: the program's first draw
-        renderer.finish();
-        for (const float tau : options.pixel_errors) {
-          std::vector<double> times;
-          double triangles = 0.0;
-          for (int r = 0; r < options.repeats; ++r) {
-            Stopwatch clock;
-            target.clear(sky);
-            triangles = double(options.gpu_high->draw(camera, tau, target).draw.triangles);
-            renderer.finish();
-            times.push_back(clock.milliseconds());
-          }
-          sprite_samples.push_back({triangles, 1.0, double(w) * double(h), median(times)});
-        }
+        timeCdlod(sprite_samples);
         options.gpu_high->renderer().clearSprite();
         sprite.clear(sky);
       }
