@@ -180,6 +180,10 @@ TEST(TerrainBenchGL, LodSpriteIsCloserToHighThanLowIs) {
   ASSERT_TRUE(r.psnr_mean.count("low") && r.psnr_mean.count("lod-sprite"));
   EXPECT_GT(r.psnr_mean.at("lod-sprite"), r.psnr_mean.at("low"));
   EXPECT_LT(r.psnr_mean.at("low"), kPsnrCapDb);  // the low LOD differs from the high one on this terrain
+  // Against the full-resolution grid (drawn: this terrain is small), the 1 px LOD is closer than the 4 px one.
+  ASSERT_TRUE(r.psnr_full_mean.count("high") && r.psnr_full_mean.count("low"));
+  EXPECT_GT(r.psnr_full_mean.at("high"), r.psnr_full_mean.at("low"));
+  EXPECT_LT(r.psnr_full_mean.at("high"), kPsnrCapDb);
   for (const char* variant : {"lod-sprite-always", "lod-sprite-predict", "lod-sprite-cache"}) {
     ASSERT_TRUE(r.psnr_mean.count(variant)) << variant;
     EXPECT_GT(r.psnr_mean.at(variant), r.psnr_mean.at("low")) << variant;

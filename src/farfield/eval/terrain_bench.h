@@ -75,7 +75,8 @@ struct TerrainBenchOptions {
 // Per measured frame of the quality pass: mode -> PSNR against the high-resolution frame (dB, capped at kPsnrCapDb).
 struct TerrainQualityRow {
   size_t path_frame = 0;
-  std::map<std::string, double> psnr;
+  std::map<std::string, double> psnr;       // against the high-resolution LOD's frame ("today's high")
+  std::map<std::string, double> psnr_full;  // against the full-resolution grid's frame, where it is drawn; "high" too
 };
 
 // Figure 12: lod-sprite keyframes over the path at another frame count (render-free simulation).
@@ -123,6 +124,7 @@ struct TerrainBenchResult {
   size_t stalled_frames = 0;               // left out of the filtered totals
   std::vector<TerrainQualityRow> quality;
   std::map<std::string, double> psnr_mean;  // mode -> mean PSNR against high over `quality`
+  std::map<std::string, double> psnr_full_mean;  // mode -> mean PSNR against full resolution (empty: not drawn)
   std::vector<KeyframesVsFrames> keyframes_vs_frames;  // empty without sweeps
   std::vector<EpsilonSweepRow> epsilon_sweep;          // empty without sweeps
   std::vector<BackAndForthRow> back_and_forth;         // empty without sweeps

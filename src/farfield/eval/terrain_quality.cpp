@@ -33,11 +33,13 @@
 
 namespace farfield::eval::terrain_experiment {
 
-// 2. Quality pass (untimed): every mode's frame against the high-resolution frame, and Figure 6's views.
+// 2. Quality pass (untimed): every mode's frame against the high-resolution frame (and against the full-resolution
+// grid's frame where it fits: which LOD is closer to the surface itself), and Figure 6's views.
 void runQuality(Experiment& x) {
   const TerrainBenchOptions& o = x.options;
   const BenchResult& bench = x.result.bench;
   const terrain::TerrainData& data = x.data();
+  const bool full = size_t(data.hf.width - 1) * size_t(data.hf.height - 1) * 2 <= o.full_max_triangles;
   say(o, "quality: frames against high resolution (every %zu)\n", o.quality_stride);
   gpu::TerrainRenderer& renderer = x.run->gpuRenderer();
   gpu::RenderTarget target(o.width, o.height);
@@ -71,8 +73,18 @@ void runQuality(Experiment& x) {
     const bool measure = k % o.quality_stride == 0 || views.count(pf);
     TerrainQualityRow row;
     row.path_frame = pf;
-    image::ColorImage high_image, low_image;
+    image::ColorImage high_image, low_image, full_image;
     uint64_t high_tris = 0, low_tris = 0;
+    // A mode's frame against high (and full): the one place the rows are filled.
+    auto compare = [&](const std::string& name, const image::ColorImage& img) {
+      row.psnr[name] = std::min(image::psnr(high_image, img), kPsnrCapDb);
+      if (full) row.psnr_full[name] = std::min(image::psnr(full_image, img), kPsnrCapDb);
+    };
+    if (measure && full) {
+      target.clear(x.run->sky);
+      terrain::renderLodFrame(*data.lod, renderer, camera, {1e-6f, true, false}, target, mesh);
+      full_image = target.readColor();
+    }
     if (measure) {
       target.clear(x.run->sky);
       high_tris = terrain::renderLodFrame(*data.lod, renderer, camera, {o.high_error, true, false}, target, mesh)
@@ -82,7 +94,8 @@ void runQuality(Experiment& x) {
       low_tris = terrain::renderLodFrame(*data.lod, renderer, camera, {o.low_error, true, false}, target, mesh)
                      .triangles;
       low_image = target.readColor();
-      row.psnr["low"] = std::min(image::psnr(high_image, low_image), kPsnrCapDb);
+      compare("low", low_image);
+      if (full) row.psnr_full["high"] = std::min(image::psnr(full_image, high_image), kPsnrCapDb);
     }
     for (auto& [name, s] : sprites) {
       target.clear(x.run->sky);
@@ -90,7 +103,7 @@ void runQuality(Experiment& x) {
       s->render(camera, target, &info);
       if (!measure) continue;
       const image::ColorImage img = target.readColor();
-      row.psnr[name] = std::min(image::psnr(high_image, img), kPsnrCapDb);
+      compare(name, img);
       if (name == "lod-sprite" && views.count(pf)) {
         ++view_number;
         const std::string tag = "view" + std::to_string(view_number);
@@ -111,7 +124,7 @@ void runQuality(Experiment& x) {
       t->render(camera, target);
       if (!measure) continue;
       const image::ColorImage img = target.readColor();
-      row.psnr[name] = std::min(image::psnr(high_image, img), kPsnrCapDb);
+      compare(name, img);
       if (views.count(pf)) {  // Figure 6's views for the tile modes too, next to lod-sprite's
         const std::string tag = "view" + std::to_string(1 + std::distance(views.begin(), views.find(pf)));
         const fs::path dir = x.figures / "fig06";
@@ -124,7 +137,7 @@ void runQuality(Experiment& x) {
       target.clear(x.run->sky);
       x.run->gpuLod().draw(camera, name == "high-gpu" ? o.high_error : o.low_error, target);
       const image::ColorImage img = target.readColor();
-      row.psnr[name] = std::min(image::psnr(high_image, img), kPsnrCapDb);
+      compare(name, img);
       if (views.count(pf)) {
         const std::string tag = "view" + std::to_string(1 + std::distance(views.begin(), views.find(pf)));
         const fs::path dir = x.figures / "fig06";
@@ -137,19 +150,26 @@ void runQuality(Experiment& x) {
   }
   progress.finish();
   writeText(x.figures / "fig06_views.csv", views_csv.str());
-  for (const TerrainQualityRow& row : x.result.quality)
+  for (const TerrainQualityRow& row : x.result.quality) {
     for (const auto& [name, v] : row.psnr) x.result.psnr_mean[name] += v / double(x.result.quality.size());
+    for (const auto& [name, v] : row.psnr_full) x.result.psnr_full_mean[name] += v / double(x.result.quality.size());
+  }
 
   std::ostringstream q;
   q << "path_frame";
   std::vector<std::string> qnames;
   if (!x.result.quality.empty())
     for (const auto& [name, v] : x.result.quality.front().psnr) qnames.push_back(name);
+  std::vector<std::string> fnames;
+  if (!x.result.quality.empty())
+    for (const auto& [name, v] : x.result.quality.front().psnr_full) fnames.push_back(name);
   for (const std::string& n : qnames) q << ",psnr_" << n << "_vs_high_db";
+  for (const std::string& n : fnames) q << ",psnr_" << n << "_vs_full_db";
   q << "\n";
   for (const TerrainQualityRow& row : x.result.quality) {
     q << row.path_frame;
     for (const std::string& n : qnames) q << "," << num(row.psnr.at(n), 3);
+    for (const std::string& n : fnames) q << "," << num(row.psnr_full.at(n), 3);
     q << "\n";
   }
   writeText(x.figures / "quality.csv", q.str());
