@@ -17,7 +17,7 @@
 # frames they served; it is the governed walkthrough's) and OUT/report.md, and OUT/impostor_stretch.json: the drive's
 # longest stretch drawn with impostors, for the viewer.
 # Environment: FF_DEMO_BLOCKS, FF_DEMO_DETAIL, FF_DEMO_SEED, FF_DEMO_FRAMES, FF_DEMO_STRIDE, FF_DEMO_TMAX_FACTOR,
-# FF_DEMO_TMAX (ms), FF_DEMO_BOUND (px).
+# FF_DEMO_TMAX (ms), FF_DEMO_BOUND (px), FF_DEMO_GOVERNOR_SCALES (the governor's resolution levels).
 set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
 OUT=${2:-out/demo}
@@ -28,6 +28,8 @@ FRAMES=${FF_DEMO_FRAMES:-300}
 STRIDE=${FF_DEMO_STRIDE:-2}
 TMAX_FACTOR=${FF_DEMO_TMAX_FACTOR:-0.9}
 TMAX=${FF_DEMO_TMAX:-}
+# The governor's render-resolution levels, the last resort (each side's scale; the frame scaled up): down to 0.35.
+SCALES=${FF_DEMO_GOVERNOR_SCALES:-1,0.84,0.71,0.59,0.5,0.42,0.35}
 BOUND=${FF_DEMO_BOUND:-2}
 SIZE=640x360
 FOV=60
@@ -86,6 +88,7 @@ echo "== $impostors impostors placed"
 step "benchmark full, culled, placed and placed under the frame governor against full-geometry reference frames (a few minutes)" "$OUT/bench.txt" \
   "$FARFIELD" bench "$OUT/city.glb" --path "$OUT/path.json" --impostors "$OUT/placement" \
   --modes full,culled,placed,governed --mode-option governed=placed --mode-option governor_error_px="$BOUND" \
+  --mode-option governor_scales="$SCALES" \
   --reference --size "$SIZE" --tmax "$TMAX" --error-px "$BOUND" --stride "$STRIDE" -o "$OUT" \
   --report "$OUT/bench_report.md"
 # The viewer's path: the drive's longest stretch of frames the governed walkthrough drew with impostors.
