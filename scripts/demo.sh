@@ -42,7 +42,7 @@ step() {  # TITLE LOG COMMAND...: runs a step, keeps its output in LOG and the c
   local title=$1 log=$2
   shift 2
   echo "== [$(( $(date +%s) - start )) s] $title"
-  echo "${*/#$FARFIELD/farfield}" | sed "s|$OUT/||g" >> "$commands"
+  echo "${*/#$FARFIELD/farfield}" | sed -E -e "s#$OUT/##g" -e "s# -o $OUT( |\$)# -o .\1#g" >> "$commands"
   "$@" 2>&1 | tee "$log"
 }
 
