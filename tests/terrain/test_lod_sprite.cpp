@@ -482,6 +482,22 @@ TEST(LodSpriteGL, TheSpriteFrameOnTheGpuWaitsForNothing) {
   EXPECT_LT(sprite.counters().fresh_keyframes, cameras.size() / 2);
   EXPECT_GT(worst_psnr, 25.0);
 
+  // Where sprite frames cost as much as the high LOD, no sprite can pay: every frame is the high LOD, and the error
+  // metric is not run (no quadrant evaluated).
+  TerrainCost even = cost;
+  even.gpu_sprite->base_ms = 50.0;
+  LodSpriteOptions no_gain = options;
+  no_gain.cost = &even;
+  LodSpriteRenderer high_only(*scene.lod, *scene.renderer, 128, 128, no_gain);
+  for (size_t f = 0; f < 6; ++f) {
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    high_only.render(cameras[f], frame, &info);
+    EXPECT_EQ(info.path, TerrainPath::High) << "frame " << f;
+    EXPECT_EQ(info.quadrants, 0u) << "frame " << f;
+  }
+  EXPECT_EQ(high_only.counters().fresh_keyframes, 0u);
+
   LodSpriteOptions bad = options;
   bad.predict = true;
   EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);

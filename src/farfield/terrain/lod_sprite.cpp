@@ -353,6 +353,24 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   }
   const double beta = pixelAngle(camera);
   auto errorOf = [&](const Keyframe& k) { return frameError(k.camera.eye, camera.eye); };
+  const bool choose = options_.cost != nullptr;
+  PathCosts costs;
+  if (choose) {
+    costs = predictCosts(low_triangles_);
+    info.predicted_high_ms = costs.high_ms;
+    info.predicted_sprite_ms = costs.sprite_ms;
+    info.predicted_keyframe_ms = costs.keyframe_ms;
+  }
+  // The sprite frame on the GPU, where a sprite frame costs no less than the high LOD: no sprite can pay (a keyframe
+  // costs a sprite frame more), so the frame is the high LOD without the error metric, whose sampled cells are most
+  // of this path's CPU time (on a smooth terrain the 4 px CDLOD mesh is nearly the 1 px one). The virtual keyframe
+  // stays where it was; the metric resumes when sprites are cheaper again.
+  if (options_.gpu_low && choose && costs.sprite_ms >= costs.high_ms) {
+    info.source = SpriteSource::None;
+    const gpu::FrameStats high_stats = renderHigh(camera, target, info);
+    if (out) *out = info;
+    return high_stats;
+  }
 
   // Lines 3-5: error of the current sprite (or of the virtual keyframe the high LOD stands for); a new one when it
   // reaches the threshold.
@@ -364,14 +382,6 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     due = keyframeDue(e, beta, options_.epsilon);
   }
   info.keyframe_due = due;
-  const bool choose = options_.cost != nullptr;
-  PathCosts costs;
-  if (choose) {
-    costs = predictCosts(low_triangles_);
-    info.predicted_high_ms = costs.high_ms;
-    info.predicted_sprite_ms = costs.sprite_ms;
-    info.predicted_keyframe_ms = costs.keyframe_ms;
-  }
   // While the high LOD stands in for a virtual keyframe, that keyframe has already lasted `age` frames: a sprite
   // lives at least that long here, so a keyframe may be taken now, before the metric trips, when that pays (the run's
   // first sprite has no lifetime measured yet, and a sprite that would last the whole path never trips).
