@@ -124,7 +124,8 @@ void writeSummary(Experiment& x) {
      << "\n- speedup = total time of high / total time of the mode over the path (the paper's 316 s / 32 s = 9.9x), "
         "over the frames without stalls (" << r.stalled_frames << " of " << bench.frame_indices.size()
      << " frames left out: some mode took over max(1 s, 20x its median) there); raw total and median ratios in "
-        "brackets; PSNR against the high-resolution frame (untimed quality pass)\n"
+        "brackets; PSNR against the high-resolution LOD's frame and against the full-resolution grid's (where it is "
+        "drawn), in an untimed quality pass\n"
      << (full_triangles <= o.full_max_triangles ? ""
                                                 : "- full: NOT drawn (the full-resolution grid is over the triangle "
                                                   "cap); its row times an empty frame\n")
