@@ -92,7 +92,34 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRendere
       throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) has no keyframe prediction or cache");
     if (options.cost && !options.cost->gpu_sprite)
       throw Error("lod-sprite", "the sprite frame on the GPU needs a cost model fitted on its frames (TerrainCost::gpu_sprite)");
+    warmUpSpriteFrame();
   }
+}
+
+void LodSpriteRenderer::warmUpSpriteFrame() {
+  // One sprite frame of 8 x 8 pixels over the terrain's middle, with the renderer's hole: the driver makes the
+  // program's code at its first draw (llvmpipe: tens of milliseconds), which would otherwise be the first sprite
+  // frame's (a 104 ms frame on the city-on-terrain drive).
+  const Heightfield& hf = lod_.heightfield();
+  Camera c;
+  c.width = c.height = 8;
+  c.at = Vec3(float(0.5 * hf.extentX()), float(0.5 * hf.extentY()), hf.minHeight());
+  c.eye = c.at + Vec3(0.0f, -0.5f * float(hf.extentY()), hf.maxHeight() - hf.minHeight() + 100.0f);
+  c.far_plane = float(4.0 * (hf.extentX() + hf.extentY()) + 1000.0);
+  gpu::RenderTarget key(8, 8), frame(8, 8);
+  key.clear(options_.sky_color);
+  frame.clear(options_.sky_color);
+  GpuLodTerrain& terrain = *options_.gpu_high;
+  gpu::CdlodSprite sprite;
+  sprite.colour = &key.colorTexture();
+  sprite.depth = &key.depthTexture();
+  sprite.camera = c;
+  terrain.renderer().setSprite(sprite);
+  terrain.setHole(options_.hole);
+  terrain.draw(c, options_.low_error, frame);
+  terrain.clearHole();
+  terrain.renderer().clearSprite();
+  terrain.renderer().finish();
 }
 
 gpu::FrameStats LodSpriteRenderer::drawHigh(const Camera& camera, gpu::RenderTarget& target, LodMesh& mesh, int slot) {

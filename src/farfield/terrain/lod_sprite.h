@@ -211,6 +211,9 @@ class LodSpriteRenderer {
   // The high-resolution LOD of options_.hole for a camera into a target (bound, not cleared): the CDLOD terrain's or
   // the quadtree's (mesh: its scratch, slot: the renderer's index slot); returns the draw's counts.
   gpu::FrameStats drawHigh(const Camera& camera, gpu::RenderTarget& target, LodMesh& mesh, int slot);
+  // With gpu_low: one small sprite frame drawn at construction, so that the first real one does not pay for the
+  // driver making the program's code.
+  void warmUpSpriteFrame();
   // With gpu_low: the frame's low-resolution selection (GpuLodTerrain::select's handle) and its triangles.
   int low_handle_ = -1;
   size_t low_triangles_ = 0;
