@@ -255,6 +255,14 @@ std::vector<Camera> choicePath(const Heightfield& hf, int frames) {
   return cameras;
 }
 
+// LOD-sprite's options with its high-resolution LOD drawn by a CDLOD terrain, on the tests' sky.
+LodSpriteOptions cdlodOptions(GpuLodTerrain& gpu_lod) {
+  LodSpriteOptions options;
+  options.sky_color = kSky;
+  options.gpu_high = &gpu_lod;
+  return options;
+}
+
 // path_choice.h in the renderer: a machine where the sprite frame (two draw calls) costs more than the high LOD
 // (one) never takes the sprite path, and its frames are the high LOD's, pixel for pixel; the error metric still
 // trips where the render-free simulation says.
@@ -375,9 +383,7 @@ TEST(LodSpriteGL, TheGpuHighLodDrawsHighFramesAndKeyframes) {
   Scene scene(testFractal());
   GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
   const std::vector<Camera> cameras = choicePath(scene.hf, 16);
-  LodSpriteOptions options;
-  options.sky_color = kSky;
-  options.gpu_high = &gpu_lod;
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
   gpu::RenderTarget frame(128, 128), expected(128, 128);
 
   TerrainCost cheap;  // sprite frames cost 2 draws, CDLOD frames nothing
@@ -436,9 +442,7 @@ TEST(LodSpriteGL, TheSpriteFrameOnTheGpuWaitsForNothing) {
   Scene scene(testFractal());
   GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
   const std::vector<Camera> cameras = choicePath(scene.hf, 24);
-  LodSpriteOptions options;
-  options.sky_color = kSky;
-  options.gpu_high = &gpu_lod;
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
   options.gpu_low = true;
   TerrainCost cost;  // CDLOD high frames expensive, sprite frames cheap: the sprite path once a sprite has lasted
   cost.gpu_high = gpu::CostModel{};

@@ -264,9 +264,10 @@ BenchResult runBench(gpu::Context& context, const scene::Scene& scene, const gen
       }
       result.samples.push_back(std::move(sample_frame));
     }
-    if (options.reference)
+    if (options.reference) {
       for (size_t m = 0; m < mode_count; ++m) previous_frame[m] = std::move(frames[m]);
-    if (options.reference) previous_reference = std::move(reference);
+      previous_reference = std::move(reference);
+    }
   }
   progress.finish();
   // The repeats: whole passes over the path again, timing only, each frame's fastest render kept. A frame's renders are

@@ -157,12 +157,14 @@ void runQuality(Experiment& x) {
 
   std::ostringstream q;
   q << "path_frame";
-  std::vector<std::string> qnames;
-  if (!x.result.quality.empty())
-    for (const auto& [name, v] : x.result.quality.front().psnr) qnames.push_back(name);
-  std::vector<std::string> fnames;
-  if (!x.result.quality.empty())
-    for (const auto& [name, v] : x.result.quality.front().psnr_full) fnames.push_back(name);
+  auto namesOf = [&](const std::map<std::string, double> TerrainQualityRow::*column) {
+    std::vector<std::string> names;
+    if (!x.result.quality.empty())
+      for (const auto& [name, v] : x.result.quality.front().*column) names.push_back(name);
+    return names;
+  };
+  const std::vector<std::string> qnames = namesOf(&TerrainQualityRow::psnr);
+  const std::vector<std::string> fnames = namesOf(&TerrainQualityRow::psnr_full);
   for (const std::string& n : qnames) q << ",psnr_" << n << "_vs_high_db";
   for (const std::string& n : fnames) q << ",psnr_" << n << "_vs_full_db";
   q << "\n";

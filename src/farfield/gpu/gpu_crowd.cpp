@@ -85,7 +85,8 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
     if (!(mo.stride_m > 0.0f) || !(mo.radius > 0.0f) || mo.palette_poses < 1 || mo.frames < 1 || mo.azimuths < 1 ||
         mo.elevations < 1)
       throw Error(what, "model " + std::to_string(m) + ": stride, radius, poses, frames and views must be positive");
-    model_records.push_back({Vec4(mo.centre, mo.radius), Vec4(float(2 * m), mo.stride_m, float(mo.geometry_indices / 3), 0.0f),
+    model_records.push_back({Vec4(mo.centre, mo.radius),
+                             Vec4(float(2 * m), mo.stride_m, float(mo.geometry_indices / 3), 0.0f),
                              {mo.palette_poses, mo.frames, mo.azimuths, mo.elevations},
                              Vec4(mo.max_elevation, 0.0f, 0.0f, 0.0f)});
     initial_commands_.push_back({mo.geometry_indices, 0, mo.geometry_first_index, 0, 0});
@@ -211,8 +212,9 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
   for (float d : switch_m)
     if (d < 1e30f) largest_switch = std::max(largest_switch, d);
   const bool budget = budget_ > 0 && largest_switch > 0.0f;
+  const uint32_t budget_triangles = uint32_t(std::min<uint64_t>(budget_, UINT32_MAX));
   if (budget) {
-    classify_.set("u_budget", uint32_t(std::min<uint64_t>(budget_, UINT32_MAX)));
+    classify_.set("u_budget", budget_triangles);
     classify_.set("u_buckets", kBudgetBuckets);
     classify_.set("u_buckets_per_m", float(kBudgetBuckets) / largest_switch);
   }
@@ -220,7 +222,7 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
   if (budget) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     budget_scan_.use();
-    budget_scan_.set("u_budget", uint32_t(std::min<uint64_t>(budget_, UINT32_MAX)));
+    budget_scan_.set("u_budget", budget_triangles);
     budget_scan_.set("u_buckets", kBudgetBuckets);
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

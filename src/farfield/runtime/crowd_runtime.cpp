@@ -386,8 +386,8 @@ std::vector<gpu::GpuCrowdModel> CrowdRuntime::gpuCrowdModels(float nominal_speed
   return out;
 }
 
-std::vector<float> CrowdRuntime::gpuSwitches(const gpu::GpuCrowd& crowd, const Camera& camera,
-                                             CrowdPolicy policy) const {
+std::vector<float> CrowdRuntime::prepareGpuCrowd(gpu::GpuCrowd& crowd, const Camera& camera,
+                                                 CrowdPolicy policy) const {
   if (crowd.modelCount() != models_.size())
     throw Error("crowd runtime", "a GPU crowd of " + std::to_string(crowd.modelCount()) + " models for " +
                                      std::to_string(models_.size()));
@@ -396,12 +396,14 @@ std::vector<float> CrowdRuntime::gpuSwitches(const gpu::GpuCrowd& crowd, const C
     switches[m] = policy == CrowdPolicy::Geometry ? std::numeric_limits<float>::max()
                   : policy == CrowdPolicy::Impostor ? -1.0f
                                                     : float(switchDistances(m, camera).both());
+  crowd.setGeometryBudget(policy == CrowdPolicy::Mixed ? options_.max_geometry_triangles : 0);
   return switches;
 }
 
 CrowdFrameStats CrowdRuntime::drawGpuLists(const Camera& camera, gpu::GpuCrowd& crowd,
                                            const gpu::LightSettings& light) {
   CrowdFrameStats stats;
+  stats.budget_triangles = crowd.geometryBudget();
   const size_t command = sizeof(gpu::GpuCrowdCommand);
   for (size_t m = 0; m < models_.size(); ++m) {
     stats.draw.draw_calls +=
@@ -419,23 +421,19 @@ CrowdFrameStats CrowdRuntime::drawGpuLists(const Camera& camera, gpu::GpuCrowd& 
 
 CrowdFrameStats CrowdRuntime::drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                                       const gpu::LightSettings& light, const gpu::RenderTarget* occluders) {
-  const std::vector<float> switches = gpuSwitches(crowd, camera, policy);
-  crowd.setGeometryBudget(policy == CrowdPolicy::Mixed ? options_.max_geometry_triangles : 0);
+  const std::vector<float> switches = prepareGpuCrowd(crowd, camera, policy);
   if (occluders) {
     crowd.occludeBehind(*occluders);
     occluders->bindForOpaquePass();  // the pyramid's compute left the draw state to us
   }
   crowd.cullAndClassify(camera, switches);
-  CrowdFrameStats stats = drawGpuLists(camera, crowd, light);
-  stats.budget_triangles = crowd.geometryBudget();
-  return stats;
+  return drawGpuLists(camera, crowd, light);
 }
 
 CrowdFrameStats CrowdRuntime::drawGpuShadowed(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                                               const gpu::LightSettings& light, const gpu::RenderTarget& target,
                                               const CrowdShadowOptions& shadows, bool occlude) {
-  const std::vector<float> switches = gpuSwitches(crowd, camera, policy);
-  crowd.setGeometryBudget(policy == CrowdPolicy::Mixed ? options_.max_geometry_triangles : 0);
+  const std::vector<float> switches = prepareGpuCrowd(crowd, camera, policy);
   if (occlude) crowd.occludeBehind(target);
   crowd.cullAndClassify(camera, switches);
   // The map over the receivers, grown by what a caster standing on one reaches (its sphere about its feet).
@@ -459,7 +457,6 @@ CrowdFrameStats CrowdRuntime::drawGpuShadowed(const Camera& camera, gpu::GpuCrow
   }
   target.bindForOpaquePass();
   CrowdFrameStats stats = drawGpuLists(camera, crowd, light);
-  stats.budget_triangles = crowd.geometryBudget();
   stats.shadow_texel_m = fit.projection.texel_m;
   if (!receiver_) receiver_ = std::make_unique<gpu::ShadowReceiver>();
   receiver_->apply(camera, *shadow_map_, fit.projection, target, light, shadows.agent_id_mask, shadows.bias_m,

@@ -167,8 +167,8 @@ class CrowdRuntime {
   // agents hidden behind its depth are left out first (GpuCrowd::occludeBehind, cullBehind's test). No readback and
   // no per-agent upload. Mixed's budget in triangles (max_geometry_triangles) holds here too, on the GPU
   // (GpuCrowd::setGeometryBudget: impostors of the farthest, by distance buckets), and so do blended views; not on
-  // this path yet: the budget in milliseconds, budget_coarsens and levels of detail. The stats count draw calls and the budget
-  // only (the agents are counted on the GPU: GpuCrowd::readCommands, readCounts).
+  // this path yet: the budget in milliseconds, budget_coarsens and levels of detail. The stats count draw calls and
+  // the budget only (the agents are counted on the GPU: GpuCrowd::readCommands, readCounts).
   CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                           const gpu::LightSettings& light, const gpu::RenderTarget* occluders = nullptr);
   // As drawGpu into `target` (holding the city), with the agents' shadows: the map fitted to the receivers the
@@ -222,8 +222,9 @@ class CrowdRuntime {
     CrowdAtlasChoice choice;
     std::vector<double> level_m{0.0};  // per level of detail: its distance to the mesh (agent metres)
   };
-  // The GPU path's switch distances per model for a policy; throws farfield::Error for a crowd of other models.
-  std::vector<float> gpuSwitches(const gpu::GpuCrowd& crowd, const Camera& camera, CrowdPolicy policy) const;
+  // The GPU path's frame set up for a policy: Mixed's triangle budget given to the crowd, and the switch distances
+  // per model returned; throws farfield::Error for a crowd of other models.
+  std::vector<float> prepareGpuCrowd(gpu::GpuCrowd& crowd, const Camera& camera, CrowdPolicy policy) const;
   // The GPU path's camera lists, drawn.
   CrowdFrameStats drawGpuLists(const Camera& camera, gpu::GpuCrowd& crowd, const gpu::LightSettings& light);
   // Agents' GPU records by model and representation (culled with the camera's frustum unless null).

@@ -87,11 +87,13 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRendere
   if (options.gpu_high && options.cost && !options.cost->gpu_high)
     throw Error("lod-sprite", "the CDLOD high LOD needs a cost model fitted on its frames (TerrainCostOptions::gpu_high)");
   if (options.gpu_low) {
-    if (!options.gpu_high) throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) needs the CDLOD terrain (gpu_high)");
+    if (!options.gpu_high)
+      throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) needs the CDLOD terrain (gpu_high)");
     if (options.predict || options.cache_size > 1)
       throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) has no keyframe prediction or cache");
     if (options.cost && !options.cost->gpu_sprite)
-      throw Error("lod-sprite", "the sprite frame on the GPU needs a cost model fitted on its frames (TerrainCost::gpu_sprite)");
+      throw Error("lod-sprite",
+                  "the sprite frame on the GPU needs a cost model fitted on its frames (TerrainCost::gpu_sprite)");
     warmUpSpriteFrame();
   }
 }
@@ -109,17 +111,8 @@ void LodSpriteRenderer::warmUpSpriteFrame() {
   gpu::RenderTarget key(8, 8), frame(8, 8);
   key.clear(options_.sky_color);
   frame.clear(options_.sky_color);
-  GpuLodTerrain& terrain = *options_.gpu_high;
-  gpu::CdlodSprite sprite;
-  sprite.colour = &key.colorTexture();
-  sprite.depth = &key.depthTexture();
-  sprite.camera = c;
-  terrain.renderer().setSprite(sprite);
-  terrain.setHole(options_.hole);
-  terrain.draw(c, options_.low_error, frame);
-  terrain.clearHole();
-  terrain.renderer().clearSprite();
-  terrain.renderer().finish();
+  drawCdlodSprite(c, options_.gpu_high->select(c, options_.low_error), frame, c, key);
+  options_.gpu_high->renderer().finish();
 }
 
 gpu::FrameStats LodSpriteRenderer::drawHigh(const Camera& camera, gpu::RenderTarget& target, LodMesh& mesh, int slot) {
@@ -308,22 +301,21 @@ SpriteError LodSpriteRenderer::frameError(const Vec3& v1, const Vec3& v2) const 
   return spriteError(lod_, low_.quadrants, v1, v2);
 }
 
-gpu::FrameStats LodSpriteRenderer::drawSpriteFrame(const Camera& camera, gpu::RenderTarget& target,
-                                                   LodSpriteFrameInfo& info) {
+gpu::FrameStats LodSpriteRenderer::drawCdlodSprite(const Camera& camera, int handle, gpu::RenderTarget& target,
+                                                   const Camera& key_camera, const gpu::RenderTarget& key) {
   GpuLodTerrain& terrain = *options_.gpu_high;
   gpu::CdlodSprite sprite;
-  sprite.colour = &current_->target.colorTexture();
-  sprite.depth = &current_->target.depthTexture();
-  sprite.camera = current_->camera;
+  sprite.colour = &key.colorTexture();
+  sprite.depth = &key.depthTexture();
+  sprite.camera = key_camera;
   sprite.thickness_m = options_.visibility.thickness_m;
   sprite.thickness_rel = options_.visibility.thickness_rel;
   sprite.footprint_pixels = options_.visibility.footprint_pixels;
   terrain.renderer().setSprite(sprite);
   terrain.setHole(options_.hole);
-  const gpu::FrameStats stats = terrain.drawSelection(camera, low_handle_, target).draw;
+  const gpu::FrameStats stats = terrain.drawSelection(camera, handle, target).draw;
   terrain.clearHole();
   terrain.renderer().clearSprite();
-  info.low_triangles = stats.triangles;
   return stats;
 }
 
@@ -498,7 +490,9 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
 
   // Lines 7-11: visible triangles with the sprite, the others with the original texture.
   if (options_.gpu_low) {
-    gpu::addDraw(stats, drawSpriteFrame(camera, target, info));
+    const gpu::FrameStats sprite = drawCdlodSprite(camera, low_handle_, target, current_->camera, current_->target);
+    info.low_triangles = sprite.triangles;
+    gpu::addDraw(stats, sprite);
     if (out) *out = info;
     return stats;
   }

@@ -219,7 +219,10 @@ class LodSpriteRenderer {
   size_t low_triangles_ = 0;
   // Equation 2 for the frame's low-resolution mesh, the sprite seen from v1 and the frame from v2.
   SpriteError frameError(const Vec3& v1, const Vec3& v2) const;
-  gpu::FrameStats drawSpriteFrame(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo& info);
+  // A sprite frame on the GPU: CDLOD selection `handle` (GpuLodTerrain::select) for `camera` into `target`, tested
+  // against and textured by keyframe `key` seen from key_camera (its size), with options_' hole and visibility.
+  gpu::FrameStats drawCdlodSprite(const Camera& camera, int handle, gpu::RenderTarget& target,
+                                  const Camera& key_camera, const gpu::RenderTarget& key);
   uint64_t high_triangles_frame_ = 0;  // last high-LOD triangle counts seen at the frame's and the keyframe's camera
   uint64_t high_triangles_key_ = 0;
   bool high_latest_is_key_ = false;

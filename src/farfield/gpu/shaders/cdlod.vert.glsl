@@ -31,7 +31,7 @@ uniform vec2 u_uv_scale;
 uniform vec2 u_uv_offset;
 
 out vec2 v_uv;
-out vec2 v_world_xy;
+out vec2 v_world_xy;  // for the fragment shader's hole (terrain.frag.glsl with FF_HOLE)
 #ifdef FF_CDLOD_SPRITE
 uniform mat4 u_sprite_view_proj;
 layout(binding = 4) uniform sampler2D u_sprite_depth;  // the keyframe's window depth (reversed Z), row 0 at the bottom
@@ -71,7 +71,7 @@ bool spriteVisible(vec3 p, vec3 n, vec4 clip) {
   }
   return abs(clip.w - z_buffer) < u_sprite_thickness.x + (u_sprite_thickness.y + footprint) * clip.w;
 }
-#endif  // for the fragment shader's hole (terrain.frag.glsl with FF_HOLE)
+#endif
 
 float bilinear(vec2 g, ivec2 last, int layer) {
   g = clamp(g, vec2(0.0), vec2(last));

@@ -144,6 +144,12 @@ bool hidden(vec3 c, float r) {
   return nearest * (1.0 + 1e-5) + 1e-12 < farthest(x0, x1);
 }
 
+// The direction to the eye in agent space from an agent at `pose` whose sphere is centred at c (the impostor view's).
+vec3 eyeInAgentSpace(vec4 pose, vec3 c) {
+  vec3 local = turn(-pose.w, u_eye - c);
+  return length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0);
+}
+
 #ifndef FF_SIMULATE
 // Agent i into its model's geometry or impostor list after `first_list`, as the renderer's record: the palette pose
 // or the atlas frame nearest its phase, and for an impostor the view nearest `view_dir` (agent space).
@@ -235,8 +241,7 @@ void main() {
   vec3 c = pose.xyz + turn(pose.w, m.sphere.xyz);
   bool impostor = bucket >= stats[2];
   if (impostor) atomicAdd(stats[3], 1u);
-  vec3 local = turn(-pose.w, u_eye - c);
-  append(0u, i, a, m, pose, length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0), impostor);
+  append(0u, i, a, m, pose, eyeInAgentSpace(pose, c), impostor);
 }
 #else
 void main() {
@@ -263,7 +268,6 @@ void main() {
     atomicAdd(buckets[bucket], uint(m.lists.z));
     return;
   }
-  vec3 local = turn(-pose.w, u_eye - c);  // the eye in agent space
-  append(0u, i, a, m, pose, length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0), impostor);
+  append(0u, i, a, m, pose, eyeInAgentSpace(pose, c), impostor);
 }
 #endif
