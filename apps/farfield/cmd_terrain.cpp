@@ -59,7 +59,9 @@ struct BenchText {
   std::string size = "512x512";
   std::string sweep_epsilons = "0.25,0.5,1,2,4,8";
   std::string sweep_frames = "75,150,300,600,1200,2400";
-  std::string modes = "high,high-gpu,low,lod-sprite,lod-sprite-gpu,lod-sprite-always,lod-sprite-predict,lod-sprite-cache";
+  std::string modes =
+      "high,high-gpu,low,lod-sprite,lod-sprite-gpu,lod-sprite-gpu-predict,lod-sprite-always,lod-sprite-predict,"
+      "lod-sprite-cache";
   bool no_sweeps = false, no_plots = false, no_choice = false, no_section5 = false;
 };
 

@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include "farfield/core/camera.h"
 #include "farfield/gpu/context.h"
@@ -49,6 +50,16 @@ inline Camera makeCamera(Vec3 eye, Vec3 at, int size = 128) {
   c.near_plane = 1.0f;
   c.far_plane = 50000.0f;
   return c;
+}
+
+// Motion over the test fractal: forwards and a little sideways, 40 m a frame.
+inline std::vector<Camera> choicePath(const Heightfield& hf, int frames) {
+  const float top = hf.maxHeight();
+  std::vector<Camera> cameras;
+  for (int f = 0; f < frames; ++f)
+    cameras.push_back(makeCamera(Vec3(600.0f + 40.0f * f, 300.0f + 10.0f * f, top + 700.0f),
+                                 Vec3(900.0f + 40.0f * f, 1600.0f + 10.0f * f, 0.0f)));
+  return cameras;
 }
 
 // 129 x 129 points, 20 m cells, 500 m of relief.

@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "farfield/core/error.h"
@@ -95,6 +97,39 @@ TEST(GpuLodGL, CloseToTheQuadtreeLodAndTheFullGrid) {
     // A much larger bound changes the frame more (the comparison can fail).
     EXPECT_LT(image::psnr(drawGpuLod(terrain, camera, 64.0f), full), vs_full);
   }
+}
+
+// drawNodes: a selection kept by the caller, drawn in runs over several "frames" while the terrain makes selections
+// for every other bound in between (each range slot remade), is the whole selection's frame pixel for pixel.
+TEST(GpuLodGL, ASelectionDrawnInRunsIsTheWholeFrame) {
+  test::Scene scene(test::testFractal());
+  GpuLodTerrain terrain(scene.hf, scene.texture, CdlodOptions{8, 16, 0.3f});
+  int differing = 0;
+  for (const Camera& camera : views(scene.hf)) {
+    const image::ColorImage whole = drawGpuLod(terrain, camera, 1.0f);
+    const std::vector<CdlodNode> nodes = terrain.lastSelection().nodes;
+    ASSERT_GT(nodes.size(), 3u);
+    gpu::RenderTarget target(camera.width, camera.height);
+    target.clear(kSky);
+    const size_t runs = 3, per_run = (nodes.size() + runs - 1) / runs;
+    size_t drawn = 0;
+    for (size_t r = 0; r < runs; ++r) {
+      for (float other : {2.0f, 3.0f, 5.0f, 7.0f}) terrain.select(views(scene.hf)[0], other);  // every slot remade
+      const size_t first = std::min(nodes.size(), r * per_run);
+      const std::span<const CdlodNode> run(nodes.data() + first, std::min(per_run, nodes.size() - first));
+      const GpuLodFrame part = terrain.drawNodes(camera, 1.0f, run, target);
+      EXPECT_EQ(part.nodes, run.size());
+      drawn += part.nodes;
+    }
+    EXPECT_EQ(drawn, nodes.size());
+    EXPECT_TRUE(target.readColor().pixels() == whole.pixels()) << "eye " << camera.eye.x;
+    // The nodes drawn with another bound's ranges morph differently: the comparison can fail.
+    target.clear(kSky);
+    terrain.drawNodes(camera, 8.0f, nodes, target);
+    if (target.readColor().pixels() != whole.pixels()) ++differing;
+  }
+  EXPECT_GT(differing, 0);
+  EXPECT_THROW(terrain.drawNodes(views(scene.hf)[0], 0.0f, {}, *std::make_unique<gpu::RenderTarget>(8, 8)), Error);
 }
 
 // LOD-sprite's sprite frame on the GPU (CdlodRenderer::setSprite): against the CPU reference of the same selection,

@@ -181,7 +181,11 @@ void calibrate(Experiment& x) {
   std::vector<Camera> views;
   const size_t n = x.path.frames.size();
   for (size_t k = 0; k < 5; ++k) views.push_back(x.cameraAt(x.path, std::min(n - 1, (2 * k + 1) * n / 10)));
-  const bool gpu_sprite = std::find(o.modes.begin(), o.modes.end(), "lod-sprite-gpu") != o.modes.end();
+  const bool gpu_sprite = std::any_of(o.modes.begin(), o.modes.end(), [](const std::string& m) {
+    SpriteVariant variant;
+    bool gpu = false;
+    return spriteVariantOf(m, variant, &gpu) && gpu;
+  });
   const terrain::TerrainCostOptions c = spriteCostOptions(*x.run, std::move(views), o.width, o.height,
                                                           gpu_sprite ? &x.run->gpuLod() : nullptr);
   x.run->cost = terrain::calibrateTerrainCost(*x.data().lod, x.run->gpuRenderer(), c);

@@ -51,8 +51,8 @@ struct TerrainBenchOptions {
   float high_error = 1.0f;  // LOD thresholds, pixels: 0 < high_error <= low_error
   float low_error = 4.0f;
   std::vector<std::string> modes{"high",       "high-gpu",          "low",
-                                 "lod-sprite", "lod-sprite-gpu",    "lod-sprite-always",
-                                 "lod-sprite-predict", "lod-sprite-cache"};
+                                 "lod-sprite", "lod-sprite-gpu",    "lod-sprite-gpu-predict",
+                                 "lod-sprite-always", "lod-sprite-predict", "lod-sprite-cache"};
   bool choice = true;       // calibrate the cost model; "lod-sprite" chooses per frame (false: always the sprite)
   bool reference = false;   // also compare every mode with full-geometry frames (the harness)
   // The harness's "full" baseline draws the full-resolution grid; above this many triangles it draws nothing (a

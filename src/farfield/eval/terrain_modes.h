@@ -135,7 +135,8 @@ terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant var
 terrain::TerrainCostOptions spriteCostOptions(const TerrainRun& run, std::vector<Camera> views, int width, int height,
                                               terrain::GpuLodTerrain* gpu_high = nullptr);
 // "lod-sprite" -> Paper, "lod-sprite-always" -> Always, "lod-sprite-predict" -> Predict, "lod-sprite-cache" -> Cache; false for other names.
-// "lod-sprite-gpu" is the Paper variant drawn by the CDLOD terrain on the GPU: keyframes, high and sprite frames.
+// "lod-sprite-gpu" is the Paper variant drawn by the CDLOD terrain on the GPU: keyframes, high and sprite frames;
+// "lod-sprite-gpu-predict" the Predict variant drawn so, which keeps the per-frame choice.
 bool spriteVariantOf(const std::string& mode_name, SpriteVariant& variant, bool* gpu_high = nullptr);
 
 // `lod-sprite` and its section 5 variants. Each pass over the path (the harness's warm-up frame is one) starts

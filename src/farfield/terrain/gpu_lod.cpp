@@ -60,9 +60,7 @@ gpu::CdlodInstance cdlodInstance(const CdlodNode& node, int patch_cells, int lay
   return {int32_t(node.x * cells), int32_t(node.y * cells), int32_t(node.level), int32_t(layer)};
 }
 
-int GpuLodTerrain::select(const Camera& camera, float pixel_error, bool cull) {
-  // The slot whose ranges were made for this bound, else the least recently used one.
-  const double scale = QuadtreeLod::pixelsPerRadian(camera) / double(pixel_error);
+int GpuLodTerrain::slotFor(double scale) {
   int slot = 0;
   for (int s = 0; s < gpu::CdlodRenderer::kRangeSlots; ++s) {
     if (selections_[s].ranges.scale == scale) {
@@ -72,6 +70,11 @@ int GpuLodTerrain::select(const Camera& camera, float pixel_error, bool cull) {
     if (used_[s] < used_[slot]) slot = s;
   }
   used_[slot] = ++frame_;
+  return slot;
+}
+
+int GpuLodTerrain::select(const Camera& camera, float pixel_error, bool cull) {
+  const int slot = slotFor(QuadtreeLod::pixelsPerRadian(camera) / double(pixel_error));
   last_ = slot;
   CdlodSelection& selection = selections_[slot];
   lod_.select(camera, pixel_error, cull, selection);
@@ -85,16 +88,37 @@ const CdlodSelection& GpuLodTerrain::selection(int handle) const {
   return selections_[handle];
 }
 
+GpuLodFrame GpuLodTerrain::drawInstances(const Camera& camera, std::span<const CdlodNode> nodes, int slot,
+                                         gpu::RenderTarget& target) {
+  instances_.clear();
+  for (const CdlodNode& n : nodes) instances_.push_back(cdlodInstance(n, lod_.patchCells()));
+  GpuLodFrame frame;
+  frame.draw = renderer_.draw(camera, target, instances_, slot);
+  frame.nodes = nodes.size();
+  return frame;
+}
+
 GpuLodFrame GpuLodTerrain::drawSelection(const Camera& camera, int handle, gpu::RenderTarget& target) {
   const CdlodSelection& sel = selection(handle);
-  instances_.clear();
-  for (const CdlodNode& n : sel.nodes) instances_.push_back(cdlodInstance(n, lod_.patchCells()));
-  GpuLodFrame frame;
-  frame.draw = renderer_.draw(camera, target, instances_, handle);
-  frame.nodes = sel.nodes.size();
+  GpuLodFrame frame = drawInstances(camera, sel.nodes, handle, target);
   frame.nodes_visited = sel.visited;
   frame.nodes_culled = sel.culled;
   return frame;
+}
+
+GpuLodFrame GpuLodTerrain::drawNodes(const Camera& camera, float pixel_error, std::span<const CdlodNode> nodes,
+                                     gpu::RenderTarget& target) {
+  const double scale = QuadtreeLod::pixelsPerRadian(camera) / double(pixel_error);
+  const int slot = slotFor(scale);
+  CdlodSelection& held = selections_[slot];
+  if (held.ranges.scale != scale) {
+    // The slot is remade for this bound: its old selection is gone (a handle to it now names an empty one).
+    held.nodes.clear();
+    held.visited = held.culled = 0;
+    lod_.updateRanges(camera, pixel_error, held.ranges);  // throws for a bound that is not a positive number
+    uploadRanges(held, renderer_, slot);
+  }
+  return drawInstances(camera, nodes, slot, target);
 }
 
 GpuLodFrame GpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull) {

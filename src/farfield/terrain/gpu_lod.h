@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "farfield/core/camera.h"
@@ -43,6 +44,12 @@ class GpuLodTerrain {
   int select(const Camera& camera, float pixel_error, bool cull = true);
   const CdlodSelection& selection(int handle) const;
   GpuLodFrame drawSelection(const Camera& camera, int handle, gpu::RenderTarget& target);
+  // Part of a selection kept by the caller: `nodes` (a copy of selection(handle).nodes made for this camera and
+  // bound, or a run of it) drawn with the ranges of the bound at the camera's pixel density, made again where no
+  // slot still holds them. LOD-sprite draws a keyframe rendered ahead this way, in slices over several frames, while
+  // other selections are made in between. nodes_visited and nodes_culled are 0.
+  GpuLodFrame drawNodes(const Camera& camera, float pixel_error, std::span<const CdlodNode> nodes,
+                        gpu::RenderTarget& target);
 
   // Leaves out the ground of a rectangle of grid points (the quadtree LOD's hole, removeTrianglesInside: a city's
   // ground drawn by someone else): fragments strictly inside it, in world x, y, are discarded. An empty rectangle
@@ -65,6 +72,11 @@ class GpuLodTerrain {
   uint64_t frame_ = 0;
   int last_ = 0;
   std::vector<gpu::CdlodInstance> instances_;
+  // The slot for a scale (lambda / tau): the one whose ranges were made for it, else the least recently used; marked
+  // used.
+  int slotFor(double scale);
+  GpuLodFrame drawInstances(const Camera& camera, std::span<const CdlodNode> nodes, int slot,
+                            gpu::RenderTarget& target);
 };
 
 }  // namespace farfield::terrain

@@ -89,8 +89,6 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRendere
   if (options.gpu_low) {
     if (!options.gpu_high)
       throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) needs the CDLOD terrain (gpu_high)");
-    if (options.predict || options.cache_size > 1)
-      throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) has no keyframe prediction or cache");
     if (options.cost && !options.cost->gpu_sprite)
       throw Error("lod-sprite",
                   "the sprite frame on the GPU needs a cost model fitted on its frames (TerrainCost::gpu_sprite)");
@@ -138,6 +136,7 @@ void LodSpriteRenderer::reset() {
   counters_ = {};
   frame_ = 0;
   sprite_since_ = 0;
+  sprite_error_at_take_ = 0.0;
   last_lifetime_ = 10;
   pending_chunk_ = 0;
   pending_chunks_ = 1;
@@ -213,27 +212,52 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
 }
 
 double LodSpriteRenderer::coverage(Keyframe& keyframe) {
+  if (options_.gpu_low) return nodeCoverage(options_.gpu_high->selection(low_handle_).nodes, keyframe);
   probe_.reset(lod_, keyframe.camera, &keyframe.depth, options_.visibility);
   return probe_.visibleShare(low_.indices);
 }
 
-void LodSpriteRenderer::schedulePrediction(const Camera& camera) {
+double LodSpriteRenderer::nodeCoverage(std::span<const CdlodNode> nodes, const Keyframe& keyframe) const {
+  // Every node is a patch of the same triangles: the share of nodes stands for the share of triangles.
+  if (nodes.empty()) return 1.0;
+  const CdlodTerrain& lod = options_.gpu_high->lod();
+  size_t inside = 0;
+  for (const CdlodNode& n : nodes) {
+    const Vec4 p = keyframe.view_proj * Vec4(lod.nodeBox(n).center(), 1.0f);
+    if (p.w > 0.0f && std::abs(p.x) <= p.w && std::abs(p.y) <= p.w) ++inside;
+  }
+  return double(inside) / double(nodes.size());
+}
+
+void LodSpriteRenderer::schedulePrediction(const Camera& camera, float ahead, size_t chunks) {
   if (pending_) {
     ++counters_.predicted_discarded;
     spare_.push_back(std::move(pending_));
   }
-  // Linear extrapolation of eye and look-at over the recent viewpoints, as many frames ahead as the previous sprite
-  // lasted (at least long enough to finish drawing it).
+  // Linear extrapolation of eye and look-at over the recent viewpoints, `ahead` frames ahead.
   const size_t n = history_.size();
   Vec3 eye_velocity(0.0f), at_velocity(0.0f);
   if (n >= 2) {
     eye_velocity = (history_.back().first - history_.front().first) / float(n - 1);
     at_velocity = (history_.back().second - history_.front().second) / float(n - 1);
   }
-  const float ahead = std::clamp(float(last_lifetime_) * options_.predict_lead, 2.0f, 600.0f);
   Camera predicted = camera;
   predicted.eye = camera.eye + eye_velocity * ahead;
   predicted.at = camera.at + at_velocity * ahead;
+  if (options_.predict_late && n >= 2) {
+    // Late: the direction turned at its recent angular rate (the look-at point's distance changes with the path, so
+    // its linear extrapolation turns the view by other angles); at most 30 degrees.
+    const Vec3 f0 = glm::normalize(history_.front().second - history_.front().first);
+    const Vec3 f1 = camera.forward();
+    const Vec3 axis = glm::cross(f0, f1);
+    const float turned = std::atan2(glm::length(axis), glm::dot(f0, f1));
+    Vec3 f = f1;
+    if (glm::length(axis) > 1e-6f) {
+      const float angle = std::min(turned / float(n - 1) * ahead, glm::radians(30.0f));
+      f = f1 * std::cos(angle) + glm::cross(glm::normalize(axis), f1) * std::sin(angle);  // axis is normal to f1
+    }
+    predicted.at = predicted.eye + f * glm::length(camera.at - camera.eye);
+  }
   // Never extrapolate into the ground (a descent would otherwise end below the terrain): keep at least half of the
   // current height above the ground.
   const Heightfield& hf = lod_.heightfield();
@@ -251,32 +275,41 @@ void LodSpriteRenderer::schedulePrediction(const Camera& camera) {
   pending_->camera = keyframeCamera(predicted);
   pending_->view_proj = pending_->camera.viewProjection();
   pending_chunk_ = 0;
-  // Ready by about half of the expected lifetime: at most predict_chunks slices, fewer for short-lived sprites.
-  pending_chunks_ = size_t(std::clamp<uint64_t>(last_lifetime_ / 2, 1, uint64_t(options_.predict_chunks)));
+  pending_chunks_ = chunks;
 }
 
 void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info) {
-  // Step 0 (the frame after the switch): the mesh; steps 1..chunks: one slice of it each; then the z-buffer.
-  // With the CDLOD terrain: step 0 draws it whole, step 1 reads the z-buffer.
   Keyframe& k = *pending_;
   const size_t chunks = pending_chunks_;
-  if (options_.gpu_high && pending_chunk_ == 0) {
-    k.target.clear(options_.sky_color);
-    const gpu::FrameStats ahead = drawHigh(k.camera, k.target, pending_mesh_, 1);
+  if (options_.gpu_high) {
+    // The CDLOD terrain: step 0 selects its nodes (on the CPU; kept here, as the terrain's selections are remade by
+    // the frames in between); steps 0..chunks-1 draw one run of them each.
+    GpuLodTerrain& terrain = *options_.gpu_high;
+    if (pending_chunk_ == 0) {
+      terrain.lod().select(k.camera, options_.high_error, true, pending_selection_);
+      k.target.clear(options_.sky_color);
+    }
+    const std::span<const CdlodNode> nodes = pending_selection_.nodes;
+    const size_t per_chunk = (nodes.size() + chunks - 1) / chunks;
+    const size_t first = std::min(nodes.size(), pending_chunk_ * per_chunk);
+    terrain.setHole(options_.hole);
+    const gpu::FrameStats ahead =
+        terrain.drawNodes(k.camera, options_.high_error, nodes.subspan(first, std::min(nodes.size() - first, per_chunk)),
+                          k.target).draw;
+    terrain.clearHole();
     gpu::addDraw(stats, ahead);
     info.ahead_triangles += ahead.triangles;
-    ++pending_chunk_;
-    return;
-  }
-  if (pending_chunk_ == 0) {
-    lod_.build(k.camera, LodSettings{options_.high_error, true, false}, pending_mesh_);
-    removeTrianglesInside(pending_mesh_, options_.hole, uint32_t(lod_.width()));
-    renderer_.setIndices(pending_mesh_.indices, 1);
-    k.target.clear(options_.sky_color);
-    ++pending_chunk_;
-    return;
-  }
-  if (!options_.gpu_high) {
+    if (++pending_chunk_ < chunks) return;
+  } else {
+    // The quadtree LOD: step 0 (the frame after the switch) builds the mesh; steps 1..chunks draw one slice of it each.
+    if (pending_chunk_ == 0) {
+      lod_.build(k.camera, LodSettings{options_.high_error, true, false}, pending_mesh_);
+      removeTrianglesInside(pending_mesh_, options_.hole, uint32_t(lod_.width()));
+      renderer_.setIndices(pending_mesh_.indices, 1);
+      k.target.clear(options_.sky_color);
+      ++pending_chunk_;
+      return;
+    }
     const size_t total = pending_mesh_.triangleCount();
     const size_t per_chunk = (total + chunks - 1) / chunks;
     const size_t first = std::min(total, (pending_chunk_ - 1) * per_chunk);
@@ -285,13 +318,46 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     info.ahead_triangles += count;
     if (++pending_chunk_ <= chunks) return;
   }
-  k.depth = k.target.readDepth();
   k.ready = true;
   ++counters_.predicted_rendered;
-  // Its own coverage, for the reuse test: the low-resolution mesh at its viewpoint against its z-buffer.
+  // Its own coverage, for the reuse test: the low-resolution mesh at its viewpoint, against its z-buffer (read here;
+  // the sprite frame on the GPU reads nothing and tests the CDLOD nodes against its image instead).
+  if (options_.gpu_low) {
+    options_.gpu_high->lod().select(k.frame_camera, options_.low_error, true, probe_selection_);
+    k.coverage_at_creation = nodeCoverage(probe_selection_.nodes, k);
+    return;
+  }
+  k.depth = k.target.readDepth();
   lod_.build(k.frame_camera, LodSettings{options_.low_error, true, false}, probe_mesh_);
   probe_.reset(lod_, k.camera, &k.depth, options_.visibility);
   k.coverage_at_creation = probe_.visibleShare(probe_mesh_.indices);
+}
+
+void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* costs) {
+  // The error grows about linearly with the frames since the sprite was taken (with the distance moved); at the rate
+  // seen since then it trips in `left` frames. Started once about 1.5 times predict_chunks frames are left, drawn
+  // in slices that end two thirds of the way (the rate may rise), the extrapolation is short, so it is still right on
+  // a curving path.
+  const double age = double(frame_ - sprite_since_);
+  const double grown = error_px - sprite_error_at_take_;
+  if (age < 2.0 || !(grown > 0.05 * options_.epsilon)) return;
+  const double left = (options_.epsilon - error_px) * age / grown;
+  // Slices of at most half a sprite frame each by the cost model (at most predict_chunks of them).
+  double chunks = double(options_.predict_chunks);
+  if (costs && costs->sprite_ms > 0.0)
+    chunks = std::clamp(std::ceil((costs->keyframe_ms - costs->sprite_ms) / (0.5 * costs->sprite_ms)), 1.0, chunks);
+  if (left > 1.5 * chunks + 1.0) return;
+  // From half way to where it trips: its error there is small, and the extrapolation half as long.
+  schedulePrediction(camera, float(std::clamp(0.5 * left, 0.0, 600.0)),
+                     size_t(std::clamp(std::floor(left * 2.0 / 3.0), 1.0, chunks)));
+}
+
+bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, double* error_px) {
+  // Only with some life left (error at most 3/4 of the threshold here), or it would trip again at once.
+  const SpriteError e = frameError(keyframe.camera.eye, eye);
+  if (error_px) *error_px = e.pixels(beta);
+  return !keyframeDue(e, beta, 0.75 * options_.epsilon) &&
+         coverage(keyframe) >= options_.reuse_coverage * keyframe.coverage_at_creation;
 }
 
 SpriteError LodSpriteRenderer::frameError(const Vec3& v1, const Vec3& v2) const {
@@ -411,7 +477,19 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     switch_now = choosePath(costs, false, info.expected_lifetime) == TerrainPath::Sprite;
   }
   info.switched = switch_now;
-  if (due || switch_now) {
+  // predict_late: a keyframe rendered ahead is taken as soon as it is ready, where it has less error than the current
+  // sprite and covers the view; otherwise it is stale (its viewpoint, half way to the predicted trip, is far behind
+  // or off the path) and dropped, so that a new one is made.
+  bool early = false;
+  if (options_.predict_late && !due && current_ && pending_ && pending_->ready) {
+    double e = 0.0;
+    early = takesOver(*pending_, camera.eye, beta, &e) && e < info.error_px;
+    if (!early) {
+      ++counters_.predicted_discarded;
+      spare_.push_back(std::move(pending_));
+    }
+  }
+  if (due || switch_now || early) {
     if (switch_now) ++counters_.switches;
     if (due && anchored_) {
       last_lifetime_ = std::max<uint64_t>(frame_ - anchor_since_, 1);
@@ -424,12 +502,10 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     Keyframe* chosen = nullptr;
     double chosen_error = 0.0;
     if (pending_ && pending_->ready) {
-      const SpriteError e = errorOf(*pending_);
-      // Only with some life left (error at most 3/4 of the threshold here), or it would trip again at once.
-      if (!keyframeDue(e, beta, 0.75 * options_.epsilon) &&
-          coverage(*pending_) >= options_.reuse_coverage * pending_->coverage_at_creation) {
+      double e = 0.0;
+      if (takesOver(*pending_, camera.eye, beta, &e)) {
         chosen = pending_.get();
-        chosen_error = e.pixels(beta);
+        chosen_error = e;
         info.source = SpriteSource::Predicted;
         ++counters_.predicted_used;
         keep(std::move(pending_));
@@ -472,9 +548,20 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     }
     current_ = chosen;
     sprite_since_ = frame_;
+    sprite_error_at_take_ = chosen_error;
     info.error_px = chosen_error;
     if (!options_.gpu_low) visibility_.reset(lod_, current_->camera, &current_->depth, options_.visibility);
-    if (options_.predict) schedulePrediction(camera);
+    if (pending_ && options_.predict_late) {
+      // Not taken: a new one is made when this sprite is about to trip.
+      ++counters_.predicted_discarded;
+      spare_.push_back(std::move(pending_));
+    }
+    if (options_.predict && !options_.predict_late) {
+      // As many frames ahead as the previous sprite lasted (times the lead; at least long enough to finish drawing
+      // it), ready by about half of that lifetime: at most predict_chunks slices, fewer for short-lived sprites.
+      schedulePrediction(camera, std::clamp(float(last_lifetime_) * options_.predict_lead, 2.0f, 600.0f),
+                         size_t(std::clamp<uint64_t>(last_lifetime_ / 2, 1, uint64_t(options_.predict_chunks))));
+    }
   } else if (!current_ || (choose && choosePath(costs, true, 0.0) == TerrainPath::High)) {
     // A virtual keyframe still valid, or a valid sprite that costs more to draw than the high LOD.
     info.source = SpriteSource::None;
@@ -483,6 +570,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     return high_stats;
   }
   current_->last_used = frame_;
+  if (options_.predict && options_.predict_late && !due && !pending_)
+    scheduleLatePrediction(camera, info.error_px, choose ? &costs : nullptr);
 
   // Section 5: the keyframe rendered ahead, one step per frame, from the frame after a switch on (the switch frame
   // may already have drawn a whole keyframe).
@@ -490,6 +579,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
 
   // Lines 7-11: visible triangles with the sprite, the others with the original texture.
   if (options_.gpu_low) {
+    if (info.source == SpriteSource::Fresh && (options_.predict || options_.cache_size > 1))
+      current_->coverage_at_creation = coverage(*current_);
     const gpu::FrameStats sprite = drawCdlodSprite(camera, low_handle_, target, current_->camera, current_->target);
     info.low_triangles = sprite.triangles;
     gpu::addDraw(stats, sprite);

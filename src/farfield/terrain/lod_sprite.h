@@ -12,7 +12,8 @@
 //   extrapolated linearly from the last few viewpoints to the frame where the current sprite is expected to expire
 //   (predict_lead times as many frames ahead as the previous sprite lasted). From the next frame on, its mesh is
 //   built (one frame), then its triangles are drawn in up to `predict_chunks` slices, one per frame (no frame pays
-//   a whole keyframe; fewer slices when sprites are short-lived), then its z-buffer is read. When
+//   a whole keyframe; fewer slices when sprites are short-lived), then its z-buffer is read (with the CDLOD terrain,
+//   gpu_high: its nodes are selected and the first slice drawn in the first frame; with gpu_low nothing is read). When
 //   the current sprite's error trips, the predicted keyframe is used if its error at the current viewpoint is below
 //   3/4 of the threshold and it covers the view (see reuse_coverage); otherwise a keyframe is rendered at once.
 // - cache_size > 1: the most recent keyframes are kept (least recently used replaced). When the error trips, the
@@ -33,6 +34,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "farfield/core/camera.h"
@@ -86,6 +88,13 @@ struct LodSpriteOptions {
   // next keyframe on the stretch where it will be used, so it serves views before and after it (with steady motion,
   // lead 1.25 makes sprites last about 4/3 as long; above 1.5 they would be too far ahead to take over).
   float predict_lead = 1.25f;
+  // When the keyframe is rendered ahead: false = right after a sprite is taken into use, from a viewpoint
+  // predict_lead lifetimes of the previous sprite ahead (the paper's suggestion); true = once the current sprite's
+  // error, growing with its age, says it will trip within about 1.5 times the frames it is drawn in (with a cost
+  // model, slices of at most half a sprite frame's cost, at most predict_chunks of them), from a viewpoint half way
+  // to that trip, the view direction turned at its recent angular rate (a short extrapolation, right on curving
+  // paths; predict_lead is then not used).
+  bool predict_late = false;
   int cache_size = 1;       // keyframes kept (1 = only the current one, as in the paper)
   double reuse_coverage = 0.95;
   // The per-frame choice between the high LOD and the sprite path (path_choice.h); null = always the sprite path.
@@ -98,14 +107,16 @@ struct LodSpriteOptions {
   // The high-resolution LOD (keyframes, predicted keyframes, high frames) drawn by the CDLOD terrain on the GPU
   // (gpu_lod.h) at high_error instead of the quadtree LOD; null = the quadtree LOD. With a cost model, the high
   // frames and keyframes are then predicted by its gpu_high model (calibrateTerrainCost with gpu_high), which it must
-  // have. A predicted keyframe is drawn whole in one frame (no slices). Must outlive the renderer.
+  // have. A predicted keyframe's nodes are drawn in slices as the quadtree's triangles are. Must outlive the renderer.
   GpuLodTerrain* gpu_high = nullptr;
   // With gpu_high: the sprite frame on the GPU too. Its low-resolution mesh is gpu_high's CDLOD selection at
   // low_error; equation 2 runs over that mesh's cells (sprite_error.h, a sample of at most error_quadrants of them);
   // equation 3 runs per vertex in the vertex shader against the keyframe's depth texture (gpu::CdlodSprite), and the
   // frame is one draw. Nothing is read back: a keyframe's depth stays on the GPU (spriteDepth() is empty) and
-  // LodSpriteFrameInfo::visible_triangles is not counted. No prediction and no keyframe cache (their coverage test
-  // reads the keyframe's depth). With a cost model, its sprite frames are predicted by the gpu_sprite model.
+  // LodSpriteFrameInfo::visible_triangles is not counted. The reuse test of predicted and cached keyframes ("covers
+  // the view") then counts the low-resolution CDLOD nodes whose box centre lies in the keyframe's image, with no
+  // z-buffer (what the keyframe hides is still tested per vertex when drawn). With a cost model, its sprite frames are
+  // predicted by the gpu_sprite model.
   bool gpu_low = false;
   size_t error_quadrants = 1024;
 };
@@ -180,7 +191,16 @@ class LodSpriteRenderer {
   Camera keyframeCamera(const Camera& camera) const;
   Keyframe* renderKeyframe(const Camera& camera, gpu::FrameStats& stats, LodSpriteFrameInfo& info);
   double coverage(Keyframe& keyframe);
-  void schedulePrediction(const Camera& camera);
+  // Whether a keyframe may become the sprite at viewpoint `eye`: its error there at most 3/4 of the threshold (some
+  // life left) and it covers the view; error_px: that error.
+  bool takesOver(Keyframe& keyframe, const Vec3& eye, double beta, double* error_px = nullptr);
+  // With gpu_low: the share of CDLOD nodes whose box centre lies in the keyframe's image.
+  double nodeCoverage(std::span<const CdlodNode> nodes, const Keyframe& keyframe) const;
+  // The keyframe rendered ahead from the viewpoint extrapolated `ahead` frames on, drawn in `chunks` slices.
+  void schedulePrediction(const Camera& camera, float ahead, size_t chunks);
+  // With predict_late: schedules it when the current sprite's error (at its age) says it trips within 1.5 times the
+  // slices it needs (costs: the frame's predicted costs, which size the slices; null = predict_chunks slices).
+  void scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* costs);
   void advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info);
   void keep(std::unique_ptr<Keyframe> keyframe);
   PathCosts predictCosts(size_t low_triangles) const;
@@ -193,6 +213,7 @@ class LodSpriteRenderer {
   LodSpriteCounters counters_;
   uint64_t frame_ = 0;
   uint64_t sprite_since_ = 0;    // frame the current sprite was taken into use
+  double sprite_error_at_take_ = 0.0;  // its error then (pixels; 0 for a fresh one)
   uint64_t last_lifetime_ = 10;  // frames the previous sprite lasted
   std::vector<std::unique_ptr<Keyframe>> kept_;  // the current sprite and (with a cache) earlier ones
   std::vector<std::unique_ptr<Keyframe>> spare_;
@@ -201,6 +222,7 @@ class LodSpriteRenderer {
   LodMesh low_, high_, pending_mesh_, probe_mesh_;
   size_t pending_chunk_ = 0;   // next step of the predicted keyframe (0 = build its mesh)
   size_t pending_chunks_ = 1;  // slices it is drawn in
+  CdlodSelection pending_selection_, probe_selection_;  // with gpu_high: its nodes; with gpu_low: its own low mesh
   KeyframeVisibility visibility_, probe_;
   std::deque<std::pair<Vec3, Vec3>> history_;  // recent (eye, look-at)
   // The per-frame choice: the viewpoint of the last keyframe, real or virtual, and recent sprite lifetimes.

@@ -1,0 +1,244 @@
+// LOD-sprite drawn by the CDLOD terrain on the GPU (LodSpriteOptions::gpu_high, gpu_low; llvmpipe in CI, 128x128
+// frames, the small test fractal): high frames and keyframes are CDLOD frames pixel for pixel, the sprite frame waits
+// for nothing, and keyframes rendered ahead late (predict_late) are drawn in slices that together are the whole
+// keyframe, and taken in time, so that no frame draws a whole keyframe.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "farfield/core/error.h"
+#include "farfield/gpu/context.h"
+#include "farfield/gpu/gl_counters.h"
+#include "farfield/gpu/render_target.h"
+#include "farfield/image/metrics.h"
+#include "farfield/terrain/gpu_lod.h"
+#include "farfield/terrain/lod_sprite.h"
+#include "terrain_gl_scene.h"
+
+namespace farfield::terrain {
+namespace {
+
+using test::choicePath;
+using test::kSky;
+using test::makeCamera;
+using test::Scene;
+using test::testFractal;
+
+// LOD-sprite's options with its high-resolution LOD drawn by a CDLOD terrain, on the tests' sky.
+LodSpriteOptions cdlodOptions(GpuLodTerrain& gpu_lod) {
+  LodSpriteOptions options;
+  options.sky_color = kSky;
+  options.gpu_high = &gpu_lod;
+  return options;
+}
+
+// LodSpriteOptions::gpu_high: the high LOD is the CDLOD terrain's. Where its frames are predicted cheap, every frame
+// is the CDLOD frame, pixel for pixel; where they are expensive, the sprite path is taken and each keyframe is the
+// CDLOD terrain drawn at the keyframe's camera. Without a CDLOD cost model the choice is refused.
+TEST(LodSpriteGL, TheGpuHighLodDrawsHighFramesAndKeyframes) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  const std::vector<Camera> cameras = choicePath(scene.hf, 16);
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
+  gpu::RenderTarget frame(128, 128), expected(128, 128);
+
+  TerrainCost cheap;  // sprite frames cost 2 draws, CDLOD frames nothing
+  cheap.frame.ms_per_draw = 3.0;
+  cheap.gpu_high = gpu::CostModel{};
+  cheap.gpu_high->base_ms = 0.5;
+  options.cost = &cheap;
+  {
+    LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+    for (size_t f = 0; f < cameras.size(); ++f) {
+      frame.clear(kSky);
+      LodSpriteFrameInfo info;
+      sprite.render(cameras[f], frame, &info);
+      EXPECT_EQ(info.path, TerrainPath::High) << "frame " << f;
+      EXPECT_DOUBLE_EQ(info.predicted_high_ms, 0.5) << "frame " << f;
+      EXPECT_EQ(info.high_triangles % (2 * 8 * 8), 0u) << "CDLOD patches";
+      expected.clear(kSky);
+      gpu_lod.draw(cameras[f], options.high_error, expected);
+      EXPECT_EQ(frame.readColor().pixels(), expected.readColor().pixels()) << "frame " << f;
+    }
+  }
+
+  TerrainCost expensive = cheap;  // now the CDLOD frames cost a lot
+  expensive.gpu_high->base_ms = 50.0;
+  expensive.frame.ms_per_draw = 0.1;
+  options.cost = &expensive;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  size_t keyframes = 0;
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    sprite.render(cameras[f], frame, &info);
+    if (info.source != SpriteSource::Fresh) continue;
+    ++keyframes;
+    EXPECT_GT(info.keyframe_triangles, 0u);
+    EXPECT_EQ(info.keyframe_triangles % (2 * 8 * 8), 0u);
+    const Camera& key = *sprite.spriteCamera();
+    gpu::RenderTarget key_expected(key.width, key.height);
+    key_expected.clear(kSky);
+    gpu_lod.draw(key, options.high_error, key_expected);
+    EXPECT_EQ(sprite.spriteTarget()->readColor().pixels(), key_expected.readColor().pixels()) << "frame " << f;
+  }
+  EXPECT_GE(keyframes, 1u);
+  EXPECT_GE(sprite.counters().frames - sprite.counters().high_frames, cameras.size() / 2);
+
+  TerrainCost without = cheap;
+  without.gpu_high.reset();
+  options.cost = &without;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, options), Error);
+}
+
+// The sprite frame on the GPU too (gpu_low): a keyframe is a CDLOD frame whose depth stays on the GPU, a sprite frame
+// is one CDLOD draw tested against it, and no frame waits for the GPU; the frames stay close to the CDLOD high
+// frames, the metric over the CDLOD mesh trips along the path, and the choice predicts sprite frames by gpu_sprite.
+TEST(LodSpriteGL, TheSpriteFrameOnTheGpuWaitsForNothing) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  const std::vector<Camera> cameras = choicePath(scene.hf, 24);
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
+  options.gpu_low = true;
+  TerrainCost cost;  // CDLOD high frames expensive, sprite frames cheap: the sprite path once a sprite has lasted
+  cost.gpu_high = gpu::CostModel{};
+  cost.gpu_high->base_ms = 50.0;
+  cost.gpu_sprite = gpu::CostModel{};
+  cost.gpu_sprite->base_ms = 0.25;
+  options.cost = &cost;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const bool counting = gpu::installGlCounters();
+  gpu::RenderTarget frame(128, 128), expected(128, 128);
+  double worst_psnr = 1e9;
+  size_t sprite_frames = 0;
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    const gpu::GlCounters before = gpu::glCounters();
+    const gpu::FrameStats stats = sprite.render(cameras[f], frame, &info);
+    const gpu::GlCounters used = gpu::glCounters() - before;
+    EXPECT_DOUBLE_EQ(info.predicted_sprite_ms, 0.25) << "frame " << f;
+    if (info.path == TerrainPath::Sprite) {
+      ++sprite_frames;
+      EXPECT_TRUE(sprite.spriteDepth()->empty());
+    }
+    EXPECT_EQ(stats.draw_calls, info.source == SpriteSource::Fresh ? 2u : 1u) << "frame " << f;
+    EXPECT_EQ(info.low_triangles % (2 * 8 * 8), 0u) << "CDLOD patches";
+    if (counting) {
+      EXPECT_EQ(used.syncs, 0u) << "frame " << f;
+    }
+    if (f > 0) {
+      EXPECT_GT(info.quadrants, 100u) << "frame " << f;
+    }
+    expected.clear(kSky);
+    gpu_lod.draw(cameras[f], options.high_error, expected);
+    worst_psnr = std::min(worst_psnr, image::psnr(frame.readColor(), expected.readColor()));
+  }
+  std::printf("%zu keyframes in %zu frames, %zu sprite frames; worst PSNR against the CDLOD high frame %.1f dB\n",
+              sprite.counters().fresh_keyframes, cameras.size(), sprite_frames, worst_psnr);
+  // The first keyframe is virtual (no sprite lifetime measured yet: the high frame wins); then sprites.
+  EXPECT_GE(sprite_frames, cameras.size() * 3 / 4);
+  EXPECT_GE(sprite.counters().fresh_keyframes, 2u);
+  EXPECT_LT(sprite.counters().fresh_keyframes, cameras.size() / 2);
+  EXPECT_GT(worst_psnr, 25.0);
+
+  // Where sprite frames cost as much as the high LOD, no sprite can pay: every frame is the high LOD, and the error
+  // metric is not run (no quadrant evaluated).
+  TerrainCost even = cost;
+  even.gpu_sprite->base_ms = 50.0;
+  LodSpriteOptions no_gain = options;
+  no_gain.cost = &even;
+  LodSpriteRenderer high_only(*scene.lod, *scene.renderer, 128, 128, no_gain);
+  for (size_t f = 0; f < 6; ++f) {
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    high_only.render(cameras[f], frame, &info);
+    EXPECT_EQ(info.path, TerrainPath::High) << "frame " << f;
+    EXPECT_EQ(info.quadrants, 0u) << "frame " << f;
+  }
+  EXPECT_EQ(high_only.counters().fresh_keyframes, 0u);
+
+  LodSpriteOptions bad = options;
+  bad.gpu_high = nullptr;
+  bad.cost = nullptr;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);
+  TerrainCost no_sprite_model = cost;
+  no_sprite_model.gpu_sprite.reset();
+  bad = options;
+  bad.cost = &no_sprite_model;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);
+}
+
+
+// predict_late on the GPU: along a straight, steady flight, each keyframe after the first is rendered ahead in slices
+// (no frame draws a whole keyframe, each draws at most one slice) and taken before the sprite trips; a keyframe made of
+// slices is the CDLOD frame at its camera pixel for pixel (the terrain's selections for other bounds and cameras,
+// made in between, do not change it), and every frame stays within the error threshold and close to the CDLOD frame.
+TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
+  options.gpu_low = true;
+  options.predict = true;
+  options.predict_late = true;
+  options.predict_chunks = 4;
+  TerrainCost cost;  // as above: sprites pay; a keyframe is many sprite frames, so it takes all 4 slices
+  cost.gpu_high = gpu::CostModel{};
+  cost.gpu_high->base_ms = 50.0;
+  cost.gpu_sprite = gpu::CostModel{};
+  cost.gpu_sprite->base_ms = 0.25;
+  options.cost = &cost;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const float top = scene.hf.maxHeight();
+  gpu::RenderTarget frame(128, 128), expected(128, 128);
+  double worst_psnr = 1e9;
+  uint64_t slice_max = 0;
+  size_t first_fresh = 0, slices = 0, checked = 0;
+  for (size_t f = 0; f < 90; ++f) {
+    const float x = 300.0f + 24.0f * float(f);
+    const Camera camera = makeCamera(Vec3(x, 300, top + 700), Vec3(x + 100, 1500, 0));
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    sprite.render(camera, frame, &info);
+    if (info.source == SpriteSource::Fresh && first_fresh == 0) first_fresh = f;
+    if (first_fresh > 0 && f > first_fresh) {
+      EXPECT_EQ(info.keyframe_triangles, 0u) << "frame " << f << ": a whole keyframe";
+    }
+    if (info.ahead_triangles > 0) {
+      ++slices;
+      slice_max = std::max(slice_max, info.ahead_triangles);
+    }
+    EXPECT_LE(info.error_px, options.epsilon + 1e-9) << "frame " << f;
+    if (std::getenv("FF_TERRAIN_DUMP"))
+      std::printf("frame %zu %s error %.3f ahead %lu\n", f, spriteSourceName(info.source), info.error_px,
+                  (unsigned long)info.ahead_triangles);
+    if (info.source == SpriteSource::Predicted) {
+      const Camera& key = *sprite.spriteCamera();
+      gpu::RenderTarget key_expected(key.width, key.height);
+      key_expected.clear(kSky);
+      gpu_lod.draw(key, options.high_error, key_expected);
+      EXPECT_EQ(sprite.spriteTarget()->readColor().pixels(), key_expected.readColor().pixels()) << "frame " << f;
+      ++checked;
+    }
+    expected.clear(kSky);
+    gpu_lod.draw(camera, options.high_error, expected);
+    worst_psnr = std::min(worst_psnr, image::psnr(frame.readColor(), expected.readColor()));
+  }
+  const LodSpriteCounters& c = sprite.counters();
+  std::printf("%zu fresh, %zu rendered ahead (%zu used, %zu dropped), %zu slice frames, largest slice %lu "
+              "triangles; worst PSNR against the CDLOD high frame %.1f dB\n",
+              c.fresh_keyframes, c.predicted_rendered, c.predicted_used, c.predicted_discarded, slices,
+              (unsigned long)slice_max, worst_psnr);
+  EXPECT_GT(first_fresh, 0u) << "the first keyframe is taken when it pays, after a high frame or more";
+  EXPECT_EQ(c.fresh_keyframes, 1u);
+  EXPECT_GE(c.predicted_used, 2u);
+  EXPECT_EQ(checked, c.predicted_used);
+  EXPECT_GE(slices, c.predicted_rendered * 2) << "each keyframe rendered ahead is spread over frames";
+  EXPECT_GT(worst_psnr, 25.0);
+}
+
+}  // namespace
+}  // namespace farfield::terrain
