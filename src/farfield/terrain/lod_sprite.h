@@ -186,7 +186,17 @@ class LodSpriteRenderer {
   const image::DepthImage* spriteDepth() const;
 
  private:
-  struct Keyframe;
+  // A sprite: the keyframe's colour (the target's colour texture), its camera and z-buffer.
+  struct Keyframe {
+    Camera camera;        // the keyframe's camera (with the guard band)
+    Camera frame_camera;  // the frame's camera it was made for
+    Mat4 view_proj{1.0f};
+    gpu::RenderTarget target;
+    image::DepthImage depth;
+    double coverage_at_creation = 1.0;  // visible share of its own low-resolution mesh (gpu_low: of its nodes)
+    uint64_t last_used = 0;
+    bool ready = false;
+  };
   std::unique_ptr<Keyframe> takeKeyframe();
   Camera keyframeCamera(const Camera& camera) const;
   Keyframe* renderKeyframe(const Camera& camera, gpu::FrameStats& stats, LodSpriteFrameInfo& info);

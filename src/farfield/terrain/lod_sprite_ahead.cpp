@@ -1,0 +1,161 @@
+// LOD-sprite's keyframes rendered ahead (Chen et al. 1999, section 5) and the test that a kept or predicted keyframe
+// may take over: scheduling (right after a sprite is taken, or late, when its error says it is about to trip), the
+// slices each frame draws, and the view coverage.
+#include <algorithm>
+#include <cmath>
+
+#include "farfield/core/error.h"
+#include "farfield/terrain/lod_sprite.h"
+
+namespace farfield::terrain {
+
+double LodSpriteRenderer::coverage(Keyframe& keyframe) {
+  if (options_.gpu_low) return nodeCoverage(options_.gpu_high->selection(low_handle_).nodes, keyframe);
+  probe_.reset(lod_, keyframe.camera, &keyframe.depth, options_.visibility);
+  return probe_.visibleShare(low_.indices);
+}
+
+double LodSpriteRenderer::nodeCoverage(std::span<const CdlodNode> nodes, const Keyframe& keyframe) const {
+  // Every node is a patch of the same triangles: the share of nodes stands for the share of triangles.
+  if (nodes.empty()) return 1.0;
+  const CdlodTerrain& lod = options_.gpu_high->lod();
+  size_t inside = 0;
+  for (const CdlodNode& n : nodes) {
+    const Vec4 p = keyframe.view_proj * Vec4(lod.nodeBox(n).center(), 1.0f);
+    if (p.w > 0.0f && std::abs(p.x) <= p.w && std::abs(p.y) <= p.w) ++inside;
+  }
+  return double(inside) / double(nodes.size());
+}
+
+void LodSpriteRenderer::schedulePrediction(const Camera& camera, float ahead, size_t chunks) {
+  if (pending_) {
+    ++counters_.predicted_discarded;
+    spare_.push_back(std::move(pending_));
+  }
+  // Linear extrapolation of eye and look-at over the recent viewpoints, `ahead` frames ahead.
+  const size_t n = history_.size();
+  Vec3 eye_velocity(0.0f), at_velocity(0.0f);
+  if (n >= 2) {
+    eye_velocity = (history_.back().first - history_.front().first) / float(n - 1);
+    at_velocity = (history_.back().second - history_.front().second) / float(n - 1);
+  }
+  Camera predicted = camera;
+  predicted.eye = camera.eye + eye_velocity * ahead;
+  predicted.at = camera.at + at_velocity * ahead;
+  if (options_.predict_late && n >= 2) {
+    // Late: the direction turned at its recent angular rate (the look-at point's distance changes with the path, so
+    // its linear extrapolation turns the view by other angles); at most 30 degrees.
+    const Vec3 f0 = glm::normalize(history_.front().second - history_.front().first);
+    const Vec3 f1 = camera.forward();
+    const Vec3 axis = glm::cross(f0, f1);
+    const float turned = std::atan2(glm::length(axis), glm::dot(f0, f1));
+    Vec3 f = f1;
+    if (glm::length(axis) > 1e-6f) {
+      const float angle = std::min(turned / float(n - 1) * ahead, glm::radians(30.0f));
+      f = f1 * std::cos(angle) + glm::cross(glm::normalize(axis), f1) * std::sin(angle);  // axis is normal to f1
+    }
+    predicted.at = predicted.eye + f * glm::length(camera.at - camera.eye);
+  }
+  // Never extrapolate into the ground (a descent would otherwise end below the terrain): keep at least half of the
+  // current height above the ground.
+  const Heightfield& hf = lod_.heightfield();
+  const float ground_now = hf.sample(camera.eye.x, camera.eye.y);
+  const float ground_then = hf.sample(predicted.eye.x, predicted.eye.y);
+  predicted.eye.z = std::max(predicted.eye.z, ground_then + 0.5f * std::max(camera.eye.z - ground_now, 0.0f));
+  if (glm::length(predicted.at - predicted.eye) < 1e-3f) predicted.at = predicted.eye + camera.forward();
+  try {
+    predicted.validate("predicted keyframe camera");
+  } catch (const Error&) {
+    return;  // e.g. extrapolated into looking straight up: no prediction this time
+  }
+  pending_ = takeKeyframe();
+  pending_->frame_camera = predicted;
+  pending_->camera = keyframeCamera(predicted);
+  pending_->view_proj = pending_->camera.viewProjection();
+  pending_chunk_ = 0;
+  pending_chunks_ = chunks;
+}
+
+void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info) {
+  Keyframe& k = *pending_;
+  const size_t chunks = pending_chunks_;
+  if (options_.gpu_high) {
+    // The CDLOD terrain: step 0 selects its nodes (on the CPU; kept here, as the terrain's selections are remade by
+    // the frames in between); steps 0..chunks-1 draw one run of them each.
+    GpuLodTerrain& terrain = *options_.gpu_high;
+    if (pending_chunk_ == 0) {
+      terrain.lod().select(k.camera, options_.high_error, true, pending_selection_);
+      k.target.clear(options_.sky_color);
+    }
+    const std::span<const CdlodNode> nodes = pending_selection_.nodes;
+    const size_t per_chunk = (nodes.size() + chunks - 1) / chunks;
+    const size_t first = std::min(nodes.size(), pending_chunk_ * per_chunk);
+    terrain.setHole(options_.hole);
+    const gpu::FrameStats ahead =
+        terrain.drawNodes(k.camera, options_.high_error, nodes.subspan(first, std::min(nodes.size() - first, per_chunk)),
+                          k.target).draw;
+    terrain.clearHole();
+    gpu::addDraw(stats, ahead);
+    info.ahead_triangles += ahead.triangles;
+    if (++pending_chunk_ < chunks) return;
+  } else {
+    // The quadtree LOD: step 0 (the frame after the switch) builds the mesh; steps 1..chunks draw one slice of it each.
+    if (pending_chunk_ == 0) {
+      lod_.build(k.camera, LodSettings{options_.high_error, true, false}, pending_mesh_);
+      removeTrianglesInside(pending_mesh_, options_.hole, uint32_t(lod_.width()));
+      renderer_.setIndices(pending_mesh_.indices, 1);
+      k.target.clear(options_.sky_color);
+      ++pending_chunk_;
+      return;
+    }
+    const size_t total = pending_mesh_.triangleCount();
+    const size_t per_chunk = (total + chunks - 1) / chunks;
+    const size_t first = std::min(total, (pending_chunk_ - 1) * per_chunk);
+    const size_t count = std::min(total - first, per_chunk);
+    gpu::addDraw(stats, renderer_.drawTextured(k.camera, k.target, first, count, 1));
+    info.ahead_triangles += count;
+    if (++pending_chunk_ <= chunks) return;
+  }
+  k.ready = true;
+  ++counters_.predicted_rendered;
+  // Its own coverage, for the reuse test: the low-resolution mesh at its viewpoint, against its z-buffer (read here;
+  // the sprite frame on the GPU reads nothing and tests the CDLOD nodes against its image instead).
+  if (options_.gpu_low) {
+    options_.gpu_high->lod().select(k.frame_camera, options_.low_error, true, probe_selection_);
+    k.coverage_at_creation = nodeCoverage(probe_selection_.nodes, k);
+    return;
+  }
+  k.depth = k.target.readDepth();
+  lod_.build(k.frame_camera, LodSettings{options_.low_error, true, false}, probe_mesh_);
+  probe_.reset(lod_, k.camera, &k.depth, options_.visibility);
+  k.coverage_at_creation = probe_.visibleShare(probe_mesh_.indices);
+}
+
+void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* costs) {
+  // The error grows about linearly with the frames since the sprite was taken (with the distance moved); at the rate
+  // seen since then it trips in `left` frames. Started once about 1.5 times predict_chunks frames are left, drawn
+  // in slices that end two thirds of the way (the rate may rise), the extrapolation is short, so it is still right on
+  // a curving path.
+  const double age = double(frame_ - sprite_since_);
+  const double grown = error_px - sprite_error_at_take_;
+  if (age < 2.0 || !(grown > 0.05 * options_.epsilon)) return;
+  const double left = (options_.epsilon - error_px) * age / grown;
+  // Slices of at most half a sprite frame each by the cost model (at most predict_chunks of them).
+  double chunks = double(options_.predict_chunks);
+  if (costs && costs->sprite_ms > 0.0)
+    chunks = std::clamp(std::ceil((costs->keyframe_ms - costs->sprite_ms) / (0.5 * costs->sprite_ms)), 1.0, chunks);
+  if (left > 1.5 * chunks + 1.0) return;
+  // From half way to where it trips: its error there is small, and the extrapolation half as long.
+  schedulePrediction(camera, float(std::clamp(0.5 * left, 0.0, 600.0)),
+                     size_t(std::clamp(std::floor(left * 2.0 / 3.0), 1.0, chunks)));
+}
+
+bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, double* error_px) {
+  // Only with some life left (error at most 3/4 of the threshold here), or it would trip again at once.
+  const SpriteError e = frameError(keyframe.camera.eye, eye);
+  if (error_px) *error_px = e.pixels(beta);
+  return !keyframeDue(e, beta, 0.75 * options_.epsilon) &&
+         coverage(keyframe) >= options_.reuse_coverage * keyframe.coverage_at_creation;
+}
+
+}  // namespace farfield::terrain
