@@ -316,8 +316,8 @@ void registerTerrainModes() {
                  return std::make_unique<SpriteMode>("lod-sprite-gpu", SpriteVariant::Paper, 0.0, true);
                });
   registerMode("lod-sprite-gpu-predict",
-               "terrain: lod-sprite-gpu with keyframes rendered ahead, in slices of at most half a sprite frame (by the cost model) (section 5), "
-               "so that no frame draws a whole keyframe (terrain bench)",
+               "terrain: lod-sprite-gpu with keyframes rendered ahead (section 5), late and in slices of a third of a "
+               "sprite frame by the cost model, so that no frame draws a whole keyframe (terrain bench)",
                [](const ModeContext&) {
                  return std::make_unique<SpriteMode>("lod-sprite-gpu-predict", SpriteVariant::Predict, 0.0, true);
                });

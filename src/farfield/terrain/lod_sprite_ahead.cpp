@@ -8,6 +8,13 @@
 #include "farfield/terrain/lod_sprite.h"
 
 namespace farfield::terrain {
+namespace {
+
+// A slice of a keyframe rendered ahead late costs at most this share of a sprite frame by the cost model (whose
+// sprite frames measure 1.2-1.5x its prediction on llvmpipe: about half a sprite frame measured).
+constexpr double kSliceShare = 1.0 / 3.0;
+
+}  // namespace
 
 double LodSpriteRenderer::coverage(Keyframe& keyframe) {
   if (options_.gpu_low) return nodeCoverage(options_.gpu_high->selection(low_handle_).nodes, keyframe);
@@ -132,22 +139,24 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
 }
 
 void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* costs) {
-  // The error grows about linearly with the frames since the sprite was taken (with the distance moved); at the rate
-  // seen since then it trips in `left` frames. Started once about 1.5 times predict_chunks frames are left, drawn
-  // in slices that end two thirds of the way (the rate may rise), the extrapolation is short, so it is still right on
-  // a curving path.
+  // The error grows roughly with the distance moved since the sprite was taken; at the rate seen since then it trips
+  // in `left` frames. The next keyframe is started once about 1.5 times the frames it is drawn in are left, or once
+  // the error has reached 3/4 of the threshold (an error that creeps near the threshold for a long time trips at a
+  // jump the rate does not see).
   const double age = double(frame_ - sprite_since_);
   const double grown = error_px - sprite_error_at_take_;
   if (age < 2.0 || !(grown > 0.05 * options_.epsilon)) return;
   const double left = (options_.epsilon - error_px) * age / grown;
-  // Slices of at most half a sprite frame each by the cost model (at most predict_chunks of them).
+  // Slices of at most kSliceShare of a sprite frame each by the cost model (at most predict_chunks of them).
   double chunks = double(options_.predict_chunks);
   if (costs && costs->sprite_ms > 0.0)
-    chunks = std::clamp(std::ceil((costs->keyframe_ms - costs->sprite_ms) / (0.5 * costs->sprite_ms)), 1.0, chunks);
-  if (left > 1.5 * chunks + 1.0) return;
-  // From half way to where it trips: its error there is small, and the extrapolation half as long.
-  schedulePrediction(camera, float(std::clamp(0.5 * left, 0.0, 600.0)),
-                     size_t(std::clamp(std::floor(left * 2.0 / 3.0), 1.0, chunks)));
+    chunks = std::clamp(std::ceil((costs->keyframe_ms - costs->sprite_ms) / (kSliceShare * costs->sprite_ms)), 1.0, chunks);
+  if (left > 1.5 * chunks + 1.0 && error_px < 0.75 * options_.epsilon) return;
+  // Never in fewer slices than the cost model wants, even where the rate says the trip comes sooner (the error grows
+  // more slowly as the sprite ages, so the rate is pessimistic; a trip before it is ready is a keyframe drawn at
+  // once, as without prediction). From where the camera will be when it is ready, which is when it is taken (it
+  // then has less error than the current sprite): a short extrapolation.
+  schedulePrediction(camera, float(chunks), size_t(chunks));
 }
 
 bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, double* error_px) {
