@@ -13,9 +13,9 @@
 #   demo     the 400-block detail-2 city at 640x360 (make demo's until 2026-12-05): the same modes
 #   check    farfield cull-check on the held-out city at 1920x1080 (GPU-culled frames against frustum-culled ones)
 #   crowd    the crowd bench at 1920x1080 with the GPU crowd beside the CPU path (--gpu-crowd), 10,000 to 1,000,000
-#            agents, no shadows (the GPU path has none yet)
+#            agents, no shadows (the crowd alone; shadows are measured on llvmpipe)
 #   terrain  the terrain LODs at 1920x1080, 600-frame flythroughs: the quadtree LOD (high, low, lod-sprite) against
-#            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu) on the shared DEM (.gpu/data/terrain/*.tif, when
+#            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu[-predict]) on the shared DEM (.gpu/data/terrain/*.tif, when
 #            carried) and on the 8,193^2 fractal
 set -uo pipefail
 STAGES=${STAGES:-smoke heldout big demo check terrain crowd}
@@ -129,7 +129,7 @@ fi
 if [[ " $STAGES " == *" terrain "* ]]; then
   T=terrain
   mkdir -p $T
-  tmodes=high,high-gpu,low,low-gpu,lod-sprite,lod-sprite-gpu
+  tmodes=high,high-gpu,low,low-gpu,lod-sprite,lod-sprite-gpu,lod-sprite-gpu-predict
   dem=$(ls "$DATA"/terrain/*.tif 2>/dev/null | head -1)
   for spec in ${dem:+"$dem"} fractal:8193:7; do
     name=$(basename "$spec" .tif | tr ':' '-')

@@ -455,6 +455,59 @@ TEST(GpuCrowdGL, ShadowsFallWhereTheCpuPathsFall) {
   EXPECT_GE(double(both_dark), 0.7 * double(gpu_dark));
 }
 
+// Mixed's budget in milliseconds on the GPU path: the skinned draws are timed and their triangles copied, both read
+// frames later, with no wait counted in the frame; the budget in triangles follows the measured cost. A budget of a
+// millionth of a millisecond turns every skinned agent into an impostor once a frame has been measured (10,000
+// triangles before, TriangleRate's start); a budget of a thousand seconds keeps the agents the unbudgeted frame draws.
+TEST(GpuCrowdGL, TheBudgetInMillisecondsFollowsTheMeasuredSkinnedDraws) {
+  CrowdScene scene;
+  gpu::installGlCounters();
+  const gpu::LightSettings light;
+  gpu::RenderTarget target(scene.camera.width, scene.camera.height);
+  auto geometryAgents = [&] {
+    uint64_t n = 0;
+    const std::vector<gpu::GpuCrowdCommand> commands = scene.gc.readCommands();
+    for (size_t m = 0; m < scene.rt.modelCount(); ++m) n += commands[2 * m].instance_count;
+    return n;
+  };
+  target.bindForOpaquePass();
+  scene.rt.drawGpu(scene.camera, scene.gc, runtime::CrowdPolicy::Mixed, light);
+  const uint64_t unbudgeted = geometryAgents();
+  ASSERT_GT(unbudgeted, 0u) << "the camera sees skinned agents";
+  for (double ms : {1e-6, 1e6}) {
+    runtime::CrowdRuntimeOptions o;
+    o.geometry_ms = ms;
+    runtime::CrowdRuntime rt(scene.models.models, scene.models.options, o);
+    for (int f = 0; f < 5; ++f) {
+      target.bindForOpaquePass();
+      const gpu::GlCounters before = gpu::glCounters();
+      const runtime::CrowdFrameStats stats = rt.drawGpu(scene.camera, scene.gc, runtime::CrowdPolicy::Mixed, light);
+      const gpu::GlCounters used = gpu::glCounters() - before;
+      if (gpu::glCountersInstalled()) {
+        EXPECT_EQ(used.syncs, 0u) << "frame " << f;
+      }
+      if (f == 0) {
+        EXPECT_EQ(stats.budget_triangles, 10000u) << "no measurement yet";
+      }
+      const uint64_t drawn = geometryAgents();
+      std::printf("budget %g ms, frame %d: %llu triangles allowed, %llu skinned agents (unbudgeted %llu), last "
+                  "measured %.3f ms\n", ms, f, (unsigned long long)stats.budget_triangles, (unsigned long long)drawn,
+                  (unsigned long long)unbudgeted, stats.geometry_ms);
+      rt.finish();
+      if (f < 2) continue;  // measured frames arrive from the first one on
+      EXPECT_GT(rt.msPerSkinnedTriangle(), 0.0) << "frame " << f;
+      if (ms < 1.0) {
+        EXPECT_EQ(stats.budget_triangles, 1u) << "frame " << f;
+        EXPECT_EQ(drawn, 0u) << "frame " << f;
+      } else {
+        EXPECT_GT(stats.budget_triangles, 1'000'000u) << "frame " << f;
+        EXPECT_EQ(drawn, unbudgeted) << "frame " << f;
+      }
+    }
+    EXPECT_GT(rt.collectGpuGeometryMs(scene.gc), 0.0);
+  }
+}
+
 TEST(GpuCrowdGL, BadInputIsAnError) {
   gpu::sharedHeadlessContext().makeCurrent();
   const gen::Crowd crowd = testCrowd(10, false);

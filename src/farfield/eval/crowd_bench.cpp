@@ -429,7 +429,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         }
         if (options.runtime.geometry_ms > 0.0 && specs[m].policy == runtime::CrowdPolicy::Mixed &&
             out.stats.geometry > 0)
-          out.skinned = mode_rt.collectGeometryMs();
+          out.skinned = specs[m].gpu ? rt.collectGpuGeometryMs(*gpu_crowd) : mode_rt.collectGeometryMs();
         return out;
       };
       for (size_t k = 0; k <= options.frames; ++k) {  // k = 0: the untimed warm-up frame

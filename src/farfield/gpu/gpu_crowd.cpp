@@ -4,6 +4,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <iterator>
 #include <string>
 
@@ -113,6 +114,7 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
   casters_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_CASTERS 1\n");
   budget_scan_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_BUDGET_SCAN 1\n");
   budget_assign_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_BUDGET_ASSIGN 1\n");
+  late_commands_ = std::make_unique<LateReadback>(2 * models_ * sizeof(GpuCrowdCommand));
 }
 
 GpuCrowd::~GpuCrowd() {
@@ -181,6 +183,19 @@ GpuCrowd::Counts GpuCrowd::readCounts() const {
     counts.budget_triangles_wanted = c[5];
   }
   return counts;
+}
+
+void GpuCrowd::captureCommands(uint64_t frame) {
+  late_commands_->capture(commands_, 0, frame);
+}
+
+size_t GpuCrowd::finishedCommands(
+    const std::function<void(uint64_t, std::span<const GpuCrowdCommand>)>& use) {
+  return late_commands_->finished([&](uint64_t frame, std::span<const uint8_t> bytes) {
+    std::vector<GpuCrowdCommand> commands(2 * models_);
+    std::memcpy(commands.data(), bytes.data(), bytes.size());
+    use(frame, commands);
+  });
 }
 
 void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> switch_m) {

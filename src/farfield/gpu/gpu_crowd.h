@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "farfield/core/camera.h"
 #include "farfield/core/math.h"
 #include "farfield/gpu/gpu_depth_pyramid.h"
+#include "farfield/gpu/late_readback.h"
 #include "farfield/gpu/program.h"
 #include "farfield/gpu/render_target.h"
 
@@ -109,6 +111,11 @@ class GpuCrowd {
     uint32_t over_budget = 0, budget_triangles_kept = 0, budget_triangles_wanted = 0;
   };
   Counts readCounts() const;
+  // The camera lists' commands (2 per model, as readCommands) copied for reading frames later, tagged `frame`: after
+  // cullAndClassify, no wait (gpu/late_readback.h; skipped while 8 copies are in flight). finishedCommands calls
+  // `use` with each copy the GPU has completed, oldest first, and never waits.
+  void captureCommands(uint64_t frame);
+  size_t finishedCommands(const std::function<void(uint64_t frame, std::span<const GpuCrowdCommand> commands)>& use);
 
   size_t agentCount() const { return agents_; }
   size_t modelCount() const { return models_; }
@@ -138,6 +145,7 @@ class GpuCrowd {
   uint32_t agent_buf_ = 0, routes_ = 0, points_ = 0, poses_ = 0, phases_ = 0, model_buf_ = 0, commands_ = 0,
            initial_ = 0, lists_ = 0, counts_ = 0, candidates_ = 0, buckets_ = 0;
   uint64_t budget_ = 0;
+  std::unique_ptr<LateReadback> late_commands_;  // captureCommands' copies
   std::unique_ptr<GpuDepthPyramid> pyramid_;  // made by the first occludeBehind
   bool occlude_next_ = false;
   size_t bytes_ = 0;

@@ -11,6 +11,7 @@
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/gpu/gpu_depth_pyramid.h"
+#include "farfield/gpu/late_readback.h"
 #include "farfield/gpu/program.h"
 
 namespace farfield::gpu {
@@ -69,14 +70,7 @@ struct GpuCuller::Impl {
   // The depth pyramid (level 0 is the target's depth).
   GpuDepthPyramid pyramid;
 
-  struct Slot {
-    GLuint buffer = 0;
-    const uint32_t* mapped = nullptr;
-    GLsync fence = nullptr;
-    uint64_t frame = 0;
-  };
-  std::array<Slot, kRing> ring{};
-  size_t ring_next = 0;  // the slot the next frame writes
+  std::unique_ptr<LateReadback> late_stats;  // the statistics, read frames later
 
   static CullLocations locate(const Program& program) {
     const GLuint c = program.handle();
@@ -105,13 +99,6 @@ struct GpuCuller::Impl {
                               commands[0], commands[1], counts[0], counts[1],   work,        drawn,
                               drawn_list,  part_visible, instance_part};
     glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
-    for (Slot& s : ring) {
-      if (s.fence) glDeleteSync(s.fence);
-      if (s.buffer) {
-        glUnmapNamedBuffer(s.buffer);
-        glDeleteBuffers(1, &s.buffer);
-      }
-    }
   }
 
   // Pyramid levels for a width x height target (GpuDepthPyramid), their sizes into the stages that test them.
@@ -158,13 +145,7 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   std::vector<uint32_t> first(std::max<size_t>(im.groups, 1), 0);
   for (uint32_t g = 0; g < im.groups; ++g) first[g] = arena.groups()[g].first_instance;
   im.group_first = createBuffer(first.size() * sizeof(uint32_t), first.data());
-  for (Impl::Slot& s : im.ring) {
-    const GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
-    s.buffer = createBuffer(kStatCount * sizeof(uint32_t), nullptr, flags);
-    s.mapped = static_cast<const uint32_t*>(
-        glMapNamedBufferRange(s.buffer, 0, GLsizeiptr(kStatCount * sizeof(uint32_t)), flags));
-    FF_CHECK_MSG(s.mapped != nullptr, "mapping a statistics buffer failed");
-  }
+  im.late_stats = std::make_unique<LateReadback>(kStatCount * sizeof(uint32_t), kRing);
 }
 
 GpuCuller::~GpuCuller() = default;
@@ -419,31 +400,17 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glUseProgram(0);
 
   // ---- statistics, read frames later ----
-  Impl::Slot& slot = im.ring[im.ring_next];
-  if (!slot.fence) {
-    glCopyNamedBufferSubData(im.stats, slot.buffer, 0, 0, GLsizeiptr(kStatCount * sizeof(uint32_t)));
-    slot.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-    slot.frame = frame;
-    im.ring_next = (im.ring_next + 1) % kRing;
-  }
+  im.late_stats->capture(im.stats, 0, frame);
   return stats;
 }
 
 std::vector<GpuCullStats> GpuCuller::finishedStats() {
-  Impl& im = *impl_;
   std::vector<GpuCullStats> out;
-  // Slots are filled in ring order: the oldest unfinished one follows the last one written.
-  for (size_t n = 0; n < kRing; ++n) {
-    Impl::Slot& s = im.ring[(im.ring_next + n) % kRing];
-    if (!s.fence) continue;
-    GLint status = GL_UNSIGNALED;
-    glGetSynciv(s.fence, GL_SYNC_STATUS, 1, nullptr, &status);
-    if (status != GL_SIGNALED) break;
-    glDeleteSync(s.fence);
-    s.fence = nullptr;
+  impl_->late_stats->finished([&](uint64_t frame, std::span<const uint8_t> bytes) {
+    uint32_t v[kStatCount];
+    std::memcpy(v, bytes.data(), sizeof(v));
     GpuCullStats st;
-    st.frame = s.frame;
-    const uint32_t* v = s.mapped;
+    st.frame = frame;
     st.instances_in_plan = v[0];
     st.commands = v[9];
     st.drawn_early = v[1];
@@ -454,7 +421,7 @@ std::vector<GpuCullStats> GpuCuller::finishedStats() {
     st.occlusion_culled = v[7];
     st.objects = v[8];
     out.push_back(st);
-  }
+  });
   return out;
 }
 

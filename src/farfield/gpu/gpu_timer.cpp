@@ -49,6 +49,13 @@ void GpuTimer::end() {
   ended_ = true;
 }
 
+bool GpuTimer::ready() const {
+  if (!ended_ || source_ == Source::CpuClock) return true;
+  GLuint available = 0;
+  glGetQueryObjectuiv(query_, GL_QUERY_RESULT_AVAILABLE, &available);
+  return available != 0;
+}
+
 double GpuTimer::elapsedMs() const {
   // A query that never ran has no result; asking for it would be a GL error.
   if (!ended_) return 0.0;

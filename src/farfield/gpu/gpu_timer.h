@@ -35,6 +35,8 @@ class GpuTimer {
   // Query: capped at the CPU wall time from begin() to the result (the GPU cannot have worked longer; llvmpipe, if
   // asked to use queries, sometimes reports a time since boot).
   double elapsedMs() const;
+  // Whether elapsedMs() would return without waiting (a query's result is available; the clock's is at once).
+  bool ready() const;
   // The source in use (never Auto).
   Source source() const { return source_; }
 

@@ -6,6 +6,7 @@
 // ground through one shadow map (drawShadowed).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -15,6 +16,7 @@
 #include "farfield/gpu/crowd_renderer.h"
 #include "farfield/gpu/gpu_crowd.h"
 #include "farfield/gpu/gpu_timer.h"
+#include "farfield/gpu/late_readback.h"
 #include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/shadow_map.h"
@@ -81,7 +83,7 @@ struct CrowdRuntimeOptions {
   // above (the smaller holds): each frame's skinned draws are timed (gpu::GpuTimer), and the budget in triangles is
   // geometry_ms over the moving average of the measured time per triangle times the largest measured / predicted
   // ratio of the last 16 frames (runtime::TriangleRate; 10,000 triangles before the first measurement). A frame's
-  // measurement is read when the next frame is prepared.
+  // measurement is read when the next frame is prepared (the GPU path: when the GPU has finished it, frames later).
   double geometry_ms = 0.0;
   // Under the budget, coarser levels as well as impostors (above). Off by default: on the crowd bench's walks the
   // coarser levels kept the budget at a lower PSNR than impostors of the farthest (docs/BENCHMARKS.md, Crowds).
@@ -166,9 +168,12 @@ class CrowdRuntime {
   // representation, the meshes at level 0. With occluders (the target holding the city, the camera's size), the
   // agents hidden behind its depth are left out first (GpuCrowd::occludeBehind, cullBehind's test). No readback and
   // no per-agent upload. Mixed's budget in triangles (max_geometry_triangles) holds here too, on the GPU
-  // (GpuCrowd::setGeometryBudget: impostors of the farthest, by distance buckets), and so do blended views; not on
-  // this path yet: the budget in milliseconds, budget_coarsens and levels of detail. The stats count draw calls and
-  // the budget only (the agents are counted on the GPU: GpuCrowd::readCommands, readCounts).
+  // (GpuCrowd::setGeometryBudget: impostors of the farthest, by distance buckets), and so does the budget in
+  // milliseconds (geometry_ms: the skinned draws timed by gpu::LateTimer and their triangles copied by
+  // GpuCrowd::captureCommands, both read frames later without waiting; on a software rasterizer the timer's clock
+  // waits for the work, as a measurement), and blended views; not on this path yet: budget_coarsens and levels of
+  // detail. The stats count draw calls and the budget only (the agents are counted on the GPU:
+  // GpuCrowd::readCommands, readCounts).
   CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                           const gpu::LightSettings& light, const gpu::RenderTarget* occluders = nullptr);
   // As drawGpu into `target` (holding the city), with the agents' shadows: the map fitted to the receivers the
@@ -191,6 +196,9 @@ class CrowdRuntime {
   // With CrowdRuntimeOptions::geometry_ms: the time of the last timed frame's skinned draws (ms; waits for it), taken
   // into the budget's cost per triangle now rather than when the next frame is prepared; 0 before any.
   double collectGeometryMs();
+  // The GPU path's collectGeometryMs: the skinned draws' times and triangles that the GPU has finished (no wait),
+  // taken into the budget's cost per triangle; returns the latest time (ms), 0 before any.
+  double collectGpuGeometryMs(gpu::GpuCrowd& crowd);
   // The budget's current cost per skinned triangle (ms; 0 before the first measurement).
   double msPerSkinnedTriangle() const { return triangle_rate_.msPerTriangle(); }
   // The switch distance of model m for a camera (metres; Dobbyn's texel rule and the view error bound).
@@ -224,7 +232,7 @@ class CrowdRuntime {
   };
   // The GPU path's frame set up for a policy: Mixed's triangle budget given to the crowd, and the switch distances
   // per model returned; throws farfield::Error for a crowd of other models.
-  std::vector<float> prepareGpuCrowd(gpu::GpuCrowd& crowd, const Camera& camera, CrowdPolicy policy) const;
+  std::vector<float> prepareGpuCrowd(gpu::GpuCrowd& crowd, const Camera& camera, CrowdPolicy policy);
   // The GPU path's camera lists, drawn.
   CrowdFrameStats drawGpuLists(const Camera& camera, gpu::GpuCrowd& crowd, const gpu::LightSettings& light);
   // Agents' GPU records by model and representation (culled with the camera's frustum unless null).
@@ -280,6 +288,11 @@ class CrowdRuntime {
   bool geometry_timed_ = false;
   uint64_t timed_triangles_ = 0;
   double last_geometry_ms_ = 0.0;
+  // The GPU path's: its timer, its frame count, and times and triangles by frame until both have arrived.
+  std::unique_ptr<gpu::LateTimer> gpu_geometry_timer_;
+  uint64_t gpu_frame_ = 0;
+  std::map<uint64_t, double> gpu_ms_;
+  std::map<uint64_t, uint64_t> gpu_triangles_;
   gpu::DepthPyramid occluders_;  // cullBehind's depth, for the next draw
   std::vector<float> depth_rows_;
   bool cull_next_ = false;
