@@ -411,7 +411,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         mode_rt.finish();
         out.total = clock.milliseconds();
         out.crowd = out.total - city_ms;
-        out.crowd_cpu = std::max(0.0, out.crowd - (gpu::glCounters() - gl_before).driver_ms);
+        const gpu::GlCounters gl_used = gpu::glCounters() - gl_before;
+        out.crowd_cpu = std::max(0.0, out.crowd - gl_used.driver_ms - gl_used.measure_ms);  // as frame_runner.cpp
         if (specs[m].gpu) {  // the lists' sizes, read after the timed frame
           const std::vector<gpu::GpuCrowdCommand> commands = gpu_crowd->readCommands();
           for (size_t list = 0; list < 2 * gpu_crowd->modelCount(); ++list) {  // the camera's lists
