@@ -12,6 +12,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/gpu/gl_counters.h"
+#include "farfield/gpu/render_target.h"
 #include "gpu/gpu_fixture.h"
 
 namespace farfield::gpu {
@@ -53,14 +54,16 @@ TEST_F(GpuTest, LateReadbackReturnsEachCaptureInOrderWithItsBytes) {
   EXPECT_EQ(late.finished([](uint64_t, std::span<const uint8_t>) {}), 0u) << "each capture comes back once";
   EXPECT_TRUE(late.capture(source, 0, 5));  // the slots are free again
   glDeleteBuffers(1, &source);
+  EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
   EXPECT_THROW(LateReadback(0), Error);  // nothing to read
 }
 
 TEST_F(GpuTest, LateTimerReturnsEachFrameOnce) {
   LateTimer timer(2);
+  RenderTarget target(64, 64);
   for (uint64_t frame = 1; frame <= 3; ++frame) {
     timer.begin(frame);
-    glClear(GL_COLOR_BUFFER_BIT);
+    target.clear(Vec4(0.1f * float(frame)));
     timer.end();
   }
   EXPECT_EQ(timer.skipped(), 1u) << "the third frame found both slots in flight";
@@ -72,6 +75,7 @@ TEST_F(GpuTest, LateTimerReturnsEachFrameOnce) {
   });
   EXPECT_EQ(frames, (std::vector<uint64_t>{1, 2}));
   EXPECT_EQ(timer.finished([](uint64_t, double) {}), 0u);
+  EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
 }
 
 }  // namespace

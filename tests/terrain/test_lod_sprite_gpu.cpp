@@ -27,6 +27,16 @@ using test::makeCamera;
 using test::Scene;
 using test::testFractal;
 
+// A machine where CDLOD high frames (and keyframes) are expensive and sprite frames cheap: 50 against 0.25 ms.
+TerrainCost spritesPay() {
+  TerrainCost cost;
+  cost.gpu_high = gpu::CostModel{};
+  cost.gpu_high->base_ms = 50.0;
+  cost.gpu_sprite = gpu::CostModel{};
+  cost.gpu_sprite->base_ms = 0.25;
+  return cost;
+}
+
 // LOD-sprite's options with its high-resolution LOD drawn by a CDLOD terrain, on the tests' sky.
 LodSpriteOptions cdlodOptions(GpuLodTerrain& gpu_lod) {
   LodSpriteOptions options;
@@ -103,11 +113,7 @@ TEST(LodSpriteGL, TheSpriteFrameOnTheGpuWaitsForNothing) {
   const std::vector<Camera> cameras = choicePath(scene.hf, 24);
   LodSpriteOptions options = cdlodOptions(gpu_lod);
   options.gpu_low = true;
-  TerrainCost cost;  // CDLOD high frames expensive, sprite frames cheap: the sprite path once a sprite has lasted
-  cost.gpu_high = gpu::CostModel{};
-  cost.gpu_high->base_ms = 50.0;
-  cost.gpu_sprite = gpu::CostModel{};
-  cost.gpu_sprite->base_ms = 0.25;
+  TerrainCost cost = spritesPay();  // the sprite path once a sprite has lasted
   options.cost = &cost;
   LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
   const bool counting = gpu::installGlCounters();
@@ -185,11 +191,7 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
   options.predict = true;
   options.predict_late = true;
   options.predict_chunks = 4;
-  TerrainCost cost;  // as above: sprites pay; a keyframe is many sprite frames, so it takes all 4 slices
-  cost.gpu_high = gpu::CostModel{};
-  cost.gpu_high->base_ms = 50.0;
-  cost.gpu_sprite = gpu::CostModel{};
-  cost.gpu_sprite->base_ms = 0.25;
+  TerrainCost cost = spritesPay();  // a keyframe is many sprite frames, so it takes all 4 slices
   options.cost = &cost;
   LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
   const float top = scene.hf.maxHeight();
