@@ -508,6 +508,34 @@ TEST(GpuCrowdGL, TheBudgetInMillisecondsFollowsTheMeasuredSkinnedDraws) {
   }
 }
 
+// Under a geometry budget the casters are cast as the camera draws them (runtime::CrowdRuntime::castsAsImpostor):
+// an agent the budget turned into an impostor casts as one, so every agent casting as geometry is drawn as geometry.
+TEST(GpuCrowdGL, UnderABudgetAgentsCastAsTheyAreDrawn) {
+  CrowdScene scene;
+  runtime::CrowdRuntimeOptions o;
+  o.max_geometry_triangles = 2000;  // about 4 of the agents inside their switch
+  runtime::CrowdRuntime rt(scene.models.models, scene.models.options, o);
+  const gpu::LightSettings light;
+  gpu::RenderTarget target(scene.camera.width, scene.camera.height);
+  target.clear(Vec4(0.5f, 0.6f, 0.7f, 1.0f));
+  rt.drawGpuShadowed(scene.camera, scene.gc, runtime::CrowdPolicy::Mixed, light, target);
+  rt.finish();
+  std::set<uint32_t> drawn_geometry, cast_geometry;
+  size_t cast_impostors = 0;
+  for (size_t m = 0; m < scene.gc.modelCount(); ++m) {
+    for (uint32_t id : scene.gc.readList(2 * m)) drawn_geometry.insert(id);
+    for (uint32_t id : scene.gc.readList(scene.gc.casterList(m, false))) cast_geometry.insert(id);
+    cast_impostors += scene.gc.readList(scene.gc.casterList(m, true)).size();
+  }
+  const gpu::GpuCrowd::Counts counts = scene.gc.readCounts();
+  std::printf("%zu drawn as geometry, %u over the budget; %zu cast as geometry, %zu as impostors\n",
+              drawn_geometry.size(), counts.over_budget, cast_geometry.size(), cast_impostors);
+  ASSERT_GT(counts.over_budget, 0u) << "the budget binds";
+  EXPECT_GT(cast_geometry.size(), 0u);
+  EXPECT_GT(cast_impostors, 0u);
+  for (uint32_t id : cast_geometry) EXPECT_TRUE(drawn_geometry.count(id)) << "agent " << id << " casts as geometry";
+}
+
 TEST(GpuCrowdGL, BadInputIsAnError) {
   gpu::sharedHeadlessContext().makeCurrent();
   const gen::Crowd crowd = testCrowd(10, false);

@@ -167,6 +167,7 @@ void GpuCrowd::castShadows(const Camera& camera, std::span<const float> switch_m
                            GLintptr(half * sizeof(GpuCrowdCommand)), GLsizeiptr(half * sizeof(GpuCrowdCommand)));
   usePass(casters_, camera, switch_m);
   casters_.set("u_first_list", uint32_t(2 * models_));
+  casters_.set("u_budget", uint32_t(budgeted_ ? 1 : 0));  // the last classification's candidates and cut
   casters_.set("u_light_view_proj", light_view_proj);
   casters_.set("u_to_light", glm::normalize(to_light));
   glUniform2f(casters_.uniformLocation("u_light_scale"), 2.0f / side_m, 1.0f / depth_range_m);
@@ -227,6 +228,7 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
   for (float d : switch_m)
     if (d < 1e30f) largest_switch = std::max(largest_switch, d);
   const bool budget = budget_ > 0 && largest_switch > 0.0f;
+  budgeted_ = budget;
   const uint32_t budget_triangles = uint32_t(std::min<uint64_t>(budget_, UINT32_MAX));
   if (budget) {
     classify_.set("u_budget", budget_triangles);

@@ -81,8 +81,9 @@ class GpuCrowd {
 
   // The shadow casters of a map (after simulate and cullAndClassify): every agent whose sphere reaches into the map's
   // box (light_view_proj: orthographic, x and y to [-1, 1] over side_m metres, z to [0, 1] over depth_range_m), in
-  // the representation the switch distances give it (as cullAndClassify), impostors with their view towards the
-  // light (to_light: unit, towards it); into the caster lists, whose counts alone are reset. One dispatch.
+  // the representation the switch distances give it (as cullAndClassify; under a geometry budget, as that call drew
+  // it: geometry only where the budget kept it, an agent not drawn as an impostor), impostors with their view towards
+  // the light (to_light: unit, towards it); into the caster lists, whose counts alone are reset. One dispatch.
   void castShadows(const Camera& camera, std::span<const float> switch_m, const Mat4& light_view_proj, float side_m,
                    float depth_range_m, const Vec3& to_light);
   // Lists: the camera's, 2m (geometry) and 2m + 1 (impostors); the casters', casterList(m, impostor).
@@ -145,6 +146,7 @@ class GpuCrowd {
   uint32_t agent_buf_ = 0, routes_ = 0, points_ = 0, poses_ = 0, phases_ = 0, model_buf_ = 0, commands_ = 0,
            initial_ = 0, lists_ = 0, counts_ = 0, candidates_ = 0, buckets_ = 0;
   uint64_t budget_ = 0;
+  bool budgeted_ = false;  // the last cullAndClassify ran under the budget (its candidates and cut are valid)
   std::unique_ptr<LateReadback> late_commands_;  // captureCommands' copies
   std::unique_ptr<GpuDepthPyramid> pyramid_;  // made by the first occludeBehind
   bool occlude_next_ = false;

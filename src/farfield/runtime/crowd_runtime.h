@@ -180,8 +180,8 @@ class CrowdRuntime {
   // camera sees within shadows.distance_m (runtime::fitShadowReceivers: the casters are known on the GPU only), the
   // agents whose spheres reach into it cast in the representation the policy gives them (GpuCrowd::castShadows), and
   // the target's receivers are darkened (gpu::ShadowReceiver). occlude: agents behind the target's depth left out
-  // (their shadows still cast). shadows.impostor_casters is not on this path, and casters take the switch distance
-  // alone (an agent turned into an impostor by the budget casts as geometry).
+  // (their shadows still cast). shadows.impostor_casters is not on this path; under a budget, casters are cast as
+  // they are drawn, and those not drawn as impostors (castsAsImpostor's rule).
   CrowdFrameStats drawGpuShadowed(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                                   const gpu::LightSettings& light, const gpu::RenderTarget& target,
                                   const CrowdShadowOptions& shadows = {}, bool occlude = false);

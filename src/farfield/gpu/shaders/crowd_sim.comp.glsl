@@ -194,7 +194,9 @@ void main() {
 }
 #elif defined(FF_CASTERS)
 // FF_CASTERS: the agents whose sphere reaches into the shadow map's box cast, in the representation the camera's
-// switch gives them (runtime::CrowdRuntime's rule without a budget); impostors show their view towards the light.
+// switch gives them; under a geometry budget (u_budget != 0: the last classification had one), as the camera draws
+// them: geometry only where the budget kept it, and an agent not drawn (out of view, hidden) as an impostor
+// (runtime::CrowdRuntime::castsAsImpostor). Impostors show their view towards the light.
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= u_agents) return;
@@ -207,7 +209,9 @@ void main() {
   if (abs(p.x) > 1.0 + r * u_light_scale.x || abs(p.y) > 1.0 + r * u_light_scale.x || p.z < -r * u_light_scale.y ||
       p.z > 1.0 + r * u_light_scale.y)
     return;
-  append(u_first_list, i, a, m, pose, turn(-pose.w, u_to_light), !(distance(u_eye, c) < u_switch[a.model]));
+  bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
+  if (u_budget != 0u) impostor = candidates[i] == kNone || candidates[i] >= stats[2];
+  append(u_first_list, i, a, m, pose, turn(-pose.w, u_to_light), impostor);
 }
 #elif defined(FF_BUDGET_SCAN)
 // One invocation: the first bucket whose running sum of triangles passes the budget (u_buckets: none does), the
