@@ -536,6 +536,84 @@ TEST(GpuCrowdGL, UnderABudgetAgentsCastAsTheyAreDrawn) {
   for (uint32_t id : cast_geometry) EXPECT_TRUE(drawn_geometry.count(id)) << "agent " << id << " casts as geometry";
 }
 
+// Levels of detail on the GPU path (GpuCrowd::setLevelScale, from the runtime's geometry_lod_px): each skinned agent
+// at the level the CPU path's levelFor gives it, each level drawn by its own command, and the frames equal on the
+// crowd's pixels.
+TEST(GpuCrowdGL, LevelsOfDetailAreTheCpuPathsLevels) {
+  CrowdScene scene;
+  runtime::CrowdRuntimeOptions o;
+  o.geometry_lod_px = 1.0;
+  runtime::CrowdRuntime rt(scene.models.models, scene.models.options, o);
+  gpu::GpuCrowd gc(gpuCrowdRoutes(scene.crowd), gpuCrowdAgents(scene.crowd, kCrowdIdBit),
+                   rt.gpuCrowdModels(kCrowdNominalSpeed));
+  gc.simulate(scene.t);
+  const std::vector<runtime::CrowdAgentState> states = crowdAgentStates(scene.crowd, rt, scene.t);
+  const Camera& camera = scene.camera;
+  const gpu::LightSettings light;
+  gpu::RenderTarget cpu(camera.width, camera.height), gpu_path(camera.width, camera.height);
+  cpu.clear(Vec4(0.5f, 0.6f, 0.7f, 1.0f));
+  cpu.bindForOpaquePass();
+  rt.draw(camera, states, runtime::CrowdPolicy::Mixed, light);
+  gpu_path.clear(Vec4(0.5f, 0.6f, 0.7f, 1.0f));
+  gpu_path.bindForOpaquePass();
+  const runtime::CrowdFrameStats gs = rt.drawGpu(camera, gc, runtime::CrowdPolicy::Mixed, light);
+  size_t coarser = 0, levels_drawn = 0;
+  for (size_t m = 0; m < rt.modelCount(); ++m) {
+    ASSERT_EQ(gc.levelCount(m), rt.levelDistances(m).size());
+    for (size_t l = 0; l < gc.levelCount(m); ++l) {
+      std::set<uint32_t> on_gpu, on_cpu;
+      for (uint32_t id : gc.readLevelList(m, l)) on_gpu.insert(id);
+      for (size_t i = 0; i < states.size(); ++i)
+        if (states[i].model == m && rt.drawnLevel(i) == int(l)) on_cpu.insert(states[i].object_id);
+      EXPECT_EQ(on_gpu, on_cpu) << "model " << m << " level " << l;
+      coarser += l > 0 ? on_gpu.size() : 0;
+      levels_drawn += on_gpu.empty() ? 0 : 1;
+    }
+  }
+  EXPECT_GT(coarser, 0u) << "the view needs agents at coarser levels";
+  EXPECT_GE(levels_drawn, 3u);
+  EXPECT_EQ(gc.readCounts().level_overflow, 0u);
+  size_t draws = 0;
+  for (size_t m = 0; m < rt.modelCount(); ++m) draws += gc.levelCount(m) + 1;
+  EXPECT_EQ(gs.draw.draw_calls, draws) << "a draw per level and model, one per model for the impostors";
+  const image::IdImage a = cpu.readIds(), b = gpu_path.readIds();
+  size_t crowd_px = 0, same = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      if (!(a.at(x, y) & kCrowdIdBit) && !(b.at(x, y) & kCrowdIdBit)) continue;
+      ++crowd_px;
+      same += a.at(x, y) == b.at(x, y) ? 1 : 0;
+    }
+  std::printf("%zu agents at coarser levels, %zu levels drawn; %zu crowd pixels, %zu the same agent\n", coarser,
+              levels_drawn, crowd_px, same);
+  EXPECT_GT(crowd_px, 500u);
+  EXPECT_GE(double(same), 0.999 * double(crowd_px));
+
+  // Under a budget of half the skinned triangles, the budget counts each agent's level's triangles.
+  auto levelTriangles = [&] {
+    uint64_t t = 0;
+    for (size_t m = 0; m < rt.modelCount(); ++m)
+      for (size_t l = 0; l < gc.levelCount(m); ++l)
+        t += gc.readLevelList(m, l).size() * rt.gpuModel(m).triangleCount(l);
+    return t;
+  };
+  const uint64_t unbudgeted = levelTriangles();
+  runtime::CrowdRuntimeOptions ob = o;
+  ob.max_geometry_triangles = unbudgeted / 2;
+  runtime::CrowdRuntime budgeted(scene.models.models, scene.models.options, ob);
+  gpu_path.bindForOpaquePass();
+  budgeted.drawGpu(camera, gc, runtime::CrowdPolicy::Mixed, light);
+  const uint64_t kept = levelTriangles();
+  const gpu::GpuCrowd::Counts counts = gc.readCounts();
+  std::printf("budget %llu of %llu triangles: %llu kept, %u agents over it\n",
+              (unsigned long long)ob.max_geometry_triangles, (unsigned long long)unbudgeted, (unsigned long long)kept,
+              counts.over_budget);
+  EXPECT_GT(counts.over_budget, 0u);
+  EXPECT_LE(kept, ob.max_geometry_triangles);
+  EXPECT_EQ(uint64_t(counts.budget_triangles_kept), kept);
+  EXPECT_EQ(uint64_t(counts.budget_triangles_wanted), unbudgeted);
+}
+
 TEST(GpuCrowdGL, BadInputIsAnError) {
   gpu::sharedHeadlessContext().makeCurrent();
   const gen::Crowd crowd = testCrowd(10, false);

@@ -415,10 +415,15 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         out.crowd_cpu = std::max(0.0, out.crowd - gl_used.driver_ms - gl_used.measure_ms);  // as frame_runner.cpp
         if (specs[m].gpu) {  // the lists' sizes, read after the timed frame
           const std::vector<gpu::GpuCrowdCommand> commands = gpu_crowd->readCommands();
-          for (size_t list = 0; list < 2 * gpu_crowd->modelCount(); ++list) {  // the camera's lists
-            (list % 2 ? out.stats.impostors : out.stats.geometry) += commands[list].instance_count;
-            if (list % 2 == 0) out.stats.draw.triangles += uint64_t(commands[list].instance_count) * rt.modelTriangles(list / 2);
-            else out.stats.draw.triangles += 2 * uint64_t(commands[list].instance_count);
+          for (size_t m2 = 0; m2 < gpu_crowd->modelCount(); ++m2) {  // the camera's lists, each level's
+            for (size_t l = 0; l < gpu_crowd->levelCount(m2); ++l) {
+              const uint64_t n = commands[gpu_crowd->levelCommand(m2, l)].instance_count;
+              out.stats.geometry += n;
+              out.stats.coarser += l > 0 ? n : 0;
+              out.stats.draw.triangles += n * rt.gpuModel(m2).triangleCount(l);
+            }
+            out.stats.impostors += commands[2 * m2 + 1].instance_count;
+            out.stats.draw.triangles += 2 * uint64_t(commands[2 * m2 + 1].instance_count);
           }
           for (size_t m2 = 0; options.shadows && m2 < gpu_crowd->modelCount(); ++m2)
             out.stats.shadow_casters += commands[gpu_crowd->casterList(m2, false)].instance_count +

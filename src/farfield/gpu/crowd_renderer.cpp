@@ -375,12 +375,13 @@ const Program& CrowdRenderer::useImpostors(const Camera& camera, const ImpostorA
 
 FrameStats CrowdRenderer::drawSkinnedIndirect(const Camera& camera, const SkinnedGpuModel& model, uint32_t agents,
                                               size_t offset, size_t bytes, uint32_t commands, size_t command_offset,
-                                              const LightSettings& light) {
+                                              const LightSettings& light, size_t level) {
   FrameStats stats;
-  if (model.indexCount() == 0 || bytes == 0) return stats;
+  FF_CHECK(level < model.levels_.size());
+  if (model.levels_[level].index_count == 0 || bytes == 0) return stats;
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
   const Program& p = useSkinned(camera, model, light);
-  p.set("u_first_triangle", model.levels_[0].first_triangle);
+  p.set("u_first_triangle", model.levels_[level].first_triangle);
   glEnable(GL_CULL_FACE);
   drawIndirect(model.vao_, commands, command_offset, true);
   stats.draw_calls = 1;

@@ -56,6 +56,9 @@ class SkinnedGpuModel {
   uint32_t jointCount() const { return joint_count_; }
   uint32_t poseCount() const { return pose_count_; }
   uint32_t indexCount() const { return levels_[0].index_count; }  // the mesh's (level 0)
+  // A level's range of the index buffer (level 0: the mesh).
+  uint32_t indexCount(size_t level) const { return levels_[level].index_count; }
+  uint32_t firstIndex(size_t level) const { return levels_[level].first_index; }
   size_t levelCount() const { return levels_.size(); }
   uint64_t triangleCount(size_t level = 0) const { return levels_[level].index_count / 3; }
   const Mat4& modelToAgent() const { return model_to_agent_; }
@@ -149,8 +152,10 @@ class CrowdRenderer {
   // storage buffer `agents`, drawn by the indirect command at `command_offset` of `commands` (its instance count
   // written on the GPU: skinned, a DrawElementsIndirectCommand over the mesh; impostors, a DrawArraysIndirectCommand
   // of 4 vertices). No upload and no wait; the stats count the draw call alone (the agents are known on the GPU).
+  // level: the model's level of detail the command draws (its colour regions; the command holds its index range).
   FrameStats drawSkinnedIndirect(const Camera& camera, const SkinnedGpuModel& model, uint32_t agents, size_t offset,
-                                 size_t bytes, uint32_t commands, size_t command_offset, const LightSettings& light);
+                                 size_t bytes, uint32_t commands, size_t command_offset, const LightSettings& light,
+                                 size_t level = 0);
   // blend_views as drawImpostors' (the four views around each quad's direction, found in the vertex shader).
   FrameStats drawImpostorsIndirect(const Camera& camera, const ImpostorAtlasGpu& atlas, uint32_t agents,
                                    size_t offset, size_t bytes, uint32_t commands, size_t command_offset,

@@ -28,6 +28,8 @@ struct ModelRecord {
   Vec4 lists;
   uint32_t counts[4];
   Vec4 grid;
+  float level_m[GpuCrowd::kMaxLevels];
+  uint32_t level_tris[GpuCrowd::kMaxLevels];
 };
 struct ListRecord {  // gpu::CrowdAgentGpu
   Vec4 pos_heading, tint;
@@ -86,15 +88,32 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
     if (!(mo.stride_m > 0.0f) || !(mo.radius > 0.0f) || mo.palette_poses < 1 || mo.frames < 1 || mo.azimuths < 1 ||
         mo.elevations < 1)
       throw Error(what, "model " + std::to_string(m) + ": stride, radius, poses, frames and views must be positive");
-    model_records.push_back({Vec4(mo.centre, mo.radius),
-                             Vec4(float(2 * m), mo.stride_m, float(mo.geometry_indices / 3), 0.0f),
-                             {mo.palette_poses, mo.frames, mo.azimuths, mo.elevations},
-                             Vec4(mo.max_elevation, 0.0f, 0.0f, 0.0f)});
+    if (mo.levels.size() + 1 > size_t(kMaxLevels))
+      throw Error(what, "model " + std::to_string(m) + ": " + std::to_string(mo.levels.size() + 1) +
+                            " levels of detail (at most " + std::to_string(kMaxLevels) + ")");
+    ModelRecord record{Vec4(mo.centre, mo.radius),
+                       Vec4(float(2 * m), mo.stride_m, float(mo.geometry_indices / 3), float(mo.levels.size() + 1)),
+                       {mo.palette_poses, mo.frames, mo.azimuths, mo.elevations},
+                       Vec4(mo.max_elevation, 0.0f, 0.0f, 0.0f),
+                       {},
+                       {}};
+    record.level_tris[0] = mo.geometry_indices / 3;
+    for (size_t l = 0; l < mo.levels.size(); ++l) {
+      record.level_m[l + 1] = mo.levels[l].distance_m;
+      record.level_tris[l + 1] = mo.levels[l].indices / 3;
+    }
+    model_records.push_back(record);
+    level_counts_.push_back(mo.levels.size() + 1);
     initial_commands_.push_back({mo.geometry_indices, 0, mo.geometry_first_index, 0, 0});
     initial_commands_.push_back({4, 0, 0, 0, 0});  // count 4, instances, first 0, base instance 0
   }
-  // The casters' lists after the camera's, alike.
+  // The casters' lists after the camera's, alike; then levels 1.. of each model (levelCommand).
   for (size_t k = 0, n = initial_commands_.size(); k < n; ++k) initial_commands_.push_back(initial_commands_[k]);
+  for (const GpuCrowdModel& mo : models)
+    for (size_t l = 1; l < size_t(kMaxLevels); ++l)
+      initial_commands_.push_back(l <= mo.levels.size()
+                                      ? GpuCrowdCommand{mo.levels[l - 1].indices, 0, mo.levels[l - 1].first_index, 0, 0}
+                                      : GpuCrowdCommand{});
   agent_buf_ = makeBuffer(agent_records.data(), agent_records.size() * sizeof(AgentRecord), bytes_);
   routes_ = makeBuffer(route_records.data(), route_records.size() * sizeof(RouteRecord), bytes_);
   points_ = makeBuffer(points.data(), points.size() * sizeof(Vec4), bytes_);
@@ -103,9 +122,13 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
   model_buf_ = makeBuffer(model_records.data(), model_records.size() * sizeof(ModelRecord), bytes_);
   commands_ = makeBuffer(initial_commands_.data(), initial_commands_.size() * sizeof(GpuCrowdCommand), bytes_);
   initial_ = makeBuffer(initial_commands_.data(), initial_commands_.size() * sizeof(GpuCrowdCommand), bytes_);
-  capacity_ = (agents.size() + 63) / 64 * 64;  // 64 records = 3,072 bytes: list offsets aligned for binding
-  lists_ = makeBuffer(nullptr, initial_commands_.size() * capacity_ * sizeof(ListRecord), bytes_);
-  counts_ = makeBuffer(nullptr, 6 * sizeof(uint32_t), bytes_);
+  // 64 records = 3,072 bytes: list offsets (and levels' parts of a list) aligned for binding.
+  capacity_ = std::max<size_t>((agents.size() + 63) / 64 * 64, size_t(kMaxLevels) * 64);
+  level_capacity_ = capacity_ / size_t(kMaxLevels) / 64 * 64;
+  lists_ = makeBuffer(nullptr, 4 * models_ * capacity_ * sizeof(ListRecord), bytes_);  // the camera's, the casters'
+  counts_ = makeBuffer(nullptr, 8 * sizeof(uint32_t), bytes_);
+  const std::vector<uint32_t> no_levels(size_t(kMaxModels) * size_t(kMaxLevels), 0);
+  level_count_buf_ = makeBuffer(no_levels.data(), no_levels.size() * sizeof(uint32_t), bytes_);
   candidates_ = makeBuffer(nullptr, agents.size() * sizeof(uint32_t), bytes_);
   const std::vector<uint32_t> zero(kBudgetBuckets, 0);
   buckets_ = makeBuffer(zero.data(), zero.size() * sizeof(uint32_t), bytes_);
@@ -114,18 +137,19 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
   casters_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_CASTERS 1\n");
   budget_scan_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_BUDGET_SCAN 1\n");
   budget_assign_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_BUDGET_ASSIGN 1\n");
-  late_commands_ = std::make_unique<LateReadback>(2 * models_ * sizeof(GpuCrowdCommand));
+  level_counts_pass_ = Program::computeFromEmbedded("crowd_sim.comp.glsl", "#define FF_LEVEL_COUNTS 1\n");
+  late_commands_ = std::make_unique<LateReadback>(initial_commands_.size() * sizeof(GpuCrowdCommand));
 }
 
 GpuCrowd::~GpuCrowd() {
   for (uint32_t b : {agent_buf_, routes_, points_, poses_, phases_, model_buf_, commands_, initial_, lists_, counts_,
-                     candidates_, buckets_})
+                     candidates_, buckets_, level_count_buf_})
     if (b) glDeleteBuffers(1, &b);
 }
 
 void GpuCrowd::bindBuffers() const {
-  const uint32_t buffers[] = {agent_buf_, routes_,  points_, poses_,      phases_, model_buf_,
-                              commands_,  lists_,   counts_, candidates_, buckets_};
+  const uint32_t buffers[] = {agent_buf_, routes_, points_,  poses_,      phases_, model_buf_,
+                              commands_,  lists_,  counts_, candidates_, buckets_, level_count_buf_};
   for (GLuint b = 0; b < GLuint(std::size(buffers)); ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, buffers[b]);
 }
 
@@ -137,6 +161,10 @@ void GpuCrowd::usePass(const Program& pass, const Camera& camera, std::span<cons
   pass.set("u_eye", camera.eye);
   pass.set("u_capacity", uint32_t(capacity_));
   pass.set("u_budget", uint32_t(0));
+  pass.set("u_lod_m_per_m", lod_m_per_m_);
+  pass.set("u_level_capacity", uint32_t(level_capacity_));
+  pass.set("u_level_command0", uint32_t(4 * models_));
+  pass.set("u_models", uint32_t(models_));
   glUniform1fv(pass.uniformLocation("u_switch[0]"), kMaxModels, switches);
   bindBuffers();
 }
@@ -162,9 +190,9 @@ void GpuCrowd::castShadows(const Camera& camera, std::span<const float> switch_m
     throw Error("GPU crowd", std::to_string(switch_m.size()) + " switch distances for " + std::to_string(models_) +
                                  " models");
   if (!(side_m > 0.0f) || !(depth_range_m > 0.0f)) throw Error("GPU crowd", "an empty shadow map box");
-  const size_t half = initial_commands_.size() / 2;  // the casters' commands, reset from their initial values
-  glCopyNamedBufferSubData(initial_, commands_, GLintptr(half * sizeof(GpuCrowdCommand)),
-                           GLintptr(half * sizeof(GpuCrowdCommand)), GLsizeiptr(half * sizeof(GpuCrowdCommand)));
+  // The casters' commands (2m .. 4m), reset from their initial values.
+  const GLintptr casters = GLintptr(2 * models_ * sizeof(GpuCrowdCommand));
+  glCopyNamedBufferSubData(initial_, commands_, casters, casters, casters);
   usePass(casters_, camera, switch_m);
   casters_.set("u_first_list", uint32_t(2 * models_));
   casters_.set("u_budget", uint32_t(budgeted_ ? 1 : 0));  // the last classification's candidates and cut
@@ -176,8 +204,9 @@ void GpuCrowd::castShadows(const Camera& camera, std::span<const float> switch_m
 }
 
 GpuCrowd::Counts GpuCrowd::readCounts() const {
-  const std::vector<uint32_t> c = readBuffer<uint32_t>(counts_, 0, 6);
+  const std::vector<uint32_t> c = readBuffer<uint32_t>(counts_, 0, 7);
   Counts counts{c[0], c[1]};
+  counts.level_overflow = c[6];
   if (budget_ > 0) {
     counts.over_budget = c[3];
     counts.budget_triangles_kept = c[4];
@@ -193,7 +222,7 @@ void GpuCrowd::captureCommands(uint64_t frame) {
 size_t GpuCrowd::finishedCommands(
     const std::function<void(uint64_t, std::span<const GpuCrowdCommand>)>& use) {
   return late_commands_->finished([&](uint64_t frame, std::span<const uint8_t> bytes) {
-    std::vector<GpuCrowdCommand> commands(2 * models_);
+    std::vector<GpuCrowdCommand> commands(initial_commands_.size());
     std::memcpy(commands.data(), bytes.data(), bytes.size());
     use(frame, commands);
   });
@@ -246,6 +275,11 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
     usePass(budget_assign_, camera, switch_m);
     glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
   }
+  if (lod_m_per_m_ > 0.0f) {
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    usePass(level_counts_pass_, camera, switch_m);
+    glDispatchCompute(1, 1, 1);
+  }
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
   if (occlude) {
     glBindTextureUnit(2, 0);
@@ -263,6 +297,14 @@ std::vector<uint32_t> GpuCrowd::readList(size_t list) const {
   const size_t n = readCommands()[list].instance_count;
   std::vector<uint32_t> ids;
   for (const ListRecord& r : readBuffer<ListRecord>(lists_, listOffset(list), n)) ids.push_back(r.object_id);
+  return ids;
+}
+std::vector<uint32_t> GpuCrowd::readLevelList(size_t m, size_t level) const {
+  FF_CHECK(m < models_ && level < size_t(kMaxLevels));
+  const size_t n = readCommands()[levelCommand(m, level)].instance_count;
+  std::vector<uint32_t> ids;
+  for (const ListRecord& r : readBuffer<ListRecord>(lists_, listOffset(2 * m) + levelOffset(level), n))
+    ids.push_back(r.object_id);
   return ids;
 }
 size_t GpuCrowd::gpuBytes() const { return bytes_; }

@@ -53,6 +53,13 @@ struct GpuCrowdModel {
   // The lists' draw commands: the geometry's indexed draw (index count and first index of the mesh), the
   // impostors' 4-vertex strip (a DrawArraysIndirectCommand in the same 20-byte slot).
   uint32_t geometry_indices = 0, geometry_first_index = 0;
+  // Levels of detail after the mesh (level 0), at most GpuCrowd::kMaxLevels - 1: each one's index range in the same
+  // index buffer and its distance to the mesh (agent metres, increasing), as runtime::CrowdRuntime's levels.
+  struct Level {
+    uint32_t indices = 0, first_index = 0;
+    float distance_m = 0.0f;
+  };
+  std::vector<Level> levels;
 };
 
 // The indirect draw command of a list (GL's DrawElementsIndirectCommand).
@@ -65,6 +72,7 @@ struct GpuCrowdCommand {
 class GpuCrowd {
  public:
   static constexpr int kMaxModels = 16;
+  static constexpr int kMaxLevels = 8;  // levels of detail per model, the mesh included
   // Needs a current context. Throws farfield::Error for no agents, an agent naming a missing route or model, a route
   // of fewer than 2 points or mismatched arrays, more than kMaxModels models.
   GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCrowdAgent> agents,
@@ -98,6 +106,20 @@ class GpuCrowd {
   void setGeometryBudget(uint64_t triangles) { budget_ = triangles; }
   uint64_t geometryBudget() const { return budget_; }
 
+  // Levels of detail for the cullAndClassify calls that follow (0: the mesh alone, the default): a skinned agent at
+  // distance d takes the coarsest level whose distance to the mesh is at most lod_m_per_m * d (the runtime's levelFor:
+  // geometry_lod_px over the focal length); the budget counts its level's triangles. Level l of model m is drawn by
+  // command levelCommand(m, l) over levelCapacity() records at listOffset(2m) + levelOffset(l); an agent past its
+  // level's capacity is drawn as an impostor (Counts::level_overflow). One more dispatch.
+  void setLevelScale(float lod_m_per_m) { lod_m_per_m_ = lod_m_per_m; }
+  float levelScale() const { return lod_m_per_m_; }
+  size_t levelCount(size_t m) const { return level_counts_[m]; }
+  size_t levelCommand(size_t m, size_t level) const {
+    return level == 0 ? 2 * m : 4 * models_ + m * (kMaxLevels - 1) + level - 1;
+  }
+  size_t levelCapacity() const { return level_capacity_; }
+  size_t levelOffset(size_t level) const { return level * level_capacity_ * 48; }
+
   // Occlusion culling of the next cullAndClassify (that call only): agents whose bounding box lies behind `target`'s
   // current depth (the city, drawn first) over the box's whole footprint are left out, by the test of the CPU runtime's
   // cullBehind (gpu::projectBox, DepthPyramid::hides) on a depth pyramid built on the GPU: no readback. The target
@@ -110,11 +132,12 @@ class GpuCrowd {
   struct Counts {
     uint32_t in_view = 0, occluded = 0;
     uint32_t over_budget = 0, budget_triangles_kept = 0, budget_triangles_wanted = 0;
+    uint32_t level_overflow = 0;  // with levels of detail: skinned agents past their level's part of the list
   };
   Counts readCounts() const;
-  // The camera lists' commands (2 per model, as readCommands) copied for reading frames later, tagged `frame`: after
-  // cullAndClassify, no wait (gpu/late_readback.h; skipped while 8 copies are in flight). finishedCommands calls
-  // `use` with each copy the GPU has completed, oldest first, and never waits.
+  // Every command (as readCommands: the camera's lists, the casters', the levels') copied for reading frames later,
+  // tagged `frame`: after cullAndClassify, no wait (gpu/late_readback.h; skipped while 8 copies are in flight).
+  // finishedCommands calls `use` with each copy the GPU has completed, oldest first, and never waits.
   void captureCommands(uint64_t frame);
   size_t finishedCommands(const std::function<void(uint64_t frame, std::span<const GpuCrowdCommand> commands)>& use);
 
@@ -133,8 +156,9 @@ class GpuCrowd {
   std::vector<Vec4> readPoses() const;
   std::vector<float> readPhases() const;
   std::vector<GpuCrowdCommand> readCommands() const;
-  // The object ids of a list's agents, in list order.
+  // The object ids of a list's agents, in list order; readLevelList: those of model m's level l (with levels).
   std::vector<uint32_t> readList(size_t list) const;
+  std::vector<uint32_t> readLevelList(size_t m, size_t level) const;
   size_t gpuBytes() const;
 
  private:
@@ -146,6 +170,11 @@ class GpuCrowd {
   uint32_t agent_buf_ = 0, routes_ = 0, points_ = 0, poses_ = 0, phases_ = 0, model_buf_ = 0, commands_ = 0,
            initial_ = 0, lists_ = 0, counts_ = 0, candidates_ = 0, buckets_ = 0;
   uint64_t budget_ = 0;
+  float lod_m_per_m_ = 0.0f;
+  size_t level_capacity_ = 0;
+  std::vector<size_t> level_counts_;  // per model
+  uint32_t level_count_buf_ = 0;
+  Program level_counts_pass_;
   bool budgeted_ = false;  // the last cullAndClassify ran under the budget (its candidates and cut are valid)
   std::unique_ptr<LateReadback> late_commands_;  // captureCommands' copies
   std::unique_ptr<GpuDepthPyramid> pyramid_;  // made by the first occludeBehind

@@ -12,7 +12,6 @@ namespace farfield::runtime {
 
 namespace {
 
-double focalOf(const Camera& camera) { return double(camera.height) / (2.0 * std::tan(double(camera.fov_y) / 2.0)); }
 
 // Agent space -> world for an agent at `position` with `heading` (a turn about +z).
 Vec3 turn(float heading, const Vec3& v) {
@@ -21,6 +20,10 @@ Vec3 turn(float heading, const Vec3& v) {
 }
 
 }  // namespace
+
+double CrowdRuntime::focalOf(const Camera& camera) {
+  return double(camera.height) / (2.0 * std::tan(double(camera.fov_y) / 2.0));
+}
 
 CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
                            std::span<const CrowdModelOptions> model_options, const CrowdRuntimeOptions& options)

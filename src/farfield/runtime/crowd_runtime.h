@@ -230,6 +230,8 @@ class CrowdRuntime {
     CrowdAtlasChoice choice;
     std::vector<double> level_m{0.0};  // per level of detail: its distance to the mesh (agent metres)
   };
+  // The camera's focal length in pixels (its image height over the field of view).
+  static double focalOf(const Camera& camera);
   // The GPU path's frame set up for a policy: Mixed's triangle budget given to the crowd, and the switch distances
   // per model returned; throws farfield::Error for a crowd of other models.
   std::vector<float> prepareGpuCrowd(gpu::GpuCrowd& crowd, const Camera& camera, CrowdPolicy policy);

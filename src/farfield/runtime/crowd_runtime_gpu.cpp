@@ -27,6 +27,8 @@ std::vector<gpu::GpuCrowdModel> CrowdRuntime::gpuCrowdModels(float nominal_speed
     g.max_elevation = grid.max_elevation;
     g.geometry_indices = m.gpu->indexCount();
     g.geometry_first_index = 0;
+    for (size_t l = 1; l < m.gpu->levelCount() && l < m.level_m.size(); ++l)
+      g.levels.push_back({m.gpu->indexCount(l), m.gpu->firstIndex(l), float(m.level_m[l])});
     out.push_back(g);
   }
   return out;
@@ -51,6 +53,10 @@ std::vector<float> CrowdRuntime::prepareGpuCrowd(gpu::GpuCrowd& crowd, const Cam
     }
   }
   crowd.setGeometryBudget(budget);
+  // Levels of detail as levelFor chooses them (Mixed only).
+  crowd.setLevelScale(policy == CrowdPolicy::Mixed && options_.geometry_lod_px > 0.0
+                          ? float(options_.geometry_lod_px / focalOf(camera))
+                          : 0.0f);
   return switches;
 }
 
@@ -68,11 +74,16 @@ CrowdFrameStats CrowdRuntime::drawGpuLists(const Camera& camera, gpu::GpuCrowd& 
     if (!gpu_geometry_timer_) gpu_geometry_timer_ = std::make_unique<gpu::LateTimer>();
     gpu_geometry_timer_->begin(gpu_frame_);
   }
+  const bool levels = crowd.levelScale() > 0.0f;
   for (size_t m = 0; m < models_.size(); ++m)
-    stats.draw.draw_calls +=
-        renderer_.drawSkinnedIndirect(camera, *models_[m].gpu, crowd.listBuffer(), crowd.listOffset(2 * m),
-                                      crowd.listBytes(), crowd.commandBuffer(), 2 * m * command, light)
-            .draw_calls;
+    for (size_t l = 0; l < (levels ? crowd.levelCount(m) : 1); ++l)
+      stats.draw.draw_calls +=
+          renderer_
+              .drawSkinnedIndirect(camera, *models_[m].gpu, crowd.listBuffer(),
+                                   crowd.listOffset(2 * m) + (levels ? crowd.levelOffset(l) : 0),
+                                   levels ? crowd.levelCapacity() * sizeof(gpu::CrowdAgentGpu) : crowd.listBytes(),
+                                   crowd.commandBuffer(), crowd.levelCommand(m, l) * command, light, l)
+              .draw_calls;
   if (timed) gpu_geometry_timer_->end();
   for (size_t m = 0; m < models_.size(); ++m)
     stats.draw.draw_calls +=
@@ -90,8 +101,9 @@ double CrowdRuntime::collectGpuGeometryMs(gpu::GpuCrowd& crowd) {
     gpu_geometry_timer_->finished([&](uint64_t frame, double ms) { gpu_ms_[frame] = ms; });
   crowd.finishedCommands([&](uint64_t frame, std::span<const gpu::GpuCrowdCommand> commands) {
     uint64_t triangles = 0;
-    for (size_t m = 0; m < models_.size() && 2 * m < commands.size(); ++m)
-      triangles += uint64_t(commands[2 * m].instance_count) * modelTriangles(m);
+    for (size_t m = 0; m < models_.size(); ++m)
+      for (size_t l = 0; l < crowd.levelCount(m); ++l)
+        triangles += uint64_t(commands[crowd.levelCommand(m, l)].instance_count) * models_[m].gpu->triangleCount(l);
     gpu_triangles_[frame] = triangles;
   });
   for (auto it = gpu_ms_.begin(); it != gpu_ms_.end();) {

@@ -98,9 +98,8 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     const size_t per_chunk = (nodes.size() + chunks - 1) / chunks;
     const size_t first = std::min(nodes.size(), pending_chunk_ * per_chunk);
     terrain.setHole(options_.hole);
-    const gpu::FrameStats ahead =
-        terrain.drawNodes(k.camera, options_.high_error, nodes.subspan(first, std::min(nodes.size() - first, per_chunk)),
-                          k.target).draw;
+    const std::span<const CdlodNode> run = nodes.subspan(first, std::min(nodes.size() - first, per_chunk));
+    const gpu::FrameStats ahead = terrain.drawNodes(k.camera, options_.high_error, run, k.target).draw;
     terrain.clearHole();
     gpu::addDraw(stats, ahead);
     info.ahead_triangles += ahead.triangles;
@@ -150,7 +149,8 @@ void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double erro
   // Slices of at most kSliceShare of a sprite frame each by the cost model (at most predict_chunks of them).
   double chunks = double(options_.predict_chunks);
   if (costs && costs->sprite_ms > 0.0)
-    chunks = std::clamp(std::ceil((costs->keyframe_ms - costs->sprite_ms) / (kSliceShare * costs->sprite_ms)), 1.0, chunks);
+    chunks = std::clamp(std::ceil((costs->keyframe_ms - costs->sprite_ms) / (kSliceShare * costs->sprite_ms)), 1.0,
+                        chunks);
   if (left > 1.5 * chunks + 1.0 && error_px < 0.75 * options_.epsilon) return;
   // Never in fewer slices than the cost model wants, even where the rate says the trip comes sooner (the error grows
   // more slowly as the sprite ages, so the rate is pessimistic; a trip before it is ready is a keyframe drawn at

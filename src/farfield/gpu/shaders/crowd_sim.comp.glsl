@@ -23,9 +23,12 @@ struct Route {
 };
 struct Model {
   vec4 sphere;        // centre (agent space: feet at the origin, facing +x, z up) and radius
-  vec4 lists;         // x: this model's first list (geometry; impostors x + 1), y: stride (metres a walk cycle)
+  vec4 lists;         // x: this model's first list (geometry; impostors x + 1), y: stride (metres a walk cycle),
+                      // z: the mesh's triangles, w: levels of detail (1: the mesh alone)
   uvec4 counts;       // palette poses, atlas frames, azimuths, elevations
   vec4 grid;          // x: the views' largest elevation (radians)
+  vec4 level_m[2];    // per level (0..7): its distance to the mesh (agent metres; level 0: 0)
+  uvec4 level_tris[2];  // per level: its triangles
 };
 // An agent as the crowd renderer's shaders read it (gpu::CrowdAgentGpu, 48 bytes).
 struct Record {
@@ -56,7 +59,7 @@ uniform float u_switch[16];    // per model: geometry nearer than this (metres)
 uniform uint u_capacity;       // agents a list holds
 // Occlusion (GpuCrowd::occludeBehind): the target's depth pyramid, and the camera that projects agents into it.
 // in view, of them left out behind the depth; under a budget: the first bucket over it, candidates over it, the
-// triangles kept, the triangles wanted
+// triangles kept, the triangles wanted; with levels of detail, the agents past their level's part of the list
 layout(std430, binding = 8) buffer Stats { uint stats[]; };
 layout(binding = 2) uniform sampler2D u_depth;               // level 0: the target's depth
 layout(binding = 3) uniform sampler2D u_pyramid;             // levels 1.. in its mips 0..
@@ -77,6 +80,16 @@ uniform uint u_budget;
 uniform uint u_buckets;
 uniform float u_buckets_per_m;
 const uint kNone = 0xFFFFFFFFu;
+// Levels of detail (GpuCrowd::setLevelScale; u_lod_m_per_m > 0): a skinned agent takes the coarsest level whose
+// distance to the mesh is at most u_lod_m_per_m times its distance (runtime::CrowdRuntime::levelFor); level l of a
+// model's geometry list holds u_level_capacity records from l * u_level_capacity, counted in level_counts (model * 8
+// + level) and written into the commands by FF_LEVEL_COUNTS; an agent past a level's capacity is an impostor.
+const uint kMaxLevels = 8u;
+layout(std430, binding = 11) buffer LevelCounts { uint level_counts[]; };
+uniform float u_lod_m_per_m;
+uniform uint u_level_capacity;
+uniform uint u_level_command0;  // the command of level 1 of model 0; model m's level l: + m * 7 + l - 1
+uniform uint u_models;
 
 const float kTwoPi = 6.28318530717958647692;
 
@@ -150,6 +163,23 @@ vec3 eyeInAgentSpace(vec4 pose, vec3 c) {
   return length(local) > 0.0 ? local : vec3(1.0, 0.0, 0.0);
 }
 
+// The level of detail of a skinned agent at distance d (metres) from the eye.
+uint levelOf(Model m, float d) {
+  uint level = 0u;
+  if (u_lod_m_per_m > 0.0) {
+    float allowed = u_lod_m_per_m * d;
+    for (uint l = 1u; l < uint(m.lists.w); ++l)
+      if (m.level_m[l / 4u][l % 4u] <= allowed) level = l;
+  }
+  return level;
+}
+
+// A skinned agent's triangles at distance d (what the budget counts).
+uint geometryTriangles(Model m, float d) {
+  uint l = levelOf(m, d);
+  return m.level_tris[l / 4u][l % 4u];
+}
+
 #ifndef FF_SIMULATE
 // Agent i into its model's geometry or impostor list after `first_list`, as the renderer's record: the palette pose
 // or the atlas frame nearest its phase, and for an impostor the view nearest `view_dir` (agent space).
@@ -163,6 +193,27 @@ void append(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 view_dir,
   uint view = impostor ? nearestView(m, view_dir) : 0u;
   r.misc = uvec4(index, view, a.id, a.outfit);
   lists[list * u_capacity + slot] = r;
+}
+
+// Agent i, inside its switch at distance d, into the camera's lists as geometry: with levels of detail, into its
+// level's part of the geometry list (an impostor when that part is full, counted in stats[6]).
+void appendGeometry(uint i, Agent a, Model m, vec4 pose, vec3 view_dir, float d) {
+  if (!(u_lod_m_per_m > 0.0)) {
+    append(0u, i, a, m, pose, view_dir, false);
+    return;
+  }
+  uint level = levelOf(m, d);
+  uint slot = atomicAdd(level_counts[a.model * kMaxLevels + level], 1u);
+  if (slot >= u_level_capacity) {
+    atomicAdd(stats[6], 1u);
+    append(0u, i, a, m, pose, view_dir, true);
+    return;
+  }
+  Record r;
+  r.pos_heading = pose;
+  r.tint = a.tint;
+  r.misc = uvec4(cycleIndex(phases[i], m.counts.x), 0u, a.id, a.outfit);
+  lists[uint(m.lists.x) * u_capacity + level * u_level_capacity + slot] = r;
 }
 #endif
 
@@ -244,8 +295,23 @@ void main() {
   vec4 pose = poses[i];
   vec3 c = pose.xyz + turn(pose.w, m.sphere.xyz);
   bool impostor = bucket >= stats[2];
-  if (impostor) atomicAdd(stats[3], 1u);
-  append(0u, i, a, m, pose, eyeInAgentSpace(pose, c), impostor);
+  if (impostor) {
+    atomicAdd(stats[3], 1u);
+    append(0u, i, a, m, pose, eyeInAgentSpace(pose, c), true);
+  } else {
+    appendGeometry(i, a, m, pose, eyeInAgentSpace(pose, c), distance(u_eye, c));
+  }
+}
+#elif defined(FF_LEVEL_COUNTS)
+// One invocation: each level's count (at most its part of the list) into its command; the counts cleared.
+void main() {
+  if (gl_GlobalInvocationID.x != 0u) return;
+  for (uint mo = 0u; mo < u_models; ++mo)
+    for (uint l = 0u; l < kMaxLevels; ++l) {
+      uint command = l == 0u ? 2u * mo : u_level_command0 + mo * (kMaxLevels - 1u) + l - 1u;
+      commands[command].instance_count = min(level_counts[mo * kMaxLevels + l], u_level_capacity);
+      level_counts[mo * kMaxLevels + l] = 0u;
+    }
 }
 #else
 void main() {
@@ -269,9 +335,10 @@ void main() {
   if (u_budget != 0u && !impostor) {  // a candidate for geometry: FF_BUDGET_ASSIGN decides
     uint bucket = min(uint(d * u_buckets_per_m), u_buckets - 1u);
     candidates[i] = bucket;
-    atomicAdd(buckets[bucket], uint(m.lists.z));
+    atomicAdd(buckets[bucket], geometryTriangles(m, d));
     return;
   }
-  append(0u, i, a, m, pose, eyeInAgentSpace(pose, c), impostor);
+  if (impostor) append(0u, i, a, m, pose, eyeInAgentSpace(pose, c), true);
+  else appendGeometry(i, a, m, pose, eyeInAgentSpace(pose, c), d);
 }
 #endif
