@@ -171,9 +171,9 @@ class CrowdRuntime {
   // (GpuCrowd::setGeometryBudget: impostors of the farthest, by distance buckets), and so does the budget in
   // milliseconds (geometry_ms: the skinned draws timed by gpu::LateTimer and their triangles copied by
   // GpuCrowd::captureCommands, both read frames later without waiting; on a software rasterizer the timer's clock
-  // waits for the work, as a measurement), and blended views; not on this path yet: budget_coarsens and levels of
-  // detail. The stats count draw calls and the budget only (the agents are counted on the GPU:
-  // GpuCrowd::readCommands, readCounts).
+  // waits for the work, as a measurement), blended views and levels of detail (geometry_lod_px: GpuCrowd::
+  // setLevelScale, a draw per level; shadow casters at the mesh); not on this path yet: budget_coarsens. The stats
+  // count draw calls and the budget only (the agents are counted on the GPU: GpuCrowd::readCommands, readCounts).
   CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                           const gpu::LightSettings& light, const gpu::RenderTarget* occluders = nullptr);
   // As drawGpu into `target` (holding the city), with the agents' shadows: the map fitted to the receivers the
