@@ -110,7 +110,7 @@ const RegisterCommand reg("view", [](CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--crowd-gpu", o.crowd.gpu,
                 "The crowd simulated, culled (behind the city too), classified, drawn and shadowed on the GPU "
-                "(--crowd-triangles holds there; --crowd-ms and --crowd-lod-px not yet)");
+                "(--crowd-triangles, --crowd-ms and --crowd-lod-px hold there too)");
   cmd->callback([args] { runViewCommand(*args); });
 });
 

@@ -106,8 +106,9 @@ run_ok(${FARFIELD} diff ${WORK}/cc_alone/frame_2.png ${WORK}/cc_builtin/frame_2.
 if(LAST_OUT MATCHES "identical")
   message(FATAL_ERROR "farfield view --crowd (built-in figures) drew the same frame as without the crowd:\n${LAST_OUT}")
 endif()
-# The same crowd on the GPU (--crowd-gpu): agents drawn, and the frame as the CPU path draws it without shadows.
-run_ok(${FARFIELD} view ${WORK}/cc.glb ${cc_script} -o ${WORK}/cc_gpu --crowd 400 --crowd-gpu)
+# The same crowd on the GPU (--crowd-gpu, with its budget in time and levels of detail): agents drawn.
+run_ok(${FARFIELD} view ${WORK}/cc.glb ${cc_script} -o ${WORK}/cc_gpu --crowd 400 --crowd-gpu --crowd-ms 5
+       --crowd-lod-px 0.5)
 run_ok(${FARFIELD} diff ${WORK}/cc_alone/frame_2.png ${WORK}/cc_gpu/frame_2.png)
 if(LAST_OUT MATCHES "identical")
   message(FATAL_ERROR "farfield view --crowd-gpu drew the same frame as without the crowd:\n${LAST_OUT}")

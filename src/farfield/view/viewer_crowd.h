@@ -31,8 +31,8 @@ struct ViewerCrowdOptions {
   double geometry_ms = 0.0;         // skinned drawing a frame in ms, at the measured time per triangle (0: none)
   bool shadows = true;
   // The crowd simulated, culled (frustum, and behind the mode's frame), classified, drawn and shadowed on the GPU
-  // (gpu/gpu_crowd.h, CrowdRuntime::drawGpuShadowed): no per-agent work on the CPU; without budgets or levels of
-  // detail yet.
+  // (gpu/gpu_crowd.h, CrowdRuntime::drawGpuShadowed): no per-agent work on the CPU; the budgets (triangles,
+  // milliseconds) and the levels of detail hold there too.
   bool gpu = false;
 };
 
