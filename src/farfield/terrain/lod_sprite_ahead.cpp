@@ -93,6 +93,9 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     if (pending_chunk_ == 0) {
       terrain.lod().select(k.camera, options_.high_error, true, pending_selection_);
       k.target.clear(options_.sky_color);
+      // The freshest count of a keyframe's triangles, for the next predictions (predictCosts).
+      high_triangles_key_ = pending_selection_.nodes.size() * terrain.renderer().trianglesPerNode();
+      high_latest_is_key_ = true;
     }
     const std::span<const CdlodNode> nodes = pending_selection_.nodes;
     const size_t per_chunk = (nodes.size() + chunks - 1) / chunks;
