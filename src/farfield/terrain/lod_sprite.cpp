@@ -317,8 +317,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   }
   info.switched = switch_now;
   // predict_late: a keyframe rendered ahead is taken as soon as it is ready, where it has less error than the current
-  // sprite and covers the view; otherwise it is stale (its viewpoint, half way to the predicted trip, is far behind
-  // or off the path) and dropped, so that a new one is made.
+  // sprite and covers the view; otherwise it is stale (the camera went elsewhere than extrapolated) and dropped, so
+  // that a new one is made.
   bool early = false;
   if (options_.predict_late && !due && current_ && pending_ && pending_->ready) {
     double e = 0.0;
