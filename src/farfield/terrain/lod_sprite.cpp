@@ -317,12 +317,14 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   }
   info.switched = switch_now;
   // predict_late: a keyframe rendered ahead is taken as soon as it is ready, where it has less error than the current
-  // sprite and covers the view; otherwise it is stale (the camera went elsewhere than extrapolated) and dropped, so
-  // that a new one is made.
+  // sprite and covers the view, or covers it at least as well as the current sprite (which is in use anyway);
+  // otherwise it is stale (the camera went elsewhere than extrapolated) and dropped, so that a new one is made.
   bool early = false;
   if (options_.predict_late && !due && current_ && pending_ && pending_->ready) {
     double e = 0.0;
-    early = takesOver(*pending_, camera.eye, beta, &e) && e < info.error_px;
+    const bool takes = takesOver(*pending_, camera.eye, beta, &e);
+    early = e < info.error_px &&
+            (takes || (e < 0.75 * options_.epsilon && coverage(*pending_) >= coverage(*current_)));
     if (!early) {
       ++counters_.predicted_discarded;
       spare_.push_back(std::move(pending_));
@@ -342,7 +344,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     double chosen_error = 0.0;
     if (pending_ && pending_->ready) {
       double e = 0.0;
-      if (takesOver(*pending_, camera.eye, beta, &e)) {
+      const bool takes = takesOver(*pending_, camera.eye, beta, &e);
+      if (early || takes) {
         chosen = pending_.get();
         chosen_error = e;
         info.source = SpriteSource::Predicted;
