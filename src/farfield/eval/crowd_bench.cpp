@@ -158,6 +158,9 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
                ? "; coarser levels of detail too (\"coarsened for the budget\"), each step the least error on screen"
                : "")
        << "\n";
+  if (options.gpu_crowd && options.runtime.budget_coarsens)
+    md << "- crowd-mixed-gpu does not coarsen for the budget (--budget-coarsens is the CPU path's): the agents its "
+          "budget leaves out are impostors\n";
   if (options.runtime.geometry_lod_px > 0.0) {
     md << "- crowd-mixed's skinned agents at the coarsest level of detail within "
        << fmt("%.2f", options.runtime.geometry_lod_px) << " px (levels held over every palette pose; "
