@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
+#include <map>
 #include <random>
 #include <set>
 #include <span>
@@ -588,6 +589,26 @@ TEST(GpuCrowdGL, LevelsOfDetailAreTheCpuPathsLevels) {
               levels_drawn, crowd_px, same);
   EXPECT_GT(crowd_px, 500u);
   EXPECT_GE(double(same), 0.999 * double(crowd_px));
+
+  // With shadows: an agent casting as geometry casts at the level it is drawn at.
+  gpu_path.clear(Vec4(0.5f, 0.6f, 0.7f, 1.0f));
+  rt.drawGpuShadowed(camera, gc, runtime::CrowdPolicy::Mixed, light, gpu_path);
+  std::map<uint32_t, size_t> drawn_level;
+  for (size_t m = 0; m < rt.modelCount(); ++m)
+    for (size_t l = 0; l < gc.levelCount(m); ++l)
+      for (uint32_t id : gc.readLevelList(m, l)) drawn_level[id] = l;
+  size_t cast_drawn = 0, cast_coarser = 0;
+  for (size_t m = 0; m < rt.modelCount(); ++m)
+    for (size_t l = 0; l < gc.levelCount(m); ++l)
+      for (uint32_t id : gc.readLevelList(m, l, true)) {
+        const auto it = drawn_level.find(id);
+        if (it == drawn_level.end()) continue;  // cast, not in view
+        ++cast_drawn;
+        cast_coarser += l > 0 ? 1 : 0;
+        EXPECT_EQ(it->second, l) << "agent " << id << " casts at another level than it is drawn at";
+      }
+  std::printf("%zu drawn agents cast as geometry, %zu of them at coarser levels\n", cast_drawn, cast_coarser);
+  EXPECT_GT(cast_coarser, 0u);
 
   // Under a budget of half the skinned triangles, the budget counts each agent's level's triangles.
   auto levelTriangles = [&] {

@@ -428,9 +428,11 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
             out.stats.impostors += commands[2 * m2 + 1].instance_count;
             out.stats.draw.triangles += 2 * uint64_t(commands[2 * m2 + 1].instance_count);
           }
-          for (size_t m2 = 0; options.shadows && m2 < gpu_crowd->modelCount(); ++m2)
-            out.stats.shadow_casters += commands[gpu_crowd->casterList(m2, false)].instance_count +
-                                        commands[gpu_crowd->casterList(m2, true)].instance_count;
+          for (size_t m2 = 0; options.shadows && m2 < gpu_crowd->modelCount(); ++m2) {
+            out.stats.shadow_casters += commands[gpu_crowd->casterList(m2, true)].instance_count;
+            for (size_t l = 0; l < gpu_crowd->levelCount(m2); ++l)
+              out.stats.shadow_casters += commands[gpu_crowd->levelCommand(m2, l, true)].instance_count;
+          }
           const gpu::GpuCrowd::Counts counts = gpu_crowd->readCounts();
           out.stats.in_view = counts.in_view;
           out.stats.occluded = counts.occluded;

@@ -481,15 +481,16 @@ FrameStats CrowdRenderer::drawImpostorDepth(const Mat4& light_view_proj, const V
 
 FrameStats CrowdRenderer::drawSkinnedDepthIndirect(const Mat4& light_view_proj, const SkinnedGpuModel& model,
                                                    uint32_t agents, size_t offset, size_t bytes, uint32_t commands,
-                                                   size_t command_offset) {
+                                                   size_t command_offset, size_t level) {
   FrameStats stats;
-  if (model.indexCount() == 0 || bytes == 0) return stats;
+  FF_CHECK(level < model.levels_.size());
+  if (model.levels_[level].index_count == 0 || bytes == 0) return stats;
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, agents, GLintptr(offset), GLsizeiptr(bytes));
   const Program& p = program(skinned_depth_, model);
   p.use();
   p.set("u_view_proj", light_view_proj);
   bindModel(p, model);
-  p.set("u_first_triangle", model.levels_[0].first_triangle);
+  p.set("u_first_triangle", model.levels_[level].first_triangle);
   drawIndirect(model.vao_, commands, command_offset, true);
   stats.draw_calls = 1;
   return stats;

@@ -162,7 +162,8 @@ class CrowdRenderer {
                                    const LightSettings& light, bool blend_views = false);
   // The shadow casters' depth-only draws for GPU-written records, as drawSkinnedIndirect and drawImpostorsIndirect.
   FrameStats drawSkinnedDepthIndirect(const Mat4& light_view_proj, const SkinnedGpuModel& model, uint32_t agents,
-                                      size_t offset, size_t bytes, uint32_t commands, size_t command_offset);
+                                      size_t offset, size_t bytes, uint32_t commands, size_t command_offset,
+                                      size_t level = 0);
   FrameStats drawImpostorDepthIndirect(const Mat4& light_view_proj, const Vec3& to_light,
                                        const ImpostorAtlasGpu& atlas, uint32_t agents, size_t offset, size_t bytes,
                                        uint32_t commands, size_t command_offset);

@@ -107,13 +107,15 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
     initial_commands_.push_back({mo.geometry_indices, 0, mo.geometry_first_index, 0, 0});
     initial_commands_.push_back({4, 0, 0, 0, 0});  // count 4, instances, first 0, base instance 0
   }
-  // The casters' lists after the camera's, alike; then levels 1.. of each model (levelCommand).
+  // The casters' lists after the camera's, alike; then levels 1.. of each model, the camera's and the casters'
+  // (levelCommand).
   for (size_t k = 0, n = initial_commands_.size(); k < n; ++k) initial_commands_.push_back(initial_commands_[k]);
-  for (const GpuCrowdModel& mo : models)
-    for (size_t l = 1; l < size_t(kMaxLevels); ++l)
-      initial_commands_.push_back(l <= mo.levels.size()
-                                      ? GpuCrowdCommand{mo.levels[l - 1].indices, 0, mo.levels[l - 1].first_index, 0, 0}
-                                      : GpuCrowdCommand{});
+  for (int pass = 0; pass < 2; ++pass)
+    for (const GpuCrowdModel& mo : models)
+      for (size_t l = 1; l < size_t(kMaxLevels); ++l)
+        initial_commands_.push_back(
+            l <= mo.levels.size() ? GpuCrowdCommand{mo.levels[l - 1].indices, 0, mo.levels[l - 1].first_index, 0, 0}
+                                  : GpuCrowdCommand{});
   agent_buf_ = makeBuffer(agent_records.data(), agent_records.size() * sizeof(AgentRecord), bytes_);
   routes_ = makeBuffer(route_records.data(), route_records.size() * sizeof(RouteRecord), bytes_);
   points_ = makeBuffer(points.data(), points.size() * sizeof(Vec4), bytes_);
@@ -127,7 +129,7 @@ GpuCrowd::GpuCrowd(std::span<const GpuCrowdRoute> routes, std::span<const GpuCro
   level_capacity_ = capacity_ / size_t(kMaxLevels) / 64 * 64;
   lists_ = makeBuffer(nullptr, 4 * models_ * capacity_ * sizeof(ListRecord), bytes_);  // the camera's, the casters'
   counts_ = makeBuffer(nullptr, 8 * sizeof(uint32_t), bytes_);
-  const std::vector<uint32_t> no_levels(size_t(kMaxModels) * size_t(kMaxLevels), 0);
+  const std::vector<uint32_t> no_levels(2 * size_t(kMaxModels) * size_t(kMaxLevels), 0);  // camera, casters
   level_count_buf_ = makeBuffer(no_levels.data(), no_levels.size() * sizeof(uint32_t), bytes_);
   candidates_ = makeBuffer(nullptr, agents.size() * sizeof(uint32_t), bytes_);
   const std::vector<uint32_t> zero(kBudgetBuckets, 0);
@@ -200,6 +202,7 @@ void GpuCrowd::castShadows(const Camera& camera, std::span<const float> switch_m
   casters_.set("u_to_light", glm::normalize(to_light));
   glUniform2f(casters_.uniformLocation("u_light_scale"), 2.0f / side_m, 1.0f / depth_range_m);
   glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
+  if (lod_m_per_m_ > 0.0f) countLevels(camera, switch_m, true);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
 }
 
@@ -275,11 +278,7 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
     usePass(budget_assign_, camera, switch_m);
     glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
   }
-  if (lod_m_per_m_ > 0.0f) {
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    usePass(level_counts_pass_, camera, switch_m);
-    glDispatchCompute(1, 1, 1);
-  }
+  if (lod_m_per_m_ > 0.0f) countLevels(camera, switch_m, false);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
   if (occlude) {
     glBindTextureUnit(2, 0);
@@ -299,11 +298,19 @@ std::vector<uint32_t> GpuCrowd::readList(size_t list) const {
   for (const ListRecord& r : readBuffer<ListRecord>(lists_, listOffset(list), n)) ids.push_back(r.object_id);
   return ids;
 }
-std::vector<uint32_t> GpuCrowd::readLevelList(size_t m, size_t level) const {
+void GpuCrowd::countLevels(const Camera& camera, std::span<const float> switch_m, bool casters) {
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  usePass(level_counts_pass_, camera, switch_m);
+  level_counts_pass_.set("u_first_list", uint32_t(casters ? 2 * models_ : 0));
+  glDispatchCompute(1, 1, 1);
+}
+
+std::vector<uint32_t> GpuCrowd::readLevelList(size_t m, size_t level, bool caster) const {
   FF_CHECK(m < models_ && level < size_t(kMaxLevels));
-  const size_t n = readCommands()[levelCommand(m, level)].instance_count;
+  const size_t n = readCommands()[levelCommand(m, level, caster)].instance_count;
+  const size_t list = caster ? casterList(m, false) : 2 * m;
   std::vector<uint32_t> ids;
-  for (const ListRecord& r : readBuffer<ListRecord>(lists_, listOffset(2 * m) + levelOffset(level), n))
+  for (const ListRecord& r : readBuffer<ListRecord>(lists_, listOffset(list) + levelOffset(level), n))
     ids.push_back(r.object_id);
   return ids;
 }

@@ -110,12 +110,15 @@ class GpuCrowd {
   // distance d takes the coarsest level whose distance to the mesh is at most lod_m_per_m * d (the runtime's levelFor:
   // geometry_lod_px over the focal length); the budget counts its level's triangles. Level l of model m is drawn by
   // command levelCommand(m, l) over levelCapacity() records at listOffset(2m) + levelOffset(l); an agent past its
-  // level's capacity is drawn as an impostor (Counts::level_overflow). One more dispatch.
+  // level's capacity is drawn as an impostor (Counts::level_overflow). One more dispatch. Shadow casters drawn as
+  // geometry take the level the camera gives them, in their lists' parts alike (caster: levelCommand(m, l, true),
+  // at listOffset(casterList(m, false)) + levelOffset(l)).
   void setLevelScale(float lod_m_per_m) { lod_m_per_m_ = lod_m_per_m; }
   float levelScale() const { return lod_m_per_m_; }
   size_t levelCount(size_t m) const { return level_counts_[m]; }
-  size_t levelCommand(size_t m, size_t level) const {
-    return level == 0 ? 2 * m : 4 * models_ + m * (kMaxLevels - 1) + level - 1;
+  size_t levelCommand(size_t m, size_t level, bool caster = false) const {
+    if (level == 0) return caster ? casterList(m, false) : 2 * m;
+    return 4 * models_ + (caster ? models_ : 0) * (kMaxLevels - 1) + m * (kMaxLevels - 1) + level - 1;
   }
   size_t levelCapacity() const { return level_capacity_; }
   size_t levelOffset(size_t level) const { return level * level_capacity_ * 48; }
@@ -156,9 +159,10 @@ class GpuCrowd {
   std::vector<Vec4> readPoses() const;
   std::vector<float> readPhases() const;
   std::vector<GpuCrowdCommand> readCommands() const;
-  // The object ids of a list's agents, in list order; readLevelList: those of model m's level l (with levels).
+  // The object ids of a list's agents, in list order; readLevelList: those of model m's level l (with levels; the
+  // camera's, or the casters').
   std::vector<uint32_t> readList(size_t list) const;
-  std::vector<uint32_t> readLevelList(size_t m, size_t level) const;
+  std::vector<uint32_t> readLevelList(size_t m, size_t level, bool caster = false) const;
   size_t gpuBytes() const;
 
  private:
@@ -175,6 +179,7 @@ class GpuCrowd {
   std::vector<size_t> level_counts_;  // per model
   uint32_t level_count_buf_ = 0;
   Program level_counts_pass_;
+  void countLevels(const Camera& camera, std::span<const float> switch_m, bool casters);  // FF_LEVEL_COUNTS
   bool budgeted_ = false;  // the last cullAndClassify ran under the budget (its candidates and cut are valid)
   std::unique_ptr<LateReadback> late_commands_;  // captureCommands' copies
   std::unique_ptr<GpuDepthPyramid> pyramid_;  // made by the first occludeBehind

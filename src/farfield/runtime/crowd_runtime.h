@@ -172,7 +172,7 @@ class CrowdRuntime {
   // milliseconds (geometry_ms: the skinned draws timed by gpu::LateTimer and their triangles copied by
   // GpuCrowd::captureCommands, both read frames later without waiting; on a software rasterizer the timer's clock
   // waits for the work, as a measurement), blended views and levels of detail (geometry_lod_px: GpuCrowd::
-  // setLevelScale, a draw per level; shadow casters at the mesh); not on this path yet: budget_coarsens. The stats
+  // setLevelScale, a draw per level; casters at their drawn level); not on this path yet: budget_coarsens. The stats
   // count draw calls and the budget only (the agents are counted on the GPU: GpuCrowd::readCommands, readCounts).
   CrowdFrameStats drawGpu(const Camera& camera, gpu::GpuCrowd& crowd, CrowdPolicy policy,
                           const gpu::LightSettings& light, const gpu::RenderTarget* occluders = nullptr);

@@ -10,6 +10,23 @@
 #include "farfield/runtime/crowd_runtime.h"
 
 namespace farfield::runtime {
+namespace {
+
+// Where model m's level l of the camera's (or the casters') geometry list lies: its records in the list buffer and
+// its command (gpu::GpuCrowd's layout; without levels of detail, the whole list at level 0).
+struct ListRange {
+  size_t offset = 0, bytes = 0, command = 0;
+};
+ListRange geometryRange(const gpu::GpuCrowd& crowd, size_t m, size_t level, bool caster) {
+  const size_t list = caster ? crowd.casterList(m, false) : 2 * m;
+  if (crowd.levelScale() > 0.0f)
+    return {crowd.listOffset(list) + crowd.levelOffset(level), crowd.levelCapacity() * sizeof(gpu::CrowdAgentGpu),
+            crowd.levelCommand(m, level, caster)};
+  return {crowd.listOffset(list), crowd.listBytes(), list};
+}
+size_t drawnLevels(const gpu::GpuCrowd& crowd, size_t m) { return crowd.levelScale() > 0.0f ? crowd.levelCount(m) : 1; }
+
+}  // namespace
 
 std::vector<gpu::GpuCrowdModel> CrowdRuntime::gpuCrowdModels(float nominal_speed) const {
   std::vector<gpu::GpuCrowdModel> out;
@@ -74,16 +91,14 @@ CrowdFrameStats CrowdRuntime::drawGpuLists(const Camera& camera, gpu::GpuCrowd& 
     if (!gpu_geometry_timer_) gpu_geometry_timer_ = std::make_unique<gpu::LateTimer>();
     gpu_geometry_timer_->begin(gpu_frame_);
   }
-  const bool levels = crowd.levelScale() > 0.0f;
   for (size_t m = 0; m < models_.size(); ++m)
-    for (size_t l = 0; l < (levels ? crowd.levelCount(m) : 1); ++l)
-      stats.draw.draw_calls +=
-          renderer_
-              .drawSkinnedIndirect(camera, *models_[m].gpu, crowd.listBuffer(),
-                                   crowd.listOffset(2 * m) + (levels ? crowd.levelOffset(l) : 0),
-                                   levels ? crowd.levelCapacity() * sizeof(gpu::CrowdAgentGpu) : crowd.listBytes(),
-                                   crowd.commandBuffer(), crowd.levelCommand(m, l) * command, light, l)
-              .draw_calls;
+    for (size_t l = 0; l < drawnLevels(crowd, m); ++l) {
+      const ListRange r = geometryRange(crowd, m, l, false);
+      stats.draw.draw_calls += renderer_
+                                   .drawSkinnedIndirect(camera, *models_[m].gpu, crowd.listBuffer(), r.offset,
+                                                        r.bytes, crowd.commandBuffer(), r.command * command, light, l)
+                                   .draw_calls;
+    }
   if (timed) gpu_geometry_timer_->end();
   for (size_t m = 0; m < models_.size(); ++m)
     stats.draw.draw_calls +=
@@ -152,9 +167,12 @@ CrowdFrameStats CrowdRuntime::drawGpuShadowed(const Camera& camera, gpu::GpuCrow
   shadow_map_->bindForCasters();
   const size_t command = sizeof(gpu::GpuCrowdCommand);
   for (size_t m = 0; m < models_.size(); ++m) {
-    const size_t g = crowd.casterList(m, false), i = crowd.casterList(m, true);
-    renderer_.drawSkinnedDepthIndirect(fit.projection.view_proj, *models_[m].gpu, crowd.listBuffer(),
-                                       crowd.listOffset(g), crowd.listBytes(), crowd.commandBuffer(), g * command);
+    const size_t i = crowd.casterList(m, true);
+    for (size_t l = 0; l < drawnLevels(crowd, m); ++l) {
+      const ListRange r = geometryRange(crowd, m, l, true);
+      renderer_.drawSkinnedDepthIndirect(fit.projection.view_proj, *models_[m].gpu, crowd.listBuffer(), r.offset,
+                                         r.bytes, crowd.commandBuffer(), r.command * command, l);
+    }
     renderer_.drawImpostorDepthIndirect(fit.projection.view_proj, to_light, *models_[m].impostor->atlas,
                                         crowd.listBuffer(), crowd.listOffset(i), crowd.listBytes(),
                                         crowd.commandBuffer(), i * command);

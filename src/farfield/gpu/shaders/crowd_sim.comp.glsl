@@ -83,12 +83,14 @@ const uint kNone = 0xFFFFFFFFu;
 // Levels of detail (GpuCrowd::setLevelScale; u_lod_m_per_m > 0): a skinned agent takes the coarsest level whose
 // distance to the mesh is at most u_lod_m_per_m times its distance (runtime::CrowdRuntime::levelFor); level l of a
 // model's geometry list holds u_level_capacity records from l * u_level_capacity, counted in level_counts (model * 8
-// + level) and written into the commands by FF_LEVEL_COUNTS; an agent past a level's capacity is an impostor.
+// + level; the casters' from 16 * 8) and written into the commands by FF_LEVEL_COUNTS; an agent past a level's
+// capacity is an impostor.
 const uint kMaxLevels = 8u;
 layout(std430, binding = 11) buffer LevelCounts { uint level_counts[]; };
 uniform float u_lod_m_per_m;
 uniform uint u_level_capacity;
-uniform uint u_level_command0;  // the command of level 1 of model 0; model m's level l: + m * 7 + l - 1
+uniform uint u_level_command0;  // the command of level 1 of model 0; model m's level l: + m * 7 + l - 1 (the
+                                // casters' after the camera's: + u_models * 7)
 uniform uint u_models;
 
 const float kTwoPi = 6.28318530717958647692;
@@ -195,25 +197,29 @@ void append(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 view_dir,
   lists[list * u_capacity + slot] = r;
 }
 
-// Agent i, inside its switch at distance d, into the camera's lists as geometry: with levels of detail, into its
-// level's part of the geometry list (an impostor when that part is full, counted in stats[6]).
-void appendGeometry(uint i, Agent a, Model m, vec4 pose, vec3 view_dir, float d) {
+// Where the level counters of the lists after first_list start (the camera's or the casters').
+uint counterBase(uint first_list) { return first_list == 0u ? 0u : 16u * kMaxLevels; }
+
+// Agent i, inside its switch at distance d from the eye, into the lists after first_list (the camera's or the
+// casters') as geometry: with levels of detail, into its level's part of the geometry list (an impostor when that
+// part is full; the camera's counted in stats[6]).
+void appendGeometry(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 view_dir, float d) {
   if (!(u_lod_m_per_m > 0.0)) {
-    append(0u, i, a, m, pose, view_dir, false);
+    append(first_list, i, a, m, pose, view_dir, false);
     return;
   }
   uint level = levelOf(m, d);
-  uint slot = atomicAdd(level_counts[a.model * kMaxLevels + level], 1u);
+  uint slot = atomicAdd(level_counts[counterBase(first_list) + a.model * kMaxLevels + level], 1u);
   if (slot >= u_level_capacity) {
-    atomicAdd(stats[6], 1u);
-    append(0u, i, a, m, pose, view_dir, true);
+    if (first_list == 0u) atomicAdd(stats[6], 1u);
+    append(first_list, i, a, m, pose, view_dir, true);
     return;
   }
   Record r;
   r.pos_heading = pose;
   r.tint = a.tint;
   r.misc = uvec4(cycleIndex(phases[i], m.counts.x), 0u, a.id, a.outfit);
-  lists[uint(m.lists.x) * u_capacity + level * u_level_capacity + slot] = r;
+  lists[(first_list + uint(m.lists.x)) * u_capacity + level * u_level_capacity + slot] = r;
 }
 #endif
 
@@ -260,9 +266,12 @@ void main() {
   if (abs(p.x) > 1.0 + r * u_light_scale.x || abs(p.y) > 1.0 + r * u_light_scale.x || p.z < -r * u_light_scale.y ||
       p.z > 1.0 + r * u_light_scale.y)
     return;
-  bool impostor = !(distance(u_eye, c) < u_switch[a.model]);
+  float d = distance(u_eye, c);
+  bool impostor = !(d < u_switch[a.model]);
   if (u_budget != 0u) impostor = candidates[i] == kNone || candidates[i] >= stats[2];
-  append(u_first_list, i, a, m, pose, turn(-pose.w, u_to_light), impostor);
+  vec3 view_dir = turn(-pose.w, u_to_light);
+  if (impostor) append(u_first_list, i, a, m, pose, view_dir, true);
+  else appendGeometry(u_first_list, i, a, m, pose, view_dir, d);  // at the level the camera draws it
 }
 #elif defined(FF_BUDGET_SCAN)
 // One invocation: the first bucket whose running sum of triangles passes the budget (u_buckets: none does), the
@@ -299,18 +308,21 @@ void main() {
     atomicAdd(stats[3], 1u);
     append(0u, i, a, m, pose, eyeInAgentSpace(pose, c), true);
   } else {
-    appendGeometry(i, a, m, pose, eyeInAgentSpace(pose, c), distance(u_eye, c));
+    appendGeometry(0u, i, a, m, pose, eyeInAgentSpace(pose, c), distance(u_eye, c));
   }
 }
 #elif defined(FF_LEVEL_COUNTS)
-// One invocation: each level's count (at most its part of the list) into its command; the counts cleared.
+// One invocation: each level's count of the lists after u_first_list (the camera's or the casters'), at most its
+// part of the list, into its command; the counts cleared.
 void main() {
   if (gl_GlobalInvocationID.x != 0u) return;
+  uint base = counterBase(u_first_list);
+  uint levels = u_level_command0 + (u_first_list == 0u ? 0u : u_models * (kMaxLevels - 1u));
   for (uint mo = 0u; mo < u_models; ++mo)
     for (uint l = 0u; l < kMaxLevels; ++l) {
-      uint command = l == 0u ? 2u * mo : u_level_command0 + mo * (kMaxLevels - 1u) + l - 1u;
-      commands[command].instance_count = min(level_counts[mo * kMaxLevels + l], u_level_capacity);
-      level_counts[mo * kMaxLevels + l] = 0u;
+      uint command = l == 0u ? u_first_list + 2u * mo : levels + mo * (kMaxLevels - 1u) + l - 1u;
+      commands[command].instance_count = min(level_counts[base + mo * kMaxLevels + l], u_level_capacity);
+      level_counts[base + mo * kMaxLevels + l] = 0u;
     }
 }
 #else
@@ -339,6 +351,6 @@ void main() {
     return;
   }
   if (impostor) append(0u, i, a, m, pose, eyeInAgentSpace(pose, c), true);
-  else appendGeometry(i, a, m, pose, eyeInAgentSpace(pose, c), d);
+  else appendGeometry(0u, i, a, m, pose, eyeInAgentSpace(pose, c), d);
 }
 #endif
