@@ -9,7 +9,10 @@
 #include "farfield/eval/frame_runner.h"
 #include "farfield/eval/terrain_paths.h"
 #include "farfield/gpu/context.h"
+#include "farfield/terrain/gpu_lod.h"
 #include "farfield/terrain/lod_sprite.h"
+#include "farfield/terrain/terrain_data.h"
+#include "farfield/terrain/terrain_texture.h"
 #include "support/test_support.h"
 
 namespace farfield::eval {
@@ -18,7 +21,8 @@ namespace {
 TEST(TerrainModes, RegisteredByName) {
   registerTerrainModes();
   registerTerrainModes();  // idempotent
-  for (const char* m : {"high", "low", "lod-sprite", "lod-sprite-predict", "lod-sprite-cache"}) {
+  for (const char* m : {"high", "low", "lod-sprite", "lod-sprite-predict", "lod-sprite-cache", "lod-sprite-gpu",
+                        "lod-sprite-gpu-predict"}) {
     EXPECT_TRUE(hasMode(m)) << m;
     EXPECT_NE(modeDescription(m).find("terrain"), std::string::npos) << m;
   }
@@ -30,6 +34,12 @@ TEST(TerrainModes, RegisteredByName) {
   EXPECT_TRUE(spriteVariantOf("lod-sprite", v));
   EXPECT_EQ(v, SpriteVariant::Paper);
   EXPECT_FALSE(spriteVariantOf("high", v));
+  bool gpu = true;
+  EXPECT_TRUE(spriteVariantOf("lod-sprite-predict", v, &gpu));
+  EXPECT_FALSE(gpu);
+  EXPECT_TRUE(spriteVariantOf("lod-sprite-gpu-predict", v, &gpu));
+  EXPECT_EQ(v, SpriteVariant::Predict);
+  EXPECT_TRUE(gpu);
   TerrainRun run;
   run.high_error = 0.5f;
   run.low_error = 3.0f;
@@ -40,7 +50,24 @@ TEST(TerrainModes, RegisteredByName) {
   EXPECT_EQ(o.cache_size, 8);
   EXPECT_FALSE(o.predict);
   EXPECT_TRUE(spriteOptions(run, SpriteVariant::Predict, 1.0).predict);
+  EXPECT_FALSE(spriteOptions(run, SpriteVariant::Predict, 1.0).predict_late);
   EXPECT_EQ(spriteOptions(run, SpriteVariant::Paper, 1.0).cache_size, 1);
+}
+
+// On the GPU (a CDLOD terrain given): the sprite frame too, and for the Predict variant keyframes rendered ahead late,
+// with the per-frame choice kept.
+TEST(TerrainModesGL, TheGpuVariantsDrawTheSpriteFrameOnTheGpu) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  const std::unique_ptr<terrain::TerrainData> data = terrain::TerrainData::load("fractal:65:2");
+  terrain::GpuLodTerrain cdlod(data->hf, terrain::terrainTexture(data->hf));
+  TerrainRun run;
+  const terrain::LodSpriteOptions g = spriteOptions(run, SpriteVariant::Predict, 1.0, &cdlod);
+  EXPECT_TRUE(g.gpu_low && g.predict && g.predict_late);
+  EXPECT_EQ(g.predict_chunks, 16);
+  EXPECT_EQ(g.gpu_high, &cdlod);
+  const terrain::LodSpriteOptions p = spriteOptions(run, SpriteVariant::Paper, 1.0, &cdlod);
+  EXPECT_TRUE(p.gpu_low);
+  EXPECT_FALSE(p.predict);
 }
 
 struct Terrain {
