@@ -291,12 +291,15 @@ std::vector<float> GpuCrowd::readPhases() const { return readBuffer<float>(phase
 std::vector<GpuCrowdCommand> GpuCrowd::readCommands() const {
   return readBuffer<GpuCrowdCommand>(commands_, 0, initial_commands_.size());
 }
-std::vector<uint32_t> GpuCrowd::readList(size_t list) const {
-  FF_CHECK(list < initial_commands_.size());
-  const size_t n = readCommands()[list].instance_count;
+std::vector<uint32_t> GpuCrowd::readIds(size_t offset, size_t command) const {
+  const size_t n = readCommands()[command].instance_count;
   std::vector<uint32_t> ids;
-  for (const ListRecord& r : readBuffer<ListRecord>(lists_, listOffset(list), n)) ids.push_back(r.object_id);
+  for (const ListRecord& r : readBuffer<ListRecord>(lists_, offset, n)) ids.push_back(r.object_id);
   return ids;
+}
+std::vector<uint32_t> GpuCrowd::readList(size_t list) const {
+  FF_CHECK(list < 4 * models_);
+  return readIds(listOffset(list), list);
 }
 void GpuCrowd::countLevels(const Camera& camera, std::span<const float> switch_m, bool casters) {
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -307,12 +310,7 @@ void GpuCrowd::countLevels(const Camera& camera, std::span<const float> switch_m
 
 std::vector<uint32_t> GpuCrowd::readLevelList(size_t m, size_t level, bool caster) const {
   FF_CHECK(m < models_ && level < size_t(kMaxLevels));
-  const size_t n = readCommands()[levelCommand(m, level, caster)].instance_count;
-  const size_t list = caster ? casterList(m, false) : 2 * m;
-  std::vector<uint32_t> ids;
-  for (const ListRecord& r : readBuffer<ListRecord>(lists_, listOffset(list) + levelOffset(level), n))
-    ids.push_back(r.object_id);
-  return ids;
+  return readIds(levelListOffset(m, level, caster), levelCommand(m, level, caster));
 }
 size_t GpuCrowd::gpuBytes() const { return bytes_; }
 

@@ -122,6 +122,10 @@ class GpuCrowd {
   }
   size_t levelCapacity() const { return level_capacity_; }
   size_t levelOffset(size_t level) const { return level * level_capacity_ * 48; }
+  // Where model m's level l of the camera's (or the casters') geometry list starts in the list buffer, bytes.
+  size_t levelListOffset(size_t m, size_t level, bool caster = false) const {
+    return listOffset(caster ? casterList(m, false) : 2 * m) + levelOffset(level);
+  }
 
   // Occlusion culling of the next cullAndClassify (that call only): agents whose bounding box lies behind `target`'s
   // current depth (the city, drawn first) over the box's whole footprint are left out, by the test of the CPU runtime's
@@ -180,6 +184,8 @@ class GpuCrowd {
   uint32_t level_count_buf_ = 0;
   Program level_counts_pass_;
   void countLevels(const Camera& camera, std::span<const float> switch_m, bool casters);  // FF_LEVEL_COUNTS
+  // The object ids of the records at `offset` of the list buffer, as many as command `command` counts.
+  std::vector<uint32_t> readIds(size_t offset, size_t command) const;
   bool budgeted_ = false;  // the last cullAndClassify ran under the budget (its candidates and cut are valid)
   std::unique_ptr<LateReadback> late_commands_;  // captureCommands' copies
   std::unique_ptr<GpuDepthPyramid> pyramid_;  // made by the first occludeBehind

@@ -18,10 +18,10 @@ struct ListRange {
   size_t offset = 0, bytes = 0, command = 0;
 };
 ListRange geometryRange(const gpu::GpuCrowd& crowd, size_t m, size_t level, bool caster) {
-  const size_t list = caster ? crowd.casterList(m, false) : 2 * m;
   if (crowd.levelScale() > 0.0f)
-    return {crowd.listOffset(list) + crowd.levelOffset(level), crowd.levelCapacity() * sizeof(gpu::CrowdAgentGpu),
+    return {crowd.levelListOffset(m, level, caster), crowd.levelCapacity() * sizeof(gpu::CrowdAgentGpu),
             crowd.levelCommand(m, level, caster)};
+  const size_t list = crowd.levelCommand(m, 0, caster);  // level 0's command is the list's own
   return {crowd.listOffset(list), crowd.listBytes(), list};
 }
 size_t drawnLevels(const gpu::GpuCrowd& crowd, size_t m) { return crowd.levelScale() > 0.0f ? crowd.levelCount(m) : 1; }

@@ -320,11 +320,13 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   // sprite and covers the view, or covers it at least as well as the current sprite (which is in use anyway);
   // otherwise it is stale (the camera went elsewhere than extrapolated) and dropped, so that a new one is made.
   bool early = false;
+  double early_error = 0.0;  // the early-taken keyframe's error here (pixels)
   if (options_.predict_late && !due && current_ && pending_ && pending_->ready) {
-    double e = 0.0;
-    const bool takes = takesOver(*pending_, camera.eye, beta, &e);
-    early = e < info.error_px &&
-            (takes || (e < 0.75 * options_.epsilon && coverage(*pending_) >= coverage(*current_)));
+    early_error = frameError(pending_->camera.eye, camera.eye).pixels(beta);
+    if (early_error < info.error_px && early_error < 0.75 * options_.epsilon) {
+      const double cover = coverage(*pending_);
+      early = cover >= options_.reuse_coverage * pending_->coverage_at_creation || cover >= coverage(*current_);
+    }
     if (!early) {
       ++counters_.predicted_discarded;
       spare_.push_back(std::move(pending_));
@@ -343,9 +345,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     Keyframe* chosen = nullptr;
     double chosen_error = 0.0;
     if (pending_ && pending_->ready) {
-      double e = 0.0;
-      const bool takes = takesOver(*pending_, camera.eye, beta, &e);
-      if (early || takes) {
+      double e = early_error;
+      if (early || takesOver(*pending_, camera.eye, beta, &e)) {
         chosen = pending_.get();
         chosen_error = e;
         info.source = SpriteSource::Predicted;

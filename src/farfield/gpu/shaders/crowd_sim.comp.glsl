@@ -183,18 +183,23 @@ uint geometryTriangles(Model m, float d) {
 }
 
 #ifndef FF_SIMULATE
-// Agent i into its model's geometry or impostor list after `first_list`, as the renderer's record: the palette pose
-// or the atlas frame nearest its phase, and for an impostor the view nearest `view_dir` (agent space).
-void append(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 view_dir, bool impostor) {
-  uint list = first_list + uint(m.lists.x) + (impostor ? 1u : 0u);
-  uint slot = atomicAdd(commands[list].instance_count, 1u);
+// Agent i as the renderer's record: the palette pose or the atlas frame nearest its phase, and for an impostor the
+// view nearest `view_dir` (agent space).
+Record recordOf(uint i, Agent a, Model m, vec4 pose, vec3 view_dir, bool impostor) {
   Record r;
   r.pos_heading = pose;
   r.tint = a.tint;
   uint index = cycleIndex(phases[i], impostor ? m.counts.y : m.counts.x);
   uint view = impostor ? nearestView(m, view_dir) : 0u;
   r.misc = uvec4(index, view, a.id, a.outfit);
-  lists[list * u_capacity + slot] = r;
+  return r;
+}
+
+// Agent i into its model's geometry or impostor list after `first_list`.
+void append(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 view_dir, bool impostor) {
+  uint list = first_list + uint(m.lists.x) + (impostor ? 1u : 0u);
+  uint slot = atomicAdd(commands[list].instance_count, 1u);
+  lists[list * u_capacity + slot] = recordOf(i, a, m, pose, view_dir, impostor);
 }
 
 // Where the level counters of the lists after first_list start (the camera's or the casters').
@@ -215,11 +220,8 @@ void appendGeometry(uint first_list, uint i, Agent a, Model m, vec4 pose, vec3 v
     append(first_list, i, a, m, pose, view_dir, true);
     return;
   }
-  Record r;
-  r.pos_heading = pose;
-  r.tint = a.tint;
-  r.misc = uvec4(cycleIndex(phases[i], m.counts.x), 0u, a.id, a.outfit);
-  lists[(first_list + uint(m.lists.x)) * u_capacity + level * u_level_capacity + slot] = r;
+  lists[(first_list + uint(m.lists.x)) * u_capacity + level * u_level_capacity + slot] =
+      recordOf(i, a, m, pose, view_dir, false);
 }
 #endif
 
