@@ -8,6 +8,8 @@
 # outputs get the suffix -occlusion-off), to compare with the default (on). INVEST=0 runs them with
 # --mode-option lost_frame_investment=0 (suffix -invest-0): a frame over t_max whatever it does regenerates nothing.
 # PAY_BACK=off (suffix -pay-back-off): every invalid image that fits t_max is regenerated, paying or not.
+# GEOMETRY=cpu (suffix -geometry-cpu): the modes' geometry culled on the CPU (--mode-option geometry=cpu; with the
+# image cache's occlusion culling, read back), against the default, the GPU-driven frame's culler.
 # MODES=all (suffix -all) adds billboard and warp, for the table of every mode against full and culled.
 # Usage: scripts/bench_dynamic_budget.sh FARFIELD OUT [TMAX_MS] [FRAMES] [STRIDE]
 set -euo pipefail
@@ -23,6 +25,8 @@ INVEST=${INVEST:-1}
 [ "$INVEST" = 1 ] || SUFFIX="$SUFFIX-invest-$INVEST"
 PAY_BACK=${PAY_BACK:-on}
 [ "$PAY_BACK" = on ] || SUFFIX="$SUFFIX-pay-back-$PAY_BACK"
+GEOMETRY=${GEOMETRY:-gpu}
+[ "$GEOMETRY" = gpu ] || SUFFIX="$SUFFIX-geometry-$GEOMETRY"
 MODES_LIST=culled,dynamic-shade,dynamic-schaufler,layered
 if [ "${MODES:-}" = all ]; then
   MODES_LIST=culled,billboard,dynamic-shade,dynamic-schaufler,layered,warp
@@ -46,6 +50,7 @@ for run in "city city_trees.glb drive2.json" "forest forest5.glb fly5.json"; do
   "$FARFIELD" bench "$scene" --path "$path" --modes "$MODES_LIST" --reference \
     --repeats 3 --tmax "$TMAX" --frames "$FRAMES" --stride "$STRIDE" --mode-option error_px=2 \
     --mode-option t_max_ms="$TMAX" --mode-option profile="$OUT/profile-$name.json" --mode-option occlusion="$OCCLUSION" \
+    --mode-option geometry="$GEOMETRY" \
     --mode-option lost_frame_investment="$INVEST" --mode-option pay_back="$PAY_BACK" \
     -o "$run_dir" > "$run_dir.txt" 2>&1
 done

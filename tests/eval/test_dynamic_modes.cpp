@@ -62,6 +62,64 @@ TEST(DynamicModesGl, RunOnAForestCloseToTheFullFrames) {
   EXPECT_THROW(createMode("billboard", bare.context)->prepare(bare.context), Error);
 }
 
+// The image cache's geometry drawn by the GPU-driven frame (geometry=gpu, the default): its frames are its CPU path's
+// without occlusion culling (the same images, the same regenerations, the geometry culled and drawn by the GPU), and
+// a frame that regenerates no image waits for nothing, where the CPU path's occlusion culling reads depth back.
+TEST(DynamicModesGl, TheImageCacheOnTheGpuDrawsWhatItsCpuPathDraws) {
+  registerImpostorModes();
+  const scene::Scene forest = smallForest(30, 4);
+  gpu::sharedHeadlessContext().makeCurrent();
+  // pay_back off and no t_max: every invalid image is regenerated, whatever each run's fitted cost model says.
+  const std::map<std::string, std::string> common{{"error_px", "4"}, {"pay_back", "off"}};
+  auto with = [&](std::map<std::string, std::string> more) {
+    more.insert(common.begin(), common.end());
+    return more;
+  };
+  for (const std::string name : {"dynamic-shade", "layered"}) {
+    SCOPED_TRACE(name);
+    ModeRunResources on_gpu(forest, 160, 96, common);
+    ModeRunResources on_cpu(forest, 160, 96, with({{"geometry", "cpu"}, {"occlusion", "off"}}));
+    ModeRunResources occluded(forest, 160, 96, with({{"geometry", "cpu"}}));
+    std::unique_ptr<Mode> g = createMode(name, on_gpu.context), c = createMode(name, on_cpu.context),
+                          o = createMode(name, occluded.context);
+    g->prepare(on_gpu.context);
+    c->prepare(on_cpu.context);
+    o->prepare(occluded.context);
+    FrameRunner run_g(on_gpu.renderer, on_gpu.target), run_c(on_cpu.renderer, on_cpu.target),
+        run_o(occluded.renderer, occluded.target);
+    double worst = 99.0;
+    for (size_t k = 0; k < 6; ++k) {
+      SCOPED_TRACE("frame " + std::to_string(k));
+      Camera cam;
+      cam.width = 160;
+      cam.height = 96;
+      // Each eye twice: the second frame finds every image valid and regenerates none.
+      cam.eye = Vec3(-60.0f + 6.0f * float(k / 2), -60.0f, 25.0f);
+      cam.at = Vec3(0, 0, 0);
+      const FrameRecord fg = run_g.run(*g, cam, k);
+      const image::ColorImage got = on_gpu.target.readColor();
+      run_c.run(*c, cam, k);
+      const FrameRecord fo = run_o.run(*o, cam, k);
+      worst = std::min(worst, image::psnr(got, on_cpu.target.readColor()));
+      ASSERT_TRUE(fg.counted && fo.counted);
+      if (k % 2 == 1) {
+        EXPECT_FALSE(g->info().count("regenerations_at_frame_" + std::to_string(k)));
+        EXPECT_EQ(fg.syncs, 0u);
+        EXPECT_GE(fo.syncs, 1u);
+      }
+    }
+    std::printf("%s on the GPU: worst PSNR %.1f dB against its CPU path\n", name.c_str(), worst);
+    EXPECT_GT(worst, 50.0);
+    const std::map<std::string, double> gi = g->info(), ci = c->info();
+    EXPECT_EQ(gi.at("geometry_gpu"), 1.0);
+    EXPECT_EQ(ci.at("geometry_gpu"), 0.0);
+    EXPECT_GT(gi.at("gpu_triangles"), 0.0);  // the geometry went through the GPU culler
+    EXPECT_GT(gi.at("regenerations_per_frame"), 0.0);
+    for (const char* key : {"regenerations_per_frame", "images_per_frame", "invalid_as_geometry_per_frame"})
+      EXPECT_EQ(gi.at(key), ci.at(key)) << key;
+  }
+}
+
 // The billboard mode's geometry is occlusion-culled like the culled mode's, on the GPU (the default) or the CPU: exact,
 // so its frames equal the frames drawn without it, from eyes among the trees where near trunks and crowns hide others.
 TEST(DynamicModesGl, BillboardOcclusionCullingLeavesTheFrameAsItWas) {

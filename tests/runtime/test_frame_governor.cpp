@@ -151,6 +151,38 @@ TEST(FrameGovernor, RefinesBackWhenTheLoadFallsAndOnlyThen) {
   EXPECT_EQ(sim.overAfterFirstMeasurement(t_max), 0u);
 }
 
+TEST(FrameGovernor, ColdFramesExpectTheModelTimesTheColdRatioUntilAFrameIsMeasured) {
+  const double t_max = 10.0;
+  // A constant 11 ms that the model puts at 8 ms (1.375x optimistic): trusted, the model puts the first frames
+  // (before the first measurement, two frames late) at the full level and they break t_max; with a cold ratio of 1.5
+  // they are coarsened before they are drawn, and no frame breaks it.
+  const auto load = [](size_t) { return 11.0; };
+  const auto model = [](size_t) { return 8.0; };
+  const Simulation trusted = simulate(40, t_max, load, model, 0.0);
+  EXPECT_EQ(trusted.frames[0].level, 0u);
+  EXPECT_GT(trusted.frames[0].cost_ms, t_max);
+  GovernorOptions cold;
+  cold.cold_ratio = 1.5;
+  const Simulation sim = simulate(40, t_max, load, model, 0.0, 2, cold);
+  EXPECT_EQ(sim.frames[0].level, 1u);  // 8 x 1.5 = 12 > 9; 8 x 0.7 x 1.5 = 8.4 fits
+  for (const SimFrame& f : sim.frames) EXPECT_LE(f.cost_ms, t_max);
+  EXPECT_EQ(sim.frames.back().level, 1u);  // measured: 11 ms at the full level stays over the aim
+  FrameGovernor governor({{"full", 1.0}}, [&] {
+    GovernorOptions o = cold;
+    o.t_max_ms = t_max;
+    return o;
+  }());
+  EXPECT_DOUBLE_EQ(governor.corrected(4.0), 6.0);
+  const double p[1] = {4.0};
+  governor.decide(0, p);
+  governor.measured(0, 5.0);
+  EXPECT_DOUBLE_EQ(governor.corrected(4.0), 5.0);  // the measured ratio 1.25, no longer the cold 1.5
+  GovernorOptions bad = cold;
+  bad.t_max_ms = t_max;
+  bad.cold_ratio = 0.5;
+  EXPECT_THROW(FrameGovernor({{"full", 1.0}}, bad), Error);
+}
+
 TEST(FrameGovernor, TheCorrectionIsTheSmallerOfTheWorstRatioAndTheWorstDifference) {
   GovernorOptions options;
   options.t_max_ms = 100.0;

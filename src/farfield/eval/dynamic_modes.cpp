@@ -131,7 +131,9 @@ DynamicImpostorMode::DynamicImpostorMode(impostor::ValidityMetric metric, const 
   options_.pay_back = switchOption(context, "pay_back", true);
   options_.impostor.plane_in_front = choiceOption(context, "plane", "best", {"best", "front"}) == "front";
   profile_path_ = context.option("profile");
-  if (switchOption(context, "occlusion", true)) {
+  if (choiceOption(context, "geometry", "gpu", {"gpu", "cpu"}) == "gpu") {
+    geometry_draw_.emplace(context, name());  // its own occlusion option: the GPU culler's test
+  } else if (switchOption(context, "occlusion", true)) {
     occlusion_.emplace();
     occlusion_->occluder_share = occluderShareOption(context, name());
   }
@@ -176,10 +178,21 @@ void DynamicImpostorMode::prepare(const ModeContext& context) {
   }
   calibrate_s_ = clock.seconds();
   cache_ = std::make_unique<runtime::ImageCache>(*context.scene, *context.gpu_scene, options_);
+  if (geometry_draw_) geometry_draw_->prepare(context);
 }
 
 void DynamicImpostorMode::frame(FrameContext& frame) {
   gpu::RenderTarget& target = frame.beginOwnPass();
+  if (geometry_draw_) {
+    // Regenerations first (into their own targets), then the geometry through the GPU culler, then the images.
+    geometry_objects_.clear();
+    per_frame_[frame.pathFrame()] = cache_->frame(frame.renderer(), frame.camera(), frame.pathFrame(), frame.items(),
+                                                  nullptr, &geometry_objects_);
+    std::sort(geometry_objects_.begin(), geometry_objects_.end());
+    geometry_objects_.erase(std::unique(geometry_objects_.begin(), geometry_objects_.end()), geometry_objects_.end());
+    geometry_draw_->submitObjects(frame, geometry_objects_);
+    return;
+  }
   if (occlusion_) {
     occlusion_->target = &target;
     occlusion_->draw_occluders = [&frame](std::span<const gpu::DrawItem> items) { frame.drawPass(items); };
@@ -219,7 +232,9 @@ std::map<std::string, double> DynamicImpostorMode::info() const {
     hidden_fallback_tris += double(s.hidden_fallback_triangles);
   }
   const double f = double(std::max<size_t>(per_frame_.size(), 1));
-  std::map<std::string, double> out;
+  // geometry_gpu and the GPU culler's numbers (gpu_*), or geometry_gpu 0 and the CPU occlusion's below.
+  std::map<std::string, double> out =
+      geometry_draw_ ? geometry_draw_->info() : std::map<std::string, double>{{"geometry_gpu", 0.0}};
   // Which path frames regenerated (to check their measured times against t_max): "regenerations_at_frame_K", for at
   // most 500 such frames.
   size_t listed = 0;

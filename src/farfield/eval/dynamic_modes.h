@@ -18,9 +18,13 @@
 //   plane=best|front  (dynamic-*) the best plane, or the best plane moved in front of the node's samples
 //   profile=FILE      (dynamic-*, layered) a cost profile of this machine (farfield calibrate over the path's view
 //                     space): its model, safety factor and layered terms predict the frame; default: a quick fit here
-//   occlusion=on|off  (dynamic-*, layered) the cache's near geometry occlusion-culled against the depth of its nearest
-//                     items, and nodes hidden behind that depth skipped: no image, no regeneration (default on);
-//                     billboard: its geometry (what is not a billboard) occlusion-culled as the culled mode's
+//   geometry=gpu|cpu  (billboard, dynamic-*, layered) the geometry (what is not an image) culled and drawn by the
+//                     GPU-driven frame (gpu::GpuCuller: frustum, cones, hierarchical-Z; no readback), the default, or
+//                     culled on the CPU (eval/plan_geometry.h)
+//   occlusion=on|off  on the GPU: the GPU culler's occlusion test; on the CPU (dynamic-*, layered): the cache's near
+//                     geometry occlusion-culled against the depth of its nearest items, read back, and nodes hidden
+//                     behind that depth skipped: no image, no regeneration (default on); billboard: its geometry
+//                     occlusion-culled as the culled-cpu mode's
 //   occluder_share=S  the nearest near items drawn first as occluders hold this share of the triangles of the near
 //                     geometry and the cut's nodes (default 0.1)
 //   warp_interval=N   (warp) a keyframe of culled geometry every N path frames (default 4)
@@ -79,9 +83,15 @@ class DynamicImpostorMode final : public Mode {
   std::string name() const override;
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
+  std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
+    return geometry_draw_ ? geometry_draw_->lateFrameStats(path_frame) : std::nullopt;
+  }
   std::map<std::string, double> info() const override;
 
  private:
+  // geometry=gpu: the cache's geometry as objects, culled and drawn by the GPU (no CPU occlusion, no readback).
+  std::optional<PlanGeometry> geometry_draw_;
+  std::vector<uint32_t> geometry_objects_;
   runtime::ImageCacheOptions options_;
   std::unique_ptr<runtime::ImageCache> cache_;
   const scene::Scene* scene_ = nullptr;

@@ -25,7 +25,9 @@
 // levels' bounds, 0 first, increasing), governor_error_px (the promised bound, default 1 px: bound scales are relative
 // to it), governor_scales=1,0.84,... (the resolution scales, 1 first, decreasing, each in [0.25, 1]), governor_lag
 // (frames, default 2),
-// governor_aim, governor_refine_below, governor_refine_after, governor_window (runtime::GovernorOptions),
+// governor_aim, governor_refine_below, governor_refine_after, governor_window, governor_cold_ratio (default 1.5:
+// the model, fitted on the calibration's quiet frames, is taken 1.5x larger until the first frame is measured)
+// (runtime::GovernorOptions),
 // governor_calibration_repeats (default 3), governor_t_max_ms (the budget where the command has no --tmax, e.g. walk;
 // it wins over --tmax). Needs one of them.
 #pragma once

@@ -29,11 +29,13 @@ FrameGovernor::FrameGovernor(std::vector<GovernorLevel> levels, GovernorOptions 
     throw Error(where, "refine_below must be in (0, aim]");
   if (options_.refine_after < 1 || options_.window < 1 || options_.max_pending < 1)
     throw Error(where, "refine_after, window and max_pending must be at least 1");
+  if (!(std::isfinite(options_.cold_ratio) && options_.cold_ratio >= 1.0))
+    throw Error(where, "cold_ratio must be a finite number >= 1");
   stats_.frames_at_level.assign(levels_.size(), 0);
 }
 
 double FrameGovernor::corrected(double predicted_ms) const {
-  if (residuals_.empty()) return predicted_ms;
+  if (residuals_.empty()) return predicted_ms * options_.cold_ratio;
   double ratio = 0.0, difference = -std::numeric_limits<double>::infinity();
   for (const Residual& r : residuals_) {
     ratio = std::max(ratio, r.ratio);

@@ -160,7 +160,10 @@ double ImageCache::expectedReuse(const Node& n, const DVec3& eye, double theta) 
 }
 
 ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& camera, size_t frame_index,
-                                       std::vector<gpu::DrawItem>& out, const ImageCacheOcclusion* occlusion) {
+                                       std::vector<gpu::DrawItem>& out, const ImageCacheOcclusion* occlusion,
+                                       std::vector<uint32_t>* geometry_objects) {
+  if (occlusion && geometry_objects)
+    throw Error("image cache", "occlusion culling on the CPU and geometry as objects for the GPU are exclusive");
   ImageCacheFrameStats st;
   const bool repeat = last_frame_ && *last_frame_ == frame_index;
   if (!repeat) {
@@ -230,6 +233,8 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
     });
     st.occlusion_ms = os.readback_ms + os.pyramid_ms + test.milliseconds();
     out.insert(out.end(), visible_.begin(), visible_.end());
+  } else if (geometry_objects) {
+    geometry_objects->insert(geometry_objects->end(), near_objects.begin(), near_objects.end());
   } else {
     out.insert(out.end(), scratch_.begin(), scratch_.end());
   }
@@ -263,8 +268,11 @@ ImageCacheFrameStats ImageCache::frame(gpu::Renderer& renderer, const Camera& ca
     return geometryMs(triangles, n.fallback_end - n.fallback_begin);
   };
   auto appendFallback = [&](const Node& n) {
-    out.insert(out.end(), fallback_items_.begin() + std::ptrdiff_t(n.fallback_begin),
-               fallback_items_.begin() + std::ptrdiff_t(n.fallback_end));
+    if (geometry_objects)
+      geometry_objects->insert(geometry_objects->end(), n.objects.begin(), n.objects.end());
+    else
+      out.insert(out.end(), fallback_items_.begin() + std::ptrdiff_t(n.fallback_begin),
+                 fallback_items_.begin() + std::ptrdiff_t(n.fallback_end));
     ++st.geometry_nodes;
   };
   std::vector<RegenerationRequest> requests;

@@ -120,8 +120,13 @@ class ImageCache {
   // call repeats that frame's work (the same regenerations), so repeated timings of one frame time the same work.
   // With `occlusion`, the occluders are drawn through it before any regeneration, and `out` receives only what they
   // do not hide.
+  // With `geometry_objects` (a GPU-driven frame: gpu::GpuCuller culls and draws them), the geometry goes there as
+  // object ids (the near objects and those of the nodes drawn as geometry, unsorted) and `out` receives the images
+  // only; nothing is read back. The cost is still predicted from the frustum-culled items. Throws farfield::Error
+  // with both `occlusion` and `geometry_objects` (the GPU culler does the occlusion culling of such a frame).
   ImageCacheFrameStats frame(gpu::Renderer& renderer, const Camera& camera, size_t frame_index,
-                             std::vector<gpu::DrawItem>& out, const ImageCacheOcclusion* occlusion = nullptr);
+                             std::vector<gpu::DrawItem>& out, const ImageCacheOcclusion* occlusion = nullptr,
+                             std::vector<uint32_t>* geometry_objects = nullptr);
 
   size_t nodeCount() const { return nodes_.size(); }
   size_t textureBytes() const { return texture_bytes_; }
