@@ -125,8 +125,11 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
                   "per vertex, timed on the same frames");
   bench->add_flag("--gpu-crowd", o.gpu_crowd,
                   "Also crowd-geometry-gpu, crowd-impostor-gpu and crowd-mixed-gpu: the crowd simulated, culled, "
-                  "classified, drawn and shadowed on the GPU (--geometry-triangles and --blend-views hold there; "
-                  "--geometry-ms, --budget-coarsens and --skinned-lod not yet)");
+                  "classified, drawn and shadowed on the GPU (--geometry-triangles, --geometry-ms, --skinned-lod and "
+                  "--blend-views hold there; --budget-coarsens not yet)");
+  bench->add_flag("--city-cpu", o.city_cpu,
+                  "The city under the crowd culled on the CPU with its occluders' depth read back (the culled-cpu "
+                  "mode) instead of the GPU-driven frame (the culled mode; no wait in the frame)");
   bench->add_option("--skinned-lod", o.runtime.geometry_lod_px,
                     "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels "
                     "(0: the mesh)")

@@ -17,6 +17,7 @@
 #include "farfield/eval/gpu_crowd_input.h"
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/gpu_crowd.h"
+#include "farfield/gpu/gpu_culler.h"
 #include "farfield/eval/crowd_walk.h"
 #include "farfield/eval/frame_runner.h"
 #include "farfield/eval/mode.h"
@@ -105,7 +106,10 @@ namespace {
 std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOptions& options) {
   std::ostringstream md;
   md << "- city: generated, " << options.blocks << " blocks, detail " << options.detail << ", seed " << options.city_seed
-     << " (" << thousands(result.city_triangles) << " triangles, frustum, facing and occlusion culled in every mode)\n";
+     << " (" << thousands(result.city_triangles) << " triangles, drawn in every mode as "
+     << (options.city_cpu ? "culled-cpu draws it: frustum, facing and occlusion culled on the CPU, depth read back"
+                          : "culled draws it: the GPU-driven frame, no readback")
+     << ")\n";
   md << "- size " << options.width << "x" << options.height << ", " << options.frames << " measured frames per run (every "
      << options.frame_step << "th frame of a 30 fps street walk, seed " << options.path_seed << "), one warm-up frame"
      << (options.timing_passes > 1 ? ", each frame's time the fastest of " + std::to_string(options.timing_passes) +
@@ -330,6 +334,11 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
   const std::vector<ModeSpec> specs = modeSpecs(options.compare_skinning, options.gpu_crowd);
   const gpu::LightSettings light = renderer.light();
   gpu::installGlCounters();  // the crowd pass's own CPU time: its wall time less the time inside GL calls
+  std::unique_ptr<gpu::GpuCuller> city_gpu;
+  if (!options.city_cpu) {
+    city_gpu = std::make_unique<gpu::GpuCuller>(res.context.arena());
+    city_gpu->setAllObjects();
+  }
 
   for (const std::string& path_name : options.paths) {
     if (path_name != "pedestrian" && path_name != "elevated")
@@ -365,6 +374,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       std::vector<gpu::DrawItem> items;
       std::vector<Box3> item_bounds;
       gpu::OcclusionCuller city_culler;
+      if (city_gpu) city_gpu->resetHistory();  // a new walk: no clusters visible "last frame"
       const size_t sample_every = options.samples > 0 ? std::max<size_t>(1, options.frames / size_t(options.samples)) : 0;
       // Path frame k's camera, agents and city items.
       float frame_time = 0.0f;  // the path frame's time, seconds (the GPU crowd's simulation)
@@ -395,7 +405,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         Stopwatch clock;
         target.bindForOpaquePass();
         target.clear(light.sky_color);
-        city_culler.draw(renderer, camera, items, item_bounds, target);
+        if (city_gpu) city_gpu->draw(camera, target, gpu::RenderMode::Shaded, light);
+        else city_culler.draw(renderer, camera, items, item_bounds, target);
         rt.finish();
         const double city_ms = clock.milliseconds();
         runtime::CrowdRuntime& mode_rt = specs[m].palette && rt_palette ? *rt_palette : rt;

@@ -56,6 +56,9 @@ struct CrowdBenchOptions {
   // drawn on the GPU (gpu/gpu_crowd.h, runtime::CrowdRuntime::drawGpu and drawGpuShadowed; its simulation inside
   // the crowd pass's time), with shadows and agent_occlusion as the others, without budgets yet.
   bool gpu_crowd = false;
+  // The city under the crowd: the GPU-driven frame (gpu::GpuCuller over the city's arena, no readback), as the
+  // culled mode draws it; city_cpu: culled on the CPU with its occluders' depth read back (the culled-cpu mode).
+  bool city_cpu = false;
   std::string out_dir;
   int samples = 2;  // sample frames per run saved (reference, each mode, heat maps)
 };
