@@ -14,12 +14,14 @@
 #include <cstdio>
 #include <random>
 #include <set>
+#include <utility>
 #include <span>
 #include <variant>
 
 #include "farfield/core/error.h"
 #include "farfield/eval/parallax_error.h"
 #include "farfield/gen/city.h"
+#include "farfield/gpu/gpu_culler.h"
 #include "farfield/gpu/occlusion_culler.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/impostor/layered_fill.h"
@@ -210,6 +212,74 @@ TEST(PlaceTest, EveryViewKeepsBothPromisesWhereItsProblemWasSolved) {
   EXPECT_EQ(v.over_tolerance, 0u);
   std::printf("guarded views %zu, with impostors %zu, worst parallax p99 %.2f px\n", v.guarded, v.with_impostors,
               v.worst_parallax);
+}
+
+// A plan for a GPU-driven frame over the placement (geometry as objects): the region's visible set less what the
+// impostors drawn stand for, with no frustum query, culled and drawn by gpu::GpuCuller with the plan's impostors after
+// it, gives the frame of the plan's items (culled on the CPU) pixel for pixel; and its list changes only when the
+// region or the impostors drawn do, not as the camera turns or moves inside a region.
+TEST(PlaceTest, AGpuDrivenPlanListsItsRegionsObjectsAndDrawsTheSameFrame) {
+  const Placed& s = placed();
+  const scene::Scene& scene = s.city.scene;
+  gpu::sharedHeadlessContext().makeCurrent();
+  const gpu::GpuScene gpu_scene(scene);
+  const scene::Bvh bvh(scene);
+  const gpu::SceneArena arena(scene);
+  gpu::GpuCuller culler(arena);
+  gpu::Renderer renderer;
+  runtime::WalkthroughOptions options;
+  options.database = s.dir;
+  options.representation = runtime::Representation::Placed;
+  runtime::Walkthrough with_items(scene, gpu_scene, bvh, renderer, options);
+  options.geometry_items = false;
+  runtime::Walkthrough with_objects(scene, gpu_scene, bvh, renderer, options);
+  const store::PlacementIndex index = store::readPlacementIndex(s.dir);
+  const Box3 space = index.view_space;
+  gpu::RenderTarget target(128, 128), reference_target(128, 128);
+  uint64_t version = 0;
+  size_t list_changes = 0, key_changes = 0, impostor_frames = 0;
+  std::pair<uint32_t, std::vector<uint32_t>> last_key{~uint32_t(1), {}};  // no region has that index
+  const int frames = 120;
+  for (int f = 0; f < frames; ++f) {
+    SCOPED_TRACE("frame " + std::to_string(f));
+    // Across the view space at mid height, turning slowly.
+    const float t = float(f) / float(frames - 1);
+    Camera camera;
+    camera.eye = Vec3(space.lo.x + (space.hi.x - space.lo.x) * (0.1f + 0.8f * t), space.lo.y + 0.5f * (space.hi.y - space.lo.y),
+                      0.5f * (space.lo.z + space.hi.z));
+    const float yaw = 0.3f + 2.5f * t;
+    camera.at = camera.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
+    camera.width = camera.height = 128;
+    camera.fov_y = float(degToRad(45.0));
+    const runtime::FramePlan& a = with_items.plan(camera);
+    renderer.render(camera, a.items, reference_target);
+    const runtime::FramePlan& b = with_objects.plan(camera);
+    EXPECT_EQ(b.geometry_items, 0u);
+    EXPECT_TRUE(std::is_sorted(b.geometry_objects.begin(), b.geometry_objects.end()));
+    for (size_t i = 0; i < a.geometry_items; ++i)
+      EXPECT_TRUE(std::binary_search(b.geometry_objects.begin(), b.geometry_objects.end(), a.items[i].object_id));
+    ASSERT_EQ(b.items.size(), a.items.size() - a.geometry_items);  // the same impostors
+    impostor_frames += !b.items.empty();
+    list_changes += b.geometry_version != version;
+    version = b.geometry_version;
+    std::pair<uint32_t, std::vector<uint32_t>> key{store::lookupLeaf(index, camera.eye).value_or(~uint32_t(0)), {}};
+    for (const runtime::LayerDecision& d : b.layers)
+      if (const auto* i = std::get_if<runtime::ClusterAsImpostor>(&d)) key.second.push_back(i->impostor);
+    key_changes += key != last_key;
+    last_key = key;
+    culler.setObjects(b.geometry_objects);
+    target.bind();
+    target.clear(renderer.light().sky_color);
+    culler.draw(camera, target, gpu::RenderMode::Shaded, renderer.light());
+    renderer.draw(camera, b.items, target);
+    EXPECT_EQ(target.readIds().pixels(), reference_target.readIds().pixels());
+    EXPECT_EQ(target.readColor().pixels(), reference_target.readColor().pixels());
+  }
+  EXPECT_GT(impostor_frames, 0u);  // the walk draws impostors: the lists lose their objects
+  EXPECT_LE(list_changes, key_changes);
+  EXPECT_LT(list_changes, size_t(frames) / 4);
+  std::printf("%d frames: %zu list changes, %zu region or impostor changes, %zu frames with impostors\n", frames,
+              list_changes, key_changes, impostor_frames);
 }
 
 // The small city placed again with other candidate view cells (shafts and/or boxes) into a scratch folder.

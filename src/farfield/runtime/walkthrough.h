@@ -171,7 +171,9 @@ struct FramePlan {
   // Without geometry items (WalkthroughOptions::geometry_items false): the objects (ids, ascending) drawn as geometry,
   // those of the frame's view that no impostor stands for, for a GPU-driven frame to cull per cluster
   // (gpu::GpuCuller::setObjects). geometry_version changes exactly when the list does, so a frame that sees it
-  // unchanged sends nothing.
+  // unchanged sends nothing. Over a placement (Representation::Placed) the list is not frustum-culled: the eye's
+  // region's visible set (or every object) less what the impostors drawn stand for, so that it changes only when
+  // the region or the impostors drawn do; the GPU culls it by the frustum.
   std::vector<uint32_t> geometry_objects;
   uint64_t geometry_version = 0;
   std::vector<LayerDecision> layers;  // per layer of the current cell, or per impostor of the current CPV (Placed)
@@ -212,6 +214,8 @@ class Walkthrough {
   void dropStaleDynamic(const Camera& camera, Cell& cell);
   // The frame's geometry (ids_, ascending) into the plan: items culled per cluster, or the objects.
   void setGeometry(FramePlan& plan, const Camera& camera);
+  void setListedGeometry(FramePlan& plan, const std::vector<uint32_t>* base, uint32_t base_key,
+                         const std::vector<uint32_t>& drawn);  // walkthrough_placed.cpp
   void updateDynamic(const Camera& camera, Cell& cell, const std::function<void()>& before_gpu_work);
 
   const scene::Scene& scene_;

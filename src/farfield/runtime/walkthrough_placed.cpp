@@ -33,6 +33,36 @@ void Walkthrough::openPlacement() {
   p.hidden.assign(scene_.objects.size() + 1, 0);
 }
 
+// The plan's objects for a GPU-driven frame: the base list (a region's visible set, ascending; null: every object) less
+// the objects of the impostors drawn. Remade only when the base or the impostors drawn change (the key), so that a
+// frame in the same region with the same impostors costs nothing here and sends nothing (geometry_version unchanged).
+void Walkthrough::setListedGeometry(FramePlan& plan, const std::vector<uint32_t>* base, uint32_t base_key,
+                                    const std::vector<uint32_t>& drawn) {
+  Placed& p = *placed_;
+  if (p.listed_valid && p.listed_base == base_key && p.listed_drawn == drawn) {
+    plan.report.geometry_triangles = p.listed_triangles;
+    return;
+  }
+  p.listed_valid = true;
+  p.listed_base = base_key;
+  p.listed_drawn = drawn;
+  ids_.clear();
+  if (base) {
+    for (uint32_t id : *base)
+      if (!p.hidden[id]) ids_.push_back(id);
+  } else {
+    for (uint32_t id = 1; id <= uint32_t(scene_.objects.size()); ++id)
+      if (!p.hidden[id]) ids_.push_back(id);
+  }
+  p.listed_triangles = 0;
+  for (uint32_t id : ids_) p.listed_triangles += object_triangles_[id];
+  plan.report.geometry_triangles = p.listed_triangles;
+  if (ids_ != plan.geometry_objects) {
+    plan.geometry_objects.assign(ids_.begin(), ids_.end());
+    ++plan.geometry_version;
+  }
+}
+
 const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   Placed& p = *placed_;
   FramePlan& plan = plan_;
@@ -46,22 +76,30 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   const ErrorBound bound = ErrorBound::forCamera(options_.error_px, camera);
   report.bound_px = options_.error_px;
   report.bound_rad = bound.angle();
-  ids_.clear();
-  bvh_.queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
-  std::sort(ids_.begin(), ids_.end());
   // From-region visibility: where placement sampled what the region sees, only that is drawn (its times assumed it).
   const std::optional<uint32_t> leaf = store::lookupLeaf(p.index, camera.eye);
-  if (leaf) {
-    const store::StoredViewSpaceNode& node = p.index.nodes[*leaf];
-    if (node.has_visible) {
+  const store::StoredViewSpaceNode* visible =
+      leaf && p.index.nodes[*leaf].has_visible ? &p.index.nodes[*leaf] : nullptr;
+  if (visible) ++p.stats.visibility_frames;
+  // A GPU-driven frame (geometry as objects) culls by the frustum itself: its objects are the region's visible set, or
+  // every object, with no frustum query here, so that the list changes only when the region or the impostors drawn
+  // do. Geometry items are culled here: the objects in the frustum (and in the visible set).
+  const bool listed = !options_.geometry_items;
+  ids_.clear();
+  if (!listed) {
+    bvh_.queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
+    std::sort(ids_.begin(), ids_.end());
+    if (visible)
       ids_.erase(std::remove_if(ids_.begin(), ids_.end(),
                                 [&](uint32_t id) {
-                                  return !std::binary_search(node.visible.begin(), node.visible.end(), id);
+                                  return !std::binary_search(visible->visible.begin(), visible->visible.end(), id);
                                 }),
                  ids_.end());
-      ++p.stats.visibility_frames;
-    }
   }
+  const auto drawable = [&](uint32_t id) {
+    if (!listed) return std::binary_search(ids_.begin(), ids_.end(), id);
+    return !visible || std::binary_search(visible->visible.begin(), visible->visible.end(), id);
+  };
 
   const std::optional<uint32_t> cpv =
       leaf ? store::cpvInLeaf(p.index, *leaf, camera.eye, camera.forward()) : std::nullopt;
@@ -75,7 +113,7 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
     const auto leaveToGeometry = [&](uint32_t id, const store::StoredPlacedImpostor& record) {
       ClusterAsGeometry g{id, 0};
       for (uint32_t o : record.objects)
-        if (std::binary_search(ids_.begin(), ids_.end(), o)) g.triangles += object_triangles_[o];
+        if (drawable(o)) g.triangles += object_triangles_[o];
       plan.layers.push_back(g);
       ++report.layers_as_geometry;
     };
@@ -127,11 +165,14 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
       }
     }
   }
-  // Geometry: every object in the frustum that no impostor of this frame stands for.
-  ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [&](uint32_t id) { return p.hidden[id] != 0; }), ids_.end());
-  // The geometry items come first, with their bounds, so an engine can occlusion-cull them (gpu::OcclusionCuller);
-  // or the objects, for a GPU-driven frame.
-  setGeometry(plan, camera);
+  // Geometry: every object in the frustum (or, listed, in the region) that no impostor of this frame stands for.
+  if (listed) {
+    setListedGeometry(plan, visible ? &visible->visible : nullptr, visible ? *leaf : ~uint32_t(0), drawn);
+  } else {
+    ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [&](uint32_t id) { return p.hidden[id] != 0; }), ids_.end());
+    // The geometry items come first, with their bounds, so an engine can occlusion-cull them (gpu::OcclusionCuller).
+    setGeometry(plan, camera);
+  }
   for (uint32_t id : drawn) {
     const Placed::Resident& r = p.resident.at(id);
     r.gpu->appendDrawItems(plan.items);
