@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <utility>
+
 #include <algorithm>
 #include <variant>
 
@@ -101,7 +104,8 @@ TEST_F(WalkthroughTest, WhereNoImpostorIsValidThePlanIsTheGeometryOfTheCell) {
 
 // A plan for a GPU-driven frame (geometry_items false) lists its geometry as objects: drawn by gpu::GpuCuller over
 // the scene's arena, then its impostors, every frame equals the frame of the plan's items (geometry culled on the
-// CPU), the impostors included; the list's version changes exactly when the list does.
+// CPU), the impostors included; the list's version changes exactly when the list does, and the list only when the
+// cell or its layers drawn as geometry do (no frustum query: the GPU culls it).
 TEST_F(WalkthroughTest, APlansGeometryObjectsDrawnOnTheGpuEqualItsItems) {
   const BakedCity& s = bakedCity();
   const scene::Scene& scene = s.city.scene;
@@ -120,7 +124,8 @@ TEST_F(WalkthroughTest, APlansGeometryObjectsDrawnOnTheGpuEqualItsItems) {
     Walkthrough with_objects(scene, gpu_scene, bvh, renderer, options);
     std::vector<uint32_t> last;
     uint64_t version = 0;
-    size_t impostor_items = 0;
+    size_t impostor_items = 0, list_changes = 0, key_changes = 0;
+    std::pair<uint32_t, std::vector<uint32_t>> last_key{~uint32_t(1), {}};
     for (size_t f = 0; f < s.path.frames.size(); ++f) {
       const Camera camera = s.path.camera(f, 160, 96);
       const FramePlan& a = with_items.plan(camera);
@@ -129,7 +134,13 @@ TEST_F(WalkthroughTest, APlansGeometryObjectsDrawnOnTheGpuEqualItsItems) {
       EXPECT_EQ(b.geometry_items, 0u);
       EXPECT_TRUE(std::is_sorted(b.geometry_objects.begin(), b.geometry_objects.end()));
       EXPECT_EQ(b.geometry_version != version, b.geometry_objects != last) << "frame " << f;
+      list_changes += b.geometry_version != version;
       version = b.geometry_version;
+      std::pair<uint32_t, std::vector<uint32_t>> key{b.report.cell, {}};
+      for (const LayerDecision& d : b.layers)
+        if (const auto* g = std::get_if<LayerAsGeometry>(&d)) key.second.push_back(g->layer);
+      key_changes += key != last_key;
+      last_key = key;
       last = b.geometry_objects;
       // Every object the items draw is listed.
       for (size_t i = 0; i < a.geometry_items; ++i)
@@ -143,10 +154,20 @@ TEST_F(WalkthroughTest, APlansGeometryObjectsDrawnOnTheGpuEqualItsItems) {
       renderer.draw(camera, b.items, target);
       EXPECT_EQ(target.readIds().pixels(), reference_target.readIds().pixels()) << "frame " << f;
       EXPECT_EQ(target.readColor().pixels(), reference_target.readColor().pixels()) << "frame " << f;
+      // Then the same view with a near far plane sees fewer objects in its frustum, and the same cell and layers: the
+      // same list (the GPU culls by the frustum), not another.
+      Camera shallow = camera;
+      shallow.far_plane = 20.0f;
+      const uint64_t before = b.geometry_version;
+      EXPECT_EQ(with_objects.plan(shallow).geometry_version, before) << "frame " << f;
     }
     if (error_px == 0.0) {
       EXPECT_GT(impostor_items, 0u);
     }
+    EXPECT_LE(list_changes, key_changes);
+    EXPECT_LT(key_changes, s.path.frames.size());  // not vacuous: frames that keep their cell and layers
+    std::printf("%zu frames, %zu list changes, %zu cell or layer changes\n", s.path.frames.size(), list_changes,
+                key_changes);
   }
 }
 

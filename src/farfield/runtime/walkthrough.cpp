@@ -177,6 +177,8 @@ std::unique_ptr<Walkthrough::Cell> Walkthrough::loadCell(const store::CellEntry&
   cell->geometry_mask.assign(scene_.objects.size() + 1, 0);
   const std::vector<uint32_t>& geometry = kind == Representation::Visible ? record.pvs : record.near;
   for (uint32_t id : geometry) cell->geometry_mask[id] = 1;
+  for (uint32_t id = 1; id < uint32_t(cell->geometry_mask.size()); ++id)
+    if (cell->geometry_mask[id]) cell->geometry.push_back(id);
   if (kind == Representation::Local || kind == Representation::Visible) return cell;
 
   impostor::GpuImpostorOptions gpu_options;
@@ -276,6 +278,27 @@ void Walkthrough::setGeometry(FramePlan& plan, const Camera& camera) {
   for (uint32_t id : ids_) plan.report.geometry_triangles += object_triangles_[id];
 }
 
+bool Walkthrough::listedUnchanged(FramePlan& plan, uint64_t base, const std::vector<uint32_t>& extra) {
+  if (listed_.valid && listed_.base == base && listed_.extra == extra) {
+    plan.report.geometry_triangles = listed_.triangles;
+    return true;
+  }
+  listed_.valid = true;
+  listed_.base = base;
+  listed_.extra = extra;
+  return false;
+}
+
+void Walkthrough::setListed(FramePlan& plan) {
+  listed_.triangles = 0;
+  for (uint32_t id : ids_) listed_.triangles += object_triangles_[id];
+  plan.report.geometry_triangles = listed_.triangles;
+  if (ids_ != plan.geometry_objects) {
+    plan.geometry_objects.assign(ids_.begin(), ids_.end());
+    ++plan.geometry_version;
+  }
+}
+
 const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<void()>& before_gpu_work) {
   if (placed_) return planPlaced(camera);
   FramePlan& plan = plan_;
@@ -293,9 +316,13 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   const ErrorBound bound = ErrorBound::forCamera(options_.error_px, camera);
   report.bound_px = options_.error_px;
   report.bound_rad = bound.angle();
-  const Frustum frustum = Frustum::fromMatrix(camera.viewProjection());
+  // A GPU-driven frame (geometry as objects) culls by the frustum itself: its list is the cell's geometry and the
+  // objects of its layers drawn as geometry, with no frustum query here (but for MmiDynamic, whose budget predicts
+  // from the frustum's triangles), remade only when the cell or those layers change.
+  const bool listed = !options_.geometry_items && options_.representation != Representation::MmiDynamic;
+  bool listed_unchanged = false;
   ids_.clear();
-  bvh_.queryFrustum(frustum, ids_);
+  if (!listed) bvh_.queryFrustum(Frustum::fromMatrix(camera.viewProjection()), ids_);
   Cell* current = nullptr;
   if (entry) {
     ++stats_.visited[half_edge];
@@ -334,21 +361,43 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
       ++report.layers_as_geometry;
       for (uint32_t id : layer.objects) invalid_object_[id] = 1;
     }
-    // Geometry: the cell's near objects and the objects of layers drawn as geometry, in the frustum.
-    ids_.erase(std::remove_if(ids_.begin(), ids_.end(),
-                              [&](uint32_t id) { return !current->geometry_mask[id] && !invalid_object_[id]; }),
-               ids_.end());
-    std::sort(ids_.begin(), ids_.end());
+    // Geometry: the cell's near objects and the objects of layers drawn as geometry, in the frustum (or listed).
+    if (listed) {
+      listed_extra_.clear();
+      for (const LayerDecision& decision : plan.layers)
+        if (const auto* g = std::get_if<LayerAsGeometry>(&decision)) listed_extra_.push_back(g->layer);
+      listed_unchanged = listedUnchanged(plan, half_edge, listed_extra_);
+      if (!listed_unchanged) {
+        ids_ = current->geometry;
+        for (const LayerDecision& decision : plan.layers)
+          if (const auto* g = std::get_if<LayerAsGeometry>(&decision))
+            for (uint32_t id : current->layers[g->layer].objects)
+              if (!current->geometry_mask[id]) ids_.push_back(id);
+        std::sort(ids_.begin(), ids_.end());
+        ids_.erase(std::unique(ids_.begin(), ids_.end()), ids_.end());
+      }
+    } else {
+      ids_.erase(std::remove_if(ids_.begin(), ids_.end(),
+                                [&](uint32_t id) { return !current->geometry_mask[id] && !invalid_object_[id]; }),
+                 ids_.end());
+      std::sort(ids_.begin(), ids_.end());
+    }
     for (LayerDecision& decision : plan.layers)
       if (auto* g = std::get_if<LayerAsGeometry>(&decision)) {
         for (uint32_t id : current->layers[g->layer].objects) {
-          if (invalid_object_[id] && std::binary_search(ids_.begin(), ids_.end(), id))
+          if (invalid_object_[id] && (listed || std::binary_search(ids_.begin(), ids_.end(), id)))
             g->triangles += object_triangles_[id];
           invalid_object_[id] = 0;
         }
       }
   } else {
     ++stats_.fallback_frames;  // not baked: everything in the frustum, as the culled mode
+    if (listed) {
+      listed_extra_.clear();
+      listed_unchanged = listedUnchanged(plan, ~uint64_t(0), listed_extra_);
+      if (!listed_unchanged)
+        for (uint32_t id = 1; id <= uint32_t(scene_.objects.size()); ++id) ids_.push_back(id);
+    }
   }
   report.resident_bytes = resident_bytes_;
   report.read_ahead_bytes = reader_ ? reader_->heldBytes() : 0;
@@ -364,8 +413,12 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   report.over_gpu_budget = resident_bytes_ > options_.gpu_budget_bytes;
   stats_.resident_bytes_max = std::max(stats_.resident_bytes_max, resident_bytes_);
   if (report.over_gpu_budget) ++stats_.over_gpu_budget_frames;
-  std::sort(ids_.begin(), ids_.end());
-  setGeometry(plan, camera);
+  if (!listed) {
+    std::sort(ids_.begin(), ids_.end());
+    setGeometry(plan, camera);
+  } else if (!listed_unchanged) {
+    setListed(plan);
+  }
   stats_.geometry_triangles += double(report.geometry_triangles);
   if (report.layers_as_geometry > 0) ++stats_.invalid_frames;
   stats_.invalid_layer_draws += report.layers_as_geometry;

@@ -171,9 +171,11 @@ struct FramePlan {
   // Without geometry items (WalkthroughOptions::geometry_items false): the objects (ids, ascending) drawn as geometry,
   // those of the frame's view that no impostor stands for, for a GPU-driven frame to cull per cluster
   // (gpu::GpuCuller::setObjects). geometry_version changes exactly when the list does, so a frame that sees it
-  // unchanged sends nothing. Over a placement (Representation::Placed) the list is not frustum-culled: the eye's
-  // region's visible set (or every object) less what the impostors drawn stand for, so that it changes only when
-  // the region or the impostors drawn do; the GPU culls it by the frustum.
+  // unchanged sends nothing. The list is not frustum-culled (the GPU culls it by the frustum), so that it changes
+  // only when the plan does: over a placement (Representation::Placed), the eye's region's visible set (or every
+  // object) less what the impostors drawn stand for; over cells, the cell's geometry and the objects of its layers
+  // drawn as geometry (every object outside the baked cells). MmiDynamic keeps the frustum's objects, whose triangles
+  // its budget predicts from.
   std::vector<uint32_t> geometry_objects;
   uint64_t geometry_version = 0;
   std::vector<LayerDecision> layers;  // per layer of the current cell, or per impostor of the current CPV (Placed)
@@ -214,8 +216,20 @@ class Walkthrough {
   void dropStaleDynamic(const Camera& camera, Cell& cell);
   // The frame's geometry (ids_, ascending) into the plan: items culled per cluster, or the objects.
   void setGeometry(FramePlan& plan, const Camera& camera);
-  void setListedGeometry(FramePlan& plan, const std::vector<uint32_t>* base, uint32_t base_key,
-                         const std::vector<uint32_t>& drawn);  // walkthrough_placed.cpp
+  // A GPU-driven frame's list without a frustum query (geometry_items false): remade only when its key changes, the
+  // base (a cell, a region; ~0 = every object) and what else decides it (the layers drawn as geometry, the impostors
+  // drawn). listedUnchanged() is true, with the report's triangles set, when the key is the last one; otherwise it
+  // keeps the key, and the caller makes ids_ (ascending) and calls setListed().
+  bool listedUnchanged(FramePlan& plan, uint64_t base, const std::vector<uint32_t>& extra);
+  void setListed(FramePlan& plan);
+  struct Listed {
+    bool valid = false;
+    uint64_t base = 0;
+    std::vector<uint32_t> extra;
+    uint64_t triangles = 0;
+  };
+  Listed listed_;
+  std::vector<uint32_t> listed_extra_;  // this frame's key (scratch)
   void updateDynamic(const Camera& camera, Cell& cell, const std::function<void()>& before_gpu_work);
 
   const scene::Scene& scene_;

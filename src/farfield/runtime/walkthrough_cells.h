@@ -35,6 +35,7 @@ struct Walkthrough::Layer {
 
 struct Walkthrough::Cell {
   std::vector<uint8_t> geometry_mask;  // per object id: always drawn as geometry with this cell
+  std::vector<uint32_t> geometry;      // the same objects, ascending (a GPU-driven frame's list)
   std::vector<Layer> layers;           // MMI layers, or the single mesh as one layer (Smi)
   bool online = false;                 // stages run at load time
   uint64_t gpu_bytes = 0;              // of its impostors

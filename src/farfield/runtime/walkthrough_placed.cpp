@@ -33,36 +33,6 @@ void Walkthrough::openPlacement() {
   p.hidden.assign(scene_.objects.size() + 1, 0);
 }
 
-// The plan's objects for a GPU-driven frame: the base list (a region's visible set, ascending; null: every object) less
-// the objects of the impostors drawn. Remade only when the base or the impostors drawn change (the key), so that a
-// frame in the same region with the same impostors costs nothing here and sends nothing (geometry_version unchanged).
-void Walkthrough::setListedGeometry(FramePlan& plan, const std::vector<uint32_t>* base, uint32_t base_key,
-                                    const std::vector<uint32_t>& drawn) {
-  Placed& p = *placed_;
-  if (p.listed_valid && p.listed_base == base_key && p.listed_drawn == drawn) {
-    plan.report.geometry_triangles = p.listed_triangles;
-    return;
-  }
-  p.listed_valid = true;
-  p.listed_base = base_key;
-  p.listed_drawn = drawn;
-  ids_.clear();
-  if (base) {
-    for (uint32_t id : *base)
-      if (!p.hidden[id]) ids_.push_back(id);
-  } else {
-    for (uint32_t id = 1; id <= uint32_t(scene_.objects.size()); ++id)
-      if (!p.hidden[id]) ids_.push_back(id);
-  }
-  p.listed_triangles = 0;
-  for (uint32_t id : ids_) p.listed_triangles += object_triangles_[id];
-  plan.report.geometry_triangles = p.listed_triangles;
-  if (ids_ != plan.geometry_objects) {
-    plan.geometry_objects.assign(ids_.begin(), ids_.end());
-    ++plan.geometry_version;
-  }
-}
-
 const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   Placed& p = *placed_;
   FramePlan& plan = plan_;
@@ -167,7 +137,18 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   }
   // Geometry: every object in the frustum (or, listed, in the region) that no impostor of this frame stands for.
   if (listed) {
-    setListedGeometry(plan, visible ? &visible->visible : nullptr, visible ? *leaf : ~uint32_t(0), drawn);
+    // The region's visible set (or every object) less the impostors' objects; remade when either changes.
+    if (!listedUnchanged(plan, visible ? uint64_t(*leaf) : ~uint64_t(0), drawn)) {
+      ids_.clear();
+      if (visible) {
+        for (uint32_t id : visible->visible)
+          if (!p.hidden[id]) ids_.push_back(id);
+      } else {
+        for (uint32_t id = 1; id <= uint32_t(scene_.objects.size()); ++id)
+          if (!p.hidden[id]) ids_.push_back(id);
+      }
+      setListed(plan);
+    }
   } else {
     ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [&](uint32_t id) { return p.hidden[id] != 0; }), ids_.end());
     // The geometry items come first, with their bounds, so an engine can occlusion-cull them (gpu::OcclusionCuller).

@@ -25,12 +25,6 @@ struct Walkthrough::Placed {
   std::list<uint32_t> lru;                          // most recent first
   uint64_t resident_bytes = 0;
   std::vector<uint8_t> hidden;                      // per object id: drawn by an impostor this frame
-  // The last listed geometry (Walkthrough::setListedGeometry): its base (leaf, ~0 = every object), the impostors
-  // drawn, and its objects' triangles.
-  bool listed_valid = false;
-  uint32_t listed_base = 0;
-  std::vector<uint32_t> listed_drawn;
-  uint64_t listed_triangles = 0;
   struct {
     size_t frames = 0, cpv_frames = 0, visibility_frames = 0, impostor_draws = 0, geometry_fallbacks = 0, loads = 0, evictions = 0;
     double load_ms_total = 0.0, load_ms_max = 0.0, geometry_triangles = 0.0, impostor_quads = 0.0;
