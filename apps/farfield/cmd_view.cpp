@@ -82,12 +82,18 @@ const RegisterCommand reg("view", [](CLI::App& app) {
   cmd->add_flag("--tint", o.tint, "Tint impostors by kind");
   cmd->add_flag("--check-every-frame", o.check_every_frame, "Compare every frame with full geometry (slow)");
   cmd->add_option("--terrain", o.terrain,
-                  "Terrain under the city in full and culled, drawn by LOD-sprite: the DEM or fractal:... the city was "
-                  "made on (gen city --terrain)");
+                  "Terrain under the city in full and culled (drawn by --terrain-technique): the DEM or fractal:... "
+                  "the city was made on (gen city --terrain)");
   cmd->add_option("--terrain-scale", o.terrain_scale, "Vertical scale the city was made with (gen city --terrain-scale)")
       ->capture_default_str();
-  cmd->add_flag("--terrain-gpu", o.terrain_gpu,
-                "Draw the terrain by CDLOD on the GPU (high-gpu: no per-frame CPU mesh) instead of LOD-sprite");
+  cmd->add_option("--terrain-technique", o.terrain_technique,
+                  "How the terrain is drawn: lod-sprite-gpu (LOD-sprite over CDLOD keyframes on the GPU), high-gpu "
+                  "(CDLOD at 1 px), lod-sprite or high (the quadtree LOD remade on the CPU every frame)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"lod-sprite-gpu", "high-gpu", "lod-sprite", "high"}));
+  cmd->add_flag_callback(
+      "--terrain-gpu", [args] { args->options.terrain_technique = "high-gpu"; },
+      "The same as --terrain-technique high-gpu");
   cmd->add_option("--crowd", o.crowd.agents,
                   "Agents walking the sidewalks of the street graph, drawn over every mode as crowd-mixed (0: none)")
       ->capture_default_str();

@@ -71,8 +71,9 @@ if(EXISTS ${WORK}/shots/frame_1.png)
   message(FATAL_ERROR "farfield view wrote frame_1.png, which --screenshot-at did not ask for")
 endif()
 
-# A city on a terrain, the terrain drawn under it (LOD-sprite) in culled: the frame differs from the city alone; a
-# wrong vertical scale is refused (the city's ground would not lie on the terrain).
+# A city on a terrain, the terrain drawn under it (LOD-sprite over CDLOD keyframes on the GPU, the default) in culled:
+# the frame differs from the city alone; a wrong vertical scale is refused (the city's ground would not lie on the
+# terrain).
 set(terrain fractal:129:5:relief=300)
 run_ok(${FARFIELD} gen city --blocks 12 --seed 3 --detail 0 --terrain ${terrain} --terrain-scale 0.5
        -o ${WORK}/tc.glb)
@@ -84,13 +85,18 @@ run_ok(${FARFIELD} diff ${WORK}/tc_alone/frame_0.png ${WORK}/tc_terrain/frame_0.
 if(LAST_OUT MATCHES "identical")
   message(FATAL_ERROR "farfield view --terrain drew the same frame as without the terrain:\n${LAST_OUT}")
 endif()
-# The same terrain drawn by CDLOD on the GPU (--terrain-gpu): a terrain is drawn too, close to LOD-sprite's.
-run_ok(${FARFIELD} view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_terrain_gpu --terrain ${terrain} --terrain-scale 0.5
-       --terrain-gpu)
-run_ok(${FARFIELD} diff ${WORK}/tc_alone/frame_0.png ${WORK}/tc_terrain_gpu/frame_0.png)
-if(LAST_OUT MATCHES "identical")
-  message(FATAL_ERROR "farfield view --terrain-gpu drew the same frame as without the terrain:\n${LAST_OUT}")
-endif()
+# The same terrain drawn by the other techniques (CDLOD at 1 px on the GPU, LOD-sprite over the quadtree LOD on the
+# CPU): a terrain is drawn too.
+foreach(technique high-gpu lod-sprite)
+  run_ok(${FARFIELD} view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_terrain_${technique} --terrain ${terrain}
+         --terrain-scale 0.5 --terrain-technique ${technique})
+  run_ok(${FARFIELD} diff ${WORK}/tc_alone/frame_0.png ${WORK}/tc_terrain_${technique}/frame_0.png)
+  if(LAST_OUT MATCHES "identical")
+    message(FATAL_ERROR "farfield view --terrain-technique ${technique} drew the same frame as without the terrain:\n${LAST_OUT}")
+  endif()
+endforeach()
+expect_error("--terrain-technique" view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_bad --terrain ${terrain}
+             --terrain-scale 0.5 --terrain-technique clipmap)
 expect_error("gen city --terrain" view ${WORK}/tc.glb ${tc_script} -o ${WORK}/tc_bad --terrain ${terrain}
              --terrain-scale 2)
 

@@ -97,7 +97,7 @@ void ModeRenderer::select(const std::string& mode) {
                                          "(local, visible, smi, mmi, mmi-dynamic, placed)");
     std::unique_ptr<eval::Mode> created;
     if (settings_.terrain.empty()) created = eval::createMode(mode, context_);
-    else created = std::make_unique<eval::CityOnTerrainMode>(settings_.terrain_gpu ? "high-gpu" : "lod-sprite", mode);
+    else created = std::make_unique<eval::CityOnTerrainMode>(settings_.terrain_technique, mode);
     created->prepare(context_);
     eval_mode_ = std::move(created);
     walkthrough_.reset();

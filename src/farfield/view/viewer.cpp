@@ -101,7 +101,7 @@ class Viewer {
     settings.error_px = options_.error_px;
     settings.terrain = options_.terrain;
     settings.terrain_scale = options_.terrain_scale;
-    settings.terrain_gpu = options_.terrain_gpu;
+    settings.terrain_technique = options_.terrain_technique;
     panel_.gpu_budget_bytes = settings.gpu_budget_bytes;
     modes_ = std::make_unique<ModeRenderer>(scene_, gpu_scene_, bvh_, renderer_, target_, settings);
     selectMode(options_.mode.empty() ? defaultMode(database_) : options_.mode);
@@ -419,6 +419,9 @@ void checkViewerOptions(const ViewerOptions& o) {
   if (!o.path.empty() && !o.replay.empty()) throw Error("--path/--replay", "give one camera path, not both");
   if (!(o.terrain_scale > 0.0f) || !std::isfinite(o.terrain_scale))
     throw Error("--terrain-scale", "must be a finite number > 0");
+  if (o.terrain_technique != "lod-sprite-gpu" && o.terrain_technique != "high-gpu" &&
+      o.terrain_technique != "lod-sprite" && o.terrain_technique != "high")
+    throw Error("--terrain-technique", "'" + o.terrain_technique + "' is not lod-sprite-gpu, high-gpu, lod-sprite or high");
   if (!o.screenshot_at.empty() && o.out_dir.empty()) throw Error("--screenshot-at", "needs -o DIR");
   if (o.exit_at_end && o.replay.empty() && o.screenshot_at.empty())
     throw Error("--exit", "needs --replay or --screenshot-at (otherwise nothing would be shown)");

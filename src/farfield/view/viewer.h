@@ -41,7 +41,9 @@ struct ViewerOptions {
   Navigation navigation = Navigation::Fly;
   std::string terrain;             // a terrain under the city in full and culled (DEM file or fractal:...; "" = none)
   float terrain_scale = 1.0f;      // the vertical scale the city was made with (gen city --terrain-scale)
-  bool terrain_gpu = false;        // the terrain drawn by CDLOD on the GPU (high-gpu) instead of LOD-sprite
+  // How the terrain is drawn (eval/city_on_terrain_mode.h): lod-sprite-gpu (LOD-sprite over CDLOD keyframes, no
+  // per-frame CPU mesh; the default), high-gpu (CDLOD at 1 px), lod-sprite or high (the quadtree LOD on the CPU).
+  std::string terrain_technique = "lod-sprite-gpu";
   // A crowd on the street graph's sidewalks, drawn over every mode's frame (viewer_crowd.h; crowd.agents 0: none).
   // Its time follows the display (a replay: 30 frames a second of the path).
   ViewerCrowdOptions crowd;
