@@ -18,7 +18,13 @@
 #   terrain  the terrain LODs at 1920x1080, 600-frame flythroughs: the quadtree LOD (high, low, lod-sprite) against
 #            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu[-predict]) on the shared DEM (.gpu/data/terrain/*.tif, when
 #            carried) and on the 8,193^2 fractal
+#   makedemo (not in the default) the demo's main job, scripts/demo.sh at its 640x360: t_max from this machine,
+#            impostors placed, full, culled, placed and governed against reference frames; its verdict (issues 43, 46)
+#   dynamic  (not in the default) the image-cache modes (dynamic-shade, dynamic-schaufler, layered) with their
+#            geometry through the GPU-driven frame and through the CPU's occlusion culling (a readback a frame),
+#            scripts/bench_dynamic_budget.sh's city and forest at 640x360, t_max 50 ms
 set -uo pipefail
+ROOT=$PWD
 STAGES=${STAGES:-smoke heldout big demo check terrain crowd}
 DATA=$PWD/.gpu/data
 OUTD=${OUT:-/tmp/out}
@@ -159,5 +165,22 @@ if [[ " $STAGES " == *" crowd "* ]]; then
   echo "rc $?"
   grep -E "^\| [0-9]|^- [0-9]" $C/budget/crowd.md | head -40
   keep crowd $C/bench/crowd.json $C/bench/crowd.md $C/bench.txt $C/budget/crowd.json $C/budget/crowd.md $C/budget.txt
+fi
+if [[ " $STAGES " == *" makedemo "* ]]; then
+  say "makedemo: scripts/demo.sh, 640x360"
+  timeout 900 bash "$ROOT/scripts/demo.sh" $FF $W/makedemo > makedemo.txt 2>&1
+  echo "rc $?"
+  grep -E "frames over t_max|impostors placed|relaxed|t_max:" makedemo.txt | head -8
+  summ makedemo/bench.json
+  keep makedemo makedemo/bench.json makedemo/frames.csv makedemo/report.md makedemo/*.txt makedemo.txt
+fi
+if [[ " $STAGES " == *" dynamic "* ]]; then
+  say "dynamic: the image-cache modes, geometry on the GPU and on the CPU, 640x360"
+  timeout 600 bash "$ROOT/scripts/bench_dynamic_budget.sh" $FF $W/dynamic 50 40 3 > dynamic.txt 2>&1
+  echo "rc $?"
+  GEOMETRY=cpu timeout 600 bash "$ROOT/scripts/bench_dynamic_budget.sh" $FF $W/dynamic 50 40 3 >> dynamic.txt 2>&1
+  echo "rc $?"
+  summ dynamic/bench-*/bench.json
+  keep dynamic dynamic/bench-*/bench.json dynamic/bench-*/frames.csv dynamic/*.txt dynamic.txt
 fi
 say "done"
