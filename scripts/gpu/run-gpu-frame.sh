@@ -67,6 +67,10 @@ for p in sys.argv[1:]:
         keys = ["median_ms", "p99_ms", "gpu_median_ms", "cpu_median_ms", "cpu_p95_ms", "mean_draw_calls",
                 "mean_gl_calls", "mean_upload_bytes", "mean_syncs", "mean_triangles", "psnr_db_min"]
         print("  ", name, {k: m.get(k) for k in keys if k in m})
+        stages = {k[10:-3]: round(v, 3) for k, v in m.get("info", {}).items()
+                  if k.startswith("gpu_stage_") and k.endswith("_ms")}
+        if stages:
+            print("     GPU ms per stage:", stages)
 PY
 }
 bench3() {  # bench3 DIR SIZE STRIDE [FRAMES]: frustum, culled-cpu, culled on DIR/city.glb along DIR/path.json
@@ -75,6 +79,11 @@ bench3() {  # bench3 DIR SIZE STRIDE [FRAMES]: frustum, culled-cpu, culled on DI
     --stride "$stride" --frames "$frames" -o $d/bench > $d/bench.txt 2>&1
   echo "rc $?"
   summ $d/bench/bench.json
+  # Where culled's GPU time goes (timestamp queries between its stages, read late; no wait on a GPU).
+  timeout 200 $FF bench $d/city.glb --path $d/path.json --modes culled --mode-option gpu_stage_times=on \
+    --size "$size" --stride "$stride" --frames 60 -o $d/stages > $d/stages.txt 2>&1
+  echo "rc $?"
+  summ $d/stages/bench.json
 }
 say "machine"
 nvidia-smi -L
@@ -103,7 +112,7 @@ fi
 if [[ " $STAGES " == *" heldout "* ]]; then
   say "heldout: 400 blocks, detail 3, 1920x1080"
   bench3 $H 1920x1080 1
-  keep heldout $H/bench/bench.json $H/bench/frames.csv $H/*.txt
+  keep heldout $H/bench/bench.json $H/bench/frames.csv $H/stages/bench.json $H/*.txt
 fi
 
 if [[ " $STAGES " == *" big "* ]]; then
@@ -113,7 +122,7 @@ if [[ " $STAGES " == *" big "* ]]; then
   timeout 300 $FF gen city --blocks 100000 --detail 0 --seed 3 -o $B/city.glb > $B/gen.txt 2>&1
   $FF path street $B/city.streets.json --frames 300 --seed 41 --car --fov 60 -o $B/path.json > /dev/null 2>&1
   bench3 $B 1920x1080 2 150
-  keep big $B/bench/bench.json $B/bench/frames.csv $B/*.txt
+  keep big $B/bench/bench.json $B/bench/frames.csv $B/stages/bench.json $B/*.txt
 fi
 
 if [[ " $STAGES " == *" demo "* ]]; then
@@ -123,7 +132,7 @@ if [[ " $STAGES " == *" demo "* ]]; then
   timeout 120 $FF gen city --blocks 400 --detail 2 --seed 1 --objects buildings -o $D/city.glb > $D/gen.txt 2>&1
   $FF path street $D/city.streets.json --frames 300 --seed 1 --car --fov 60 -o $D/path.json > /dev/null 2>&1
   bench3 $D 640x360 1
-  keep demo $D/bench/bench.json $D/bench/frames.csv $D/*.txt
+  keep demo $D/bench/bench.json $D/bench/frames.csv $D/stages/bench.json $D/*.txt
 fi
 
 if [[ " $STAGES " == *" check "* ]]; then

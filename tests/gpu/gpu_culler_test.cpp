@@ -294,6 +294,43 @@ TEST_F(GpuCullerTest, AFrameWaitsForNothingAndDrawsOncePerMaterialGroupAndPhase)
   EXPECT_EQ((glCounters() - glCounters()).syncs, 0u);
 }
 
+// With stage times, the frames are the same, and each frame's GPU time comes back split into its stages: the
+// multi-draws of a frame that draws take time, and so do the culling passes; without occlusion the pyramid, the
+// second phase and the history take none.
+TEST_F(GpuCullerTest, StageTimesSplitTheFramesWorkWithoutChangingIt) {
+  for (const bool occlusion : {true, false}) {
+    SCOPED_TRACE(occlusion ? "occlusion" : "no occlusion");
+    GpuCullOptions options;
+    options.occlusion = occlusion;
+    GpuCuller plain(*arena_, options);
+    options.stage_times = true;
+    GpuCuller timed(*arena_, options);
+    EXPECT_TRUE(plain.finishedStageTimes().empty());
+    std::array<double, kGpuCullStages.size()> sum{};
+    size_t frames = 0;
+    for (const Camera& camera : walk(4, 6)) {
+      culled(plain, camera, RenderMode::Shaded);
+      const image::ColorImage want = target_.readColor();
+      culled(timed, camera, RenderMode::Shaded);
+      EXPECT_TRUE(target_.readColor().pixels() == want.pixels());
+      glFinish();
+      for (const GpuStageTimes& t : timed.finishedStageTimes()) {
+        for (size_t i = 0; i < t.ms.size(); ++i) sum[i] += t.ms[i];
+        ++frames;
+      }
+    }
+    EXPECT_EQ(frames, 6u);
+    EXPECT_GT(sum[0], 0.0);  // the first (or only) phase's culling
+    EXPECT_GT(sum[1], 0.0);  // its multi-draws
+    if (occlusion) {
+      EXPECT_GT(sum[2], 0.0);  // the pyramid
+      EXPECT_GT(sum[4], 0.0);
+    } else {
+      for (size_t i = 2; i < sum.size(); ++i) EXPECT_LT(sum[i], 0.05 * (sum[0] + sum[1])) << kGpuCullStages[i];
+    }
+  }
+}
+
 // With occlusion off, the clusters drawn are those a CPU brute force over the same sphere, box and cone tests finds.
 TEST_F(GpuCullerTest, StatisticsMatchABruteForceCountOfClustersInView) {
   GpuCullOptions options;

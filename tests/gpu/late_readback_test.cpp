@@ -13,6 +13,7 @@
 #include "farfield/core/error.h"
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
+#include "farfield/gpu/stage_clock.h"
 #include "gpu/gpu_fixture.h"
 
 namespace farfield::gpu {
@@ -76,6 +77,41 @@ TEST_F(GpuTest, LateTimerReturnsEachFrameOnce) {
   EXPECT_EQ(frames, (std::vector<uint64_t>{1, 2}));
   EXPECT_EQ(timer.finished([](uint64_t, double) {}), 0u);
   EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+}
+
+// Stage times: each frame comes back once with one time per stage, a stage that draws a large target takes longer than
+// one that does nothing, a mark left out gives its stage 0, and a full ring skips; with either source (timestamp
+// queries are only mechanics on a software rasterizer, whose clock the CPU source stands in for).
+TEST_F(GpuTest, StageClockReturnsEachFrameWithItsStages) {
+  for (const GpuTimer::Source source : {GpuTimer::Source::Auto, GpuTimer::Source::Query}) {
+    SCOPED_TRACE(source == GpuTimer::Source::Auto ? "auto" : "query");
+    StageClock clock(4, 2, source);
+    EXPECT_EQ(clock.stages(), 3u);
+    RenderTarget big(1024, 1024), small(8, 8);
+    for (uint64_t frame = 1; frame <= 3; ++frame) {
+      clock.beginFrame(frame);
+      for (int k = 0; k < 20; ++k) big.clear(Vec4(0.05f * float(k)));  // stage 0: work
+      clock.mark(1);
+      small.clear(Vec4(0.5f));  // stage 1: next to nothing
+      // mark 2 left out: stage 2 takes 0, stage 1 runs to mark 3
+      clock.mark(3);
+    }
+    EXPECT_EQ(clock.skipped(), 1u) << "the third frame found both slots in flight";
+    glFinish();
+    std::vector<uint64_t> frames;
+    clock.finished([&](uint64_t frame, std::span<const double> ms) {
+      frames.push_back(frame);
+      ASSERT_EQ(ms.size(), 3u);
+      for (double m : ms) EXPECT_GE(m, 0.0);
+      EXPECT_EQ(ms[2], 0.0);
+      if (clock.source() == GpuTimer::Source::CpuClock) {
+        EXPECT_GT(ms[0], ms[1]);
+      }
+    });
+    EXPECT_EQ(frames, (std::vector<uint64_t>{1, 2}));
+    EXPECT_EQ(clock.finished([](uint64_t, std::span<const double>) {}), 0u) << "each frame comes back once";
+    EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+  }
 }
 
 }  // namespace

@@ -20,6 +20,7 @@ gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string
   options.cone = onOff(context, "gpu_cones", options.cone, mode_name);
   options.compact = onOff(context, "gpu_compact", options.compact, mode_name);
   options.refine_history = onOff(context, "gpu_refine_history", options.refine_history, mode_name);
+  options.stage_times = onOff(context, "gpu_stage_times", options.stage_times, mode_name);
   return options;
 }
 
@@ -43,6 +44,10 @@ void GpuCullRun::collect() {
     occluded_ += s.occlusion_culled;
     commands_ += s.commands;
     triangles_ += double(s.triangles);
+  }
+  for (const gpu::GpuStageTimes& t : culler_->finishedStageTimes()) {
+    for (size_t i = 0; i < t.ms.size(); ++i) stage_ms_[i] += t.ms[i];
+    stage_frames_ += 1.0;
   }
 }
 
@@ -73,6 +78,11 @@ std::map<std::string, double> GpuCullRun::info() const {
     out["gpu_occlusion_culled"] = occluded_ / frames_;
     out["gpu_draw_commands"] = commands_ / frames_;
     out["gpu_triangles"] = triangles_ / frames_;
+  }
+  if (stage_frames_ > 0.0) {
+    for (size_t i = 0; i < stage_ms_.size(); ++i)
+      out[std::string("gpu_stage_") + gpu::kGpuCullStages[i] + "_ms"] = stage_ms_[i] / stage_frames_;
+    out["gpu_stage_frames"] = stage_frames_;
   }
   return out;
 }

@@ -7,9 +7,12 @@
 // Options (--mode-option), shared by every mode that draws through the arena: gpu_occlusion=on|off (the pyramid test;
 // off: frustum and cones only), gpu_cones=on|off, gpu_compact=on|off (compacted command lists with
 // glMultiDrawElementsIndirectCount where the driver has it), gpu_refine_history=on|off (GpuCullOptions::
-// refine_history: the next frame's early list from a pyramid of this frame's final depth).
+// refine_history: the next frame's early list from a pyramid of this frame's final depth), gpu_stage_times=on|off
+// (off by default: the GPU time of each stage, gpu_stage_<stage>_ms in info(); timestamp queries on a GPU, a wait
+// after each stage on a software rasterizer, which slows the frame).
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <optional>
@@ -21,8 +24,8 @@
 
 namespace farfield::eval {
 
-// The GpuCuller options of a run's --mode-option keys (gpu_occlusion, gpu_cones, gpu_compact, gpu_refine_history: on
-// or off); throws farfield::Error naming the key for another value.
+// The GpuCuller options of a run's --mode-option keys (gpu_occlusion, gpu_cones, gpu_compact, gpu_refine_history,
+// gpu_stage_times: on or off); throws farfield::Error naming the key for another value.
 gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string& mode_name);
 
 // A GpuCuller over the run's arena drawing into bench frames, its statistics read late and kept per path frame.
@@ -39,7 +42,8 @@ class GpuCullRun {
   // run), indirect_count (1 or 0), and per frame
   // (means over the frames whose statistics came back): gpu_clusters_drawn_early, gpu_clusters_drawn_late,
   // gpu_frustum_culled, gpu_cone_culled, gpu_occlusion_culled, gpu_draw_commands (indirect draws after merging runs
-  // of clusters), gpu_triangles.
+  // of clusters), gpu_triangles; with gpu_stage_times, gpu_stage_<stage>_ms (gpu::kGpuCullStages) and
+  // gpu_stage_frames.
   std::map<std::string, double> info() const;
 
  private:
@@ -50,6 +54,8 @@ class GpuCullRun {
   std::map<size_t, gpu::GpuCullStats> latest_;  // per path frame, the last statistics that came back
   double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0, commands_ = 0.0;
   double triangles_ = 0.0;
+  std::array<double, gpu::kGpuCullStages.size()> stage_ms_{};
+  double stage_frames_ = 0.0;
   double arena_build_s_ = 0.0;
 };
 

@@ -13,6 +13,7 @@
 #include "farfield/gpu/gpu_depth_pyramid.h"
 #include "farfield/gpu/late_readback.h"
 #include "farfield/gpu/program.h"
+#include "farfield/gpu/stage_clock.h"
 
 namespace farfield::gpu {
 namespace {
@@ -71,6 +72,7 @@ struct GpuCuller::Impl {
   GpuDepthPyramid pyramid;
 
   std::unique_ptr<LateReadback> late_stats;  // the statistics, read frames later
+  std::unique_ptr<StageClock> stage_clock;   // GpuCullOptions::stage_times
 
   static CullLocations locate(const Program& program) {
     const GLuint c = program.handle();
@@ -146,6 +148,7 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   for (uint32_t g = 0; g < im.groups; ++g) first[g] = arena.groups()[g].first_instance;
   im.group_first = createBuffer(first.size() * sizeof(uint32_t), first.data());
   im.late_stats = std::make_unique<LateReadback>(kStatCount * sizeof(uint32_t), kRing);
+  if (options_.stage_times) im.stage_clock = std::make_unique<StageClock>(kGpuCullStages.size() + 1, kRing);
 }
 
 GpuCuller::~GpuCuller() = default;
@@ -371,18 +374,31 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     if (indirect_count_) glBindBuffer(GL_PARAMETER_BUFFER_ARB, 0);
   };
 
+  // Marks between the stages (kGpuCullStages) when they are timed.
+  StageClock* clock = im.stage_clock.get();
+  auto mark = [clock](size_t stage_end) {
+    if (clock) clock->mark(stage_end);
+  };
+  if (clock) clock->beginFrame(frame);
   if (!options_.occlusion) {
     listParts(2);
     cullPhase(2, 1);
+    mark(1);
     drawPhase(1);
+    mark(2);
   } else {
     listParts(0);
     cullPhase(0, 0);
+    mark(1);
     drawPhase(0);
+    mark(2);
     buildPyramid();
+    mark(3);
     listParts(1);
     cullPhase(1, 1);
+    mark(4);
     drawPhase(1);
+    mark(5);
     if (options_.refine_history) {
       // The drawn instances become the work list: their dispatch, then the test against the final depth, which
       // also decides the parts' visibility (cleared first).
@@ -397,11 +413,24 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.work);
     }
   }
+  mark(kGpuCullStages.size());
   glUseProgram(0);
 
   // ---- statistics, read frames later ----
   im.late_stats->capture(im.stats, 0, frame);
   return stats;
+}
+
+std::vector<GpuStageTimes> GpuCuller::finishedStageTimes() {
+  std::vector<GpuStageTimes> out;
+  if (!impl_->stage_clock) return out;
+  impl_->stage_clock->finished([&](uint64_t frame, std::span<const double> ms) {
+    GpuStageTimes t;
+    t.frame = frame;
+    std::copy(ms.begin(), ms.end(), t.ms.begin());
+    out.push_back(t);
+  });
+  return out;
 }
 
 std::vector<GpuCullStats> GpuCuller::finishedStats() {

@@ -16,6 +16,7 @@
 // after draw() (no depth clear, no depth test other than GL_GREATER): the next frame's early phase relies on it.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -43,6 +44,20 @@ struct GpuCullOptions {
   // The simplified levels (ArenaOptions::lod_ratio): a part whose level's error projects to at most this many pixels
   // of the target (partLodErrorPx) is drawn with it; 0: always the full level. GpuCuller::setLodErrorPx changes it.
   float lod_error_px = 0.0f;
+  // GPU time per stage of each frame, read frames later (GpuCuller::finishedStageTimes; gpu/stage_clock.h): timestamp
+  // queries on a GPU; on a software rasterizer a wait after each stage, which changes the frame it measures.
+  bool stage_times = false;
+};
+
+// The stages a frame's GPU time is split into (GpuCullOptions::stage_times). With occlusion culling: the first
+// phase's culling (its parts, clusters and commands) and its multi-draws, the depth pyramid, the second phase's
+// culling and multi-draws, and the history (the second pyramid and the test that chooses the next frame's first
+// phase). Without: the one phase in the first two, 0 in the others.
+constexpr std::array<const char*, 6> kGpuCullStages{"cull_early", "draw_early", "pyramid",
+                                                    "cull_late",  "draw_late",  "history"};
+struct GpuStageTimes {
+  uint64_t frame = 0;  // GpuCuller::frames() before the draw() that made it
+  std::array<double, kGpuCullStages.size()> ms{};
 };
 
 // One frame's statistics, read when the GPU has finished it.
@@ -86,6 +101,9 @@ class GpuCuller {
   // Statistics of earlier frames that the GPU has finished, oldest first, each returned once. Never waits. A frame
   // whose statistics found the ring full (more than 8 frames unfinished) has none.
   std::vector<GpuCullStats> finishedStats();
+  // With GpuCullOptions::stage_times: the stage times of earlier frames the GPU has finished, oldest first, each
+  // returned once, never waiting; empty without it.
+  std::vector<GpuStageTimes> finishedStageTimes();
 
  private:
   struct Impl;
