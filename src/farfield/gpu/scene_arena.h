@@ -65,6 +65,7 @@ struct ArenaInstance {
 // The instances of one object part (its mesh's clusters, contiguous among the instances): culled whole first.
 struct ArenaPart {
   uint32_t object = 0;  // index into Scene::objects
+  uint32_t material = 0;  // index into Scene::materials
   uint32_t first_instance = 0;
   uint32_t instance_count = 0;
   Box3 bounds;  // its mesh's, in the object's own space
@@ -137,7 +138,9 @@ class SceneArena {
 
   // GL names for gpu::GpuCuller.
   struct Buffers {
-    uint32_t vertex_array = 0;  // positions, normals, uvs (locations 0-2) and the instance index (3, per instance)
+    // Positions, normals, uvs (locations 0-2), and per instance (a draw's baseInstance: its part) the part's row:
+    // the object's transform (3-6), normal matrix (7-9), the material's colour (10), object id, unlit, layer (11).
+    uint32_t vertex_array = 0;
     uint32_t clusters = 0, instances = 0, objects = 0, materials = 0, parts = 0;
   };
   const Buffers& buffers() const { return buffers_; }
@@ -146,6 +149,7 @@ class SceneArena {
 
  private:
   void uploadObjects(uint32_t first, uint32_t count);
+  void uploadPartRows(uint32_t first, uint32_t count);
 
   const scene::Scene* scene_;
   std::vector<ArenaCluster> clusters_;
@@ -158,7 +162,9 @@ class SceneArena {
   uint64_t triangles_ = 0, lod_triangles_ = 0;
   size_t gpu_bytes_ = 0;
   Buffers buffers_;
-  uint32_t vertex_buffer_ = 0, index_buffer_ = 0, instance_ids_ = 0;
+  uint32_t vertex_buffer_ = 0, index_buffer_ = 0, part_rows_ = 0;
+  std::vector<uint32_t> object_parts_;    // the parts of object o: [object_parts_[o], object_parts_[o + 1])
+  std::vector<uint32_t> material_layer_;  // per material: its texture's layer in its array (0 untextured)
   size_t vertex_count_ = 0, index_count_ = 0;
   std::vector<uint32_t> texture_arrays_;
 };

@@ -314,7 +314,7 @@ void main() {
         count += clusters[instances[j + 1u].x].range.y;
       const uint group = instances[i].w & 0xffffu;
       const uint slot = u_compact != 0 ? group_first[group] + atomicAdd(counts[group], 1u) : i;
-      commands[slot] = Command(count, 1u, range.x, int(range.z), i);
+      commands[slot] = Command(count, 1u, range.x, int(range.z), instance_part[i]);  // baseInstance: the part's row
       atomicAdd(s_stats[kCommands], 1u);
     }
   }
