@@ -252,6 +252,32 @@ TEST_F(GpuCullerTest, ABrokenPyramidTestIsCaught) {
   EXPECT_GT(differing, 3u);
 }
 
+// Objects moved after the arena was made (SceneArena::updateTransforms) are culled and drawn where they now stand:
+// the frames equal the moved scene's, and differ from the unmoved scene's (the move shows).
+TEST_F(GpuCullerTest, MovedObjectsAreDrawnWhereTheyNowStand) {
+  const std::vector<Camera> cameras = walk(5, 8);
+  std::vector<Reference> before;
+  for (const Camera& camera : cameras) before.push_back(reference(camera, RenderMode::Shaded));
+  std::vector<uint32_t> moved;
+  for (scene::Object& object : scene_.objects)
+    if (object.id % 3 == 0) {
+      object.transform = glm::translate(Mat4(1.0f), Vec3(1.5f, -2.0f, 0.75f)) * object.transform;
+      moved.push_back(object.id);
+    }
+  ASSERT_FALSE(moved.empty());
+  arena_->updateTransforms(moved);
+  gpu_scene_ = std::make_unique<GpuScene>(scene_);
+  GpuCuller culler(*arena_);
+  size_t changed = 0;
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    const Reference want = reference(cameras[f], RenderMode::Shaded);
+    culled(culler, cameras[f], RenderMode::Shaded);
+    EXPECT_EQ(differences(want, true), 0u) << "frame " << f;
+    changed += differences(before[f], false) > 0;
+  }
+  EXPECT_GT(changed, cameras.size() / 2);
+}
+
 // Only the plan's objects are drawn, and changing the plan changes the frame.
 TEST_F(GpuCullerTest, OnlyThePlansObjectsAreDrawn) {
   GpuCuller culler(*arena_);
