@@ -220,17 +220,22 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
                                                             "whole-frame sprite (0 = no)")->capture_default_str();
   tiles->add_option("--epsilon", to.epsilon, "Sprite error threshold, pixels")->capture_default_str();
   tiles->add_option("--low-error", to.low_error, "Low-resolution LOD threshold, pixels")->capture_default_str();
-  tiles->add_flag("--render", to.render, "Draw every frame from GPU patches paged under --gpu-budget-mb, timed, "
-                                         "with sample frames in OUTDIR/frames");
+  tiles->add_flag("--render", to.render, "Draw every frame (the CDLOD terrain paged under --gpu-budget-mb; --cpu-lod: "
+                                         "the quadtree LOD per tile), timed, with sample frames in OUTDIR/frames");
   tiles->add_option("--gpu-budget-mb", to.gpu_budget_mb, "GPU memory budget of the tiles' patches, MiB")
       ->capture_default_str();
   tiles->add_option("--prefetch-frames", to.prefetch_frames, "With --render: load tiles this many frames ahead of the "
                                                              "camera's motion on a worker thread (0 = on demand)")
       ->capture_default_str();
-  tiles->add_flag("--gpu-lod", to.gpu_lod,
-                  "With --render: draw with the CDLOD terrain paged from the cache (pages of full-resolution heights "
-                  "under --gpu-budget-mb, an overview for far nodes) instead of the quadtree LOD per tile");
-  tiles->add_option("--patch-cells", to.patch_cells, "With --gpu-lod: quads per CDLOD patch side (a power of two)");
+  tiles->add_flag_callback(
+      "--cpu-lod", [t] { t->first.gpu_lod = false; },
+      "With --render: draw the quadtree LOD per tile (its patches remade on the CPU and uploaded under "
+      "--gpu-budget-mb) instead of the CDLOD terrain paged from the cache (pages of full-resolution heights under "
+      "--gpu-budget-mb, an overview for far nodes; the default)");
+  tiles->add_flag_callback(
+      "--gpu-lod", [t] { t->first.gpu_lod = true; },
+      "With --render: the CDLOD terrain (the default; kept for older commands)");
+  tiles->add_option("--patch-cells", to.patch_cells, "With --render: quads per CDLOD patch side (a power of two)");
   tiles->callback([t] { runTiles(t->first, t->second); });
 });
 

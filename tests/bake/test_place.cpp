@@ -245,8 +245,8 @@ TEST(PlaceTest, AGpuDrivenPlanListsItsRegionsObjectsAndDrawsTheSameFrame) {
     // Across the view space at mid height, turning slowly.
     const float t = float(f) / float(frames - 1);
     Camera camera;
-    camera.eye = Vec3(space.lo.x + (space.hi.x - space.lo.x) * (0.1f + 0.8f * t), space.lo.y + 0.5f * (space.hi.y - space.lo.y),
-                      0.5f * (space.lo.z + space.hi.z));
+    camera.eye = Vec3(space.lo.x + (space.hi.x - space.lo.x) * (0.1f + 0.8f * t),
+                      space.lo.y + 0.5f * (space.hi.y - space.lo.y), 0.5f * (space.lo.z + space.hi.z));
     const float yaw = 0.3f + 2.5f * t;
     camera.at = camera.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
     camera.width = camera.height = 128;

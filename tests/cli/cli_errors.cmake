@@ -88,4 +88,4 @@ expect_error("--gpu-budget-mb: must be positive" terrain tiles fractal:65 --bloc
 expect_error("--prefetch-frames: must be 0 or more" terrain tiles fractal:65 --block 16 --frames 4 --render
              --prefetch-frames -1 -o ${WORK}/tiles)
 expect_error("a GPU budget of 0.01 MiB cannot hold a tile" terrain tiles fractal:65 --block 16 --frames 4 --render
-             --gpu-budget-mb 0.01 -o ${WORK}/tiles)
+             --cpu-lod --gpu-budget-mb 0.01 -o ${WORK}/tiles)

@@ -66,6 +66,7 @@ TEST(TerrainTilesGL, ADemFileIsStreamedAndDrawnFromPagedPatches) {
   o.check_stride = 0;
   o.sprite_tile_cells = 0;
   o.render = true;
+  o.gpu_lod = false;  // the quadtree LOD per tile (--cpu-lod)
   o.budget_mb = 0.5;  // tiles come with their positions and texture until drawn
   o.gpu_budget_mb = 1.0;
   o.sample_stride = 10;
@@ -95,14 +96,14 @@ TEST(TerrainTilesGL, ADemFileIsStreamedAndDrawnFromPagedPatches) {
   EXPECT_GT(s["process_peak_rss"].get<size_t>(), 0u);
 }
 
-// --render --gpu-lod: the CDLOD terrain paged from the same cache draws every frame, under its GPU budget, and reports
-// its pages.
+// --render (the CDLOD terrain, the default): paged from the same cache, it draws every frame, under its GPU budget, and
+// reports its pages.
 TEST(TerrainTilesGL, TheCdlodTerrainIsDrawnFromPagesOfTheCache) {
   TerrainTilesOptions o = smallRun("terrain_tiles_cdlod");
   o.check_stride = 0;
   o.sprite_tile_cells = 0;
   o.render = true;
-  o.gpu_lod = true;
+  EXPECT_TRUE(o.gpu_lod);  // the default
   o.gpu_budget_mb = 2.0;
   o.sample_stride = 10;
   runTerrainTiles(o);
@@ -117,7 +118,8 @@ TEST(TerrainTilesGL, TheCdlodTerrainIsDrawnFromPagesOfTheCache) {
   for (const char* f : {"frame_00000.png", "frame_00010.png", "frame_00020.png"})
     EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(o.out_dir) / "frames" / f)) << f;
   o.render = false;
-  test::expectErrorMentions([&] { runTerrainTiles(o); }, {"--gpu-lod", "--render"});
+  o.gpu_lod = false;
+  test::expectErrorMentions([&] { runTerrainTiles(o); }, {"--cpu-lod", "--render"});
 }
 
 TEST(TerrainTiles, BadOptionsAreRefused) {

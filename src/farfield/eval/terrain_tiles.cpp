@@ -142,7 +142,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   double cdlod_prepare_seconds = 0.0;
   std::unique_ptr<terrain::PagedTerrainRenderer> paged;
   std::unique_ptr<terrain::PagedGpuLodTerrain> cdlod;
-  if (o.gpu_lod && !o.render) throw Error("--gpu-lod", "draws frames: needs --render");
+  if (!o.gpu_lod && !o.render) throw Error("--cpu-lod", "draws frames: needs --render");
   if (o.render) {
     if (!(o.gpu_budget_mb > 0.0)) throw Error("--gpu-budget-mb", "must be positive");
     gpu::sharedHeadlessContext().makeCurrent();

@@ -41,8 +41,9 @@ struct TerrainTilesOptions {
   int prefetch_frames = 32;  // with render: tiles loaded ahead along the camera's motion (0 = every tile on demand)
   size_t sample_stride = 100;
   // With render: draw with the CDLOD terrain paged from the cache (terrain/paged_gpu_lod.h: pages of full-resolution
-  // heights and colours under gpu_budget_mb, an overview for the far nodes) instead of the quadtree LOD per tile.
-  bool gpu_lod = false;
+  // heights and colours under gpu_budget_mb, an overview for the far nodes; no per-frame CPU mesh), the default;
+  // false: the quadtree LOD per tile, its patches remade on the CPU and uploaded (--cpu-lod).
+  bool gpu_lod = true;
   int patch_cells = 16;
 };
 

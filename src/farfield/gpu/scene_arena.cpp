@@ -418,8 +418,8 @@ void SceneArena::uploadPartRows(uint32_t first, uint32_t count) {
     r.info[2] = material_layer_[part.material];
     r.info[3] = 0u;
   }
-  glNamedBufferSubData(part_rows_, GLintptr(first) * GLintptr(sizeof(GpuPartRow)), GLsizeiptr(count * sizeof(GpuPartRow)),
-                       rows.data());
+  glNamedBufferSubData(part_rows_, GLintptr(first) * GLintptr(sizeof(GpuPartRow)),
+                       GLsizeiptr(count * sizeof(GpuPartRow)), rows.data());
 }
 
 void SceneArena::updateTransforms(std::span<const uint32_t> ids) {

@@ -28,8 +28,8 @@ struct ModeSettings {
   std::string database;        // impostor database directory ("" = none)
   double error_px = 0.0;       // the walkthrough's bound; 0 = the database's
   uint64_t gpu_budget_bytes = uint64_t(512) << 20;
-  // A terrain under the city (eval/city_on_terrain_mode.h), drawn by terrain_technique in full and culled: a DEM file or
-  // fractal:... spec and the vertical scale the city was made with (gen city --terrain SPEC --terrain-scale S).
+  // A terrain under the city (eval/city_on_terrain_mode.h), drawn by terrain_technique in full and culled: a DEM file
+  // or fractal:... spec and the vertical scale the city was made with (gen city --terrain SPEC --terrain-scale S).
   std::string terrain;
   float terrain_scale = 1.0f;
   // The terrain technique (eval/city_on_terrain_mode.h): lod-sprite-gpu, high-gpu, lod-sprite or high.

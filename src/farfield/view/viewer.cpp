@@ -421,7 +421,8 @@ void checkViewerOptions(const ViewerOptions& o) {
     throw Error("--terrain-scale", "must be a finite number > 0");
   if (o.terrain_technique != "lod-sprite-gpu" && o.terrain_technique != "high-gpu" &&
       o.terrain_technique != "lod-sprite" && o.terrain_technique != "high")
-    throw Error("--terrain-technique", "'" + o.terrain_technique + "' is not lod-sprite-gpu, high-gpu, lod-sprite or high");
+    throw Error("--terrain-technique",
+                "'" + o.terrain_technique + "' is not lod-sprite-gpu, high-gpu, lod-sprite or high");
   if (!o.screenshot_at.empty() && o.out_dir.empty()) throw Error("--screenshot-at", "needs -o DIR");
   if (o.exit_at_end && o.replay.empty() && o.screenshot_at.empty())
     throw Error("--exit", "needs --replay or --screenshot-at (otherwise nothing would be shown)");
