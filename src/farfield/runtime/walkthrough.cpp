@@ -22,7 +22,6 @@ bool contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
 }
 
-
 }  // namespace
 
 const char* representationName(Representation representation) {
@@ -58,7 +57,6 @@ std::string missingStage(const store::StoreIndex& index, Representation kind) {
     return me + " needs the pvs stage baked";
   return "";
 }
-
 
 Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_scene, const scene::Bvh& bvh,
                          gpu::Renderer& renderer, WalkthroughOptions options)
