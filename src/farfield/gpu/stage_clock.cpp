@@ -41,6 +41,7 @@ void StageClock::setMark(Slot& slot, size_t index) {
 }
 
 void StageClock::beginFrame(uint64_t frame) {
+  if (open_) open_->busy = false;  // a frame whose last mark never came: dropped
   open_ = nullptr;
   Slot& slot = slots_[next_];
   if (slot.busy) {

@@ -29,7 +29,7 @@ class StageClock {
   StageClock(const StageClock&) = delete;
   StageClock& operator=(const StageClock&) = delete;
 
-  // Starts frame `frame` and sets its mark 0.
+  // Starts frame `frame` and sets its mark 0 (a frame begun before whose last mark was never set is dropped).
   void beginFrame(uint64_t frame);
   // Sets mark `index` (1 .. marks - 1, increasing) of the frame begun last; the last mark ends it. A mark left out is
   // the next one's time (its stage takes 0 ms).
