@@ -5,12 +5,14 @@
 # set). Writes OUT/<stage>.tgz (bench.json, frames.csv, cull checks, logs; no images) and
 # OUT/log.txt; prints a summary per stage.
 #
-# Stages (STAGES, default "smoke heldout big demo check terrain"):
+# Stages (STAGES, default "smoke heldout makedemo crowd terrain big check"; they run in the script's order, smoke,
+# heldout, big, demo, check, terrain, crowd, makedemo, dynamic, each under a timeout; with 15 minutes of device time,
+# name a few per call, e.g. STAGES="smoke heldout makedemo" then STAGES="smoke crowd terrain"):
 #   smoke    a small city, one bench; stops everything unless the NVIDIA driver drew it
 #   heldout  a 400-block detail-3 city (about 17 M triangles) and a 300-frame car drive at 1920x1080: frustum,
 #            culled-cpu and culled (the GPU-driven frame), GPU time from timer queries, own CPU time, syncs
 #   big      the 100,000-block city (detail 0) at 1920x1080, 150 frames: the same modes
-#   demo     the 400-block detail-2 city at 640x360 (make demo's until 2026-12-05): the same modes
+#   demo     (not in the default) the 400-block detail-2 city at 640x360 (make demo's until 2026-12-05): the same modes
 #   check    farfield cull-check on the held-out city at 1920x1080 (GPU-culled frames against frustum-culled ones)
 #   crowd    the crowd bench at 1920x1080 with the GPU crowd beside the CPU path (--gpu-crowd), 10,000 to 1,000,000
 #            agents, no shadows (the crowd alone; shadows are measured on llvmpipe); then at 0.5 px with levels of
@@ -18,14 +20,14 @@
 #   terrain  the terrain LODs at 1920x1080, 600-frame flythroughs: the quadtree LOD (high, low, lod-sprite) against
 #            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu[-predict]) on the shared DEM (.gpu/data/terrain/*.tif, when
 #            carried) and on the 8,193^2 fractal
-#   makedemo (not in the default) the demo's main job, scripts/demo.sh at its 640x360: t_max from this machine,
+#   makedemo the demo's main job, scripts/demo.sh at its 640x360: t_max from this machine,
 #            impostors placed, full, culled, placed and governed against reference frames; its verdict (issues 43, 46)
 #   dynamic  (not in the default) the image-cache modes (dynamic-shade, dynamic-schaufler, layered) with their
 #            geometry through the GPU-driven frame and through the CPU's occlusion culling (a readback a frame),
 #            scripts/bench_dynamic_budget.sh's city and forest at 640x360, t_max 50 ms
 set -uo pipefail
 ROOT=$PWD
-STAGES=${STAGES:-smoke heldout big demo check terrain crowd}
+STAGES=${STAGES:-smoke heldout makedemo crowd terrain big check}
 DATA=$PWD/.gpu/data
 OUTD=${OUT:-/tmp/out}
 mkdir -p "$OUTD"
