@@ -40,7 +40,11 @@ void drawWalkthrough(const PanelState& s) {
   else
     ImGui::Text("cell: none%s", r.cpv != urban::kNone ? "" : " (outside the streets)");
   if (r.cpv != urban::kNone) ImGui::Text("CPV %u, placed time bound %.1f ms", r.cpv, r.cpv_t_after_ms);
-  ImGui::Text("triangles: %" PRIu64 " geometry, %" PRIu64 " impostor", r.geometry_triangles, r.impostor_triangles);
+  // A GPU-driven plan lists whole objects, which the GPU then culls: its count is what it may draw, not what it drew
+  // (the frame's line above).
+  const bool listed = plan->geometry_items == 0 && !plan->geometry_objects.empty();
+  ImGui::Text("triangles: %" PRIu64 " geometry%s, %" PRIu64 " impostor", r.geometry_triangles,
+              listed ? " listed for the GPU" : "", r.impostor_triangles);
   // Every kind the mode can draw, zeros included, so that the panel keeps its size from frame to frame.
   const bool placed = s.modes[size_t(s.mode_index)] == "placed";
   for (size_t k = placed ? 4 : 0; k < (placed ? kDecisionKinds : 4); ++k) {
