@@ -85,7 +85,7 @@ void LodSpriteRenderer::schedulePrediction(const Camera& camera, float ahead, si
 
 void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info) {
   Keyframe& k = *pending_;
-  const size_t chunks = pending_chunks_;
+  size_t chunks = pending_chunks_;
   if (options_.gpu_high) {
     // The CDLOD terrain: step 0 selects its nodes (on the CPU; kept here, as the terrain's selections are remade by
     // the frames in between); steps 0..chunks-1 draw one run of them each.
@@ -96,6 +96,16 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
       // The freshest count of a keyframe's triangles, for the next predictions (predictCosts).
       high_triangles_key_ = pending_selection_.nodes.size() * terrain.renderer().trianglesPerNode();
       high_latest_is_key_ = true;
+      // Late: the slices sized from this keyframe's own triangles, now known, where the schedule had the last
+      // keyframe's: more of them where it is larger (never fewer than scheduled; at most predict_chunks).
+      if (options_.predict_late && options_.cost) {
+        const PathCosts costs = predictCosts(low_triangles_);
+        if (costs.sprite_ms > 0.0) {
+          const double want = std::ceil((costs.keyframe_ms - costs.sprite_ms) / (kSliceShare * costs.sprite_ms));
+          chunks = std::max(chunks, size_t(std::clamp(want, 1.0, double(options_.predict_chunks))));
+          pending_chunks_ = chunks;
+        }
+      }
     }
     const std::span<const CdlodNode> nodes = pending_selection_.nodes;
     const size_t per_chunk = (nodes.size() + chunks - 1) / chunks;
