@@ -2,6 +2,8 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
+
 #include "farfield/core/check.h"
 
 namespace farfield::gpu {
@@ -47,15 +49,22 @@ bool GpuDepthPyramid::resize(int width, int height) {
 void GpuDepthPyramid::build(const RenderTarget& target) {
   depth_ = target.depthTexture().handle();
   resize(target.width(), target.height());
+  const int levels = int(level_size_.size());
+  if (levels < 2) return;
   program_.use();
+  const std::vector<int> sizes = levelSizes();
+  glUniform2iv(program_.uniformLocation("u_size[0]"), GLsizei(levels), sizes.data());
   glBindTextureUnit(2, depth_);
-  for (size_t k = 1; k < level_size_.size(); ++k) {
-    program_.set("u_from_depth", k == 1 ? 1 : 0);
-    glUniform2i(program_.uniformLocation("u_src_size"), level_size_[k - 1][0], level_size_[k - 1][1]);
-    glUniform2i(program_.uniformLocation("u_dst_size"), level_size_[k][0], level_size_[k][1]);
-    glBindImageTexture(0, texture_, GLint(k == 1 ? 0 : k - 2), GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-    glBindImageTexture(1, texture_, GLint(k - 1), GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glDispatchCompute(GLuint(level_size_[k][0] + 7) / 8, GLuint(level_size_[k][1] + 7) / 8, 1);
+  // Up to kLevelsPerDispatch levels a dispatch (depth_pyramid.comp.glsl), each invocation one texel of the last.
+  for (int first = 0; first + 1 < levels; first += kLevelsPerDispatch) {
+    const int count = std::min(kLevelsPerDispatch, levels - 1 - first);
+    program_.set("u_first", first);
+    program_.set("u_count", count);
+    if (first >= 1) glBindImageTexture(0, texture_, GLint(first - 1), GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+    for (int j = 1; j <= count; ++j)
+      glBindImageTexture(GLuint(j), texture_, GLint(first + j - 1), GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    const auto& made = level_size_[size_t(first + count)];
+    glDispatchCompute(GLuint(made[0] + 7) / 8, GLuint(made[1] + 7) / 8, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
   }
   glBindTextureUnit(2, 0);

@@ -16,6 +16,7 @@ namespace farfield::gpu {
 class GpuDepthPyramid {
  public:
   static constexpr int kMaxLevels = 16;
+  static constexpr int kLevelsPerDispatch = 3;  // an invocation's 4 x 4 texels halved twice in registers
   GpuDepthPyramid();  // needs a current context
   ~GpuDepthPyramid();
   GpuDepthPyramid(const GpuDepthPyramid&) = delete;
@@ -23,7 +24,8 @@ class GpuDepthPyramid {
 
   // Sizes the levels for a width x height target (allocating when the size changes); true when it changed.
   bool resize(int width, int height);
-  // Builds the levels of what `target` holds now (resizing to it). No wait.
+  // Builds the levels of what `target` holds now (resizing to it), up to kLevelsPerDispatch levels per compute
+  // dispatch. No wait.
   void build(const RenderTarget& target);
   // Binds the target's depth (level 0) and the pyramid (levels 1.. as mips 0..) to two texture units.
   void bind(int depth_unit, int pyramid_unit) const;
