@@ -91,6 +91,17 @@ void runCalibrateCommand(CalibrateArgs& args) {
                 "%.2f %% (n = %zu; more --views lower it)\n",
                 200.0 / double(r.checks.size() + 1), r.checks.size());
   std::printf("views slower than predicted (before the factor): %zu\n", r.under_predicted);
+  const auto term = [](const char* name, const eval::TermValidation& t) {
+    std::printf("%-20s%.4f ms + %.3f ms/Mtri + %.5f ms/draw + %.3f ms/Mpixel of fill (fit r2 %.3f); measured/predicted "
+                "p50 %.3f  p95 %.3f  max %.3f\n", name, t.model.base_ms, t.model.ms_per_mtriangle, t.model.ms_per_draw,
+                t.model.ms_per_mfill, t.model.r2,
+                t.ratio_p50, t.ratio_p95, t.ratio_max);
+  };
+  term("CPU term:", r.cpu);
+  term("GPU term:", r.gpu);
+  std::printf("max(CPU, GPU):      the frame's wall time / max of the two predictions: p50 %.3f  p95 %.3f  max %.3f "
+              "(placement and the governor use the wall model above)\n",
+              r.max_term.ratio_p50, r.max_term.ratio_p95, r.max_term.ratio_max);
   if (r.profile.layered.calibrated) {
     const gpu::LayeredCost& l = r.profile.layered;
     const eval::LayeredCalibrateResult& lr = r.layered;

@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "farfield/core/error.h"
@@ -107,6 +110,75 @@ TEST(CalibrationTest, TheSafetyFactorBoundsTheViewsItCameFrom) {
   EXPECT_EQ(half.over_factor, above);
   EXPECT_EQ(half.over_bound, above_both);
   EXPECT_LE(above, 12u);
+}
+
+// The frame's CPU and GPU terms are fitted on their own measurements: each validation view's predictions are the
+// terms' models applied to its workload (recomputed here), the quantiles and counts are those of the views'
+// measured / predicted (recomputed), and the profile's validation and the CSV carry them.
+TEST(CalibrationTest, TheCpuAndGpuTermsAreFittedAndCheckedOnTheirOwnMeasurements) {
+  const CalibrateResult r = calibrate(gpu::sharedHeadlessContext(), smallCity(), quickOptions(16));
+  ASSERT_EQ(r.checks.size(), 16u);
+  EXPECT_EQ(r.cpu.model.samples, 12u);  // the fitting views
+  EXPECT_EQ(r.gpu.model.samples, 12u);
+  const double pixels = 64.0 * 64.0;
+  size_t cpu_under = 0, gpu_under = 0, wall_under = 0, drawing = 0;
+  double cpu_max = 0.0, gpu_max = 0.0, wall_max = 0.0;
+  std::vector<double> gpu_ratios;
+  for (const ViewCheck& c : r.checks) {
+    EXPECT_GT(c.measured_cpu_ms, 0.0);
+    EXPECT_GT(c.measured_gpu_ms, 0.0);
+    // Farfield's own CPU time is a part of the frame's wall time, both the minimum of the same single render.
+    EXPECT_LE(c.measured_cpu_ms, c.measured_ms);
+    const gpu::CostModel& cm = r.cpu.model;
+    const double t = double(c.triangles), d = double(c.draw_calls);
+    EXPECT_NEAR(c.predicted_cpu_ms, cm.base_ms + cm.ms_per_mtriangle * t / 1e6 + cm.ms_per_draw * d +
+                                        cm.ms_per_mpixel * pixels / 1e6, 1e-9);
+    const gpu::CostModel& gm = r.gpu.model;
+    // The GPU term counts the triangles drawn after the GPU culler's culling: never more than the objects'.
+    drawing += c.drawn_triangles > 0;
+    EXPECT_LE(c.drawn_triangles, c.triangles);
+    const double drawn = double(c.drawn_triangles);
+    EXPECT_NEAR(c.predicted_gpu_ms, gm.base_ms + gm.ms_per_mtriangle * drawn / 1e6 + gm.ms_per_draw * d +
+                                        gm.ms_per_mpixel * pixels / 1e6, 1e-9);
+    cpu_under += c.measured_cpu_ms > c.predicted_cpu_ms;
+    gpu_under += c.measured_gpu_ms > c.predicted_gpu_ms;
+    const double both = std::max(c.predicted_cpu_ms, c.predicted_gpu_ms);
+    wall_under += c.measured_ms > both;
+    cpu_max = std::max(cpu_max, c.measured_cpu_ms / c.predicted_cpu_ms);
+    gpu_max = std::max(gpu_max, c.measured_gpu_ms / c.predicted_gpu_ms);
+    wall_max = std::max(wall_max, c.measured_ms / both);
+    gpu_ratios.push_back(c.measured_gpu_ms / c.predicted_gpu_ms);
+  }
+  EXPECT_GT(drawing, 8u) << "most street views draw something";
+  EXPECT_EQ(r.cpu.under_predicted, cpu_under);
+  EXPECT_EQ(r.gpu.under_predicted, gpu_under);
+  EXPECT_EQ(r.max_term.under_predicted, wall_under);
+  EXPECT_NEAR(r.cpu.ratio_max, cpu_max, 1e-9);
+  EXPECT_NEAR(r.gpu.ratio_max, gpu_max, 1e-9);
+  EXPECT_NEAR(r.max_term.ratio_max, wall_max, 1e-9);
+  std::sort(gpu_ratios.begin(), gpu_ratios.end());
+  EXPECT_NEAR(r.gpu.ratio_p50, 0.5 * (gpu_ratios[7] + gpu_ratios[8]), 1e-9);  // 16 views: the 8th and 9th
+  EXPECT_LE(r.gpu.ratio_p50, r.gpu.ratio_p95);
+  EXPECT_LE(r.gpu.ratio_p95, r.gpu.ratio_max);
+  EXPECT_EQ(r.profile.validation["cpu_term"]["ratio_p95"].get<double>(), r.cpu.ratio_p95);
+  EXPECT_EQ(r.profile.validation["gpu_term"]["model"]["samples"].get<size_t>(), 12u);
+  EXPECT_EQ(r.profile.validation["max_term"]["ratio_max"].get<double>(), r.max_term.ratio_max);
+
+  const std::string csv = ::testing::TempDir() + "/calibration_terms.csv";
+  writeCalibrationCsv(r, csv);
+  std::ifstream in(csv);
+  std::string header, row;
+  std::getline(in, header);
+  std::getline(in, row);
+  EXPECT_NE(header.find(",predicted_cpu_ms,measured_cpu_ms,drawn_triangles,predicted_gpu_ms,measured_gpu_ms"),
+            std::string::npos);
+  std::vector<double> fields;
+  std::stringstream cells(row);
+  for (std::string cell; std::getline(cells, cell, ',');) fields.push_back(std::stod(cell));
+  ASSERT_EQ(fields.size(), 18u);
+  EXPECT_NEAR(fields[14], r.checks[0].measured_cpu_ms, 1e-4 * r.checks[0].measured_cpu_ms);
+  EXPECT_EQ(fields[15], double(r.checks[0].drawn_triangles));
+  EXPECT_NEAR(fields[17], r.checks[0].measured_gpu_ms, 1e-4 * r.checks[0].measured_gpu_ms);
 }
 
 // The fill term (core/object_fill.h) is fitted only when asked; either way each view's estimated fill is reported,

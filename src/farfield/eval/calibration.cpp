@@ -212,7 +212,7 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   const auto render = [&](const Camera& camera, const std::vector<uint32_t>& view_ids) {
     geometry.ids = view_ids;
     if (options.gpu_frames) runner.run(geometry, camera, 0);
-    return runner.run(geometry, camera, 0).wall_ms;
+    return runner.run(geometry, camera, 0);
   };
   // Every view rendered once, then again in further passes over all of them, the fastest render kept: a view's
   // renders are a pass apart (seconds), so a slow spell of the machine does not slow all of them. The fitting and the
@@ -239,8 +239,12 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
                           std::to_string(options.repeats),
                       cameras.size());
     for (size_t i : order) {
-      const double ms = render(cameras[i], view_ids[i]);
-      checks[i].measured_ms = r == 0 ? ms : std::min(checks[i].measured_ms, ms);
+      const FrameRecord frame = render(cameras[i], view_ids[i]);
+      ViewCheck& c = checks[i];
+      c.measured_ms = r == 0 ? frame.wall_ms : std::min(c.measured_ms, frame.wall_ms);
+      c.measured_cpu_ms = r == 0 ? frame.cpu_ms : std::min(c.measured_cpu_ms, frame.cpu_ms);
+      c.measured_gpu_ms = r == 0 ? frame.gpu_ms : std::min(c.measured_gpu_ms, frame.gpu_ms);
+      c.drawn_triangles = frame.triangles;  // the GPU culler's count of this frame (FrameRunner, after its wait)
       if (options.progress) progress.advance();
     }
     progress.finish();
@@ -256,9 +260,44 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
     }
     profile.model = options.fill_term ? fitWithFillCap(samples, pixels, region_fills) : gpu::CostModel::fit(samples);
   }
+  // The CPU and GPU terms, each fitted on its own measurements of the fitting views (the fill as the wall model has it,
+  // uncapped); the GPU term's triangles are those drawn after culling.
+  const auto fitTerm = [&](double ViewCheck::*measured, auto&& triangles) {
+    std::vector<gpu::CostSample> samples;
+    for (size_t i = 0; i < fit_views.size(); ++i) {
+      const ViewCheck& c = checks[i];
+      samples.push_back({triangles(c), double(c.draw_calls), pixels, std::max(0.0, c.*measured),
+                         options.fill_term ? c.fill : 0.0});
+    }
+    return gpu::CostModel::fit(samples);
+  };
+  const auto counted = [](const ViewCheck& c) { return double(c.triangles); };
+  const auto drawn = [](const ViewCheck& c) { return double(c.drawn_triangles); };
+  result.cpu.model = fitTerm(&ViewCheck::measured_cpu_ms, counted);
+  result.gpu.model = fitTerm(&ViewCheck::measured_gpu_ms, drawn);
   result.checks.assign(checks.begin() + std::ptrdiff_t(fit_views.size()), checks.end());
-  for (ViewCheck& check : result.checks)
-    check.predicted_ms = profile.model.predict(double(check.triangles), double(check.draw_calls), pixels, check.fill);
+  for (ViewCheck& check : result.checks) {
+    const double t = double(check.triangles), d = double(check.draw_calls);
+    check.predicted_ms = profile.model.predict(t, d, pixels, check.fill);
+    check.predicted_cpu_ms = result.cpu.model.predict(t, d, pixels, check.fill);
+    check.predicted_gpu_ms = result.gpu.model.predict(double(check.drawn_triangles), d, pixels, check.fill);
+  }
+  const auto validateTerm = [&](TermValidation& term, auto&& measured, auto&& predicted) {
+    std::vector<double> ratios;
+    for (const ViewCheck& c : result.checks) {
+      ratios.push_back(measured(c) / std::max(predicted(c), 1e-6));
+      term.under_predicted += measured(c) > predicted(c) ? 1 : 0;
+    }
+    term.ratio_p50 = percentile(ratios, 50.0);
+    term.ratio_p95 = percentile(ratios, 95.0);
+    term.ratio_max = percentile(ratios, 100.0);
+  };
+  validateTerm(result.cpu, [](const ViewCheck& c) { return c.measured_cpu_ms; },
+               [](const ViewCheck& c) { return c.predicted_cpu_ms; });
+  validateTerm(result.gpu, [](const ViewCheck& c) { return c.measured_gpu_ms; },
+               [](const ViewCheck& c) { return c.predicted_gpu_ms; });
+  validateTerm(result.max_term, [](const ViewCheck& c) { return c.measured_ms; },
+               [](const ViewCheck& c) { return std::max(c.predicted_cpu_ms, c.predicted_gpu_ms); });
 
   std::vector<double> ratios, errors;
   for (const ViewCheck& c : result.checks) {
@@ -325,21 +364,30 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
                         {"under_predicted", result.under_predicted},
                         {"margin_ms", profile.safety_margin_ms},
                         {"over_factor", result.over_factor},
-                        {"over_bound", result.over_bound}};
+                        {"over_bound", result.over_bound},
+                        {"cpu_term", result.cpu.toJson()},
+                        {"gpu_term", result.gpu.toJson()},
+                        {"max_term", result.max_term.toJson()}};
   return result;
+}
+
+nlohmann::json TermValidation::toJson() const {
+  return {{"model", model.toJson()}, {"ratio_p50", ratio_p50}, {"ratio_p95", ratio_p95}, {"ratio_max", ratio_max},
+          {"under_predicted", under_predicted}};
 }
 
 void writeCalibrationCsv(const CalibrateResult& result, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw Error(path, "cannot write");
   out << "view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,fill_pixels,region_fill_pixels,predicted_ms,"
-         "measured_ms\n";
+         "measured_ms,predicted_cpu_ms,measured_cpu_ms,drawn_triangles,predicted_gpu_ms,measured_gpu_ms\n";
   for (size_t i = 0; i < result.checks.size(); ++i) {
     const ViewCheck& c = result.checks[i];
     const Vec3 d = c.camera.forward();
     out << i << ',' << c.camera.eye.x << ',' << c.camera.eye.y << ',' << c.camera.eye.z << ',' << d.x << ',' << d.y
         << ',' << d.z << ',' << c.triangles << ',' << c.draw_calls << ',' << c.fill << ',' << c.region_fill << ','
-        << c.predicted_ms << ',' << c.measured_ms << '\n';
+        << c.predicted_ms << ',' << c.measured_ms << ',' << c.predicted_cpu_ms << ',' << c.measured_cpu_ms << ','
+        << c.drawn_triangles << ',' << c.predicted_gpu_ms << ',' << c.measured_gpu_ms << '\n';
   }
   if (!out) throw Error(path, "write failed");
 }

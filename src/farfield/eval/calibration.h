@@ -76,6 +76,25 @@ struct ViewCheck {
   double region_fill = 0.0;
   double predicted_ms = 0.0;
   double measured_ms = 0.0;  // minimum of the repeats
+  // The frame's two sides, each the minimum of the repeats (eval/frame_runner.h's FrameRecord): Farfield's own CPU
+  // time and the GPU's (timer queries; on a software rasterizer the CPU clock to the frame's end), and their
+  // predictions by the terms fitted on them (CalibrateResult::cpu, gpu).
+  double measured_cpu_ms = 0.0, measured_gpu_ms = 0.0;
+  double predicted_cpu_ms = 0.0, predicted_gpu_ms = 0.0;
+  // Triangles the frame drew after its culling (the GPU culler's count, read once the frame finished; on the CPU
+  // path the items drawn): the GPU term's triangle feature. The runtime knows it a frame or two late (the governor's
+  // feature), placement not at all (it keeps `triangles`, counted over whole objects).
+  uint64_t drawn_triangles = 0;
+};
+
+// One term of the frame's cost (CPU or GPU) fitted on the fitting views' measurements of it, and checked on the
+// validation views: quantiles of measured / predicted. The CPU term's workload is the view's as placement counts it;
+// the GPU term's triangles are those drawn after culling (ViewCheck::drawn_triangles).
+struct TermValidation {
+  gpu::CostModel model;
+  double ratio_p50 = 0.0, ratio_p95 = 0.0, ratio_max = 0.0;
+  size_t under_predicted = 0;  // views whose term took longer than predicted
+  nlohmann::json toJson() const;
 };
 
 struct CalibrateResult {
@@ -87,6 +106,11 @@ struct CalibrateResult {
   size_t under_predicted = 0;  // views slower than predicted (before the safety factor)
   size_t over_factor = 0;      // views slower than predicted * safety factor
   size_t over_bound = 0;       // views slower than the profile's bound (the factor's and the margin's smaller)
+  // The CPU and GPU terms (issue 43: a frame costs max(CPU, GPU) plus its synchronisations), each fitted on its own
+  // measurements, and max_term: the frame's wall time against max(predicted CPU, predicted GPU) (its model unused).
+  // Recorded in the profile's validation ("cpu_term", "gpu_term", "max_term"); placement and the governor use
+  // `profile.model`, fitted on the wall time.
+  TermValidation cpu, gpu, max_term;
   double wall_s = 0.0;
   LayeredCalibrateResult layered;  // empty when CalibrateOptions::layered_samples is 0
 };
@@ -118,7 +142,8 @@ gpu::CostModel fitWithFillCap(std::span<const gpu::CostSample> samples, double f
 // < 1, quantile outside (0, 1], an empty scene, a view space that is not finite).
 CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, const CalibrateOptions& options);
 
-// view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,fill_pixels,region_fill_pixels,predicted_ms,measured_ms
+// view,eye_x,eye_y,eye_z,dir_x,dir_y,dir_z,triangles,draw_calls,fill_pixels,region_fill_pixels,predicted_ms,measured_ms,
+// predicted_cpu_ms,measured_cpu_ms,drawn_triangles,predicted_gpu_ms,measured_gpu_ms
 void writeCalibrationCsv(const CalibrateResult& result, const std::string& path);
 
 }  // namespace farfield::eval
