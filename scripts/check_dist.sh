@@ -4,7 +4,9 @@
 # 1. ROOT_DIR: `debootstrap --variant=minbase bookworm` plus only libglvnd and Mesa's EGL with llvmpipe, built once and
 #    reused (ROOT_DIR/.farfield-dist-root marks a finished one);
 # 2. the positive check, in a chroot with /proc (and /dev) mounted and an empty environment: every library the tool
-#    loads comes from the tarball's lib/ or is one it leaves out (glibc, libstdc++, libgcc_s, the GL dispatch); a
+#    loads (ldd of it, and of the libraries it opens with dlopen: share/farfield/dlopened.txt) comes from the
+#    tarball's lib/ or is one it leaves out (glibc, libstdc++, libgcc_s, the GL dispatch), and every file of lib/ is
+#    one of them; a
 #    headless frame (render builtin:cubes), a short walkthrough benchmark on llvmpipe (gen city, path street, bench
 #    --modes culled) and an OpenStreetMap import exported as 3D Tiles (PROJ with the tarball's proj.db: the root has
 #    no /usr/share/proj);
@@ -93,8 +95,21 @@ echo "check_dist: positive check in the root ($name)"
 step version "$ff" --version
 # Every object the loader maps: from the tarball's lib/, or glibc, the C++ runtime or the GL dispatch of the root.
 inroot ldd "$ff" 2>&1 | sed 's|/bin/\.\./lib/|/lib/|' >"$ROOT$work/ldd.txt" || true
-bundled=$(grep -c "=> /opt/ff-check/$name/lib/" "$ROOT$work/ldd.txt" || true)
-strays=$(grep '=>' "$ROOT$work/ldd.txt" | grep -v "=> /opt/ff-check/$name/lib/" |
+# The libraries the tool opens with dlopen (make_dist.sh lists them) and what they load, as ldd of each finds it.
+dlopened_list=$ROOT/opt/ff-check/$name/share/farfield/dlopened.txt
+if [ -f "$dlopened_list" ]; then
+  while read -r d; do
+    [ -n "$d" ] || continue
+    echo "	$d => /opt/ff-check/$name/lib/$d (opened with dlopen)" >>"$ROOT$work/ldd.txt"
+    if [ -f "$ROOT/opt/ff-check/$name/lib/$d" ]; then
+      inroot ldd "/opt/ff-check/$name/lib/$d" >>"$ROOT$work/ldd.txt" 2>&1 || true
+    else
+      echo "	$d => not found" >>"$ROOT$work/ldd.txt"
+    fi
+  done <"$dlopened_list"
+fi
+bundled=$(grep "=> /opt/ff-check/$name/lib/" "$ROOT$work/ldd.txt" | awk '{print $1}' | sort -u | wc -l)
+strays=$(grep '=>' "$ROOT$work/ldd.txt" | grep -v "=> /opt/ff-check/$name/lib/" | sort -u |
   grep -vE '^\s*(libc|libm|libdl|libpthread|librt|libresolv|libstdc\+\+|libgcc_s|libOpenGL|libGLdispatch|libEGL|libGLX|libGL)\.so' || true)
 if [ -n "$strays" ] || [ "$bundled" -ne "$(ls "$ROOT/opt/ff-check/$name/lib" | wc -l)" ]; then
   echo "  FAIL  libraries: $bundled of $(ls "$ROOT/opt/ff-check/$name/lib" | wc -l) from lib/; elsewhere or missing:"

@@ -104,6 +104,8 @@ for p in "${!packages[@]}"; do
 done
 
 cp "$ROOT/tools/plot_bench.py" "$ROOT/tools/plot_terrain.py" "$ROOT/README.md" "$pkg/share/farfield/"
+# The libraries loaded with dlopen, which ldd of the tool does not list (scripts/check_dist.sh checks them too).
+for path in "${dlopened[@]}"; do basename "$path"; done > "$pkg/share/farfield/dlopened.txt"
 
 rm -f "$tarball"
 tar -C "$stage" --sort=name --owner=0 --group=0 --numeric-owner -cf - "$name" | xz -9 -T2 >"$tarball.tmp"
