@@ -67,6 +67,7 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   runtime::GovernorOptions& g = loop_options_.governor;
   g.t_max_ms = t_max;
   g.aim = numberOption(context, "governor_aim", g.aim, 0.05, 1.0);
+  read_ahead_ = switchOption(context, "governor_read_ahead", true);
   g.refine_below = numberOption(context, "governor_refine_below", g.refine_below, 0.05, g.aim);
   g.refine_after = countOption(context, "governor_refine_after", g.refine_after);
   g.window = countOption(context, "governor_window", g.window);
@@ -181,6 +182,15 @@ void GovernedMode::frame(FrameContext& frame) {
     level.target.copyScaledTo(out);
   }
   if (const std::optional<bool> drew = drewImpostors()) impostor_frames_[frame.pathFrame()] = *drew;
+  // What the frame is expected to leave of the budget goes to loading what later frames will need (the placed
+  // walkthrough's impostors ahead), so that those frames do not load them; the measurement the loop gets leaves it
+  // out (the model is of the frame's drawing; the read-ahead only fills what the model says is left).
+  last_read_ahead_ms_ = 0.0;
+  if (read_ahead_) {
+    const double slack = loop_options_.governor.aim * loop_options_.governor.t_max_ms - decision.corrected_ms;
+    if (slack > 0.0) last_read_ahead_ms_ = inners_[level.inner]->readAhead(frame.camera(), slack);
+    read_ahead_ms_total_ += last_read_ahead_ms_;
+  }
 }
 
 std::optional<gpu::FrameStats> GovernedMode::lateFrameStats(size_t path_frame) {
@@ -193,7 +203,8 @@ std::optional<gpu::FrameStats> GovernedMode::lateFrameStats(size_t path_frame) {
 
 void GovernedMode::frameMeasured(size_t path_frame, double wall_ms) {
   inners_[last_inner_]->frameMeasured(path_frame, wall_ms);
-  if (last_frame_ && path_frame == last_path_frame_) loop_->frameMeasured(*last_frame_, wall_ms);
+  if (last_frame_ && path_frame == last_path_frame_)
+    loop_->frameMeasured(*last_frame_, std::max(0.0, wall_ms - last_read_ahead_ms_));
 }
 
 std::optional<FrameGovernance> GovernedMode::governance(size_t /*path_frame*/) const { return last_; }
@@ -223,6 +234,7 @@ std::map<std::string, double> GovernedMode::info() const {
   info["governor_predicted_over"] = double(s.predicted_over_frames);
   info["governor_lag_frames"] = double(loop_options_.lag);
   info["governor_calibration_s"] = calibration_s_;
+  info["governor_read_ahead_ms_total"] = read_ahead_ms_total_;
   info["governor_model_base_ms"] = model.base_ms;
   info["governor_model_ms_per_mtriangle"] = model.ms_per_mtriangle;
   info["governor_model_ms_per_mpixel"] = model.ms_per_mpixel;

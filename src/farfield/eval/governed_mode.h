@@ -29,7 +29,9 @@
 // the model, fitted on the calibration's quiet frames, is taken 1.5x larger until the first frame is measured)
 // (runtime::GovernorOptions),
 // governor_calibration_repeats (default 3), governor_t_max_ms (the budget where the command has no --tmax, e.g. walk;
-// it wins over --tmax). Needs one of them.
+// it wins over --tmax). Needs one of them. governor_read_ahead=on|off (default on): after each frame, what the
+// governor expects it to leave of aim x t_max goes to Mode::readAhead (the placed walkthrough loads the impostors it
+// will soon need), and that time is left out of the measurement the loop is given.
 #pragma once
 
 #include <map>
@@ -97,6 +99,9 @@ class GovernedMode final : public Mode {
   std::optional<uint64_t> last_frame_;  // the loop's number of the last frame drawn (none: it calibrated)
   size_t last_path_frame_ = 0;
   std::optional<FrameGovernance> last_;
+  bool read_ahead_ = true;           // governor_read_ahead: the slack goes to Mode::readAhead
+  double last_read_ahead_ms_ = 0.0;  // the last frame's read-ahead, left out of its measurement
+  double read_ahead_ms_total_ = 0.0;
 };
 
 }  // namespace farfield::eval

@@ -54,6 +54,8 @@ MmiMode::MmiMode(runtime::Representation representation, const ModeContext& cont
   o.error_px = numberOption(context, "error_px", 0.0, 0.0);
   o.layer_tiles = switchOption(context, "layer_tiles", true);
   o.coarser_impostors = switchOption(context, "coarser_impostors", true);
+  o.placed_read_ahead_frames = countOption(context, "read_ahead_frames", o.placed_read_ahead_frames, 0);
+  read_ahead_ms_ = numberOption(context, "read_ahead_ms", 0.0, 0.0);
   geometry_.emplace(context, runtime::representationName(representation));
   geometry_->configure(o);
 }
@@ -76,6 +78,7 @@ void MmiMode::frame(FrameContext& frame) {
     return !std::holds_alternative<runtime::LayerAsGeometry>(d) && !std::holds_alternative<runtime::ClusterAsGeometry>(d);
   });
   impostor_frames_[frame.pathFrame()] = last_drew_impostors_;
+  if (read_ahead_ms_ > 0.0) walkthrough_->readAheadPlaced(frame.camera(), read_ahead_ms_);
 }
 
 std::map<std::string, double> MmiMode::info() const {

@@ -26,6 +26,10 @@
 //   coarser_impostors=on|off  placed: impostors placed under a coarser bound (place --fallback-bounds) drawn, held
 //                           to their own bound (default on), or their objects drawn as geometry (off: every frame
 //                           keeps error_px; the governed mode's impostor levels raise it to take them)
+//   read_ahead_ms=MS        placed: each frame loads the impostors it will soon need within MS after it is drawn
+//                           (runtime::Walkthrough::readAheadPlaced; default 0: loaded by the frame that needs them;
+//                           the governed mode gives its slack instead, governor_read_ahead)
+//   read_ahead_frames=N     placed: how far ahead along the eye's motion it looks (default 15 frames; 0: never)
 //   geometry=gpu|cpu        the plan's geometry culled and drawn on the GPU through the run's arena (default; as
 //                           the culled mode, gpu_occlusion, gpu_cones, gpu_compact apply) or culled per cluster on
 //                           the CPU (eval/plan_geometry.h)
@@ -70,6 +74,9 @@ class MmiMode final : public Mode {
     return geometry_->lateFrameStats(path_frame);
   }
   bool setGeometryErrorPx(double px) override { return geometry_ && geometry_->setGeometryErrorPx(px); }
+  double readAhead(const Camera& camera, double budget_ms) override {
+    return walkthrough_ ? walkthrough_->readAheadPlaced(camera, budget_ms) : 0.0;
+  }
   std::map<std::string, double> info() const override;
   // None for local and visible, which draw geometry only.
   std::optional<bool> drewImpostors() const override {
@@ -86,6 +93,7 @@ class MmiMode final : public Mode {
   std::optional<PlanGeometry> geometry_;  // how the plans' geometry is drawn (--mode-option geometry, occlusion)
   std::map<size_t, bool> impostor_frames_;  // per path frame: an impostor drawn (addImpostorFrames)
   bool last_drew_impostors_ = false;
+  double read_ahead_ms_ = 0.0;  // placed: each frame's own read-ahead budget (--mode-option read_ahead_ms)
 };
 
 }  // namespace farfield::eval

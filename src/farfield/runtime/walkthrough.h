@@ -91,6 +91,8 @@ struct WalkthroughOptions {
   // own bound and counted (true), or their objects drawn as geometry so that every frame keeps error_px (false: a
   // frame governor then takes them as a coarser level by raising error_px).
   bool coarser_impostors = true;
+  // Placed: how many frames ahead readAheadPlaced() looks along the eye's motion (0: it loads nothing).
+  size_t placed_read_ahead_frames = 15;
   // true: the plan's geometry as draw items culled per cluster on the CPU (FramePlan::items, geometry_items);
   // false: as the objects a GPU-driven frame culls itself (FramePlan::geometry_objects, gpu::GpuCuller), the items
   // then holding the impostors only.
@@ -194,6 +196,15 @@ class Walkthrough {
   // once before the walkthrough renders anything itself in this frame (dynamic updates into their own targets), so a
   // host can start its frame timer or clear its target first. The plan stays valid until the next call.
   const FramePlan& plan(const Camera& camera, const std::function<void()>& before_gpu_work = {});
+
+  // Placed: impostors the walkthrough will soon need, loaded within `budget_ms` (the time the host can spare in this
+  // frame: Decoret et al. 1999, section 5.5, "from the desired and the predicted frame times we can determine how much
+  // time we have to accomplish such updates"), so that the frame that first draws one does not load it. They are the
+  // impostors, not yet resident, of the CPV holding the eye `placed_read_ahead_frames` frames on along its motion
+  // over the last frame, looking as now; one is loaded only when the slowest load so far fits in what is left (the
+  // first on trust), and none beyond the GPU budget. Returns the milliseconds spent; 0 for another representation
+  // (cells are read ahead on their own thread) or before a first plan.
+  double readAheadPlaced(const Camera& camera, double budget_ms);
 
   const WalkthroughOptions& options() const { return options_; }
   double errorBoundPx() const { return options_.error_px; }

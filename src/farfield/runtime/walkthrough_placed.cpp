@@ -33,8 +33,58 @@ void Walkthrough::openPlacement() {
   p.hidden.assign(scene_.objects.size() + 1, 0);
 }
 
+Walkthrough::Placed::Resident& Walkthrough::Placed::load(const WalkthroughOptions& options, uint32_t id,
+                                                         const store::StoredPlacedImpostor& record) {
+  Stopwatch timer;
+  const impostor::LayeredImpostor imp = store::loadPlacedImpostor(options.database, record);
+  Resident r;
+  r.gpu = std::make_unique<impostor::GpuLayeredImpostor>(
+      imp, options.layer_tiles ? impostor::LayerDraw::Tiles : impostor::LayerDraw::WholeQuads);
+  r.error_rad = imp.plan.error_angle;
+  r.bytes = r.gpu->gpuBytes();
+  resident_bytes += r.bytes;
+  lru.push_front(id);
+  r.lru = lru.begin();
+  Resident& placed = resident.emplace(id, std::move(r)).first->second;
+  ++stats.loads;
+  const double ms = timer.milliseconds();
+  stats.load_ms_total += ms;
+  stats.load_ms_max = std::max(stats.load_ms_max, ms);
+  stats.resident_bytes_max = std::max(stats.resident_bytes_max, resident_bytes);
+  return placed;
+}
+
+double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {
+  if (!placed_ || !(budget_ms > 0.0) || options_.placed_read_ahead_frames == 0) return 0.0;
+  Placed& p = *placed_;
+  if (!p.has_eye) return 0.0;
+  Stopwatch timer;
+  // Where the eye will be, moving on as over the last frame, and looking as now.
+  const Vec3 ahead = camera.eye + p.motion * float(options_.placed_read_ahead_frames);
+  const std::optional<uint32_t> cpv = store::lookupCpv(p.index, ahead, camera.forward());
+  if (!cpv) return 0.0;
+  for (uint32_t id : p.index.cpvs[*cpv].impostors) {
+    if (p.resident.count(id)) continue;
+    const store::StoredPlacedImpostor& record = *p.index.find(id);
+    if (record.bound.pixels > options_.error_px * (1.0 + 1e-9) && !options_.coarser_impostors) continue;
+    // The next load fits when the slowest so far does in what is left (the first is taken on trust); nothing is
+    // evicted for it: a read-ahead that would push the residents over the budget waits until the frame needs it.
+    const double left = budget_ms - timer.milliseconds();
+    if (p.stats.loads > 0 && p.stats.load_ms_max > left) break;
+    if (p.resident_bytes >= options_.gpu_budget_bytes) break;
+    p.load(options_, id, record);
+    ++p.stats.read_ahead_loads;
+  }
+  const double ms = timer.milliseconds();
+  p.stats.read_ahead_ms += ms;
+  return ms;
+}
+
 const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   Placed& p = *placed_;
+  p.motion = p.has_eye ? camera.eye - p.last_eye : Vec3(0.0f);
+  p.last_eye = camera.eye;
+  p.has_eye = true;
   FramePlan& plan = plan_;
   plan.items.clear();
   plan.geometry_bounds.clear();
@@ -100,22 +150,9 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
       }
       auto it = p.resident.find(id);
       if (it == p.resident.end()) {
-        Stopwatch timer;
-        const impostor::LayeredImpostor imp = store::loadPlacedImpostor(options_.database, record);
-        Placed::Resident r;
-        r.gpu = std::make_unique<impostor::GpuLayeredImpostor>(
-            imp, options_.layer_tiles ? impostor::LayerDraw::Tiles : impostor::LayerDraw::WholeQuads);
-        r.error_rad = imp.plan.error_angle;
-        r.bytes = r.gpu->gpuBytes();
-        p.resident_bytes += r.bytes;
-        p.lru.push_front(id);
-        r.lru = p.lru.begin();
-        it = p.resident.emplace(id, std::move(r)).first;
+        p.load(options_, id, record);
+        it = p.resident.find(id);
         report.loaded = true;
-        ++p.stats.loads;
-        const double ms = timer.milliseconds();
-        p.stats.load_ms_total += ms;
-        p.stats.load_ms_max = std::max(p.stats.load_ms_max, ms);
       } else {
         p.lru.splice(p.lru.begin(), p.lru, it->second.lru);  // most recent first, in constant time
       }
@@ -199,6 +236,8 @@ std::map<std::string, double> Walkthrough::placedStatistics() const {
   out["impostor_loads"] = double(s.loads);
   out["impostor_load_ms_mean"] = s.loads ? s.load_ms_total / double(s.loads) : 0.0;
   out["impostor_load_ms_max"] = s.load_ms_max;
+  out["impostors_read_ahead"] = double(s.read_ahead_loads);
+  out["impostor_read_ahead_ms"] = s.read_ahead_ms;
   out["cache_evictions"] = double(s.evictions);
   out["gpu_budget_bytes"] = double(options_.gpu_budget_bytes);
   out["resident_bytes_max"] = double(s.resident_bytes_max);

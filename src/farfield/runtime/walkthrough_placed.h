@@ -32,7 +32,14 @@ struct Walkthrough::Placed {
     size_t over_gpu_budget_frames = 0;
     size_t coarse_draws = 0;  // fallback impostors drawn (placed under a coarser bound than the walkthrough's)
     size_t coarse_left_to_geometry = 0;  // ... left to geometry (WalkthroughOptions::coarser_impostors false)
+    size_t read_ahead_loads = 0;         // loads by readAheadPlaced (also in loads)
+    double read_ahead_ms = 0.0;
   } stats;
+  // The eye's motion over the last frame (readAheadPlaced looks ahead along it).
+  bool has_eye = false;
+  Vec3 last_eye{0.0f}, motion{0.0f};
+  // Reads, uploads and makes resident the impostor `id` (stats.loads and its time); returns it.
+  Resident& load(const WalkthroughOptions& options, uint32_t id, const store::StoredPlacedImpostor& record);
 };
 
 }  // namespace farfield::runtime
