@@ -129,9 +129,7 @@ ViewChecks checkViews(const scene::Scene& scene, const gpu::CostProfile& profile
   const gpu::GpuScene gpu_scene(scene);
   const scene::Bvh bvh(scene);
   gpu::Renderer renderer;
-  runtime::WalkthroughOptions options;
-  options.database = dir;
-  options.representation = runtime::Representation::Placed;
+  runtime::WalkthroughOptions options = test::placedWalkthroughOptions(dir);
   runtime::Walkthrough walkthrough(scene, gpu_scene, bvh, renderer, options);
   const store::PlacementIndex index = store::readPlacementIndex(dir);
   const Box3 space = index.view_space;
@@ -227,9 +225,7 @@ TEST(PlaceTest, AGpuDrivenPlanListsItsRegionsObjectsAndDrawsTheSameFrame) {
   const gpu::SceneArena arena(scene);
   gpu::GpuCuller culler(arena);
   gpu::Renderer renderer;
-  runtime::WalkthroughOptions options;
-  options.database = s.dir;
-  options.representation = runtime::Representation::Placed;
+  runtime::WalkthroughOptions options = test::placedWalkthroughOptions(s.dir);
   runtime::Walkthrough with_items(scene, gpu_scene, bvh, renderer, options);
   options.geometry_items = false;
   runtime::Walkthrough with_objects(scene, gpu_scene, bvh, renderer, options);
@@ -242,15 +238,7 @@ TEST(PlaceTest, AGpuDrivenPlanListsItsRegionsObjectsAndDrawsTheSameFrame) {
   const int frames = 120;
   for (int f = 0; f < frames; ++f) {
     SCOPED_TRACE("frame " + std::to_string(f));
-    // Across the view space at mid height, turning slowly.
-    const float t = float(f) / float(frames - 1);
-    Camera camera;
-    camera.eye = Vec3(space.lo.x + (space.hi.x - space.lo.x) * (0.1f + 0.8f * t),
-                      space.lo.y + 0.5f * (space.hi.y - space.lo.y), 0.5f * (space.lo.z + space.hi.z));
-    const float yaw = 0.3f + 2.5f * t;
-    camera.at = camera.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
-    camera.width = camera.height = 128;
-    camera.fov_y = float(degToRad(45.0));
+    const Camera camera = test::viewSpaceWalkCamera(space, f, frames);
     const runtime::FramePlan& a = with_items.plan(camera);
     renderer.render(camera, a.items, reference_target);
     const runtime::FramePlan& b = with_objects.plan(camera);

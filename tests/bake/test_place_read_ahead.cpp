@@ -27,9 +27,7 @@ TEST(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChange
   const gpu::GpuScene gpu_scene(scene);
   const scene::Bvh bvh(scene);
   gpu::Renderer renderer;
-  runtime::WalkthroughOptions options;
-  options.database = dir;
-  options.representation = runtime::Representation::Placed;
+  runtime::WalkthroughOptions options = test::placedWalkthroughOptions(dir);
   runtime::Walkthrough plain(scene, gpu_scene, bvh, renderer, options);
   runtime::Walkthrough ahead(scene, gpu_scene, bvh, renderer, options);
   const Box3 space = store::readPlacementIndex(dir).view_space;
@@ -38,15 +36,7 @@ TEST(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChange
   const int frames = 120;
   for (int f = 0; f < frames; ++f) {
     SCOPED_TRACE("frame " + std::to_string(f));
-    // Across the view space at mid height, turning slowly.
-    const float t = float(f) / float(frames - 1);
-    Camera camera;
-    camera.eye = Vec3(space.lo.x + (space.hi.x - space.lo.x) * (0.1f + 0.8f * t),
-                      space.lo.y + 0.5f * (space.hi.y - space.lo.y), 0.5f * (space.lo.z + space.hi.z));
-    const float yaw = 0.3f + 2.5f * t;
-    camera.at = camera.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
-    camera.width = camera.height = 128;
-    camera.fov_y = float(degToRad(45.0));
+    const Camera camera = test::viewSpaceWalkCamera(space, f, frames);
     const runtime::FramePlan& a = plain.plan(camera);
     plain_loads += a.report.loaded;
     renderer.render(camera, a.items, plain_target);

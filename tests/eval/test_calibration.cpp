@@ -125,7 +125,7 @@ TEST(CalibrationTest, TheCpuAndGpuTermsAreFittedAndCheckedOnTheirOwnMeasurements
   double cpu_max = 0.0, gpu_max = 0.0, wall_max = 0.0;
   std::vector<double> gpu_ratios;
   for (const ViewCheck& c : r.checks) {
-    EXPECT_GT(c.measured_cpu_ms, 0.0);
+    EXPECT_GE(c.measured_cpu_ms, 0.0);  // wall less the GL calls' time, clamped at 0 (a loaded machine may get there)
     EXPECT_GT(c.measured_gpu_ms, 0.0);
     // Farfield's own CPU time is a part of the frame's wall time, both the minimum of the same single render.
     EXPECT_LE(c.measured_cpu_ms, c.measured_ms);
@@ -144,18 +144,19 @@ TEST(CalibrationTest, TheCpuAndGpuTermsAreFittedAndCheckedOnTheirOwnMeasurements
     gpu_under += c.measured_gpu_ms > c.predicted_gpu_ms;
     const double both = std::max(c.predicted_cpu_ms, c.predicted_gpu_ms);
     wall_under += c.measured_ms > both;
-    cpu_max = std::max(cpu_max, c.measured_cpu_ms / c.predicted_cpu_ms);
-    gpu_max = std::max(gpu_max, c.measured_gpu_ms / c.predicted_gpu_ms);
-    wall_max = std::max(wall_max, c.measured_ms / both);
-    gpu_ratios.push_back(c.measured_gpu_ms / c.predicted_gpu_ms);
+    // A prediction of 0 (a term fitted to nothing) counts as 1e-6 ms, as the calibration takes it.
+    cpu_max = std::max(cpu_max, c.measured_cpu_ms / std::max(c.predicted_cpu_ms, 1e-6));
+    gpu_max = std::max(gpu_max, c.measured_gpu_ms / std::max(c.predicted_gpu_ms, 1e-6));
+    wall_max = std::max(wall_max, c.measured_ms / std::max(both, 1e-6));
+    gpu_ratios.push_back(c.measured_gpu_ms / std::max(c.predicted_gpu_ms, 1e-6));
   }
   EXPECT_GT(drawing, 8u) << "most street views draw something";
   EXPECT_EQ(r.cpu.under_predicted, cpu_under);
   EXPECT_EQ(r.gpu.under_predicted, gpu_under);
   EXPECT_EQ(r.max_term.under_predicted, wall_under);
-  EXPECT_NEAR(r.cpu.ratio_max, cpu_max, 1e-9);
-  EXPECT_NEAR(r.gpu.ratio_max, gpu_max, 1e-9);
-  EXPECT_NEAR(r.max_term.ratio_max, wall_max, 1e-9);
+  EXPECT_NEAR(r.cpu.ratio_max, cpu_max, 1e-9 * cpu_max);
+  EXPECT_NEAR(r.gpu.ratio_max, gpu_max, 1e-9 * gpu_max);
+  EXPECT_NEAR(r.max_term.ratio_max, wall_max, 1e-9 * wall_max);
   std::sort(gpu_ratios.begin(), gpu_ratios.end());
   EXPECT_NEAR(r.gpu.ratio_p50, 0.5 * (gpu_ratios[7] + gpu_ratios[8]), 1e-9);  // 16 views: the 8th and 9th
   EXPECT_LE(r.gpu.ratio_p50, r.gpu.ratio_p95);

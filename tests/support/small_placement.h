@@ -4,7 +4,9 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "farfield/bake/place.h"
@@ -12,6 +14,7 @@
 #include "farfield/gpu/cost_profile.h"
 #include "farfield/core/object_fill.h"
 #include "farfield/gpu/renderer.h"
+#include "farfield/runtime/walkthrough.h"
 
 namespace farfield::test {
 
@@ -53,6 +56,28 @@ inline bake::PlaceOptions smallPlaceOptions(const scene::Scene& scene) {
   p.progress = false;
   p.t_max_ms = 9.0;
   return p;
+}
+
+// A walkthrough over the placement database in `dir`, with the runtime's defaults otherwise.
+inline runtime::WalkthroughOptions placedWalkthroughOptions(const std::string& dir) {
+  runtime::WalkthroughOptions options;
+  options.database = dir;
+  options.representation = runtime::Representation::Placed;
+  return options;
+}
+
+// Frame f of `frames` of a walk across the placement's view space at mid height, turning slowly (128 x 128, 45
+// degrees, as the placement's frames).
+inline Camera viewSpaceWalkCamera(const Box3& space, int f, int frames) {
+  const float t = float(f) / float(frames - 1);
+  Camera camera;
+  camera.eye = Vec3(space.lo.x + (space.hi.x - space.lo.x) * (0.1f + 0.8f * t),
+                    space.lo.y + 0.5f * (space.hi.y - space.lo.y), 0.5f * (space.lo.z + space.hi.z));
+  const float yaw = 0.3f + 2.5f * t;
+  camera.at = camera.eye + Vec3(std::cos(yaw), std::sin(yaw), 0.0f);
+  camera.width = camera.height = 128;
+  camera.fov_y = float(degToRad(45.0));
+  return camera;
 }
 
 // The fill term's workload of drawn items (gpu/cost_model.h): each scene object among them counted once, from the
