@@ -24,6 +24,7 @@ bool GpuDepthPyramid::resize(int width, int height) {
   if (width == width_ && height == height_) return false;
   {
     width_ = width, height_ = height;
+    sizes_uploaded_ = false;
     level_size_.assign(1, {width_, height_});
     while (level_size_.back()[0] > 1 || level_size_.back()[1] > 1)
       level_size_.push_back({(level_size_.back()[0] + 1) / 2, (level_size_.back()[1] + 1) / 2});
@@ -51,9 +52,12 @@ void GpuDepthPyramid::build(const RenderTarget& target) {
   resize(target.width(), target.height());
   const int levels = int(level_size_.size());
   if (levels < 2) return;
+  if (!sizes_uploaded_) {  // the level sizes change with the target's only (resize)
+    const std::vector<int> sizes = levelSizes();
+    glProgramUniform2iv(program_.handle(), program_.uniformLocation("u_size[0]"), GLsizei(levels), sizes.data());
+    sizes_uploaded_ = true;
+  }
   program_.use();
-  const std::vector<int> sizes = levelSizes();
-  glUniform2iv(program_.uniformLocation("u_size[0]"), GLsizei(levels), sizes.data());
   glBindTextureUnit(2, depth_);
   // Up to kLevelsPerDispatch levels a dispatch (depth_pyramid.comp.glsl), each invocation one texel of the last.
   for (int first = 0; first + 1 < levels; first += kLevelsPerDispatch) {

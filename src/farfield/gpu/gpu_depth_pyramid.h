@@ -38,6 +38,7 @@ class GpuDepthPyramid {
   Program program_;
   uint32_t texture_ = 0, depth_ = 0;
   int width_ = 0, height_ = 0;
+  bool sizes_uploaded_ = false;  // the shader's u_size holds level_size_
   std::vector<std::array<int, 2>> level_size_;
 };
 

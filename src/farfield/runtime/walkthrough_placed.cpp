@@ -33,8 +33,17 @@ void Walkthrough::openPlacement() {
   p.hidden.assign(scene_.objects.size() + 1, 0);
 }
 
-Walkthrough::Placed::Resident& Walkthrough::Placed::load(const WalkthroughOptions& options, uint32_t id,
-                                                         const store::StoredPlacedImpostor& record) {
+namespace {
+
+// A fallback impostor: placed under a coarser bound than the walkthrough's (bake::PlaceOptions::fallback_bound_factors).
+bool underCoarserBound(const store::StoredPlacedImpostor& record, double error_px) {
+  return record.bound.pixels > error_px * (1.0 + 1e-9);
+}
+
+}  // namespace
+
+std::unordered_map<uint32_t, Walkthrough::Placed::Resident>::iterator Walkthrough::Placed::load(
+    const WalkthroughOptions& options, uint32_t id, const store::StoredPlacedImpostor& record) {
   Stopwatch timer;
   const impostor::LayeredImpostor imp = store::loadPlacedImpostor(options.database, record);
   Resident r;
@@ -45,12 +54,11 @@ Walkthrough::Placed::Resident& Walkthrough::Placed::load(const WalkthroughOption
   resident_bytes += r.bytes;
   lru.push_front(id);
   r.lru = lru.begin();
-  Resident& placed = resident.emplace(id, std::move(r)).first->second;
+  const auto placed = resident.emplace(id, std::move(r)).first;
   ++stats.loads;
   const double ms = timer.milliseconds();
   stats.load_ms_total += ms;
   stats.load_ms_max = std::max(stats.load_ms_max, ms);
-  stats.resident_bytes_max = std::max(stats.resident_bytes_max, resident_bytes);
   return placed;
 }
 
@@ -66,7 +74,7 @@ double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {
   for (uint32_t id : p.index.cpvs[*cpv].impostors) {
     if (p.resident.count(id)) continue;
     const store::StoredPlacedImpostor& record = *p.index.find(id);
-    if (record.bound.pixels > options_.error_px * (1.0 + 1e-9) && !options_.coarser_impostors) continue;
+    if (underCoarserBound(record, options_.error_px) && !options_.coarser_impostors) continue;
     // The next load fits when the slowest so far does in what is left (the first is taken on trust); nothing is
     // evicted for it: a read-ahead that would push the residents over the budget waits until the frame needs it.
     const double left = budget_ms - timer.milliseconds();
@@ -75,6 +83,7 @@ double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {
     p.load(options_, id, record);
     ++p.stats.read_ahead_loads;
   }
+  p.stats.resident_bytes_max = std::max(p.stats.resident_bytes_max, p.resident_bytes);
   const double ms = timer.milliseconds();
   p.stats.read_ahead_ms += ms;
   return ms;
@@ -142,7 +151,7 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
       // A fallback impostor (placed under a coarser bound for a CPV the bound could not bring under t_max, see
       // bake::PlaceOptions::fallback_bound_factors) is held to its own bound, and counted; or, without
       // coarser_impostors, left to geometry (and not loaded).
-      const bool coarse = record.bound.pixels > options_.error_px * (1.0 + 1e-9);
+      const bool coarse = underCoarserBound(record, options_.error_px);
       if (coarse && !options_.coarser_impostors) {
         leaveToGeometry(id, record);
         ++p.stats.coarse_left_to_geometry;
@@ -150,8 +159,7 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
       }
       auto it = p.resident.find(id);
       if (it == p.resident.end()) {
-        p.load(options_, id, record);
-        it = p.resident.find(id);
+        it = p.load(options_, id, record);
         report.loaded = true;
       } else {
         p.lru.splice(p.lru.begin(), p.lru, it->second.lru);  // most recent first, in constant time

@@ -39,7 +39,8 @@ struct Walkthrough::Placed {
   bool has_eye = false;
   Vec3 last_eye{0.0f}, motion{0.0f};
   // Reads, uploads and makes resident the impostor `id` (stats.loads and its time); returns it.
-  Resident& load(const WalkthroughOptions& options, uint32_t id, const store::StoredPlacedImpostor& record);
+  std::unordered_map<uint32_t, Resident>::iterator load(const WalkthroughOptions& options, uint32_t id,
+                                                        const store::StoredPlacedImpostor& record);
 };
 
 }  // namespace farfield::runtime
