@@ -68,6 +68,8 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   g.t_max_ms = t_max;
   g.aim = numberOption(context, "governor_aim", g.aim, 0.05, 1.0);
   read_ahead_ = switchOption(context, "governor_read_ahead", true);
+  upscale_channels_ = switchOption(context, "governor_upscale_depth", false) ? gpu::TargetUpscaler::Channels::All
+                                                                            : gpu::TargetUpscaler::Channels::ColorAndIds;
   g.refine_below = numberOption(context, "governor_refine_below", g.refine_below, 0.05, g.aim);
   g.refine_after = countOption(context, "governor_refine_after", g.refine_after);
   g.window = countOption(context, "governor_window", g.window);
@@ -83,6 +85,7 @@ void GovernedMode::prepare(const ModeContext& context) {
   renderer_ = context.renderer;
   finish_target_ = gpu::RenderTarget(1, 1);
   full_target_ = gpu::RenderTarget(context.width, context.height);
+  upscaler_ = std::make_unique<gpu::TargetUpscaler>();
   // The levels, in the order: impostors under larger bounds (governor_impostor_px), then the simplified levels
   // (at full resolution, with the coarsest impostor bound), where the governed mode draws through the arena; then the
   // lower resolutions, with the coarsest of both.
@@ -146,8 +149,8 @@ void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {
     for (size_t level = 0; level < levels_.size(); ++level) {
       Stopwatch clock;
       const gpu::FrameStats drawn = drawLevel(camera, path_frame, level);
-      // A lower resolution's frame is scaled up as in a real frame (the first blit also makes the driver's state).
-      if (levels_[level].scale < 1.0) levels_[level].target.copyScaledTo(full_target_);
+      // A lower resolution's frame is scaled up as in a real frame (the first also makes the driver's state).
+      if (levels_[level].scale < 1.0) upscaler_->draw(levels_[level].target, full_target_, upscale_channels_);
       renderer_->render(tiny, {}, finish_target_);  // waits for the GPU (Renderer::render's glFinish)
       const double ms = clock.milliseconds();
       double triangles = double(drawn.triangles);
@@ -177,9 +180,10 @@ void GovernedMode::frame(FrameContext& frame) {
     inners_[level.inner]->setGeometryErrorPx(level.lod_px);
     inners_[level.inner]->frame(frame);
   } else {
-    gpu::RenderTarget& out = frame.beginOwnPass();
+    // The upscale writes every pixel of the frame's target: no clear of it first.
+    gpu::RenderTarget& out = frame.beginOwnPassOverwritingAll();
     frame.addStats(drawLevel(frame.camera(), frame.pathFrame(), decision.level));
-    level.target.copyScaledTo(out);
+    upscaler_->draw(level.target, out, upscale_channels_);
   }
   if (const std::optional<bool> drew = drewImpostors()) impostor_frames_[frame.pathFrame()] = *drew;
   // What the frame is expected to leave of the budget goes to loading what later frames will need (the placed

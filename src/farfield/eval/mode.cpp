@@ -98,6 +98,14 @@ gpu::RenderTarget& FrameContext::beginOwnPass() {
   return target_;
 }
 
+gpu::RenderTarget& FrameContext::beginOwnPassOverwritingAll() {
+  if (!drew_passes_) {
+    drew_passes_ = true;
+    if (timer_) timer_->begin();
+  }
+  return target_;
+}
+
 void FrameContext::addStats(const gpu::FrameStats& stats) {
   pass_stats_.triangles += stats.triangles;
   pass_stats_.draw_calls += stats.draw_calls;

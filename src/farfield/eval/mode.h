@@ -114,6 +114,9 @@ class FrameContext {
   // Inside frame() draw with Renderer::draw or the mode's own programs, never with Renderer::render: render() waits
   // for the GPU (a stall no real frame would have) and its GL_TIME_ELAPSED query cannot nest in the harness's.
   gpu::RenderTarget& beginOwnPass();
+  // beginOwnPass for a pass that writes every pixel's colour, id and depth itself (gpu::TargetUpscaler): the frame's
+  // GPU timer starts, and the target is not cleared first.
+  gpu::RenderTarget& beginOwnPassOverwritingAll();
   void addStats(const gpu::FrameStats& stats);
 
   // Harness side, after Mode::frame(): the main pass. The target is cleared first (and the timer started) when the

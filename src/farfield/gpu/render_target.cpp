@@ -58,24 +58,6 @@ RenderTarget& RenderTarget::operator=(RenderTarget&& other) noexcept {
   return *this;
 }
 
-void RenderTarget::copyScaledTo(const RenderTarget& to) const {
-  // A blit writes every draw buffer of the destination from the one read buffer, and colour and ids have different
-  // formats (RGBA8, R32UI): one attachment at a time, the read and draw buffers set for it and restored after.
-  const GLenum color_only[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
-  const GLenum ids_only[] = {GL_NONE, GL_COLOR_ATTACHMENT1};
-  const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glDisable(GL_SCISSOR_TEST);
-  glNamedFramebufferDrawBuffers(to.fbo_, 2, color_only);
-  glBlitNamedFramebuffer(fbo_, to.fbo_, 0, 0, width_, height_, 0, 0, to.width_, to.height_, GL_COLOR_BUFFER_BIT,
-                         GL_LINEAR);
-  glNamedFramebufferReadBuffer(fbo_, GL_COLOR_ATTACHMENT1);
-  glNamedFramebufferDrawBuffers(to.fbo_, 2, ids_only);
-  glBlitNamedFramebuffer(fbo_, to.fbo_, 0, 0, width_, height_, 0, 0, to.width_, to.height_,
-                         GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT, GL_NEAREST);
-  glNamedFramebufferReadBuffer(fbo_, GL_COLOR_ATTACHMENT0);
-  glNamedFramebufferDrawBuffers(to.fbo_, 2, both);
-}
-
 void RenderTarget::bind() const {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glViewport(0, 0, width_, height_);

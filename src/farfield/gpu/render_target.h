@@ -35,10 +35,6 @@ class RenderTarget {
   // readback of a frame's own depth for occlusion culling, with no flip and no allocation once sized.
   void readDepthRows(std::vector<float>& rows) const;
 
-  // Scales this target's colour (bilinear), object ids and depth (nearest) over the whole of `to` (another size):
-  // a frame rendered at a lower resolution shown at the full one. GPU work only, no wait.
-  void copyScaledTo(const RenderTarget& to) const;
-
   const Texture& colorTexture() const { return color_; }
   const Texture& depthTexture() const { return depth_; }
   const Texture& idTexture() const { return ids_; }
