@@ -11,7 +11,9 @@
 //
 // With T_MAX_MS, a frame governor keeps that budget (runtime/governor_loop.h): the arena gets simplified levels, the
 // first view is drawn at each level with waits (the engine's loading frame: the calibration), and then each frame's
-// level is chosen before it is drawn from the model and the GPU times of earlier frames, read two frames late.
+// level is chosen before it is drawn from the model and the GPU times of earlier frames, read two frames late. The
+// last level, for a budget the simplified geometry cannot keep, draws at half the resolution and scales the frame up
+// (gpu::TargetUpscaler, an engine's dynamic resolution); it keeps twice the bound, and says so (relaxed).
 #include <algorithm>
 #include <cstdio>
 #include <cstdint>
@@ -29,6 +31,7 @@
 #include "farfield/gpu/gpu_timer.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/gpu/renderer.h"
+#include "farfield/gpu/target_upscaler.h"
 #include "farfield/image/png_io.h"
 #include "farfield/runtime/governor_loop.h"
 #include "farfield/runtime/walkthrough.h"
@@ -68,24 +71,38 @@ int main(int argc, char** argv) {
     const gpu::SceneArena arena(scene, arena_options);
     gpu::GpuCuller culler(arena);
 
-    // The frame governor's levels: the simplified geometry under 0, 1, 2 and 4 pixels, each keeping max(bound, px).
-    const std::vector<float> lod_px{0.0f, 1.0f, 2.0f, 4.0f};
+    // The frame governor's levels: the simplified geometry under 0, 1, 2 and 4 pixels, each keeping max(bound, px),
+    // then the 4 px geometry at half the resolution, keeping twice that (a pixel there is two of the frame's).
+    struct Level {
+      float lod_px, scale;
+    };
+    const std::vector<Level> levels_drawn{{0.0f, 1.0f}, {1.0f, 1.0f}, {2.0f, 1.0f}, {4.0f, 1.0f}, {4.0f, 0.5f}};
+    gpu::RenderTarget half(width / 2, height / 2);
+    std::unique_ptr<gpu::TargetUpscaler> upscaler;
     std::unique_ptr<runtime::GovernorLoop> governor;
     if (t_max_ms > 0.0) {
+      upscaler = std::make_unique<gpu::TargetUpscaler>();
       std::vector<runtime::LoopLevel> levels;
-      for (float px : lod_px)
-        levels.push_back({{"simplified to " + std::to_string(px) + " px",
-                           std::max(1.0, double(px) / std::max(walkthrough.errorBoundPx(), 1e-9))},
-                          double(width) * double(height)});
+      for (const Level& l : levels_drawn)
+        levels.push_back({{"simplified to " + std::to_string(l.lod_px) + " px at " + std::to_string(l.scale),
+                           std::max(1.0, double(l.lod_px) / std::max(walkthrough.errorBoundPx(), 1e-9)) / l.scale},
+                          double(width) * double(height) * l.scale * l.scale});
       runtime::GovernorLoopOptions loop;
       loop.governor.t_max_ms = t_max_ms;
       governor = std::make_unique<runtime::GovernorLoop>(std::move(levels), loop);
     }
-    const auto drawFrame = [&](const Camera& camera, const runtime::FramePlan& plan) {
-      target.bind();
-      target.clear(renderer.light().sky_color);
-      culler.draw(camera, target, gpu::RenderMode::Shaded, renderer.light());
-      renderer.draw(camera, plan.items, target);
+    const auto drawFrame = [&](const Camera& camera, const runtime::FramePlan& plan, size_t level) {
+      const Level& l = levels_drawn[level];
+      culler.setLodErrorPx(l.lod_px);
+      gpu::RenderTarget& into = l.scale < 1.0f ? half : target;
+      Camera c = camera;
+      c.width = into.width();
+      c.height = into.height();
+      into.bind();
+      into.clear(renderer.light().sky_color);
+      culler.draw(c, into, gpu::RenderMode::Shaded, renderer.light());
+      renderer.draw(c, plan.items, into);
+      if (&into != &target) upscaler->draw(half, target, gpu::TargetUpscaler::Channels::ColorAndIds);
     };
     if (governor) {
       // The calibration: the first view at every level, each waited for (the public wait: a 1 x 1 render).
@@ -96,10 +113,9 @@ int main(int argc, char** argv) {
       tiny.width = tiny.height = 1;
       gpu::RenderTarget tiny_target(1, 1);
       for (int round = 0; round <= 3; ++round)
-        for (size_t level = 0; level < lod_px.size(); ++level) {
-          culler.setLodErrorPx(lod_px[level]);
+        for (size_t level = 0; level < levels_drawn.size(); ++level) {
           Stopwatch clock;
-          drawFrame(camera, plan);
+          drawFrame(camera, plan, level);
           renderer.render(tiny, {}, tiny_target);
           const double ms = clock.milliseconds();
           const std::vector<gpu::GpuCullStats> stats = culler.finishedStats();
@@ -117,10 +133,11 @@ int main(int argc, char** argv) {
     for (size_t f = 0; f < path.frames.size(); ++f) {
       const Camera camera = path.camera(f, width, height);
       const runtime::FramePlan& plan = walkthrough.plan(camera);
+      size_t level = 0;
       if (governor) {
         if (f >= 2) governor->frameMeasured(f - 2, timers[(f - 2) % 3].elapsedMs());
         const runtime::GovernorDecision decision = governor->decide(f);
-        culler.setLodErrorPx(lod_px[decision.level]);
+        level = decision.level;
         relaxed += decision.relaxed ? 1 : 0;
         timers[f % 3].begin();
       }
@@ -130,7 +147,7 @@ int main(int argc, char** argv) {
         culler.setObjects(plan.geometry_objects);
         version = plan.geometry_version;
       }
-      drawFrame(camera, plan);
+      drawFrame(camera, plan, level);
       if (governor) timers[f % 3].end();
       for (const gpu::GpuCullStats& s : culler.finishedStats()) {  // earlier frames', as the GPU finishes them
         if (governor && s.frame >= first_culler_frame) governor->frameTriangles(s.frame - first_culler_frame, double(s.triangles));
@@ -155,7 +172,7 @@ int main(int argc, char** argv) {
     if (governor) {
       const runtime::FrameGovernor::Statistics& s = governor->governor().statistics();
       std::printf("governor: t_max %.2f ms, frames per level", t_max_ms);
-      for (size_t level = 0; level < lod_px.size(); ++level) std::printf(" %zu", s.frames_at_level[level]);
+      for (size_t l = 0; l < levels_drawn.size(); ++l) std::printf(" %zu", s.frames_at_level[l]);
       std::printf(", relaxed %zu of %zu, measured over t_max %zu\n", relaxed, path.frames.size(), s.measured_over);
     }
     if (argc > 5) image::writePng(argv[5], target.readColor());

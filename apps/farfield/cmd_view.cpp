@@ -66,7 +66,8 @@ const RegisterCommand reg("view", [](CLI::App& app) {
                                          "database offers, with the two promises measured (docs/VIEWER.md).");
   cmd->add_option("scene", args->scene, "Scene file (glTF, OBJ, ...) or builtin:NAME")->required();
   cmd->add_option("--impostors", o.impostors, "Impostor database: farfield bake --pipeline or farfield place output");
-  cmd->add_option("--mode", o.mode, "Starting mode (default: the database's best, else full)");
+  cmd->add_option("--mode", o.mode, "Starting mode (default: the database's best, else full; over a placement, "
+                                    "governed: placed under the frame governor, keeping --tmax)");
   cmd->add_option("--path", o.path, "Camera path to play in real time, looping (P pauses)");
   cmd->add_option("--replay", o.replay, "Camera path to show one frame per displayed frame (scripted runs)");
   cmd->add_option("--screenshot-at", args->screenshot_at,
@@ -75,7 +76,8 @@ const RegisterCommand reg("view", [](CLI::App& app) {
   cmd->add_flag("--exit", o.exit_at_end, "Close after the replay (or the last screenshot); errors close at once");
   cmd->add_option("--record", o.record, "Write the cameras shown to this camera path file at exit");
   cmd->add_option("--size", args->size, "Window and frame size WxH")->capture_default_str();
-  cmd->add_option("--tmax", o.t_max_ms, "Frame budget in ms the panel counts frames against (0 = none)");
+  cmd->add_option("--tmax", o.t_max_ms, "Frame budget in ms the panel counts frames against, and the governed "
+                                        "mode keeps (0 = none)");
   cmd->add_option("--error-px", o.error_px, "Error bound in pixels for the walkthrough (default: the database's)");
   cmd->add_option("--streets", o.streets, "Street graph for the map (default: the database's, or next to the scene)");
   cmd->add_flag("--walk", args->walk, "Start walking (eye 1.7 m above the ground) instead of flying");

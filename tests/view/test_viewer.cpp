@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -16,6 +17,8 @@
 #include "farfield/eval/mode.h"
 #include "farfield/image/metrics.h"
 #include "farfield/image/png_io.h"
+#include "farfield/store/placement_store.h"
+#include "farfield/view/database_modes.h"
 #include "view/view_test_city.h"
 
 namespace fs = std::filesystem;
@@ -142,6 +145,54 @@ TEST(Viewer, ReplayedPlacedFramesEqualTheBenchModeAtTheSameCamera) {
   // Another frame of the path is not close: the comparison can fail.
   runner.run(*bench_mode, eval::pathCamera(c.path, 7, size, size), 7);
   EXPECT_LT(image::psnr(image::readPng(out + "/frame_0.png"), run.target.readColor()), 40.0);
+}
+
+// Over a placement the viewer offers placed and governed (placed under the frame governor), opens on placed, and its
+// governed frames are the bench's governed mode's under the same budget: here one no level meets, so that every
+// frame is drawn at the coarsest level (half the resolution, 4 px geometry) and says the bound it kept.
+TEST(Viewer, ReplayedGovernedFramesEqualTheBenchModeUnderTheSameBudget) {
+  FF_REQUIRE_DISPLAY();
+  const test::ViewPlacement& c = test::viewPlacement();
+  const DatabaseModes modes = databaseModes(c.database);
+  EXPECT_EQ(modes.modes, (std::vector<std::string>{"full", "culled", "placed", "governed"}));
+  EXPECT_EQ(defaultMode(modes), "placed");
+  const int size = 128;
+  const double t_max_ms = 0.001;
+  const std::string out = farfield::test::scratchDir("view_governed").string();
+  ViewerOptions options;
+  options.replay = c.path_file;
+  options.screenshot_at = {0, 3, 7};
+  options.out_dir = out;
+  options.exit_at_end = true;
+  options.width = options.height = size;
+  options.mode = "governed";
+  options.impostors = c.database;
+  options.t_max_ms = t_max_ms;
+  runViewer(c.city.scene, options);
+
+  gpu::sharedHeadlessContext();
+  eval::registerImpostorModes();
+  char number[32];
+  std::snprintf(number, sizeof(number), "%.17g",
+                store::readPlacementIndex(c.database).options.at("error_px").get<double>());
+  eval::ModeRunResources run(c.city.scene, size, size,
+                             {{"impostor_dir", c.database}, {"governed", "placed"}, {"governor_t_max_ms", "0.001"},
+                              {"governor_error_px", number}});
+  std::unique_ptr<eval::Mode> governed = eval::createMode("governed", run.context);
+  governed->prepare(run.context);
+  eval::FrameRunner runner(run.renderer, run.target);
+  for (size_t i = 0; i < c.path.frames.size(); ++i) {
+    const eval::FrameRecord record = runner.run(*governed, eval::pathCamera(c.path, i, size, size), i);
+    EXPECT_GT(record.bound_scale, 1.0) << "frame " << i << ": not relaxed under a budget no level meets";
+    if (i != 0 && i != 3 && i != 7) continue;
+    const image::ColorImage frame = image::readPng(out + "/frame_" + std::to_string(i) + ".png");
+    EXPECT_GT(image::psnr(frame, run.target.readColor()), 40.0) << "governed frame " << i;
+  }
+  // The placed walkthrough's own frame (level 0, the full resolution) is not close: the comparison can fail.
+  std::unique_ptr<eval::Mode> placed = eval::createMode("placed", run.context);
+  placed->prepare(run.context);
+  runner.run(*placed, eval::pathCamera(c.path, 3, size, size), 3);
+  EXPECT_LT(image::psnr(image::readPng(out + "/frame_3.png"), run.target.readColor()), 40.0);
 }
 
 TEST(Viewer, TintShowsImpostorsInTheirKindsColour) {

@@ -20,6 +20,7 @@ DatabaseModes databaseModes(const std::string& dir) {
     out.kind = DatabaseKind::Placement;
     out.placement = std::make_shared<const store::PlacementIndex>(store::readPlacementIndex(dir));
     out.modes.push_back("placed");
+    out.modes.push_back("governed");  // placed under the frame governor (eval/governed_mode.h)
     return out;
   }
   if (!fs::exists(fs::path(dir) / store::kIndexFile, ec))
@@ -40,6 +41,7 @@ DatabaseModes databaseModes(const std::string& dir) {
 }
 
 std::string defaultMode(const DatabaseModes& modes) {
+  if (modes.kind == DatabaseKind::Placement) return "placed";  // the promised bound on every frame
   return modes.kind == DatabaseKind::None ? "full" : modes.modes.back();
 }
 

@@ -1,10 +1,17 @@
 #include "farfield/view/mode_renderer.h"
 
+#include <cstdio>
+#include <filesystem>
+
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
 #include "farfield/eval/city_on_terrain_mode.h"
+#include "farfield/eval/impostor_mode.h"
 #include "farfield/eval/terrain_modes.h"
+#include "farfield/store/placement_store.h"
+
+namespace fs = std::filesystem;
 
 namespace farfield::view {
 
@@ -91,10 +98,13 @@ void ModeRenderer::select(const std::string& mode) {
     geometry_version_ = ~uint64_t(0);
     geometry_->culler().resetHistory();
     plan_frame_ = std::make_unique<PlanFrame>(*this);
+  } else if (mode == "governed") {
+    eval_mode_ = governedMode();
+    walkthrough_.reset();
   } else {
     if (mode != "full" && mode != "culled")
-      throw Error("mode '" + mode + "'", "unknown; the viewer draws full, culled and the database's representations "
-                                         "(local, visible, smi, mmi, mmi-dynamic, placed)");
+      throw Error("mode '" + mode + "'", "unknown; the viewer draws full, culled, the database's representations "
+                                         "(local, visible, smi, mmi, mmi-dynamic, placed) and governed");
     std::unique_ptr<eval::Mode> created;
     if (settings_.terrain.empty()) created = eval::createMode(mode, context_);
     else created = std::make_unique<eval::CityOnTerrainMode>(settings_.terrain_technique, mode);
@@ -107,6 +117,61 @@ void ModeRenderer::select(const std::string& mode) {
   last_plan_ = nullptr;
 }
 
+std::unique_ptr<eval::Mode> ModeRenderer::governedMode() {
+  if (settings_.database.empty() || !fs::exists(fs::path(settings_.database) / store::kPlacementIndexFile))
+    throw Error("mode 'governed'", "needs a placement database (farfield place ... -o DIR; --impostors DIR)");
+  if (!(settings_.t_max_ms > 0.0))
+    throw Error("mode 'governed'", "needs a frame budget: --tmax MS (or t_max in the panel) above 0");
+  if (!settings_.terrain.empty())
+    FF_WARN("mode governed draws the city without the terrain (full and culled draw it under the city)");
+  // The promised bound the governor's levels are relative to: the viewer's, else the placement's own.
+  double bound_px = settings_.error_px;
+  if (!(bound_px > 0.0)) {
+    const nlohmann::json options = store::readPlacementIndex(settings_.database).options;
+    if (!options.contains("error_px") || !options["error_px"].is_number())
+      throw Error(settings_.database + "/" + store::kPlacementIndexFile,
+                  "options.error_px is missing: give the viewer an error bound (--error-px)");
+    bound_px = options["error_px"].get<double>();
+  }
+  governed_bound_px_ = bound_px;
+  eval::ModeContext context = context_;  // shares the run's arena
+  const auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.17g", v);
+    return std::string(text);
+  };
+  context.options["governed"] = "placed";
+  context.options["impostor_dir"] = settings_.database;
+  context.options["governor_t_max_ms"] = number(settings_.t_max_ms);
+  context.options["governor_error_px"] = number(bound_px);
+  if (settings_.error_px > 0.0) context.options["error_px"] = number(settings_.error_px);
+  // The governor's simplified levels are made with the arena. One already made without them (culled or a walkthrough
+  // mode selected first) stays: the governor then coarsens by impostors and resolution only.
+  const bool arena_without_levels = context.arena_slot->arena && !context.arena_slot->simplified_levels;
+  if (arena_without_levels) {
+    context.options["governor_lod_px"] = "0";
+    FF_WARN("mode governed: the scene's arena was made without simplified levels (--mode governed opens with "
+            "them): its coarser levels are lower resolutions only");
+  }
+  eval::registerImpostorModes();  // placed is one of them (registering again replaces the same entries)
+  std::unique_ptr<eval::Mode> created;
+  try {
+    created = eval::createMode("governed", context);  // asks for the levels (ArenaSlot::simplified_levels)
+    if (arena_without_levels) context.arena_slot->simplified_levels = false;
+    created->prepare(context);
+  } catch (...) {
+    if (arena_without_levels) context.arena_slot->simplified_levels = false;
+    throw;
+  }
+  return created;
+}
+
+void ModeRenderer::setTMaxMs(double t_max_ms) {
+  if (t_max_ms == settings_.t_max_ms) return;
+  settings_.t_max_ms = t_max_ms;
+  if (mode_ == "governed") select("governed");
+}
+
 ViewFrame ModeRenderer::render(const Camera& camera, size_t frame_index, bool tint) {
   FF_CHECK(eval_mode_ || walkthrough_);
   ViewFrame frame;
@@ -116,6 +181,8 @@ ViewFrame ModeRenderer::render(const Camera& camera, size_t frame_index, bool ti
     frame.gpu_ms = record.gpu_ms;
     frame.triangles = record.triangles;
     frame.draw_calls = record.draw_calls;
+    frame.governance = eval_mode_->governance(frame_index);
+    if (frame.governance) frame.kept_bound_px = governed_bound_px_ * frame.governance->bound_scale;
     return frame;
   }
   plan_frame_->replan = true;

@@ -34,6 +34,8 @@ struct ModeSettings {
   float terrain_scale = 1.0f;
   // The terrain technique (eval/city_on_terrain_mode.h): lod-sprite-gpu, high-gpu, lod-sprite or high.
   std::string terrain_technique = "lod-sprite-gpu";
+  // The frame budget the governed mode keeps (its governor_t_max_ms), as it is when the mode is selected.
+  double t_max_ms = 1000.0 / 30.0;
 };
 
 // One displayed frame.
@@ -44,6 +46,10 @@ struct ViewFrame {
   uint32_t draw_calls = 0;
   const runtime::FramePlan* plan = nullptr;  // walkthrough modes; valid until the next frame
   std::array<size_t, kDecisionKinds> decisions{};
+  // The governed mode: the governor's decision for this frame, and the bound it kept (the promised bound x its
+  // bound scale, in pixels); 0 in the other modes.
+  std::optional<eval::FrameGovernance> governance;
+  double kept_bound_px = 0.0;
 };
 
 class ModeRenderer {
@@ -53,12 +59,15 @@ class ModeRenderer {
                gpu::Renderer& renderer, gpu::RenderTarget& target, ModeSettings settings);
   ~ModeRenderer();
 
-  // Switches to a mode ("full", "culled" or a runtime representation name). Throws farfield::Error (an unknown name,
-  // a database that cannot draw it, a damaged database, a city that does not lie on the terrain); the previous mode
-  // stays in use then. With a terrain, full and culled draw it under the city; the representations do not (a
+  // Switches to a mode ("full", "culled", a runtime representation name, or "governed": the placed walkthrough of a
+  // placement database under eval's frame governor, keeping settings' t_max_ms). Throws farfield::Error (an unknown
+  // name, a database that cannot draw it, a damaged database, a city that does not lie on the terrain, governed
+  // without a placement or a budget); the previous mode stays in use then. With a terrain, full and culled draw it under the city; the representations do not (a
   // warning says so).
   void select(const std::string& mode);
   const std::string& mode() const { return mode_; }
+  // A new frame budget for the governed mode: made again (and calibrated again) when it is the mode in use.
+  void setTMaxMs(double t_max_ms);
   // The walkthrough of the current mode, null for full and culled.
   const runtime::Walkthrough* walkthrough() const { return walkthrough_.get(); }
 
@@ -85,6 +94,8 @@ class ModeRenderer {
   class PlanFrame;
   friend class PlanFrame;
   std::unique_ptr<PlanFrame> plan_frame_;
+  std::unique_ptr<eval::Mode> governedMode();
+  double governed_bound_px_ = 0.0;  // the governed mode's promised bound
   std::optional<eval::GpuCullRun> geometry_;  // the walkthrough modes' GPU-driven geometry
   uint64_t geometry_version_ = ~uint64_t(0);
 

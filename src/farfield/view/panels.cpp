@@ -105,6 +105,12 @@ PanelActions drawMainPanel(PanelState& s) {
                    ImVec2(320, 48));
   ImGui::Text("triangles %" PRIu64 ", draw calls %u", s.frame.triangles, s.frame.draw_calls);
   if (s.crowd) ImGui::Text("crowd: %zu skinned, %zu impostors", s.crowd_geometry, s.crowd_impostors);
+  if (const auto& g = s.frame.governance) {
+    ImGui::Text("governor: level %zu, predicted %.2f ms (%.2f corrected)", g->level, g->predicted_ms,
+                g->corrected_ms);
+    if (g->bound_scale > 1.0) ImGui::Text("  relaxed: bound %.2f px kept (%.2fx)", s.frame.kept_bound_px,
+                                          g->bound_scale);
+  }
   drawWalkthrough(s);
   drawPromises(s);
   float t_max = float(s.t_max_ms);

@@ -102,6 +102,7 @@ class Viewer {
     settings.terrain = options_.terrain;
     settings.terrain_scale = options_.terrain_scale;
     settings.terrain_technique = options_.terrain_technique;
+    settings.t_max_ms = options_.t_max_ms;
     panel_.gpu_budget_bytes = settings.gpu_budget_bytes;
     modes_ = std::make_unique<ModeRenderer>(scene_, gpu_scene_, bvh_, renderer_, target_, settings);
     selectMode(options_.mode.empty() ? defaultMode(database_) : options_.mode);
@@ -299,11 +300,16 @@ class Viewer {
     camera_ = player_.active() && !player_.paused() ? player_.camera(options_.width, options_.height)
                                                      : controller_.camera(options_.width, options_.height);
     if (player_.active() && !player_.paused()) controller_.setPose(camera_);
+    try {
+      modes_->setTMaxMs(panel_.t_max_ms);  // the governed mode keeps the panel's t_max
+    } catch (const Error& e) {
+      notice_ = e.what();
+    }
     panel_.frame = modes_->render(camera_, shown_, panel_.tint);
     if (crowd_) drawCrowd(dt);
     const runtime::FramePlan* plan = panel_.frame.plan;
     const runtime::Walkthrough* walkthrough = modes_->walkthrough();
-    panel_.bound_px = plan ? plan->report.bound_px : 0.0;
+    panel_.bound_px = plan ? plan->report.bound_px : panel_.frame.kept_bound_px;
     if (walkthrough && panel_.bound_px <= 0.0) panel_.bound_px = walkthrough->errorBoundPx();
     history_.add(panel_.frame.cpu_ms, panel_.frame.gpu_ms, panel_.t_max_ms, plan && plan->report.layers_unchecked > 0);
     if (recording_) recorder_.add(camera_);
