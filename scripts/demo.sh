@@ -126,6 +126,8 @@ elapsed=$(( $(date +%s) - start ))
   echo "t_max: $TMAX ms ($TMAX_SOURCE)"
   echo
   echo "Look around where the impostors are: farfield view $OUT/city.glb --impostors $OUT/placement --path $OUT/impostor_stretch.json"
+  echo "The same under the frame governor at t_max and the frame size it was set for (the panel shows each frame's level and the bound it kept):"
+  echo "  farfield view $OUT/city.glb --impostors $OUT/placement --path $OUT/impostor_stretch.json --mode governed --tmax $TMAX --size $SIZE"
 } > "$OUT/notes.txt"
 "$FARFIELD" report "$OUT" --mode governed --database "$OUT/placement" --notes "$OUT/notes.txt" \
   --title "Farfield demo: the default city, impostors placed under ${BOUND} px and ${TMAX} ms, kept by the frame governor" \
@@ -143,3 +145,5 @@ elapsed=$(( $(date +%s) - start ))
 echo "demo: $elapsed s; open $OUT/report.html (also $OUT/report.md)"
 echo "demo: look around where the impostors are (the drive's frames $stretch_first-$stretch_last) with:"
 echo "  $FARFIELD view $OUT/city.glb --impostors $OUT/placement --path $OUT/impostor_stretch.json --tint"
+echo "demo: the same under the frame governor, which keeps t_max = $TMAX ms by coarsening frames (and says which bound each kept):"
+echo "  $FARFIELD view $OUT/city.glb --impostors $OUT/placement --path $OUT/impostor_stretch.json --mode governed --tmax $TMAX --size $SIZE"
