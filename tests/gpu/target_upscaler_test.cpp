@@ -1,6 +1,7 @@
 // A smaller target's frame over a larger one (gpu/target_upscaler.h): every pixel of the larger target is written,
 // its colour the bilinear mix of the four nearest source texels, its id and depth the nearest texel's (or the far
-// plane where depth is not scaled up), whatever the larger target held before. Checked against a CPU computation of the same mapping from the uploaded texels.
+// plane where depth is not scaled up), whatever the larger target held before. Checked against a CPU computation of
+// the same mapping from the uploaded texels.
 #include "farfield/gpu/target_upscaler.h"
 
 #include <gtest/gtest.h>
@@ -87,21 +88,23 @@ TEST_F(GpuTest, TheUpscaledFrameIsTheSmallFramesNearestIdsAndDepthAndItsBilinear
   TargetUpscaler upscaler;
   const int sizes[][4] = {{16, 9, 32, 18}, {37, 23, 100, 61}, {20, 20, 21, 47}};
   uint32_t seed = 1;
-  for (const auto& size : sizes)
-  for (const TargetUpscaler::Channels channels : {TargetUpscaler::Channels::All, TargetUpscaler::Channels::ColorAndIds}) {
-    SCOPED_TRACE(testing::Message() << size[0] << "x" << size[1] << " to " << size[2] << "x" << size[3]
-                                    << (channels == TargetUpscaler::Channels::All ? ", all" : ", colour and ids"));
-    RenderTarget small(size[0], size[1]), big(size[2], size[3]);
-    const SourceTexels source = fillRandomly(small, seed++);
-    // What the big target held before is nearer than anything (reversed Z: 1 is the near plane) and another colour:
-    // the upscale must overwrite it all.
-    big.clear(Vec4(1.0f, 0.0f, 1.0f, 1.0f));
-    const float near_depth = 1.0f;
-    big.bind();
-    glDepthMask(GL_TRUE);
-    glClearBufferfv(GL_DEPTH, 0, &near_depth);
-    upscaler.draw(small, big, channels);
-    expectUpscaled(source, big, channels);
+  using Channels = TargetUpscaler::Channels;
+  for (const auto& size : sizes) {
+    for (const Channels channels : {Channels::All, Channels::ColorAndIds}) {
+      SCOPED_TRACE(testing::Message() << size[0] << "x" << size[1] << " to " << size[2] << "x" << size[3]
+                                      << (channels == Channels::All ? ", all" : ", colour and ids"));
+      RenderTarget small(size[0], size[1]), big(size[2], size[3]);
+      const SourceTexels source = fillRandomly(small, seed++);
+      // What the big target held before is nearer than anything (reversed Z: 1 is the near plane) and another colour:
+      // the upscale must overwrite it all.
+      big.clear(Vec4(1.0f, 0.0f, 1.0f, 1.0f));
+      const float near_depth = 1.0f;
+      big.bind();
+      glDepthMask(GL_TRUE);
+      glClearBufferfv(GL_DEPTH, 0, &near_depth);
+      upscaler.draw(small, big, channels);
+      expectUpscaled(source, big, channels);
+    }
   }
   EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
 }

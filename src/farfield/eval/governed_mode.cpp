@@ -68,8 +68,8 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   g.t_max_ms = t_max;
   g.aim = numberOption(context, "governor_aim", g.aim, 0.05, 1.0);
   read_ahead_ = switchOption(context, "governor_read_ahead", true);
-  upscale_channels_ = switchOption(context, "governor_upscale_depth", false) ? gpu::TargetUpscaler::Channels::All
-                                                                            : gpu::TargetUpscaler::Channels::ColorAndIds;
+  using Channels = gpu::TargetUpscaler::Channels;
+  upscale_channels_ = switchOption(context, "governor_upscale_depth", false) ? Channels::All : Channels::ColorAndIds;
   g.refine_below = numberOption(context, "governor_refine_below", g.refine_below, 0.05, g.aim);
   g.refine_after = countOption(context, "governor_refine_after", g.refine_after);
   g.window = countOption(context, "governor_window", g.window);

@@ -29,8 +29,8 @@ void TargetUpscaler::draw(const RenderTarget& from, const RenderTarget& to, Chan
   }
   glDisable(GL_CULL_FACE);
   program.use();
-  glProgramUniform2f(program.handle(), program.uniformLocation("u_from_per_to"), float(from.width()) / float(to.width()),
-                     float(from.height()) / float(to.height()));
+  glProgramUniform2f(program.handle(), program.uniformLocation("u_from_per_to"),
+                     float(from.width()) / float(to.width()), float(from.height()) / float(to.height()));
   glProgramUniform2i(program.handle(), program.uniformLocation("u_from_size"), from.width(), from.height());
   from.colorTexture().bind(0);
   from.idTexture().bind(1);

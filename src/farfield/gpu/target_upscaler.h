@@ -1,8 +1,8 @@
 // A frame rendered at a lower resolution shown at the full one: one full-target draw that writes the colour
 // (bilinear), the object ids and the depth (nearest texel) of a smaller RenderTarget over the whole of a larger one.
-// It does what RenderTarget::copyScaledTo does with two blits (one per colour format), in one pass: on llvmpipe a
-// blit of 640 x 360 took about 1 ms, and the governor's resolution levels paid two a frame (docs/DESIGN-NOTES.md,
-// "The governor's floor").
+// It replaces two blits (glBlitFramebuffer takes one colour format at a time) and a clear: on llvmpipe a blit of
+// 640 x 360 took about 1 ms, and the governor's resolution levels paid two a frame (docs/DESIGN-NOTES.md, "The
+// governor's floor").
 #pragma once
 
 #include <cstdint>

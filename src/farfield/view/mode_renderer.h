@@ -62,8 +62,8 @@ class ModeRenderer {
   // Switches to a mode ("full", "culled", a runtime representation name, or "governed": the placed walkthrough of a
   // placement database under eval's frame governor, keeping settings' t_max_ms). Throws farfield::Error (an unknown
   // name, a database that cannot draw it, a damaged database, a city that does not lie on the terrain, governed
-  // without a placement or a budget); the previous mode stays in use then. With a terrain, full and culled draw it under the city; the representations do not (a
-  // warning says so).
+  // without a placement or a budget); the previous mode stays in use then. With a terrain, full and culled draw it
+  // under the city; the representations do not (a warning says so).
   void select(const std::string& mode);
   const std::string& mode() const { return mode_; }
   // A new frame budget for the governed mode: made again (and calibrated again) when it is the mode in use.
