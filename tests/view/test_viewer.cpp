@@ -112,21 +112,25 @@ TEST(Viewer, ReplayedImpostorFramesEqualTheBenchModeAtTheSameCamera) {
   }
 }
 
+constexpr int kPlacementSize = 128;  // the frames the test placement was made for
+
+// The viewer over the test placement, replaying its path in `mode` and writing frames 0, 3 and 7 to out_dir.
+ViewerOptions placementScript(const std::string& out_dir, const std::string& mode) {
+  const test::ViewPlacement& c = test::viewPlacement();
+  ViewerOptions o = scripted(out_dir, mode);
+  o.replay = c.path_file;
+  o.width = o.height = kPlacementSize;
+  o.impostors = c.database;
+  return o;
+}
+
 TEST(Viewer, ReplayedPlacedFramesEqualTheBenchModeAtTheSameCamera) {
   FF_REQUIRE_DISPLAY();
   const test::ViewPlacement& c = test::viewPlacement();
   ASSERT_GT(c.report.impostors, 0u) << "the placement placed nothing: the test would not see an impostor";
-  const int size = 128;  // the frames the placement was made for
+  const int size = kPlacementSize;
   const std::string out = farfield::test::scratchDir("view_placed").string();
-  ViewerOptions options;
-  options.replay = c.path_file;
-  options.screenshot_at = {0, 3, 7};
-  options.out_dir = out;
-  options.exit_at_end = true;
-  options.width = options.height = size;
-  options.mode = "placed";
-  options.impostors = c.database;
-  runViewer(c.city.scene, options);
+  runViewer(c.city.scene, placementScript(out, "placed"));
 
   gpu::sharedHeadlessContext();
   eval::registerImpostorModes();
@@ -156,18 +160,10 @@ TEST(Viewer, ReplayedGovernedFramesEqualTheBenchModeUnderTheSameBudget) {
   const DatabaseModes modes = databaseModes(c.database);
   EXPECT_EQ(modes.modes, (std::vector<std::string>{"full", "culled", "placed", "governed"}));
   EXPECT_EQ(defaultMode(modes), "placed");
-  const int size = 128;
-  const double t_max_ms = 0.001;
+  const int size = kPlacementSize;
   const std::string out = farfield::test::scratchDir("view_governed").string();
-  ViewerOptions options;
-  options.replay = c.path_file;
-  options.screenshot_at = {0, 3, 7};
-  options.out_dir = out;
-  options.exit_at_end = true;
-  options.width = options.height = size;
-  options.mode = "governed";
-  options.impostors = c.database;
-  options.t_max_ms = t_max_ms;
+  ViewerOptions options = placementScript(out, "governed");
+  options.t_max_ms = 0.001;
   runViewer(c.city.scene, options);
 
   gpu::sharedHeadlessContext();
