@@ -167,6 +167,27 @@ TEST(GovernedMode, ImpostorBoundsComeFirstAndTheCoarsestLevelKeepsTheLargestOfEv
   EXPECT_DOUBLE_EQ(f.bound_scale, 16.0);  // max(1 px promised, 8 px impostors, 2 px geometry) at half resolution
 }
 
+// An arena a mode of the run made before without simplified levels (the viewer's culled, selected first) stays: the
+// governed mode over it has no simplified level and says so, and asking for one is an error; before any arena, it
+// asks for them, and the arena made next has them.
+TEST(GovernedMode, AnArenaMadeWithoutSimplifiedLevelsIsGovernedWithoutThem) {
+  Harness h(10.0);
+  h.context.options.erase("governor_lod_px");
+  auto culled = h.make("culled");  // makes the run's arena, without simplified levels
+  ASSERT_TRUE(h.context.arena_slot->arena);
+  auto governed = h.make("governed");
+  EXPECT_FALSE(h.context.arena_slot->simplified_levels) << "the arena made before still has none";
+  EXPECT_EQ(governed->info().at("governor_levels"), 2.0) << "the frame itself and half the resolution only";
+  h.context.options["governor_lod_px"] = "0,2";
+  EXPECT_THROW(createMode("governed", h.context), Error);
+
+  Harness fresh(10.0);
+  fresh.context.options.erase("governor_lod_px");
+  auto first = fresh.make("governed");
+  EXPECT_TRUE(fresh.context.arena_slot->simplified_levels);
+  EXPECT_EQ(first->info().at("governor_levels"), 5.0) << "0, 1, 2 and 4 px, then half the resolution";
+}
+
 TEST(GovernedMode, BadOptionsAreClearErrors) {
   Harness h(std::nullopt);
   EXPECT_THROW(createMode("governed", h.context), Error);  // no --tmax

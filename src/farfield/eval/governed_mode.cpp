@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "farfield/core/error.h"
+#include "farfield/core/log.h"
 #include "farfield/core/timer.h"
 #include "farfield/eval/frame_stats.h"
 #include "farfield/eval/mode_options.h"
@@ -38,7 +39,12 @@ std::vector<double> parseLevelList(const std::string& text, const std::string& k
 GovernedMode::GovernedMode(const ModeContext& context) {
   inner_name_ = context.option("governed", "culled");
   if (inner_name_ == "governed") throw Error("--mode-option governed", "cannot govern itself");
-  context.arena_slot->simplified_levels = true;  // before any mode of the run makes the arena (in prepare)
+  // The simplified levels are made with the run's arena (in a mode's prepare). An arena some mode made already without
+  // them (the viewer's culled, selected first) stays: the simplified levels are then left out.
+  const bool simplified = !context.arena_slot->arena || context.arena_slot->simplified_levels;
+  if (simplified) context.arena_slot->simplified_levels = true;
+  else FF_WARN("mode governed: the run's arena was made without simplified levels: the coarser levels are impostors "
+               "and lower resolutions only");
   inners_.push_back(createMode(inner_name_, context));
   // Impostors accepted under larger bounds: the governed mode again, its walkthrough's bound (error_px) set to each.
   const std::string impostor_px = context.option("governor_impostor_px");
@@ -58,8 +64,10 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   // Resolution scales, 1 (the frame itself) first, decreasing; the simplified levels' bounds, 0 (full detail) first.
   scales_ = parseLevelList(context.option("governor_scales", "1,0.84,0.71,0.59,0.5"), "governor_scales", 0.25, 1.0,
                            1.0, false, "a scale in [0.25, 1]");
-  lod_px_ = parseLevelList(context.option("governor_lod_px", "0,1,2,4"), "governor_lod_px", 0.0, 64.0, 0.0, true,
-                           "a number of pixels in [0, 64]");
+  lod_px_ = parseLevelList(context.option("governor_lod_px", simplified ? "0,1,2,4" : "0"), "governor_lod_px", 0.0,
+                           64.0, 0.0, true, "a number of pixels in [0, 64]");
+  if (!simplified && lod_px_.size() > 1)
+    throw Error("--mode-option governor_lod_px", "the run's arena has no simplified levels to draw");
   error_px_ = positiveOption(context, "governor_error_px", error_px_);
   // The budget: --mode-option governor_t_max_ms (for commands without --tmax: walk), else the run's --tmax.
   const double t_max = numberOption(context, "governor_t_max_ms", context.t_max_ms.value_or(0.0), 0.0);

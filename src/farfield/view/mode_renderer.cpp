@@ -145,27 +145,14 @@ std::unique_ptr<eval::Mode> ModeRenderer::governedMode() {
   context.options["governor_t_max_ms"] = number(settings_.t_max_ms);
   context.options["governor_error_px"] = number(bound_px);
   if (settings_.error_px > 0.0) context.options["error_px"] = number(settings_.error_px);
-  // The governor's simplified levels are made with the arena. One already made without them (culled or a walkthrough
-  // mode selected first) stays: the governor then coarsens by impostors and resolution only.
-  const bool arena_without_levels = context.arena_slot->arena && !context.arena_slot->simplified_levels;
-  if (arena_without_levels) {
-    context.options["governor_lod_px"] = "0";
-    FF_WARN("mode governed: the scene's arena was made without simplified levels (--mode governed opens with "
-            "them): its coarser levels are lower resolutions only");
-  }
+  // The governed mode asks for the arena's simplified levels; an arena made before without them (culled or a
+  // walkthrough mode selected first) stays, and it governs without them (eval/governed_mode.cpp says so).
   if (!context.arena_slot->arena)
     FF_INFO("mode governed: making the scene's arena with its simplified levels (meshopt_simplify per mesh; about "
             "2.5x the time of the arena alone)");
   eval::registerImpostorModes();  // placed is one of them (registering again replaces the same entries)
-  std::unique_ptr<eval::Mode> created;
-  try {
-    created = eval::createMode("governed", context);  // asks for the levels (ArenaSlot::simplified_levels)
-    if (arena_without_levels) context.arena_slot->simplified_levels = false;
-    created->prepare(context);
-  } catch (...) {
-    if (arena_without_levels) context.arena_slot->simplified_levels = false;
-    throw;
-  }
+  std::unique_ptr<eval::Mode> created = eval::createMode("governed", context);
+  created->prepare(context);
   return created;
 }
 
