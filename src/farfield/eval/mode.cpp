@@ -64,11 +64,11 @@ FrameContext::FrameContext(const Camera& camera, size_t path_frame, gpu::Rendere
   items_.clear();
 }
 
-void FrameContext::clearOnce() {
+void FrameContext::clearOnce(bool clear) {
   if (drew_passes_) return;
   drew_passes_ = true;
   if (timer_) timer_->begin();
-  target_.clear(renderer_.light().sky_color);
+  if (clear) target_.clear(renderer_.light().sky_color);
 }
 
 gpu::FrameStats FrameContext::drawPass(std::span<const gpu::DrawItem> items, gpu::RenderMode mode) {
@@ -99,10 +99,7 @@ gpu::RenderTarget& FrameContext::beginOwnPass() {
 }
 
 gpu::RenderTarget& FrameContext::beginOwnPassOverwritingAll() {
-  if (!drew_passes_) {
-    drew_passes_ = true;
-    if (timer_) timer_->begin();
-  }
+  clearOnce(false);
   return target_;
 }
 

@@ -124,7 +124,8 @@ class FrameContext {
   gpu::FrameStats drawMainPass();
 
  private:
-  void clearOnce();
+  // Once per frame, before its first pass: starts the frame's timer and clears the target (unless `clear` is false).
+  void clearOnce(bool clear = true);
 
   const Camera& camera_;
   size_t path_frame_;
