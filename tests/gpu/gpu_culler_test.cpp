@@ -237,6 +237,32 @@ TEST_F(GpuCullerTest, FramesEqualFrustumCulledFramesAlongAWalk) {
   }
 }
 
+// Occlusion culling turned on and off between frames (GpuCuller::setOcclusion, what gpu_occlusion=auto does) changes
+// no frame: each equals the frame of every cluster in view, and the frames with it on do occlusion-cull while those
+// with it off cull nothing by depth.
+TEST_F(GpuCullerTest, OcclusionTurnedOnAndOffBetweenFramesChangesNoFrame) {
+  const std::vector<Camera> cameras = walk(11, 48);
+  GpuCuller culler(*arena_);
+  std::mt19937 rng(17);
+  std::vector<bool> on_in_frame;
+  uint64_t occluded_on = 0, occluded_off = 0, switches_on = 0;
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    // Runs of a few frames each way, as the chooser's probes make them.
+    const bool on = f < 4 ? true : (rng() % 3 == 0 ? !on_in_frame.back() : bool(on_in_frame.back()));
+    switches_on += f > 0 && on && !on_in_frame.back();
+    on_in_frame.push_back(on);
+    culler.setOcclusion(on);
+    const Reference want = reference(cameras[f], RenderMode::ItemBuffer);
+    culled(culler, cameras[f], RenderMode::ItemBuffer);
+    ASSERT_EQ(differences(want, false), 0u) << "frame " << f << " occlusion " << on;
+    for (const GpuCullStats& s : culler.finishedStats()) (on_in_frame[s.frame] ? occluded_on : occluded_off) += s.occlusion_culled;
+  }
+  EXPECT_GT(switches_on, 3u);
+  EXPECT_GT(occluded_on, 200u);
+  EXPECT_EQ(occluded_off, 0u);
+  EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+}
+
 // The same check fails when the pyramid test hides boxes that lie in front of the depth (a negative margin): the
 // comparison above can see a dropped visible cluster.
 TEST_F(GpuCullerTest, ABrokenPyramidTestIsCaught) {

@@ -166,8 +166,11 @@ CalibrateResult calibrate(gpu::Context& context, const scene::Scene& scene, cons
   mode_context.renderer = &renderer;
   mode_context.width = options.width;
   mode_context.height = options.height;
+  // Occlusion culling on in every GPU-driven frame: the walkthrough modes' gpu_occlusion=auto keeps it off only where
+  // their frames measure faster without it, so the model is fitted on the slower of the two where they differ.
   mode_context.options = {{"geometry", options.gpu_frames ? "gpu" : "cpu"},
-                          {"occlusion", options.gpu_frames || placed ? "on" : "off"}};
+                          {"occlusion", options.gpu_frames || placed ? "on" : "off"},
+                          {"gpu_occlusion", "on"}};
   RuntimeGeometry geometry(mode_context);
   FrameRunner runner(renderer, target);
   // A view's workload, counted once: the objects it draws (returned in `view_ids`) and their triangles, draw calls and

@@ -60,6 +60,7 @@ class BillboardMode final : public Mode {
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
     return geometry_draw_->lateFrameStats(path_frame);
   }
+  void frameMeasured(size_t path_frame, double wall_ms) override { geometry_draw_->frameMeasured(path_frame, wall_ms); }
   std::map<std::string, double> info() const override;
 
  private:
@@ -85,6 +86,9 @@ class DynamicImpostorMode final : public Mode {
   void frame(FrameContext& frame) override;
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
     return geometry_draw_ ? geometry_draw_->lateFrameStats(path_frame) : std::nullopt;
+  }
+  void frameMeasured(size_t path_frame, double wall_ms) override {
+    if (geometry_draw_) geometry_draw_->frameMeasured(path_frame, wall_ms);
   }
   std::map<std::string, double> info() const override;
 

@@ -14,23 +14,49 @@ bool onOff(const ModeContext& context, const std::string& key, bool fallback, co
 
 }  // namespace
 
-gpu::GpuCullOptions gpuCullOptions(const ModeContext& context, const std::string& mode_name) {
-  gpu::GpuCullOptions options;
-  options.occlusion = onOff(context, "gpu_occlusion", options.occlusion, mode_name);
-  options.cone = onOff(context, "gpu_cones", options.cone, mode_name);
-  options.compact = onOff(context, "gpu_compact", options.compact, mode_name);
-  options.refine_history = onOff(context, "gpu_refine_history", options.refine_history, mode_name);
-  options.stage_times = onOff(context, "gpu_stage_times", options.stage_times, mode_name);
+GpuRunOptions gpuRunOptions(const ModeContext& context, const std::string& mode_name,
+                            const std::string& occlusion_default) {
+  GpuRunOptions options;
+  gpu::GpuCullOptions& cull = options.cull;
+  const std::string occlusion = context.option("gpu_occlusion", occlusion_default);
+  if (occlusion != "on" && occlusion != "off" && occlusion != "auto")
+    throw Error("mode '" + mode_name + "'", "gpu_occlusion must be on, off or auto, got '" + occlusion + "'");
+  cull.occlusion = occlusion != "off";
+  options.occlusion_auto = occlusion == "auto";
+  cull.cone = onOff(context, "gpu_cones", cull.cone, mode_name);
+  cull.compact = onOff(context, "gpu_compact", cull.compact, mode_name);
+  cull.refine_history = onOff(context, "gpu_refine_history", cull.refine_history, mode_name);
+  cull.stage_times = onOff(context, "gpu_stage_times", cull.stage_times, mode_name);
   return options;
 }
 
-GpuCullRun::GpuCullRun(const ModeContext& context, const gpu::GpuCullOptions& options)
-    : culler_(std::make_unique<gpu::GpuCuller>(context.arena(), options)), arena_build_s_(context.arena_slot->build_s) {}
+GpuCullRun::GpuCullRun(const ModeContext& context, const GpuRunOptions& options)
+    : culler_(std::make_unique<gpu::GpuCuller>(context.arena(), options.cull)),
+      arena_build_s_(context.arena_slot->build_s) {
+  if (options.occlusion_auto) occlusion_choice_.emplace(0);
+}
 
 void GpuCullRun::draw(FrameContext& frame) {
   gpu::RenderTarget& target = frame.beginOwnPass();
+  if (occlusion_choice_) {
+    const bool on = occlusion_choice_->decide(path_frame_of_.size()) == 0;
+    culler_->setOcclusion(on);
+    occlusion_frames_ += on ? 1.0 : 0.0;
+  }
   path_frame_of_.push_back(frame.pathFrame());
   frame.addStats(culler_->draw(frame.camera(), target, gpu::RenderMode::Shaded, frame.renderer().light()));
+}
+
+void GpuCullRun::frameMeasured(size_t path_frame, double wall_ms) {
+  if (!occlusion_choice_) return;
+  // The last frame drawn for it: a governor's calibration draws a path frame several times, untimed.
+  for (size_t i = path_frame_of_.size(); i-- > 0;) {
+    if (path_frame_of_[i] == path_frame) {
+      occlusion_choice_->measured(i, wall_ms);
+      return;
+    }
+    if (path_frame_of_.size() - i > 64) return;
+  }
 }
 
 void GpuCullRun::collect() {
@@ -79,6 +105,14 @@ std::map<std::string, double> GpuCullRun::info() const {
     out["gpu_draw_commands"] = commands_ / frames_;
     out["gpu_triangles"] = triangles_ / frames_;
   }
+  if (occlusion_choice_) {
+    const double drawn = double(path_frame_of_.size());
+    out["gpu_occlusion_auto"] = 1.0;
+    out["gpu_occlusion_frames"] = drawn > 0.0 ? occlusion_frames_ / drawn : 0.0;
+    out["gpu_occlusion_kept"] = occlusion_choice_->kept() == 0 ? 1.0 : 0.0;
+    out["gpu_occlusion_probes"] = double(occlusion_choice_->probes());
+    out["gpu_occlusion_switches"] = double(occlusion_choice_->switches());
+  }
   if (stage_frames_ > 0.0) {
     for (size_t i = 0; i < stage_ms_.size(); ++i)
       out[std::string("gpu_stage_") + gpu::kGpuCullStages[i] + "_ms"] = stage_ms_[i] / stage_frames_;
@@ -87,7 +121,7 @@ std::map<std::string, double> GpuCullRun::info() const {
   return out;
 }
 
-GpuCulledMode::GpuCulledMode(const ModeContext& context) : options_(gpuCullOptions(context, "culled")) {}
+GpuCulledMode::GpuCulledMode(const ModeContext& context) : options_(gpuRunOptions(context, "culled")) {}
 
 void GpuCulledMode::prepare(const ModeContext& context) { run_.emplace(context, options_); }
 

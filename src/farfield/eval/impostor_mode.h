@@ -53,6 +53,7 @@ class ImpostorMode final : public Mode {
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
     return geometry_->lateFrameStats(path_frame);
   }
+  void frameMeasured(size_t path_frame, double wall_ms) override { geometry_->frameMeasured(path_frame, wall_ms); }
   bool setGeometryErrorPx(double px) override { return geometry_ && geometry_->setGeometryErrorPx(px); }
   // The walkthrough's statistics (runtime::Walkthrough::statistics): cells, loads, fallback frames, triangles, and
   // the bound with the layer draws it turned into geometry.

@@ -8,8 +8,11 @@ PlanGeometry::PlanGeometry(const ModeContext& context, const std::string& mode_n
   gpu_ = choiceOption(context, "geometry", "gpu", {"gpu", "cpu"}) == "gpu";
   const bool occlusion = switchOption(context, "occlusion", true);
   if (gpu_) {
-    gpu_options_ = gpuCullOptions(context, mode_name);
-    gpu_options_.occlusion = gpu_options_.occlusion && occlusion;
+    gpu_options_ = gpuRunOptions(context, mode_name, "auto");
+    if (!occlusion) {
+      gpu_options_.cull.occlusion = false;
+      gpu_options_.occlusion_auto = false;
+    }
   } else if (occlusion) {
     occlusion_.emplace(occluderShareOption(context, mode_name));
   }
@@ -52,6 +55,10 @@ void PlanGeometry::submit(FrameContext& frame, const runtime::FramePlan& plan) {
   run_->draw(frame);
   frame.items().insert(frame.items().end(), plan.items.begin() + std::ptrdiff_t(plan.geometry_items),
                        plan.items.end());
+}
+
+void PlanGeometry::frameMeasured(size_t path_frame, double wall_ms) {
+  if (run_) run_->frameMeasured(path_frame, wall_ms);
 }
 
 std::optional<gpu::FrameStats> PlanGeometry::lateFrameStats(size_t path_frame) {

@@ -1,7 +1,8 @@
 // How a walkthrough mode draws its plans' geometry (--mode-option geometry=gpu|cpu, default gpu):
 //   gpu: the plan lists its geometry objects (runtime::WalkthroughOptions::geometry_items false) and a GpuCullRun over
 //        the run's arena culls and draws their clusters on the GPU, as the culled mode does (gpu_occlusion, gpu_cones,
-//        gpu_compact apply); the plan's CPU work is its choice of objects, and only a change of it is uploaded;
+//        gpu_compact apply; gpu_occlusion is auto by default: region visibility has culled the lists already, and
+//        whether the pyramid test still pays is measured on the run's frames); the plan's CPU work is its choice of objects, and only a change of it is uploaded;
 //   cpu: the plan's items culled per cluster on the CPU, occlusion-culled against the depth of their nearest ones
 //        (the culled-cpu mode's pass) unless occlusion=off.
 // Either way the plan's impostors follow in the frame's main pass. occlusion=off turns occlusion off on both paths.
@@ -37,6 +38,8 @@ class PlanGeometry {
   // view are culled (and occlusion-culled) into draw items. An empty list draws nothing.
   void submitObjects(FrameContext& frame, std::span<const uint32_t> ids);
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame);
+  // Mode::frameMeasured: what gpu_occlusion=auto chooses by.
+  void frameMeasured(size_t path_frame, double wall_ms);
   // The GPU run's simplified levels (Mode::setGeometryErrorPx); false on the CPU path.
   bool setGeometryErrorPx(double px) {
     if (!run_) return false;
@@ -48,7 +51,7 @@ class PlanGeometry {
 
  private:
   bool gpu_ = true;
-  gpu::GpuCullOptions gpu_options_;
+  GpuRunOptions gpu_options_;
   std::optional<GpuCullRun> run_;
   std::optional<OcclusionPass> occlusion_;
   const gpu::GpuScene* gpu_scene_ = nullptr;

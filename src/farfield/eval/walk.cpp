@@ -59,6 +59,7 @@ WalkResult runWalk(gpu::Context& context, const scene::Scene& scene, const gen::
     progress.advance();
   }
   progress.finish();
+  result.info = mode->info();
 
   summarizeFrames(result);
   return result;
@@ -107,6 +108,18 @@ std::string formatWalkSummary(const WalkResult& r) {
                   r.calls.gl_calls_mean, r.calls.dispatches_mean, r.calls.upload_bytes_mean,
                   (unsigned long long)r.calls.upload_bytes_max, r.calls.syncs_mean, r.calls.syncs_max,
                   r.calls.frames_with_syncs);
+    text += buf;
+  }
+  const auto info = [&](const char* key) {
+    const auto it = r.info.find(key);
+    return it == r.info.end() ? 0.0 : it->second;
+  };
+  if (info("gpu_occlusion_auto") > 0.0) {
+    std::snprintf(buf, sizeof(buf),
+                  "occlusion:       auto (gpu_occlusion): on in %.0f%% of frames, %s at the end; %.0f probes, %.0f "
+                  "switches\n",
+                  100.0 * info("gpu_occlusion_frames"), info("gpu_occlusion_kept") > 0.0 ? "on" : "off",
+                  info("gpu_occlusion_probes"), info("gpu_occlusion_switches"));
     text += buf;
   }
   return text;

@@ -41,6 +41,7 @@ struct WalkResult {
   double mean_draw_calls = 0.0;
   double mean_objects = 0.0;
   std::vector<std::string> written_frames;  // PNG paths
+  std::map<std::string, double> info;       // the mode's Mode::info() after the walk
 };
 
 // Makes the context current and runs the walk. Throws farfield::Error for an unknown mode (listing the known ones),

@@ -210,6 +210,12 @@ void GpuCuller::resetHistory() {
   glClearNamedBufferData(impl_->part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 }
 
+void GpuCuller::setOcclusion(bool on) {
+  if (on == options_.occlusion) return;
+  if (on) resetHistory();
+  options_.occlusion = on;
+}
+
 FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMode mode, const LightSettings& light) {
   camera.validate("camera");
   Impl& im = *impl_;

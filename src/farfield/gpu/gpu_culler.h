@@ -92,6 +92,10 @@ class GpuCuller {
   void setLodErrorPx(float px);
   // Forgets the last frame's visibility (a camera cut): the next frame draws in its second phase only.
   void resetHistory();
+  // Occlusion culling (GpuCullOptions::occlusion) on or off from the next frame on: the frame drawn is the same
+  // either way, only its cost differs (runtime/faster_variant.h chooses). Turning it on forgets the history, which
+  // frames without it do not keep: the first frame with it draws in its second phase only.
+  void setOcclusion(bool on);
 
   // Draws the frame's clusters into target (bound for an opaque pass here; not cleared; what it holds counts as drawn
   // geometry for the occlusion test). Returns the draw calls issued (triangles are known frames later).

@@ -45,6 +45,9 @@ class ModeRenderer::PlanFrame final : public eval::Mode {
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
     return owner_.geometry_->lateFrameStats(path_frame);
   }
+  void frameMeasured(size_t path_frame, double wall_ms) override {
+    owner_.geometry_->frameMeasured(path_frame, wall_ms);
+  }
 
  private:
   ModeRenderer& owner_;
@@ -94,7 +97,8 @@ void ModeRenderer::select(const std::string& mode) {
     auto walkthrough = std::make_unique<runtime::Walkthrough>(scene_, gpu_scene_, bvh_, renderer_, options);
     walkthrough_ = std::move(walkthrough);
     eval_mode_.reset();
-    if (!geometry_) geometry_.emplace(context_, gpu::GpuCullOptions{});
+    // Occlusion culling as the bench's walkthrough modes have it: on or off, whichever the frames measure faster.
+    if (!geometry_) geometry_.emplace(context_, eval::GpuRunOptions{.cull = {}, .occlusion_auto = true});
     geometry_version_ = ~uint64_t(0);
     geometry_->culler().resetHistory();
     plan_frame_ = std::make_unique<PlanFrame>(*this);

@@ -1,0 +1,152 @@
+// The faster-variant chooser against a synthetic machine whose two variants' frame costs are known (with noise): it
+// must keep the faster one, pay few frames of the slower one for its probes, follow a change of which is faster, and
+// keep what it has where the two are alike.
+#include "farfield/runtime/faster_variant.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <limits>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "farfield/core/error.h"
+
+using namespace farfield;
+using runtime::FasterVariant;
+using runtime::FasterVariantOptions;
+
+namespace {
+
+// Frame costs: cost(frame, variant) in ms, times a uniform noise factor in [1 - noise, 1 + noise].
+using Cost = std::function<double(uint64_t frame, int variant)>;
+
+// Drives the chooser over `frames` frames, each measured `lag` frames after it is decided (0: at once); returns the
+// variant of every frame. Frames in `unmeasured` are never measured.
+std::vector<int> drive(FasterVariant& chooser, uint64_t frames, const Cost& cost, double noise, size_t lag = 0,
+                       uint64_t unmeasured = 0, uint32_t seed = 7) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(1.0 - noise, 1.0 + noise);
+  std::vector<int> variants;
+  std::deque<std::pair<uint64_t, double>> pending;
+  for (uint64_t f = 0; f < frames; ++f) {
+    const int v = chooser.decide(f);
+    variants.push_back(v);
+    if (f >= unmeasured) pending.push_back({f, cost(f, v) * jitter(rng)});
+    while (pending.size() > lag) {
+      chooser.measured(pending.front().first, pending.front().second);
+      pending.pop_front();
+    }
+  }
+  return variants;
+}
+
+size_t count(const std::vector<int>& variants, int v, size_t from = 0, size_t to = std::numeric_limits<size_t>::max()) {
+  const auto end = variants.begin() + std::ptrdiff_t(std::min(to, variants.size()));
+  const auto begin = variants.begin() + std::ptrdiff_t(std::min(from, variants.size()));
+  return size_t(std::count(begin, end, v));
+}
+
+}  // namespace
+
+TEST(FasterVariant, KeepsTheFasterVariantAfterOneProbe) {
+  for (size_t lag : {0u, 3u}) {
+    FasterVariant chooser(0);
+    // Variant 1 is 35 % faster (occlusion culling off on llvmpipe over a region's visible set).
+    const auto variants = drive(chooser, 2000, [](uint64_t, int v) { return v == 0 ? 10.0 : 6.5; }, 0.1, lag);
+    EXPECT_EQ(chooser.kept(), 1) << "lag " << lag;
+    EXPECT_EQ(chooser.switches(), 1u) << "lag " << lag;
+    // Switched within the first probe: 4 measured frames of the first, then 3 of the other (plus the lag).
+    size_t first_switch = 0;
+    while (variants[first_switch] == 0) ++first_switch;
+    EXPECT_LE(first_switch, 4 + lag) << "lag " << lag;
+    // Afterwards the slower variant only in probes, which give up after two or three measured frames (plus the lag
+    // of frames already decided), each probe after a doubled interval.
+    EXPECT_LE(count(variants, 0, first_switch + 10), (3 + lag) * chooser.probes()) << "lag " << lag;
+    EXPECT_LE(chooser.probes(), 6u) << "lag " << lag;
+    EXPECT_EQ(chooser.probesGivenUp(), chooser.probes() - 1) << "lag " << lag;
+  }
+}
+
+TEST(FasterVariant, KeepsTheFirstVariantWhenTheOtherIsNotFasterByTheMargin) {
+  FasterVariant chooser(0);
+  const auto variants = drive(chooser, 3000, [](uint64_t, int v) { return v == 0 ? 10.0 : 10.2; }, 0.03);
+  EXPECT_EQ(chooser.kept(), 0);
+  EXPECT_EQ(chooser.switches(), 0u);
+  // Probes of the other variant, less and less often: 120, 240, 480, 960, 960 ... frames apart.
+  EXPECT_GE(chooser.probes(), 4u);
+  EXPECT_LE(chooser.probes(), 6u);
+  EXPECT_LE(count(variants, 1), 3 * chooser.probes());
+}
+
+TEST(FasterVariant, GivesUpAProbeOfAMuchSlowerVariantAfterTwoFrames) {
+  FasterVariantOptions options;
+  FasterVariant chooser(0, options);
+  const auto variants = drive(chooser, 2000, [](uint64_t, int v) { return v == 0 ? 5.0 : 15.0; }, 0.05);
+  EXPECT_EQ(chooser.kept(), 0);
+  EXPECT_EQ(chooser.probesGivenUp(), chooser.probes());
+  EXPECT_LE(count(variants, 1), 2 * chooser.probes());
+}
+
+TEST(FasterVariant, FollowsAChangeOfWhichVariantIsFaster) {
+  FasterVariant chooser(0);
+  // Variant 0 faster for 2000 frames, then variant 1 (the walk leaves the open streets for a dense old town).
+  const Cost cost = [](uint64_t f, int v) { return (f < 2000) == (v == 0) ? 6.0 : 9.0; };
+  const auto variants = drive(chooser, 4000, cost, 0.08);
+  EXPECT_EQ(chooser.kept(), 1);
+  EXPECT_EQ(chooser.switches(), 1u);
+  // The change is found by the next probe: at most reprobe_max frames and a probe later.
+  size_t switched = 2000;
+  while (switched < variants.size() && variants[switched] == 0) ++switched;
+  EXPECT_LE(switched, 2000u + 960u + 10u);
+  EXPECT_GE(count(variants, 1, switched, switched + 200), 195u);
+}
+
+TEST(FasterVariant, ProbesNothingBeforeFramesOfTheFirstVariantAreMeasured) {
+  FasterVariant chooser(1);
+  // A host's untimed first draws (a governor's calibration): 50 frames never measured.
+  const auto variants = drive(chooser, 60, [](uint64_t, int v) { return v == 1 ? 10.0 : 5.0; }, 0.0, 0, 50);
+  EXPECT_EQ(count(variants, 1, 0, 54), 54u);
+  EXPECT_EQ(chooser.kept(), 0);  // then measured: 4 frames of the first, 3 of the faster other
+}
+
+TEST(FasterVariant, GivesUpAProbeWhoseFramesAreNeverMeasured) {
+  FasterVariantOptions options;
+  options.max_in_flight = 16;
+  FasterVariant chooser(0, options);
+  for (uint64_t f = 0; f < 4; ++f) {
+    EXPECT_EQ(chooser.decide(f), 0);
+    chooser.measured(f, 5.0);
+  }
+  for (uint64_t f = 4; f < 4 + 16; ++f) EXPECT_EQ(chooser.decide(f), 1);  // a probe whose host stopped measuring
+  EXPECT_EQ(chooser.decide(20), 0);
+  EXPECT_EQ(chooser.probesGivenUp(), 1u);
+  EXPECT_EQ(chooser.kept(), 0);
+}
+
+TEST(FasterVariant, RejectsBadOptionsOrderAndTimes) {
+  EXPECT_THROW(FasterVariant(2), Error);
+  FasterVariantOptions bad;
+  bad.margin = 1.0;
+  EXPECT_THROW(FasterVariant(0, bad), Error);
+  bad = {};
+  bad.give_up_ratio = 1.0;
+  EXPECT_THROW(FasterVariant(0, bad), Error);
+  bad = {};
+  bad.reprobe_max = bad.reprobe_after - 1;
+  EXPECT_THROW(FasterVariant(0, bad), Error);
+  bad = {};
+  bad.min_kept = 9;
+  EXPECT_THROW(FasterVariant(0, bad), Error);
+  FasterVariant chooser(0);
+  chooser.decide(5);
+  EXPECT_THROW(chooser.decide(5), Error);
+  EXPECT_THROW(chooser.measured(5, std::nan("")), Error);
+  EXPECT_THROW(chooser.measured(5, -1.0), Error);
+  chooser.measured(99, 1.0);  // never decided: ignored
+  EXPECT_EQ(chooser.probes(), 0u);
+}
