@@ -33,29 +33,32 @@ GpuRunOptions gpuRunOptions(const ModeContext& context, const std::string& mode_
 GpuCullRun::GpuCullRun(const ModeContext& context, const GpuRunOptions& options)
     : culler_(std::make_unique<gpu::GpuCuller>(context.arena(), options.cull)),
       arena_build_s_(context.arena_slot->build_s) {
-  if (options.occlusion_auto) occlusion_choice_.emplace(0);
+  occlusion_auto_ = options.occlusion_auto;
 }
 
 void GpuCullRun::draw(FrameContext& frame) {
   gpu::RenderTarget& target = frame.beginOwnPass();
-  if (occlusion_choice_) {
-    const bool on = occlusion_choice_->decide(path_frame_of_.size()) == 0;
+  if (occlusion_auto_) {
+    // One choice per kind of frame: a governor's levels (sizes, simplified levels) differ in what the test saves.
+    const auto key = std::make_tuple(target.width(), target.height(), culler_->options().lod_error_px);
+    runtime::FasterVariant& choice = occlusion_choices_.try_emplace(key, 0).first->second;
+    const bool on = choice.decide(path_frame_of_.size()) == 0;
     culler_->setOcclusion(on);
     occlusion_frames_ += on ? 1.0 : 0.0;
+    chooser_of_.push_back(&choice);
   }
   path_frame_of_.push_back(frame.pathFrame());
   frame.addStats(culler_->draw(frame.camera(), target, gpu::RenderMode::Shaded, frame.renderer().light()));
 }
 
 void GpuCullRun::frameMeasured(size_t path_frame, double wall_ms) {
-  if (!occlusion_choice_) return;
+  if (!occlusion_auto_) return;
   // The last frame drawn for it: a governor's calibration draws a path frame several times, untimed.
-  for (size_t i = path_frame_of_.size(); i-- > 0;) {
+  for (size_t i = path_frame_of_.size(); i-- > 0 && path_frame_of_.size() - i <= 64;) {
     if (path_frame_of_[i] == path_frame) {
-      occlusion_choice_->measured(i, wall_ms);
+      chooser_of_[i]->measured(i, wall_ms);
       return;
     }
-    if (path_frame_of_.size() - i > 64) return;
   }
 }
 
@@ -105,13 +108,24 @@ std::map<std::string, double> GpuCullRun::info() const {
     out["gpu_draw_commands"] = commands_ / frames_;
     out["gpu_triangles"] = triangles_ / frames_;
   }
-  if (occlusion_choice_) {
+  if (occlusion_auto_) {
     const double drawn = double(path_frame_of_.size());
     out["gpu_occlusion_auto"] = 1.0;
     out["gpu_occlusion_frames"] = drawn > 0.0 ? occlusion_frames_ / drawn : 0.0;
-    out["gpu_occlusion_kept"] = occlusion_choice_->kept() == 0 ? 1.0 : 0.0;
-    out["gpu_occlusion_probes"] = double(occlusion_choice_->probes());
-    out["gpu_occlusion_switches"] = double(occlusion_choice_->switches());
+    out["gpu_occlusion_kinds"] = double(occlusion_choices_.size());
+    double probes = 0.0, switches = 0.0;
+    size_t most = 0;
+    for (const auto& [key, choice] : occlusion_choices_) {
+      probes += double(choice.probes());
+      switches += double(choice.switches());
+      const size_t frames = choice.framesOf(0) + choice.framesOf(1);
+      if (frames > most) {
+        most = frames;
+        out["gpu_occlusion_kept"] = choice.kept() == 0 ? 1.0 : 0.0;  // the choice of the kind drawn most
+      }
+    }
+    out["gpu_occlusion_probes"] = probes;
+    out["gpu_occlusion_switches"] = switches;
   }
   if (stage_frames_ > 0.0) {
     for (size_t i = 0; i < stage_ms_.size(); ++i)

@@ -19,6 +19,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "farfield/eval/mode.h"
@@ -57,15 +58,19 @@ class GpuCullRun {
   // gpu_frustum_culled, gpu_cone_culled, gpu_occlusion_culled, gpu_draw_commands (indirect draws after merging runs
   // of clusters), gpu_triangles; with gpu_stage_times, gpu_stage_<stage>_ms (gpu::kGpuCullStages) and
   // gpu_stage_frames; with occlusion_auto, gpu_occlusion_auto (1), gpu_occlusion_frames (the share of frames drawn
-  // with occlusion culling), gpu_occlusion_kept (1 or 0: the choice at the end), gpu_occlusion_probes,
-  // gpu_occlusion_switches.
+  // with occlusion culling), gpu_occlusion_kinds (the kinds of frame chosen for apart: target sizes and simplified
+  // levels, a governor's levels), gpu_occlusion_kept (1 or 0: the choice at the end for the kind drawn most),
+  // gpu_occlusion_probes, gpu_occlusion_switches (summed over the kinds).
   std::map<std::string, double> info() const;
 
  private:
   void collect();
 
   std::unique_ptr<gpu::GpuCuller> culler_;
-  std::optional<runtime::FasterVariant> occlusion_choice_;  // variant 0: occlusion on, 1: off
+  bool occlusion_auto_ = false;
+  // Per kind of frame (the target's width and height, the simplified levels' bound): variant 0 occlusion on, 1 off.
+  std::map<std::tuple<int, int, float>, runtime::FasterVariant> occlusion_choices_;
+  std::vector<runtime::FasterVariant*> chooser_of_;  // per culler frame, with occlusion_auto
   std::vector<size_t> path_frame_of_;           // per culler frame
   std::map<size_t, gpu::GpuCullStats> latest_;  // per path frame, the last statistics that came back
   double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0, commands_ = 0.0;
