@@ -113,11 +113,12 @@ std::map<std::string, double> GpuCullRun::info() const {
     out["gpu_occlusion_auto"] = 1.0;
     out["gpu_occlusion_frames"] = drawn > 0.0 ? occlusion_frames_ / drawn : 0.0;
     out["gpu_occlusion_kinds"] = double(occlusion_choices_.size());
-    double probes = 0.0, switches = 0.0;
+    double probes = 0.0, switches = 0.0, early = 0.0;
     size_t most = 0;
     for (const auto& [key, choice] : occlusion_choices_) {
       probes += double(choice.probes());
       switches += double(choice.switches());
+      early += double(choice.earlyProbes());
       const size_t frames = choice.framesOf(0) + choice.framesOf(1);
       if (frames > most) {
         most = frames;
@@ -126,6 +127,7 @@ std::map<std::string, double> GpuCullRun::info() const {
     }
     out["gpu_occlusion_probes"] = probes;
     out["gpu_occlusion_switches"] = switches;
+    out["gpu_occlusion_early_probes"] = early;
   }
   if (stage_frames_ > 0.0) {
     for (size_t i = 0; i < stage_ms_.size(); ++i)

@@ -60,7 +60,8 @@ class GpuCullRun {
   // gpu_stage_frames; with occlusion_auto, gpu_occlusion_auto (1), gpu_occlusion_frames (the share of frames drawn
   // with occlusion culling), gpu_occlusion_kinds (the kinds of frame chosen for apart: target sizes and simplified
   // levels, a governor's levels), gpu_occlusion_kept (1 or 0: the choice at the end for the kind drawn most),
-  // gpu_occlusion_probes, gpu_occlusion_switches (summed over the kinds).
+  // gpu_occlusion_probes, gpu_occlusion_switches, gpu_occlusion_early_probes (those a change of the frame time
+  // started; summed over the kinds).
   std::map<std::string, double> info() const;
 
  private:

@@ -116,10 +116,10 @@ std::string formatWalkSummary(const WalkResult& r) {
   };
   if (info("gpu_occlusion_auto") > 0.0) {
     std::snprintf(buf, sizeof(buf),
-                  "occlusion:       auto (gpu_occlusion): on in %.0f%% of frames, %s at the end; %.0f probes, %.0f "
-                  "switches\n",
+                  "occlusion:       auto (gpu_occlusion): on in %.0f%% of frames, %s at the end; %.0f probes (%.0f "
+                  "on a change of the frame time), %.0f switches\n",
                   100.0 * info("gpu_occlusion_frames"), info("gpu_occlusion_kept") > 0.0 ? "on" : "off",
-                  info("gpu_occlusion_probes"), info("gpu_occlusion_switches"));
+                  info("gpu_occlusion_probes"), info("gpu_occlusion_early_probes"), info("gpu_occlusion_switches"));
     text += buf;
   }
   return text;

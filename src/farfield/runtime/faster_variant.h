@@ -3,22 +3,29 @@
 // Occlusion culling on the GPU (gpu/gpu_culler.h) draws the frame that drawing everything in view draws, at the cost
 // of two depth pyramids and a second culling phase. Whether that pays depends on the machine and on the list: tens of
 // microseconds on a GPU; on llvmpipe 2-3 ms a frame at 640 x 360, where a region's visible set (already culled by
-// region visibility) then draws faster without it. No model fitted once knows which: the host's own frame times do.
-// The rule:
-//   - the kept variant's last measured frames (up to 8) give its recent median; a probe starts once there are
-//     `min_kept` of them and draws the other variant until `probe_frames` of its frames are measured: the other
-//     variant is kept from then on only when their median is lower than the kept one's recent median by more than
-//     `margin` (frames a few apart see about the same view);
+// region visibility) then often draws faster without it, and a heavier city's does not. No model fitted once knows
+// which: the host's own frame times do. The rule:
+//   - a probe draws the two variants in runs of two frames, in the order other, kept, kept, other (repeated),
+//     `probe_runs` runs of each; the first frame of each run is not counted (it pays for the switch: occlusion
+//     culling turned on has no history). The counted frames of the two variants then lie at the same mean time along
+//     the path, so that a steady change of the frame time (a view opening up) cancels out of the comparison;
+//   - the other variant is kept from then on only when the mean of its counted frames is lower than the kept one's
+//     by more than `margin`;
 //   - probes repeat `reprobe_after` frames after a decision, the interval doubling (up to `reprobe_max`) each time the
 //     decision stands and starting again from `reprobe_after` when it changes, so that a choice that stands costs a
 //     few frames of the slower variant per `reprobe_max` frames;
-//   - a probe stops as soon as the median of its measured frames (two or more: the first frame after a switch may
-//     pay for the switch) is over `give_up_ratio` times the kept one's recent median, so that a probe of a much slower
-//     variant costs two or three frames;
-//   - measured times may come back any number of frames late (a timer query read late) and in any order; frames never
-//     measured (a host's untimed calibration draws) only delay the probe, and a probe that draws `max_in_flight`
-//     frames without its measurements is given up. Nothing is probed before frames of the kept variant were measured,
-//     so a host's untimed first draws all see the first variant.
+//   - and sooner where the workload changes: when the median of the kept variant's last `min_kept` frames departs
+//     from its level at the last decision by more than `change_ratio` (either way), a probe starts at once (at least
+//     16 frames after the last one) and the interval starts again from `reprobe_after`. On the demo's drive,
+//     occlusion culling off is faster over its first 20 frames and 1.4x slower from frame 80 on, where its frames
+//     jump from 21 to 34 ms: the jump starts the probe that turns it back on;
+//   - a probe stops drawing the other variant once two of its counted frames have a median over `give_up_ratio`
+//     times the kept variant's recent median (its last 8 measured frames), so that a probe of a much slower variant
+//     costs a few frames;
+//   - measured times may come back any number of frames late (a timer query read late); frames never measured (a
+//     host's untimed draws) only delay a probe: nothing is probed before `min_kept` frames of the kept variant were
+//     measured, so a host's untimed first draws all see the first variant, and a probe whose frames stay unmeasured
+//     for `max_in_flight` frames is given up.
 // No OpenGL and no clock: the host reports what it measured (eval's GpuCullRun does so for `gpu_occlusion=auto`).
 #pragma once
 
@@ -31,12 +38,13 @@ namespace farfield::runtime {
 
 struct FasterVariantOptions {
   size_t min_kept = 4;          // measured frames of the kept variant before a probe (1..8)
-  size_t probe_frames = 3;      // measured frames of the other variant a probe decides on (>= 1)
+  size_t probe_runs = 4;        // runs of two frames of each variant a probe draws (>= 1; even: balanced)
   double margin = 0.05;         // share by which the other variant must be faster to be kept, in [0, 1)
   size_t reprobe_after = 120;   // frames from a decision to the next probe (>= 1)
   size_t reprobe_max = 960;     // the interval's ceiling while decisions stand (>= reprobe_after)
   double give_up_ratio = 1.25;  // a probe whose frames take this many times the kept one's stops early (> 1)
-  size_t max_in_flight = 64;    // decided frames kept waiting for their measurement (>= probe_frames)
+  double change_ratio = 1.4;    // a departure of the kept variant's frames from their level that probes early (> 1)
+  size_t max_in_flight = 64;    // decided frames kept waiting for their measurement (>= 4 x probe_runs)
 };
 
 class FasterVariant {
@@ -57,29 +65,36 @@ class FasterVariant {
   size_t probes() const { return probes_; }          // probes started
   size_t probesGivenUp() const { return given_up_; }  // stopped early (a much slower variant) or never measured
   size_t switches() const { return switches_; }       // decisions that changed the kept variant
+  size_t earlyProbes() const { return early_probes_; }  // probes started by a change of the workload
   size_t framesOf(int variant) const { return frames_of_[size_t(variant & 1)]; }  // frames decided per variant
 
  private:
   struct InFlight {
     uint64_t frame = 0;
     int variant = 0;
-    size_t probe = 0;  // the probe it was drawn for (probes_ then), 0: none
+    size_t probe = 0;      // the probe it was drawn for (probes_ then), 0: none
+    bool counted = false;  // a probe frame that is not the first of its run
   };
   void finishProbe(bool given_up);
-  double keptMedian() const;
+  void finishProbeIfDone();
+  double recentKeptMedian() const;
+  bool workloadChanged() const;
 
   FasterVariantOptions options_;
   int kept_ = 0;
   std::deque<InFlight> in_flight_;
   bool probing_ = false;
-  size_t probe_drawn_ = 0;          // frames the current probe has drawn
-  std::vector<double> probe_ms_;    // ... and their measured times
-  std::deque<double> recent_kept_;  // the kept variant's last measured times
+  size_t probe_step_ = 0;           // frames the current probe has drawn
+  size_t probe_unmeasured_ = 0;     // ... of which not yet measured
+  std::vector<double> probe_ms_[2];  // its counted frames' times, per variant
+  std::deque<double> recent_kept_;  // the kept variant's last measured times outside probes
   uint64_t next_probe_ = 0;
+  double level_ = 0.0;        // the kept variant's frame time at the last decision, 0: none yet
+  uint64_t probe_ended_ = 0;  // the last frame decided when the last probe ended
   size_t interval_ = 0;
   bool any_decided_ = false;
   uint64_t last_frame_ = 0;
-  size_t probes_ = 0, given_up_ = 0, switches_ = 0;
+  size_t probes_ = 0, given_up_ = 0, switches_ = 0, early_probes_ = 0;
   size_t frames_of_[2] = {0, 0};
 };
 
