@@ -9,8 +9,8 @@
 #      frame budget, t_max = FF_DEMO_TMAX_FACTOR x M (0.9 by default), so that on any machine the budget asks for
 #      impostors; the same bench measures the frame governor's floor on this machine (the governor over that
 #      placement under a budget no frame meets: every frame at its coarsest level), and t_max is never below
-#      FF_DEMO_FLOOR_MARGIN (1.1) x the slowest of those frames, a budget the governor cannot keep being no promise to
-#      demonstrate (FF_DEMO_TMAX in ms overrides both);
+#      FF_DEMO_FLOOR_MARGIN (1.2) x the 99th percentile of those frames, a budget the governor cannot keep being no
+#      promise to demonstrate (FF_DEMO_TMAX in ms overrides both);
 #   4. automatic impostor placement over the district under the two promises (an error bound of 2 px and t_max); a
 #      placement with no impostor fails the demo loudly: it would show nothing of the product;
 #   5. the walkthrough benchmark of full geometry, culling (the GPU-driven frame), the placed impostors, and the placed
@@ -33,9 +33,12 @@ STRIDE=${FF_DEMO_STRIDE:-2}
 TMAX_FACTOR=${FF_DEMO_TMAX_FACTOR:-0.9}
 TMAX=${FF_DEMO_TMAX:-}
 # Over the floor: the machine's noise, and the first frame that draws an impostor loads it (2-3 ms on llvmpipe: a
-# clean clone's run had that frame at 31.7 ms for a t_max of 31.8). More margin asks for fewer impostors: at 1.2 a run
-# whose floor had one slow frame (33.6 ms) set t_max at 40.3 ms and its 9 impostors served no frame of the drive.
-FLOOR_MARGIN=${FF_DEMO_FLOOR_MARGIN:-1.1}
+# clean clone's run had that frame at 31.7 ms for a t_max of 31.8). The floor is the 99th percentile of the coarsest
+# frames, not the slowest: over four runs on the 2-core machine the p99 was 28.3-29.6 ms and the slowest 28.6-37.7
+# (one hiccup decided t_max), while the governed walkthrough's slowest frame was 32.7-33.5 ms, 1.13-1.16x the p99.
+# More margin asks for fewer impostors: at 1.2 over the slowest frame, a run whose floor had one slow frame (33.6 ms)
+# set t_max at 40.3 ms and its 9 impostors served no frame of the drive.
+FLOOR_MARGIN=${FF_DEMO_FLOOR_MARGIN:-1.2}
 # The governor's render-resolution levels, the last resort (each side's scale; the frame scaled up): down to 0.35.
 SCALES=${FF_DEMO_GOVERNOR_SCALES:-1,0.84,0.71,0.59,0.5,0.42,0.35}
 BOUND=${FF_DEMO_BOUND:-2}
@@ -80,15 +83,15 @@ if [ -z "$TMAX" ]; then
   read -r median floor <<< "$(python3 -c '
 import json, sys
 modes = json.load(open(sys.argv[1]))["modes"]
-print("%.2f %.2f" % (modes["placed"]["median_ms"], modes["governed"]["max_ms"]))' "$OUT/no_impostor_bench/bench.json")"
+print("%.2f %.2f" % (modes["placed"]["median_ms"], modes["governed"]["p99_ms"]))' "$OUT/no_impostor_bench/bench.json")"
   [ -n "$median" ] && [ -n "$floor" ] || { echo "demo: no frame times in $OUT/no_impostor_bench/bench.json" >&2; exit 1; }
   TMAX=$(awk -v m="$median" -v f="$TMAX_FACTOR" -v g="$floor" -v k="$FLOOR_MARGIN" \
     'BEGIN {t = m * f; if (g * k > t) t = g * k; printf "%.1f", t}')
   TMAX_SOURCE="the larger of $TMAX_FACTOR x $median ms, the median frame of the walkthrough with region visibility"
-  TMAX_SOURCE+=" alone on this machine, and $FLOOR_MARGIN x $floor ms, the slowest frame of the frame governor's"
+  TMAX_SOURCE+=" alone on this machine, and $FLOOR_MARGIN x $floor ms, the 99th percentile of the frame governor's"
   TMAX_SOURCE+=" coarsest level over it"
   echo "== t_max = max($TMAX_FACTOR x $median ms, the median with region visibility alone; $FLOOR_MARGIN x $floor ms," \
-    "the governor's slowest coarsest frame) = $TMAX ms"
+    "the 99th percentile of the governor's coarsest frames) = $TMAX ms"
 fi
 step "place impostors under ${BOUND} px and t_max ${TMAX} ms over the district" "$OUT/place.txt" \
   "$FARFIELD" place "$OUT/city.glb" --profile "$OUT/profile.json" -o "$OUT/placement" --tmax "$TMAX" "${district[@]}"
