@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <string>
+
 #include "eval/eval_test_scenes.h"
 #include "eval/mode_harness.h"
 #include "farfield/core/error.h"
@@ -101,6 +104,34 @@ TEST(GovernedMode, ABudgetEveryFrameKeepsLeavesTheFrameItself) {
     EXPECT_EQ(differingPixels(governed_ids, h.target->readIds()), 0u);
     EXPECT_EQ(g.syncs, 0u);
   }
+}
+
+// With gpu_occlusion=auto the calibration draws every level with the occlusion test on and off, and each level's
+// chooser starts from those times (no first frames with the test on waiting for a probe); the frames stay those of
+// the test always on.
+TEST(GovernedMode, WithOcclusionAutoEachLevelsChooserStartsFromTheCalibration) {
+  Harness h(1e9);
+  h.context.options["gpu_occlusion"] = "auto";
+  auto governed = h.make("governed");
+  h.context.options["gpu_occlusion"] = "on";
+  auto culled = h.make("culled");
+  FrameRunner runner(*h.renderer, *h.target);
+  const gen::CameraPath path = test::sideWalkPath(4);
+  runner.run(*governed, pathCamera(path, 0, kSize, kSize), 0);  // warm-up: the calibration
+  runner.run(*culled, pathCamera(path, 0, kSize, kSize), 0);
+  std::map<std::string, double> info = governed->info();
+  EXPECT_EQ(info.at("gpu_occlusion_kinds"), 2.0);  // full size and half size
+  EXPECT_EQ(info.at("gpu_occlusion_started"), 2.0);
+  for (size_t i = 0; i < path.frames.size(); ++i) {
+    SCOPED_TRACE("path frame " + std::to_string(i));
+    const Camera camera = pathCamera(path, i, kSize, kSize);
+    runner.run(*governed, camera, i);
+    const image::IdImage governed_ids = h.target->readIds();
+    runner.run(*culled, camera, i);
+    EXPECT_EQ(differingPixels(governed_ids, h.target->readIds()), 0u);
+  }
+  info = governed->info();
+  EXPECT_EQ(info.at("gpu_occlusion_probes"), 0.0);  // four frames: the first probe is 120 frames after the start
 }
 
 // Spheres of 8,192 triangles in a row going away from the eye: the far ones are simplified under a few pixels.

@@ -170,6 +170,31 @@ TEST(FasterVariant, GivesUpAProbeWhoseFramesAreNeverMeasured) {
   EXPECT_EQ(chooser.kept(), 0);
 }
 
+// A host's timing of both variants (a governor's calibration) starts the chooser: on the faster one where it is
+// faster by the margin, with the next probe `reprobe_after` frames later.
+TEST(FasterVariant, StartsFromAHostsTimingOfBothVariants) {
+  FasterVariant faster(0);
+  for (uint64_t f = 0; f < 8; ++f) EXPECT_EQ(faster.decide(f), 0);  // untimed draws
+  faster.startFrom(10.0, 6.0);
+  EXPECT_EQ(faster.kept(), 1);
+  EXPECT_EQ(faster.starts(), 1u);
+  // Measured frames twice as slow as the host's times (taken otherwise): no change of the workload is seen in that.
+  std::vector<int> after;
+  for (uint64_t f = 8; f < 7 + 120; ++f) {
+    after.push_back(faster.decide(f));
+    faster.measured(f, after.back() == 0 ? 20.0 : 12.0);
+  }
+  EXPECT_EQ(std::count(after.begin(), after.end(), 1), 119);  // no probe before 120 frames after the start
+  EXPECT_EQ(faster.probes(), 0u);
+  EXPECT_EQ(faster.decide(7 + 120), 0);  // then the first probe's run of the other
+
+  FasterVariant alike(0);
+  alike.startFrom(10.0, 9.8);  // within the margin: the first variant stays
+  EXPECT_EQ(alike.kept(), 0);
+  EXPECT_THROW(alike.startFrom(-1.0, 2.0), Error);
+  EXPECT_THROW(alike.startFrom(1.0, std::nan("")), Error);
+}
+
 TEST(FasterVariant, RejectsBadOptionsOrderAndTimes) {
   EXPECT_THROW(FasterVariant(2), Error);
   FasterVariantOptions bad;

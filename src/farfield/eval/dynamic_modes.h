@@ -61,6 +61,7 @@ class BillboardMode final : public Mode {
     return geometry_draw_->lateFrameStats(path_frame);
   }
   void frameMeasured(size_t path_frame, double wall_ms) override { geometry_draw_->frameMeasured(path_frame, wall_ms); }
+  GpuCullRun* gpuCullRun() override { return geometry_draw_ ? geometry_draw_->gpuRun() : nullptr; }
   std::map<std::string, double> info() const override;
 
  private:
@@ -90,6 +91,7 @@ class DynamicImpostorMode final : public Mode {
   void frameMeasured(size_t path_frame, double wall_ms) override {
     if (geometry_draw_) geometry_draw_->frameMeasured(path_frame, wall_ms);
   }
+  GpuCullRun* gpuCullRun() override { return geometry_draw_ ? geometry_draw_->gpuRun() : nullptr; }
   std::map<std::string, double> info() const override;
 
  private:

@@ -8,6 +8,7 @@
 #include "farfield/core/log.h"
 #include "farfield/core/timer.h"
 #include "farfield/eval/frame_stats.h"
+#include "farfield/eval/gpu_culled_mode.h"
 #include "farfield/eval/mode_options.h"
 
 namespace farfield::eval {
@@ -152,19 +153,54 @@ void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {
   Stopwatch total;
   Camera tiny = camera;
   tiny.width = tiny.height = 1;
+  // One draw of a level, waited for: its triangles (read after the wait) and milliseconds.
+  struct Timed {
+    double triangles = 0.0, ms = 0.0;
+  };
+  const auto timedDraw = [&](size_t level) {
+    Stopwatch clock;
+    const gpu::FrameStats drawn = drawLevel(camera, path_frame, level);
+    // A lower resolution's frame is scaled up as in a real frame (the first also makes the driver's state).
+    if (levels_[level].scale < 1.0) upscaler_->draw(levels_[level].target, full_target_, upscale_channels_);
+    renderer_->render(tiny, {}, finish_target_);  // waits for the GPU (Renderer::render's glFinish)
+    Timed t;
+    t.ms = clock.milliseconds();
+    t.triangles = double(drawn.triangles);
+    if (const std::optional<gpu::FrameStats> late = inners_[levels_[level].inner]->lateFrameStats(path_frame))
+      t.triangles += double(late->triangles);
+    return t;
+  };
+  // Where the inner mode chooses its occlusion test by its frames (gpu_occlusion=auto), each level is drawn with the
+  // test on and off: the level's chooser starts on the faster (instead of drawing its first frames with the test on
+  // and probing later, frames a governor near its floor has no room for), and the model is fitted on that variant.
+  std::vector<std::vector<Timed>> on(levels_.size()), off(levels_.size());
+  std::vector<bool> both(levels_.size(), false);
   // One untimed round first (targets, pyramids and caches made), then `repeats` timed rounds over the levels.
   for (int round = 0; round <= calibration_repeats_; ++round) {
     for (size_t level = 0; level < levels_.size(); ++level) {
-      Stopwatch clock;
-      const gpu::FrameStats drawn = drawLevel(camera, path_frame, level);
-      // A lower resolution's frame is scaled up as in a real frame (the first also makes the driver's state).
-      if (levels_[level].scale < 1.0) upscaler_->draw(levels_[level].target, full_target_, upscale_channels_);
-      renderer_->render(tiny, {}, finish_target_);  // waits for the GPU (Renderer::render's glFinish)
-      const double ms = clock.milliseconds();
-      double triangles = double(drawn.triangles);
-      if (const std::optional<gpu::FrameStats> late = inners_[levels_[level].inner]->lateFrameStats(path_frame))
-        triangles += double(late->triangles);
-      if (round > 0) loop_->calibrationSample(level, triangles, ms);
+      GpuCullRun* run = inners_[levels_[level].inner]->gpuCullRun();
+      both[level] = run && run->occlusionAuto();
+      if (!both[level]) {
+        const Timed t = timedDraw(level);
+        if (round > 0) loop_->calibrationSample(level, t.triangles, t.ms);
+        continue;
+      }
+      run->forceOcclusion(true);
+      const Timed with = timedDraw(level);
+      run->forceOcclusion(false);
+      const Timed without = timedDraw(level);
+      run->forceOcclusion(std::nullopt);
+      if (round == 0) continue;
+      on[level].push_back(with);
+      off[level].push_back(without);
+      if (round == calibration_repeats_) {
+        double on_ms = 0.0, off_ms = 0.0;
+        for (size_t r = 0; r < on[level].size(); ++r) on_ms += on[level][r].ms, off_ms += off[level][r].ms;
+        run->startOcclusionFrom(on_ms, off_ms);  // the kind just drawn: this level's
+        // The samples of the variant the chooser starts with (the test stays on unless off is faster by its margin).
+        const bool keep_off = off_ms < (1.0 - runtime::FasterVariantOptions{}.margin) * on_ms;
+        for (const Timed& t : keep_off ? off[level] : on[level]) loop_->calibrationSample(level, t.triangles, t.ms);
+      }
     }
   }
   loop_->finishCalibration();

@@ -40,12 +40,16 @@ void GpuCullRun::draw(FrameContext& frame) {
   gpu::RenderTarget& target = frame.beginOwnPass();
   if (occlusion_auto_) {
     // One choice per kind of frame: a governor's levels (sizes, simplified levels) differ in what the test saves.
-    const auto key = std::make_tuple(target.width(), target.height(), culler_->options().lod_error_px);
-    runtime::FasterVariant& choice = occlusion_choices_.try_emplace(key, 0).first->second;
-    const bool on = choice.decide(path_frame_of_.size()) == 0;
+    last_kind_ = std::make_tuple(target.width(), target.height(), culler_->options().lod_error_px);
+    runtime::FasterVariant* choice = nullptr;
+    bool on = forced_occlusion_.value_or(true);
+    if (!forced_occlusion_) {
+      choice = &occlusion_choices_.try_emplace(last_kind_, 0).first->second;
+      on = choice->decide(path_frame_of_.size()) == 0;
+    }
     culler_->setOcclusion(on);
     occlusion_frames_ += on ? 1.0 : 0.0;
-    chooser_of_.push_back(&choice);
+    chooser_of_.push_back(choice);
   }
   path_frame_of_.push_back(frame.pathFrame());
   frame.addStats(culler_->draw(frame.camera(), target, gpu::RenderMode::Shaded, frame.renderer().light()));
@@ -56,10 +60,15 @@ void GpuCullRun::frameMeasured(size_t path_frame, double wall_ms) {
   // The last frame drawn for it: a governor's calibration draws a path frame several times, untimed.
   for (size_t i = path_frame_of_.size(); i-- > 0 && path_frame_of_.size() - i <= 64;) {
     if (path_frame_of_[i] == path_frame) {
-      chooser_of_[i]->measured(i, wall_ms);
+      if (chooser_of_[i]) chooser_of_[i]->measured(i, wall_ms);
       return;
     }
   }
+}
+
+void GpuCullRun::startOcclusionFrom(double on_ms, double off_ms) {
+  if (!occlusion_auto_) return;
+  occlusion_choices_.try_emplace(last_kind_, 0).first->second.startFrom(on_ms, off_ms);
 }
 
 void GpuCullRun::collect() {
@@ -113,12 +122,13 @@ std::map<std::string, double> GpuCullRun::info() const {
     out["gpu_occlusion_auto"] = 1.0;
     out["gpu_occlusion_frames"] = drawn > 0.0 ? occlusion_frames_ / drawn : 0.0;
     out["gpu_occlusion_kinds"] = double(occlusion_choices_.size());
-    double probes = 0.0, switches = 0.0, early = 0.0;
+    double probes = 0.0, switches = 0.0, early = 0.0, started = 0.0;
     size_t most = 0;
     for (const auto& [key, choice] : occlusion_choices_) {
       probes += double(choice.probes());
       switches += double(choice.switches());
       early += double(choice.earlyProbes());
+      started += double(choice.starts());
       const size_t frames = choice.framesOf(0) + choice.framesOf(1);
       if (frames > most) {
         most = frames;
@@ -128,6 +138,7 @@ std::map<std::string, double> GpuCullRun::info() const {
     out["gpu_occlusion_probes"] = probes;
     out["gpu_occlusion_switches"] = switches;
     out["gpu_occlusion_early_probes"] = early;
+    out["gpu_occlusion_started"] = started;
   }
   if (stage_frames_ > 0.0) {
     for (size_t i = 0; i < stage_ms_.size(); ++i)

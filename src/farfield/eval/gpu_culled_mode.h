@@ -52,6 +52,12 @@ class GpuCullRun {
   // The measured time of the last frame drawn for this path frame (Mode::frameMeasured): what occlusion_auto
   // chooses by.
   void frameMeasured(size_t path_frame, double wall_ms);
+  // For a host's timed calibration (the governor's): with occlusion_auto, the next frames are drawn with the test on
+  // or off whatever the chooser says (nullopt: the chooser again), and the chooser of the last frame's kind (target
+  // size, simplified levels) starts from both variants' times (runtime::FasterVariant::startFrom).
+  bool occlusionAuto() const { return occlusion_auto_; }
+  void forceOcclusion(std::optional<bool> on) { forced_occlusion_ = on; }
+  void startOcclusionFrom(double on_ms, double off_ms);
   // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, arena_build_s (making the arena, once a
   // run), indirect_count (1 or 0), and per frame
   // (means over the frames whose statistics came back): gpu_clusters_drawn_early, gpu_clusters_drawn_late,
@@ -61,7 +67,7 @@ class GpuCullRun {
   // with occlusion culling), gpu_occlusion_kinds (the kinds of frame chosen for apart: target sizes and simplified
   // levels, a governor's levels), gpu_occlusion_kept (1 or 0: the choice at the end for the kind drawn most),
   // gpu_occlusion_probes, gpu_occlusion_switches, gpu_occlusion_early_probes (those a change of the frame time
-  // started; summed over the kinds).
+  // started), gpu_occlusion_started (kinds started from a host's timing of both; summed over the kinds).
   std::map<std::string, double> info() const;
 
  private:
@@ -69,9 +75,11 @@ class GpuCullRun {
 
   std::unique_ptr<gpu::GpuCuller> culler_;
   bool occlusion_auto_ = false;
+  std::optional<bool> forced_occlusion_;
+  std::tuple<int, int, float> last_kind_{0, 0, 0.0f};
   // Per kind of frame (the target's width and height, the simplified levels' bound): variant 0 occlusion on, 1 off.
   std::map<std::tuple<int, int, float>, runtime::FasterVariant> occlusion_choices_;
-  std::vector<runtime::FasterVariant*> chooser_of_;  // per culler frame, with occlusion_auto
+  std::vector<runtime::FasterVariant*> chooser_of_;  // per culler frame, with occlusion_auto (null: forced)
   std::vector<size_t> path_frame_of_;           // per culler frame
   std::map<size_t, gpu::GpuCullStats> latest_;  // per path frame, the last statistics that came back
   double frames_ = 0.0, early_ = 0.0, late_ = 0.0, frustum_ = 0.0, cone_ = 0.0, occluded_ = 0.0, commands_ = 0.0;
@@ -90,6 +98,7 @@ class GpuCulledMode final : public Mode {
   void frame(FrameContext& frame) override { run_->draw(frame); }
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override { return run_->lateFrameStats(path_frame); }
   void frameMeasured(size_t path_frame, double wall_ms) override { run_->frameMeasured(path_frame, wall_ms); }
+  GpuCullRun* gpuCullRun() override { return run_ ? &*run_ : nullptr; }
   std::map<std::string, double> info() const override { return run_ ? run_->info() : std::map<std::string, double>{}; }
   bool setGeometryErrorPx(double px) override {
     if (!run_) return false;

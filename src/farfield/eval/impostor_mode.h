@@ -54,6 +54,7 @@ class ImpostorMode final : public Mode {
     return geometry_->lateFrameStats(path_frame);
   }
   void frameMeasured(size_t path_frame, double wall_ms) override { geometry_->frameMeasured(path_frame, wall_ms); }
+  GpuCullRun* gpuCullRun() override { return geometry_ ? geometry_->gpuRun() : nullptr; }
   bool setGeometryErrorPx(double px) override { return geometry_ && geometry_->setGeometryErrorPx(px); }
   // The walkthrough's statistics (runtime::Walkthrough::statistics): cells, loads, fallback frames, triangles, and
   // the bound with the layer draws it turned into geometry.

@@ -74,6 +74,7 @@ class MmiMode final : public Mode {
     return geometry_->lateFrameStats(path_frame);
   }
   void frameMeasured(size_t path_frame, double wall_ms) override { geometry_->frameMeasured(path_frame, wall_ms); }
+  GpuCullRun* gpuCullRun() override { return geometry_ ? geometry_->gpuRun() : nullptr; }
   bool setGeometryErrorPx(double px) override { return geometry_ && geometry_->setGeometryErrorPx(px); }
   double readAhead(const Camera& camera, double budget_ms) override {
     return walkthrough_ ? walkthrough_->readAheadPlaced(camera, budget_ms) : 0.0;

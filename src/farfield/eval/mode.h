@@ -147,6 +147,8 @@ struct FrameGovernance {
   double bound_scale = 1.0;   // the error bound kept / the promised bound (1: not relaxed)
 };
 
+class GpuCullRun;
+
 class Mode {
  public:
   virtual ~Mode() = default;
@@ -166,6 +168,9 @@ class Mode {
   // The harness's measured wall time of the frame just drawn (after its wait; outside the timed part). A mode that
   // closes a loop on its frame time (a governor) takes it; in an engine it would come from a timer query read late.
   virtual void frameMeasured(size_t /*path_frame*/, double /*wall_ms*/) {}
+  // The run that draws the mode's geometry through the arena with gpu_occlusion (eval/gpu_culled_mode.h), if any: a
+  // governor times both occlusion variants of each level at its calibration. None by default.
+  virtual GpuCullRun* gpuCullRun() { return nullptr; }
   // Lets the mode draw its geometry with the arena's simplified levels where their error projects to at most `px`
   // pixels (gpu::GpuCuller::setLodErrorPx; 0: full detail) from the next frame on. Returns false for a mode that
   // cannot (its geometry is not drawn through the arena), which then draws as before.

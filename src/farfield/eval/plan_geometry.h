@@ -40,6 +40,8 @@ class PlanGeometry {
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame);
   // Mode::frameMeasured: what gpu_occlusion=auto chooses by.
   void frameMeasured(size_t path_frame, double wall_ms);
+  // Mode::gpuCullRun: the GPU path's run, null on the CPU path.
+  GpuCullRun* gpuRun() { return run_ ? &*run_ : nullptr; }
   // The GPU run's simplified levels (Mode::setGeometryErrorPx); false on the CPU path.
   bool setGeometryErrorPx(double px) {
     if (!run_) return false;

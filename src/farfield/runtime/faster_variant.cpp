@@ -17,6 +17,7 @@ constexpr uint64_t kMaxLate = 8;
 constexpr uint64_t kMinGap = 16;
 
 double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
   const size_t mid = values.size() / 2;
   std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(mid), values.end());
   if (values.size() % 2 == 1) return values[mid];
@@ -25,6 +26,7 @@ double median(std::vector<double> values) {
 }
 
 double mean(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
   double sum = 0.0;
   for (double v : values) sum += v;
   return sum / double(values.size());
@@ -85,6 +87,26 @@ void FasterVariant::finishProbe(bool given_up) {
   probe_ms_[1].clear();
 }
 
+void FasterVariant::startFrom(double ms_of_0, double ms_of_1) {
+  if (probing_) throw Error("faster variant", "startFrom during a probe");
+  if (!(std::isfinite(ms_of_0) && ms_of_0 >= 0.0 && std::isfinite(ms_of_1) && ms_of_1 >= 0.0))
+    throw Error("faster variant", "startFrom: the times must be finite and >= 0");
+  const double ms[2] = {ms_of_0, ms_of_1};
+  const int other = 1 - kept_;
+  if (ms[other] < (1.0 - options_.margin) * ms[kept_]) {
+    kept_ = other;
+    ++switches_;
+  }
+  ++starts_;
+  // The host's times may be taken unlike the measured frames (a calibration's waits): the kept variant's level is
+  // taken from its first measured frames instead.
+  recent_kept_.clear();
+  level_ = 0.0;
+  interval_ = options_.reprobe_after;
+  next_probe_ = (any_decided_ ? last_frame_ : 0) + interval_;
+  probe_ended_ = any_decided_ ? last_frame_ : 0;
+}
+
 void FasterVariant::finishProbeIfDone() {
   if (probing_ && probe_step_ >= 2 * kRun * options_.probe_runs && probe_unmeasured_ == 0) finishProbe(false);
 }
@@ -100,6 +122,7 @@ int FasterVariant::decide(uint64_t frame) {
     in_flight_.pop_front();
   }
   finishProbeIfDone();
+  if (level_ <= 0.0 && probes_ + starts_ > 0 && recent_kept_.size() >= options_.min_kept) level_ = recentKeptMedian();
   if (!probing_ && recent_kept_.size() >= options_.min_kept && (frame >= next_probe_ || workloadChanged())) {
     if (frame < next_probe_) {
       ++early_probes_;

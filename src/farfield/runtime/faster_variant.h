@@ -60,12 +60,20 @@ class FasterVariant {
   // old, are ignored.
   void measured(uint64_t frame, double ms);
 
+  // A host that timed both variants on the same frames (a governor's calibration) starts the chooser from those
+  // times instead of its first probe: the variant not kept becomes kept only where faster by the margin, as a probe
+  // would decide, and the next probe comes `reprobe_after` frames later; the level a change of the workload is seen
+  // against is taken from the first `min_kept` measured frames (the host's times may be taken unlike them). Throws
+  // farfield::Error during a probe or for a time that is negative or not finite.
+  void startFrom(double ms_of_0, double ms_of_1);
+
   int kept() const { return kept_; }
   bool probing() const { return probing_; }
   size_t probes() const { return probes_; }          // probes started
   size_t probesGivenUp() const { return given_up_; }  // stopped early (a much slower variant) or never measured
   size_t switches() const { return switches_; }       // decisions that changed the kept variant
   size_t earlyProbes() const { return early_probes_; }  // probes started by a change of the workload
+  size_t starts() const { return starts_; }              // startFrom calls
   size_t framesOf(int variant) const { return frames_of_[size_t(variant & 1)]; }  // frames decided per variant
 
  private:
@@ -94,7 +102,7 @@ class FasterVariant {
   size_t interval_ = 0;
   bool any_decided_ = false;
   uint64_t last_frame_ = 0;
-  size_t probes_ = 0, given_up_ = 0, switches_ = 0, early_probes_ = 0;
+  size_t probes_ = 0, given_up_ = 0, switches_ = 0, early_probes_ = 0, starts_ = 0;
   size_t frames_of_[2] = {0, 0};
 };
 
