@@ -255,7 +255,8 @@ TEST_F(GpuCullerTest, OcclusionTurnedOnAndOffBetweenFramesChangesNoFrame) {
     const Reference want = reference(cameras[f], RenderMode::ItemBuffer);
     culled(culler, cameras[f], RenderMode::ItemBuffer);
     ASSERT_EQ(differences(want, false), 0u) << "frame " << f << " occlusion " << on;
-    for (const GpuCullStats& s : culler.finishedStats()) (on_in_frame[s.frame] ? occluded_on : occluded_off) += s.occlusion_culled;
+    for (const GpuCullStats& s : culler.finishedStats())
+      (on_in_frame[s.frame] ? occluded_on : occluded_off) += s.occlusion_culled;
   }
   EXPECT_GT(switches_on, 3u);
   EXPECT_GT(occluded_on, 200u);

@@ -197,24 +197,19 @@ TEST(FasterVariant, StartsFromAHostsTimingOfBothVariants) {
 
 TEST(FasterVariant, RejectsBadOptionsOrderAndTimes) {
   EXPECT_THROW(FasterVariant(2), Error);
-  FasterVariantOptions bad;
-  bad.margin = 1.0;
-  EXPECT_THROW(FasterVariant(0, bad), Error);
-  bad = {};
-  bad.give_up_ratio = 1.0;
-  EXPECT_THROW(FasterVariant(0, bad), Error);
-  bad = {};
-  bad.reprobe_max = bad.reprobe_after - 1;
-  EXPECT_THROW(FasterVariant(0, bad), Error);
-  bad = {};
-  bad.change_ratio = 1.0;
-  EXPECT_THROW(FasterVariant(0, bad), Error);
-  bad = {};
-  bad.min_kept = 9;
-  EXPECT_THROW(FasterVariant(0, bad), Error);
-  bad = {};
-  bad.max_in_flight = 4 * bad.probe_runs - 1;
-  EXPECT_THROW(FasterVariant(0, bad), Error);
+  const std::vector<std::function<void(FasterVariantOptions&)>> spoil{
+      [](FasterVariantOptions& o) { o.margin = 1.0; },
+      [](FasterVariantOptions& o) { o.give_up_ratio = 1.0; },
+      [](FasterVariantOptions& o) { o.reprobe_max = o.reprobe_after - 1; },
+      [](FasterVariantOptions& o) { o.change_ratio = 1.0; },
+      [](FasterVariantOptions& o) { o.min_kept = 9; },
+      [](FasterVariantOptions& o) { o.max_in_flight = 4 * o.probe_runs - 1; },
+  };
+  for (size_t i = 0; i < spoil.size(); ++i) {
+    FasterVariantOptions bad;
+    spoil[i](bad);
+    EXPECT_THROW(FasterVariant(0, bad), Error) << "bad option " << i;
+  }
   FasterVariant chooser(0);
   chooser.decide(5);
   EXPECT_THROW(chooser.decide(5), Error);

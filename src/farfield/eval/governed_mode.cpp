@@ -174,13 +174,11 @@ void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {
   // test on and off: the level's chooser starts on the faster (instead of drawing its first frames with the test on
   // and probing later, frames a governor near its floor has no room for), and the model is fitted on that variant.
   std::vector<std::vector<Timed>> on(levels_.size()), off(levels_.size());
-  std::vector<bool> both(levels_.size(), false);
   // One untimed round first (targets, pyramids and caches made), then `repeats` timed rounds over the levels.
   for (int round = 0; round <= calibration_repeats_; ++round) {
     for (size_t level = 0; level < levels_.size(); ++level) {
       GpuCullRun* run = inners_[levels_[level].inner]->gpuCullRun();
-      both[level] = run && run->occlusionAuto();
-      if (!both[level]) {
+      if (!run || !run->occlusionAuto()) {
         const Timed t = timedDraw(level);
         if (round > 0) loop_->calibrationSample(level, t.triangles, t.ms);
         continue;
@@ -196,10 +194,9 @@ void GovernedMode::calibrate(const Camera& camera, size_t path_frame) {
       if (round == calibration_repeats_) {
         double on_ms = 0.0, off_ms = 0.0;
         for (size_t r = 0; r < on[level].size(); ++r) on_ms += on[level][r].ms, off_ms += off[level][r].ms;
-        run->startOcclusionFrom(on_ms, off_ms);  // the kind just drawn: this level's
-        // The samples of the variant the chooser starts with (the test stays on unless off is faster by its margin).
-        const bool keep_off = off_ms < (1.0 - runtime::FasterVariantOptions{}.margin) * on_ms;
-        for (const Timed& t : keep_off ? off[level] : on[level]) loop_->calibrationSample(level, t.triangles, t.ms);
+        // The kind just drawn is this level's; the samples are those of the variant its chooser starts with.
+        const bool keeps_on = run->startOcclusionFrom(on_ms, off_ms);
+        for (const Timed& t : keeps_on ? on[level] : off[level]) loop_->calibrationSample(level, t.triangles, t.ms);
       }
     }
   }

@@ -66,9 +66,11 @@ void GpuCullRun::frameMeasured(size_t path_frame, double wall_ms) {
   }
 }
 
-void GpuCullRun::startOcclusionFrom(double on_ms, double off_ms) {
-  if (!occlusion_auto_) return;
-  occlusion_choices_.try_emplace(last_kind_, 0).first->second.startFrom(on_ms, off_ms);
+bool GpuCullRun::startOcclusionFrom(double on_ms, double off_ms) {
+  if (!occlusion_auto_) return culler_->options().occlusion;
+  runtime::FasterVariant& choice = occlusion_choices_.try_emplace(last_kind_, 0).first->second;
+  choice.startFrom(on_ms, off_ms);
+  return choice.kept() == 0;
 }
 
 void GpuCullRun::collect() {

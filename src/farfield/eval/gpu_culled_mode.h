@@ -54,10 +54,11 @@ class GpuCullRun {
   void frameMeasured(size_t path_frame, double wall_ms);
   // For a host's timed calibration (the governor's): with occlusion_auto, the next frames are drawn with the test on
   // or off whatever the chooser says (nullopt: the chooser again), and the chooser of the last frame's kind (target
-  // size, simplified levels) starts from both variants' times (runtime::FasterVariant::startFrom).
+  // size, simplified levels) starts from both variants' times (runtime::FasterVariant::startFrom); returns whether it
+  // keeps the test on.
   bool occlusionAuto() const { return occlusion_auto_; }
   void forceOcclusion(std::optional<bool> on) { forced_occlusion_ = on; }
-  void startOcclusionFrom(double on_ms, double off_ms);
+  bool startOcclusionFrom(double on_ms, double off_ms);
   // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, arena_build_s (making the arena, once a
   // run), indirect_count (1 or 0), and per frame
   // (means over the frames whose statistics came back): gpu_clusters_drawn_early, gpu_clusters_drawn_late,

@@ -2,7 +2,8 @@
 //   gpu: the plan lists its geometry objects (runtime::WalkthroughOptions::geometry_items false) and a GpuCullRun over
 //        the run's arena culls and draws their clusters on the GPU, as the culled mode does (gpu_occlusion, gpu_cones,
 //        gpu_compact apply; gpu_occlusion is auto by default: region visibility has culled the lists already, and
-//        whether the pyramid test still pays is measured on the run's frames); the plan's CPU work is its choice of objects, and only a change of it is uploaded;
+//        whether the pyramid test still pays is measured on the run's frames); the plan's CPU work is its choice of
+//        objects, and only a change of it is uploaded;
 //   cpu: the plan's items culled per cluster on the CPU, occlusion-culled against the depth of their nearest ones
 //        (the culled-cpu mode's pass) unless occlusion=off.
 // Either way the plan's impostors follow in the frame's main pass. occlusion=off turns occlusion off on both paths.

@@ -68,7 +68,6 @@ class FasterVariant {
   void startFrom(double ms_of_0, double ms_of_1);
 
   int kept() const { return kept_; }
-  bool probing() const { return probing_; }
   size_t probes() const { return probes_; }          // probes started
   size_t probesGivenUp() const { return given_up_; }  // stopped early (a much slower variant) or never measured
   size_t switches() const { return switches_; }       // decisions that changed the kept variant
