@@ -237,6 +237,33 @@ TEST_F(GpuCullerTest, FramesEqualFrustumCulledFramesAlongAWalk) {
   }
 }
 
+// A still camera: from its third frame on, everything drawn is drawn early (the history of the frame before holds
+// every cluster visible in its final depth, however many it drew: the history pass's dispatch covers its whole list),
+// and the frames stay equal to the frame of every cluster in view.
+TEST_F(GpuCullerTest, AStillCameraDrawsEverythingEarlyFromItsThirdFrame) {
+  const std::vector<Camera> cameras = walk(3, 48);
+  GpuCuller culler(*arena_);
+  std::vector<GpuCullStats> stats;
+  for (const size_t pick : {size_t(29), size_t(33)}) {  // views of 200 visible clusters and more
+    const Reference want = reference(cameras[pick], RenderMode::ItemBuffer);
+    for (int f = 0; f < 8; ++f) {
+      culled(culler, cameras[pick], RenderMode::ItemBuffer);
+      ASSERT_EQ(differences(want, false), 0u) << "view " << pick << " frame " << f;
+      for (const GpuCullStats& s : culler.finishedStats()) stats.push_back(s);
+    }
+  }
+  for (const GpuCullStats& s : culler.finishedStats()) stats.push_back(s);
+  size_t checked = 0;
+  for (const GpuCullStats& s : stats) {
+    const uint64_t in_run = s.frame % 8;
+    if (in_run < 2) continue;
+    EXPECT_EQ(s.drawn_late, 0u) << "frame " << s.frame;
+    EXPECT_GT(s.drawn_early, 3u * 64u) << "frame " << s.frame;  // more than a few work groups' worth
+    ++checked;
+  }
+  EXPECT_GE(checked, 8u);
+}
+
 // Occlusion culling turned on and off between frames (GpuCuller::setOcclusion, what gpu_occlusion=auto does) changes
 // no frame: each equals the frame of every cluster in view, and the frames with it on do occlusion-cull while those
 // with it off cull nothing by depth.

@@ -31,12 +31,20 @@ GLuint createBuffer(size_t bytes, const void* data, GLbitfield flags = GL_DYNAMI
   return createStorageBuffer(bytes, data, flags);
 }
 
+// Empties a list (gpu_cull.comp.glsl's Work and DrawnList): no work groups, a z of 1, length 0. The stages that append
+// to it grow its dispatch.
+void clearList(GLuint list) {
+  static constexpr std::array<uint32_t, 4> kEmpty{0, 0, 1, 0};
+  glClearNamedBufferSubData(list, GL_RGBA32UI, 0, 4 * sizeof(uint32_t), GL_RGBA_INTEGER, GL_UNSIGNED_INT,
+                            kEmpty.data());
+}
+
 }  // namespace
 
 struct GpuCuller::Impl {
-  // The culling stages (gpu_cull.comp.glsl): parts, the work list's dispatch, clusters, draw commands.
+  // The culling stages (gpu_cull.comp.glsl): parts (which also size the work list's dispatch), clusters, draw
+  // commands.
   Program parts = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_PARTS 1");
-  Program args = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_ARGS 1");
   Program cull = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_CLUSTERS 1");
   Program emit = Program::computeFromEmbedded("gpu_cull.comp.glsl", "#define FF_STAGE_EMIT 1");
   std::array<Program, kVariants> draw{
@@ -284,25 +292,21 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, im.stats);
   for (GLuint buffer : {im.counts[0], im.counts[1], im.stats})
     glClearNamedBufferData(buffer, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-  for (GLuint list : {im.work, im.drawn_list})
-    glClearNamedBufferSubData(list, GL_R32UI, 0, 4 * sizeof(uint32_t), GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+  clearList(im.drawn_list);
 
-  // A phase's work list: the parts it takes put their clusters on it (PARTS, by phase), and its length becomes the
-  // cluster stages' dispatch (ARGS).
+  // A phase's work list: the parts it takes put their clusters on it (PARTS, by phase) and size the cluster stages'
+  // dispatch with it.
   const GLuint part_groups = (uint32_t(arena_.parts().size()) + kWorkGroup - 1) / kWorkGroup;
   auto listParts = [&](int phase) {
-    glClearNamedBufferSubData(im.work, GL_R32UI, 0, 4 * sizeof(uint32_t), GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    clearList(im.work);
     glProgramUniform1i(pp, im.part_l.phase, phase);
     glUseProgram(pp);
     glBindTextureUnit(2, target.depthTexture().handle());
     glBindTextureUnit(3, im.pyramid.texture());
     glDispatchCompute(std::min(part_groups, kMaxGroupsX), (part_groups + kMaxGroupsX - 1) / kMaxGroupsX, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);
-    glUseProgram(im.args.handle());
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.work);
   };
 
@@ -406,14 +410,11 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     drawPhase(1);
     mark(5);
     if (options_.refine_history) {
-      // The drawn instances become the work list: their dispatch, then the test against the final depth, which
-      // also decides the parts' visibility (cleared first).
+      // The drawn instances become the work list (the cluster stage sized its dispatch as it appended them), tested
+      // against the final depth, which also decides the parts' visibility (cleared first).
       buildPyramid();
       glClearNamedBufferData(im.part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.drawn_list);
-      glUseProgram(im.args.handle());
-      glDispatchCompute(1, 1, 1);
-      glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
       glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.drawn_list);
       testClusters(3);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, im.work);

@@ -4,7 +4,6 @@
 //     the frustum are in view, and those visible in the last frame put their cluster instances on the work list;
 //     1 (late) parts in view whose box the depth pyramid does not hide put theirs; 2 (no occlusion) every part in
 //     view puts its instances; the others are culled whole;
-//   ARGS (one invocation): the length of the list bound as the work list as the indirect dispatch of the next stages;
 //   CLUSTERS (one per work list entry): an instance is in view when its sphere and box meet the frustum and its normal
 //     cone does not turn every triangle away from the eye; then, by phase,
 //       0 (early): those in view that were visible in the last frame are drawn,
@@ -18,15 +17,13 @@
 //   EMIT (one per work list entry): each run of consecutive drawn clusters of one object part (contiguous indices)
 //     becomes one indirect draw command, compacted per material group (an atomic counter per group, drawn with
 //     glMultiDrawElementsIndirectCount) or in its first instance's own slot (the other slots cleared).
+// A list's indirect dispatch (the work list's for CLUSTERS and EMIT, the drawn list's for phase 3) grows with it as
+// entries are appended (growDispatch), so no stage of its own turns a length into a dispatch between them.
 // The occlusion test is gpu::OcclusionCuller's (occlusion_culler.cpp: projectBox, DepthPyramid::farthest, hides),
 // the same conservative arithmetic: a box is hidden only when all of it lies behind the stored depth at every pixel
 // it may cover.
 
-#ifdef FF_STAGE_ARGS
-layout(local_size_x = 1) in;
-#else
 layout(local_size_x = 64) in;
-#endif
 
 struct Cluster {
   vec4 sphere;     // centre, radius (mesh space)
@@ -111,6 +108,18 @@ uint invocation() {
   return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
 }
 
+// The work groups (x, y) of a list of `length` entries: 64 a group, those past 65535 into y (kMaxGroupsX).
+uvec2 listDispatch(uint length) {
+  const uint groups = (length + 63u) / 64u;
+  return uvec2(min(groups, 65535u), (groups + 65534u) / 65535u);
+}
+// Whether entries [from, to) of a list start a work group: their appender then raises the list's dispatch to
+// listDispatch(to). The appender of the entry that starts the last group does so with the largest count of groups,
+// so the dispatch covers the list once every appender is done; the others leave it alone.
+bool startsGroup(uint from, uint to) {
+  return (from + 63u) / 64u != (to + 63u) / 64u;
+}
+
 // The box [lo, hi] of an object's own space under `model` against the frustum (Frustum::intersects, with each plane
 // taken into that space): false only when it certainly lies outside.
 bool boxInFrustum(vec3 lo, vec3 hi, mat4 model) {
@@ -179,6 +188,11 @@ uvec2 partRange(Part part, bool affine, uint object) {
 void appendPart(uvec2 range) {
   const uint base = atomicAdd(dispatch_args.w, range.y);
   for (uint k = 0u; k < range.y; ++k) work[base + k] = range.x + k;
+  if (startsGroup(base, base + range.y)) {
+    const uvec2 d = listDispatch(base + range.y);
+    atomicMax(dispatch_args.x, d.x);
+    atomicMax(dispatch_args.y, d.y);
+  }
 }
 
 void main() {
@@ -215,13 +229,6 @@ void main() {
     }
   }
   endStats();
-}
-
-#elif defined(FF_STAGE_ARGS)
-void main() {
-  const uint groups = (dispatch_args.w + 63u) / 64u;
-  const uint x = min(groups, 65535u);
-  dispatch_args.xyz = uvec3(x, x == 0u ? 0u : (groups + x - 1u) / x, 1u);
 }
 
 #elif defined(FF_STAGE_CLUSTERS)
@@ -279,7 +286,13 @@ void main() {
     }
     if (u_phase != 3) drawn_flag[i] = drawn ? 1u : 0u;
     if (drawn) {
-      drawn_list[atomicAdd(drawn_args.w, 1u)] = i;
+      const uint at = atomicAdd(drawn_args.w, 1u);
+      drawn_list[at] = i;
+      if (startsGroup(at, at + 1u)) {
+        const uvec2 d = listDispatch(at + 1u);
+        atomicMax(drawn_args.x, d.x);
+        atomicMax(drawn_args.y, d.y);
+      }
       atomicAdd(s_stats[u_phase == 0 ? kDrawnEarly : kDrawnLate], 1u);
       atomicAdd(s_stats[u_phase == 0 ? kTrianglesEarly : kTrianglesLate], c.range.y / 3u);
       // Distinct objects: the first instance of an object drawn in this frame counts it.
