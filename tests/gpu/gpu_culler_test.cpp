@@ -332,21 +332,34 @@ TEST_F(GpuCullerTest, MovedObjectsAreDrawnWhereTheyNowStand) {
   EXPECT_GT(changed, cameras.size() / 2);
 }
 
-// Only the plan's objects are drawn, and changing the plan changes the frame.
+// Only the plan's objects are drawn, and changing the plan changes the frame. The part stage runs over the plan's
+// parts alone, and takes every one of them: its count of instances in the plan is the sum over the plan's objects.
 TEST_F(GpuCullerTest, OnlyThePlansObjectsAreDrawn) {
   GpuCuller culler(*arena_);
   const std::vector<Camera> cameras = walk(8, 16);
   std::mt19937 rng(2);
+  std::vector<uint64_t> in_plan;  // per frame, the arena's count
+  std::vector<GpuCullStats> stats;
   for (size_t f = 0; f < cameras.size(); ++f) {
     std::vector<uint32_t> ids;
     for (uint32_t id = 1; id <= scene_.objects.size(); ++id)
       if (rng() % 3 != 0 || f % 5 == 4) ids.push_back(id);
     if (f % 5 == 4) culler.setAllObjects();
     else culler.setObjects(ids);
+    uint64_t instances = 0;
+    for (const uint32_t id : ids) {
+      const auto [first, end] = arena_->objectParts(id - 1);
+      for (uint32_t p = first; p < end; ++p) instances += arena_->parts()[p].instance_count;
+    }
+    in_plan.push_back(instances);
     const Reference want = reference(cameras[f], RenderMode::ItemBuffer, ids);
     culled(culler, cameras[f], RenderMode::ItemBuffer);
     ASSERT_EQ(differences(want, false), 0u) << "frame " << f;
+    for (const GpuCullStats& s : culler.finishedStats()) stats.push_back(s);
   }
+  for (const GpuCullStats& s : culler.finishedStats()) stats.push_back(s);
+  EXPECT_GT(stats.size(), cameras.size() / 2);
+  for (const GpuCullStats& s : stats) EXPECT_EQ(s.instances_in_plan, in_plan.at(s.frame)) << "frame " << s.frame;
   const std::vector<uint32_t> bad{uint32_t(scene_.objects.size() + 1)};
   EXPECT_THROW(culler.setObjects(bad), Error);
 }

@@ -54,7 +54,7 @@ struct GpuCuller::Impl {
 
   struct CullLocations {
     int view_proj, planes, eye, viewport, phase, compact, cone, count, levels, level_size, margin, frame, lod_px,
-        lod_scale;
+        lod_scale, listed;
   };
   CullLocations cl{}, part_l{}, emit_l{};
   struct DrawLocations {
@@ -65,6 +65,11 @@ struct GpuCuller::Impl {
   GLuint enabled = 0, visibility = 0, stats = 0, group_first = 0, object_frame = 0, work = 0, drawn = 0;
   GLuint drawn_list = 0;  // the instances drawn in this frame (the history pass's work list)
   GLuint part_visible = 0, instance_part = 0;  // per part: visible last frame, in view; per instance: its part
+  // The parts of the plan's objects (ascending), which the part stage runs over when not every object is drawn: a
+  // frame's culling work follows the plan, not the scene.
+  GLuint part_list = 0;
+  uint32_t listed_parts = 0;
+  std::vector<uint32_t> list;
   // Per phase: the commands, and the number written per group (buffers of their own: bound whole, no offset
   // alignment to respect).
   std::array<GLuint, 2> commands{}, counts{};
@@ -90,7 +95,8 @@ struct GpuCuller::Impl {
             glGetUniformLocation(c, "u_cone"),      glGetUniformLocation(c, "u_count"),
             glGetUniformLocation(c, "u_levels"),    glGetUniformLocation(c, "u_level_size"),
             glGetUniformLocation(c, "u_margin"),    glGetUniformLocation(c, "u_frame"),
-            glGetUniformLocation(c, "u_lod_px"),    glGetUniformLocation(c, "u_lod_scale")};
+            glGetUniformLocation(c, "u_lod_px"),    glGetUniformLocation(c, "u_lod_scale"),
+            glGetUniformLocation(c, "u_listed")};
   }
 
   Impl() {
@@ -107,7 +113,7 @@ struct GpuCuller::Impl {
   ~Impl() {
     const GLuint buffers[] = {enabled,     visibility,  stats,     group_first, object_frame,
                               commands[0], commands[1], counts[0], counts[1],   work,        drawn,
-                              drawn_list,  part_visible, instance_part};
+                              drawn_list,  part_visible, instance_part, part_list};
     glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
   }
 
@@ -140,6 +146,7 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   im.work = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
   im.drawn_list = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
   im.part_visible = createBuffer(arena.parts().size() * sizeof(uint32_t), nullptr);
+  im.part_list = createBuffer(std::max<size_t>(arena.parts().size(), 1) * sizeof(uint32_t), nullptr);
   glClearNamedBufferData(im.part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   std::vector<uint32_t> part_of(std::max<size_t>(im.instances, 1), 0);
   for (uint32_t p = 0; p < arena.parts().size(); ++p)
@@ -172,6 +179,7 @@ void GpuCuller::setAllObjects() {
   }
   im.all_enabled = true;
   im.enabled_ids.clear();
+  im.listed_parts = 0;
 }
 
 void GpuCuller::setObjects(std::span<const uint32_t> ids) {
@@ -183,6 +191,7 @@ void GpuCuller::setObjects(std::span<const uint32_t> ids) {
   if (!im.next_ids.empty() && (im.next_ids.front() == 0 || im.next_ids.back() > objects))
     throw Error("object id " + std::to_string(im.next_ids.front() == 0 ? 0u : im.next_ids.back()),
                 "out of range (the scene has " + std::to_string(objects) + " objects, ids from 1)");
+  const bool was_all = im.all_enabled;
   if (im.all_enabled) {
     // From all to a list: clear everything once, then set the list.
     if (objects > 0) glClearNamedBufferData(im.enabled, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -206,6 +215,16 @@ void GpuCuller::setObjects(std::span<const uint32_t> ids) {
     i = j;
   }
   std::swap(im.enabled_ids, im.next_ids);
+  if (im.changes.empty() && !was_all) return;
+  // The plan's parts, for the part stage: work in the size of the plan.
+  im.list.clear();
+  for (const uint32_t id : im.enabled_ids) {
+    const auto [first, end] = arena_.objectParts(id - 1);
+    for (uint32_t p = first; p < end; ++p) im.list.push_back(p);
+  }
+  im.listed_parts = uint32_t(im.list.size());
+  if (!im.list.empty())
+    glNamedBufferSubData(im.part_list, 0, GLsizeiptr(im.list.size() * sizeof(uint32_t)), im.list.data());
 }
 
 void GpuCuller::setLodErrorPx(float px) {
@@ -251,7 +270,9 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glProgramUniform2i(pp, im.part_l.viewport, target.width(), target.height());
   glProgramUniform1f(pp, im.part_l.margin, options_.occlusion_margin);
   glProgramUniform1i(pp, im.part_l.levels, im.pyramid.levels());
-  glProgramUniform1ui(pp, im.part_l.count, uint32_t(arena_.parts().size()));
+  const uint32_t part_count = im.all_enabled ? uint32_t(arena_.parts().size()) : im.listed_parts;
+  glProgramUniform1ui(pp, im.part_l.count, part_count);
+  glProgramUniform1i(pp, im.part_l.listed, im.all_enabled ? 0 : 1);
   glProgramUniform3fv(pp, im.part_l.eye, 1, glm::value_ptr(camera.eye));
   glProgramUniform1f(pp, im.part_l.lod_px, options_.lod_error_px);
   // Pixels per unit of error at distance 1 (partLodErrorPx's pixels_per_unit).
@@ -289,6 +310,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, im.drawn_list);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 15, im.part_visible);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 16, im.instance_part);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 17, im.part_list);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, im.stats);
   for (GLuint buffer : {im.counts[0], im.counts[1], im.stats})
     glClearNamedBufferData(buffer, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -296,7 +318,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
 
   // A phase's work list: the parts it takes put their clusters on it (PARTS, by phase) and size the cluster stages'
   // dispatch with it.
-  const GLuint part_groups = (uint32_t(arena_.parts().size()) + kWorkGroup - 1) / kWorkGroup;
+  const GLuint part_groups = (part_count + kWorkGroup - 1) / kWorkGroup;
   auto listParts = [&](int phase) {
     clearList(im.work);
     glProgramUniform1i(pp, im.part_l.phase, phase);

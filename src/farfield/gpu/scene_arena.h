@@ -121,6 +121,8 @@ class SceneArena {
   std::pair<uint32_t, float> meshLodClusters(uint32_t mesh) const { return mesh_lod_.at(mesh); }
   std::span<const ArenaInstance> instances() const { return instances_; }
   std::span<const ArenaPart> parts() const { return parts_; }
+  // The parts of object index o (into Scene::objects): parts()[objectParts(o).first, .second), consecutive.
+  std::pair<uint32_t, uint32_t> objectParts(size_t o) const { return {object_parts_.at(o), object_parts_.at(o + 1)}; }
   std::span<const MaterialGroup> groups() const { return groups_; }
   uint64_t triangleCount() const { return triangles_; }       // of the full levels
   uint64_t lodTriangleCount() const { return lod_triangles_; }  // of the simplified levels

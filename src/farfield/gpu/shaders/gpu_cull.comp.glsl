@@ -1,9 +1,9 @@
 #version 450 core
 // Farfield cluster culling (gpu/gpu_culler.h), in stages compiled from this one file (FF_STAGE_*):
-//   PARTS (one invocation per object part), by phase: 0 (early) parts of objects in this frame's plan whose box meets
-//     the frustum are in view, and those visible in the last frame put their cluster instances on the work list;
-//     1 (late) parts in view whose box the depth pyramid does not hide put theirs; 2 (no occlusion) every part in
-//     view puts its instances; the others are culled whole;
+//   PARTS (one invocation per part of the plan's objects: every part, or those of part_list), by phase: 0 (early)
+//     parts of objects in this frame's plan whose box meets the frustum are in view, and those visible in the last
+//     frame put their cluster instances on the work list; 1 (late) parts in view whose box the depth pyramid does
+//     not hide put theirs; 2 (no occlusion) every part in view puts its instances; the others are culled whole;
 //   CLUSTERS (one per work list entry): an instance is in view when its sphere and box meet the frustum and its normal
 //     cone does not turn every triangle away from the eye; then, by phase,
 //       0 (early): those in view that were visible in the last frame are drawn,
@@ -57,9 +57,13 @@ layout(std430, binding = 1) readonly buffer Instances { uvec4 instances[]; };  /
 layout(std430, binding = 2) readonly buffer Objects { Object objects[]; };
 layout(std430, binding = 4) readonly buffer Enabled { uint enabled[]; };        // per object: drawn in the plan
 layout(std430, binding = 5) buffer Visibility { uint visible[]; };              // per instance: visible last frame
+// Declared in the stages that use them: an implementation may count every declared block against its limit of
+// storage blocks per compute shader (16 on llvmpipe).
+#ifdef FF_STAGE_EMIT
 layout(std430, binding = 6) buffer Commands { Command commands[]; };
 layout(std430, binding = 7) buffer Counts { uint counts[]; };                   // per group: commands written
 layout(std430, binding = 8) readonly buffer GroupFirst { uint group_first[]; };
+#endif
 layout(std430, binding = 9) buffer Stats { uint stats[]; };
 layout(std430, binding = 10) buffer ObjectFrame { uint object_frame[]; };    // per object: last frame it was drawn
 layout(std430, binding = 11) readonly buffer Parts { Part parts[]; };
@@ -71,6 +75,9 @@ layout(std430, binding = 14) buffer DrawnList { uvec4 drawn_args; uint drawn_lis
 // may be older than its part's, from a frame before the part was hidden).
 layout(std430, binding = 15) buffer PartVisible { uint part_visible[]; };
 layout(std430, binding = 16) readonly buffer InstancePart { uint instance_part[]; };
+#ifdef FF_STAGE_PARTS
+layout(std430, binding = 17) readonly buffer PartList { uint part_list[]; };  // with u_listed: the plan's parts
+#endif
 
 layout(binding = 2) uniform sampler2D u_depth;    // pyramid level 0: the frame's depth
 layout(binding = 3) uniform sampler2D u_pyramid;  // levels 1.. in its mip levels 0..
@@ -82,7 +89,8 @@ uniform ivec2 u_viewport;
 uniform int u_phase;
 uniform int u_compact;
 uniform int u_cone;
-uniform uint u_count;    // PARTS: parts; the instances of the arena otherwise
+uniform uint u_count;    // PARTS: parts (the listed ones with u_listed); the instances of the arena otherwise
+uniform int u_listed;    // PARTS: 1 when the invocations take the parts of part_list (the plan's), 0 every part
 uniform int u_levels;
 uniform ivec2 u_level_size[16];
 uniform float u_margin;  // relative depth margin of the occlusion test
@@ -197,8 +205,9 @@ void appendPart(uvec2 range) {
 
 void main() {
   beginStats();
-  const uint i = invocation();
-  if (i < u_count) {
+  const uint invoked = invocation();
+  if (invoked < u_count) {
+    const uint i = u_listed != 0 ? part_list[invoked] : invoked;
     const Part part = parts[i];
     const uint object = part.info.x;
     const bool affine = (objects[object].info.y & 1u) != 0u;
