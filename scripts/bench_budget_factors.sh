@@ -12,9 +12,10 @@
 # Usage: scripts/bench_budget_factors.sh FARFIELD OUT
 # Environment: CASES (default "150:3:211:car 150:3:307:walk 200:2:419:car": blocks:detail:seed:path, path car or
 # walk), FACTORS (default "0.4 0.6 0.8"), BOUND (px, default 2), FRAMES (path frames, default 300), STRIDE (default 3),
-# WALK_ONLY=1 (no bench: the baseline, placed and governed walkthroughs walked alone over every frame, t_max from the
-# baseline walked alone; OUT/budget_walk.md: what a program embedding the runtime sees, without the bench's
-# full-geometry and reference frames between its frames).
+# CALIBRATE_OPTIONS (more options of `farfield calibrate`, e.g. --fill-term), WALK_ONLY=1 (no bench: the baseline,
+# placed and governed walkthroughs walked alone over every frame, t_max from the baseline walked alone;
+# OUT/budget_walk.md: what a program embedding the runtime sees, without the bench's full-geometry and reference
+# frames between its frames).
 set -euo pipefail
 FARFIELD=${1:-build/release/bin/farfield}
 OUT=${2:-out/bench/budget}
@@ -35,7 +36,7 @@ if [ "${WALK_ONLY:-0}" = 1 ]; then
     echo
     echo "WALK_ONLY=1 scripts/bench_budget_factors.sh; $SIZE, every frame of ${FRAMES}-frame paths, ${BOUND} px."
     echo
-    echo "| city (blocks, detail, seed) | path | region visibility alone walked: median ms | model held-out measured/predicted p50, p95 | factor | t_max ms | impostors | GPU MiB | placed: median, max ms, frames over t_max | governed: median, max ms, frames over t_max |"
+    echo "| city (blocks, detail, seed) | path | region visibility alone walked: median ms | model held-out measured/predicted p50, p95 (CPU term p95, GPU term p95) | factor | t_max ms | impostors | GPU MiB | placed: median, max ms, frames over t_max | governed: median, max ms, frames over t_max |"
     echo "|---|---|---:|---|---:|---:|---:|---:|---|---|"
   } > "$OUT/budget_walk.md"
   table=/dev/null
@@ -45,7 +46,7 @@ fi
   echo
   echo "scripts/bench_budget_factors.sh; $SIZE, ${FRAMES}-frame paths, every ${STRIDE}th frame measured, ${BOUND} px."
   echo
-  echo "| city (blocks, detail, seed) | path | region visibility alone: median ms | model held-out measured/predicted p50, p95 | factor | t_max ms | impostors | GPU MiB | placed: median ms, frames over t_max | governed: median ms, frames over t_max, relaxed (largest bound px) | PSNR placed / governed dB | frames over the bound | walked alone: placed, governed median ms, frames over t_max |"
+  echo "| city (blocks, detail, seed) | path | region visibility alone: median ms | model held-out measured/predicted p50, p95 (CPU term p95, GPU term p95) | factor | t_max ms | impostors | GPU MiB | placed: median ms, frames over t_max | governed: median ms, frames over t_max, relaxed (largest bound px) | PSNR placed / governed dB | frames over the bound | walked alone: placed, governed median ms, frames over t_max |"
   echo "|---|---|---:|---|---:|---:|---:|---:|---|---|---|---|---|"
 } > "$table"
 for spec in $CASES; do
@@ -65,12 +66,14 @@ for spec in $CASES; do
   "$FARFIELD" place "$dir/city.glb" -o "$dir/visibility" "${district[@]}" --visibility-only > "$dir/visibility.txt" 2>&1
   say "calibrate"
   "$FARFIELD" calibrate "$dir/city.glb" -o "$dir/profile.json" --size "$SIZE" --fov "$FOV" --views 60 --fit-views 40 \
-    --visibility-cache "$dir/visibility.bin" > "$dir/calibrate.txt" 2>&1
+    --visibility-cache "$dir/visibility.bin" ${CALIBRATE_OPTIONS:-} > "$dir/calibrate.txt" 2>&1
   ratios=$(python3 -c '
 import json, sys
 p = json.load(open(sys.argv[1]))
 v = p.get("validation", {})
-print("%.2f, %.2f" % (v.get("ratio_p50", float("nan")), v.get("ratio_p95", float("nan"))))' "$dir/profile.json" \
+term = lambda k: v.get(k, {}).get("ratio_p95", float("nan"))
+print("%.2f, %.2f (%.2f, %.2f)" % (v.get("ratio_p50", float("nan")), v.get("ratio_p95", float("nan")),
+                                 term("cpu_term"), term("gpu_term")))' "$dir/profile.json" \
     2>/dev/null || echo "?")
   say "region visibility alone: every region's visible set, no impostor; benchmarked"
   "$FARFIELD" place "$dir/city.glb" --profile "$dir/profile.json" -o "$dir/no_impostor" --tmax 0.001 \

@@ -1,10 +1,11 @@
 // farfield calibrate SCENE -o profile.json [--size WxH] [--fov DEG] [--views N] [--repeats N]
 //                    [--view-min X,Y,Z --view-max X,Y,Z] [--seed S] [--margin-quantile Q] [--csv FILE]
-//                    [--fill-term] [--visibility-cache FILE] [--cpu-frames]
+//                    [--fill-term | --no-fill-term] [--visibility-cache FILE] [--cpu-frames]
 // Fits the frame-time cost model on this machine and validates it on random views of the view space
 // (eval/calibration.h); writes the cost profile that placement bounds frame times with.
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "cli_util.h"
 #include "command.h"
@@ -26,6 +27,7 @@ struct CalibrateArgs {
   float margin = 50.0f;
   std::string csv;
   std::string visibility_cache;
+  std::optional<bool> fill_term;  // --fill-term / --no-fill-term; unset: on for the placed runtime's frames
   eval::CalibrateOptions options;
 };
 
@@ -48,6 +50,9 @@ void runCalibrateCommand(CalibrateArgs& args) {
     o.visible_set = [&cache](const Vec3& eye) { return cache.visibleFrom(eye); };
     o.region_of = [&cache](const Vec3& eye) { return cache.regionOf(eye); };
   }
+  // The fill term by default where the frames are the placed walkthrough's (the GPU-driven frame over a region's
+  // visible set): there it is what the views differ by besides triangles (docs/DESIGN-NOTES.md, "A fill term").
+  o.fill_term = args.fill_term.value_or(!args.visibility_cache.empty() && o.gpu_frames);
   const eval::CalibrateResult r = eval::calibrate(gpu::sharedHeadlessContext(), scene, o);
   ensureParentDirectory(args.out);
   gpu::saveCostProfile(r.profile, args.out);
@@ -151,9 +156,11 @@ const RegisterCommand reg("calibrate", [](CLI::App& app) {
   cmd->add_flag("!--cpu-frames", args->options.gpu_frames,
                 "Time the CPU-culled frames of before (occlusion culler or frustum-culled clusters) instead of the "
                 "runtime's GPU-driven ones");
-  cmd->add_flag("--fill-term", args->options.fill_term,
-                "Fit the estimated-fill term too, counted up to a cap chosen on the fitting views (with "
-                "--visibility-cache: the tightest model placement can bound; see docs/BENCHMARKS.md)");
+  cmd->add_flag_function(
+      "--fill-term,!--no-fill-term", [args](int64_t count) { args->fill_term = count > 0; },
+      "Fit the estimated-fill term too, counted up to a cap chosen on the fitting views (with --visibility-cache: "
+      "the tightest model placement can bound; see docs/BENCHMARKS.md). Default: on with --visibility-cache (the "
+      "placed walkthrough's frames), off otherwise");
   cmd->add_option("--layered-samples", args->options.layered_samples,
                   "Layered impostors the draw and capture terms are fitted on (as many validate them; 0: none)")
       ->capture_default_str();

@@ -134,6 +134,23 @@ TEST(GovernedMode, WithOcclusionAutoEachLevelsChooserStartsFromTheCalibration) {
   EXPECT_EQ(info.at("gpu_occlusion_probes"), 0.0);  // four frames: the first probe is 120 frames after the start
 }
 
+// A frame the governor expects near its budget has no room for a probe of the other occlusion variant: with a budget
+// no level keeps, no probe in 140 frames (the first is due 120 frames after the calibration); with room, one.
+TEST(GovernedMode, FramesNearTheBudgetProbeNoOcclusionVariant) {
+  const gen::CameraPath path = test::sideWalkPath(140);
+  for (const double t_max : {1e-3, 1e9}) {
+    SCOPED_TRACE("t_max " + std::to_string(t_max));
+    Harness h(t_max);
+    h.context.options["gpu_occlusion"] = "auto";
+    auto governed = h.make("governed");
+    FrameRunner runner(*h.renderer, *h.target);
+    for (size_t i = 0; i < path.frames.size(); ++i) runner.run(*governed, pathCamera(path, i, kSize, kSize), i);
+    const std::map<std::string, double> info = governed->info();
+    if (t_max < 1.0) EXPECT_EQ(info.at("gpu_occlusion_probes"), 0.0);
+    else EXPECT_GE(info.at("gpu_occlusion_probes"), 1.0);
+  }
+}
+
 // Spheres of 8,192 triangles in a row going away from the eye: the far ones are simplified under a few pixels.
 scene::Scene spheres() {
   scene::Scene scene;

@@ -26,15 +26,16 @@ namespace {
 using Cost = std::function<double(uint64_t frame, int variant)>;
 
 // Drives the chooser over `frames` frames, each measured `lag` frames after it is decided (0: at once); returns the
-// variant of every frame. Frames in `unmeasured` are never measured.
+// variant of every frame. Frames in `unmeasured` are never measured. room(f): whether frame f has room for a probe
+// (empty: every frame has).
 std::vector<int> drive(FasterVariant& chooser, uint64_t frames, const Cost& cost, double noise, size_t lag = 0,
-                       uint64_t unmeasured = 0, uint32_t seed = 7) {
+                       uint64_t unmeasured = 0, uint32_t seed = 7, const std::function<bool(uint64_t)>& room = {}) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(1.0 - noise, 1.0 + noise);
   std::vector<int> variants;
   std::deque<std::pair<uint64_t, double>> pending;
   for (uint64_t f = 0; f < frames; ++f) {
-    const int v = chooser.decide(f);
+    const int v = chooser.decide(f, !room || room(f));
     variants.push_back(v);
     if (f >= unmeasured) pending.push_back({f, cost(f, v) * jitter(rng)});
     while (pending.size() > lag) {
@@ -193,6 +194,31 @@ TEST(FasterVariant, StartsFromAHostsTimingOfBothVariants) {
   EXPECT_EQ(alike.kept(), 0);
   EXPECT_THROW(alike.startFrom(-1.0, 2.0), Error);
   EXPECT_THROW(alike.startFrom(1.0, std::nan("")), Error);
+}
+
+// A host without room for the other variant in a frame (a governor near its budget): no probe starts there, one due
+// starts at the first frame with room, and one under way is given up at a frame without room.
+TEST(FasterVariant, AFrameWithoutRoomDrawsNoProbe) {
+  const Cost cost = [](uint64_t, int v) { return v == 0 ? 10.0 : 6.5; };
+  {
+    FasterVariant chooser(0);
+    const auto variants = drive(chooser, 600, cost, 0.1, 0, 0, 7, [](uint64_t f) { return f >= 300; });
+    EXPECT_EQ(count(variants, 1, 0, 300), 0u);
+    EXPECT_EQ(variants[300], 1);  // the probe due since frame 4, at the first frame with room
+    EXPECT_EQ(variants[301], 1);
+    EXPECT_EQ(chooser.kept(), 1);
+    EXPECT_EQ(chooser.probesHeld(), 0u);
+  }
+  {
+    FasterVariant chooser(0);
+    const auto variants = drive(chooser, 600, cost, 0.1, 0, 0, 7, [](uint64_t f) { return f != 6; });
+    EXPECT_EQ(variants[4], 1);  // the first probe's first run
+    EXPECT_EQ(variants[6], 0);  // given up at the frame without room
+    EXPECT_EQ(chooser.probesHeld(), 1u);
+    EXPECT_EQ(count(variants, 1, 6, 126), 0u);  // the next probe after the interval
+    EXPECT_EQ(variants[126], 1);
+    EXPECT_EQ(chooser.kept(), 1);
+  }
 }
 
 TEST(FasterVariant, RejectsBadOptionsOrderAndTimes) {

@@ -37,7 +37,8 @@ struct CalibrateOptions {
   // the term is 0.
   // Uncapped, a region's fill bounded from its nearest point counts every adjacent building as a whole frame, and
   // placement's problem view space grew several times; capped and fitted on placed frames (visible_set) it gives the
-  // tightest bound measured (docs/BENCHMARKS.md).
+  // tightest bound measured (docs/BENCHMARKS.md). `farfield calibrate` turns it on by default with a visibility
+  // cache (the placed runtime's frames).
   bool fill_term = false;
   // Placed frames (`farfield calibrate --visibility-cache`): when set, a view draws the objects this returns for its
   // eye (the visible set of the region holding it; nullptr: every object) that its frustum meets, through the

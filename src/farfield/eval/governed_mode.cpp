@@ -216,6 +216,10 @@ void GovernedMode::frame(FrameContext& frame) {
 
   const Level& level = levels_[decision.level];
   last_inner_ = level.inner;
+  // A frame expected near the budget has no room for a probe of the other occlusion variant (gpu_occlusion=auto),
+  // whose first frame pays for the switch: only one expected under the governor's refine threshold has.
+  if (GpuCullRun* run = inners_[level.inner]->gpuCullRun())
+    run->setProbeRoom(decision.corrected_ms <= loop_options_.governor.refine_below * loop_options_.governor.t_max_ms);
   if (level.scale == 1.0) {
     // The frame itself, drawn as the governed mode draws it (simplified and under the bound the level says).
     inners_[level.inner]->setGeometryErrorPx(level.lod_px);

@@ -45,7 +45,7 @@ void GpuCullRun::draw(FrameContext& frame) {
     bool on = forced_occlusion_.value_or(true);
     if (!forced_occlusion_) {
       choice = &occlusion_choices_.try_emplace(last_kind_, 0).first->second;
-      on = choice->decide(path_frame_of_.size()) == 0;
+      on = choice->decide(path_frame_of_.size(), probe_room_) == 0;
     }
     culler_->setOcclusion(on);
     occlusion_frames_ += on ? 1.0 : 0.0;
@@ -124,10 +124,11 @@ std::map<std::string, double> GpuCullRun::info() const {
     out["gpu_occlusion_auto"] = 1.0;
     out["gpu_occlusion_frames"] = drawn > 0.0 ? occlusion_frames_ / drawn : 0.0;
     out["gpu_occlusion_kinds"] = double(occlusion_choices_.size());
-    double probes = 0.0, switches = 0.0, early = 0.0, started = 0.0;
+    double probes = 0.0, switches = 0.0, early = 0.0, started = 0.0, held = 0.0;
     size_t most = 0;
     for (const auto& [key, choice] : occlusion_choices_) {
       probes += double(choice.probes());
+      held += double(choice.probesHeld());
       switches += double(choice.switches());
       early += double(choice.earlyProbes());
       started += double(choice.starts());
@@ -141,6 +142,7 @@ std::map<std::string, double> GpuCullRun::info() const {
     out["gpu_occlusion_switches"] = switches;
     out["gpu_occlusion_early_probes"] = early;
     out["gpu_occlusion_started"] = started;
+    out["gpu_occlusion_held"] = held;
   }
   if (stage_frames_ > 0.0) {
     for (size_t i = 0; i < stage_ms_.size(); ++i)

@@ -58,6 +58,9 @@ class GpuCullRun {
   // keeps the test on.
   bool occlusionAuto() const { return occlusion_auto_; }
   void forceOcclusion(std::optional<bool> on) { forced_occlusion_ = on; }
+  // Whether the frames drawn next have room for a probe of the other variant (runtime::FasterVariant::decide's
+  // `room`; a governor near its budget says no). True unless set.
+  void setProbeRoom(bool room) { probe_room_ = room; }
   bool startOcclusionFrom(double on_ms, double off_ms);
   // arena_clusters, arena_instances, arena_material_groups, arena_gpu_bytes, arena_build_s (making the arena, once a
   // run), indirect_count (1 or 0), and per frame
@@ -68,7 +71,8 @@ class GpuCullRun {
   // with occlusion culling), gpu_occlusion_kinds (the kinds of frame chosen for apart: target sizes and simplified
   // levels, a governor's levels), gpu_occlusion_kept (1 or 0: the choice at the end for the kind drawn most),
   // gpu_occlusion_probes, gpu_occlusion_switches, gpu_occlusion_early_probes (those a change of the frame time
-  // started), gpu_occlusion_started (kinds started from a host's timing of both; summed over the kinds).
+  // started), gpu_occlusion_held (given up for want of room: setProbeRoom), gpu_occlusion_started (kinds started from
+  // a host's timing of both; summed over the kinds).
   std::map<std::string, double> info() const;
 
  private:
@@ -77,6 +81,7 @@ class GpuCullRun {
   std::unique_ptr<gpu::GpuCuller> culler_;
   bool occlusion_auto_ = false;
   std::optional<bool> forced_occlusion_;
+  bool probe_room_ = true;
   std::tuple<int, int, float> last_kind_{0, 0, 0.0f};
   // Per kind of frame (the target's width and height, the simplified levels' bound): variant 0 occlusion on, 1 off.
   std::map<std::tuple<int, int, float>, runtime::FasterVariant> occlusion_choices_;

@@ -111,7 +111,7 @@ void FasterVariant::finishProbeIfDone() {
   if (probing_ && probe_step_ >= 2 * kRun * options_.probe_runs && probe_unmeasured_ == 0) finishProbe(false);
 }
 
-int FasterVariant::decide(uint64_t frame) {
+int FasterVariant::decide(uint64_t frame, bool room) {
   if (any_decided_ && frame <= last_frame_)
     throw Error("faster variant",
                 "frame " + std::to_string(frame) + " decided after frame " + std::to_string(last_frame_));
@@ -122,8 +122,13 @@ int FasterVariant::decide(uint64_t frame) {
     in_flight_.pop_front();
   }
   finishProbeIfDone();
+  if (!room && probing_ && probe_step_ < 2 * kRun * options_.probe_runs) {
+    // No room for the other variant's frames: the probe is given up (its frames so far decide nothing).
+    ++held_;
+    finishProbe(true);
+  }
   if (level_ <= 0.0 && probes_ + starts_ > 0 && recent_kept_.size() >= options_.min_kept) level_ = recentKeptMedian();
-  if (!probing_ && recent_kept_.size() >= options_.min_kept && (frame >= next_probe_ || workloadChanged())) {
+  if (room && !probing_ && recent_kept_.size() >= options_.min_kept && (frame >= next_probe_ || workloadChanged())) {
     if (frame < next_probe_) {
       ++early_probes_;
       interval_ = options_.reprobe_after;  // the choice is for a new workload: check it again soon

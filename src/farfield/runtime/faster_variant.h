@@ -22,6 +22,8 @@
 //   - a probe stops drawing the other variant once two of its counted frames have a median over `give_up_ratio`
 //     times the kept variant's recent median (its last 8 measured frames), so that a probe of a much slower variant
 //     costs a few frames;
+//   - a host with no room in a frame for the other variant (a governor near its budget) says so, and no probe draws
+//     in that frame: one under way is given up, one due waits for a frame with room;
 //   - measured times may come back any number of frames late (a timer query read late); frames never measured (a
 //     host's untimed draws) only delay a probe: nothing is probed before `min_kept` frames of the kept variant were
 //     measured, so a host's untimed first draws all see the first variant, and a probe whose frames stay unmeasured
@@ -54,8 +56,10 @@ class FasterVariant {
   explicit FasterVariant(int first = 0, FasterVariantOptions options = {});
 
   // The variant frame `frame` draws; frames increase from call to call (a repeated or older frame throws
-  // farfield::Error).
-  int decide(uint64_t frame);
+  // farfield::Error). `room` false: the host has no room in this frame for a frame of the other variant (a governor
+  // near its budget: a probe's first frame pays for the switch), so no probe starts, and a probe under way is given
+  // up (counted: probesHeld); a probe that was due starts at the first frame with room.
+  int decide(uint64_t frame, bool room = true);
   // The measured time of a decided frame (ms >= 0 and finite, else farfield::Error); frames never decided, or too
   // old, are ignored.
   void measured(uint64_t frame, double ms);
@@ -73,6 +77,7 @@ class FasterVariant {
   size_t switches() const { return switches_; }       // decisions that changed the kept variant
   size_t earlyProbes() const { return early_probes_; }  // probes started by a change of the workload
   size_t starts() const { return starts_; }              // startFrom calls
+  size_t probesHeld() const { return held_; }            // probes given up for want of room (decide's `room`)
   size_t framesOf(int variant) const { return frames_of_[size_t(variant & 1)]; }  // frames decided per variant
 
  private:
@@ -101,7 +106,7 @@ class FasterVariant {
   size_t interval_ = 0;
   bool any_decided_ = false;
   uint64_t last_frame_ = 0;
-  size_t probes_ = 0, given_up_ = 0, switches_ = 0, early_probes_ = 0, starts_ = 0;
+  size_t probes_ = 0, given_up_ = 0, switches_ = 0, early_probes_ = 0, starts_ = 0, held_ = 0;
   size_t frames_of_[2] = {0, 0};
 };
 
