@@ -419,6 +419,7 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
     return camera;
   };
   size_t guarded = 0, drawn = 0;
+  std::set<double> workloads;
   for (int k = 0; k < 400; ++k) {
     const Camera camera = randomCamera();
     const runtime::FramePlan& plan = walkthrough.plan(camera);
@@ -439,8 +440,21 @@ TEST(PlaceTest, LayeredFillIsChargedAndTheFallbackIsCounted) {
       ++guarded;
       EXPECT_LE(predicted, options.t_max_ms + 1e-9) << "view " << k << " cpv " << plan.report.cpv;
     }
+    // What the walkthrough tells a governor before planning (expectedTriangles): the triangles of the visible set of
+    // the region holding the eye, counted here from the scene, and at least the plan's geometry.
+    const std::optional<uint32_t> leaf = store::lookupLeaf(index, camera.eye);
+    double visible_triangles = 0.0;
+    for (const scene::Object& o : city.scene.objects)
+      if (!leaf || !index.nodes[*leaf].has_visible ||
+          std::binary_search(index.nodes[*leaf].visible.begin(), index.nodes[*leaf].visible.end(), o.id))
+        for (const scene::Part& part : o.parts) visible_triangles += double(city.scene.meshes[part.mesh].triangleCount());
+    const double expected = walkthrough.expectedTriangles(camera.eye);
+    EXPECT_EQ(expected, visible_triangles) << "view " << k;
+    EXPECT_GE(expected, double(plan.report.geometry_triangles)) << "view " << k;
+    workloads.insert(expected);
   }
   EXPECT_GT(guarded, 30u);
+  EXPECT_GT(workloads.size(), 2u);  // regions of different visible sets
   std::printf("fill charged: %zu CPVs over t_max at the bound, %zu after the fallback (%zu coarser impostors); %zu "
               "guarded views, %zu impostors drawn\n",
               r.unsolved_at_bound, r.unsolved_cpvs, r.fallback_impostors, guarded, drawn);

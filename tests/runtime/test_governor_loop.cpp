@@ -47,7 +47,9 @@ struct LoopRun {
 };
 
 // Frames whose full-detail triangles follow `load`; each frame's triangles and time come back `lag` frames later.
-LoopRun run(GovernorLoop& loop, size_t frames, double t_max, double (*load)(size_t), size_t lag = 2) {
+// hint: the host tells the loop each frame's load before drawing it (decide's workload).
+LoopRun run(GovernorLoop& loop, size_t frames, double t_max, double (*load)(size_t), size_t lag = 2,
+            bool hint = false) {
   LoopRun r;
   std::deque<std::tuple<uint64_t, double, double>> pending;  // frame, triangles, ms
   for (size_t f = 0; f < frames; ++f) {
@@ -58,7 +60,7 @@ LoopRun run(GovernorLoop& loop, size_t frames, double t_max, double (*load)(size
       loop.frameMeasured(frame, ms);
       pending.pop_front();
     }
-    const runtime::GovernorDecision d = loop.decide(f);
+    const runtime::GovernorDecision d = loop.decide(f, hint ? load(f) : 0.0);
     const double triangles = load(f) * kShare[d.level];
     const double ms = cost(triangles, d.level);
     r.frames.emplace_back(d.level, ms, load(f));
@@ -69,6 +71,7 @@ LoopRun run(GovernorLoop& loop, size_t frames, double t_max, double (*load)(size
 
 double wander(size_t f) { return 150000.0 + 100000.0 * std::sin(double(f) * 0.05) + 30000.0 * std::sin(double(f) * 0.31); }
 double ramp(size_t f) { return 50000.0 + 1200.0 * double(f); }
+double step(size_t f) { return f < 100 ? 50000.0 : 300000.0; }  // a new plan: a region's visible set 6x larger
 
 }  // namespace
 
@@ -107,6 +110,27 @@ TEST(GovernorLoop, ARampIsKeptUnderTmaxOnceTheLoadIsMeasured) {
   EXPECT_EQ(over, 0u);  // the model sees the load rise through the frames' triangles, before any frame breaks t_max
   EXPECT_GT(coarsened, 100u);
   EXPECT_EQ(std::get<0>(r.frames.back()), kPixels.size() - 1);
+}
+
+// A step of the load (a new region's plan): told the frame's workload before drawing it, the loop coarsens in the
+// step's first frame and no frame breaks t_max; without it, the frames decided before the step's triangles come back
+// break it.
+TEST(GovernorLoop, AStepOfThePlansWorkloadIsSeenInItsFirstFrame) {
+  size_t over_told = 0, over_blind = 0;
+  for (const bool hint : {true, false}) {
+    GovernorLoopOptions options;
+    options.governor.t_max_ms = 14.0;
+    GovernorLoop loop(levels(), options);
+    calibrate(loop, 50000.0);
+    const LoopRun r = run(loop, 160, 14.0, step, 2, hint);
+    size_t& over = hint ? over_told : over_blind;
+    for (const auto& [level, ms, load] : r.frames) over += ms > 14.0;
+    if (hint) {
+      EXPECT_EQ(std::get<0>(r.frames[100]), kPixels.size() - 1);  // the coarsest, at once
+    }
+  }
+  EXPECT_EQ(over_told, 0u);
+  EXPECT_GE(over_blind, 1u);
 }
 
 TEST(GovernorLoop, BadUseIsAClearError) {

@@ -209,7 +209,10 @@ void GovernedMode::frame(FrameContext& frame) {
   const bool calibrating = !loop_->calibrated();
   if (calibrating) calibrate(frame.camera(), frame.pathFrame());
   const uint64_t number = next_frame_++;
-  const runtime::GovernorDecision decision = loop_->decide(number);
+  // What the frame will draw, known before drawing it (a new region's visible set), scales the prediction: the
+  // triangles the loop predicts from are a frame or two old.
+  const runtime::GovernorDecision decision =
+      loop_->decide(number, inners_[levels_.front().inner]->planWorkload(frame.camera()));
   last_frame_ = calibrating ? std::nullopt : std::optional<uint64_t>(number);
   last_path_frame_ = frame.pathFrame();
   last_ = FrameGovernance{decision.level, decision.predicted_ms, decision.corrected_ms, decision.bound_scale};

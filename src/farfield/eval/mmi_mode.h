@@ -79,6 +79,9 @@ class MmiMode final : public Mode {
   double readAhead(const Camera& camera, double budget_ms) override {
     return walkthrough_ ? walkthrough_->readAheadPlaced(camera, budget_ms) : 0.0;
   }
+  double planWorkload(const Camera& camera) const override {
+    return walkthrough_ ? walkthrough_->expectedTriangles(camera.eye) : 0.0;
+  }
   std::map<std::string, double> info() const override;
   // None for local and visible, which draw geometry only.
   std::optional<bool> drewImpostors() const override {

@@ -183,6 +183,10 @@ class Mode {
   // loads the impostors it will soon need (runtime::Walkthrough::readAheadPlaced). Returns the milliseconds spent;
   // 0 for modes with nothing to read ahead. Called inside the timed frame, after the mode's frame().
   virtual double readAhead(const Camera& /*camera*/, double /*budget_ms*/) { return 0.0; }
+  // What the mode knows of the next frame's load before drawing it, in triangles (the placed walkthrough: the visible
+  // set of the region holding the eye; runtime::Walkthrough::expectedTriangles); a governor scales its prediction by
+  // it (runtime::GovernorLoop::decide). 0: unknown.
+  virtual double planWorkload(const Camera& /*camera*/) const { return 0.0; }
 };
 
 // The measured path frames that drew an impostor (per path frame: whether the frame drew one) into a mode's info():

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 
 #include "farfield/core/error.h"
@@ -97,15 +98,23 @@ void GovernorLoop::deliver(uint64_t now) {
   in_flight_.erase(std::remove_if(in_flight_.begin(), in_flight_.end(), delivered), in_flight_.end());
 }
 
-GovernorDecision GovernorLoop::decide(uint64_t frame) {
+GovernorDecision GovernorLoop::decide(uint64_t frame, double workload) {
   if (!calibrated_) throw Error("governor loop", "decide() before finishCalibration()");
+  if (!(std::isfinite(workload) && workload >= 0.0))
+    throw Error("governor loop", "frame " + std::to_string(frame) + ": a workload must be finite and >= 0");
   deliver(frame);
   std::vector<double> predicted(levels_.size());
-  const double full_triangles = last_triangles_ / shares_[last_level_];
+  double full_triangles = last_triangles_ / shares_[last_level_];
+  // This frame's load against the load of the frame those triangles are from (a new plan).
+  if (workload > 0.0 && last_workload_ > 0.0) full_triangles *= workload / last_workload_;
   for (size_t level = 0; level < levels_.size(); ++level)
     predicted[level] = model_.predict(full_triangles * shares_[level], 0.0, levels_[level].pixels);
   const GovernorDecision decision = governor_.decide(frame, predicted);
-  in_flight_.push_back({frame, decision});
+  InFlight f;
+  f.frame = frame;
+  f.decision = decision;
+  f.workload = workload;
+  in_flight_.push_back(f);
   return decision;
 }
 
@@ -115,6 +124,7 @@ void GovernorLoop::frameTriangles(uint64_t frame, double triangles) {
   f->triangles = triangles;
   last_triangles_ = triangles;
   last_level_ = f->decision.level;
+  last_workload_ = f->workload;
 }
 
 void GovernorLoop::frameMeasured(uint64_t frame, double ms) {

@@ -48,7 +48,12 @@ class GovernorLoop {
 
   // The level of frame `frame` (increasing from call to call): measured times at least `lag` frames old go to the
   // governor first. Throws farfield::Error before finishCalibration().
-  GovernorDecision decide(uint64_t frame);
+  // workload (> 0, optional): what the host knows of this frame's load before drawing it, in any unit that scales
+  // with its triangles (a walkthrough's plan: the triangles of the objects it draws). The triangles the frame is
+  // predicted from, the last frame's that came back, are then scaled by this frame's workload over that frame's, so
+  // that a new plan (a region whose visible set is twice as large) is seen in its first frame rather than two frames
+  // later. 0: unknown (no scaling).
+  GovernorDecision decide(uint64_t frame, double workload = 0.0);
   // What came back about a decided frame; frames never decided, or too old, are ignored.
   void frameTriangles(uint64_t frame, double triangles);
   void frameMeasured(uint64_t frame, double ms);
@@ -70,6 +75,7 @@ class GovernorLoop {
     GovernorDecision decision;
     double triangles = -1.0;    // -1 until it comes back
     double measured_ms = -1.0;  // -1 until it comes back
+    double workload = 0.0;      // decide's
   };
   void refit();
   void deliver(uint64_t now);
@@ -87,6 +93,7 @@ class GovernorLoop {
   bool calibrated_ = false;
   double last_triangles_ = 0.0;  // of the last frame whose count came back ...
   size_t last_level_ = 0;        // ... drawn at this level
+  double last_workload_ = 0.0;   // ... with this workload (decide's; 0: unknown)
   std::vector<InFlight> in_flight_;
   std::vector<double> ratio_, corrected_ratio_;
 };

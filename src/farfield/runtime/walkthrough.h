@@ -205,6 +205,11 @@ class Walkthrough {
   // first on trust), and none beyond the GPU budget. Returns the milliseconds spent; 0 for another representation
   // (cells are read ahead on their own thread) or before a first plan.
   double readAheadPlaced(const Camera& camera, double budget_ms);
+  // Placed: what a frame at `eye` draws at most as geometry, known before planning it: the triangles of the visible
+  // set of the region holding the eye (every object where placement sampled none), whole objects. A host that keeps a
+  // frame budget tells its governor (runtime::GovernorLoop::decide's workload) so that a new region's heavier set is
+  // seen in its first frame. 0 for another representation.
+  double expectedTriangles(const Vec3& eye) const;
 
   const WalkthroughOptions& options() const { return options_; }
   double errorBoundPx() const { return options_.error_px; }

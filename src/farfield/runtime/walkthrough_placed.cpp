@@ -62,6 +62,19 @@ std::unordered_map<uint32_t, Walkthrough::Placed::Resident>::iterator Walkthroug
   return placed;
 }
 
+double Walkthrough::expectedTriangles(const Vec3& eye) const {
+  if (!placed_) return 0.0;
+  const store::PlacementIndex& index = placed_->index;
+  const std::optional<uint32_t> leaf = store::lookupLeaf(index, eye);
+  double triangles = 0.0;
+  if (leaf && index.nodes[*leaf].has_visible) {
+    for (uint32_t id : index.nodes[*leaf].visible) triangles += double(object_triangles_[id]);
+  } else {
+    for (uint64_t t : object_triangles_) triangles += double(t);
+  }
+  return triangles;
+}
+
 double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {
   if (!placed_ || !(budget_ms > 0.0) || options_.placed_read_ahead_frames == 0) return 0.0;
   Placed& p = *placed_;
