@@ -68,7 +68,6 @@ struct GpuCuller::Impl {
   // The parts of the plan's objects (ascending), which the part stage runs over when not every object is drawn: a
   // frame's culling work follows the plan, not the scene.
   GLuint part_list = 0;
-  uint32_t listed_parts = 0;
   std::vector<uint32_t> list;
   // Per phase: the commands, and the number written per group (buffers of their own: bound whole, no offset
   // alignment to respect).
@@ -179,7 +178,6 @@ void GpuCuller::setAllObjects() {
   }
   im.all_enabled = true;
   im.enabled_ids.clear();
-  im.listed_parts = 0;
 }
 
 void GpuCuller::setObjects(std::span<const uint32_t> ids) {
@@ -222,7 +220,6 @@ void GpuCuller::setObjects(std::span<const uint32_t> ids) {
     const auto [first, end] = arena_.objectParts(id - 1);
     for (uint32_t p = first; p < end; ++p) im.list.push_back(p);
   }
-  im.listed_parts = uint32_t(im.list.size());
   if (!im.list.empty())
     glNamedBufferSubData(im.part_list, 0, GLsizeiptr(im.list.size() * sizeof(uint32_t)), im.list.data());
 }
@@ -270,7 +267,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
   glProgramUniform2i(pp, im.part_l.viewport, target.width(), target.height());
   glProgramUniform1f(pp, im.part_l.margin, options_.occlusion_margin);
   glProgramUniform1i(pp, im.part_l.levels, im.pyramid.levels());
-  const uint32_t part_count = im.all_enabled ? uint32_t(arena_.parts().size()) : im.listed_parts;
+  const uint32_t part_count = uint32_t(im.all_enabled ? arena_.parts().size() : im.list.size());
   glProgramUniform1ui(pp, im.part_l.count, part_count);
   glProgramUniform1i(pp, im.part_l.listed, im.all_enabled ? 0 : 1);
   glProgramUniform3fv(pp, im.part_l.eye, 1, glm::value_ptr(camera.eye));

@@ -31,6 +31,14 @@ void Walkthrough::openPlacement() {
     options_.error_px = o["error_px"].get<double>();
   }
   p.hidden.assign(scene_.objects.size() + 1, 0);
+  for (uint64_t t : object_triangles_) p.all_triangles += double(t);
+  p.node_triangles.assign(p.index.nodes.size(), p.all_triangles);
+  for (size_t n = 0; n < p.index.nodes.size(); ++n) {
+    if (!p.index.nodes[n].has_visible) continue;
+    double visible = 0.0;
+    for (uint32_t id : p.index.nodes[n].visible) visible += double(object_triangles_[id]);
+    p.node_triangles[n] = visible;
+  }
 }
 
 namespace {
@@ -64,15 +72,8 @@ std::unordered_map<uint32_t, Walkthrough::Placed::Resident>::iterator Walkthroug
 
 double Walkthrough::expectedTriangles(const Vec3& eye) const {
   if (!placed_) return 0.0;
-  const store::PlacementIndex& index = placed_->index;
-  const std::optional<uint32_t> leaf = store::lookupLeaf(index, eye);
-  double triangles = 0.0;
-  if (leaf && index.nodes[*leaf].has_visible) {
-    for (uint32_t id : index.nodes[*leaf].visible) triangles += double(object_triangles_[id]);
-  } else {
-    for (uint64_t t : object_triangles_) triangles += double(t);
-  }
-  return triangles;
+  const std::optional<uint32_t> leaf = store::lookupLeaf(placed_->index, eye);
+  return leaf ? placed_->node_triangles[*leaf] : placed_->all_triangles;
 }
 
 double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {

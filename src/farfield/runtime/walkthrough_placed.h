@@ -25,6 +25,10 @@ struct Walkthrough::Placed {
   std::list<uint32_t> lru;                          // most recent first
   uint64_t resident_bytes = 0;
   std::vector<uint8_t> hidden;                      // per object id: drawn by an impostor this frame
+  // Per view-space node: the triangles of its visible set (whole objects; every object's where it has none), and
+  // every object's, made when the placement is opened (Walkthrough::expectedTriangles).
+  std::vector<double> node_triangles;
+  double all_triangles = 0.0;
   struct {
     size_t frames = 0, cpv_frames = 0, visibility_frames = 0, impostor_draws = 0, geometry_fallbacks = 0, loads = 0, evictions = 0;
     double load_ms_total = 0.0, load_ms_max = 0.0, geometry_triangles = 0.0, impostor_quads = 0.0;

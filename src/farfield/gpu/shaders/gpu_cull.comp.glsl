@@ -18,7 +18,7 @@
 //     becomes one indirect draw command, compacted per material group (an atomic counter per group, drawn with
 //     glMultiDrawElementsIndirectCount) or in its first instance's own slot (the other slots cleared).
 // A list's indirect dispatch (the work list's for CLUSTERS and EMIT, the drawn list's for phase 3) grows with it as
-// entries are appended (growDispatch), so no stage of its own turns a length into a dispatch between them.
+// entries are appended (startsGroup, listDispatch), so no stage of its own turns a length into a dispatch between them.
 // The occlusion test is gpu::OcclusionCuller's (occlusion_culler.cpp: projectBox, DepthPyramid::farthest, hides),
 // the same conservative arithmetic: a box is hidden only when all of it lies behind the stored depth at every pixel
 // it may cover.
