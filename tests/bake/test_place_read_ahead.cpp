@@ -1,5 +1,7 @@
-// Reading placed impostors ahead (runtime::Walkthrough::readAheadPlaced): the impostors a walk will soon draw are
-// loaded in an earlier frame's spare time, so fewer frames load one themselves, and no frame changes.
+// Reading placed impostors ahead: the impostors a walk will soon draw are loaded in an earlier frame's spare time
+// (runtime::Walkthrough::readAheadPlaced), so fewer frames load one themselves; and they are read and packed on a
+// background thread (WalkthroughOptions::read_ahead), so that the frame that needs one only uploads it. Neither
+// changes a frame.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -28,6 +30,7 @@ TEST(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChange
   const scene::Bvh bvh(scene);
   gpu::Renderer renderer;
   runtime::WalkthroughOptions options = test::placedWalkthroughOptions(dir);
+  options.read_ahead = false;  // every impostor read by the frame (or the read-ahead) that needs it
   runtime::Walkthrough plain(scene, gpu_scene, bvh, renderer, options);
   runtime::Walkthrough ahead(scene, gpu_scene, bvh, renderer, options);
   const Box3 space = store::readPlacementIndex(dir).view_space;
@@ -59,6 +62,51 @@ TEST(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChange
   // Every impostor is loaded once either way (nothing evicted under the default budget).
   EXPECT_EQ(stats.at("cache_evictions"), 0.0);
   EXPECT_LE(plain.statistics().at("impostor_loads"), stats.at("impostor_loads"));
+}
+
+TEST(PlaceReadAheadTest, ImpostorsReadInTheBackgroundChangeNoFrame) {
+  const gen::City city = test::smallPlacementCity();
+  const scene::Scene& scene = city.scene;
+  const std::string dir = test::scratchDir("place_background_reads").string();
+  const PlaceReport report = placeImpostors(gpu::sharedHeadlessContext(), scene, test::handProfile(),
+                                            test::smallPlaceOptions(scene), dir);
+  ASSERT_GT(report.impostors, 0u);
+  gpu::sharedHeadlessContext().makeCurrent();
+  const gpu::GpuScene gpu_scene(scene);
+  const scene::Bvh bvh(scene);
+  gpu::Renderer renderer;
+  runtime::WalkthroughOptions options = test::placedWalkthroughOptions(dir);
+  options.read_ahead = false;
+  runtime::Walkthrough plain(scene, gpu_scene, bvh, renderer, options);
+  options.read_ahead = true;
+  runtime::Walkthrough background(scene, gpu_scene, bvh, renderer, options);
+  const Box3 space = store::readPlacementIndex(dir).view_space;
+  gpu::RenderTarget plain_target(128, 128), background_target(128, 128);
+  const int frames = 120;
+  for (int f = 0; f < frames; ++f) {
+    SCOPED_TRACE("frame " + std::to_string(f));
+    const Camera camera = test::viewSpaceWalkCamera(space, f, frames);
+    const runtime::FramePlan& a = plain.plan(camera);
+    renderer.render(camera, a.items, plain_target);
+    const runtime::FramePlan& b = background.plan(camera);
+    EXPECT_EQ(b.items.size(), a.items.size());
+    renderer.render(camera, b.items, background_target);
+    EXPECT_EQ(background_target.readColor().pixels(), plain_target.readColor().pixels());
+    EXPECT_EQ(background_target.readIds().pixels(), plain_target.readIds().pixels());
+  }
+  const auto stats = background.statistics();
+  std::printf("%.0f impostors loaded: %.0f queued for the reader, %.0f read by it (%.0f taken ready, %.0f while "
+              "read), %.0f read by the frame\n", stats.at("impostor_loads"), stats.at("impostors_queued_for_the_reader"),
+              stats.at("impostors_read_in_the_background"), stats.at("impostors_taken_ready"),
+              stats.at("impostors_taken_while_read"), stats.at("impostors_read_by_the_frame"));
+  EXPECT_EQ(stats.at("impostor_loads"), plain.statistics().at("impostor_loads"));
+  ASSERT_GT(stats.at("impostor_loads"), 0.0);
+  // The walk's motion announces the problem views ahead: the reader read impostors the frames then took, and fewer
+  // were read by the frame that drew them than were loaded.
+  EXPECT_GT(stats.at("impostors_read_in_the_background"), 0.0);
+  EXPECT_GT(stats.at("impostors_taken_ready") + stats.at("impostors_taken_while_read"), 0.0);
+  EXPECT_LT(stats.at("impostors_read_by_the_frame"), stats.at("impostor_loads"));
+  EXPECT_EQ(plain.statistics().count("impostors_read_by_the_frame"), 0u);
 }
 
 }  // namespace

@@ -14,7 +14,8 @@
 // Mode options (--mode-option key=value; `farfield bench --impostors DIR` sets impostor_dir):
 //   impostor_dir=DIR        the pipeline store (mmi_dir=DIR overrides it for these modes)
 //   gpu_budget_mb=MB        GPU bytes of resident impostors, least recently used cells evicted (default 512)
-//   read_ahead=on|off       read the cells ahead of the viewer on a background thread (default on)
+//   read_ahead=on|off       read the cells (placed: the impostors of the problem views ahead along the eye's motion)
+//                           ahead of the viewer on a background thread (default on)
 //   memory_budget_mb=MB     one budget for the database in memory (resident impostors and cells read ahead;
 //                           replaces gpu_budget_mb; `--memory-budget` of walk and bench)
 //   streaming_csv=FILE      per-frame streaming log: cell entered, stall, resident bytes (runtime/streaming.h)

@@ -206,14 +206,28 @@ enum class LayerDraw { Tiles, WholeQuads };
 // made elsewhere (impostor/environment_map.h) calls it once its layers are set.
 void packAtlases(LayeredPlan& plan);
 
-// The layers on the GPU: per atlas (LayeredPlan::atlas_sizes) one texture (and id texture) and one mesh of its layers'
-// tile rectangles (LayerDraw::Tiles; whole quads with LayerDraw::WholeQuads; normal = the axis, uvs into the atlas),
-// with an unlit, double-sided material: one draw call per atlas. The renderer's alpha test cuts out texels with alpha
-// below 0.5 and its depth test composes the layers (and any geometry around them), so the draw order does not change
-// the image. Needs a current context. Movable; draw items point into it.
+// A layered impostor's atlases made on the CPU, ready to upload: per atlas (LayeredPlan::atlas_sizes) its image (and
+// id image, with id textures) holding its layers' images and their padding, and the mesh of its layers' tile
+// rectangles (LayerDraw::Tiles; whole quads with LayerDraw::WholeQuads; normal = the axis, uvs into the atlas). No GL:
+// a reader thread makes them ahead of the frame that uploads them (runtime/walkthrough_placed.cpp).
+struct LayeredAtlases {
+  std::vector<image::ColorImage> colors;
+  std::vector<image::IdImage> ids;  // empty without id textures
+  std::vector<scene::Mesh> meshes;
+  uint32_t quads = 0;       // layers
+  uint32_t rectangles = 0;  // quads drawn: tile rectangles, or one per layer
+  uint64_t cpuBytes() const;  // the images' texels and the meshes' vertex and index bytes
+};
+LayeredAtlases packLayeredAtlases(const LayeredImpostor& impostor, LayerDraw draw = LayerDraw::Tiles);
+
+// The layers on the GPU: per atlas one texture (and id texture) and one mesh (LayeredAtlases), with an unlit,
+// double-sided material: one draw call per atlas. The renderer's alpha test cuts out texels with alpha below 0.5 and
+// its depth test composes the layers (and any geometry around them), so the draw order does not change the image.
+// Needs a current context. Movable; draw items point into it.
 class GpuLayeredImpostor {
  public:
-  explicit GpuLayeredImpostor(const LayeredImpostor& impostor, LayerDraw draw = LayerDraw::Tiles);
+  explicit GpuLayeredImpostor(const LayeredImpostor& impostor, LayerDraw draw = LayerDraw::Tiles);  // packs, uploads
+  explicit GpuLayeredImpostor(const LayeredAtlases& atlases);  // uploads
   GpuLayeredImpostor(GpuLayeredImpostor&&) noexcept = default;
   GpuLayeredImpostor& operator=(GpuLayeredImpostor&&) noexcept = default;
 

@@ -75,8 +75,10 @@ struct WalkthroughOptions {
   // GPU bytes of resident impostors (textures, id textures, meshes); least recently used cells are evicted beyond
   // it. The current cell stays even when it alone exceeds the budget (reported as over_gpu_budget).
   uint64_t gpu_budget_bytes = uint64_t(512) << 20;
-  bool read_ahead = true;                      // read the cells ahead on a background thread
-  uint64_t read_ahead_bytes = uint64_t(256) << 20;  // decoded bytes of cells read ahead and not yet entered
+  // Read the cells (Placed: the impostors of the CPVs the eye will be in over the next placed_read_ahead_frames
+  // frames, along its motion) ahead on a background thread, so that the frame that needs them only uploads them.
+  bool read_ahead = true;
+  uint64_t read_ahead_bytes = uint64_t(256) << 20;  // decoded bytes read ahead and not yet used
   // One budget for the database in memory (> 0 replaces the two above): a quarter for the cells read ahead, the rest
   // for the resident impostors; the current cell stays even when it alone exceeds it.
   uint64_t memory_budget_bytes = 0;
@@ -91,7 +93,7 @@ struct WalkthroughOptions {
   // own bound and counted (true), or their objects drawn as geometry so that every frame keeps error_px (false: a
   // frame governor then takes them as a coarser level by raising error_px).
   bool coarser_impostors = true;
-  // Placed: how many frames ahead readAheadPlaced() looks along the eye's motion (0: it loads nothing).
+  // Placed: how many frames ahead readAheadPlaced() and the background reads look along the eye's motion (0: none).
   size_t placed_read_ahead_frames = 15;
   // true: the plan's geometry as draw items culled per cluster on the CPU (FramePlan::items, geometry_items);
   // false: as the objects a GPU-driven frame culls itself (FramePlan::geometry_objects, gpu::GpuCuller), the items
@@ -201,9 +203,11 @@ class Walkthrough {
   // frame: Decoret et al. 1999, section 5.5, "from the desired and the predicted frame times we can determine how much
   // time we have to accomplish such updates"), so that the frame that first draws one does not load it. They are the
   // impostors, not yet resident, of the CPV holding the eye `placed_read_ahead_frames` frames on along its motion
-  // over the last frame, looking as now; one is loaded only when the slowest load so far fits in what is left (the
-  // first on trust), and none beyond the GPU budget. Returns the milliseconds spent; 0 for another representation
-  // (cells are read ahead on their own thread) or before a first plan.
+  // over the last frame, looking as now. With read_ahead, one the background thread has read is uploaded when the
+  // slowest such upload fits in what is left; one it has not, read (or waited for) when the slowest load so far fits,
+  // else left to the thread; without, read when the slowest load fits (the first of either on trust). None beyond the
+  // GPU budget. Returns the milliseconds spent; 0 for another representation (cells are read ahead on their own
+  // thread) or before a first plan.
   double readAheadPlaced(const Camera& camera, double budget_ms);
   // Placed: what a frame at `eye` draws at most as geometry, known before planning it: the triangles of the visible
   // set of the region holding the eye (every object where placement sampled none), whole objects. A host that keeps a

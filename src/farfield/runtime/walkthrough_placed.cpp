@@ -39,6 +39,21 @@ void Walkthrough::openPlacement() {
     for (uint32_t id : p.index.nodes[n].visible) visible += double(object_triangles_[id]);
     p.node_triangles[n] = visible;
   }
+  if (options_.memory_budget_bytes > 0) {
+    options_.read_ahead_bytes = options_.memory_budget_bytes / 4;
+    options_.gpu_budget_bytes = options_.memory_budget_bytes - options_.read_ahead_bytes;
+  }
+  if (options_.read_ahead) {
+    const WalkthroughOptions options = options_;
+    const store::PlacementIndex& index = p.index;  // lives as long as the reader (Placed's member before it)
+    p.reader = std::make_unique<store::BackgroundReader<Placed::Prepared>>(
+        [options, &index](uint32_t id) {
+          const store::StoredPlacedImpostor* record = index.find(id);
+          if (!record) throw Error(options.database, "holds no impostor " + std::to_string(id));
+          return Placed::prepare(options, *record);
+        },
+        [](const Placed::Prepared& prepared) { return prepared.atlases.cpuBytes(); }, options_.read_ahead_bytes);
+  }
 }
 
 namespace {
@@ -50,24 +65,43 @@ bool underCoarserBound(const store::StoredPlacedImpostor& record, double error_p
 
 }  // namespace
 
-std::unordered_map<uint32_t, Walkthrough::Placed::Resident>::iterator Walkthrough::Placed::load(
-    const WalkthroughOptions& options, uint32_t id, const store::StoredPlacedImpostor& record) {
-  Stopwatch timer;
+Walkthrough::Placed::Prepared Walkthrough::Placed::prepare(const WalkthroughOptions& options,
+                                                           const store::StoredPlacedImpostor& record) {
   const impostor::LayeredImpostor imp = store::loadPlacedImpostor(options.database, record);
-  Resident r;
-  r.gpu = std::make_unique<impostor::GpuLayeredImpostor>(
+  Prepared out;
+  out.atlases = impostor::packLayeredAtlases(
       imp, options.layer_tiles ? impostor::LayerDraw::Tiles : impostor::LayerDraw::WholeQuads);
-  r.error_rad = imp.plan.error_angle;
+  out.error_rad = imp.plan.error_angle;
+  return out;
+}
+
+std::unordered_map<uint32_t, Walkthrough::Placed::Resident>::iterator Walkthrough::Placed::makeResident(
+    uint32_t id, const Prepared& prepared) {
+  Resident r;
+  r.gpu = std::make_unique<impostor::GpuLayeredImpostor>(prepared.atlases);
+  r.error_rad = prepared.error_rad;
   r.bytes = r.gpu->gpuBytes();
   resident_bytes += r.bytes;
   lru.push_front(id);
   r.lru = lru.begin();
-  const auto placed = resident.emplace(id, std::move(r)).first;
   ++stats.loads;
+  return resident.emplace(id, std::move(r)).first;
+}
+
+std::unordered_map<uint32_t, Walkthrough::Placed::Resident>::iterator Walkthrough::Placed::load(
+    const WalkthroughOptions& options, uint32_t id, const store::StoredPlacedImpostor& record) {
+  Stopwatch timer;
+  const auto placed = reader ? makeResident(id, *reader->take(id)) : makeResident(id, prepare(options, record));
   const double ms = timer.milliseconds();
   stats.load_ms_total += ms;
   stats.load_ms_max = std::max(stats.load_ms_max, ms);
   return placed;
+}
+
+void Walkthrough::Placed::prefetchCpv(const WalkthroughOptions& options, uint32_t cpv) {
+  for (uint32_t id : index.cpvs[cpv].impostors)
+    if (!resident.count(id) && (options.coarser_impostors || !underCoarserBound(*index.find(id), options.error_px)))
+      reader->prefetch(id);
 }
 
 double Walkthrough::expectedTriangles(const Vec3& eye) const {
@@ -89,11 +123,28 @@ double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {
     if (p.resident.count(id)) continue;
     const store::StoredPlacedImpostor& record = *p.index.find(id);
     if (underCoarserBound(record, options_.error_px) && !options_.coarser_impostors) continue;
-    // The next load fits when the slowest so far does in what is left (the first is taken on trust); nothing is
-    // evicted for it: a read-ahead that would push the residents over the budget waits until the frame needs it.
-    const double left = budget_ms - timer.milliseconds();
-    if (p.stats.loads > 0 && p.stats.load_ms_max > left) break;
+    // Nothing is evicted for a load: a read-ahead that would push the residents over the budget waits until the frame
+    // needs it.
     if (p.resident_bytes >= options_.gpu_budget_bytes) break;
+    const double left = budget_ms - timer.milliseconds();
+    // One read and packed already on the reader's thread is uploaded when the slowest such upload fits in what is
+    // left (the first on trust).
+    if (p.reader) {
+      if (p.stats.loads > 0 && p.stats.upload_ms_max > left) break;
+      Stopwatch upload;
+      if (const std::shared_ptr<Placed::Prepared> ready = p.reader->takeIfReady(id)) {
+        p.makeResident(id, *ready);
+        p.stats.upload_ms_max = std::max(p.stats.upload_ms_max, upload.milliseconds());
+        ++p.stats.read_ahead_loads;
+        continue;
+      }
+    }
+    // Else one is read (or waited for) when the slowest load so far fits (the first on trust); otherwise it stays
+    // queued for the reader.
+    if (p.stats.loads > 0 && p.stats.load_ms_max > left) {
+      if (p.reader) p.reader->prefetch(id);
+      continue;
+    }
     p.load(options_, id, record);
     ++p.stats.read_ahead_loads;
   }
@@ -108,6 +159,15 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   p.motion = p.has_eye ? camera.eye - p.last_eye : Vec3(0.0f);
   p.last_eye = camera.eye;
   p.has_eye = true;
+  // The impostors of the CPVs the eye will be in over the next placed_read_ahead_frames frames, moving on as over
+  // the last frame and looking as now, are queued for the reader (no work of this frame's but the lookups).
+  if (p.reader && options_.placed_read_ahead_frames > 0 && p.motion != Vec3(0.0f)) {
+    const size_t frames = options_.placed_read_ahead_frames, step = std::max<size_t>(1, frames / 3);
+    for (size_t k = step; k <= frames; k += step)
+      if (const std::optional<uint32_t> ahead =
+              store::lookupCpv(p.index, camera.eye + p.motion * float(k), camera.forward()))
+        p.prefetchCpv(options_, *ahead);
+  }
   FramePlan& plan = plan_;
   plan.items.clear();
   plan.geometry_bounds.clear();
@@ -260,6 +320,17 @@ std::map<std::string, double> Walkthrough::placedStatistics() const {
   out["impostor_load_ms_max"] = s.load_ms_max;
   out["impostors_read_ahead"] = double(s.read_ahead_loads);
   out["impostor_read_ahead_ms"] = s.read_ahead_ms;
+  out["impostor_upload_ms_max"] = s.upload_ms_max;
+  if (p.reader) {
+    const store::BackgroundReaderStats r = p.reader->stats();
+    out["impostors_queued_for_the_reader"] = double(r.prefetch_requests);
+    out["impostors_read_in_the_background"] = double(r.read_ahead);
+    out["impostors_taken_ready"] = double(r.taken_ready);
+    out["impostors_taken_while_read"] = double(r.taken_waited);
+    out["impostors_read_by_the_frame"] = double(r.taken_cold);
+    out["impostor_reader_wait_ms"] = r.wait_ms_total;
+    out["impostor_reader_bytes_max"] = double(r.held_bytes_max);
+  }
   out["cache_evictions"] = double(s.evictions);
   out["gpu_budget_bytes"] = double(options_.gpu_budget_bytes);
   out["resident_bytes_max"] = double(s.resident_bytes_max);

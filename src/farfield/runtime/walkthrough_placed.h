@@ -9,6 +9,7 @@
 
 #include "farfield/impostor/layered.h"
 #include "farfield/runtime/walkthrough.h"
+#include "farfield/store/background_reader.h"
 #include "farfield/store/placement_store.h"
 
 namespace farfield::runtime {
@@ -38,13 +39,29 @@ struct Walkthrough::Placed {
     size_t coarse_left_to_geometry = 0;  // ... left to geometry (WalkthroughOptions::coarser_impostors false)
     size_t read_ahead_loads = 0;         // loads by readAheadPlaced (also in loads)
     double read_ahead_ms = 0.0;
+    double upload_ms_max = 0.0;          // the slowest upload of an impostor read and packed already
   } stats;
   // The eye's motion over the last frame (readAheadPlaced looks ahead along it).
   bool has_eye = false;
   Vec3 last_eye{0.0f}, motion{0.0f};
-  // Reads, uploads and makes resident the impostor `id` (stats.loads and its time); returns it.
+  // An impostor read from the database and its atlases packed: what the GPU upload needs (no GL).
+  struct Prepared {
+    impostor::LayeredAtlases atlases;
+    double error_rad = 0.0;
+  };
+  static Prepared prepare(const WalkthroughOptions& options, const store::StoredPlacedImpostor& record);
+  // Reads (or takes from the reader, waiting for it), uploads and makes resident the impostor `id` (stats.loads and
+  // its time); returns it.
   std::unordered_map<uint32_t, Resident>::iterator load(const WalkthroughOptions& options, uint32_t id,
                                                         const store::StoredPlacedImpostor& record);
+  // Uploads a prepared impostor and makes it resident (stats.loads; its time is the caller's).
+  std::unordered_map<uint32_t, Resident>::iterator makeResident(uint32_t id, const Prepared& prepared);
+  // Queues the impostors of `cpv` that are not resident (and that the walkthrough may draw) for the reader.
+  void prefetchCpv(const WalkthroughOptions& options, uint32_t cpv);
+
+  // Impostors read and packed on a background thread ahead of the frames that need them (WalkthroughOptions::
+  // read_ahead), so that such a frame only uploads; null without. Last: its thread reads the index above.
+  std::unique_ptr<store::BackgroundReader<Prepared>> reader;
 };
 
 }  // namespace farfield::runtime
