@@ -12,7 +12,7 @@ namespace farfield::geodata {
 
 namespace {
 
-constexpr float kRoofTile = 4.0f;  // metres per roof texture repeat (gen/buildings.cpp)
+constexpr float kRoofTile = 4.0f;  // metres per roof texture repeat (gen/building_parts.h)
 constexpr Vec3 kUp{0.0f, 0.0f, 1.0f};
 
 void tri(scene::Mesh& m, uint32_t a, uint32_t b, uint32_t c) { m.indices.insert(m.indices.end(), {a, b, c}); }

@@ -1,6 +1,6 @@
 // Reading a glTF accessor's elements safely: every offset, stride and count checked against its buffer view and
 // buffer, so that a corrupt or truncated file gives a farfield::Error naming the file and the accessor instead of a
-// read outside its data. Shared by the static importer (import.cpp) and the skinned-model reader (gltf_skin.cpp).
+// read outside its data. Shared by the static importer (import_gltf.cpp) and the skinned-model reader (gltf_skin.cpp).
 #pragma once
 
 #include <cstddef>
@@ -29,7 +29,7 @@ GltfView gltfAccessor(const tinygltf::Model& model, int index, const std::string
 // The bytes of image `index` when it lives in a buffer view (Image::bufferView >= 0), checked against the view and
 // its buffer. Empty, with *why saying what is wrong, for an image index, view or buffer out of range, or a view that
 // does not fit in its buffer. tinygltf 2.7 hands its image callback &buffer.data[byteOffset] and byteLength without
-// that check (a corrupt file made the callback read past the buffer), so the callbacks of import.cpp and
+// that check (a corrupt file made the callback read past the buffer), so the callbacks of import_gltf.cpp and
 // gltf_skin.cpp leave such images alone and the readers take their bytes from here once the model is loaded.
 std::span<const unsigned char> gltfImageBytes(const tinygltf::Model& model, int index, std::string* why);
 

@@ -18,7 +18,7 @@
 namespace farfield::scene {
 
 namespace detail {
-void checkTinygltfBinding();  // import.cpp
+void checkTinygltfBinding();  // import_gltf.cpp
 }
 
 namespace {

@@ -51,7 +51,7 @@
 // Writes (SQLite's rule: a write is atomic or did not happen): each data file goes to NAME.tmp, is fsync'ed and
 // renamed over NAME (store::writeFileAtomic: store::setFileOperationHook sees its create, write, fsync and rename, and
 // the sync of DIR after the index's rename; the directory syncs before it and the removals are not reported, the
-// hook's machinery being private to impostor_store.cpp); writePlacementIndex syncs
+// hook's machinery being private to store_integrity.cpp); writePlacementIndex syncs
 // DIR/impostors, then replaces DIR/placement.json atomically, then removes the files under DIR/impostors with
 // placement names (gG.* and their .tmp) that the new index does not name, and DIR/placement.json.tmp. A rewrite uses
 // generation nextPlacementGeneration(DIR), so the old index and its files stay untouched until the new index is in
