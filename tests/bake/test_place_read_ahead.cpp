@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <string>
 
 #include "farfield/bake/place.h"
 #include "farfield/gpu/render_target.h"
@@ -18,14 +20,32 @@
 namespace farfield::bake {
 namespace {
 
-TEST(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChangeNoFrame) {
-  const gen::City city = test::smallPlacementCity();
-  const scene::Scene& scene = city.scene;
-  const std::string dir = test::scratchDir("place_read_ahead").string();
-  const PlaceReport report = placeImpostors(gpu::sharedHeadlessContext(), scene, test::handProfile(),
-                                            test::smallPlaceOptions(scene), dir);
-  ASSERT_GT(report.impostors, 0u);
-  gpu::sharedHeadlessContext().makeCurrent();
+// The small test city placed once for the suite's tests.
+class PlaceReadAheadTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    city_ = std::make_unique<gen::City>(test::smallPlacementCity());
+    dir_ = test::scratchDir("place_read_ahead").string();
+    impostors_ = placeImpostors(gpu::sharedHeadlessContext(), city_->scene, test::handProfile(),
+                                test::smallPlaceOptions(city_->scene), dir_)
+                     .impostors;
+  }
+  static void TearDownTestSuite() { city_.reset(); }
+  void SetUp() override {
+    ASSERT_GT(impostors_, 0u);
+    gpu::sharedHeadlessContext().makeCurrent();
+  }
+  static std::unique_ptr<gen::City> city_;
+  static std::string dir_;
+  static size_t impostors_;
+};
+std::unique_ptr<gen::City> PlaceReadAheadTest::city_;
+std::string PlaceReadAheadTest::dir_;
+size_t PlaceReadAheadTest::impostors_ = 0;
+
+TEST_F(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChangeNoFrame) {
+  const scene::Scene& scene = city_->scene;
+  const std::string& dir = dir_;
   const gpu::GpuScene gpu_scene(scene);
   const scene::Bvh bvh(scene);
   gpu::Renderer renderer;
@@ -64,14 +84,9 @@ TEST(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChange
   EXPECT_LE(plain.statistics().at("impostor_loads"), stats.at("impostor_loads"));
 }
 
-TEST(PlaceReadAheadTest, ImpostorsReadInTheBackgroundChangeNoFrame) {
-  const gen::City city = test::smallPlacementCity();
-  const scene::Scene& scene = city.scene;
-  const std::string dir = test::scratchDir("place_background_reads").string();
-  const PlaceReport report = placeImpostors(gpu::sharedHeadlessContext(), scene, test::handProfile(),
-                                            test::smallPlaceOptions(scene), dir);
-  ASSERT_GT(report.impostors, 0u);
-  gpu::sharedHeadlessContext().makeCurrent();
+TEST_F(PlaceReadAheadTest, ImpostorsReadInTheBackgroundChangeNoFrame) {
+  const scene::Scene& scene = city_->scene;
+  const std::string& dir = dir_;
   const gpu::GpuScene gpu_scene(scene);
   const scene::Bvh bvh(scene);
   gpu::Renderer renderer;
@@ -96,7 +111,8 @@ TEST(PlaceReadAheadTest, ImpostorsReadInTheBackgroundChangeNoFrame) {
   }
   const auto stats = background.statistics();
   std::printf("%.0f impostors loaded: %.0f queued for the reader, %.0f read by it (%.0f taken ready, %.0f while "
-              "read), %.0f read by the frame\n", stats.at("impostor_loads"), stats.at("impostors_queued_for_the_reader"),
+              "read), %.0f read by the frame\n",
+              stats.at("impostor_loads"), stats.at("impostors_queued_for_the_reader"),
               stats.at("impostors_read_in_the_background"), stats.at("impostors_taken_ready"),
               stats.at("impostors_taken_while_read"), stats.at("impostors_read_by_the_frame"));
   EXPECT_EQ(stats.at("impostor_loads"), plain.statistics().at("impostor_loads"));

@@ -52,7 +52,9 @@ class CellReader {
   void prefetch(uint32_t half_edge);
   // The cell's views: waiting ones at once, one being read after its read, others read now on the calling thread.
   // Throws what the read threw. *how, when given: "ready", "waited" or "cold".
-  std::shared_ptr<CellViews> take(uint32_t half_edge, const char** how = nullptr) { return reader_.take(half_edge, how); }
+  std::shared_ptr<CellViews> take(uint32_t half_edge, const char** how = nullptr) {
+    return reader_.take(half_edge, how);
+  }
   // Forgets queued (not yet started) prefetches: the viewer turned elsewhere.
   void cancelQueued() { reader_.cancelQueued(); }
 

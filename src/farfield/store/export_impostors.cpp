@@ -126,7 +126,7 @@ class PipelineExport {
   ImpostorExportStats& stats_;
 };
 
-// One quad per layer, as GpuLayeredImpostor draws it with LayerDraw::WholeQuads (layered.cpp; the same image as its
+// One quad per layer, as GpuLayeredImpostor draws it with LayerDraw::WholeQuads (layered_gpu.cpp; the same image as its
 // tiles) but with each layer's own image: uv (0, 0) at the image's top-left texel, the capture's -right, +up corner;
 // counter-clockwise seen from the viewers. One glTF mesh with a primitive per layer (far to near), so a CPV drawing
 // the impostor needs one node.
