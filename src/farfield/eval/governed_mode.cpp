@@ -63,8 +63,10 @@ GovernedMode::GovernedMode(const ModeContext& context) {
     }
   }
   // Resolution scales, 1 (the frame itself) first, decreasing; the simplified levels' bounds, 0 (full detail) first.
-  scales_ = parseLevelList(context.option("governor_scales", "1,0.84,0.71,0.59,0.5"), "governor_scales", 0.25, 1.0,
-                           1.0, false, "a scale in [0.25, 1]");
+  // The last resort goes down to a quarter per side: on llvmpipe the levels under half resolution take 15-25 % off
+  // the floor (docs/DESIGN-NOTES.md, "The governor's floor").
+  scales_ = parseLevelList(context.option("governor_scales", "1,0.84,0.71,0.59,0.5,0.42,0.35,0.3,0.25"),
+                           "governor_scales", 0.25, 1.0, 1.0, false, "a scale in [0.25, 1]");
   lod_px_ = parseLevelList(context.option("governor_lod_px", simplified ? "0,1,2,4" : "0"), "governor_lod_px", 0.0,
                            64.0, 0.0, true, "a number of pixels in [0, 64]");
   if (!simplified && lod_px_.size() > 1)

@@ -23,7 +23,7 @@
 // Options (--mode-option): governed=MODE (the mode governed; default culled), governor_impostor_px (none by default),
 // governor_lod_px=0,1,2,4 (the simplified
 // levels' bounds, 0 first, increasing; 0 alone over an arena a mode of the run made before without them), governor_error_px (the promised bound, default 1 px: bound scales are relative
-// to it), governor_scales=1,0.84,... (the resolution scales, 1 first, decreasing, each in [0.25, 1]), governor_lag
+// to it), governor_scales=1,0.84,... (the resolution scales, 1 first, decreasing, each in [0.25, 1]; default down to 0.25), governor_lag
 // (frames, default 2),
 // governor_aim, governor_refine_below, governor_refine_after, governor_window, governor_cold_ratio (default 1.5:
 // the model, fitted on the calibration's quiet frames, is taken 1.5x larger until the first frame is measured)
