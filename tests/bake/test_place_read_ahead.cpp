@@ -34,7 +34,19 @@ class PlaceReadAheadTest : public ::testing::Test {
   void SetUp() override {
     ASSERT_GT(impostors_, 0u);
     gpu::sharedHeadlessContext().makeCurrent();
+    gpu_scene_ = std::make_unique<gpu::GpuScene>(city_->scene);
+    bvh_ = std::make_unique<scene::Bvh>(city_->scene);
+    renderer_ = std::make_unique<gpu::Renderer>();
   }
+  // A walkthrough over the placement (read_ahead: its impostors read on a background thread).
+  std::unique_ptr<runtime::Walkthrough> walkthrough(bool read_ahead) {
+    runtime::WalkthroughOptions options = test::placedWalkthroughOptions(dir_);
+    options.read_ahead = read_ahead;
+    return std::make_unique<runtime::Walkthrough>(city_->scene, *gpu_scene_, *bvh_, *renderer_, options);
+  }
+  std::unique_ptr<gpu::GpuScene> gpu_scene_;
+  std::unique_ptr<scene::Bvh> bvh_;
+  std::unique_ptr<gpu::Renderer> renderer_;
   static std::unique_ptr<gen::City> city_;
   static std::string dir_;
   static size_t impostors_;
@@ -44,16 +56,11 @@ std::string PlaceReadAheadTest::dir_;
 size_t PlaceReadAheadTest::impostors_ = 0;
 
 TEST_F(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChangeNoFrame) {
-  const scene::Scene& scene = city_->scene;
-  const std::string& dir = dir_;
-  const gpu::GpuScene gpu_scene(scene);
-  const scene::Bvh bvh(scene);
-  gpu::Renderer renderer;
-  runtime::WalkthroughOptions options = test::placedWalkthroughOptions(dir);
-  options.read_ahead = false;  // every impostor read by the frame (or the read-ahead) that needs it
-  runtime::Walkthrough plain(scene, gpu_scene, bvh, renderer, options);
-  runtime::Walkthrough ahead(scene, gpu_scene, bvh, renderer, options);
-  const Box3 space = store::readPlacementIndex(dir).view_space;
+  // Every impostor read by the frame (or the read-ahead) that needs it.
+  const auto plain_walkthrough = walkthrough(false), ahead_walkthrough = walkthrough(false);
+  runtime::Walkthrough &plain = *plain_walkthrough, &ahead = *ahead_walkthrough;
+  gpu::Renderer& renderer = *renderer_;
+  const Box3 space = store::readPlacementIndex(dir_).view_space;
   gpu::RenderTarget plain_target(128, 128), ahead_target(128, 128);
   size_t plain_loads = 0, ahead_loads = 0, impostor_frames = 0;
   const int frames = 120;
@@ -85,17 +92,10 @@ TEST_F(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChan
 }
 
 TEST_F(PlaceReadAheadTest, ImpostorsReadInTheBackgroundChangeNoFrame) {
-  const scene::Scene& scene = city_->scene;
-  const std::string& dir = dir_;
-  const gpu::GpuScene gpu_scene(scene);
-  const scene::Bvh bvh(scene);
-  gpu::Renderer renderer;
-  runtime::WalkthroughOptions options = test::placedWalkthroughOptions(dir);
-  options.read_ahead = false;
-  runtime::Walkthrough plain(scene, gpu_scene, bvh, renderer, options);
-  options.read_ahead = true;
-  runtime::Walkthrough background(scene, gpu_scene, bvh, renderer, options);
-  const Box3 space = store::readPlacementIndex(dir).view_space;
+  const auto plain_walkthrough = walkthrough(false), background_walkthrough = walkthrough(true);
+  runtime::Walkthrough &plain = *plain_walkthrough, &background = *background_walkthrough;
+  gpu::Renderer& renderer = *renderer_;
+  const Box3 space = store::readPlacementIndex(dir_).view_space;
   gpu::RenderTarget plain_target(128, 128), background_target(128, 128);
   const int frames = 120;
   for (int f = 0; f < frames; ++f) {

@@ -14,6 +14,18 @@
 
 namespace farfield::scene {
 
+namespace {
+
+// stb_image's RGBA8 pixels as an image; the pixels are freed.
+TexturePtr takeStbPixels(unsigned char* pixels, int w, int h) {
+  auto img = std::make_shared<image::ColorImage>(w, h);
+  std::memcpy(img->data(), pixels, size_t(w) * size_t(h) * 4);
+  stbi_image_free(pixels);
+  return img;
+}
+
+}  // namespace
+
 TexturePtr decodeImage(const unsigned char* bytes, size_t size, std::string* why) {
   if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
     *why = "empty or oversized image data";
@@ -26,10 +38,7 @@ TexturePtr decodeImage(const unsigned char* bytes, size_t size, std::string* why
     *why = std::string("cannot decode image (") + (reason ? reason : "unknown reason") + ")";
     return nullptr;
   }
-  auto img = std::make_shared<image::ColorImage>(w, h);
-  std::memcpy(img->data(), pixels, size_t(w) * size_t(h) * 4);
-  stbi_image_free(pixels);
-  return img;
+  return takeStbPixels(pixels, w, h);
 }
 
 namespace {
@@ -50,10 +59,7 @@ TexturePtr readImageFile(const fs::path& file, std::string* why) {
     *why = file.string() + ": cannot decode image (" + (reason ? reason : "unknown reason") + ")";
     return nullptr;
   }
-  auto img = std::make_shared<image::ColorImage>(w, h);
-  std::memcpy(img->data(), pixels, size_t(w) * size_t(h) * 4);
-  stbi_image_free(pixels);
-  return img;
+  return takeStbPixels(pixels, w, h);
 }
 
 }  // namespace
