@@ -70,6 +70,11 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
   object_triangles_.assign(scene.objects.size() + 1, 0);
   for (const scene::Object& o : scene.objects)
     for (const scene::Part& p : o.parts) object_triangles_[o.id] += scene.meshes[p.mesh].triangleCount();
+  // One budget for the database in memory: a quarter for what is read ahead, the rest for the resident impostors.
+  if (options_.memory_budget_bytes > 0) {
+    options_.read_ahead_bytes = options_.memory_budget_bytes / 4;
+    options_.gpu_budget_bytes = options_.memory_budget_bytes - options_.read_ahead_bytes;
+  }
   if (kind == Representation::Placed) {
     openPlacement();
     return;
@@ -114,10 +119,6 @@ Walkthrough::Walkthrough(const scene::Scene& scene, const gpu::GpuScene& gpu_sce
       cell_options.block_margin = index_.options["block_margin"].get<float>();
     cell_map_ = std::make_unique<urban::CellMap>(graph_, scene, cell_options);
     runner_ = std::make_unique<extract::PipelineRunner>(scene, gpu_scene, *cell_map_, pipeline_options);
-  }
-  if (options_.memory_budget_bytes > 0) {
-    options_.read_ahead_bytes = options_.memory_budget_bytes / 4;
-    options_.gpu_budget_bytes = options_.memory_budget_bytes - options_.read_ahead_bytes;
   }
   streaming_ = StreamingLog(options_.memory_budget_bytes);
   if (!options_.streaming_csv.empty()) StreamingLog().writeCsv(options_.streaming_csv);  // writable: fail now

@@ -39,10 +39,6 @@ void Walkthrough::openPlacement() {
     for (uint32_t id : p.index.nodes[n].visible) visible += double(object_triangles_[id]);
     p.node_triangles[n] = visible;
   }
-  if (options_.memory_budget_bytes > 0) {
-    options_.read_ahead_bytes = options_.memory_budget_bytes / 4;
-    options_.gpu_budget_bytes = options_.memory_budget_bytes - options_.read_ahead_bytes;
-  }
   if (options_.read_ahead) {
     const WalkthroughOptions options = options_;
     const store::PlacementIndex& index = p.index;  // lives as long as the reader (Placed's member before it)
@@ -98,10 +94,13 @@ std::unordered_map<uint32_t, Walkthrough::Placed::Resident>::iterator Walkthroug
   return placed;
 }
 
+bool Walkthrough::Placed::wanted(const WalkthroughOptions& options, uint32_t id) const {
+  return !resident.count(id) && (options.coarser_impostors || !underCoarserBound(*index.find(id), options.error_px));
+}
+
 void Walkthrough::Placed::prefetchCpv(const WalkthroughOptions& options, uint32_t cpv) {
   for (uint32_t id : index.cpvs[cpv].impostors)
-    if (!resident.count(id) && (options.coarser_impostors || !underCoarserBound(*index.find(id), options.error_px)))
-      reader->prefetch(id);
+    if (wanted(options, id)) reader->prefetch(id);
 }
 
 double Walkthrough::expectedTriangles(const Vec3& eye) const {
@@ -120,9 +119,7 @@ double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {
   const std::optional<uint32_t> cpv = store::lookupCpv(p.index, ahead, camera.forward());
   if (!cpv) return 0.0;
   for (uint32_t id : p.index.cpvs[*cpv].impostors) {
-    if (p.resident.count(id)) continue;
-    const store::StoredPlacedImpostor& record = *p.index.find(id);
-    if (underCoarserBound(record, options_.error_px) && !options_.coarser_impostors) continue;
+    if (!p.wanted(options_, id)) continue;
     // Nothing is evicted for a load: a read-ahead that would push the residents over the budget waits until the frame
     // needs it.
     if (p.resident_bytes >= options_.gpu_budget_bytes) break;
@@ -139,13 +136,10 @@ double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {
         continue;
       }
     }
-    // Else one is read (or waited for) when the slowest load so far fits (the first on trust); otherwise it stays
-    // queued for the reader.
-    if (p.stats.loads > 0 && p.stats.load_ms_max > left) {
-      if (p.reader) p.reader->prefetch(id);
-      continue;
-    }
-    p.load(options_, id, record);
+    // Else one is read (or waited for) when the slowest load so far fits (the first on trust); otherwise it is left
+    // to the reader, which the frame's plan queued it for.
+    if (p.stats.loads > 0 && p.stats.load_ms_max > left) continue;
+    p.load(options_, id, *p.index.find(id));
     ++p.stats.read_ahead_loads;
   }
   p.stats.resident_bytes_max = std::max(p.stats.resident_bytes_max, p.resident_bytes);
@@ -162,11 +156,14 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   // The impostors of the CPVs the eye will be in over the next placed_read_ahead_frames frames, moving on as over
   // the last frame and looking as now, are queued for the reader (no work of this frame's but the lookups).
   if (p.reader && options_.placed_read_ahead_frames > 0 && p.motion != Vec3(0.0f)) {
-    const size_t frames = options_.placed_read_ahead_frames, step = std::max<size_t>(1, frames / 3);
-    for (size_t k = step; k <= frames; k += step)
+    // At a third, two thirds and all of them (the last where readAheadPlaced looks).
+    for (size_t part = 1; part <= 3; ++part) {
+      const size_t k = options_.placed_read_ahead_frames * part / 3;
+      if (k == 0) continue;
       if (const std::optional<uint32_t> ahead =
               store::lookupCpv(p.index, camera.eye + p.motion * float(k), camera.forward()))
         p.prefetchCpv(options_, *ahead);
+    }
   }
   FramePlan& plan = plan_;
   plan.items.clear();

@@ -56,7 +56,9 @@ struct Walkthrough::Placed {
                                                         const store::StoredPlacedImpostor& record);
   // Uploads a prepared impostor and makes it resident (stats.loads; its time is the caller's).
   std::unordered_map<uint32_t, Resident>::iterator makeResident(uint32_t id, const Prepared& prepared);
-  // Queues the impostors of `cpv` that are not resident (and that the walkthrough may draw) for the reader.
+  // An impostor to load: not resident, and one the walkthrough may draw (not left to geometry for its coarser bound).
+  bool wanted(const WalkthroughOptions& options, uint32_t id) const;
+  // Queues the impostors of `cpv` that are wanted for the reader.
   void prefetchCpv(const WalkthroughOptions& options, uint32_t cpv);
 
   // Impostors read and packed on a background thread ahead of the frames that need them (WalkthroughOptions::
