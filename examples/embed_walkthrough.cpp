@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <exception>
+#include <map>
 #include <memory>
 #include <string>
 #include <variant>
@@ -134,11 +135,13 @@ int main(int argc, char** argv) {
       const Camera camera = path.camera(f, width, height);
       const runtime::FramePlan& plan = walkthrough.plan(camera);
       size_t level = 0;
+      double spare_ms = 2.0;  // without a budget: a fixed share of each frame for loading what later frames need
       if (governor) {
         if (f >= 2) governor->frameMeasured(f - 2, timers[(f - 2) % 3].elapsedMs());
         const runtime::GovernorDecision decision = governor->decide(f);
         level = decision.level;
         relaxed += decision.relaxed ? 1 : 0;
+        spare_ms = t_max_ms - decision.corrected_ms;  // what the frame is expected to leave of the budget
         timers[f % 3].begin();
       }
       // The engine draws the plan: the geometry's objects through the GPU culler (only a change of the list is
@@ -149,6 +152,9 @@ int main(int argc, char** argv) {
       }
       drawFrame(camera, plan, level);
       if (governor) timers[f % 3].end();
+      // The cells the viewer may enter next, read on the walkthrough's thread, uploaded in the time the frame spares,
+      // so that entering one uploads nothing.
+      if (spare_ms > 0.0) walkthrough.loadAhead(camera, spare_ms);
       for (const gpu::GpuCullStats& s : culler.finishedStats()) {  // earlier frames', as the GPU finishes them
         if (governor && s.frame >= first_culler_frame) governor->frameTriangles(s.frame - first_culler_frame, double(s.triangles));
         ++gpu_frames;
@@ -166,6 +172,13 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(plan.report.impostor_triangles));
     }
     std::printf("layers drawn as impostors %zu times, as geometry %zu times\n", impostor_layers, geometry_layers);
+    {
+      const std::map<std::string, double> w = walkthrough.statistics();
+      const auto at = [&](const char* key) { return w.count(key) ? w.at(key) : 0.0; };
+      std::printf("cells: %.0f entered, %.0f of them uploaded ahead in spare time, %.0f partly; slowest load in a frame "
+                  "%.2f ms\n", at("cell_entries"), at("cells_entered_uploaded"), at("cells_entered_partly_uploaded"),
+                  at("cell_load_ms_max"));
+    }
     std::printf("GPU: %llu frames counted, %.0f geometry triangles and %.0f hidden clusters a frame\n",
                 static_cast<unsigned long long>(gpu_frames), double(gpu_triangles) / double(std::max<uint64_t>(gpu_frames, 1)),
                 double(gpu_hidden) / double(std::max<uint64_t>(gpu_frames, 1)));

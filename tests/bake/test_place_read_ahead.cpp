@@ -1,5 +1,5 @@
 // Reading placed impostors ahead: the impostors a walk will soon draw are loaded in an earlier frame's spare time
-// (runtime::Walkthrough::readAheadPlaced), so fewer frames load one themselves; and they are read and packed on a
+// (runtime::Walkthrough::loadAhead), so fewer frames load one themselves; and they are read and packed on a
 // background thread (WalkthroughOptions::read_ahead), so that the frame that needs one only uploads it. Neither
 // changes a frame.
 #include <gtest/gtest.h>
@@ -77,8 +77,8 @@ TEST_F(PlaceReadAheadTest, ImpostorsLoadedAheadSpareTheFramesThatDrawThemAndChan
     EXPECT_EQ(ahead_target.readColor().pixels(), plain_target.readColor().pixels());
     EXPECT_EQ(ahead_target.readIds().pixels(), plain_target.readIds().pixels());
     // No budget, no work; then a generous one.
-    EXPECT_EQ(ahead.readAheadPlaced(camera, 0.0), 0.0);
-    ahead.readAheadPlaced(camera, 1000.0);
+    EXPECT_EQ(ahead.loadAhead(camera, 0.0), 0.0);
+    ahead.loadAhead(camera, 1000.0);
   }
   const auto stats = ahead.statistics();
   std::printf("%zu frames with impostors; frames that loaded one: %zu without reading ahead, %zu with (%.0f read "

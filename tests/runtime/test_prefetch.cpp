@@ -3,13 +3,18 @@
 // a walkthrough along a straight street chain of a baked city, prefetching one cell only, finds every cell it enters
 // after the first already read ("ready": loaded before the viewer entered it), while without read-ahead every entry
 // stalls (the test can fail both ways); under a memory budget that holds one cell and not three, the resident
-// impostors and the cells read ahead stay within it at every frame while each entry evicts.
+// impostors and the cells read ahead stay within it at every frame while each entry evicts. With the time a host
+// spares after each frame given to Walkthrough::loadAhead, every cell after the first is entered uploaded (the frame
+// loads nothing) and the frames draw what they drew without it; with no time to spare for a view, nothing is uploaded
+// ahead; with a GPU budget a byte short of the first two cells, the second is entered partly uploaded, and the budget
+// holds at every frame.
 #include "farfield/runtime/prefetch.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <cmath>
 #include <set>
 #include <thread>
@@ -192,6 +197,64 @@ TEST(PrefetchWalkTest, OnAStraightPathTheNextCellIsLoadedBeforeTheViewerEntersIt
   EXPECT_EQ(entered, chain);
   EXPECT_GE(held_max, largest);  // the largest cell was resident
   EXPECT_EQ(walkthrough.statistics().at("frames_over_memory_budget"), 0.0);
+
+  // Uploads ahead, in the time a host spares after each frame.
+  struct Walked {
+    std::vector<std::string> entries;
+    std::vector<double> entry_load_ms;
+    std::vector<uint64_t> impostor_triangles;  // per frame
+    std::vector<size_t> items;                 // per frame
+    std::map<std::string, double> stats;
+    uint64_t resident_max = 0;
+  };
+  const auto walk = [&](double spare_ms, uint64_t gpu_budget) {
+    WalkthroughOptions o;
+    o.database = store;
+    o.prefetch_cells = 1;
+    o.gpu_budget_bytes = gpu_budget;
+    Walkthrough walker(city.scene, gpu_scene, bvh, renderer, o);
+    Walked out;
+    for (size_t f = 0; f < path.frames.size(); ++f) {
+      const Camera camera = path.camera(f, 64, 36);
+      const FramePlan& plan = walker.plan(camera);
+      if (plan.report.loaded) {
+        out.entries.push_back(plan.report.read);
+        out.entry_load_ms.push_back(plan.report.load_ms);
+      }
+      out.impostor_triangles.push_back(plan.report.impostor_triangles);
+      out.items.push_back(plan.items.size());
+      out.resident_max = std::max(out.resident_max, plan.report.resident_bytes);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      if (spare_ms > 0.0) walker.loadAhead(camera, spare_ms);
+    }
+    out.stats = walker.statistics();
+    return out;
+  };
+  const uint64_t unbound = uint64_t(1) << 40;
+  const Walked in_frame = walk(0.0, unbound);
+  const Walked ahead = walk(1000.0, unbound);
+  EXPECT_EQ(in_frame.entries, (std::vector<std::string>{"cold", "ready", "ready"}));
+  EXPECT_EQ(ahead.entries, (std::vector<std::string>{"cold", "uploaded", "uploaded"}));
+  ASSERT_EQ(ahead.entry_load_ms.size(), 3u);
+  EXPECT_EQ(ahead.entry_load_ms[1], 0.0);
+  EXPECT_EQ(ahead.entry_load_ms[2], 0.0);
+  EXPECT_GT(in_frame.entry_load_ms[1] + in_frame.entry_load_ms[2], 0.0);
+  EXPECT_EQ(ahead.stats.at("cells_uploaded_ahead"), 2.0);
+  EXPECT_EQ(ahead.stats.at("cell_loads"), 1.0);  // in a frame: the first cell only
+  EXPECT_GT(ahead.stats.at("views_uploaded_ahead"), 0.0);
+  EXPECT_EQ(ahead.impostor_triangles, in_frame.impostor_triangles);  // the same impostors drawn in every frame
+  EXPECT_EQ(ahead.items, in_frame.items);
+  const Walked little = walk(1e-9, unbound);  // the upload rate is known from the first cell's: nothing fits
+  EXPECT_EQ(little.entries, in_frame.entries);
+  EXPECT_EQ(little.stats.at("views_uploaded_ahead"), 0.0);
+  const uint64_t half = cell_bytes[0] + cell_bytes[1] - 1;  // not both cells: the second's last view waits
+  const Walked partly = walk(1000.0, half);
+  ASSERT_EQ(partly.entries.size(), 3u);
+  EXPECT_EQ(partly.entries[1], "partly");
+  EXPECT_GT(partly.stats.at("views_uploaded_ahead"), 0.0);
+  EXPECT_LE(partly.stats.at("resident_bytes_max"), double(std::max(half, largest)));
+  EXPECT_LE(partly.resident_max, std::max(half, largest));
+  EXPECT_EQ(partly.impostor_triangles, in_frame.impostor_triangles);
 }
 
 }  // namespace

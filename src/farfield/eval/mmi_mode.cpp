@@ -78,7 +78,7 @@ void MmiMode::frame(FrameContext& frame) {
     return !std::holds_alternative<runtime::LayerAsGeometry>(d) && !std::holds_alternative<runtime::ClusterAsGeometry>(d);
   });
   impostor_frames_[frame.pathFrame()] = last_drew_impostors_;
-  if (read_ahead_ms_ > 0.0) walkthrough_->readAheadPlaced(frame.camera(), read_ahead_ms_);
+  if (read_ahead_ms_ > 0.0) walkthrough_->loadAhead(frame.camera(), read_ahead_ms_);
 }
 
 std::map<std::string, double> MmiMode::info() const {

@@ -27,9 +27,10 @@
 //   coarser_impostors=on|off  placed: impostors placed under a coarser bound (place --fallback-bounds) drawn, held
 //                           to their own bound (default on), or their objects drawn as geometry (off: every frame
 //                           keeps error_px; the governed mode's impostor levels raise it to take them)
-//   read_ahead_ms=MS        placed: each frame loads the impostors it will soon need within MS after it is drawn
-//                           (runtime::Walkthrough::readAheadPlaced; default 0: loaded by the frame that needs them;
-//                           the governed mode gives its slack instead, governor_read_ahead)
+//   read_ahead_ms=MS        each frame loads what it will soon need within MS after it is drawn: the placed
+//                           impostors of the problem view ahead, or the views of the cells read ahead (smi, mmi,
+//                           mmi-dynamic) (runtime::Walkthrough::loadAhead; default 0: loaded by the frame that needs
+//                           them; the governed mode gives its slack instead, governor_read_ahead)
 //   read_ahead_frames=N     placed: how far ahead along the eye's motion it looks (default 15 frames; 0: never)
 //   geometry=gpu|cpu        the plan's geometry culled and drawn on the GPU through the run's arena (default; as
 //                           the culled mode, gpu_occlusion, gpu_cones, gpu_compact apply) or culled per cluster on
@@ -78,7 +79,7 @@ class MmiMode final : public Mode {
   GpuCullRun* gpuCullRun() override { return geometry_ ? geometry_->gpuRun() : nullptr; }
   bool setGeometryErrorPx(double px) override { return geometry_ && geometry_->setGeometryErrorPx(px); }
   double readAhead(const Camera& camera, double budget_ms) override {
-    return walkthrough_ ? walkthrough_->readAheadPlaced(camera, budget_ms) : 0.0;
+    return walkthrough_ ? walkthrough_->loadAhead(camera, budget_ms) : 0.0;
   }
   double planWorkload(const Camera& camera) const override {
     return walkthrough_ ? walkthrough_->expectedTriangles(camera.eye) : 0.0;

@@ -179,8 +179,8 @@ class Mode {
   virtual std::optional<FrameGovernance> governance(size_t /*path_frame*/) const { return std::nullopt; }
   // Whether the frame just drawn drew an impostor; none for modes that draw none by design.
   virtual std::optional<bool> drewImpostors() const { return std::nullopt; }
-  // Work for later frames done now, within `budget_ms` of this frame (a governor's slack): the placed walkthrough
-  // loads the impostors it will soon need (runtime::Walkthrough::readAheadPlaced). Returns the milliseconds spent;
+  // Work for later frames done now, within `budget_ms` of this frame (a governor's slack): the walkthrough modes load
+  // the impostors or cells they will soon need (runtime::Walkthrough::loadAhead). Returns the milliseconds spent;
   // 0 for modes with nothing to read ahead. Called inside the timed frame, after the mode's frame().
   virtual double readAhead(const Camera& /*camera*/, double /*budget_ms*/) { return 0.0; }
   // What the mode knows of the next frame's load before drawing it, in triangles (the placed walkthrough: the visible

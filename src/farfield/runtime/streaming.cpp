@@ -11,7 +11,7 @@ namespace farfield::runtime {
 
 std::map<std::string, double> StreamingLog::summary() const {
   std::map<std::string, double> out;
-  double stall_total = 0.0, stall_max = 0.0, resident_sum = 0.0;
+  double stall_total = 0.0, stall_max = 0.0, resident_sum = 0.0, ahead_max_ms = 0.0;
   uint64_t resident_max = 0, ahead_max = 0;
   size_t stalls = 0, entries = 0, over = 0;
   for (const StreamingFrame& f : frames_) {
@@ -23,6 +23,7 @@ std::map<std::string, double> StreamingLog::summary() const {
     }
     resident_max = std::max(resident_max, f.residentBytes());
     ahead_max = std::max(ahead_max, f.read_ahead_bytes);
+    ahead_max_ms = std::max(ahead_max_ms, f.ahead_ms);
     resident_sum += double(f.residentBytes());
     if (budget_ > 0 && f.residentBytes() > budget_) ++over;
   }
@@ -35,20 +36,22 @@ std::map<std::string, double> StreamingLog::summary() const {
   out["read_ahead_bytes_max"] = double(ahead_max);
   out["memory_budget_bytes"] = double(budget_);
   out["frames_over_memory_budget"] = double(over);
+  out["load_ahead_ms_max"] = ahead_max_ms;
   return out;
 }
 
 void StreamingLog::writeCsv(const std::string& file) const {
   std::ofstream out(file, std::ios::trunc);
   if (!out) throw Error(file, "cannot write the streaming log");
-  out << "frame,cell,read,load_ms,stall,gpu_bytes,read_ahead_bytes,resident_bytes\n";
+  out << "frame,cell,read,load_ms,stall,gpu_bytes,read_ahead_bytes,resident_bytes,ahead_ms\n";
   for (size_t k = 0; k < frames_.size(); ++k) {
     const StreamingFrame& f = frames_[k];
-    char load[32];
+    char load[32], ahead[32];
     std::snprintf(load, sizeof(load), "%.3f", f.load_ms);
+    std::snprintf(ahead, sizeof(ahead), "%.3f", f.ahead_ms);
     out << k << ',' << (f.cell == 0xffffffffu ? std::string("") : std::to_string(f.cell)) << ',' << f.read << ','
         << load << ',' << (f.stall() ? 1 : 0) << ',' << f.gpu_bytes << ',' << f.read_ahead_bytes << ','
-        << f.residentBytes() << '\n';
+        << f.residentBytes() << ',' << ahead << '\n';
   }
   if (!out) throw Error(file, "write failed");
 }

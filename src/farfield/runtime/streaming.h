@@ -17,6 +17,7 @@ struct StreamingFrame {
   double load_ms = 0.0;             // reading (when not ready), decoding and uploading the cell entered
   uint64_t gpu_bytes = 0;           // resident impostors after the frame's loads and evictions
   uint64_t read_ahead_bytes = 0;    // decoded cells read ahead and not yet entered
+  double ahead_ms = 0.0;            // after the frame: uploading cells ahead (Walkthrough::loadAhead)
   bool stall() const { return read == "waited" || read == "cold"; }
   uint64_t residentBytes() const { return gpu_bytes + read_ahead_bytes; }
 };
@@ -25,11 +26,16 @@ class StreamingLog {
  public:
   explicit StreamingLog(uint64_t memory_budget_bytes = 0) : budget_(memory_budget_bytes) {}
   void add(const StreamingFrame& frame) { frames_.push_back(frame); }
+  // Time the last frame's host gave to uploading cells ahead (none before a first frame).
+  void addAheadMs(double ms) {
+    if (!frames_.empty()) frames_.back().ahead_ms += ms;
+  }
   const std::vector<StreamingFrame>& frames() const { return frames_; }
   // stall_frames, stall_ms_total, stall_ms_max, cell_entries, resident_bytes_max, resident_bytes_mean,
-  // read_ahead_bytes_max, memory_budget_bytes, frames_over_memory_budget.
+  // read_ahead_bytes_max, memory_budget_bytes, frames_over_memory_budget, load_ahead_ms_max.
   std::map<std::string, double> summary() const;
-  // frame,cell,read,load_ms,stall,gpu_bytes,read_ahead_bytes,resident_bytes; throws farfield::Error naming the file.
+  // frame,cell,read,load_ms,stall,gpu_bytes,read_ahead_bytes,resident_bytes,ahead_ms; throws farfield::Error naming
+  // the file.
   void writeCsv(const std::string& file) const;
 
  private:

@@ -157,111 +157,6 @@ Walkthrough::~Walkthrough() {
   }
 }
 
-std::unique_ptr<Walkthrough::Cell> Walkthrough::loadCell(const store::CellEntry& entry) {
-  if (!entry.pipeline)
-    throw Error(options_.database, "cell " + std::to_string(entry.half_edge) + " has no pipeline record");
-  const Representation kind = options_.representation;
-  store::CellPipeline record = *entry.pipeline;
-  extract::CellWork work;
-  auto cell = std::make_unique<Cell>();
-  if (!online_stages_.empty()) {
-    Stopwatch timer;
-    work = runner_->resume(entry.half_edge, record);
-    runner_->runStages(online_stages_, work);
-    record = work.result;
-    stats_.online_ms_total += timer.milliseconds();
-    ++stats_.online_runs;
-    cell->online = true;
-  }
-  cell->geometry_mask.assign(scene_.objects.size() + 1, 0);
-  const std::vector<uint32_t>& geometry = kind == Representation::Visible ? record.pvs : record.near;
-  for (uint32_t id : geometry) cell->geometry_mask[id] = 1;
-  for (uint32_t id = 1; id < uint32_t(cell->geometry_mask.size()); ++id)
-    if (cell->geometry_mask[id]) cell->geometry.push_back(id);
-  if (kind == Representation::Local || kind == Representation::Visible) return cell;
-
-  impostor::GpuImpostorOptions gpu_options;
-  gpu_options.id_texture = options_.object_ids;  // per-pixel object ids in item buffers, one draw call per view
-  const bool single = kind == Representation::Smi;
-  const std::vector<store::StoredLayer> layers = single ? std::vector<store::StoredLayer>{record.single}
-                                                        : record.layers;
-  std::shared_ptr<store::CellViews> read;
-  if (!cell->online) read = reader_->take(entry.half_edge, &plan_.report.read);
-  for (size_t l = 0; l < layers.size(); ++l) {
-    Layer layer;
-    layer.objects = layers[l].objects;
-    layer.validity = layers[l].validity;
-    for (uint32_t id : layer.objects) layer.bounds.expand(scene_.objects[id - 1].world_bounds);
-    for (size_t v = 0; v < layers[l].views.size(); ++v) {
-      impostor::DepthMeshImpostor imp;
-      if (cell->online)
-        imp = single ? std::move(work.single_views[v]) : std::move(work.layer_views[l][v]);
-      else
-        imp = std::move(single ? read->single[v] : read->layers[l][v]);
-      if (imp.empty()) continue;
-      layer.view_eyes.push_back(imp.camera.eye);
-      layer.view_station.push_back(layers[l].views[v].station);
-      layer.views.push_back(std::make_unique<impostor::GpuImpostor>(imp, gpu_options));
-      cell->gpu_bytes += layer.views.back()->gpuBytes();
-    }
-    cell->layers.push_back(std::move(layer));
-  }
-  return cell;
-}
-
-Walkthrough::Cell& Walkthrough::cell(uint32_t half_edge, bool* loaded) {
-  *loaded = false;
-  const auto it = cells_.find(half_edge);
-  if (it != cells_.end()) {
-    order_.remove(half_edge);
-    order_.push_front(half_edge);
-    return *it->second;
-  }
-  const store::CellEntry* entry = index_.find(half_edge);
-  FF_CHECK(entry != nullptr);
-  Stopwatch timer;
-  std::unique_ptr<Cell> fresh = loadCell(*entry);
-  const double ms = timer.milliseconds();
-  plan_.report.load_ms = ms;
-  *loaded = true;
-  ++stats_.loads;
-  stats_.load_ms_total += ms;
-  stats_.load_ms_max = std::max(stats_.load_ms_max, ms);
-  resident_bytes_ += fresh->gpu_bytes;
-  order_.push_front(half_edge);
-  Cell& out = *(cells_[half_edge] = std::move(fresh));
-  evict(half_edge);
-  return out;
-}
-
-// Least recently used cells leave the GPU until the resident bytes fit the budget; `keep` (the current cell) stays.
-void Walkthrough::evict(uint32_t keep) {
-  while (resident_bytes_ > options_.gpu_budget_bytes && order_.size() > 1) {
-    const uint32_t victim = order_.back() == keep ? *std::next(order_.rbegin()) : order_.back();
-    const auto it = cells_.find(victim);
-    resident_bytes_ -= it->second->gpu_bytes;
-    cells_.erase(it);
-    order_.remove(victim);
-    ++stats_.evictions;
-  }
-}
-
-// The cells the viewer may enter next, in the direction of motion (runtime/prefetch.h). Queued when the cell or the
-// junction the viewer heads for changes; what was queued before and not started is dropped (the viewer went
-// elsewhere). The motion is measured from where the eye was when it last changed by a metre or more.
-void Walkthrough::readAhead(uint32_t half_edge, const Vec3& eye) {
-  if (!reader_ || !options_.read_ahead) return;
-  const Vec2 motion(eye.x - motion_from_.x, eye.y - motion_from_.y);
-  if (glm::length(motion) >= 1.0f) motion_from_ = eye;
-  const PrefetchChoice choice = prefetchCells(graph_, half_edge, motion, options_.prefetch_cells);
-  if (half_edge == ahead_of_ && choice.exit_junction == ahead_junction_) return;
-  ahead_of_ = half_edge;
-  ahead_junction_ = choice.exit_junction;
-  reader_->cancelQueued();
-  for (uint32_t next : choice.cells)
-    if (!cells_.count(next)) reader_->prefetch(next);
-}
-
 void Walkthrough::setGeometry(FramePlan& plan, const Camera& camera) {
   if (options_.geometry_items) {
     // GpuScene::appendDrawItems takes an empty list as "all objects".
@@ -326,7 +221,7 @@ const FramePlan& Walkthrough::plan(const Camera& camera, const std::function<voi
   if (entry) {
     ++stats_.visited[half_edge];
     current = &cell(half_edge, &report.loaded);
-    readAhead(half_edge, camera.eye);
+    queueCellsAhead(half_edge, camera.eye);
     // Fast motion and stale dynamic impostors first: a layer that loses its dynamic impostor is judged by its
     // baked views' validity below.
     if (options_.representation == Representation::MmiDynamic) dropStaleDynamic(camera, *current);
@@ -485,6 +380,13 @@ std::map<std::string, double> Walkthrough::statistics() const {
     out["read_ahead_wait_ms_total"] = r.wait_ms_total;
     out["read_ahead_held_bytes_max"] = double(r.held_bytes_max);
     out["read_ahead_budget_bytes"] = double(options_.read_ahead_bytes);
+    out["cells_uploaded_ahead"] = double(s.cells_uploaded_ahead);
+    out["views_uploaded_ahead"] = double(s.views_uploaded_ahead);
+    out["cells_entered_uploaded"] = double(s.entered_uploaded);
+    out["cells_entered_partly_uploaded"] = double(s.entered_partly);
+    out["uploads_ahead_dropped"] = double(s.uploads_dropped);
+    out["upload_ahead_ms_total"] = s.ahead_ms_total;
+    out["view_upload_ms_max"] = s.view_upload_ms_max;
   }
   for (const auto& [key, value] : streaming_.summary()) out[key] = value;
   out["online_runs"] = double(s.online_runs);

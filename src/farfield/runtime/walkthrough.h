@@ -13,8 +13,9 @@
 //
 // Cells: the viewer's cell (oriented street edge) is looked up per frame (urban::CellLocator). The cells it may enter
 // next (the streets leaving the junction ahead, the way back included) are read ahead on a background thread
-// (store/cell_reader.h); a cell's impostors are uploaded when the viewer enters it, inside that frame, and stay
-// resident on the GPU under a byte budget, least recently used evicted first. When the database left stages to the
+// (store/cell_reader.h); a cell's impostors are uploaded when the viewer enters it, inside that frame, or before, in
+// the time a host spares after its frames (loadAhead), and stay resident on the GPU under a byte budget, least
+// recently used evicted first. When the database left stages to the
 // runtime (`bake --online mmi`) they run on entry instead. A cell the database does not hold falls back to
 // frustum-culled full geometry (reported).
 //
@@ -42,6 +43,7 @@
 #include "farfield/gpu/cost_model.h"
 #include "farfield/runtime/dynamic_impostor.h"
 #include "farfield/runtime/streaming.h"
+#include "farfield/runtime/upload_rate.h"
 #include "farfield/scene/bvh.h"
 #include "farfield/store/cell_reader.h"
 #include "farfield/store/impostor_store.h"
@@ -93,7 +95,7 @@ struct WalkthroughOptions {
   // own bound and counted (true), or their objects drawn as geometry so that every frame keeps error_px (false: a
   // frame governor then takes them as a coarser level by raising error_px).
   bool coarser_impostors = true;
-  // Placed: how many frames ahead readAheadPlaced() and the background reads look along the eye's motion (0: none).
+  // Placed: how many frames ahead loadAhead() and the background reads look along the eye's motion (0: none).
   size_t placed_read_ahead_frames = 15;
   // true: the plan's geometry as draw items culled per cluster on the CPU (FramePlan::items, geometry_items);
   // false: as the objects a GPU-driven frame culls itself (FramePlan::geometry_objects, gpu::GpuCuller), the items
@@ -145,9 +147,12 @@ struct FrameReport {
   uint32_t cpv = urban::kNone;    // Placed: the conservative problem view holding the camera, kNone for none
   double cpv_t_after_ms = 0.0;    // Placed: the placement's time bound of that CPV with its impostors
   bool baked = false;             // false: the database does not hold the cell (frustum-culled geometry)
-  bool loaded = false;            // the cell was read (and its online stages run) in this frame
-  const char* read = "";          // when loaded: "ready" (read ahead), "waited" (read ahead, unfinished), "cold"
-  double load_ms = 0.0;           // when loaded: the time the frame spent on it (a stall unless "ready")
+  bool loaded = false;            // the frame entered a cell that was not resident, or that loadAhead made resident
+  // When loaded, how: "ready" (read ahead, uploaded in this frame), "waited" (its read ahead unfinished), "cold"
+  // (read in this frame), "partly" (loadAhead uploaded some of its views, the frame the rest), "uploaded" (loadAhead
+  // uploaded all: nothing to do).
+  const char* read = "";
+  double load_ms = 0.0;           // when loaded: the time the frame spent on it (a stall if "waited" or "cold")
   uint64_t read_ahead_bytes = 0;  // decoded cells read ahead and not yet entered, after this frame
   uint64_t resident_bytes = 0;    // GPU bytes of resident impostors after this frame's loads and evictions
   bool over_gpu_budget = false;   // the current cell alone exceeds gpu_budget_bytes
@@ -199,16 +204,22 @@ class Walkthrough {
   // host can start its frame timer or clear its target first. The plan stays valid until the next call.
   const FramePlan& plan(const Camera& camera, const std::function<void()>& before_gpu_work = {});
 
-  // Placed: impostors the walkthrough will soon need, loaded within `budget_ms` (the time the host can spare in this
-  // frame: Decoret et al. 1999, section 5.5, "from the desired and the predicted frame times we can determine how much
-  // time we have to accomplish such updates"), so that the frame that first draws one does not load it. They are the
-  // impostors, not yet resident, of the CPV holding the eye `placed_read_ahead_frames` frames on along its motion
-  // over the last frame, looking as now. With read_ahead, one the background thread has read is uploaded when the
-  // slowest such upload fits in what is left; one it has not, read (or waited for) when the slowest load so far fits,
-  // else left to the thread; without, read when the slowest load fits (the first of either on trust). None beyond the
-  // GPU budget. Returns the milliseconds spent; 0 for another representation (cells are read ahead on their own
-  // thread) or before a first plan.
-  double readAheadPlaced(const Camera& camera, double budget_ms);
+  // What the walkthrough will soon need, loaded within `budget_ms` (the time the host can spare in this frame: Decoret
+  // et al. 1999, section 5.5, "from the desired and the predicted frame times we can determine how much time we have
+  // to accomplish such updates"), so that the frame that first draws it does not load it. Call it after the frame's
+  // plan (before the next one). Returns the milliseconds spent; 0 before a first plan.
+  //  - Placed: the impostors, not yet resident, of the CPV holding the eye `placed_read_ahead_frames` frames on along
+  //    its motion over the last frame, looking as now. With read_ahead, one the background thread has read is
+  //    uploaded when the slowest such upload fits in what is left; one it has not, read (or waited for) when the
+  //    slowest load so far fits, else left to the thread; without, read when the slowest load fits (the first of
+  //    either on trust).
+  //  - Cells (Smi, Mmi, MmiDynamic with read_ahead): the cells read ahead (the streets the viewer may enter next, in
+  //    the reader's order) are uploaded view by view, one cell at a time, while the next view's expected upload time
+  //    (runtime/upload_rate.h) fits in what is left (the first on trust). A cell begun and not finished is finished
+  //    by the frame that enters it (report.read "partly"), one finished is entered with nothing to do ("uploaded").
+  //    Nothing is evicted for it: it stops where the next view does not fit the GPU budget (a cell being uploaded is
+  //    dropped when the cell the viewer enters needs its bytes). Online stages: nothing (they run on entry).
+  double loadAhead(const Camera& camera, double budget_ms);
   // Placed: what a frame at `eye` draws at most as geometry, known before planning it: the triangles of the visible
   // set of the region holding the eye (every object where placement sampled none), whole objects. A host that keeps a
   // frame budget tells its governor (runtime::GovernorLoop::decide's workload) so that a new region's heavier set is
@@ -227,11 +238,20 @@ class Walkthrough {
   struct Placed;  // walkthrough_placed.cpp
   void openPlacement();
   const FramePlan& planPlaced(const Camera& camera);
+  double loadPlacedAhead(const Camera& camera, double budget_ms);
   std::map<std::string, double> placedStatistics() const;
   std::unique_ptr<Placed> placed_;
+  struct CellUpload;  // walkthrough_cells.h
+  // The cell the eye is in, made resident (finishing an upload begun ahead) when it is not (walkthrough_cell_loads.cpp).
   Cell& cell(uint32_t half_edge, bool* loaded);
-  std::unique_ptr<Cell> loadCell(const store::CellEntry& entry);
-  void readAhead(uint32_t half_edge, const Vec3& eye);
+  // A cell's upload begun: the online stages run, or its decoded views taken (`read`, null: from the reader now).
+  std::unique_ptr<CellUpload> startCell(const store::CellEntry& entry, std::shared_ptr<store::CellViews> read);
+  // Uploads the next view of the cell; returns its bytes on the GPU, 0 when none was left. One larger than `room` is
+  // given back and stays the next (then *full is set).
+  uint64_t uploadNextView(CellUpload& upload, uint64_t room = ~uint64_t(0), bool* full = nullptr);
+  // The cells the viewer may enter next queued for the reader.
+  void queueCellsAhead(uint32_t half_edge, const Vec3& eye);
+  double loadCellsAhead(double budget_ms);
   void evict(uint32_t keep);
   void dropStaleDynamic(const Camera& camera, Cell& cell);
   // The frame's geometry (ids_, ascending) into the plan: items culled per cluster, or the objects.
@@ -265,6 +285,11 @@ class Walkthrough {
   std::unique_ptr<extract::PipelineRunner> runner_;    // for online stages
   std::vector<std::string> online_stages_;
   std::unique_ptr<store::CellReader> reader_;        // read ahead (none with online stages)
+  std::vector<uint32_t> cells_ahead_;               // the cells last queued, best first
+  std::unique_ptr<CellUpload> uploading_;           // a cell loadAhead began and has not finished
+  std::vector<uint32_t> uploaded_ahead_;            // cells loadAhead made resident, not entered since
+  UploadRate upload_rate_;                          // views' upload times
+  uint64_t full_at_bytes_ = ~uint64_t(0);           // loadAhead stopped at the GPU budget with this many resident
   std::list<uint32_t> order_;                       // LRU of loaded cells, most recent first
   uint64_t resident_bytes_ = 0;
   uint32_t ahead_of_ = urban::kNone;                // the cell whose successors were last queued
@@ -288,6 +313,11 @@ class Walkthrough {
     size_t frames = 0, fallback_frames = 0, loads = 0, evictions = 0, online_runs = 0, over_gpu_budget_frames = 0;
     uint64_t resident_bytes_max = 0;
     double load_ms_max = 0.0, load_ms_total = 0.0, online_ms_total = 0.0;
+    // loadAhead over cells: cells and views uploaded ahead, cells dropped unfinished, entries with nothing to do or
+    // with the rest of the views to upload, the slowest single view upload (ahead or not), and the time spent.
+    size_t cells_uploaded_ahead = 0, views_uploaded_ahead = 0, uploads_dropped = 0, entered_uploaded = 0,
+           entered_partly = 0;
+    double view_upload_ms_max = 0.0, ahead_ms_total = 0.0;
     std::map<uint32_t, size_t> visited;
     double geometry_triangles = 0.0, impostor_triangles = 0.0, layers = 0.0;
     size_t impostor_frames = 0;

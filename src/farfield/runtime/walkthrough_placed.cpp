@@ -109,7 +109,7 @@ double Walkthrough::expectedTriangles(const Vec3& eye) const {
   return leaf ? placed_->node_triangles[*leaf] : placed_->all_triangles;
 }
 
-double Walkthrough::readAheadPlaced(const Camera& camera, double budget_ms) {
+double Walkthrough::loadPlacedAhead(const Camera& camera, double budget_ms) {
   if (!placed_ || !(budget_ms > 0.0) || options_.placed_read_ahead_frames == 0) return 0.0;
   Placed& p = *placed_;
   if (!p.has_eye) return 0.0;
@@ -156,7 +156,7 @@ const FramePlan& Walkthrough::planPlaced(const Camera& camera) {
   // The impostors of the CPVs the eye will be in over the next placed_read_ahead_frames frames, moving on as over
   // the last frame and looking as now, are queued for the reader (no work of this frame's but the lookups).
   if (p.reader && options_.placed_read_ahead_frames > 0 && p.motion != Vec3(0.0f)) {
-    // At a third, two thirds and all of them (the last where readAheadPlaced looks).
+    // At a third, two thirds and all of them (the last where loadAhead looks).
     for (size_t part = 1; part <= 3; ++part) {
       const size_t k = options_.placed_read_ahead_frames * part / 3;
       if (k == 0) continue;

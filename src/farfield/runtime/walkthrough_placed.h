@@ -37,11 +37,11 @@ struct Walkthrough::Placed {
     size_t over_gpu_budget_frames = 0;
     size_t coarse_draws = 0;  // fallback impostors drawn (placed under a coarser bound than the walkthrough's)
     size_t coarse_left_to_geometry = 0;  // ... left to geometry (WalkthroughOptions::coarser_impostors false)
-    size_t read_ahead_loads = 0;         // loads by readAheadPlaced (also in loads)
+    size_t read_ahead_loads = 0;         // loads by loadAhead (also in loads)
     double read_ahead_ms = 0.0;
     double upload_ms_max = 0.0;          // the slowest upload of an impostor read and packed already
   } stats;
-  // The eye's motion over the last frame (readAheadPlaced looks ahead along it).
+  // The eye's motion over the last frame (loadAhead looks ahead along it).
   bool has_eye = false;
   Vec3 last_eye{0.0f}, motion{0.0f};
   // An impostor read from the database and its atlases packed: what the GPU upload needs (no GL).

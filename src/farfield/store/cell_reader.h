@@ -55,6 +55,8 @@ class CellReader {
   std::shared_ptr<CellViews> take(uint32_t half_edge, const char** how = nullptr) {
     return reader_.take(half_edge, how);
   }
+  // The cell's views if their background read has finished, else null: never waits and never reads.
+  std::shared_ptr<CellViews> takeIfReady(uint32_t half_edge) { return reader_.takeIfReady(half_edge); }
   // Forgets queued (not yet started) prefetches: the viewer turned elsewhere.
   void cancelQueued() { reader_.cancelQueued(); }
 
