@@ -491,10 +491,29 @@ TEST(Walk, CsvFramesAndSummary) {
   }
   EXPECT_DOUBLE_EQ(result.wall.max, max_ms);
   writeWalkCsv(result, (dir / "walk.csv").string());
-  EXPECT_EQ(lines(readText(dir / "walk.csv")).size(), 6u);
+  const std::vector<std::string> rows = lines(readText(dir / "walk.csv"));
+  EXPECT_EQ(rows.size(), 6u);
+  const auto columns = [](const std::string& row) { return std::count(row.begin(), row.end(), ',') + 1; };
+  for (const std::string& row : rows) EXPECT_EQ(columns(row), columns(rows[0])) << row;
+  EXPECT_TRUE(rows[1].ends_with(",,,,")) << rows[1];  // no governor: its columns empty
   const std::string summary = formatWalkSummary(result);
   EXPECT_NE(summary.find("p99"), std::string::npos);
   EXPECT_NE(summary.find("culled"), std::string::npos);
+
+  // Governed: each row has the level the frame was drawn at and its prediction.
+  WalkOptions governed = options;
+  governed.mode = "governed";
+  governed.frames_dir.clear();
+  governed.mode_options = {{"governor_t_max_ms", "1000"}};
+  const WalkResult g = runWalk(gpu::sharedHeadlessContext(), scene, test::sideWalkPath(3), governed);
+  writeWalkCsv(g, (dir / "governed.csv").string());
+  const std::vector<std::string> g_rows = lines(readText(dir / "governed.csv"));
+  ASSERT_EQ(g_rows.size(), 4u);
+  EXPECT_NE(g_rows[0].find("governor_level,predicted_ms"), std::string::npos);
+  for (size_t k = 1; k < g_rows.size(); ++k) {
+    EXPECT_EQ(columns(g_rows[k]), columns(g_rows[0])) << g_rows[k];
+    EXPECT_FALSE(g_rows[k].ends_with(",,,,")) << g_rows[k];
+  }
 
   options.mode = "nope";
   EXPECT_THROW(runWalk(gpu::sharedHeadlessContext(), scene, test::sideWalkPath(2), options), Error);

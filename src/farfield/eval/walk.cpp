@@ -69,7 +69,7 @@ void writeWalkCsv(const WalkResult& result, const std::string& file) {
   std::ofstream out(file);
   if (!out) throw Error(file, "cannot open for writing");
   out << "frame,path_frame,mode,wall_ms,gpu_ms,triangles,draw_calls,objects,cpu_ms,driver_ms,gl_calls,dispatches,"
-         "upload_bytes,syncs,impostors\n";
+         "upload_bytes,syncs,impostors,governor_level,predicted_ms,corrected_ms,bound_scale\n";
   char line[512];
   for (size_t i = 0; i < result.frames.size(); ++i) {
     const FrameRecord& f = result.frames[i];
@@ -77,7 +77,14 @@ void writeWalkCsv(const WalkResult& result, const std::string& file) {
                   result.mode.c_str(), f.wall_ms, f.gpu_ms, (unsigned long long)f.triangles, f.draw_calls, f.objects,
                   f.cpu_ms, f.driver_ms, (unsigned long long)f.gl_calls, f.dispatches,
                   (unsigned long long)f.upload_bytes, f.syncs);
-    out << line << (f.impostors >= 0 ? std::to_string(f.impostors) : std::string()) << "\n";
+    out << line << (f.impostors >= 0 ? std::to_string(f.impostors) : std::string());
+    if (f.governor_level >= 0) {
+      std::snprintf(line, sizeof(line), ",%d,%.4f,%.4f,%.4f", f.governor_level, f.predicted_ms, f.corrected_ms,
+                    f.bound_scale);
+      out << line << "\n";
+    } else {
+      out << ",,,,\n";
+    }
   }
   if (!out) throw Error(file, "write failed");
 }

@@ -50,8 +50,8 @@ WalkResult runWalk(gpu::Context& context, const scene::Scene& scene, const gen::
                    const WalkOptions& options);
 
 // frame,path_frame,mode,wall_ms,gpu_ms,triangles,draw_calls,objects,cpu_ms,driver_ms,gl_calls,dispatches,
-// upload_bytes,syncs,impostors (one row per measured frame; impostors 1 or 0, empty for a mode that draws none by
-// design).
+// upload_bytes,syncs,impostors,governor_level,predicted_ms,corrected_ms,bound_scale (one row per measured frame;
+// impostors 1 or 0, empty for a mode that draws none by design; the governor's columns empty for a mode without one).
 void writeWalkCsv(const WalkResult& result, const std::string& file);
 // A few human-readable lines: mode, size, frames, median/p95/p99/max wall and GPU ms, mean triangles/draw calls.
 std::string formatWalkSummary(const WalkResult& result);
