@@ -1,6 +1,6 @@
 // A smaller target's frame over a larger one (gpu/target_upscaler.h): every pixel of the larger target is written,
 // its colour the bilinear mix of the four nearest source texels, its id and depth the nearest texel's (or the far
-// plane where depth is not scaled up), whatever the larger target held before. Checked against a CPU computation of
+// plane where depth is not scaled up, and 0 where ids are not), whatever the larger target held before. Checked against a CPU computation of
 // the same mapping from the uploaded texels.
 #include "farfield/gpu/target_upscaler.h"
 
@@ -62,7 +62,8 @@ void expectUpscaled(const SourceTexels& s, const RenderTarget& big, TargetUpscal
       const double ax = (x + 0.5) * per_x, ay = (y + 0.5) * per_y;  // the pixel's centre in source texels
       const size_t nearest = texel(int(ax), int(ay));
       const int top_row = big.height() - 1 - y;  // readback rows run from the top
-      ids_off += ids.at(x, top_row) != s.ids[nearest];
+      const uint32_t want_id = channels == TargetUpscaler::Channels::Color ? 0u : s.ids[nearest];
+      ids_off += ids.at(x, top_row) != want_id;
       const float want_depth = channels == TargetUpscaler::Channels::All ? s.depth[nearest] : 0.0f;  // else far
       depth_off += depth.at(x, top_row) != want_depth;
       const double tx = ax - 0.5, ty = ay - 0.5;
@@ -79,7 +80,7 @@ void expectUpscaled(const SourceTexels& s, const RenderTarget& big, TargetUpscal
       }
     }
   }
-  EXPECT_EQ(ids_off, 0) << "pixels whose id is not the nearest texel's";
+  EXPECT_EQ(ids_off, 0) << "pixels whose id is not the nearest texel's (or 0 without ids)";
   EXPECT_EQ(depth_off, 0) << "pixels whose depth is not the nearest texel's (or the far plane without depth)";
   EXPECT_EQ(color_off, 0) << "pixels whose colour is not the bilinear mix";
 }
@@ -90,14 +91,18 @@ TEST_F(GpuTest, TheUpscaledFrameIsTheSmallFramesNearestIdsAndDepthAndItsBilinear
   uint32_t seed = 1;
   using Channels = TargetUpscaler::Channels;
   for (const auto& size : sizes) {
-    for (const Channels channels : {Channels::All, Channels::ColorAndIds}) {
+    for (const Channels channels : {Channels::All, Channels::ColorAndIds, Channels::Color}) {
       SCOPED_TRACE(testing::Message() << size[0] << "x" << size[1] << " to " << size[2] << "x" << size[3]
-                                      << (channels == Channels::All ? ", all" : ", colour and ids"));
+                                      << (channels == Channels::All           ? ", all"
+                                          : channels == Channels::ColorAndIds ? ", colour and ids"
+                                                                              : ", colour"));
       RenderTarget small(size[0], size[1]), big(size[2], size[3]);
       const SourceTexels source = fillRandomly(small, seed++);
       // What the big target held before is nearer than anything (reversed Z: 1 is the near plane) and another colour:
       // the upscale must overwrite it all.
       big.clear(Vec4(1.0f, 0.0f, 1.0f, 1.0f));
+      const GLuint stale_id = 77;  // and ids that are not 0
+      glClearNamedFramebufferuiv(big.framebuffer(), GL_COLOR, 1, &stale_id);
       const float near_depth = 1.0f;
       big.bind();
       glDepthMask(GL_TRUE);

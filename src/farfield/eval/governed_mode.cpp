@@ -80,7 +80,9 @@ GovernedMode::GovernedMode(const ModeContext& context) {
   g.aim = numberOption(context, "governor_aim", g.aim, 0.05, 1.0);
   read_ahead_ = switchOption(context, "governor_read_ahead", true);
   using Channels = gpu::TargetUpscaler::Channels;
-  upscale_channels_ = switchOption(context, "governor_upscale_depth", false) ? Channels::All : Channels::ColorAndIds;
+  upscale_channels_ = switchOption(context, "governor_upscale_depth", false) ? Channels::All
+                      : context.ids_read                                   ? Channels::ColorAndIds
+                                                                           : Channels::Color;
   g.refine_below = numberOption(context, "governor_refine_below", g.refine_below, 0.05, g.aim);
   g.refine_after = countOption(context, "governor_refine_after", g.refine_after);
   g.window = countOption(context, "governor_window", g.window);

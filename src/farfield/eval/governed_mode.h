@@ -34,6 +34,9 @@
 // will soon need), and that time is left out of the measurement the loop is given. governor_upscale_depth=on|off
 // (default off): a lower resolution's depth scaled up with its colour and ids (for a pass drawn over the frame
 // afterwards; 0.45 ms a frame on llvmpipe at 640 x 360), else the frame's depth is the far plane at those levels.
+// Ids are scaled up only where the harness reads them (ModeContext::ids_read: the bench; a walk does not, and its
+// lower resolutions' ids are 0): on llvmpipe the upscale is 1.3 ms of a 1.7 ms frame at the coarsest level, 0.3 of it
+// the ids.
 #pragma once
 
 #include <map>

@@ -41,6 +41,9 @@ struct ModeContext {
   int height = 0;
   // The run's frame budget (ms; `--tmax`), unset without one: the governed modes (eval/governed_mode.h) keep it.
   std::optional<double> t_max_ms;
+  // Whether the harness reads the frames' object ids (the bench's item buffers); false (a walk): a mode may leave
+  // them unwritten where that saves work (the governed mode's lower resolutions then scale up colour alone).
+  bool ids_read = true;
   // Free-form options of the run ("--mode-option key=value"), e.g. {"impostor_dir": "baked/city"}. A mode reads
   // the keys it knows; keys are shared by all modes of a run.
   std::map<std::string, std::string> options;

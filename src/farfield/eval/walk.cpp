@@ -35,6 +35,7 @@ WalkResult runWalk(gpu::Context& context, const scene::Scene& scene, const gen::
   gpu::Renderer& renderer = run.renderer;
   gpu::RenderTarget& target = run.target;
   ModeContext& mode_context = run.context;
+  mode_context.ids_read = false;  // a walk reads colour (frame files) and times, never the item buffers
   std::unique_ptr<Mode> mode = createMode(options.mode, mode_context);
   mode->prepare(mode_context);
 

@@ -7,7 +7,9 @@
 namespace farfield::gpu {
 
 TargetUpscaler::TargetUpscaler()
-    : program_(Program::fromEmbedded("upscale.vert.glsl", "upscale.frag.glsl", "#define FF_UPSCALE_DEPTH 1")),
+    : program_(Program::fromEmbedded("upscale.vert.glsl", "upscale.frag.glsl",
+                                     "#define FF_UPSCALE_IDS 1\n#define FF_UPSCALE_DEPTH 1")),
+      ids_program_(Program::fromEmbedded("upscale.vert.glsl", "upscale.frag.glsl", "#define FF_UPSCALE_IDS 1")),
       color_program_(Program::fromEmbedded("upscale.vert.glsl", "upscale.frag.glsl")) {
   glCreateVertexArrays(1, &vao_);
 }
@@ -19,7 +21,9 @@ TargetUpscaler::~TargetUpscaler() {
 void TargetUpscaler::draw(const RenderTarget& from, const RenderTarget& to, Channels channels) {
   FF_CHECK(from.width() > 0 && from.height() > 0 && to.width() > 0 && to.height() > 0);
   to.bindForOpaquePass();
-  const Program& program = channels == Channels::All ? program_ : color_program_;
+  const Program& program = channels == Channels::All           ? program_
+                           : channels == Channels::ColorAndIds ? ids_program_
+                                                               : color_program_;
   if (channels == Channels::All) {
     glDepthFunc(GL_ALWAYS);  // every pixel's depth written, whatever the target held
   } else {
@@ -27,13 +31,18 @@ void TargetUpscaler::draw(const RenderTarget& from, const RenderTarget& to, Chan
     glClearNamedFramebufferfv(to.framebuffer(), GL_DEPTH, 0, &far);
     glDisable(GL_DEPTH_TEST);
   }
+  if (channels == Channels::Color) {
+    const GLuint none = 0;
+    glClearNamedFramebufferuiv(to.framebuffer(), GL_COLOR, 1, &none);
+    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);  // the program writes no id
+  }
   glDisable(GL_CULL_FACE);
   program.use();
   glProgramUniform2f(program.handle(), program.uniformLocation("u_from_per_to"),
                      float(from.width()) / float(to.width()), float(from.height()) / float(to.height()));
   glProgramUniform2i(program.handle(), program.uniformLocation("u_from_size"), from.width(), from.height());
   from.colorTexture().bind(0);
-  from.idTexture().bind(1);
+  if (channels != Channels::Color) from.idTexture().bind(1);
   from.depthTexture().bind(2);
   glBindVertexArray(vao_);
   glDrawArrays(GL_TRIANGLES, 0, 3);
