@@ -6,7 +6,7 @@
 # OUT/log.txt; prints a summary per stage.
 #
 # Stages (STAGES, default "smoke heldout model makedemo crowd terrain big check"; they run in the script's order,
-# smoke, heldout, model, big, demo, check, terrain, crowd, makedemo, dynamic, each under a timeout; with 15 minutes of device time,
+# smoke, heldout, model, big, demo, check, terrain, crowd, makedemo, dynamic, stream, each under a timeout; with 15 minutes of device time,
 # name a few per call, e.g. STAGES="smoke heldout makedemo" then STAGES="smoke crowd terrain"):
 #   smoke    a small city, one bench; stops everything unless the NVIDIA driver drew it
 #   heldout  a 400-block detail-3 city (about 17 M triangles) and a 300-frame car drive at 1920x1080: frustum,
@@ -24,6 +24,9 @@
 #            carried) and on the 8,193^2 fractal
 #   makedemo the demo's main job, scripts/demo.sh at its 640x360: t_max from this machine,
 #            impostors placed, full, culled, placed and governed against reference frames; its verdict (issues 43, 46)
+#   stream   (not in the default) the mmi walkthrough streaming its database along a 3,000-frame drive of a 400-block
+#            detail-3 city at 1920x1080, cells uploaded by the frame that enters them (read_ahead_ms=0) and ahead in 2 ms
+#            a frame (docs/BENCHMARKS.md, "Cells uploaded ahead in spare time")
 #   dynamic  (not in the default) the image-cache modes (dynamic-shade, dynamic-schaufler, layered) with their
 #            geometry through the GPU-driven frame and through the CPU's occlusion culling (a readback a frame),
 #            scripts/bench_dynamic_budget.sh's city and forest at 640x360, t_max 50 ms
@@ -204,5 +207,23 @@ if [[ " $STAGES " == *" dynamic "* ]]; then
   echo "rc $?"
   summ dynamic/bench-*/bench.json
   keep dynamic dynamic/bench-*/bench.json dynamic/bench-*/frames.csv dynamic/*.txt dynamic.txt
+fi
+if [[ " $STAGES " == *" stream "* ]]; then
+  say "stream: cells uploaded in the entering frame and ahead, 400 blocks, 1920x1080"
+  S=stream
+  mkdir -p $S
+  timeout 300 $FF gen city --blocks 400 --detail 3 --seed 1 --objects buildings -o $S/city.glb > $S/gen.txt 2>&1
+  $FF path street $S/city.streets.json --frames 3000 --fps 30 --seed 41 --car -o $S/drive.json > /dev/null 2>&1
+  timeout 300 $FF bake $S/city.glb --pipeline pvs,near-far,single,mmi --error-px 2 --resolution 256 --pvs-spacing 10 \
+    --pvs-face 64 --station-spacing 10 --path $S/drive.json -o $S/imp > $S/bake.txt 2>&1
+  echo "rc $?"
+  for ms in 0 2; do
+    timeout 300 $FF walk $S/city.glb --path $S/drive.json --mode mmi --size 1920x1080 --mode-option impostor_dir=$S/imp \
+      --mode-option read_ahead_ms=$ms --mode-option streaming_csv=$S/streaming-$ms.csv --csv $S/frames-$ms.csv \
+      > $S/walk-$ms.txt 2>&1
+    echo "rc $? read_ahead_ms $ms"
+    grep -E "^(renderer|wall ms|gpu ms|own cpu)" $S/walk-$ms.txt
+  done
+  keep stream $S/*.csv $S/*.txt
 fi
 say "done"
