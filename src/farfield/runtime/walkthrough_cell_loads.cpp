@@ -115,8 +115,7 @@ Walkthrough::Cell& Walkthrough::cell(uint32_t half_edge, bool* loaded) {
   } else {
     upload = startCell(*entry, nullptr);
   }
-  while (uploadNextView(*upload) > 0) {
-  }
+  while (!upload->done()) uploadNextView(*upload);
   const double ms = timer.milliseconds();
   plan_.report.load_ms = ms;
   *loaded = true;
