@@ -41,6 +41,8 @@ class ModeRenderer::PlanFrame final : public eval::Mode {
     } else {
       frame.items() = o.last_items_;
     }
+    // After the geometry's draws are issued, while the GPU works: the next cells' (or impostors') uploads.
+    if (replan && o.settings_.load_ahead_ms > 0.0) o.walkthrough_->loadAhead(frame.camera(), o.settings_.load_ahead_ms);
   }
   std::optional<gpu::FrameStats> lateFrameStats(size_t path_frame) override {
     return owner_.geometry_->lateFrameStats(path_frame);

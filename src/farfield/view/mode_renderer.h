@@ -36,6 +36,9 @@ struct ModeSettings {
   std::string terrain_technique = "lod-sprite-gpu";
   // The frame budget the governed mode keeps (its governor_t_max_ms), as it is when the mode is selected.
   double t_max_ms = 1000.0 / 30.0;
+  // Walkthrough modes: time each frame spends after its draws loading what the next frames will need (the cells or
+  // placed impostors ahead: runtime::Walkthrough::loadAhead), so that entering a cell uploads nothing; 0: none.
+  double load_ahead_ms = 2.0;
 };
 
 // One displayed frame.
