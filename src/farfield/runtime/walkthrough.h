@@ -210,9 +210,9 @@ class Walkthrough {
   // plan (before the next one). Returns the milliseconds spent; 0 before a first plan.
   //  - Placed: the impostors, not yet resident, of the CPV holding the eye `placed_read_ahead_frames` frames on along
   //    its motion over the last frame, looking as now. With read_ahead, one the background thread has read is
-  //    uploaded when the slowest such upload fits in what is left; one it has not, read (or waited for) when the
-  //    slowest load so far fits, else left to the thread; without, read when the slowest load fits (the first of
-  //    either on trust).
+  //    uploaded when the expected upload (the recent uploads' 90th percentile: runtime/upload_rate.h) fits in what
+  //    is left; one it has not, read (or waited for) when the slowest load so far fits, else left to the thread;
+  //    without, read when the slowest load fits (the first of either on trust).
   //  - Cells (Smi, Mmi, MmiDynamic with read_ahead): the cells read ahead (the streets the viewer may enter next, in
   //    the reader's order) are uploaded view by view, one cell at a time, while the next view's expected upload time
   //    (runtime/upload_rate.h) fits in what is left (the first on trust). A cell begun and not finished is finished

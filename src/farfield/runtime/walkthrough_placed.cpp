@@ -74,7 +74,11 @@ Walkthrough::Placed::Prepared Walkthrough::Placed::prepare(const WalkthroughOpti
 std::unordered_map<uint32_t, Walkthrough::Placed::Resident>::iterator Walkthrough::Placed::makeResident(
     uint32_t id, const Prepared& prepared) {
   Resident r;
+  Stopwatch upload;
   r.gpu = std::make_unique<impostor::GpuLayeredImpostor>(prepared.atlases);
+  const double ms = upload.milliseconds();
+  upload_time.add(ms, 1);
+  stats.upload_ms_max = std::max(stats.upload_ms_max, ms);
   r.error_rad = prepared.error_rad;
   r.bytes = r.gpu->gpuBytes();
   resident_bytes += r.bytes;
@@ -124,14 +128,13 @@ double Walkthrough::loadPlacedAhead(const Camera& camera, double budget_ms) {
     // needs it.
     if (p.resident_bytes >= options_.gpu_budget_bytes) break;
     const double left = budget_ms - timer.milliseconds();
-    // One read and packed already on the reader's thread is uploaded when the slowest such upload fits in what is
-    // left (the first on trust).
+    // One read and packed already on the reader's thread is uploaded when the expected upload (the 90th percentile
+    // of the recent ones: not the slowest, which one preempted upload would set for good) fits in what is left (the
+    // first on trust).
     if (p.reader) {
-      if (p.stats.loads > 0 && p.stats.upload_ms_max > left) break;
-      Stopwatch upload;
+      if (p.upload_time.known() && p.upload_time.predictMs(1) > left) break;
       if (const std::shared_ptr<Placed::Prepared> ready = p.reader->takeIfReady(id)) {
         p.makeResident(id, *ready);
-        p.stats.upload_ms_max = std::max(p.stats.upload_ms_max, upload.milliseconds());
         ++p.stats.read_ahead_loads;
         continue;
       }

@@ -39,8 +39,11 @@ struct Walkthrough::Placed {
     size_t coarse_left_to_geometry = 0;  // ... left to geometry (WalkthroughOptions::coarser_impostors false)
     size_t read_ahead_loads = 0;         // loads by loadAhead (also in loads)
     double read_ahead_ms = 0.0;
-    double upload_ms_max = 0.0;          // the slowest upload of an impostor read and packed already
+    double upload_ms_max = 0.0;          // the slowest upload of an impostor (read and packed already)
   } stats;
+  // The recent uploads of impostors, one unit each (an impostor's size is known only once it is taken from the
+  // reader): what loadAhead expects the next to take.
+  UploadRate upload_time;
   // The eye's motion over the last frame (loadAhead looks ahead along it).
   bool has_eye = false;
   Vec3 last_eye{0.0f}, motion{0.0f};
