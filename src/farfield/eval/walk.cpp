@@ -130,7 +130,7 @@ std::string formatWalkSummary(const WalkResult& r) {
                   info("gpu_occlusion_probes"), info("gpu_occlusion_early_probes"), info("gpu_occlusion_switches"));
     text += buf;
   }
-  if (r.info.count("cell_entries") && info("cell_entries") > 0.0) {
+  if (info("cell_entries") > 0.0) {
     std::snprintf(buf, sizeof(buf),
                   "cells:           %.0f entered: %.0f uploaded ahead, %.0f partly, %.0f stalls (read in the frame); "
                   "slowest load in a frame %.2f ms, uploads ahead %.1f ms in all\n",
