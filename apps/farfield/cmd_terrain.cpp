@@ -6,7 +6,8 @@
 //                        [--clearance M] [--full-max-triangles N] [--sprite-tile-cells N]
 // farfield terrain tiles DEM -o OUTDIR [--budget-mb MB] [--block N] [--tile-blocks N] [--frames N] [--cache FILE]
 //                        [--reuse-cache] [--pixel-error PX] [--check-stride K] [--clearance M] [--size WxH]
-//                        [--sprite-tiles CELLS] [--epsilon PX] [--low-error PX]
+//                        [--sprite-tiles CELLS] [--epsilon PX] [--low-error PX] [--render [--cpu-lod]
+//                        [--gpu-budget-mb MB] [--prefetch-frames N] [--lod-sprite [--predict] [--psnr-stride K]]]
 // DEM: a GeoTIFF / netCDF / 16-bit PNG file or fractal:SIZE[:SEED].
 //
 // The LOD-sprite experiment (Chen et al. 1999) is eval::runTerrainBench (eval/terrain_bench.h). Its modes are
@@ -120,8 +121,9 @@ void runTiles(eval::TerrainTilesOptions& o, const std::string& size) {
   o.width = s.x;
   o.height = s.y;
   const eval::TerrainTilesResult result = eval::runTerrainTiles(o);
-  std::printf("%s\nwrote %s/{tiles.json,tiles.md,tiles_frames.csv%s} in %.0f s\n", result.markdown.c_str(),
-              o.out_dir.c_str(), o.render ? ",frames/" : "", result.seconds);
+  std::printf("%s\nwrote %s/{tiles.json,tiles.md,tiles_frames.csv%s%s} in %.0f s\n", result.markdown.c_str(),
+              o.out_dir.c_str(), o.lod_sprite ? ",lod_sprite_frames.csv" : "", o.render ? ",frames/" : "",
+              result.seconds);
   if (result.check_mismatches > 0) throw Error("--check-stride", "the tiled LOD differed from the whole grid's");
 }
 
@@ -236,6 +238,15 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
       "--gpu-lod", [t] { t->first.gpu_lod = true; },
       "With --render: the CDLOD terrain (the default; kept for older commands)");
   tiles->add_option("--patch-cells", to.patch_cells, "With --render: quads per CDLOD patch side (a power of two)");
+  tiles->add_flag("--lod-sprite", to.lod_sprite,
+                  "With --render: draw every frame a second time as LOD-sprite on the same paged terrain (sprite "
+                  "frames at --low-error, keyframes at --pixel-error, --epsilon; the choice by a cost model fitted on "
+                  "the path's views), timed apart, compared with the CDLOD frame");
+  tiles->add_flag("--predict", to.lod_sprite_predict,
+                  "With --lod-sprite: keyframes rendered ahead, late, in slices (as lod-sprite-gpu-predict)");
+  tiles->add_option("--psnr-stride", to.psnr_stride,
+                    "With --lod-sprite: compare every K-th frame with the CDLOD frame (0 = never)")
+      ->capture_default_str();
   tiles->callback([t] { runTiles(t->first, t->second); });
 });
 

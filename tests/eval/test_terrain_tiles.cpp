@@ -122,6 +122,44 @@ TEST(TerrainTilesGL, TheCdlodTerrainIsDrawnFromPagesOfTheCache) {
   test::expectErrorMentions([&] { runTerrainTiles(o); }, {"--cpu-lod", "--render"});
 }
 
+// --lod-sprite: every frame drawn a second time as LOD-sprite on the same paged terrain, timed apart; its frames,
+// their paths and their PSNR against the CDLOD frames are written, and the run's summary counts them.
+TEST(TerrainTilesGL, LodSpriteRunsOnThePagedTerrainBesideItsCdlodFrames) {
+  TerrainTilesOptions o = smallRun("terrain_tiles_lod_sprite");
+  o.check_stride = 0;
+  o.sprite_tile_cells = 0;
+  o.render = true;
+  o.lod_sprite = true;
+  o.psnr_stride = 5;
+  runTerrainTiles(o);
+  const std::filesystem::path out(o.out_dir);
+  std::ifstream in(out / "tiles.json");
+  const nlohmann::json s = nlohmann::json::parse(in)["render"]["lod_sprite"];
+  const size_t frames = size_t(o.frames);
+  EXPECT_EQ(s["sprite_frames"].get<size_t>() + s["high_frames"].get<size_t>(), frames);
+  EXPECT_GT(s["fresh_keyframes"].get<size_t>(), 0u);
+  EXPECT_EQ(s["psnr_vs_cdlod_frames"].get<size_t>(), (frames + 4) / 5);
+  EXPECT_GT(s["psnr_vs_cdlod_min_db"].get<double>(), 20.0);
+  EXPECT_LE(s["psnr_vs_cdlod_mean_db"].get<double>(), 99.0);  // capped where a frame is the CDLOD frame itself
+  EXPECT_GT(s["frame_ms_mean"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(s["speedup_vs_cdlod_mean"].get<double>(),
+                   s["cdlod"]["frame_ms_mean"].get<double>() / s["frame_ms_mean"].get<double>());
+  EXPECT_TRUE(s["cost"].contains("gpu_sprite"));
+  std::ifstream csv(out / "lod_sprite_frames.csv");
+  std::string line;
+  size_t rows = 0, compared = 0;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "frame,cdlod_ms,lod_sprite_ms,path,source,triangles,error_px,psnr_vs_cdlod");
+  while (std::getline(csv, line)) {
+    ++rows;
+    compared += line.back() != ',' ? 1 : 0;
+  }
+  EXPECT_EQ(rows, frames);
+  EXPECT_EQ(compared, s["psnr_vs_cdlod_frames"].get<size_t>());
+  o.gpu_lod = false;
+  test::expectErrorMentions([&] { runTerrainTiles(o); }, {"--lod-sprite", "--cpu-lod"});
+}
+
 TEST(TerrainTiles, BadOptionsAreRefused) {
   TerrainTilesOptions o = smallRun("terrain_tiles_bad");
   o.frames = 1;

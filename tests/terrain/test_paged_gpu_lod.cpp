@@ -36,7 +36,7 @@ std::vector<Camera> flight(const Heightfield& hf) {
 image::ColorImage drawPaged(PagedGpuLodTerrain& t, const Camera& c, float tau, PagedGpuLodFrame* out = nullptr) {
   gpu::RenderTarget target(c.width, c.height);
   target.clear(kSky);
-  const PagedGpuLodFrame f = t.draw(c, tau, target);
+  const PagedGpuLodFrame f = t.drawFrame(c, tau, target);
   if (out) *out = f;
   return target.readColor();
 }

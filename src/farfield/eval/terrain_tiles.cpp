@@ -16,9 +16,12 @@
 
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
+#include "farfield/eval/bench.h"
 #include "farfield/eval/terrain_paths.h"
+#include "farfield/eval/terrain_tiles_sprite.h"
 #include "farfield/gpu/context.h"
 #include "farfield/gpu/render_target.h"
+#include "farfield/image/metrics.h"
 #include "farfield/image/png_io.h"
 #include "farfield/terrain/dem_io.h"
 #include "farfield/terrain/paged_terrain.h"
@@ -143,6 +146,12 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   std::unique_ptr<terrain::PagedTerrainRenderer> paged;
   std::unique_ptr<terrain::PagedGpuLodTerrain> cdlod;
   if (!o.gpu_lod && !o.render) throw Error("--cpu-lod", "draws frames: needs --render");
+  if (o.lod_sprite && !(o.render && o.gpu_lod))
+    throw Error("--lod-sprite", "draws LOD-sprite over the CDLOD terrain: needs --render without --cpu-lod");
+  std::unique_ptr<PagedSpriteRun> sprite_run;
+  std::unique_ptr<gpu::RenderTarget> sprite_target;
+  std::vector<PagedSpriteFrame> sprite_frames;
+  std::vector<double> cdlod_ms;
   if (o.render) {
     if (!(o.gpu_budget_mb > 0.0)) throw Error("--gpu-budget-mb", "must be positive");
     gpu::sharedHeadlessContext().makeCurrent();
@@ -154,8 +163,23 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
       po.lod.patch_cells = o.patch_cells;
       po.gpu_budget_bytes = size_t(o.gpu_budget_mb * 1024.0 * 1024.0);
       po.prefetch_frames = o.prefetch_frames;
+      po.keep_heights = o.lod_sprite;  // LOD-sprite's error metric reads the held pages' heights
       cdlod = std::make_unique<terrain::PagedGpuLodTerrain>(cache, po);
       cdlod_prepare_seconds = prepare.seconds();
+      if (o.lod_sprite) {
+        std::vector<Camera> cameras;
+        for (size_t f = 0; f < path.frames.size(); ++f)
+          cameras.push_back(path.camera(f, o.width, o.height, clip.near_plane, clip.far_plane));
+        PagedSpriteOptions so;
+        so.epsilon = o.epsilon;
+        so.pixel_error = o.pixel_error;
+        so.low_error = o.low_error;
+        so.predict = o.lod_sprite_predict;
+        sprite_run = std::make_unique<PagedSpriteRun>(*cdlod, cameras, so);
+        sprite_target = std::make_unique<gpu::RenderTarget>(o.width, o.height);
+        std::fprintf(stderr, "LOD-sprite: cost model fitted on the path's views in %.1f s\n",
+                     sprite_run->calibrationSeconds());
+      }
     } else {
       paged = std::make_unique<terrain::PagedTerrainRenderer>(pager, size_t(o.gpu_budget_mb * 1024.0 * 1024.0),
                                                               o.prefetch_frames);
@@ -173,9 +197,24 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
       // The CDLOD frame: the selection, the pages it needs (read at once if missing), the draw, to the GPU's end.
       target->clear(kSky);
       const Stopwatch draw;
-      const terrain::PagedGpuLodFrame cf = cdlod->draw(camera, o.pixel_error, *target);
+      // With LOD-sprite, the pages are read ahead after the timed frame (both frames then leave it out).
+      const terrain::PagedGpuLodFrame cf = sprite_run ? cdlod->draw(camera, o.pixel_error, *target)
+                                                      : cdlod->drawFrame(camera, o.pixel_error, *target);
       cdlod->finish();
       row.frame_ms = row.ms = draw.milliseconds();
+      if (sprite_run) {
+        cdlod_ms.push_back(row.frame_ms);
+        cdlod->prefetch(camera, o.pixel_error);
+        PagedSpriteFrame sf = sprite_run->draw(camera, *sprite_target);
+        if (o.psnr_stride > 0 && f % o.psnr_stride == 0)
+          sf.psnr_vs_high = std::min(image::psnr(sprite_target->readColor(), target->readColor()), kPsnrCapDb);
+        if (o.sample_stride > 0 && f % o.sample_stride == 0) {
+          char name[40];
+          std::snprintf(name, sizeof name, "lod_sprite_%05zu.png", f);
+          image::writePng((out / "frames" / name).string(), sprite_target->readColor());
+        }
+        sprite_frames.push_back(sf);
+      }
       row.triangles = row.drawn_triangles = cf.draw.triangles;
       row.patch_loads = cf.page_loads;
       row.gpu_bytes = cdlod->stats().pages * cdlod->pageBytes();  // the pages held
@@ -325,6 +364,9 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   std::sort(fms.begin(), fms.end());
   if (cdlod) {
     const terrain::PagedGpuLodStats& cs = cdlod->stats();
+    // Pages read in the flight's frames (the LOD-sprite run's calibration, before the flight, reads some too).
+    size_t in_frames = 0;
+    for (const FrameRow& r : rows) in_frames += r.patch_loads;
     size_t over_twice = 0;
     for (double v : fms) over_twice += v > 2.0 * fms[fms.size() / 2] ? 1 : 0;
     j["render"] = {{"lod", "cdlod"},
@@ -339,7 +381,8 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                    {"overview_step", cdlod->overviewStep()},
                    {"page_layers", cdlod->pageLayers()},
                    {"pages_peak", cs.peak_pages},
-                   {"page_loads_waited_for", cs.page_loads},
+                   {"page_loads_waited_for", in_frames},
+                   {"page_loads_before_the_flight", cs.page_loads - in_frames},
                    {"pages_prefetched", cs.prefetched},
                    {"prefetch_hits", cs.prefetch_hits},
                    {"page_evictions", cs.evictions},
@@ -355,9 +398,24 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                   "overview made in %.1f s\n",
                   fsum / double(fms.size()), fms[fms.size() / 2], double(j["render"]["frame_ms_p99"]), fms.back(),
                   over_twice, double(drawn_sum) / double(rows.size()), drawn_max, cdlod->pageLayers(),
-                  mib(cdlod->gpuBytes()), cs.peak_pages, cs.page_loads, cs.prefetched, o.prefetch_frames,
+                  mib(cdlod->gpuBytes()), cs.peak_pages, in_frames, cs.prefetched, o.prefetch_frames,
                   cs.prefetch_hits, cs.evictions, cs.load_seconds, cdlod_prepare_seconds);
     render_md = line;
+    if (sprite_run) {
+      j["render"]["lod_sprite"] = sprite_run->summary(sprite_frames, cdlod_ms);
+      render_md += PagedSpriteRun::markdown(j["render"]["lod_sprite"]);
+      std::ostringstream sc;
+      sc << "frame,cdlod_ms,lod_sprite_ms,path,source,triangles,error_px,psnr_vs_cdlod\n";
+      for (size_t f = 0; f < sprite_frames.size(); ++f) {
+        const PagedSpriteFrame& sf = sprite_frames[f];
+        sc << f << ',' << cdlod_ms[f] << ',' << sf.ms << ','
+           << (sf.info.path == terrain::TerrainPath::Sprite ? "sprite" : "high") << ','
+           << terrain::spriteSourceName(sf.info.source) << ',' << sf.triangles << ',' << sf.info.error_px << ',';
+        if (sf.psnr_vs_high >= 0.0) sc << sf.psnr_vs_high;
+        sc << '\n';
+      }
+      writeFile(out / "lod_sprite_frames.csv", sc.str());
+    }
   } else if (paged) {
     const terrain::PagedTerrainStats& ps = paged->stats();
     // What drawing the whole grid would hold on the GPU: every point's position and a texel a point with mipmaps.

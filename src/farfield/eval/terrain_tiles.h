@@ -45,6 +45,14 @@ struct TerrainTilesOptions {
   // false: the quadtree LOD per tile, its patches remade on the CPU and uploaded (--cpu-lod).
   bool gpu_lod = true;
   int patch_cells = 16;
+  // With the CDLOD terrain: each frame drawn a second time as LOD-sprite wholly on the same paged terrain
+  // (terrain_tiles_sprite.h: keyframes and high frames the CDLOD frames at pixel_error, sprite frames at low_error,
+  // equation 2 at epsilon, the per-frame choice by a cost model fitted at start on the path's views), timed apart
+  // from the CDLOD frame, the pages read ahead outside both; every psnr_stride-th frame compared with the CDLOD frame
+  // (untimed). lod_sprite_predict: keyframes rendered ahead, late, in slices.
+  bool lod_sprite = false;
+  bool lod_sprite_predict = false;
+  size_t psnr_stride = 10;
 };
 
 struct TerrainTilesResult {

@@ -117,7 +117,6 @@ void CdlodRenderer::setHole(Vec2 lo, Vec2 hi) {
 
 void CdlodRenderer::setSprite(const CdlodSprite& sprite) {
   const char* where = "CDLOD renderer sprite";
-  if (pages_) throw Error(where, "a terrain paged in tiles has no sprite frame (its heights are not one texture)");
   if (!sprite.colour || !sprite.depth) throw Error(where, "needs the keyframe's colour and depth textures");
   sprite.camera.validate(where);
   for (const Texture* t : {sprite.colour, sprite.depth})

@@ -88,8 +88,9 @@ class CdlodRenderer {
   // The draws that follow test each vertex against the sprite's keyframe as keyframe_visibility.h's vertexVisible
   // does (in the vertex shader), and take the sprite, projected through its camera, over the triangles whose three
   // vertices are visible there, the original texture elsewhere: the sprite frame in one draw, with nothing read back.
-  // clearSprite draws the original texture alone again. Throws farfield::Error for missing textures, textures of
-  // another size than the camera's, or a paged terrain (its heights are not one texture).
+  // clearSprite draws the original texture alone again. A paged terrain's vertices take their normals from their
+  // node's page or the overview. Throws farfield::Error for missing textures or textures of another size than the
+  // camera's.
   void setSprite(const CdlodSprite& sprite);
   void clearSprite() { sprite_on_ = false; }
   // Waits until every command issued so far has completed (glFinish): the end of a timed terrain frame.

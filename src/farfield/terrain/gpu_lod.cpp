@@ -1,6 +1,8 @@
 #include "farfield/terrain/gpu_lod.h"
 
+#include <algorithm>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "farfield/core/error.h"
@@ -26,26 +28,59 @@ Vec2 uvOffset(const Heightfield& hf) {
 }  // namespace
 
 GpuLodTerrain::GpuLodTerrain(const Heightfield& hf, const image::ColorImage& texture, const CdlodOptions& options)
-    : lod_(hf, options),
-      renderer_(hf.width, hf.height, hf.heights, Vec2(float(hf.cell_x), float(hf.cell_y)), options.patch_cells,
-                texture, uvScale(hf), uvOffset(hf)) {
+    : lod_(hf, options) {
+  attachRenderer(std::make_unique<gpu::CdlodRenderer>(hf.width, hf.height, hf.heights,
+                                                      Vec2(float(hf.cell_x), float(hf.cell_y)), options.patch_cells,
+                                                      texture, uvScale(hf), uvOffset(hf)));
+}
+
+GpuLodTerrain::GpuLodTerrain(CdlodTerrain lod) : lod_(std::move(lod)) {}
+
+GpuLodTerrain::~GpuLodTerrain() = default;
+
+void GpuLodTerrain::attachRenderer(std::unique_ptr<gpu::CdlodRenderer> renderer) {
   std::vector<int> offsets;
   std::vector<IVec2> counts;
   for (int l = 0; l <= lod_.topLevel(); ++l) {
     offsets.push_back(int(lod_.levelOffset(l)));
     counts.emplace_back(lod_.nodesX(l), lod_.nodesY(l));
   }
-  renderer_.setLevels(offsets, counts);
+  renderer->setLevels(offsets, counts);
+  renderer_ = std::move(renderer);
 }
 
 void GpuLodTerrain::setHole(const GridRect& hole) {
   if (hole.empty()) {
-    renderer_.clearHole();
+    renderer_->clearHole();
     return;
   }
+  const CdlodGrid& g = lod_.grid();
+  renderer_->setHole(Vec2(float(hole.x0 * g.cell_x), float(hole.y0 * g.cell_y)),
+                     Vec2(float(hole.x1 * g.cell_x), float(hole.y1 * g.cell_y)));
+}
+
+float GpuLodTerrain::gridHeight(int i, int j) const {
   const Heightfield& hf = lod_.heightfield();
-  renderer_.setHole(Vec2(float(hole.x0 * hf.cell_x), float(hole.y0 * hf.cell_y)),
-                    Vec2(float(hole.x1 * hf.cell_x), float(hole.y1 * hf.cell_y)));
+  return hf.at(std::clamp(i, 0, hf.width - 1), std::clamp(j, 0, hf.height - 1));
+}
+
+float GpuLodTerrain::groundHeight(double x, double y) const { return lod_.heightfield().sample(x, y); }
+
+Box3 GpuLodTerrain::bounds() const {
+  const int top = lod_.topLevel();
+  Box3 box = lod_.nodeBox(CdlodNode{top, 0, 0});
+  for (int y = 0; y < lod_.nodesY(top); ++y)
+    for (int x = 0; x < lod_.nodesX(top); ++x) {
+      const Box3 b = lod_.nodeBox(CdlodNode{top, x, y});
+      box.lo = glm::min(box.lo, b.lo);
+      box.hi = glm::max(box.hi, b.hi);
+    }
+  return box;
+}
+
+void GpuLodTerrain::placeNodes(std::span<const CdlodNode> nodes, std::vector<gpu::CdlodInstance>& out,
+                               GpuLodFrame&) {
+  for (const CdlodNode& n : nodes) out.push_back(cdlodInstance(n, lod_.patchCells()));
 }
 
 void uploadRanges(const CdlodSelection& selection, gpu::CdlodRenderer& renderer, int slot) {
@@ -78,7 +113,7 @@ int GpuLodTerrain::select(const Camera& camera, float pixel_error, bool cull) {
   last_ = slot;
   CdlodSelection& selection = selections_[slot];
   lod_.select(camera, pixel_error, cull, selection);
-  if (selection.ranges_changed) uploadRanges(selection, renderer_, slot);
+  if (selection.ranges_changed) uploadRanges(selection, *renderer_, slot);
   return slot;
 }
 
@@ -91,9 +126,9 @@ const CdlodSelection& GpuLodTerrain::selection(int handle) const {
 GpuLodFrame GpuLodTerrain::drawInstances(const Camera& camera, std::span<const CdlodNode> nodes, int slot,
                                          gpu::RenderTarget& target) {
   instances_.clear();
-  for (const CdlodNode& n : nodes) instances_.push_back(cdlodInstance(n, lod_.patchCells()));
   GpuLodFrame frame;
-  frame.draw = renderer_.draw(camera, target, instances_, slot);
+  placeNodes(nodes, instances_, frame);
+  frame.draw = renderer_->draw(camera, target, instances_, slot);
   frame.nodes = nodes.size();
   return frame;
 }
@@ -116,7 +151,7 @@ GpuLodFrame GpuLodTerrain::drawNodes(const Camera& camera, float pixel_error, st
     held.nodes.clear();
     held.visited = held.culled = 0;
     lod_.updateRanges(camera, pixel_error, held.ranges);  // throws for a bound that is not a positive number
-    uploadRanges(held, renderer_, slot);
+    uploadRanges(held, *renderer_, slot);
   }
   return drawInstances(camera, nodes, slot, target);
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -22,6 +23,10 @@ struct GpuLodFrame {
   size_t nodes = 0;         // drawn
   size_t nodes_visited = 0; // tested by the selection
   size_t nodes_culled = 0;  // left out by the frustum
+  // A terrain paged in tiles (paged_gpu_lod.h); 0 otherwise.
+  size_t paged_nodes = 0;   // drawn nodes reading a page
+  size_t pages_needed = 0;  // distinct pages the draw read
+  size_t page_loads = 0;    // read by the draw itself (it waited)
 };
 
 // A selection's morph ranges into a renderer's range slot (when select() remade them).
@@ -34,6 +39,9 @@ class GpuLodTerrain {
   // Needs a current context; hf must outlive this. texture: the terrain's original texture, placed as
   // texCoordTransform (terrain_texture.h) places it. Throws farfield::Error as CdlodTerrain and CdlodRenderer do.
   GpuLodTerrain(const Heightfield& hf, const image::ColorImage& texture, const CdlodOptions& options = {});
+  virtual ~GpuLodTerrain();
+  GpuLodTerrain(const GpuLodTerrain&) = delete;
+  GpuLodTerrain& operator=(const GpuLodTerrain&) = delete;
 
   // Selects and draws the terrain for the camera under the bound (pixels) into the bound target (not cleared).
   GpuLodFrame draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target, bool cull = true);
@@ -55,16 +63,34 @@ class GpuLodTerrain {
   // ground drawn by someone else): fragments strictly inside it, in world x, y, are discarded. An empty rectangle
   // clears it. Applies to the draws that follow.
   void setHole(const GridRect& hole);
-  void clearHole() { renderer_.clearHole(); }
+  void clearHole() { renderer_->clearHole(); }
+
+  // The height of grid point (i, j), clamped to the grid, as the CPU holds it (LOD-sprite's error metric runs over
+  // grid points); a paged terrain answers from the pages it holds, else from its overview.
+  virtual float gridHeight(int i, int j) const;
+  // The ground's height under world (x, y), bilinear (a paged terrain: its overview's).
+  virtual float groundHeight(double x, double y) const;
+  // The box of the whole terrain (its top level's node boxes).
+  Box3 bounds() const;
 
   const CdlodTerrain& lod() const { return lod_; }
   const CdlodSelection& lastSelection() const { return selections_[last_]; }
-  gpu::CdlodRenderer& renderer() { return renderer_; }
-  size_t gpuBytes() const { return renderer_.gpuBytes(); }
+  gpu::CdlodRenderer& renderer() { return *renderer_; }
+  virtual size_t gpuBytes() const { return renderer_->gpuBytes(); }
+
+ protected:
+  // A terrain whose node data were made elsewhere (a paged one): the renderer is attached by the derived class.
+  explicit GpuLodTerrain(CdlodTerrain lod);
+  // Sets the renderer and its levels from the node tree.
+  void attachRenderer(std::unique_ptr<gpu::CdlodRenderer> renderer);
+  // The instances of the nodes to draw, with the page layer each reads (-1: none), made resident for the draw; the
+  // paged counts go to `frame`. This one: every layer -1.
+  virtual void placeNodes(std::span<const CdlodNode> nodes, std::vector<gpu::CdlodInstance>& out, GpuLodFrame& frame);
+
+  CdlodTerrain lod_;
+  std::unique_ptr<gpu::CdlodRenderer> renderer_;
 
  private:
-  CdlodTerrain lod_;
-  gpu::CdlodRenderer renderer_;
   // One selection (with its ranges) per bound in use, each drawn with its own range slot; the least recently used
   // is remade for a new bound.
   CdlodSelection selections_[gpu::CdlodRenderer::kRangeSlots];

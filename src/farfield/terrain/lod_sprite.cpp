@@ -60,7 +60,29 @@ const char* spriteSourceName(SpriteSource source) {
 
 LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, int width, int height,
                                      const LodSpriteOptions& options)
+    : LodSpriteRenderer(&lod, &renderer, width, height, options) {}
+
+namespace {
+
+LodSpriteOptions onTheGpu(GpuLodTerrain& terrain, LodSpriteOptions options) {
+  if (options.gpu_high && options.gpu_high != &terrain)
+    throw Error("lod-sprite", "options name another CDLOD terrain than the renderer's");
+  if (!options.gpu_low)
+    throw Error("lod-sprite", "a renderer without the quadtree LOD draws its sprite frames on the GPU (gpu_low)");
+  options.gpu_high = &terrain;
+  return options;
+}
+
+}  // namespace
+
+LodSpriteRenderer::LodSpriteRenderer(GpuLodTerrain& terrain, int width, int height, const LodSpriteOptions& options)
+    : LodSpriteRenderer(nullptr, nullptr, width, height, onTheGpu(terrain, options)) {}
+
+LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod* lod, gpu::TerrainRenderer* renderer, int width, int height,
+                                     const LodSpriteOptions& options)
     : lod_(lod), renderer_(renderer), width_(width), height_(height), options_(options) {
+  if (!options.gpu_low && (!lod || !renderer))
+    throw Error("lod-sprite", "the sprite frame on the CPU needs the quadtree LOD and its renderer");
   if (!(options.epsilon > 0.0)) throw Error("lod-sprite", "error threshold epsilon must be positive (pixels)");
   if (!(options.high_error > 0.0f) || !(options.low_error >= options.high_error))
     throw Error("lod-sprite", "need 0 < high-resolution error <= low-resolution error (pixels)");
@@ -88,12 +110,13 @@ void LodSpriteRenderer::warmUpSpriteFrame() {
   // One sprite frame of 8 x 8 pixels over the terrain's middle, with the renderer's hole: the driver makes the
   // program's code at its first draw (llvmpipe: tens of milliseconds), which would otherwise be the first sprite
   // frame's (a 104 ms frame on the city-on-terrain drive).
-  const Heightfield& hf = lod_.heightfield();
+  const Box3 box = options_.gpu_high->bounds();
+  const Vec3 extent = box.hi - box.lo;
   Camera c;
   c.width = c.height = 8;
-  c.at = Vec3(float(0.5 * hf.extentX()), float(0.5 * hf.extentY()), hf.minHeight());
-  c.eye = c.at + Vec3(0.0f, -0.5f * float(hf.extentY()), hf.maxHeight() - hf.minHeight() + 100.0f);
-  c.far_plane = float(4.0 * (hf.extentX() + hf.extentY()) + 1000.0);
+  c.at = Vec3(box.lo.x + 0.5f * extent.x, box.lo.y + 0.5f * extent.y, box.lo.z);
+  c.eye = c.at + Vec3(0.0f, -0.5f * extent.y, extent.z + 100.0f);
+  c.far_plane = 4.0f * (extent.x + extent.y) + 1000.0f;
   gpu::RenderTarget key(8, 8), frame(8, 8);
   key.clear(options_.sky_color);
   frame.clear(options_.sky_color);
@@ -108,10 +131,10 @@ gpu::FrameStats LodSpriteRenderer::drawHigh(const Camera& camera, gpu::RenderTar
     options_.gpu_high->clearHole();
     return stats;
   }
-  lod_.build(camera, LodSettings{options_.high_error, true, false}, mesh);
-  removeTrianglesInside(mesh, options_.hole, uint32_t(lod_.width()));
-  renderer_.setIndices(mesh.indices, slot);
-  return renderer_.drawTextured(camera, target, 0, mesh.triangleCount(), slot);
+  lod_->build(camera, LodSettings{options_.high_error, true, false}, mesh);
+  removeTrianglesInside(mesh, options_.hole, uint32_t(lod_->width()));
+  renderer_->setIndices(mesh.indices, slot);
+  return renderer_->drawTextured(camera, target, 0, mesh.triangleCount(), slot);
 }
 
 LodSpriteRenderer::~LodSpriteRenderer() = default;
@@ -200,10 +223,13 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
 }
 
 SpriteError LodSpriteRenderer::frameError(const Vec3& v1, const Vec3& v2) const {
-  if (options_.gpu_low)
-    return spriteError(options_.gpu_high->lod(), options_.gpu_high->selection(low_handle_).nodes, v1, v2,
-                       options_.error_quadrants);
-  return spriteError(lod_, low_.quadrants, v1, v2);
+  if (options_.gpu_low) {
+    const GpuLodTerrain& terrain = *options_.gpu_high;
+    return spriteError(
+        terrain.lod(), [&terrain](int i, int j) { return terrain.gridHeight(i, j); },
+        terrain.selection(low_handle_).nodes, v1, v2, options_.error_quadrants);
+  }
+  return spriteError(*lod_, low_.quadrants, v1, v2);
 }
 
 gpu::FrameStats LodSpriteRenderer::drawCdlodSprite(const Camera& camera, int handle, gpu::RenderTarget& target,
@@ -270,8 +296,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     const CdlodSelection& low = options_.gpu_high->selection(low_handle_);
     low_triangles_ = low.nodes.size() * options_.gpu_high->renderer().trianglesPerNode();
   } else {
-    lod_.build(camera, LodSettings{options_.low_error, true, true}, low_);
-    removeTrianglesInside(low_, options_.hole, uint32_t(lod_.width()));
+    lod_->build(camera, LodSettings{options_.low_error, true, true}, low_);
+    removeTrianglesInside(low_, options_.hole, uint32_t(lod_->width()));
     info.quadrants = low_.quadrants.size();
     low_triangles_ = low_.triangleCount();
   }
@@ -393,7 +419,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     sprite_since_ = frame_;
     sprite_error_at_take_ = chosen_error;
     info.error_px = chosen_error;
-    if (!options_.gpu_low) visibility_.reset(lod_, current_->camera, &current_->depth, options_.visibility);
+    if (!options_.gpu_low) visibility_.reset(*lod_, current_->camera, &current_->depth, options_.visibility);
     if (pending_ && options_.predict_late) {
       // Not taken: a new one is made when this sprite is about to trip.
       ++counters_.predicted_discarded;
@@ -433,10 +459,10 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   const size_t n = low_.triangleCount();
   const size_t visible = visibility_.partition(low_.indices);
   if (info.source == SpriteSource::Fresh) current_->coverage_at_creation = n ? double(visible) / double(n) : 1.0;
-  renderer_.setIndices(low_.indices, 0);
-  gpu::addDraw(stats,
-               renderer_.drawSprite(camera, target, current_->target.colorTexture(), current_->view_proj, 0, visible, 0));
-  gpu::addDraw(stats, renderer_.drawTextured(camera, target, visible, n - visible, 0));
+  renderer_->setIndices(low_.indices, 0);
+  gpu::addDraw(stats, renderer_->drawSprite(camera, target, current_->target.colorTexture(), current_->view_proj, 0,
+                                            visible, 0));
+  gpu::addDraw(stats, renderer_->drawTextured(camera, target, visible, n - visible, 0));
   info.low_triangles = n;
   info.visible_triangles = visible;
   if (out) *out = info;

@@ -170,6 +170,10 @@ class LodSpriteRenderer {
   // Needs a current context. lod and renderer must outlive this object; frames are width x height.
   LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer, int width, int height,
                     const LodSpriteOptions& options);
+  // LOD-sprite wholly on the CDLOD terrain, with no quadtree LOD (a paged terrain, paged_gpu_lod.h, has none): its
+  // keyframes, high frames and sprite frames (options.gpu_low, required) are the terrain's; options.gpu_high is set
+  // to it. terrain must outlive this object.
+  LodSpriteRenderer(GpuLodTerrain& terrain, int width, int height, const LodSpriteOptions& options);
   ~LodSpriteRenderer();
 
   // Draws one frame into target (bound here; not cleared: the caller clears it to the sky colour). The camera must
@@ -217,8 +221,10 @@ class LodSpriteRenderer {
   PathCosts predictCosts(size_t low_triangles) const;
   gpu::FrameStats renderHigh(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo& info);
 
-  const QuadtreeLod& lod_;
-  gpu::TerrainRenderer& renderer_;
+  LodSpriteRenderer(const QuadtreeLod* lod, gpu::TerrainRenderer* renderer, int width, int height,
+                    const LodSpriteOptions& options);
+  const QuadtreeLod* lod_;               // null on the CDLOD terrain alone
+  gpu::TerrainRenderer* renderer_;       // likewise
   int width_, height_;
   LodSpriteOptions options_;
   LodSpriteCounters counters_;

@@ -18,7 +18,7 @@ constexpr double kSliceShare = 1.0 / 3.0;
 
 double LodSpriteRenderer::coverage(Keyframe& keyframe) {
   if (options_.gpu_low) return nodeCoverage(options_.gpu_high->selection(low_handle_).nodes, keyframe);
-  probe_.reset(lod_, keyframe.camera, &keyframe.depth, options_.visibility);
+  probe_.reset(*lod_, keyframe.camera, &keyframe.depth, options_.visibility);
   return probe_.visibleShare(low_.indices);
 }
 
@@ -65,9 +65,11 @@ void LodSpriteRenderer::schedulePrediction(const Camera& camera, float ahead, si
   }
   // Never extrapolate into the ground (a descent would otherwise end below the terrain): keep at least half of the
   // current height above the ground.
-  const Heightfield& hf = lod_.heightfield();
-  const float ground_now = hf.sample(camera.eye.x, camera.eye.y);
-  const float ground_then = hf.sample(predicted.eye.x, predicted.eye.y);
+  auto ground = [&](const Vec3& p) {
+    return options_.gpu_high ? options_.gpu_high->groundHeight(p.x, p.y) : lod_->heightfield().sample(p.x, p.y);
+  };
+  const float ground_now = ground(camera.eye);
+  const float ground_then = ground(predicted.eye);
   predicted.eye.z = std::max(predicted.eye.z, ground_then + 0.5f * std::max(camera.eye.z - ground_now, 0.0f));
   if (glm::length(predicted.at - predicted.eye) < 1e-3f) predicted.at = predicted.eye + camera.forward();
   try {
@@ -120,9 +122,9 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
   } else {
     // The quadtree LOD: step 0 (the frame after the switch) builds the mesh; steps 1..chunks draw one slice of it each.
     if (pending_chunk_ == 0) {
-      lod_.build(k.camera, LodSettings{options_.high_error, true, false}, pending_mesh_);
-      removeTrianglesInside(pending_mesh_, options_.hole, uint32_t(lod_.width()));
-      renderer_.setIndices(pending_mesh_.indices, 1);
+      lod_->build(k.camera, LodSettings{options_.high_error, true, false}, pending_mesh_);
+      removeTrianglesInside(pending_mesh_, options_.hole, uint32_t(lod_->width()));
+      renderer_->setIndices(pending_mesh_.indices, 1);
       k.target.clear(options_.sky_color);
       ++pending_chunk_;
       return;
@@ -131,7 +133,7 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     const size_t per_chunk = (total + chunks - 1) / chunks;
     const size_t first = std::min(total, (pending_chunk_ - 1) * per_chunk);
     const size_t count = std::min(total - first, per_chunk);
-    gpu::addDraw(stats, renderer_.drawTextured(k.camera, k.target, first, count, 1));
+    gpu::addDraw(stats, renderer_->drawTextured(k.camera, k.target, first, count, 1));
     info.ahead_triangles += count;
     if (++pending_chunk_ <= chunks) return;
   }
@@ -145,8 +147,8 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     return;
   }
   k.depth = k.target.readDepth();
-  lod_.build(k.frame_camera, LodSettings{options_.low_error, true, false}, probe_mesh_);
-  probe_.reset(lod_, k.camera, &k.depth, options_.visibility);
+  lod_->build(k.frame_camera, LodSettings{options_.low_error, true, false}, probe_mesh_);
+  probe_.reset(*lod_, k.camera, &k.depth, options_.visibility);
   k.coverage_at_creation = probe_.visibleShare(probe_mesh_.indices);
 }
 

@@ -22,7 +22,7 @@ int defaultOverviewStep(const TileCache& cache, const CdlodOptions& lod) {
 }  // namespace
 
 PagedGpuLodTerrain::PagedGpuLodTerrain(const TileCache& cache, const PagedGpuLodOptions& options)
-    : cache_(cache), options_(options), lod_(cdlodFromTileCacheKept(cache, options.lod)) {
+    : GpuLodTerrain(cdlodFromTileCacheKept(cache, options.lod)), cache_(cache), options_(options) {
   const TileLayout& l = cache.layout();
   overview_step_ = options.overview_step > 0 ? options.overview_step : defaultOverviewStep(cache, options.lod);
   fine_levels_ = 0;
@@ -39,6 +39,7 @@ PagedGpuLodTerrain::PagedGpuLodTerrain(const TileCache& cache, const PagedGpuLod
   to.step = overview_step_;
   overview_colour_ = terrainTexture(overview_, to);
   const int page_cells = l.tile_blocks * l.block;
+  tile_cells_ = page_cells;
   const size_t layer_bytes = gpu::CdlodPages(page_cells, 1).layerBytes();
   const int layers = int(std::min<size_t>(options.gpu_budget_bytes / layer_bytes, 2048));
   if (layers < 1)
@@ -52,15 +53,8 @@ PagedGpuLodTerrain::PagedGpuLodTerrain(const TileCache& cache, const PagedGpuLod
   ov.height = overview_.height;
   ov.heights = overview_.heights;
   ov.colour = &overview_colour_;
-  renderer_ = std::make_unique<gpu::CdlodRenderer>(l.width, l.height, Vec2(float(l.cell_x), float(l.cell_y)),
-                                                   options.lod.patch_cells, ov, *pages_);
-  std::vector<int> offsets;
-  std::vector<IVec2> counts;
-  for (int level = 0; level <= lod_.topLevel(); ++level) {
-    offsets.push_back(int(lod_.levelOffset(level)));
-    counts.emplace_back(lod_.nodesX(level), lod_.nodesY(level));
-  }
-  renderer_->setLevels(offsets, counts);
+  attachRenderer(std::make_unique<gpu::CdlodRenderer>(l.width, l.height, Vec2(float(l.cell_x), float(l.cell_y)),
+                                                      options.lod.patch_cells, ov, *pages_));
   worker_ = std::thread([this] { work(); });
 }
 
@@ -74,6 +68,23 @@ PagedGpuLodTerrain::~PagedGpuLodTerrain() {
 }
 
 size_t PagedGpuLodTerrain::gpuBytes() const { return renderer_->gpuBytes() + pages_->bytes(); }
+
+float PagedGpuLodTerrain::gridHeight(int i, int j) const {
+  const TileLayout& l = cache_.layout();
+  i = std::clamp(i, 0, l.width - 1);
+  j = std::clamp(j, 0, l.height - 1);
+  const int t = tile_cells_;
+  // A point on a tile's edge is in both tiles' pages.
+  for (const int tx : {i / t, i / t - 1})
+    for (const int ty : {j / t, j / t - 1}) {
+      if (tx < 0 || ty < 0 || i - tx * t > t || j - ty * t > t) continue;
+      const auto held = heights_of_.find({tx, ty});
+      if (held != heights_of_.end()) return held->second[size_t(i - tx * t) + size_t(j - ty * t) * size_t(t + 1)];
+    }
+  return overview_.sample(double(i) * l.cell_x, double(j) * l.cell_y);
+}
+
+float PagedGpuLodTerrain::groundHeight(double x, double y) const { return overview_.sample(x, y); }
 
 PagedGpuLodTerrain::Page PagedGpuLodTerrain::makePage(int tx, int ty) const {
   const Stopwatch clock;
@@ -175,6 +186,7 @@ int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKe
       if (!needed.count(*it)) {
         layer = layer_of_.at(*it);
         layer_of_.erase(*it);
+        heights_of_.erase(*it);
         lru_.erase(std::next(it).base());
         ++stats_.evictions;
         break;
@@ -182,6 +194,7 @@ int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKe
   }
   FF_CHECK(layer >= 0);  // draw() checked that the frame's pages fit
   pages_->upload(layer, page->heights, page->colour);
+  if (options_.keep_heights) heights_of_[tile] = std::move(page->heights);
   layer_of_[tile] = layer;
   lru_.push_front(tile);
   stats_.pages = layer_of_.size();
@@ -189,41 +202,40 @@ int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKe
   return layer;
 }
 
-PagedGpuLodFrame PagedGpuLodTerrain::draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target) {
-  lod_.select(camera, pixel_error, true, selection_);
-  if (selection_.ranges_changed) uploadRanges(selection_, *renderer_);
+void PagedGpuLodTerrain::placeNodes(std::span<const CdlodNode> nodes, std::vector<gpu::CdlodInstance>& out,
+                                    GpuLodFrame& frame) {
   std::set<TileKey> needed;
-  for (const CdlodNode& n : selection_.nodes)
+  for (const CdlodNode& n : nodes)
     if (n.level < fine_levels_) needed.insert(tileOf(n));
   if (needed.size() > size_t(pages_->layers()))
-    throw Error("paged CDLOD terrain", "this view needs " + std::to_string(needed.size()) + " pages; the GPU budget holds " +
-                                           std::to_string(pages_->layers()) + ": raise it");
-  PagedGpuLodFrame frame;
-  std::map<TileKey, int> layers;  // each page the frame reads, made resident once
+    throw Error("paged CDLOD terrain", "this view needs " + std::to_string(needed.size()) +
+                                           " pages; the GPU budget holds " + std::to_string(pages_->layers()) +
+                                           ": raise it");
+  std::map<TileKey, int> layers;  // each page the draw reads, made resident once
   for (const TileKey& t : needed) layers[t] = residentLayer(t, needed, frame.page_loads);
-  instances_.clear();
-  for (const CdlodNode& n : selection_.nodes) {
+  for (const CdlodNode& n : nodes) {
     const int layer = n.level < fine_levels_ ? layers.at(tileOf(n)) : -1;
     frame.paged_nodes += layer >= 0 ? 1 : 0;
-    instances_.push_back(cdlodInstance(n, lod_.patchCells(), layer));
+    out.push_back(cdlodInstance(n, lod_.patchCells(), layer));
   }
-  frame.draw = renderer_->draw(camera, target, instances_);
-  frame.nodes = selection_.nodes.size();
   frame.pages_needed = needed.size();
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stats_.prefetched = prefetched_;
-    stats_.load_seconds += worker_seconds_;
-    worker_seconds_ = 0.0;
-  }
-  if (options_.prefetch_frames > 0) prefetchAhead(camera, pixel_error);
-  last_camera_ = camera;
+  std::lock_guard<std::mutex> lock(mutex_);
+  stats_.prefetched = prefetched_;
+  stats_.load_seconds += worker_seconds_;
+  worker_seconds_ = 0.0;
+}
+
+PagedGpuLodFrame PagedGpuLodTerrain::drawFrame(const Camera& camera, float pixel_error, gpu::RenderTarget& target) {
+  const PagedGpuLodFrame frame = draw(camera, pixel_error, target);
+  prefetch(camera, pixel_error);
   return frame;
 }
 
-void PagedGpuLodTerrain::prefetchAhead(const Camera& camera, float pixel_error) {
-  if (!last_camera_) return;
-  const Vec3 eye_step = camera.eye - last_camera_->eye, at_step = camera.at - last_camera_->at;
+void PagedGpuLodTerrain::prefetch(const Camera& camera, float pixel_error) {
+  const std::optional<Camera> last = last_camera_;
+  last_camera_ = camera;
+  if (options_.prefetch_frames == 0 || !last) return;
+  const Vec3 eye_step = camera.eye - last->eye, at_step = camera.at - last->at;
   if (glm::length(eye_step) < 1e-6f && glm::length(at_step) < 1e-6f) return;
   std::set<TileKey> wanted;
   CdlodSelection& ahead = ahead_;  // its ranges are remade only when the bound or the camera model change

@@ -10,6 +10,9 @@
 // frame the pages the camera will need half and all of prefetch_frames frames ahead, moving as it last moved, are
 // read on a worker thread, so that a steady flight rarely waits.
 //
+// It is a GpuLodTerrain (gpu_lod.h): a host may select and draw in steps (LOD-sprite, lod_sprite.h), each draw making
+// the pages its nodes read resident; drawFrame is the whole frame of a host that draws the terrain alone.
+//
 // The same tree, ranges and pages give the same frame whatever the budget (the pixels do not depend on what was
 // evicted: tested). Against the whole grid's CDLOD (gpu_lod.h) the frames differ where coarse nodes morph (the
 // overview is sampled between their vertices) and in the coarse nodes' colours (a texel per overview point).
@@ -33,6 +36,7 @@
 #include "farfield/gpu/cdlod_renderer.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/terrain/cdlod.h"
+#include "farfield/terrain/gpu_lod.h"
 #include "farfield/terrain/tile_cache.h"
 
 namespace farfield::terrain {
@@ -42,6 +46,9 @@ struct PagedGpuLodOptions {
   size_t gpu_budget_bytes = size_t(256) << 20;  // the pages' layers (heights and colours with mipmaps)
   int prefetch_frames = 32;  // pages read ahead along the camera's motion (0: only what a frame needs, at once)
   int overview_step = 0;     // 2^F; 0 = the largest power of two up to 16 that the cache and its tiles allow
+  // Keep the heights of the pages held on the CPU as well (4 bytes a grid point of a page), for gridHeight
+  // (LOD-sprite's error metric); without them gridHeight answers from the overview.
+  bool keep_heights = false;
 };
 
 struct PagedGpuLodStats {
@@ -54,37 +61,40 @@ struct PagedGpuLodStats {
   double load_seconds = 0.0;  // reading tiles and making their colours (both threads)
 };
 
-struct PagedGpuLodFrame {
-  gpu::FrameStats draw;
-  size_t nodes = 0;         // drawn
-  size_t paged_nodes = 0;   // of them, reading a page
-  size_t pages_needed = 0;  // distinct pages the frame read
-  size_t page_loads = 0;    // read in this frame (waited for)
-};
+// A frame's counts: GpuLodFrame's paged_nodes, pages_needed and page_loads (read in the frame: it waited).
+using PagedGpuLodFrame = GpuLodFrame;
 
-class PagedGpuLodTerrain {
+class PagedGpuLodTerrain : public GpuLodTerrain {
  public:
   // Needs a current context; cache must outlive this. Reads the cache's node data (every tile once) and overview.
   // Throws farfield::Error when the budget holds no page, or as cdlodFromTileCache does.
   PagedGpuLodTerrain(const TileCache& cache, const PagedGpuLodOptions& options = {});
-  ~PagedGpuLodTerrain();
-  PagedGpuLodTerrain(const PagedGpuLodTerrain&) = delete;
-  PagedGpuLodTerrain& operator=(const PagedGpuLodTerrain&) = delete;
+  ~PagedGpuLodTerrain() override;
 
-  // Draws the terrain for the camera under the bound (pixels) into the bound target (not cleared; no wait). Throws
-  // farfield::Error when the frame needs more pages than the budget holds.
-  PagedGpuLodFrame draw(const Camera& camera, float pixel_error, gpu::RenderTarget& target);
+  // A frame: draws the terrain for the camera under the bound (pixels) into the bound target (not cleared; no wait),
+  // then reads ahead (prefetch). Every draw (GpuLodTerrain's draw, drawSelection, drawNodes) throws farfield::Error
+  // when its nodes need more pages than the budget holds.
+  PagedGpuLodFrame drawFrame(const Camera& camera, float pixel_error, gpu::RenderTarget& target);
+  // Queues the pages the camera will need half and all of prefetch_frames frames ahead under the bound, moving as it
+  // moved since the last call, for the worker to read (once a frame, with the frame's camera).
+  void prefetch(const Camera& camera, float pixel_error);
 
   // Waits for the GPU (glFinish): the end of a timed frame.
   void finish() { renderer_->finish(); }
 
-  const CdlodTerrain& lod() const { return lod_; }
+  float gridHeight(int i, int j) const override;
+  float groundHeight(double x, double y) const override;
+
   const PagedGpuLodStats& stats() const { return stats_; }
   int fineLevels() const { return fine_levels_; }
   int overviewStep() const { return overview_step_; }
   int pageLayers() const { return pages_->layers(); }
   size_t pageBytes() const { return pages_->layerBytes(); }  // one page's GPU bytes
-  size_t gpuBytes() const;
+  size_t gpuBytes() const override;
+
+ protected:
+  void placeNodes(std::span<const CdlodNode> nodes, std::vector<gpu::CdlodInstance>& out,
+                  GpuLodFrame& frame) override;
 
  private:
   struct Page {
@@ -96,21 +106,18 @@ class PagedGpuLodTerrain {
   Page makePage(int tx, int ty) const;
   TileKey tileOf(const CdlodNode& node) const;
   int residentLayer(const TileKey& tile, const std::set<TileKey>& needed, size_t& loads);
-  void prefetchAhead(const Camera& camera, float pixel_error);
   void work();
 
   const TileCache& cache_;
   PagedGpuLodOptions options_;
-  CdlodTerrain lod_;
-  int overview_step_ = 1, fine_levels_ = 0;
+  int overview_step_ = 1, fine_levels_ = 0, tile_cells_ = 1;
   Heightfield overview_;
   image::ColorImage overview_colour_;
   std::unique_ptr<gpu::CdlodPages> pages_;
-  std::unique_ptr<gpu::CdlodRenderer> renderer_;
-  CdlodSelection selection_, ahead_;
-  std::vector<gpu::CdlodInstance> instances_;
+  CdlodSelection ahead_;
   PagedGpuLodStats stats_;
   std::map<TileKey, int> layer_of_;  // resident tiles
+  std::map<TileKey, std::vector<float>> heights_of_;  // with keep_heights: their heights, (S + 1)^2 each
   std::list<TileKey> lru_;           // most recently used first
   std::vector<int> free_layers_;
   std::optional<Camera> last_camera_;

@@ -150,6 +150,12 @@ SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> qua
 SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
                         size_t max_quadrants) {
   const Heightfield& hf = lod.heightfield();
+  return spriteError(lod, [&hf](int i, int j) { return hf.at(i, j); }, nodes, v1, v2, max_quadrants);
+}
+
+SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std::span<const CdlodNode> nodes,
+                        const Vec3& v1, const Vec3& v2, size_t max_quadrants) {
+  const CdlodGrid& hf = lod.grid();
   const int p = lod.patchCells();
   // Per node of level >= 1: its cells inside the grid (columns x rows), and its weight for the sample's allocation.
   struct Stratum {
@@ -179,7 +185,8 @@ SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> node
   }
   SpriteError e;
   const DVec3 eye1(v1), eye2(v2);
-  auto point = [&](int i, int j) { return DVec3(hf.position(i, j)); };
+  // As Heightfield::position: (i * cell_x, j * cell_y, height).
+  auto point = [&](int i, int j) { return DVec3(Vec3(float(i * hf.cell_x), float(j * hf.cell_y), height(i, j))); };
   DVec3 corners[4];
   double weighted = 0.0, represented = 0.0;
   for (const Stratum& st : strata) {

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <span>
 
 #include "farfield/core/camera.h"
@@ -63,6 +64,11 @@ SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> qua
 // frame. C' as spriteProjection with near. quadrants: the cells evaluated. Needs the terrain's heights.
 SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
                         size_t max_quadrants = 1024);
+// The same with the grid's heights from `height` (grid point i, j), for a terrain whose heights are not held whole
+// (a paged one: gpu_lod.h's GpuLodTerrain::gridHeight).
+using GridHeightFn = std::function<float(int, int)>;
+SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std::span<const CdlodNode> nodes,
+                        const Vec3& v1, const Vec3& v2, size_t max_quadrants = 1024);
 
 // Equation 2: true when a new keyframe is due (mean theta^2 >= (beta * epsilon)^2). No quadrants: never due.
 bool keyframeDue(const SpriteError& error, double beta, double epsilon_pixels);

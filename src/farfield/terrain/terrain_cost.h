@@ -65,5 +65,10 @@ struct TerrainCostOptions {
 // context; must not run inside a timed frame. Throws farfield::Error for no views or bad options.
 TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& renderer,
                                  const TerrainCostOptions& options);
+// The CDLOD terrain's models alone (TerrainCost::gpu_high and gpu_sprite; `frame` is left unfitted and the read-back
+// term 0): for LOD-sprite wholly on the CDLOD terrain, e.g. a paged one with no quadtree LOD. options.gpu_high and
+// sprite_calls are not used. Needs a current context; must not run inside a timed frame. Throws farfield::Error for
+// no views or bad options.
+TerrainCost calibrateCdlodCost(GpuLodTerrain& terrain, const TerrainCostOptions& options);
 
 }  // namespace farfield::terrain

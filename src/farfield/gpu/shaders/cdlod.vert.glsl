@@ -7,7 +7,8 @@
 // With FF_CDLOD_SPRITE (LOD-sprite's frame on the GPU, terrain/lod_sprite.h): each vertex is also projected into the
 // sprite's keyframe and tested against the keyframe's depth as terrain/keyframe_visibility.h's vertexVisible does
 // (Chen et al. 1999, equation 3); v_hidden is 0 for a visible vertex and large otherwise, so that it interpolates to
-// 0 only over a triangle whose three vertices are visible (terrain.frag.glsl then takes the sprite there).
+// 0 only over a triangle whose three vertices are visible (terrain.frag.glsl then takes the sprite there). Paged, the
+// vertex's normal comes from its node's source (page or overview).
 
 layout(std430, binding = 0) readonly buffer Nodes { ivec4 nodes[]; };  // x0, y0, level, page layer (FF_PAGED)
 layout(std430, binding = 1) readonly buffer Ranges { vec2 ranges[]; };  // per node: morph start and end
@@ -41,6 +42,7 @@ uniform vec3 u_sprite_thickness;   // VisibilityOptions: thickness_m, thickness_
 out vec4 v_sprite_clip;
 out float v_hidden;
 
+#ifndef FF_PAGED
 // The unit normal at grid point c from central differences, one-sided at the border (Heightfield::normal).
 vec3 gridNormal(ivec2 c) {
   ivec2 lo = max(c - 1, ivec2(0)), hi = min(c + 1, u_last);
@@ -50,6 +52,7 @@ vec3 gridNormal(ivec2 c) {
                               texelFetch(u_heights, ivec2(c.x, lo.y), 0).r) / (float(hi.y - lo.y) * u_cell.y) : 0.0;
   return normalize(vec3(-dzdx, -dzdy, 1.0));
 }
+#endif
 
 // Equation 3 (keyframe_visibility.cpp's vertexVisible): inside the keyframe, on its surface within the thickness.
 bool spriteVisible(vec3 p, vec3 n, vec4 clip) {
@@ -100,6 +103,23 @@ vec2 sourceCoord(vec2 g, ivec2 tile_origin, int layer) {
 ivec2 sourceLast(int layer) {
   return layer >= 0 ? ivec2(u_page_cells) : textureSize(u_heights, 0) - 1;
 }
+#ifdef FF_CDLOD_SPRITE
+float sourceHeight(ivec2 p, int layer) {
+  return layer >= 0 ? texelFetch(u_pages, ivec3(p, layer), 0).r : texelFetch(u_heights, p, 0).r;
+}
+// The unit normal at the source point nearest grid coordinates gm, from central differences over the node's source:
+// its page (the grid's own points; one-sided at the page's edge) or the overview (every u_overview_step-th point).
+vec3 sourceNormal(vec2 gm, ivec2 tile_origin, int layer, ivec2 last) {
+  ivec2 c = clamp(ivec2(floor(sourceCoord(gm, tile_origin, layer) + 0.5)), ivec2(0), last);
+  ivec2 lo = max(c - 1, ivec2(0)), hi = min(c + 1, last);
+  vec2 spacing = u_cell * (layer >= 0 ? 1.0 : float(u_overview_step));
+  float dzdx = hi.x > lo.x ? (sourceHeight(ivec2(hi.x, c.y), layer) - sourceHeight(ivec2(lo.x, c.y), layer)) /
+                                 (float(hi.x - lo.x) * spacing.x) : 0.0;
+  float dzdy = hi.y > lo.y ? (sourceHeight(ivec2(c.x, hi.y), layer) - sourceHeight(ivec2(c.x, lo.y), layer)) /
+                                 (float(hi.y - lo.y) * spacing.y) : 0.0;
+  return normalize(vec3(-dzdx, -dzdy, 1.0));
+}
+#endif
 #endif
 
 void main() {
@@ -149,7 +169,12 @@ void main() {
 #ifdef FF_CDLOD_SPRITE
   v_sprite_clip = u_sprite_view_proj * vec4(world, 1.0);
   // The normal of the grid point nearest the (possibly morphed) vertex.
-  v_hidden = spriteVisible(world, gridNormal(min(ivec2(floor(gm + 0.5)), u_last)), v_sprite_clip) ? 0.0 : 1e6;
+#ifdef FF_PAGED
+  vec3 normal = sourceNormal(gm, tile_origin, layer, last);
+#else
+  vec3 normal = gridNormal(min(ivec2(floor(gm + 0.5)), u_last));
+#endif
+  v_hidden = spriteVisible(world, normal, v_sprite_clip) ? 0.0 : 1e6;
 #endif
   gl_Position = u_view_proj * vec4(world, 1.0);
 }

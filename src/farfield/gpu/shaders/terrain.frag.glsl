@@ -4,7 +4,7 @@
 // correctly and divided per fragment, so a point of the surface samples the sprite where the sprite camera saw it.
 // With FF_CDLOD_SPRITE (the CDLOD terrain's LOD-sprite frame, cdlod.vert.glsl with FF_CDLOD_SPRITE): the sprite,
 // projected as with FF_SPRITE, where the fragment's triangle has its three vertices visible in the keyframe (v_hidden
-// interpolates to 0 only there), the original texture elsewhere, in one draw.
+// interpolates to 0 only there), the original texture elsewhere (a paged terrain's page colours), in one draw.
 // With FF_HOLE (the CDLOD terrain, gpu/cdlod_renderer.h), fragments inside a rectangle of world x, y are left out.
 
 layout(location = 0) out vec4 o_color;
@@ -33,6 +33,16 @@ in vec2 v_world_xy;
 uniform vec4 u_hole;
 #endif
 
+#ifndef FF_SPRITE
+// The original texture at the fragment: a paged terrain's page colours where its node reads a page.
+vec3 originalColour() {
+#ifdef FF_PAGED
+  if (v_layer >= 0) return texture(u_page_colours, vec3(v_uv, float(v_layer))).rgb;
+#endif
+  return texture(u_texture, v_uv).rgb;
+}
+#endif
+
 void main() {
 #ifdef FF_HOLE
   if (all(greaterThan(v_world_xy, u_hole.xy)) && all(lessThan(v_world_xy, u_hole.zw))) discard;
@@ -42,16 +52,13 @@ void main() {
     vec2 st = v_sprite_clip.xy / v_sprite_clip.w * 0.5 + 0.5;
     o_color = vec4(texture(u_sprite, st).rgb, 1.0);
   } else {
-    o_color = vec4(texture(u_texture, v_uv).rgb, 1.0);
+    o_color = vec4(originalColour(), 1.0);
   }
 #elif defined(FF_SPRITE)
   vec2 st = v_sprite_clip.xy / v_sprite_clip.w * 0.5 + 0.5;
   o_color = vec4(texture(u_texture, st).rgb, 1.0);
-#elif defined(FF_PAGED)
-  o_color = vec4((v_layer >= 0 ? texture(u_page_colours, vec3(v_uv, float(v_layer))) : texture(u_texture, v_uv)).rgb,
-                 1.0);
 #else
-  o_color = vec4(texture(u_texture, v_uv).rgb, 1.0);
+  o_color = vec4(originalColour(), 1.0);
 #endif
   o_id = u_object_id;
 }
