@@ -176,6 +176,10 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
   bench->add_option("--clearance", o.clearance, "Flythrough height above the ground near it, m (0 = 2% of the diagonal)")
       ->capture_default_str();
   bench->add_option("--epsilon", o.epsilon, "LOD-sprite error threshold, pixels")->capture_default_str();
+  bench->add_option("--max-magnification", o.max_magnification,
+                    "LOD-sprite: a keyframe also once the sprite is magnified more than this on average (0 = Chen et "
+                    "al.'s metric alone)")
+      ->capture_default_str();
   bench->add_option("-o,--output", o.out_dir, "Output directory")->required();
   bench->add_option("--size", a->size, "Frame size WxH")->capture_default_str();
   bench->add_option("--high-error", o.high_error, "High-resolution LOD threshold, pixels")->capture_default_str();
@@ -244,6 +248,10 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
                   "the path's views), timed apart, compared with the CDLOD frame");
   tiles->add_flag("--predict", to.lod_sprite_predict,
                   "With --lod-sprite: keyframes rendered ahead, late, in slices (as lod-sprite-gpu-predict)");
+  tiles->add_option("--max-magnification", to.max_magnification,
+                    "With --lod-sprite: a keyframe also once the sprite is magnified more than this on average (its "
+                    "texels cover more pixels: it blurs); 0 = Chen et al.'s metric alone")
+      ->capture_default_str();
   tiles->add_option("--psnr-stride", to.psnr_stride,
                     "With --lod-sprite: compare every K-th frame with the CDLOD frame (0 = never)")
       ->capture_default_str();

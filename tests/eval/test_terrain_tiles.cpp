@@ -149,13 +149,15 @@ TEST(TerrainTilesGL, LodSpriteRunsOnThePagedTerrainBesideItsCdlodFrames) {
   std::string line;
   size_t rows = 0, compared = 0;
   std::getline(csv, line);
-  EXPECT_EQ(line, "frame,cdlod_ms,lod_sprite_ms,path,source,triangles,error_px,psnr_vs_cdlod");
+  EXPECT_EQ(line, "frame,cdlod_ms,lod_sprite_ms,path,source,triangles,error_px,magnification,psnr_vs_cdlod");
   while (std::getline(csv, line)) {
     ++rows;
     compared += line.back() != ',' ? 1 : 0;
   }
   EXPECT_EQ(rows, frames);
   EXPECT_EQ(compared, s["psnr_vs_cdlod_frames"].get<size_t>());
+  for (const char* f : {"lod_sprite_00000.png", "lod_sprite_diff_00000.png"})
+    EXPECT_TRUE(std::filesystem::exists(out / "frames" / f)) << f;
   o.gpu_lod = false;
   test::expectErrorMentions([&] { runTerrainTiles(o); }, {"--lod-sprite", "--cpu-lod"});
 }

@@ -242,5 +242,53 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
   EXPECT_GT(worst_psnr, 25.0);
 }
 
+// LodSpriteOptions::max_magnification: approaching the terrain head-on, equation 2 alone lets the sprite be magnified
+// (its texels cover more than a pixel: it blurs) while theta stays small; with the bound a keyframe is taken before
+// the sprite is magnified past it, and the frames are nearer the CDLOD high frames.
+TEST(LodSpriteGL, BoundedMagnificationTakesKeyframesBeforeTheSpriteBlurs) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
+  options.gpu_low = true;
+  TerrainCost cost = spritesPay();
+  options.cost = &cost;
+  LodSpriteOptions bounded = options;
+  bounded.max_magnification = 1.3;
+  LodSpriteRenderer paper(*scene.lod, *scene.renderer, 128, 128, options);
+  LodSpriteRenderer sharp(*scene.lod, *scene.renderer, 128, 128, bounded);
+  const Vec3 target(1280.0f, 1280.0f, scene.hf.sample(1280.0, 1280.0));
+  const Vec3 start(1280.0f, -1200.0f, scene.hf.maxHeight() + 900.0f);
+  gpu::RenderTarget frame(128, 128), expected(128, 128);
+  double mean_paper = 0.0, mean_sharp = 0.0, most_paper = 1.0, most_sharp = 1.0;
+  for (int f = 0; f < 40; ++f) {
+    const Camera camera = makeCamera(start + (target - start) * (0.018f * float(f)), target);
+    expected.clear(kSky);
+    gpu_lod.draw(camera, options.high_error, expected);
+    const image::ColorImage high = expected.readColor();
+    LodSpriteFrameInfo a, b;
+    frame.clear(kSky);
+    paper.render(camera, frame, &a);
+    mean_paper += std::min(image::psnr(frame.readColor(), high), 99.0) / 40.0;
+    frame.clear(kSky);
+    sharp.render(camera, frame, &b);
+    mean_sharp += std::min(image::psnr(frame.readColor(), high), 99.0) / 40.0;
+    if (a.path == TerrainPath::Sprite) most_paper = std::max(most_paper, a.magnification);
+    if (b.path == TerrainPath::Sprite) {
+      most_sharp = std::max(most_sharp, b.magnification);
+      EXPECT_LE(b.magnification, bounded.max_magnification) << "frame " << f;
+    }
+  }
+  std::printf("equation 2 alone: %zu keyframes, sprite magnified %.2fx at most, mean PSNR %.1f dB; bounded to %.1fx: "
+              "%zu keyframes, %.2fx at most, mean PSNR %.1f dB\n",
+              paper.counters().fresh_keyframes, most_paper, mean_paper, bounded.max_magnification,
+              sharp.counters().fresh_keyframes, most_sharp, mean_sharp);
+  EXPECT_GT(most_paper, bounded.max_magnification) << "the path must magnify the sprite for the test to mean much";
+  EXPECT_GT(sharp.counters().fresh_keyframes, paper.counters().fresh_keyframes);
+  EXPECT_GT(mean_sharp, mean_paper + 0.5);
+  LodSpriteOptions bad = bounded;
+  bad.max_magnification = 0.9;
+  EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);
+}
+
 }  // namespace
 }  // namespace farfield::terrain

@@ -2,6 +2,7 @@
 // case and a numerical one (marching along the ray v1 -> C over the quadrant's fan surface).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -184,6 +185,64 @@ TEST(SpriteError, CdlodSampleStandsForEveryCell) {
     previous = all.mean_theta_sq;
   }
   EXPECT_LT(spriteError(lod, selection.nodes, camera.eye, camera.eye, 512).mean_theta_sq, 1e-20);
+}
+
+// The sprite's magnification (SpriteError::mean_magnification): over every cell, the mean of |C - v1| / |C - v2| with
+// C each cell's central grid point, counted independently here; a view that moved halfway towards the ground sees
+// the sprite magnified, one that moved away minified, and the same viewpoint not at all; the keyframe is due past
+// the bound.
+TEST(SpriteError, MagnificationIsTheMeanDistanceRatioOverTheCells) {
+  FractalOptions fo;
+  fo.size = 129;
+  fo.seed = 3;
+  fo.cell_size = 20.0;
+  fo.relief = 300.0;
+  const Heightfield hf = fractalTerrain(fo);
+  const CdlodTerrain lod(hf, CdlodOptions{8, 16, 0.2f});
+  Camera camera;
+  camera.eye = Vec3(1280.0f, -600.0f, hf.maxHeight() + 400.0f);
+  camera.at = Vec3(1280.0f, 1280.0f, 0.0f);
+  camera.width = camera.height = 256;
+  camera.fov_y = float(degToRad(60.0));
+  camera.near_plane = 1.0f;
+  camera.far_plane = 50000.0f;
+  CdlodSelection selection;
+  lod.select(camera, 4.0f, true, selection);
+  const Vec3 centre(1280.0f, 1280.0f, hf.sample(1280.0, 1280.0));
+  const int p = lod.patchCells();
+  for (const float toward : {0.5f, -0.5f, 0.0f}) {
+    const Vec3 v2 = camera.eye + (centre - camera.eye) * (0.5f * toward);
+    double sum = 0.0;
+    size_t cells = 0;
+    for (const CdlodNode& n : selection.nodes) {
+      if (n.level < 1) continue;
+      const int s = 1 << n.level;
+      for (int j = 0; j < p; ++j)
+        for (int i = 0; i < p; ++i) {
+          const int cx = (n.x * p + i) * s, cy = (n.y * p + j) * s;
+          if (cx + s > hf.width - 1 || cy + s > hf.height - 1) continue;
+          const DVec3 c(hf.position(cx + s / 2, cy + s / 2));
+          sum += glm::length(c - DVec3(camera.eye)) / glm::length(c - DVec3(v2));
+          ++cells;
+        }
+    }
+    const SpriteError e = spriteError(lod, selection.nodes, camera.eye, v2, 0);
+    ASSERT_EQ(e.skipped, 0u);
+    ASSERT_GT(cells, 100u);
+    ASSERT_EQ(e.quadrants, cells);
+    EXPECT_NEAR(e.mean_magnification, sum / double(cells), 1e-9) << "moved " << toward;
+    if (toward > 0.0f) {
+      EXPECT_GT(e.mean_magnification, 1.1);
+    } else if (toward < 0.0f) {
+      EXPECT_LT(e.mean_magnification, 0.95);
+    } else {
+      EXPECT_DOUBLE_EQ(e.mean_magnification, 1.0);
+    }
+    const double beta = pixelAngle(camera);
+    EXPECT_EQ(keyframeDue(e, beta, 1e9, std::max(1.0001, e.mean_magnification * 0.99)), toward > 0.0f);
+    EXPECT_FALSE(keyframeDue(e, beta, 1e9, e.mean_magnification + 0.01));
+    EXPECT_FALSE(keyframeDue(e, beta, 1e9, 0.0));  // no bound on the magnification
+  }
 }
 
 }  // namespace

@@ -252,6 +252,8 @@ void checkOptions(const TerrainBenchOptions& o) {
   if (o.out_dir.empty()) throw Error("--output", "an output directory is required");
   if (o.width < 1 || o.height < 1) throw Error("--size", "width and height must be positive");
   if (!(o.epsilon > 0.0)) throw Error("--epsilon", "must be positive (pixels)");
+  if (!(o.max_magnification == 0.0 || o.max_magnification > 1.0))
+    throw Error("--max-magnification", "must be above 1 (0: not bounded)");
   if (!(o.high_error > 0.0f && o.low_error >= o.high_error))
     throw Error("--high-error/--low-error", "need 0 < high <= low (pixels)");
   if (o.quality_stride < 1) throw Error("--quality-stride", "must be at least 1");
@@ -301,6 +303,7 @@ TerrainBenchResult runTerrainBench(const TerrainBenchOptions& options) {
   run->high_error = options.high_error;
   run->low_error = options.low_error;
   run->epsilon = options.epsilon;
+  run->max_magnification = options.max_magnification;
   run->sprite_tile_cells = options.sprite_tile_cells;
   const ScopedTerrainRun scoped(run);  // the harness's terrain modes draw this terrain
   result.terrain = run->data->describe();

@@ -31,6 +31,7 @@ std::shared_ptr<TerrainRun> terrainRunFor(const ModeContext& context, const std:
     loaded->low_error =
         checkedCast<float>(positiveOption(context, "low_error", loaded->low_error), "--mode-option low_error", "value");
     loaded->epsilon = positiveOption(context, "epsilon", loaded->epsilon);
+    loaded->max_magnification = numberOption(context, "max_magnification", 0.0, 0.0);
     loaded->sprite_tile_cells = intOption(context, "tile_cells", loaded->sprite_tile_cells, 1, 1 << 20);
     if (context.renderer) loaded->sky = context.renderer->light().sky_color;
     run = std::move(loaded);
@@ -151,6 +152,7 @@ terrain::LodSpriteOptions spriteOptions(const TerrainRun& run, SpriteVariant var
   o.gpu_high = gpu_high;
   o.gpu_low = gpu_high != nullptr;
   o.epsilon = epsilon;
+  o.max_magnification = run.max_magnification;
   o.high_error = run.high_error;
   o.low_error = run.low_error;
   o.sky_color = run.sky;

@@ -85,6 +85,8 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   if (!(o.budget_mb > 0.0)) throw Error("--budget-mb", "must be positive");
   if (o.tile_blocks < 1) throw Error("--tile-blocks", "must be at least 1");
   if (!(o.pixel_error > 0.0f)) throw Error("--pixel-error", "must be positive");
+  if (!(o.max_magnification == 0.0 || o.max_magnification > 1.0))
+    throw Error("--max-magnification", "must be above 1 (0: not bounded)");
   const Stopwatch total;
   const fs::path out(o.out_dir);
   fs::create_directories(out);
@@ -175,6 +177,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
         so.pixel_error = o.pixel_error;
         so.low_error = o.low_error;
         so.predict = o.lod_sprite_predict;
+        so.max_magnification = o.max_magnification;
         sprite_run = std::make_unique<PagedSpriteRun>(*cdlod, cameras, so);
         sprite_target = std::make_unique<gpu::RenderTarget>(o.width, o.height);
         std::fprintf(stderr, "LOD-sprite: cost model fitted on the path's views in %.1f s\n",
@@ -209,9 +212,13 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
         if (o.psnr_stride > 0 && f % o.psnr_stride == 0)
           sf.psnr_vs_high = std::min(image::psnr(sprite_target->readColor(), target->readColor()), kPsnrCapDb);
         if (o.sample_stride > 0 && f % o.sample_stride == 0) {
-          char name[40];
+          // The LOD-sprite frame and its difference from the CDLOD frame (frame_NNNNN.png).
+          char name[48];
+          const image::ColorImage sprite_image = sprite_target->readColor();
           std::snprintf(name, sizeof name, "lod_sprite_%05zu.png", f);
-          image::writePng((out / "frames" / name).string(), sprite_target->readColor());
+          image::writePng((out / "frames" / name).string(), sprite_image);
+          std::snprintf(name, sizeof name, "lod_sprite_diff_%05zu.png", f);
+          image::writePng((out / "frames" / name).string(), image::diffHeatmap(target->readColor(), sprite_image));
         }
         sprite_frames.push_back(sf);
       }
@@ -405,12 +412,13 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
       j["render"]["lod_sprite"] = sprite_run->summary(sprite_frames, cdlod_ms);
       render_md += PagedSpriteRun::markdown(j["render"]["lod_sprite"]);
       std::ostringstream sc;
-      sc << "frame,cdlod_ms,lod_sprite_ms,path,source,triangles,error_px,psnr_vs_cdlod\n";
+      sc << "frame,cdlod_ms,lod_sprite_ms,path,source,triangles,error_px,magnification,psnr_vs_cdlod\n";
       for (size_t f = 0; f < sprite_frames.size(); ++f) {
         const PagedSpriteFrame& sf = sprite_frames[f];
         sc << f << ',' << cdlod_ms[f] << ',' << sf.ms << ','
            << (sf.info.path == terrain::TerrainPath::Sprite ? "sprite" : "high") << ','
-           << terrain::spriteSourceName(sf.info.source) << ',' << sf.triangles << ',' << sf.info.error_px << ',';
+           << terrain::spriteSourceName(sf.info.source) << ',' << sf.triangles << ',' << sf.info.error_px << ','
+           << sf.info.magnification << ',';
         if (sf.psnr_vs_high >= 0.0) sc << sf.psnr_vs_high;
         sc << '\n';
       }

@@ -52,6 +52,7 @@ struct TerrainTilesOptions {
   // (untimed). lod_sprite_predict: keyframes rendered ahead, late, in slices.
   bool lod_sprite = false;
   bool lod_sprite_predict = false;
+  double max_magnification = 0.0;  // with lod_sprite: terrain::LodSpriteOptions::max_magnification
   size_t psnr_stride = 10;
 };
 

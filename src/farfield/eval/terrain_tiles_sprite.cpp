@@ -63,6 +63,7 @@ PagedSpriteRun::PagedSpriteRun(terrain::PagedGpuLodTerrain& terrain, std::span<c
   terrain::LodSpriteOptions o;
   o.gpu_low = true;
   o.epsilon = options.epsilon;
+  o.max_magnification = options.max_magnification;
   o.high_error = options.pixel_error;
   o.low_error = options.low_error;
   o.sky_color = kSky;
@@ -117,6 +118,7 @@ nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame>
   j["epsilon"] = options_.epsilon;
   j["low_error"] = options_.low_error;
   j["predict"] = options_.predict;
+  j["max_magnification"] = options_.max_magnification;
   j["calibration_seconds"] = calibration_seconds_;
   j["cost"] = cost_.toJson();
   return j;

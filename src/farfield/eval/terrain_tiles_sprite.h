@@ -26,6 +26,7 @@ struct PagedSpriteOptions {
   float pixel_error = 1.0f;  // keyframes' and high frames' bound, pixels
   float low_error = 4.0f;    // sprite frames' bound, pixels
   bool predict = false;      // keyframes rendered ahead, late, in slices (lod-sprite-gpu-predict)
+  double max_magnification = 0.0;  // terrain::LodSpriteOptions::max_magnification (0: equation 2 alone)
   int calibration_views = 5; // path cameras the cost model is fitted on (spread along the path)
 };
 

@@ -94,6 +94,8 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod* lod, gpu::TerrainRendere
   if (!(options.keyframe_margin >= 0.0f && options.keyframe_margin <= 1.0f))
     throw Error("lod-sprite", "keyframe margin must be 0..1 (share of the frame size per side)");
   if (options.lifetime_history < 1) throw Error("lod-sprite", "lifetime history must be at least 1 sprite");
+  if (!(options.max_magnification == 0.0 || options.max_magnification > 1.0))
+    throw Error("lod-sprite", "the largest magnification must be above 1 (0: not bounded)");
   if (options.gpu_high && options.cost && !options.cost->gpu_high)
     throw Error("lod-sprite", "the CDLOD high LOD needs a cost model fitted on its frames (TerrainCostOptions::gpu_high)");
   if (options.gpu_low) {
@@ -222,6 +224,17 @@ LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& cam
   return raw;
 }
 
+double LodSpriteRenderer::progressPx(double error_px, double magnification) const {
+  const double m = options_.max_magnification;
+  if (m > 0.0) error_px = std::max(error_px, options_.epsilon * (magnification - 1.0) / (m - 1.0));
+  return error_px;
+}
+
+bool LodSpriteRenderer::dueAt(const SpriteError& e, double beta, double share) const {
+  const double m = options_.max_magnification;
+  return keyframeDue(e, beta, share * options_.epsilon, m > 0.0 ? 1.0 + share * (m - 1.0) : 0.0);
+}
+
 SpriteError LodSpriteRenderer::frameError(const Vec3& v1, const Vec3& v2) const {
   if (options_.gpu_low) {
     const GpuLodTerrain& terrain = *options_.gpu_high;
@@ -329,7 +342,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     const SpriteError e = frameError(anchor_eye_, camera.eye);
     if (options_.gpu_low) info.quadrants = e.quadrants;
     info.trigger_error_px = info.error_px = e.pixels(beta);
-    due = keyframeDue(e, beta, options_.epsilon);
+    info.magnification = e.mean_magnification;
+    due = dueAt(e, beta, 1.0);
   }
   info.keyframe_due = due;
   // While the high LOD stands in for a virtual keyframe, that keyframe has already lasted `age` frames: a sprite
@@ -385,7 +399,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       for (auto& k : kept_) {
         if (k.get() == current_) continue;
         const SpriteError e = errorOf(*k);
-        if (keyframeDue(e, beta, options_.epsilon) || e.mean_theta_sq >= best) continue;
+        if (dueAt(e, beta, 1.0) || e.mean_theta_sq >= best) continue;
         if (coverage(*k) < options_.reuse_coverage * k->coverage_at_creation) continue;
         best = e.mean_theta_sq;
         chosen = k.get();
@@ -416,6 +430,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       info.source = SpriteSource::Fresh;
     }
     current_ = chosen;
+    info.magnification =
+        info.source == SpriteSource::Fresh ? 1.0 : frameError(chosen->camera.eye, camera.eye).mean_magnification;
     sprite_since_ = frame_;
     sprite_error_at_take_ = chosen_error;
     info.error_px = chosen_error;
@@ -440,7 +456,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   }
   current_->last_used = frame_;
   if (options_.predict && options_.predict_late && !due && !pending_)
-    scheduleLatePrediction(camera, info.error_px, choose ? &costs : nullptr);
+    scheduleLatePrediction(camera, progressPx(info.error_px, info.magnification), choose ? &costs : nullptr);
 
   // Section 5: the keyframe rendered ahead, one step per frame, from the frame after a switch on (the switch frame
   // may already have drawn a whole keyframe).

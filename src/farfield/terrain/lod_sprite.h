@@ -120,6 +120,12 @@ struct LodSpriteOptions {
   // predicted by the gpu_sprite model.
   bool gpu_low = false;
   size_t error_quadrants = 1024;
+  // A keyframe also when the sprite is magnified by more than this on average over the metric's cells
+  // (SpriteError::mean_magnification: its texels then cover more than this many pixels across, and it blurs what
+  // the high LOD shows), not only when equation 2 trips; 0 = equation 2 alone, the paper's metric. Chen et al.'s
+  // metric measures parallax only: on a smooth terrain approached head-on a sprite keeps theta near 0 while it is
+  // magnified. Above 1.
+  double max_magnification = 0.0;
 };
 
 enum class SpriteSource : uint8_t {
@@ -135,6 +141,7 @@ struct LodSpriteFrameInfo {
   SpriteSource source = SpriteSource::Kept;
   double error_px = 0.0;          // error of the sprite used in this frame at this viewpoint (0 for a fresh one)
   double trigger_error_px = 0.0;  // error of the previous sprite at this viewpoint (what the test saw)
+  double magnification = 1.0;     // the drawn sprite's mean magnification here (SpriteError::mean_magnification)
   uint64_t low_triangles = 0;
   uint64_t visible_triangles = 0;   // low-resolution triangles textured with the sprite
   uint64_t keyframe_triangles = 0;  // high-resolution triangles of a keyframe rendered in this frame
@@ -258,6 +265,11 @@ class LodSpriteRenderer {
   size_t low_triangles_ = 0;
   // Equation 2 for the frame's low-resolution mesh, the sprite seen from v1 and the frame from v2.
   SpriteError frameError(const Vec3& v1, const Vec3& v2) const;
+  // Whether a sprite with error e is due at `share` of the bounds (epsilon, and max_magnification where set).
+  bool dueAt(const SpriteError& e, double beta, double share) const;
+  // How far a sprite is towards its trip, in pixels of epsilon: its error, or with max_magnification the share of the
+  // way its magnification has gone from 1 to the bound, times epsilon, whichever is larger (predict_late's rate).
+  double progressPx(double error_px, double magnification) const;
   // A sprite frame on the GPU: CDLOD selection `handle` (GpuLodTerrain::select) for `camera` into `target`, tested
   // against and textured by keyframe `key` seen from key_camera (its size), with options_' hole and visibility.
   gpu::FrameStats drawCdlodSprite(const Camera& camera, int handle, gpu::RenderTarget& target,

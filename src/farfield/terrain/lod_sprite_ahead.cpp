@@ -175,10 +175,11 @@ void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double erro
 }
 
 bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, double* error_px) {
-  // Only with some life left (error at most 3/4 of the threshold here), or it would trip again at once.
+  // Only with some life left (error at most 3/4 of the threshold here, and magnification at most 3/4 of the way to
+  // its bound), or it would trip again at once.
   const SpriteError e = frameError(keyframe.camera.eye, eye);
   if (error_px) *error_px = e.pixels(beta);
-  return !keyframeDue(e, beta, 0.75 * options_.epsilon) &&
+  return !dueAt(e, beta, 0.75) &&
          coverage(keyframe) >= options_.reuse_coverage * keyframe.coverage_at_creation;
 }
 

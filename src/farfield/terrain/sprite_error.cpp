@@ -124,26 +124,38 @@ double quadrantTheta(const DVec3& c, std::span<const DVec3> corners, const DVec3
 
 double pixelAngle(const Camera& camera) { return double(camera.fovX()) / double(camera.width); }
 
+namespace {
+
+// |C - v1| / |C - v2| (SpriteError::mean_magnification), 1 where C is at v2.
+double magnification(const DVec3& c, const DVec3& v1, const DVec3& v2) {
+  const double near = glm::length(c - v2);
+  return near > 1e-9 ? glm::length(c - v1) / near : 1.0;
+}
+
+}  // namespace
+
 SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> quadrants, const Vec3& v1,
                         const Vec3& v2) {
   SpriteError e;
-  double sum = 0.0;
+  double sum = 0.0, stretch = 0.0;
   DVec3 corners[4];
   for (const LodQuadrant& q : quadrants) {
     for (int k = 0; k < q.corner_count; ++k) corners[k] = DVec3(lod.position(q.corners[size_t(k)]));
     bool ok = false;
+    const DVec3 c(lod.position(q.centre));
     const double theta =
-        quadrantTheta(DVec3(lod.position(q.centre)), std::span<const DVec3>(corners, q.corner_count), DVec3(v1),
-                      DVec3(v2), &ok);
+        quadrantTheta(c, std::span<const DVec3>(corners, q.corner_count), DVec3(v1), DVec3(v2), &ok);
     if (!ok) {
       ++e.skipped;
       continue;
     }
     sum += theta * theta;
+    stretch += magnification(c, DVec3(v1), DVec3(v2));
     e.max_theta = std::max(e.max_theta, theta);
     ++e.quadrants;
   }
   e.mean_theta_sq = e.quadrants ? sum / double(e.quadrants) : 0.0;
+  e.mean_magnification = e.quadrants ? stretch / double(e.quadrants) : 1.0;
   return e;
 }
 
@@ -188,7 +200,7 @@ SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std
   // As Heightfield::position: (i * cell_x, j * cell_y, height).
   auto point = [&](int i, int j) { return DVec3(Vec3(float(i * hf.cell_x), float(j * hf.cell_y), height(i, j))); };
   DVec3 corners[4];
-  double weighted = 0.0, represented = 0.0;
+  double weighted = 0.0, weighted_stretch = 0.0, represented = 0.0;
   for (const Stratum& st : strata) {
     const CdlodNode& n = *st.node;
     const size_t count = size_t(st.columns) * size_t(st.rows);
@@ -202,7 +214,7 @@ SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std
     uint32_t h = uint32_t(n.x) * 0x9E3779B1u ^ uint32_t(n.y) * 0x85EBCA77u ^ uint32_t(n.level) * 0xC2B2AE3Du;
     h ^= h >> 15;
     const int s = lod.spacing(n.level), x0 = n.x * p * s, y0 = n.y * p * s;
-    double sum = 0.0;
+    double sum = 0.0, stretch = 0.0;
     size_t used = 0;
     for (size_t c = k > 1 ? size_t(h) % k : 0; c < count; c += k) {
       const int cx = x0 + int(c % size_t(st.columns)) * s, cy = y0 + int(c / size_t(st.columns)) * s;
@@ -217,17 +229,25 @@ SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std
         continue;
       }
       sum += theta * theta;
+      stretch += magnification(point(cx + s / 2, cy + s / 2), eye1, eye2);
       e.max_theta = std::max(e.max_theta, theta);
       ++used;
     }
     if (used == 0) continue;
     // The node's mean stands for all its cells.
     weighted += sum / double(used) * double(count);
+    weighted_stretch += stretch / double(used) * double(count);
     represented += double(count);
     e.quadrants += used;
   }
   e.mean_theta_sq = represented > 0.0 ? weighted / represented : 0.0;
+  e.mean_magnification = represented > 0.0 ? weighted_stretch / represented : 1.0;
   return e;
+}
+
+bool keyframeDue(const SpriteError& error, double beta, double epsilon_pixels, double max_magnification) {
+  return keyframeDue(error, beta, epsilon_pixels) ||
+         (max_magnification > 0.0 && error.quadrants > 0 && error.mean_magnification > max_magnification);
 }
 
 bool keyframeDue(const SpriteError& error, double beta, double epsilon_pixels) {

@@ -45,6 +45,11 @@ struct SpriteError {
   size_t quadrants = 0;        // n
   size_t skipped = 0;          // quadrants with no usable C' (not in n)
   double max_theta = 0.0;      // radians
+  // The sprite's stretch: the mean over the quadrants of |C - v1| / |C - v2|, the keyframe's distance to a point
+  // over the novel view's (both draw at the same pixel density). Above 1 the keyframe's texels cover more than a
+  // pixel there: the sprite is magnified, and blurs what the high LOD would show sharp, which theta does not see
+  // (a sprite on a smooth terrain approached head-on keeps theta near 0). 1 with no quadrant.
+  double mean_magnification = 1.0;
   // The error in pixels: sqrt(mean theta^2) / beta (what the paper's Figure 10 plots).
   double pixels(double beta) const { return beta > 0.0 ? std::sqrt(mean_theta_sq) / beta : 0.0; }
 };
@@ -72,5 +77,7 @@ SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std
 
 // Equation 2: true when a new keyframe is due (mean theta^2 >= (beta * epsilon)^2). No quadrants: never due.
 bool keyframeDue(const SpriteError& error, double beta, double epsilon_pixels);
+// Equation 2, or (max_magnification > 0) the sprite magnified by more than max_magnification on average.
+bool keyframeDue(const SpriteError& error, double beta, double epsilon_pixels, double max_magnification);
 
 }  // namespace farfield::terrain
