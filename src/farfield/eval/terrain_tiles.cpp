@@ -20,6 +20,7 @@
 #include "farfield/eval/terrain_paths.h"
 #include "farfield/eval/terrain_tiles_sprite.h"
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/image/metrics.h"
 #include "farfield/image/png_io.h"
@@ -74,6 +75,7 @@ struct FrameRow {
   // With render: the frame drawn from the patches (LOD, tile reads, patch loads, draw, to the GPU's end; also in
   // ms, which is then that frame), its triangles, the patches made for it, the patches' GPU bytes after it.
   double frame_ms = 0.0;
+  double own_ms = -1.0;  // of it, in Farfield's own code (wall less the time in GL calls); -1 uncounted
   size_t drawn_triangles = 0, patch_loads = 0, gpu_bytes = 0;
   terrain::TileSpriteFrame sprites;
 };
@@ -157,6 +159,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
   if (o.render) {
     if (!(o.gpu_budget_mb > 0.0)) throw Error("--gpu-budget-mb", "must be positive");
     gpu::sharedHeadlessContext().makeCurrent();
+    gpu::installGlCounters();  // Farfield's own CPU time per frame
     target = std::make_unique<gpu::RenderTarget>(o.width, o.height);
     if (o.prefetch_frames < 0) throw Error("--prefetch-frames", "must be 0 or more");
     if (o.gpu_lod) {
@@ -199,12 +202,14 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     if (cdlod) {
       // The CDLOD frame: the selection, the pages it needs (read at once if missing), the draw, to the GPU's end.
       target->clear(kSky);
+      const gpu::GlCounters before = gpu::glCounters();
       const Stopwatch draw;
       // With LOD-sprite, the pages are read ahead after the timed frame (both frames then leave it out).
       const terrain::PagedGpuLodFrame cf = sprite_run ? cdlod->draw(camera, o.pixel_error, *target)
                                                       : cdlod->drawFrame(camera, o.pixel_error, *target);
       cdlod->finish();
       row.frame_ms = row.ms = draw.milliseconds();
+      row.own_ms = ownCpuMs(row.frame_ms, before);
       if (sprite_run) {
         cdlod_ms.push_back(row.frame_ms);
         cdlod->prefetch(camera, o.pixel_error);
@@ -376,12 +381,17 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     for (const FrameRow& r : rows) in_frames += r.patch_loads;
     size_t over_twice = 0;
     for (double v : fms) over_twice += v > 2.0 * fms[fms.size() / 2] ? 1 : 0;
+    std::vector<double> own;
+    for (const FrameRow& r : rows) own.push_back(r.own_ms);
+    const nlohmann::ordered_json own_cpu = ownCpuSummary(own);
+    const double own_median = own_cpu["median"], own_p95 = own_cpu["p95"];
     j["render"] = {{"lod", "cdlod"},
                    {"frame_ms_mean", fsum / double(fms.size())},
                    {"frame_ms_median", fms[fms.size() / 2]},
                    {"frame_ms_p99", fms[std::min(fms.size() - 1, fms.size() * 99 / 100)]},
                    {"frame_ms_max", fms.back()},
                    {"frames_over_twice_the_median", over_twice},
+                   {"own_cpu_ms", own_cpu},
                    {"triangles_mean", double(drawn_sum) / double(rows.size())},
                    {"triangles_max", drawn_max},
                    {"prepare_seconds", cdlod_prepare_seconds},
@@ -400,22 +410,25 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     std::snprintf(line, sizeof line,
                   "\ndrawn by the CDLOD terrain paged from the cache: frame %.2f ms mean, %.2f median, %.2f p99, "
                   "%.2f max (selection, pages waited for, draw, to the GPU's end); %zu frames over twice the "
-                  "median; %.0f triangles mean, %zu max; pages: %d layers (%.0f MiB), %zu held at most, %zu read "
+                  "median; Farfield's own CPU time %.3f ms median, %.3f p95; %.0f triangles mean, %zu max; pages: %d "
+                  "layers (%.0f MiB), %zu held at most, %zu read "
                   "in frames, %zu read ahead %d frames (%zu used), %zu evictions, %.1f s reading; node data and "
                   "overview made in %.1f s\n",
                   fsum / double(fms.size()), fms[fms.size() / 2], double(j["render"]["frame_ms_p99"]), fms.back(),
-                  over_twice, double(drawn_sum) / double(rows.size()), drawn_max, cdlod->pageLayers(),
+                  over_twice, own_median, own_p95, double(drawn_sum) / double(rows.size()), drawn_max,
+                  cdlod->pageLayers(),
                   mib(cdlod->gpuBytes()), cs.peak_pages, in_frames, cs.prefetched, o.prefetch_frames,
                   cs.prefetch_hits, cs.evictions, cs.load_seconds, cdlod_prepare_seconds);
     render_md = line;
     if (sprite_run) {
-      j["render"]["lod_sprite"] = sprite_run->summary(sprite_frames, cdlod_ms);
+      j["render"]["lod_sprite"] = sprite_run->summary(sprite_frames, cdlod_ms, own);
       render_md += PagedSpriteRun::markdown(j["render"]["lod_sprite"]);
       std::ostringstream sc;
-      sc << "frame,cdlod_ms,lod_sprite_ms,path,source,triangles,error_px,magnification,psnr_vs_cdlod\n";
+      sc << "frame,cdlod_ms,lod_sprite_ms,cdlod_own_cpu_ms,lod_sprite_own_cpu_ms,path,source,triangles,error_px,"
+            "magnification,psnr_vs_cdlod\n";
       for (size_t f = 0; f < sprite_frames.size(); ++f) {
         const PagedSpriteFrame& sf = sprite_frames[f];
-        sc << f << ',' << cdlod_ms[f] << ',' << sf.ms << ','
+        sc << f << ',' << cdlod_ms[f] << ',' << sf.ms << ',' << rows[f].own_ms << ',' << sf.own_ms << ','
            << (sf.info.path == terrain::TerrainPath::Sprite ? "sprite" : "high") << ','
            << terrain::spriteSourceName(sf.info.source) << ',' << sf.triangles << ',' << sf.info.error_px << ','
            << sf.info.magnification << ',';

@@ -6,6 +6,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
+#include "farfield/gpu/gl_counters.h"
 
 namespace farfield::eval {
 namespace {
@@ -39,6 +40,19 @@ nlohmann::ordered_json spreadJson(const Spread& s) {
 }
 
 }  // namespace
+
+double ownCpuMs(double wall_ms, const gpu::GlCounters& before) {
+  if (!gpu::glCountersInstalled()) return -1.0;
+  const gpu::GlCounters used = gpu::glCounters() - before;
+  return std::max(0.0, wall_ms - used.driver_ms - used.measure_ms);
+}
+
+nlohmann::ordered_json ownCpuSummary(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return x < 0.0; }), v.end());
+  if (v.empty()) return {{"median", -1.0}, {"p95", -1.0}};
+  std::sort(v.begin(), v.end());
+  return {{"median", v[v.size() / 2]}, {"p95", v[std::min(v.size() - 1, v.size() * 95 / 100)]}};
+}
 
 PagedSpriteRun::PagedSpriteRun(terrain::PagedGpuLodTerrain& terrain, std::span<const Camera> path,
                                const PagedSpriteOptions& options)
@@ -79,16 +93,20 @@ PagedSpriteRun::PagedSpriteRun(terrain::PagedGpuLodTerrain& terrain, std::span<c
 PagedSpriteFrame PagedSpriteRun::draw(const Camera& camera, gpu::RenderTarget& target) {
   PagedSpriteFrame frame;
   target.clear(kSky);
+  const gpu::GlCounters before = gpu::glCounters();
   const Stopwatch clock;
   frame.triangles = renderer_->render(camera, target, &frame.info).triangles;
   terrain_.finish();
   frame.ms = clock.milliseconds();
+  frame.own_ms = ownCpuMs(frame.ms, before);
   return frame;
 }
 
 nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame> frames,
-                                               std::span<const double> high_ms) const {
-  std::vector<double> ms;
+                                               std::span<const double> high_ms,
+                                               std::span<const double> high_own_ms) const {
+  std::vector<double> ms, own;
+  for (const PagedSpriteFrame& f : frames) own.push_back(f.own_ms);
   double psnr_min = 1e9, psnr_sum = 0.0, triangles = 0.0;
   size_t compared = 0, sprite_frames = 0;
   for (const PagedSpriteFrame& f : frames) {
@@ -105,7 +123,9 @@ nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame>
   nlohmann::ordered_json j = spreadJson(s);
   j["speedup_vs_cdlod_mean"] = s.mean > 0.0 ? h.mean / s.mean : 0.0;
   j["speedup_vs_cdlod_median"] = s.median > 0.0 ? h.median / s.median : 0.0;
+  j["own_cpu_ms"] = ownCpuSummary(own);
   j["cdlod"] = spreadJson(h);
+  j["cdlod"]["own_cpu_ms"] = ownCpuSummary(std::vector<double>(high_own_ms.begin(), high_own_ms.end()));
   j["triangles_mean"] = frames.empty() ? 0.0 : triangles / double(frames.size());
   j["sprite_frames"] = sprite_frames;
   j["high_frames"] = c.high_frames;
@@ -129,12 +149,15 @@ std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
   std::snprintf(line, sizeof line,
                 "\nLOD-sprite on the same paged terrain%s (epsilon %.2g px, sprite frames at %.2g px; the same frames, "
                 "timed apart, the pages read ahead outside both): %.2f ms mean, %.2f median, %.2f p99, %.2f max; "
-                "%zu frames over twice its median; **%.2fx the CDLOD frame's mean** (%.2f ms; median %.2fx); "
+                "%zu frames over twice its median; own CPU %.3f ms median, %.3f p95 (the CDLOD frame's %.3f, %.3f); "
+                "**%.2fx the CDLOD frame's mean** (%.2f ms; median %.2fx); "
                 "%zu sprite frames, %zu high frames, %zu keyframes drawn at once, %zu rendered ahead (%zu used); PSNR "
                 "against the CDLOD frame %.1f dB mean, %.1f min over %zu frames; cost model fitted in %.1f s\n",
                 bool(j["predict"]) ? ", keyframes rendered ahead" : "", double(j["epsilon"]), double(j["low_error"]),
                 double(j["frame_ms_mean"]), double(j["frame_ms_median"]), double(j["frame_ms_p99"]),
                 double(j["frame_ms_max"]), size_t(j["frames_over_twice_the_median"]),
+                double(j["own_cpu_ms"]["median"]), double(j["own_cpu_ms"]["p95"]),
+                double(j["cdlod"]["own_cpu_ms"]["median"]), double(j["cdlod"]["own_cpu_ms"]["p95"]),
                 double(j["speedup_vs_cdlod_mean"]), double(j["cdlod"]["frame_ms_mean"]),
                 double(j["speedup_vs_cdlod_median"]), size_t(j["sprite_frames"]), size_t(j["high_frames"]),
                 size_t(j["fresh_keyframes"]), size_t(j["keyframes_rendered_ahead"]),

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "farfield/core/camera.h"
+#include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/terrain/lod_sprite.h"
 #include "farfield/terrain/paged_gpu_lod.h"
@@ -32,10 +33,18 @@ struct PagedSpriteOptions {
 
 struct PagedSpriteFrame {
   double ms = 0.0;  // the LOD-sprite frame: choice, metric, draws, to the GPU's end
+  double own_ms = -1.0;  // of it, in Farfield's own code (wall less the time in GL calls); -1 without GL counters
   uint64_t triangles = 0;
   terrain::LodSpriteFrameInfo info;
   double psnr_vs_high = -1.0;  // against the CDLOD frame of the same camera, where compared (-1: not)
 };
+
+// Farfield's own CPU time of a frame that took wall_ms since the GL counters read `before`: the wall time less the
+// time inside GL calls (a final glFinish included) and the measurements' own, as frame_runner.cpp; -1 without the
+// counters (gpu/gl_counters.h).
+double ownCpuMs(double wall_ms, const gpu::GlCounters& before);
+// {"median", "p95"} of the counted values (those >= 0); -1 for both with none.
+nlohmann::ordered_json ownCpuSummary(std::vector<double> own_ms);
 
 class PagedSpriteRun {
  public:
@@ -49,7 +58,9 @@ class PagedSpriteRun {
 
   // The run's summary beside the CDLOD frames' times (the same frames, in order): "lod_sprite" of tiles.json and a
   // paragraph of tiles.md.
-  nlohmann::ordered_json summary(std::span<const PagedSpriteFrame> frames, std::span<const double> high_ms) const;
+  // high_own_ms: the CDLOD frames' own CPU times (-1 uncounted).
+  nlohmann::ordered_json summary(std::span<const PagedSpriteFrame> frames, std::span<const double> high_ms,
+                                 std::span<const double> high_own_ms) const;
   static std::string markdown(const nlohmann::ordered_json& summary);
 
   const terrain::TerrainCost& cost() const { return cost_; }

@@ -59,9 +59,17 @@ void GpuLodTerrain::setHole(const GridRect& hole) {
                      Vec2(float(hole.x1 * g.cell_x), float(hole.y1 * g.cell_y)));
 }
 
-float GpuLodTerrain::gridHeight(int i, int j) const {
+void GpuLodTerrain::gridHeights(std::span<const IVec2> points, std::span<float> out) const {
   const Heightfield& hf = lod_.heightfield();
-  return hf.at(std::clamp(i, 0, hf.width - 1), std::clamp(j, 0, hf.height - 1));
+  for (size_t k = 0; k < points.size(); ++k)
+    out[k] = hf.at(std::clamp(points[k].x, 0, hf.width - 1), std::clamp(points[k].y, 0, hf.height - 1));
+}
+
+float GpuLodTerrain::gridHeight(int i, int j) const {
+  const IVec2 point(i, j);
+  float h = 0.0f;
+  gridHeights({&point, 1}, {&h, 1});
+  return h;
 }
 
 float GpuLodTerrain::groundHeight(double x, double y) const { return lod_.heightfield().sample(x, y); }

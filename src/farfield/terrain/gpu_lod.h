@@ -65,9 +65,11 @@ class GpuLodTerrain {
   void setHole(const GridRect& hole);
   void clearHole() { renderer_->clearHole(); }
 
-  // The height of grid point (i, j), clamped to the grid, as the CPU holds it (LOD-sprite's error metric runs over
-  // grid points); a paged terrain answers from the pages it holds, else from its overview.
-  virtual float gridHeight(int i, int j) const;
+  // The heights of grid points (each clamped to the grid) into `out` (as many), as the CPU holds them (LOD-sprite's
+  // error metric runs over grid points, sprite_error.h); a paged terrain answers from the pages it holds, else from
+  // its overview. gridHeight: one point.
+  virtual void gridHeights(std::span<const IVec2> points, std::span<float> out) const;
+  float gridHeight(int i, int j) const;
   // The ground's height under world (x, y), bilinear (a paged terrain: its overview's).
   virtual float groundHeight(double x, double y) const;
   // The box of the whole terrain (its top level's node boxes).

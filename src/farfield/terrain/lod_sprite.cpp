@@ -239,7 +239,8 @@ SpriteError LodSpriteRenderer::frameError(const Vec3& v1, const Vec3& v2) const 
   if (options_.gpu_low) {
     const GpuLodTerrain& terrain = *options_.gpu_high;
     return spriteError(
-        terrain.lod(), [&terrain](int i, int j) { return terrain.gridHeight(i, j); },
+        terrain.lod(),
+        [&terrain](std::span<const IVec2> points, std::span<float> out) { terrain.gridHeights(points, out); },
         terrain.selection(low_handle_).nodes, v1, v2, options_.error_quadrants);
   }
   return spriteError(*lod_, low_.quadrants, v1, v2);

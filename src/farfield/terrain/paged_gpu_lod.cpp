@@ -40,6 +40,7 @@ PagedGpuLodTerrain::PagedGpuLodTerrain(const TileCache& cache, const PagedGpuLod
   overview_colour_ = terrainTexture(overview_, to);
   const int page_cells = l.tile_blocks * l.block;
   tile_cells_ = page_cells;
+  if (options.keep_heights) heights_of_.resize(size_t(l.tilesX()) * size_t(l.tilesY()));
   const size_t layer_bytes = gpu::CdlodPages(page_cells, 1).layerBytes();
   const int layers = int(std::min<size_t>(options.gpu_budget_bytes / layer_bytes, 2048));
   if (layers < 1)
@@ -69,19 +70,47 @@ PagedGpuLodTerrain::~PagedGpuLodTerrain() {
 
 size_t PagedGpuLodTerrain::gpuBytes() const { return renderer_->gpuBytes() + pages_->bytes(); }
 
-float PagedGpuLodTerrain::gridHeight(int i, int j) const {
+void PagedGpuLodTerrain::gridHeights(std::span<const IVec2> points, std::span<float> out) const {
   const TileLayout& l = cache_.layout();
-  i = std::clamp(i, 0, l.width - 1);
-  j = std::clamp(j, 0, l.height - 1);
   const int t = tile_cells_;
-  // A point on a tile's edge is in both tiles' pages.
-  for (const int tx : {i / t, i / t - 1})
-    for (const int ty : {j / t, j / t - 1}) {
-      if (tx < 0 || ty < 0 || i - tx * t > t || j - ty * t > t) continue;
-      const auto held = heights_of_.find({tx, ty});
-      if (held != heights_of_.end()) return held->second[size_t(i - tx * t) + size_t(j - ty * t) * size_t(t + 1)];
+  // First where each height lies, its cache line asked for at once; then the heights. The points are scattered over
+  // megabytes of pages, and the cache is cold after a frame's rasterization: read one by one between the metric's
+  // arithmetic, their misses did not overlap (0.5 ms for 830 cells on the 2-core machine, 0.16 ms warm).
+  std::vector<const float*>& at = lookup_;
+  at.assign(points.size(), nullptr);
+  for (size_t k = 0; k < points.size() && !heights_of_.empty(); ++k) {
+    const int i = std::clamp(points[k].x, 0, l.width - 1), j = std::clamp(points[k].y, 0, l.height - 1);
+    // A point on a tile's edge is in both tiles' pages.
+    for (const int tx : {i / t, i / t - 1}) {
+      for (const int ty : {j / t, j / t - 1}) {
+        if (tx < 0 || ty < 0 || tx >= l.tilesX() || ty >= l.tilesY() || i - tx * t > t || j - ty * t > t) continue;
+        const std::vector<float>& held = heights_of_[tileIndex({tx, ty})];
+        if (held.empty()) continue;
+        at[k] = &held[size_t(i - tx * t) + size_t(j - ty * t) * size_t(t + 1)];
+        __builtin_prefetch(at[k]);
+        break;
+      }
+      if (at[k]) break;
     }
-  return overview_.sample(double(i) * l.cell_x, double(j) * l.cell_y);
+  }
+  // The overview's rows under the other points (its bilinear sample reads two of them).
+  const int step = overview_step_;
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (at[k]) continue;
+    const int i = std::clamp(points[k].x, 0, l.width - 1) / step, j = std::clamp(points[k].y, 0, l.height - 1) / step;
+    const size_t row = size_t(std::min(j, overview_.height - 1)) * size_t(overview_.width);
+    __builtin_prefetch(&overview_.heights[row + size_t(std::min(i, overview_.width - 1))]);
+    __builtin_prefetch(&overview_.heights[std::min(row + size_t(overview_.width), overview_.heights.size() - 1) +
+                                          size_t(std::min(i, overview_.width - 1))]);
+  }
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (at[k]) {
+      out[k] = *at[k];
+      continue;
+    }
+    const int i = std::clamp(points[k].x, 0, l.width - 1), j = std::clamp(points[k].y, 0, l.height - 1);
+    out[k] = overview_.sample(double(i) * l.cell_x, double(j) * l.cell_y);
+  }
 }
 
 float PagedGpuLodTerrain::groundHeight(double x, double y) const { return overview_.sample(x, y); }
@@ -115,6 +144,10 @@ PagedGpuLodTerrain::Page PagedGpuLodTerrain::makePage(int tx, int ty) const {
   page.colour = gpu::CdlodPages::colourMips(std::move(colour));
   page.seconds = clock.seconds();
   return page;
+}
+
+size_t PagedGpuLodTerrain::tileIndex(const TileKey& tile) const {
+  return size_t(tile.first) + size_t(tile.second) * size_t(cache_.layout().tilesX());
 }
 
 PagedGpuLodTerrain::TileKey PagedGpuLodTerrain::tileOf(const CdlodNode& node) const {
@@ -186,7 +219,7 @@ int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKe
       if (!needed.count(*it)) {
         layer = layer_of_.at(*it);
         layer_of_.erase(*it);
-        heights_of_.erase(*it);
+        if (options_.keep_heights) heights_of_[tileIndex(*it)].clear();
         lru_.erase(std::next(it).base());
         ++stats_.evictions;
         break;
@@ -194,7 +227,7 @@ int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKe
   }
   FF_CHECK(layer >= 0);  // draw() checked that the frame's pages fit
   pages_->upload(layer, page->heights, page->colour);
-  if (options_.keep_heights) heights_of_[tile] = std::move(page->heights);
+  if (options_.keep_heights) heights_of_[tileIndex(tile)] = std::move(page->heights);
   layer_of_[tile] = layer;
   lru_.push_front(tile);
   stats_.pages = layer_of_.size();

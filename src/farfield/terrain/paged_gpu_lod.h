@@ -82,7 +82,7 @@ class PagedGpuLodTerrain : public GpuLodTerrain {
   // Waits for the GPU (glFinish): the end of a timed frame.
   void finish() { renderer_->finish(); }
 
-  float gridHeight(int i, int j) const override;
+  void gridHeights(std::span<const IVec2> points, std::span<float> out) const override;
   float groundHeight(double x, double y) const override;
 
   const PagedGpuLodStats& stats() const { return stats_; }
@@ -105,6 +105,7 @@ class PagedGpuLodTerrain : public GpuLodTerrain {
   using TileKey = std::pair<int, int>;
   Page makePage(int tx, int ty) const;
   TileKey tileOf(const CdlodNode& node) const;
+  size_t tileIndex(const TileKey& tile) const;
   int residentLayer(const TileKey& tile, const std::set<TileKey>& needed, size_t& loads);
   void work();
 
@@ -117,7 +118,9 @@ class PagedGpuLodTerrain : public GpuLodTerrain {
   CdlodSelection ahead_;
   PagedGpuLodStats stats_;
   std::map<TileKey, int> layer_of_;  // resident tiles
-  std::map<TileKey, std::vector<float>> heights_of_;  // with keep_heights: their heights, (S + 1)^2 each
+  // With keep_heights: the held tiles' heights, (S + 1)^2 each, by tile index tx + ty * tilesX (empty: not held).
+  std::vector<std::vector<float>> heights_of_;
+  mutable std::vector<const float*> lookup_;  // gridHeights' scratch (one thread draws)
   std::list<TileKey> lru_;           // most recently used first
   std::vector<int> free_layers_;
   std::optional<Camera> last_camera_;

@@ -162,10 +162,14 @@ SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> qua
 SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
                         size_t max_quadrants) {
   const Heightfield& hf = lod.heightfield();
-  return spriteError(lod, [&hf](int i, int j) { return hf.at(i, j); }, nodes, v1, v2, max_quadrants);
+  const auto heights = [&hf](std::span<const IVec2> points, std::span<float> out) {
+    for (size_t k = 0; k < points.size(); ++k)
+      out[k] = hf.at(std::clamp(points[k].x, 0, hf.width - 1), std::clamp(points[k].y, 0, hf.height - 1));
+  };
+  return spriteError(lod, heights, nodes, v1, v2, max_quadrants);
 }
 
-SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std::span<const CdlodNode> nodes,
+SpriteError spriteError(const CdlodTerrain& lod, const GridHeightsFn& heights, std::span<const CdlodNode> nodes,
                         const Vec3& v1, const Vec3& v2, size_t max_quadrants) {
   const CdlodGrid& hf = lod.grid();
   const int p = lod.patchCells();
@@ -174,6 +178,7 @@ SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std
     const CdlodNode* node;
     int columns, rows;
     double weight;
+    size_t first = 0, cells = 0;  // its sampled cells in `sample`
   };
   std::vector<Stratum> strata;
   strata.reserve(nodes.size());
@@ -195,16 +200,12 @@ SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std
     cells += size_t(columns) * size_t(rows);
     total_weight += w * w;
   }
-  SpriteError e;
-  const DVec3 eye1(v1), eye2(v2);
-  // As Heightfield::position: (i * cell_x, j * cell_y, height).
-  auto point = [&](int i, int j) { return DVec3(Vec3(float(i * hf.cell_x), float(j * hf.cell_y), height(i, j))); };
-  DVec3 corners[4];
-  double weighted = 0.0, weighted_stretch = 0.0, represented = 0.0;
-  for (const Stratum& st : strata) {
+  // The sample: per stratum every k-th cell (k odd, so that the sample moves across the columns), from an offset
+  // fixed by the node; five grid points a cell (its corners, then its centre), their heights gathered at once.
+  std::vector<IVec2> points;
+  for (Stratum& st : strata) {
     const CdlodNode& n = *st.node;
     const size_t count = size_t(st.columns) * size_t(st.rows);
-    // Every k-th cell (k odd, so that the sample moves across the columns), from an offset fixed by the node.
     size_t k = 1;
     if (max_quadrants > 0 && cells > max_quadrants) {
       const double share = total_weight > 0.0 ? st.weight / total_weight : 1.0 / double(strata.size());
@@ -214,30 +215,48 @@ SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std
     uint32_t h = uint32_t(n.x) * 0x9E3779B1u ^ uint32_t(n.y) * 0x85EBCA77u ^ uint32_t(n.level) * 0xC2B2AE3Du;
     h ^= h >> 15;
     const int s = lod.spacing(n.level), x0 = n.x * p * s, y0 = n.y * p * s;
-    double sum = 0.0, stretch = 0.0;
-    size_t used = 0;
+    st.first = points.size() / 5;
     for (size_t c = k > 1 ? size_t(h) % k : 0; c < count; c += k) {
       const int cx = x0 + int(c % size_t(st.columns)) * s, cy = y0 + int(c / size_t(st.columns)) * s;
-      corners[0] = point(cx, cy);
-      corners[1] = point(cx + s, cy);
-      corners[2] = point(cx + s, cy + s);
-      corners[3] = point(cx, cy + s);
+      points.insert(points.end(),
+                    {IVec2(cx, cy), IVec2(cx + s, cy), IVec2(cx + s, cy + s), IVec2(cx, cy + s),
+                     IVec2(cx + s / 2, cy + s / 2)});
+    }
+    st.cells = points.size() / 5 - st.first;
+  }
+  std::vector<float> z(points.size());
+  heights(points, z);
+  SpriteError e;
+  const DVec3 eye1(v1), eye2(v2);
+  // As Heightfield::position: (i * cell_x, j * cell_y, height).
+  auto point = [&](size_t k) {
+    return DVec3(Vec3(float(points[k].x * hf.cell_x), float(points[k].y * hf.cell_y), z[k]));
+  };
+  DVec3 corners[4];
+  double weighted = 0.0, weighted_stretch = 0.0, represented = 0.0;
+  for (const Stratum& st : strata) {
+    double sum = 0.0, stretch = 0.0;
+    size_t used = 0;
+    for (size_t c = st.first; c < st.first + st.cells; ++c) {
+      for (size_t k = 0; k < 4; ++k) corners[k] = point(5 * c + k);
+      const DVec3 centre = point(5 * c + 4);
       bool ok = false;
-      const double theta = quadrantTheta(point(cx + s / 2, cy + s / 2), corners, eye1, eye2, &ok, true);
+      const double theta = quadrantTheta(centre, corners, eye1, eye2, &ok, true);
       if (!ok) {
         ++e.skipped;
         continue;
       }
       sum += theta * theta;
-      stretch += magnification(point(cx + s / 2, cy + s / 2), eye1, eye2);
+      stretch += magnification(centre, eye1, eye2);
       e.max_theta = std::max(e.max_theta, theta);
       ++used;
     }
     if (used == 0) continue;
     // The node's mean stands for all its cells.
-    weighted += sum / double(used) * double(count);
-    weighted_stretch += stretch / double(used) * double(count);
-    represented += double(count);
+    const double count = double(st.columns) * double(st.rows);
+    weighted += sum / double(used) * count;
+    weighted_stretch += stretch / double(used) * count;
+    represented += count;
     e.quadrants += used;
   }
   e.mean_theta_sq = represented > 0.0 ? weighted / represented : 0.0;

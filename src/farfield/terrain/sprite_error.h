@@ -69,10 +69,13 @@ SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> qua
 // frame. C' as spriteProjection with near. quadrants: the cells evaluated. Needs the terrain's heights.
 SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
                         size_t max_quadrants = 1024);
-// The same with the grid's heights from `height` (grid point i, j), for a terrain whose heights are not held whole
-// (a paged one: gpu_lod.h's GpuLodTerrain::gridHeight).
-using GridHeightFn = std::function<float(int, int)>;
-SpriteError spriteError(const CdlodTerrain& lod, const GridHeightFn& height, std::span<const CdlodNode> nodes,
+// The same with the grid's heights from `heights` (the heights of grid points, clamped to the grid, into a span of
+// as many), asked once for the whole sample: a terrain whose heights are not held whole (a paged one: gpu_lod.h's
+// GpuLodTerrain::gridHeights) gathers them in one pass, so that their cache misses overlap (on the 2-core machine the
+// rasterizer evicts the CPU's caches between frames, and the sample's 5 points a cell then cost 100 ns each when
+// read one by one between the cells' arithmetic).
+using GridHeightsFn = std::function<void(std::span<const IVec2>, std::span<float>)>;
+SpriteError spriteError(const CdlodTerrain& lod, const GridHeightsFn& heights, std::span<const CdlodNode> nodes,
                         const Vec3& v1, const Vec3& v2, size_t max_quadrants = 1024);
 
 // Equation 2: true when a new keyframe is due (mean theta^2 >= (beta * epsilon)^2). No quadrants: never due.
