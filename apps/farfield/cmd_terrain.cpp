@@ -173,7 +173,8 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
   bench->add_option("--frames", o.frames, "Frames of the generated flythrough")
       ->capture_default_str()
       ->excludes(path_opt);
-  bench->add_option("--clearance", o.clearance, "Flythrough height above the ground near it, m (0 = 2% of the diagonal)")
+  bench->add_option("--clearance", o.clearance,
+                    "Flythrough height above the ground near it, m (0 = 2% of the diagonal)")
       ->capture_default_str();
   bench->add_option("--epsilon", o.epsilon, "LOD-sprite error threshold, pixels")->capture_default_str();
   bench->add_option("--max-magnification", o.max_magnification,
