@@ -6,7 +6,8 @@
 # OUT/log.txt; prints a summary per stage.
 #
 # Stages (STAGES, default "smoke heldout model makedemo crowd terrain big check"; they run in the script's order,
-# smoke, heldout, model, big, demo, check, terrain, crowd, makedemo, dynamic, stream, each under a timeout; with 15 minutes of device time,
+# smoke, heldout, model, big, demo, check, terrain, paged, crowd, makedemo, dynamic, stream, each under a timeout; with
+# 15 minutes of device time,
 # name a few per call, e.g. STAGES="smoke heldout makedemo" then STAGES="smoke crowd terrain"):
 #   smoke    a small city, one bench; stops everything unless the NVIDIA driver drew it
 #   heldout  a 400-block detail-3 city (about 17 M triangles) and a 300-frame car drive at 1920x1080: frustum,
@@ -21,7 +22,11 @@
 #            detail under a budget of 4 ms of skinned drawing
 #   terrain  the terrain LODs at 1920x1080, 600-frame flythroughs: the quadtree LOD (high, low, lod-sprite) against
 #            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu[-predict]) on the shared DEM (.gpu/data/terrain/*.tif, when
-#            carried) and on the 8,193^2 fractal
+#            carried) and on the 8,193^2 fractal; then the 8,193^2 fractal paged from disk (terrain tiles --render):
+#            the CDLOD frame and LOD-sprite on the same pages, timed apart (--lod-sprite; then --predict
+#            --max-magnification 1.5)
+#   paged    (not in the default) the same on a 16,385^2 terrain paged from disk (a 1 GiB GeoTIFF and a 6.6 GB tile
+#            cache written first: about 3 minutes on the 2-core machine)
 #   makedemo the demo's main job, scripts/demo.sh at its 640x360: t_max from this machine,
 #            impostors placed, full, culled, placed and governed against reference frames; its verdict (issues 43, 46)
 #   stream   (not in the default) the mmi walkthrough streaming its database along a 3,000-frame drive of a 400-block
@@ -172,7 +177,42 @@ if [[ " $STAGES " == *" terrain "* ]]; then
     grep -E "^cost:" $T/$name.txt
     summ $T/$name/bench.json
   done
-  keep terrain $T/*/bench.json $T/*/terrain.json $T/*/terrain.md $T/*/frames.csv $T/*.txt
+  for variant in plain predict; do
+    extra=""
+    [ $variant = predict ] && extra="--predict --max-magnification 1.5"
+    say "terrain: the 8,193^2 fractal paged from disk, CDLOD and LOD-sprite ($variant), 1920x1080"
+    reuse=""
+    [ -f $T/f8193.tiles ] && reuse=--reuse-cache
+    timeout 600 $FF terrain tiles fractal:8193:23:relief=3000:roughness=0.6 --block 256 --tile-blocks 4 --budget-mb 256 \
+      --frames 600 --clearance 1000 --size 1920x1080 --render --gpu-budget-mb 1024 --cache $T/f8193.tiles $reuse \
+      --lod-sprite $extra -o $T/paged-8193-$variant > $T/paged-8193-$variant.txt 2>&1
+    echo "rc $?"
+    grep -E "^drawn by|^LOD-sprite on" $T/paged-8193-$variant.txt
+  done
+  rm -f $T/f8193.tiles*
+  keep terrain $T/*/bench.json $T/*/terrain.json $T/*/terrain.md $T/*/frames.csv $T/*/tiles.json \
+    $T/*/lod_sprite_frames.csv $T/*.txt
+fi
+if [[ " $STAGES " == *" paged "* ]]; then
+  P=paged
+  mkdir -p $P
+  say "paged: a 16,385^2 terrain exported and written as a tile cache"
+  timeout 300 $FF terrain export fractal:16385:41:relief=4000:roughness=0.6:cell=15 -o $P/f16385.tif > $P/export.txt 2>&1
+  echo "rc $?"
+  for variant in plain predict; do
+    extra=""
+    [ $variant = predict ] && extra="--predict --max-magnification 1.5"
+    reuse=""
+    [ -f $P/f16385.tiles ] && reuse=--reuse-cache
+    say "paged: CDLOD and LOD-sprite ($variant), 1920x1080"
+    timeout 900 $FF terrain tiles $P/f16385.tif --block 256 --tile-blocks 4 --budget-mb 256 --frames 600 \
+      --clearance 1000 --size 1920x1080 --render --gpu-budget-mb 1024 --cache $P/f16385.tiles $reuse --lod-sprite \
+      $extra -o $P/$variant > $P/$variant.txt 2>&1
+    echo "rc $?"
+    grep -E "^drawn by|^LOD-sprite on" $P/$variant.txt
+  done
+  rm -f $P/f16385.tif $P/f16385.tiles*
+  keep paged $P/*/tiles.json $P/*/lod_sprite_frames.csv $P/*/tiles_frames.csv $P/*.txt
 fi
 if [[ " $STAGES " == *" crowd "* ]]; then
   say "crowd: 10,000 to 1,000,000 agents, CPU and GPU paths, 1920x1080"
