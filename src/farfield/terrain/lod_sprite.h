@@ -246,6 +246,7 @@ class LodSpriteRenderer {
   LodMesh low_, high_, pending_mesh_, probe_mesh_;
   size_t pending_chunk_ = 0;   // next step of the predicted keyframe (0 = build its mesh)
   size_t pending_chunks_ = 1;  // slices it is drawn in
+  size_t pending_most_ = 0;    // predict_late: at most this many (the frames left before the trip; 0: no limit)
   CdlodSelection pending_selection_, probe_selection_;  // with gpu_high: its nodes; with gpu_low: its own low mesh
   KeyframeVisibility visibility_, probe_;
   std::deque<std::pair<Vec3, Vec3>> history_;  // recent (eye, look-at)
