@@ -12,6 +12,7 @@
 #include "farfield/terrain/fractal.h"
 #include "farfield/terrain/lod_sprite.h"
 #include "farfield/terrain/quadtree_lod.h"
+#include "farfield/terrain/terrain_cost.h"
 #include "farfield/terrain/terrain_texture.h"
 
 namespace farfield::terrain::test {
@@ -70,6 +71,16 @@ inline Heightfield testFractal() {
   o.cell_size = 20.0;
   o.relief = 500.0;
   return fractalTerrain(o);
+}
+
+// A cost model where CDLOD high frames (and keyframes) are expensive and sprite frames cheap: 50 against 0.25 ms.
+inline TerrainCost spritesPay() {
+  TerrainCost cost;
+  cost.gpu_high = gpu::CostModel{};
+  cost.gpu_high->base_ms = 50.0;
+  cost.gpu_sprite = gpu::CostModel{};
+  cost.gpu_sprite->base_ms = 0.25;
+  return cost;
 }
 
 }  // namespace farfield::terrain::test

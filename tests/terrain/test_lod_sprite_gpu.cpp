@@ -24,18 +24,9 @@ namespace {
 using test::choicePath;
 using test::kSky;
 using test::makeCamera;
+using test::spritesPay;
 using test::Scene;
 using test::testFractal;
-
-// A machine where CDLOD high frames (and keyframes) are expensive and sprite frames cheap: 50 against 0.25 ms.
-TerrainCost spritesPay() {
-  TerrainCost cost;
-  cost.gpu_high = gpu::CostModel{};
-  cost.gpu_high->base_ms = 50.0;
-  cost.gpu_sprite = gpu::CostModel{};
-  cost.gpu_sprite->base_ms = 0.25;
-  return cost;
-}
 
 // LOD-sprite's options with its high-resolution LOD drawn by a CDLOD terrain, on the tests' sky.
 LodSpriteOptions cdlodOptions(GpuLodTerrain& gpu_lod) {

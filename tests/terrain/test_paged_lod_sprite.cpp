@@ -19,6 +19,7 @@
 #include "farfield/terrain/paged_gpu_lod.h"
 #include "farfield/terrain/sprite_error.h"
 #include "farfield/terrain/terrain_texture.h"
+#include "terrain/terrain_gl_scene.h"
 #include "terrain/tiled_test_terrain.h"
 
 namespace farfield::terrain {
@@ -136,16 +137,6 @@ TEST(PagedLodSpriteGL, GridHeightsComeFromTheHeldPagesThenTheOverview) {
   EXPECT_FLOAT_EQ(paged.gridHeight(-5, 1000), hf.at(0, hf.height - 1));  // clamped to the grid
 }
 
-// A cost model where CDLOD high frames (and keyframes) are expensive and sprite frames cheap: 50 against 0.25 ms.
-TerrainCost spritesPay() {
-  TerrainCost cost;
-  cost.gpu_high = gpu::CostModel{};
-  cost.gpu_high->base_ms = 50.0;
-  cost.gpu_sprite = gpu::CostModel{};
-  cost.gpu_sprite->base_ms = 0.25;
-  return cost;
-}
-
 // LOD-sprite wholly on the paged terrain: sprite frames where they pay, keyframes that are the paged terrain's frames
 // at their cameras, no wait in any frame, frames close to the paged high frames and to the whole grid's LOD-sprite
 // frames, and about as many keyframes as on the whole grid (the metric over the held pages' heights).
@@ -159,7 +150,7 @@ TEST(PagedLodSpriteGL, RunsWhollyOnThePagedTerrain) {
   o.prefetch_frames = 6;
   PagedGpuLodTerrain paged(cache, o);
   GpuLodTerrain whole(hf, terrainTexture(hf), kLod);
-  TerrainCost cost = spritesPay();
+  TerrainCost cost = test::spritesPay();
   LodSpriteOptions options;
   options.sky_color = kSky;
   options.gpu_low = true;

@@ -137,24 +137,36 @@ TEST(SpriteError, KeyframeDueWhenMeanSquareReachesThreshold) {
   EXPECT_FALSE(keyframeDue(e, beta, 1.0));
 }
 
+// A fractal of size^2 points, 20 m cells, for the CDLOD metric's tests.
+Heightfield cdlodTestFractal(int size, uint64_t seed, double relief) {
+  FractalOptions fo;
+  fo.size = size;
+  fo.seed = seed;
+  fo.cell_size = 20.0;
+  fo.relief = relief;
+  return fractalTerrain(fo);
+}
+
+// A size x size camera with a 60 degree field of view.
+Camera metricCamera(Vec3 eye, Vec3 at, int size) {
+  Camera camera;
+  camera.eye = eye;
+  camera.at = at;
+  camera.width = camera.height = size;
+  camera.fov_y = float(degToRad(60.0));
+  camera.near_plane = 1.0f;
+  camera.far_plane = 50000.0f;
+  return camera;
+}
+
 // Equation 2 over a CDLOD mesh (the GPU sprite frame's, lod_sprite.h's gpu_low): every cell of the selection's nodes
 // of level >= 1 inside the grid is a quadrant (counted independently here), and the evenly spread sample stands for
 // the mean over every cell.
 TEST(SpriteError, CdlodSampleStandsForEveryCell) {
-  FractalOptions fo;
-  fo.size = 257;
-  fo.seed = 5;
-  fo.cell_size = 20.0;
-  fo.relief = 600.0;
-  const Heightfield hf = fractalTerrain(fo);
+  const Heightfield hf = cdlodTestFractal(257, 5, 600.0);
   const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
-  Camera camera;
-  camera.eye = Vec3(200.0f, 300.0f, hf.maxHeight() + 300.0f);
-  camera.at = Vec3(3000.0f, 3500.0f, 0.0f);
-  camera.width = camera.height = 512;
-  camera.fov_y = float(degToRad(60.0));
-  camera.near_plane = 1.0f;
-  camera.far_plane = 50000.0f;
+  const Camera camera =
+      metricCamera(Vec3(200.0f, 300.0f, hf.maxHeight() + 300.0f), Vec3(3000.0f, 3500.0f, 0.0f), 512);
   CdlodSelection selection;
   lod.select(camera, 4.0f, true, selection);
   const int p = lod.patchCells();
@@ -192,20 +204,10 @@ TEST(SpriteError, CdlodSampleStandsForEveryCell) {
 // the sprite magnified, one that moved away minified, and the same viewpoint not at all; the keyframe is due past
 // the bound.
 TEST(SpriteError, MagnificationIsTheMeanDistanceRatioOverTheCells) {
-  FractalOptions fo;
-  fo.size = 129;
-  fo.seed = 3;
-  fo.cell_size = 20.0;
-  fo.relief = 300.0;
-  const Heightfield hf = fractalTerrain(fo);
+  const Heightfield hf = cdlodTestFractal(129, 3, 300.0);
   const CdlodTerrain lod(hf, CdlodOptions{8, 16, 0.2f});
-  Camera camera;
-  camera.eye = Vec3(1280.0f, -600.0f, hf.maxHeight() + 400.0f);
-  camera.at = Vec3(1280.0f, 1280.0f, 0.0f);
-  camera.width = camera.height = 256;
-  camera.fov_y = float(degToRad(60.0));
-  camera.near_plane = 1.0f;
-  camera.far_plane = 50000.0f;
+  const Camera camera =
+      metricCamera(Vec3(1280.0f, -600.0f, hf.maxHeight() + 400.0f), Vec3(1280.0f, 1280.0f, 0.0f), 256);
   CdlodSelection selection;
   lod.select(camera, 4.0f, true, selection);
   const Vec3 centre(1280.0f, 1280.0f, hf.sample(1280.0, 1280.0));
