@@ -38,6 +38,11 @@ set(configure_args -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX} -DC
 # examples/ on its own, the way docs/EMBEDDING.md tells an engineer to build it.
 run_ok(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples -B ${WORK}/examples ${configure_args})
 run_ok(${CMAKE_COMMAND} --build ${WORK}/examples -j2)
+foreach(example embed_walkthrough embed_terrain)
+  if(NOT EXISTS ${WORK}/examples/${example})
+    message(FATAL_ERROR "examples/ built on its own against the package made no ${example}")
+  endif()
+endforeach()
 
 # Every exported target exists and farfield::farfield links (each module's dependencies found again).
 file(GLOB module_libs RELATIVE ${prefix}/lib ${prefix}/lib/libfarfield_*.a)
