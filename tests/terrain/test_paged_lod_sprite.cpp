@@ -202,10 +202,15 @@ TEST(PagedLodSpriteGL, RunsWhollyOnThePagedTerrain) {
   EXPECT_GT(worst_high, 25.0);
   EXPECT_GT(worst_grid, 25.0);
 
-  // Without the CPU-side sprite frame's quadtree, the sprite frame must be the GPU's.
+  // Without the CPU-side sprite frame's quadtree, the sprite frame must be the GPU's; and the metric needs the pages'
+  // heights.
   LodSpriteOptions cpu_low = options;
   cpu_low.gpu_low = false;
   EXPECT_THROW(LodSpriteRenderer(paged, 160, 160, cpu_low), Error);
+  PagedGpuLodOptions without = o;
+  without.keep_heights = false;
+  PagedGpuLodTerrain overview_only(cache, without);
+  EXPECT_THROW(LodSpriteRenderer(overview_only, 160, 160, options), Error);
 }
 
 }  // namespace

@@ -70,6 +70,9 @@ class GpuLodTerrain {
   // its overview. gridHeight: one point.
   virtual void gridHeights(std::span<const IVec2> points, std::span<float> out) const;
   float gridHeight(int i, int j) const;
+  // Whether gridHeights gives the grid's own heights wherever the terrain is drawn at full resolution (a paged
+  // terrain: only when it keeps its pages' heights); LOD-sprite's metric needs them.
+  virtual bool holdsGridHeights() const { return true; }
   // The ground's height under world (x, y), bilinear (a paged terrain: its overview's).
   virtual float groundHeight(double x, double y) const;
   // The box of the whole terrain (its top level's node boxes).

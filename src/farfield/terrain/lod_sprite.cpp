@@ -101,6 +101,10 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod* lod, gpu::TerrainRendere
   if (options.gpu_low) {
     if (!options.gpu_high)
       throw Error("lod-sprite", "the sprite frame on the GPU (gpu_low) needs the CDLOD terrain (gpu_high)");
+    if (!options.gpu_high->holdsGridHeights())
+      throw Error("lod-sprite", "the terrain must keep its pages' heights (PagedGpuLodOptions::keep_heights): the error "
+                                "metric reads the grid's heights, and the overview alone would under-count it near the "
+                                "eye");
     if (options.cost && !options.cost->gpu_sprite)
       throw Error("lod-sprite",
                   "the sprite frame on the GPU needs a cost model fitted on its frames (TerrainCost::gpu_sprite)");

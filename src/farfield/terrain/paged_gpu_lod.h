@@ -83,6 +83,7 @@ class PagedGpuLodTerrain : public GpuLodTerrain {
   void finish() { renderer_->finish(); }
 
   void gridHeights(std::span<const IVec2> points, std::span<float> out) const override;
+  bool holdsGridHeights() const override { return options_.keep_heights; }
   float groundHeight(double x, double y) const override;
 
   const PagedGpuLodStats& stats() const { return stats_; }
