@@ -3,11 +3,12 @@
 //   embed_terrain TERRAIN CACHE [FRAMES] [OUT.png]
 //
 // TERRAIN is a DEM file (GeoTIFF, netCDF, 16-bit PNG) or fractal:SIZE[:SEED][...]; CACHE the tile cache, written
-// from it once when missing (the DEM read window by window, never whole). The program flies FRAMES frames (default
-// 120) of a flythrough at 640x360, drawing each frame with LOD-sprite (Chen et al. 1999) wholly on the CDLOD terrain
-// paged from the cache: keyframes and high frames are CDLOD frames at 1 px, sprite frames its 4 px selection with the
-// keyframe's visibility tested per vertex on the GPU; a cost model fitted on a few views of the path chooses per
-// frame between them; pages are read ahead on a worker. It prints what LOD-sprite chose and writes the last frame.
+// from it once when missing (the DEM read window by window, never whole). The program flies FRAMES frames (at least
+// 10; default 120) of a flythrough at 640x360, drawing each frame with LOD-sprite (Chen et al. 1999) wholly on the
+// CDLOD terrain paged from the cache: keyframes and high frames are CDLOD frames at 1 px, sprite frames its 4 px
+// selection with the keyframe's visibility tested per vertex on the GPU; a cost model fitted on a few views of the
+// path chooses per frame between them; pages are read ahead on a worker. It prints what LOD-sprite chose and writes
+// the last frame.
 #include <algorithm>
 #include <cstdio>
 #include <exception>
@@ -68,7 +69,17 @@ int run(int argc, char** argv) {
     return 2;
   }
   const std::string terrain_spec = argv[1], cache_path = argv[2];
-  const int frames = argc > 3 ? std::stoi(argv[3]) : 120;
+  int frames = 120;
+  if (argc > 3) {
+    size_t used = 0;
+    try {
+      frames = std::stoi(argv[3], &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || argv[3][used] != '\0' || frames < 10)
+      throw Error("FRAMES", std::string("expected a whole number of frames, at least 10; got '") + argv[3] + "'");
+  }
   if (!std::filesystem::exists(cache_path)) writeCache(terrain_spec, cache_path);
   const terrain::TileCache cache(cache_path);
 

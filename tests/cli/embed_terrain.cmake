@@ -24,3 +24,7 @@ execute_process(COMMAND ${EXAMPLE} ${WORK}/no-such-dem.tif ${WORK}/none.tiles RE
 if(rc EQUAL 0 OR NOT err MATCHES "no-such-dem.tif")
   message(FATAL_ERROR "embed_terrain on a missing DEM: exit ${rc}, stderr: ${err}")
 endif()
+execute_process(COMMAND ${EXAMPLE} fractal:513:7 ${WORK}/t.tiles 12x RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "FRAMES: expected a whole number")
+  message(FATAL_ERROR "embed_terrain with FRAMES 12x: exit ${rc}, stderr: ${err}")
+endif()
