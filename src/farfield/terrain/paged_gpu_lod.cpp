@@ -219,7 +219,7 @@ int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKe
       if (!needed.count(*it)) {
         layer = layer_of_.at(*it);
         layer_of_.erase(*it);
-        if (options_.keep_heights) heights_of_[tileIndex(*it)].clear();
+        if (options_.keep_heights) heights_of_[tileIndex(*it)] = std::vector<float>();  // its memory given back
         lru_.erase(std::next(it).base());
         ++stats_.evictions;
         break;
