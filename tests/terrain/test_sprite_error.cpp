@@ -7,9 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 
 #include "farfield/core/camera.h"
 #include "farfield/terrain/cdlod.h"
+#include "farfield/terrain/cdlod_sprite_error.h"
 #include "farfield/terrain/fractal.h"
 #include "farfield/terrain/sprite_error.h"
 
@@ -245,6 +247,87 @@ TEST(SpriteError, MagnificationIsTheMeanDistanceRatioOverTheCells) {
     EXPECT_FALSE(keyframeDue(e, beta, 1e9, e.mean_magnification + 0.01));
     EXPECT_FALSE(keyframeDue(e, beta, 1e9, 0.0));  // no bound on the magnification
   }
+}
+
+
+void expectSameError(const SpriteError& a, const SpriteError& b, const std::string& where) {
+  EXPECT_EQ(a.mean_theta_sq, b.mean_theta_sq) << where;
+  EXPECT_EQ(a.mean_magnification, b.mean_magnification) << where;
+  EXPECT_EQ(a.max_theta, b.max_theta) << where;
+  EXPECT_EQ(a.quadrants, b.quadrants) << where;
+  EXPECT_EQ(a.skipped, b.skipped) << where;
+}
+
+// The sample kept from measure to measure (cdlod_sprite_error.h) along a flight: every measure equals a fresh
+// spriteError over the same nodes and viewpoints, bit for bit, while most nodes' points and projections came from the
+// measures before (so that a kept sample that went stale, or a key that mixed nodes up, shows as a difference).
+TEST(CdlodSpriteError, AKeptSampleEqualsAFreshOneAlongAFlight) {
+  const Heightfield hf = cdlodTestFractal(257, 5, 600.0);
+  const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
+  CdlodSpriteError kept;
+  CdlodSelection selection;
+  Vec3 anchor(0.0f);
+  for (int f = 0; f < 40; ++f) {
+    const float t = float(f);
+    const Vec3 eye(200.0f + 30.0f * t, 300.0f + 12.0f * t, hf.maxHeight() + 300.0f - 4.0f * t);
+    const Camera camera = metricCamera(eye, Vec3(3000.0f + 20.0f * t, 3500.0f - 15.0f * t, 0.0f), 512);
+    lod.select(camera, 4.0f, true, selection);
+    if (f % 10 == 0) anchor = camera.eye;  // a keyframe
+    const std::string where = "frame " + std::to_string(f);
+    expectSameError(kept.measure(lod, heightfieldHeights(hf), 0, selection.nodes, anchor, camera.eye, 512),
+                    spriteError(lod, selection.nodes, anchor, camera.eye, 512), where);
+    if (f % 7 == 3) {  // another keyframe's error in the same frame (a keyframe rendered ahead, a cached one)
+      const Vec3 other = camera.eye + Vec3(-150.0f, 80.0f, 40.0f);
+      expectSameError(kept.measure(lod, heightfieldHeights(hf), 0, selection.nodes, other, camera.eye, 512),
+                      spriteError(lod, selection.nodes, other, camera.eye, 512), where + ", another keyframe");
+    }
+  }
+  const CdlodSpriteError::Counters& c = kept.counters();
+  std::printf("%zu measures: cells kept %zu, gathered %zu; projections kept %zu; %zu nodes held\n", c.measures,
+              c.cells_kept, c.cells_gathered, c.projections_kept, kept.heldNodes());
+  EXPECT_GT(c.cells_kept, 2 * c.cells_gathered);
+  EXPECT_GT(c.projections_kept, c.cells_gathered);
+  EXPECT_LT(kept.heldNodes(), (CdlodSpriteError::kKeepMeasures + 1) * selection.nodes.size());
+}
+
+// A height the terrain only stood in for (a paged terrain's overview, its page not held) is kept while the terrain's
+// heights version stays, and asked for again once it changed (a page came): the measure then equals a fresh one over
+// the grid's own heights; the heights that were the grid's own are never asked for again.
+TEST(CdlodSpriteError, HeightsThatStoodInAreAskedForAgainWhenPagesCame) {
+  const Heightfield hf = cdlodTestFractal(257, 6, 600.0);
+  const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
+  const Camera camera =
+      metricCamera(Vec3(200.0f, 300.0f, hf.maxHeight() + 300.0f), Vec3(3000.0f, 3500.0f, 0.0f), 512);
+  CdlodSelection selection;
+  lod.select(camera, 4.0f, true, selection);
+  const Vec3 v1 = camera.eye + Vec3(-100.0f, 40.0f, 30.0f);
+  size_t asked = 0;
+  auto heights = [&](bool east_held) {
+    return [&hf, &asked, east_held](std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) {
+      asked += points.size();
+      for (size_t k = 0; k < points.size(); ++k) {
+        const int i = std::clamp(points[k].x, 0, hf.width - 1), j = std::clamp(points[k].y, 0, hf.height - 1);
+        const bool held = east_held || i < hf.width / 2;
+        out[k] = hf.at(i, j) + (held ? 0.0f : 80.0f);  // a coarse stand-in, off by 80 m
+        own[k] = held ? 1 : 0;
+      }
+    };
+  };
+  CdlodSpriteError kept;
+  const SpriteError stood_in = kept.measure(lod, heights(false), 1, selection.nodes, v1, camera.eye, 512);
+  const size_t first = asked;
+  asked = 0;
+  expectSameError(kept.measure(lod, heights(false), 1, selection.nodes, v1, camera.eye, 512), stood_in,
+                  "the same version");
+  EXPECT_EQ(asked, 0u) << "the stand-ins are kept while the version stays";
+  const SpriteError own = kept.measure(lod, heights(true), 2, selection.nodes, v1, camera.eye, 512);
+  expectSameError(own, spriteError(lod, selection.nodes, v1, camera.eye, 512), "after the pages came");
+  EXPECT_NE(stood_in.mean_theta_sq, own.mean_theta_sq);
+  EXPECT_GT(asked, 0u);
+  EXPECT_LT(asked, first);
+  asked = 0;
+  kept.measure(lod, heights(true), 3, selection.nodes, v1, camera.eye, 512);
+  EXPECT_EQ(asked, 0u) << "every height is the grid's own now";
 }
 
 }  // namespace

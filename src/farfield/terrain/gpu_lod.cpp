@@ -59,8 +59,9 @@ void GpuLodTerrain::setHole(const GridRect& hole) {
                      Vec2(float(hole.x1 * g.cell_x), float(hole.y1 * g.cell_y)));
 }
 
-void GpuLodTerrain::gridHeights(std::span<const IVec2> points, std::span<float> out) const {
+void GpuLodTerrain::gridHeights(std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) const {
   const Heightfield& hf = lod_.heightfield();
+  std::fill(own.begin(), own.end(), uint8_t(1));
   for (size_t k = 0; k < points.size(); ++k)
     out[k] = hf.at(std::clamp(points[k].x, 0, hf.width - 1), std::clamp(points[k].y, 0, hf.height - 1));
 }

@@ -67,9 +67,13 @@ class GpuLodTerrain {
 
   // The heights of grid points (each clamped to the grid) into `out` (as many), as the CPU holds them (LOD-sprite's
   // error metric runs over grid points, sprite_error.h); a paged terrain answers from the pages it holds, else from
-  // its overview. gridHeight: one point.
-  virtual void gridHeights(std::span<const IVec2> points, std::span<float> out) const;
+  // its overview. own (empty, or as many): 1 where the height is the grid's own, 0 where it is the overview's.
+  // gridHeight: one point.
+  virtual void gridHeights(std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own = {}) const;
   float gridHeight(int i, int j) const;
+  // Changes whenever gridHeights may answer a point with another height than before (a paged terrain: when a page's
+  // heights come in for its overview's); this one: always 0.
+  virtual uint64_t heightsVersion() const { return 0; }
   // Whether gridHeights gives the grid's own heights wherever the terrain is drawn at full resolution (a paged
   // terrain: only when it keeps its pages' heights); LOD-sprite's metric needs them.
   virtual bool holdsGridHeights() const { return true; }

@@ -163,6 +163,7 @@ void LodSpriteRenderer::reset() {
   lifetimes_.clear();
   high_triangles_frame_ = high_triangles_key_ = 0;
   high_latest_is_key_ = false;
+  error_sample_.clear();
 }
 
 const Camera* LodSpriteRenderer::spriteCamera() const { return current_ ? &current_->camera : nullptr; }
@@ -242,10 +243,12 @@ bool LodSpriteRenderer::dueAt(const SpriteError& e, double beta, double share) c
 SpriteError LodSpriteRenderer::frameError(const Vec3& v1, const Vec3& v2) const {
   if (options_.gpu_low) {
     const GpuLodTerrain& terrain = *options_.gpu_high;
-    return spriteError(
+    return error_sample_.measure(
         terrain.lod(),
-        [&terrain](std::span<const IVec2> points, std::span<float> out) { terrain.gridHeights(points, out); },
-        terrain.selection(low_handle_).nodes, v1, v2, options_.error_quadrants);
+        [&terrain](std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) {
+          terrain.gridHeights(points, out, own);
+        },
+        terrain.heightsVersion(), terrain.selection(low_handle_).nodes, v1, v2, options_.error_quadrants);
   }
   return spriteError(*lod_, low_.quadrants, v1, v2);
 }

@@ -42,6 +42,7 @@
 #include "farfield/gpu/renderer.h"
 #include "farfield/gpu/terrain_renderer.h"
 #include "farfield/image/image.h"
+#include "farfield/terrain/cdlod_sprite_error.h"
 #include "farfield/terrain/gpu_lod.h"
 #include "farfield/terrain/keyframe_visibility.h"
 #include "farfield/terrain/path_choice.h"
@@ -264,8 +265,10 @@ class LodSpriteRenderer {
   // With gpu_low: the frame's low-resolution selection (GpuLodTerrain::select's handle) and its triangles.
   int low_handle_ = -1;
   size_t low_triangles_ = 0;
-  // Equation 2 for the frame's low-resolution mesh, the sprite seen from v1 and the frame from v2.
+  // Equation 2 for the frame's low-resolution mesh, the sprite seen from v1 and the frame from v2; with gpu_low its
+  // sample is kept from one measure to the next (error_sample_).
   SpriteError frameError(const Vec3& v1, const Vec3& v2) const;
+  mutable CdlodSpriteError error_sample_;
   // Whether a sprite with error e is due at `share` of the bounds (epsilon, and max_magnification where set).
   bool dueAt(const SpriteError& e, double beta, double share) const;
   // How far a sprite is towards its trip, in pixels of epsilon: its error, or with max_magnification the share of the

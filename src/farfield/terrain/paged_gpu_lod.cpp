@@ -70,7 +70,8 @@ PagedGpuLodTerrain::~PagedGpuLodTerrain() {
 
 size_t PagedGpuLodTerrain::gpuBytes() const { return renderer_->gpuBytes() + pages_->bytes(); }
 
-void PagedGpuLodTerrain::gridHeights(std::span<const IVec2> points, std::span<float> out) const {
+void PagedGpuLodTerrain::gridHeights(std::span<const IVec2> points, std::span<float> out,
+                                     std::span<uint8_t> own) const {
   const TileLayout& l = cache_.layout();
   const int t = tile_cells_;
   // First where each height lies, its cache line asked for at once; then the heights. The points are scattered over
@@ -104,6 +105,7 @@ void PagedGpuLodTerrain::gridHeights(std::span<const IVec2> points, std::span<fl
                                           size_t(std::min(i, overview_.width - 1))]);
   }
   for (size_t k = 0; k < points.size(); ++k) {
+    if (!own.empty()) own[k] = at[k] ? 1 : 0;
     if (at[k]) {
       out[k] = *at[k];
       continue;
@@ -227,7 +229,10 @@ int PagedGpuLodTerrain::residentLayer(const TileKey& tile, const std::set<TileKe
   }
   FF_CHECK(layer >= 0);  // draw() checked that the frame's pages fit
   pages_->upload(layer, page->heights, page->colour);
-  if (options_.keep_heights) heights_of_[tileIndex(tile)] = std::move(page->heights);
+  if (options_.keep_heights) {
+    heights_of_[tileIndex(tile)] = std::move(page->heights);
+    ++heights_version_;
+  }
   layer_of_[tile] = layer;
   lru_.push_front(tile);
   stats_.pages = layer_of_.size();

@@ -82,8 +82,9 @@ class PagedGpuLodTerrain : public GpuLodTerrain {
   // Waits for the GPU (glFinish): the end of a timed frame.
   void finish() { renderer_->finish(); }
 
-  void gridHeights(std::span<const IVec2> points, std::span<float> out) const override;
+  void gridHeights(std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own = {}) const override;
   bool holdsGridHeights() const override { return options_.keep_heights; }
+  uint64_t heightsVersion() const override { return heights_version_; }
   float groundHeight(double x, double y) const override;
 
   const PagedGpuLodStats& stats() const { return stats_; }
@@ -121,6 +122,7 @@ class PagedGpuLodTerrain : public GpuLodTerrain {
   std::map<TileKey, int> layer_of_;  // resident tiles
   // With keep_heights: the held tiles' heights, (S + 1)^2 each, by tile index tx + ty * tilesX (empty: not held).
   std::vector<std::vector<float>> heights_of_;
+  uint64_t heights_version_ = 0;  // a page's heights came
   mutable std::vector<const float*> lookup_;  // gridHeights' scratch (one thread draws)
   std::list<TileKey> lru_;           // most recently used first
   std::vector<int> free_layers_;

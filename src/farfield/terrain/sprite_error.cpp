@@ -118,21 +118,20 @@ double quadrantTheta(const DVec3& c, std::span<const DVec3> corners, const DVec3
   const bool good = spriteProjection(c, corners, v1, c_prime, near);
   if (ok) *ok = good;
   if (!good) return 0.0;
+  return spriteTheta(c, c_prime, v2);
+}
+
+double spriteTheta(const DVec3& c, const DVec3& c_prime, const DVec3& v2) {
   const DVec3 a = c - v2, b = c_prime - v2;
   return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
 }
 
-double pixelAngle(const Camera& camera) { return double(camera.fovX()) / double(camera.width); }
-
-namespace {
-
-// |C - v1| / |C - v2| (SpriteError::mean_magnification), 1 where C is at v2.
-double magnification(const DVec3& c, const DVec3& v1, const DVec3& v2) {
+double spriteMagnification(const DVec3& c, const DVec3& v1, const DVec3& v2) {
   const double near = glm::length(c - v2);
   return near > 1e-9 ? glm::length(c - v1) / near : 1.0;
 }
 
-}  // namespace
+double pixelAngle(const Camera& camera) { return double(camera.fovX()) / double(camera.width); }
 
 SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> quadrants, const Vec3& v1,
                         const Vec3& v2) {
@@ -150,117 +149,12 @@ SpriteError spriteError(const QuadtreeLod& lod, std::span<const LodQuadrant> qua
       continue;
     }
     sum += theta * theta;
-    stretch += magnification(c, DVec3(v1), DVec3(v2));
+    stretch += spriteMagnification(c, DVec3(v1), DVec3(v2));
     e.max_theta = std::max(e.max_theta, theta);
     ++e.quadrants;
   }
   e.mean_theta_sq = e.quadrants ? sum / double(e.quadrants) : 0.0;
   e.mean_magnification = e.quadrants ? stretch / double(e.quadrants) : 1.0;
-  return e;
-}
-
-SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
-                        size_t max_quadrants) {
-  const Heightfield& hf = lod.heightfield();
-  const auto heights = [&hf](std::span<const IVec2> points, std::span<float> out) {
-    for (size_t k = 0; k < points.size(); ++k)
-      out[k] = hf.at(std::clamp(points[k].x, 0, hf.width - 1), std::clamp(points[k].y, 0, hf.height - 1));
-  };
-  return spriteError(lod, heights, nodes, v1, v2, max_quadrants);
-}
-
-SpriteError spriteError(const CdlodTerrain& lod, const GridHeightsFn& heights, std::span<const CdlodNode> nodes,
-                        const Vec3& v1, const Vec3& v2, size_t max_quadrants) {
-  const CdlodGrid& hf = lod.grid();
-  const int p = lod.patchCells();
-  // Per node of level >= 1: its cells inside the grid (columns x rows), and its weight for the sample's allocation.
-  struct Stratum {
-    const CdlodNode* node;
-    int columns, rows;
-    double weight;
-    size_t first = 0, cells = 0;  // its sampled cells in `sample`
-  };
-  std::vector<Stratum> strata;
-  strata.reserve(nodes.size());
-  size_t cells = 0;
-  double total_weight = 0.0;
-  for (const CdlodNode& n : nodes) {
-    if (n.level < 1) continue;
-    const int s = lod.spacing(n.level);
-    const int columns = std::clamp((hf.width - 1 - n.x * p * s) / s, 0, p);
-    const int rows = std::clamp((hf.height - 1 - n.y * p * s) / s, 0, p);
-    if (columns == 0 || rows == 0) continue;
-    // A cell's theta grows with its central vertex's deviation (at most the node's error E(N)) and falls with the
-    // square of its distance from the eye.
-    const Box3 box = lod.nodeBox(n);
-    const Vec3 nearest = glm::clamp(v2, box.lo, box.hi);
-    const double d = std::max(double(glm::length(v2 - nearest)), 1.0);
-    const double w = double(lod.nodeError(n)) / (d * d);
-    strata.push_back({&n, columns, rows, w * w});
-    cells += size_t(columns) * size_t(rows);
-    total_weight += w * w;
-  }
-  // The sample: per stratum every k-th cell (k odd, so that the sample moves across the columns), from an offset
-  // fixed by the node; five grid points a cell (its corners, then its centre), their heights gathered at once.
-  std::vector<IVec2> points;
-  for (Stratum& st : strata) {
-    const CdlodNode& n = *st.node;
-    const size_t count = size_t(st.columns) * size_t(st.rows);
-    size_t k = 1;
-    if (max_quadrants > 0 && cells > max_quadrants) {
-      const double share = total_weight > 0.0 ? st.weight / total_weight : 1.0 / double(strata.size());
-      const size_t taken = std::clamp<size_t>(size_t(std::lround(share * double(max_quadrants))), 1, count);
-      k = ((count + taken - 1) / taken) | 1;
-    }
-    uint32_t h = uint32_t(n.x) * 0x9E3779B1u ^ uint32_t(n.y) * 0x85EBCA77u ^ uint32_t(n.level) * 0xC2B2AE3Du;
-    h ^= h >> 15;
-    const int s = lod.spacing(n.level), x0 = n.x * p * s, y0 = n.y * p * s;
-    st.first = points.size() / 5;
-    for (size_t c = k > 1 ? size_t(h) % k : 0; c < count; c += k) {
-      const int cx = x0 + int(c % size_t(st.columns)) * s, cy = y0 + int(c / size_t(st.columns)) * s;
-      points.insert(points.end(),
-                    {IVec2(cx, cy), IVec2(cx + s, cy), IVec2(cx + s, cy + s), IVec2(cx, cy + s),
-                     IVec2(cx + s / 2, cy + s / 2)});
-    }
-    st.cells = points.size() / 5 - st.first;
-  }
-  std::vector<float> z(points.size());
-  heights(points, z);
-  SpriteError e;
-  const DVec3 eye1(v1), eye2(v2);
-  // As Heightfield::position: (i * cell_x, j * cell_y, height).
-  auto point = [&](size_t k) {
-    return DVec3(Vec3(float(points[k].x * hf.cell_x), float(points[k].y * hf.cell_y), z[k]));
-  };
-  DVec3 corners[4];
-  double weighted = 0.0, weighted_stretch = 0.0, represented = 0.0;
-  for (const Stratum& st : strata) {
-    double sum = 0.0, stretch = 0.0;
-    size_t used = 0;
-    for (size_t c = st.first; c < st.first + st.cells; ++c) {
-      for (size_t k = 0; k < 4; ++k) corners[k] = point(5 * c + k);
-      const DVec3 centre = point(5 * c + 4);
-      bool ok = false;
-      const double theta = quadrantTheta(centre, corners, eye1, eye2, &ok, true);
-      if (!ok) {
-        ++e.skipped;
-        continue;
-      }
-      sum += theta * theta;
-      stretch += magnification(centre, eye1, eye2);
-      e.max_theta = std::max(e.max_theta, theta);
-      ++used;
-    }
-    if (used == 0) continue;
-    // The node's mean stands for all its cells.
-    const double count = double(st.columns) * double(st.rows);
-    weighted += sum / double(used) * count;
-    weighted_stretch += stretch / double(used) * count;
-    represented += count;
-    e.quadrants += used;
-  }
-  e.mean_theta_sq = represented > 0.0 ? weighted / represented : 0.0;
-  e.mean_magnification = represented > 0.0 ? weighted_stretch / represented : 1.0;
   return e;
 }
 

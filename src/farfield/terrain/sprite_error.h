@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <span>
 
@@ -36,6 +37,10 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
 // theta (radians) for one quadrant; 0 when spriteProjection fails (the caller counts those as skipped).
 double quadrantTheta(const DVec3& c, std::span<const DVec3> corners, const DVec3& v1, const DVec3& v2,
                      bool* ok = nullptr, bool near = false);
+// theta from C' already found: the angle at v2 between C and C' (radians).
+double spriteTheta(const DVec3& c, const DVec3& c_prime, const DVec3& v2);
+// |C - v1| / |C - v2| (SpriteError::mean_magnification's term), 1 where C is at v2.
+double spriteMagnification(const DVec3& c, const DVec3& v1, const DVec3& v2);
 
 // beta: the view angle of one pixel, horizontal field of view / image width (radians per pixel).
 double pixelAngle(const Camera& camera);
@@ -73,10 +78,14 @@ SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> node
 // as many), asked once for the whole sample: a terrain whose heights are not held whole (a paged one: gpu_lod.h's
 // GpuLodTerrain::gridHeights) gathers them in one pass, so that their cache misses overlap (on the 2-core machine the
 // rasterizer evicts the CPU's caches between frames, and the sample's 5 points a cell then cost 100 ns each when
-// read one by one between the cells' arithmetic).
-using GridHeightsFn = std::function<void(std::span<const IVec2>, std::span<float>)>;
+// read one by one between the cells' arithmetic). Its third span (as many): 1 where a height is the grid's own, 0
+// where it stands in for it (a paged terrain's overview). Defined in cdlod_sprite_error.cpp, which keeps the sample
+// from frame to frame (CdlodSpriteError).
+using GridHeightsFn = std::function<void(std::span<const IVec2>, std::span<float>, std::span<uint8_t>)>;
 SpriteError spriteError(const CdlodTerrain& lod, const GridHeightsFn& heights, std::span<const CdlodNode> nodes,
                         const Vec3& v1, const Vec3& v2, size_t max_quadrants = 1024);
+// A heightfield's heights as GridHeightsFn (each point clamped to the grid, every height its own); hf must outlive it.
+GridHeightsFn heightfieldHeights(const Heightfield& hf);
 
 // Equation 2: true when a new keyframe is due (mean theta^2 >= (beta * epsilon)^2). No quadrants: never due.
 bool keyframeDue(const SpriteError& error, double beta, double epsilon_pixels);

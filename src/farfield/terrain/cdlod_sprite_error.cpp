@@ -1,0 +1,188 @@
+// Equation 2 over a CDLOD mesh's cells (sprite_error.h), with the sample kept between measures
+// (cdlod_sprite_error.h).
+#include "farfield/terrain/cdlod_sprite_error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+
+namespace farfield::terrain {
+
+size_t CdlodSpriteError::KeyHash::operator()(const Key& key) const {
+  uint64_t h = uint64_t(uint32_t(key.x)) * 0x9E3779B97F4A7C15ull;
+  h ^= (uint64_t(uint32_t(key.y)) + 0x632BE59BD9B4E019ull + (h << 6) + (h >> 2)) * 0xC2B2AE3D27D4EB4Full;
+  h ^= uint64_t(uint32_t(key.level)) << 56;
+  return size_t(h ^ (h >> 29));
+}
+
+void CdlodSpriteError::clear() {
+  held_.clear();
+  measure_ = 0;
+}
+
+SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeightsFn& heights, uint64_t heights_version,
+                                      std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
+                                      size_t max_quadrants) {
+  ++measure_;
+  ++counters_.measures;
+  const CdlodGrid& hf = lod.grid();
+  const int p = lod.patchCells();
+  // Per node of level >= 1: its cells inside the grid (columns x rows), and its weight for the sample's allocation.
+  struct Stratum {
+    const CdlodNode* node;
+    int columns, rows;
+    double weight;
+    Held* held = nullptr;
+    size_t first = 0, k = 1;  // its sampled cells: first, first + k, ...
+  };
+  std::vector<Stratum> strata;
+  strata.reserve(nodes.size());
+  size_t cells = 0;
+  double total_weight = 0.0;
+  for (const CdlodNode& n : nodes) {
+    if (n.level < 1) continue;
+    const int s = lod.spacing(n.level);
+    const int columns = std::clamp((hf.width - 1 - n.x * p * s) / s, 0, p);
+    const int rows = std::clamp((hf.height - 1 - n.y * p * s) / s, 0, p);
+    if (columns == 0 || rows == 0) continue;
+    // A cell's theta grows with its central vertex's deviation (at most the node's error E(N)) and falls with the
+    // square of its distance from the eye.
+    const Box3 box = lod.nodeBox(n);
+    const Vec3 nearest = glm::clamp(v2, box.lo, box.hi);
+    const double d = std::max(double(glm::length(v2 - nearest)), 1.0);
+    const double w = double(lod.nodeError(n)) / (d * d);
+    strata.push_back({&n, columns, rows, w * w});
+    cells += size_t(columns) * size_t(rows);
+    total_weight += w * w;
+  }
+  // A cell's five grid points: its corners, then its centre.
+  auto cellPoint = [&](const Stratum& st, size_t c, int corner) {
+    const int s = lod.spacing(st.node->level);
+    const int cx = st.node->x * p * s + int(c % size_t(st.columns)) * s;
+    const int cy = st.node->y * p * s + int(c / size_t(st.columns)) * s;
+    constexpr int dx[5] = {0, 2, 2, 0, 1}, dy[5] = {0, 0, 2, 2, 1};
+    return IVec2(cx + dx[corner] * s / 2, cy + dy[corner] * s / 2);
+  };
+  // The sample: per stratum every k-th cell (k odd, so that the sample moves across the columns), from an offset
+  // fixed by the node. The cells a node never had are asked for at once.
+  points_.clear();
+  asked_.clear();
+  for (Stratum& st : strata) {
+    const CdlodNode& n = *st.node;
+    const size_t count = size_t(st.columns) * size_t(st.rows);
+    if (max_quadrants > 0 && cells > max_quadrants) {
+      const double share = total_weight > 0.0 ? st.weight / total_weight : 1.0 / double(strata.size());
+      const size_t taken = std::clamp<size_t>(size_t(std::lround(share * double(max_quadrants))), 1, count);
+      st.k = ((count + taken - 1) / taken) | 1;
+    }
+    uint32_t h = uint32_t(n.x) * 0x9E3779B1u ^ uint32_t(n.y) * 0x85EBCA77u ^ uint32_t(n.level) * 0xC2B2AE3Du;
+    h ^= h >> 15;
+    st.first = st.k > 1 ? size_t(h) % st.k : 0;
+    Held& held = held_[Key{n.level, n.x, n.y}];
+    st.held = &held;
+    held.used = measure_;
+    if (held.have.size() != count) {
+      held.z.assign(5 * count, 0.0f);
+      held.have.assign(count, 0);
+      held.c_prime.assign(count, DVec3(0.0));
+      held.projected.assign(count, 0);
+    }
+    if (held.version != heights_version) {  // the heights that stood in may have been replaced
+      std::replace(held.have.begin(), held.have.end(), uint8_t(2), uint8_t(0));
+      held.version = heights_version;
+    }
+    for (size_t c = st.first; c < count; c += st.k) {
+      if (held.have[c]) {
+        ++counters_.cells_kept;
+        continue;
+      }
+      ++counters_.cells_gathered;
+      asked_.emplace_back(&held, c);
+      for (int corner = 0; corner < 5; ++corner) points_.push_back(cellPoint(st, c, corner));
+    }
+  }
+  z_.assign(points_.size(), 0.0f);
+  own_.assign(points_.size(), uint8_t(1));
+  if (!points_.empty()) heights(points_, z_, own_);
+  for (size_t a = 0; a < asked_.size(); ++a) {
+    Held& held = *asked_[a].first;
+    const size_t c = asked_[a].second;
+    bool own = true;
+    for (size_t corner = 0; corner < 5; ++corner) {
+      held.z[5 * c + corner] = z_[5 * a + corner];
+      own = own && own_[5 * a + corner] != 0;
+    }
+    held.have[c] = own ? 1 : 2;
+    held.projected[c] = 0;
+  }
+
+  SpriteError e;
+  const DVec3 eye1(v1), eye2(v2);
+  // As Heightfield::position: (i * cell_x, j * cell_y, height).
+  auto position = [&](const Stratum& st, size_t c, int corner) {
+    const IVec2 g = cellPoint(st, c, corner);
+    return DVec3(Vec3(float(g.x * hf.cell_x), float(g.y * hf.cell_y), st.held->z[5 * c + size_t(corner)]));
+  };
+  DVec3 corners[4];
+  double weighted = 0.0, weighted_stretch = 0.0, represented = 0.0;
+  for (const Stratum& st : strata) {
+    Held& held = *st.held;
+    if (held.eye1 != eye1) {
+      std::fill(held.projected.begin(), held.projected.end(), uint8_t(0));
+      held.eye1 = eye1;
+    }
+    double sum = 0.0, stretch = 0.0;
+    size_t used = 0;
+    for (size_t c = st.first; c < held.have.size(); c += st.k) {
+      const DVec3 centre = position(st, c, 4);
+      if (held.projected[c] == 0) {
+        for (int corner = 0; corner < 4; ++corner) corners[corner] = position(st, c, corner);
+        held.projected[c] = spriteProjection(centre, corners, eye1, held.c_prime[c], true) ? 1 : 2;
+      } else {
+        ++counters_.projections_kept;
+      }
+      if (held.projected[c] == 2) {
+        ++e.skipped;
+        continue;
+      }
+      const double theta = spriteTheta(centre, held.c_prime[c], eye2);
+      sum += theta * theta;
+      stretch += spriteMagnification(centre, eye1, eye2);
+      e.max_theta = std::max(e.max_theta, theta);
+      ++used;
+    }
+    if (used == 0) continue;
+    // The node's mean stands for all its cells.
+    const double count = double(st.columns) * double(st.rows);
+    weighted += sum / double(used) * count;
+    weighted_stretch += stretch / double(used) * count;
+    represented += count;
+    e.quadrants += used;
+  }
+  e.mean_theta_sq = represented > 0.0 ? weighted / represented : 0.0;
+  e.mean_magnification = represented > 0.0 ? weighted_stretch / represented : 1.0;
+  // Nodes that no recent measure sampled are forgotten (the held set follows the path).
+  std::erase_if(held_, [this](const auto& entry) { return entry.second.used + kKeepMeasures < measure_; });
+  return e;
+}
+
+SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> nodes, const Vec3& v1, const Vec3& v2,
+                        size_t max_quadrants) {
+  return spriteError(lod, heightfieldHeights(lod.heightfield()), nodes, v1, v2, max_quadrants);
+}
+
+GridHeightsFn heightfieldHeights(const Heightfield& hf) {
+  return [&hf](std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) {
+    for (size_t k = 0; k < points.size(); ++k)
+      out[k] = hf.at(std::clamp(points[k].x, 0, hf.width - 1), std::clamp(points[k].y, 0, hf.height - 1));
+    std::fill(own.begin(), own.end(), uint8_t(1));
+  };
+}
+
+SpriteError spriteError(const CdlodTerrain& lod, const GridHeightsFn& heights, std::span<const CdlodNode> nodes,
+                        const Vec3& v1, const Vec3& v2, size_t max_quadrants) {
+  CdlodSpriteError sample;
+  return sample.measure(lod, heights, 0, nodes, v1, v2, max_quadrants);
+}
+
+}  // namespace farfield::terrain
