@@ -156,12 +156,19 @@ TEST(TerrainTilesGL, LodSpriteRunsOnThePagedTerrainBesideItsCdlodFrames) {
   size_t rows = 0, compared = 0;
   std::getline(csv, line);
   EXPECT_EQ(line, "frame,cdlod_ms,lod_sprite_ms,cdlod_own_cpu_ms,lod_sprite_own_cpu_ms,path,source,triangles,error_px,"
-                  "magnification,psnr_vs_cdlod");
+                  "magnification,page_loads,psnr_vs_cdlod");
+  size_t loads = 0;
   while (std::getline(csv, line)) {
     ++rows;
     compared += line.back() != ',' ? 1 : 0;
+    // page_loads: the 11th column.
+    size_t at = 0;
+    for (int column = 0; column < 10; ++column) at = line.find(',', at) + 1;
+    loads += std::stoul(line.substr(at, line.find(',', at) - at));
   }
   EXPECT_EQ(rows, frames);
+  EXPECT_EQ(loads, s["page_loads_waited_for"].get<size_t>());
+  EXPECT_LE(s["frames_that_waited_for_pages"].get<size_t>(), loads);
   EXPECT_EQ(compared, s["psnr_vs_cdlod_frames"].get<size_t>());
   for (const char* f : {"lod_sprite_00000.png", "lod_sprite_diff_00000.png"})
     EXPECT_TRUE(std::filesystem::exists(out / "frames" / f)) << f;

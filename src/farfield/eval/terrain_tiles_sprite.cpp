@@ -93,12 +93,14 @@ PagedSpriteRun::PagedSpriteRun(terrain::PagedGpuLodTerrain& terrain, std::span<c
 PagedSpriteFrame PagedSpriteRun::draw(const Camera& camera, gpu::RenderTarget& target) {
   PagedSpriteFrame frame;
   target.clear(kSky);
+  const size_t loads = terrain_.stats().page_loads;
   const gpu::GlCounters before = gpu::glCounters();
   const Stopwatch clock;
   frame.triangles = renderer_->render(camera, target, &frame.info).triangles;
   terrain_.finish();
   frame.ms = clock.milliseconds();
   frame.own_ms = ownCpuMs(frame.ms, before);
+  frame.page_loads = terrain_.stats().page_loads - loads;
   return frame;
 }
 
@@ -108,9 +110,11 @@ nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame>
   std::vector<double> ms, own;
   for (const PagedSpriteFrame& f : frames) own.push_back(f.own_ms);
   double psnr_min = 1e9, psnr_sum = 0.0, triangles = 0.0;
-  size_t compared = 0, sprite_frames = 0;
+  size_t compared = 0, sprite_frames = 0, page_loads = 0, waited = 0;
   for (const PagedSpriteFrame& f : frames) {
     ms.push_back(f.ms);
+    page_loads += f.page_loads;
+    waited += f.page_loads > 0 ? 1 : 0;
     triangles += double(f.triangles);
     sprite_frames += f.info.path == terrain::TerrainPath::Sprite ? 1 : 0;
     if (f.psnr_vs_high < 0.0) continue;
@@ -128,6 +132,8 @@ nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame>
   j["cdlod"]["own_cpu_ms"] = ownCpuSummary(std::vector<double>(high_own_ms.begin(), high_own_ms.end()));
   j["triangles_mean"] = frames.empty() ? 0.0 : triangles / double(frames.size());
   j["sprite_frames"] = sprite_frames;
+  j["page_loads_waited_for"] = page_loads;
+  j["frames_that_waited_for_pages"] = waited;
   j["high_frames"] = c.high_frames;
   j["fresh_keyframes"] = c.fresh_keyframes;
   j["keyframes_rendered_ahead"] = c.predicted_rendered;
@@ -152,7 +158,8 @@ std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
                 "%zu frames over twice its median; own CPU %.3f ms median, %.3f p95 (the CDLOD frame's %.3f, %.3f); "
                 "**%.2fx the CDLOD frame's mean** (%.2f ms; median %.2fx); "
                 "%zu sprite frames, %zu high frames, %zu keyframes drawn at once, %zu rendered ahead (%zu used); PSNR "
-                "against the CDLOD frame %.1f dB mean, %.1f min over %zu frames; cost model fitted in %.1f s\n",
+                "against the CDLOD frame %.1f dB mean, %.1f min over %zu frames; cost model fitted in %.1f s; %zu pages read "
+                "in its frames (%zu frames waited)\n",
                 bool(j["predict"]) ? ", keyframes rendered ahead" : "", double(j["epsilon"]), double(j["low_error"]),
                 double(j["frame_ms_mean"]), double(j["frame_ms_median"]), double(j["frame_ms_p99"]),
                 double(j["frame_ms_max"]), size_t(j["frames_over_twice_the_median"]),
@@ -162,7 +169,8 @@ std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
                 double(j["speedup_vs_cdlod_median"]), size_t(j["sprite_frames"]), size_t(j["high_frames"]),
                 size_t(j["fresh_keyframes"]), size_t(j["keyframes_rendered_ahead"]),
                 size_t(j["keyframes_rendered_ahead_used"]), double(j["psnr_vs_cdlod_mean_db"]),
-                double(j["psnr_vs_cdlod_min_db"]), size_t(j["psnr_vs_cdlod_frames"]), double(j["calibration_seconds"]));
+                double(j["psnr_vs_cdlod_min_db"]), size_t(j["psnr_vs_cdlod_frames"]), double(j["calibration_seconds"]),
+                size_t(j["page_loads_waited_for"]), size_t(j["frames_that_waited_for_pages"]));
   return line;
 }
 

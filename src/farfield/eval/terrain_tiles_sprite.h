@@ -35,6 +35,7 @@ struct PagedSpriteFrame {
   double ms = 0.0;  // the LOD-sprite frame: choice, metric, draws, to the GPU's end
   double own_ms = -1.0;  // of it, in Farfield's own code (wall less the time in GL calls); -1 without GL counters
   uint64_t triangles = 0;
+  size_t page_loads = 0;  // pages its draws read themselves (the frame waited; a keyframe's wider view, say)
   terrain::LodSpriteFrameInfo info;
   double psnr_vs_high = -1.0;  // against the CDLOD frame of the same camera, where compared (-1: not)
 };
