@@ -181,9 +181,27 @@ bool CdlodTerrain::updateRanges(const Camera& camera, float pixel_error, CdlodRa
   if (!(pixel_error > 0.0f) || !std::isfinite(pixel_error))
     throw Error("CDLOD terrain", "pixel error must be a positive number, got " + std::to_string(pixel_error));
   const double scale = QuadtreeLod::pixelsPerRadian(camera) / double(pixel_error);
-  if (r.scale == scale && r.node.size() == boxes_.size()) return false;
+  if (r.scale == scale && r.size() == boxes_.size()) return false;
   r.scale = scale;
-  r.node.assign(boxes_.size(), Vec3(0.0f));
+  {
+    std::lock_guard<std::mutex> lock(range_tables_->mutex);
+    auto& tables = range_tables_->tables;
+    std::erase_if(tables, [](const auto& t) { return t.second.expired(); });
+    for (const auto& [made_for, table] : tables)
+      if (made_for == scale) {
+        r.table = table.lock();
+        if (r.table) return true;
+      }
+  }
+  r.table = makeRanges(scale);
+  std::lock_guard<std::mutex> lock(range_tables_->mutex);
+  range_tables_->tables.emplace_back(scale, r.table);
+  return true;
+}
+
+std::shared_ptr<const std::vector<Vec3>> CdlodTerrain::makeRanges(double scale) const {
+  auto table = std::make_shared<std::vector<Vec3>>(boxes_.size(), Vec3(0.0f));
+  std::vector<Vec3>& node = *table;
   const float m = options_.morph_fraction;
   for (int l = 1; l <= top_; ++l) {
     for (int y = 0; y < nodesY(l); ++y)
@@ -194,9 +212,9 @@ bool CdlodTerrain::updateRanges(const Camera& camera, float pixel_error, CdlodRa
           for (int c = 0; c < 4; ++c) {
             const CdlodNode child{l - 1, 2 * x + (c & 1), 2 * y + (c >> 1)};
             if (child.x >= nodesX(l - 1) || child.y >= nodesY(l - 1)) continue;
-            start = std::max(start, r.node[nodeIndex(child)].z + glm::length(nodeBox(child).extent()));
+            start = std::max(start, node[nodeIndex(child)].z + glm::length(nodeBox(child).extent()));
           }
-        r.node[nodeIndex(q)] = Vec3(start, start + m * std::max(start, 0.5f * glm::length(nodeBox(q).extent())), 0.0f);
+        node[nodeIndex(q)] = Vec3(start, start + m * std::max(start, 0.5f * glm::length(nodeBox(q).extent())), 0.0f);
       }
     // endD: the largest end over each node's 3 x 3 neighbourhood.
     for (int y = 0; y < nodesY(l); ++y)
@@ -204,11 +222,11 @@ bool CdlodTerrain::updateRanges(const Camera& camera, float pixel_error, CdlodRa
         float end = 0.0f;
         for (int ny = std::max(0, y - 1); ny <= std::min(nodesY(l) - 1, y + 1); ++ny)
           for (int nx = std::max(0, x - 1); nx <= std::min(nodesX(l) - 1, x + 1); ++nx)
-            end = std::max(end, r.node[nodeIndex({l, nx, ny})].y);
-        r.node[nodeIndex({l, x, y})].z = end;
+            end = std::max(end, node[nodeIndex({l, nx, ny})].y);
+        node[nodeIndex({l, x, y})].z = end;
       }
   }
-  return true;
+  return table;
 }
 
 void CdlodTerrain::select(const Camera& camera, float pixel_error, bool cull, CdlodSelection& out) const {
@@ -228,7 +246,7 @@ void CdlodTerrain::selectNode(const CdlodNode& node, const Vec3& eye, const Frus
     ++out.culled;
     return;
   }
-  if (node.level == 0 || !(boxDistance(box, eye) < out.ranges.node[nodeIndex(node)].z)) {
+  if (node.level == 0 || !(boxDistance(box, eye) < out.ranges.node(nodeIndex(node)).z)) {
     out.nodes.push_back(node);
     return;
   }
@@ -265,7 +283,7 @@ float CdlodTerrain::morphFactor(const CdlodNode& node, int i, int j, const Cdlod
   const int ly = std::min(gy % up_cells == 0 && gy > 0 ? gy / up_cells - 1 : hy, nodesY(up) - 1);
   Vec2 range(0.0f);
   for (int qy : {ly, hy})
-    for (int qx : {lx, hx}) range = glm::max(range, Vec2(ranges.node[nodeIndex({up, qx, qy})]));
+    for (int qx : {lx, hx}) range = glm::max(range, Vec2(ranges.node(nodeIndex({up, qx, qy}))));
   if (!(range.y > range.x)) return 0.0f;
   const Vec3 p(float(gx) * float(grid_.cell_x), float(gy) * float(grid_.cell_y), heightfield().at(gx, gy));
   return std::clamp((glm::length(eye - p) - range.x) / (range.y - range.x), 0.0f, 1.0f);

@@ -41,7 +41,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <memory>
+#include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "farfield/core/bounds.h"
@@ -69,10 +72,13 @@ struct CdlodNode {
 };
 
 // Per node of levels >= 1 (indexed as CdlodTerrain::nodeIndex): start, end and endD (see the file comment), for one
-// scale lambda / tau.
+// scale lambda / tau. The table is shared by every selection of the terrain at that scale while one holds it (a
+// 16,385^2 grid's is 17 MB and 30 ms to make).
 struct CdlodRanges {
   double scale = 0.0;  // lambda / tau they were made for (0: not made)
-  std::vector<Vec3> node;
+  std::shared_ptr<const std::vector<Vec3>> table;
+  const Vec3& node(size_t index) const { return (*table)[index]; }
+  size_t size() const { return table ? table->size() : 0; }
 };
 
 struct CdlodSelection {
@@ -124,7 +130,8 @@ class CdlodTerrain {
   Box3 nodeBox(const CdlodNode& node) const;
   size_t bytes() const;
 
-  // Makes the ranges for a camera and bound tau (pixels) unless `ranges` already holds them; true when made.
+  // Makes the ranges for a camera and bound tau (pixels) unless `ranges` already holds them (true when it did not):
+  // the table of that scale that another selection holds, else a new one.
   bool updateRanges(const Camera& camera, float pixel_error, CdlodRanges& ranges) const;
   // The nodes to draw for a camera (eye, image height, field of view, frustum when cull) and bound tau (pixels).
   // Throws farfield::Error for a bound that is not a positive number.
@@ -144,6 +151,14 @@ class CdlodTerrain {
   void computeErrors();
   void computeLevelErrors();  // error_ from node_error_
   void selectNode(const CdlodNode& node, const Vec3& eye, const Frustum* frustum, CdlodSelection& out) const;
+
+  // The range tables that selections hold, by scale, shared by the terrain's copies.
+  struct RangeTables {
+    std::mutex mutex;
+    std::vector<std::pair<double, std::weak_ptr<const std::vector<Vec3>>>> tables;
+  };
+  std::shared_ptr<RangeTables> range_tables_ = std::make_shared<RangeTables>();
+  std::shared_ptr<const std::vector<Vec3>> makeRanges(double scale) const;
 
   const Heightfield* hf_ = nullptr;
   CdlodGrid grid_;

@@ -94,8 +94,8 @@ void GpuLodTerrain::placeNodes(std::span<const CdlodNode> nodes, std::vector<gpu
 
 void uploadRanges(const CdlodSelection& selection, gpu::CdlodRenderer& renderer, int slot) {
   std::vector<Vec2> ranges;
-  ranges.reserve(selection.ranges.node.size());
-  for (const Vec3& r : selection.ranges.node) ranges.emplace_back(r.x, r.y);
+  ranges.reserve(selection.ranges.size());
+  for (size_t k = 0; k < selection.ranges.size(); ++k) ranges.emplace_back(Vec2(selection.ranges.node(k)));
   renderer.setRanges(ranges, slot);
 }
 
