@@ -161,16 +161,24 @@ Camera metricCamera(Vec3 eye, Vec3 at, int size) {
   return camera;
 }
 
+// The CDLOD metric tests' view: high over the grid's corner, looking across it, and its 4 px selection.
+Camera acrossTheGrid(const Heightfield& hf) {
+  return metricCamera(Vec3(200.0f, 300.0f, hf.maxHeight() + 300.0f), Vec3(3000.0f, 3500.0f, 0.0f), 512);
+}
+CdlodSelection lowSelection(const CdlodTerrain& lod, const Camera& camera) {
+  CdlodSelection selection;
+  lod.select(camera, 4.0f, true, selection);
+  return selection;
+}
+
 // Equation 2 over a CDLOD mesh (the GPU sprite frame's, lod_sprite.h's gpu_low): every cell of the selection's nodes
 // of level >= 1 inside the grid is a quadrant (counted independently here), and the evenly spread sample stands for
 // the mean over every cell.
 TEST(SpriteError, CdlodSampleStandsForEveryCell) {
   const Heightfield hf = cdlodTestFractal(257, 5, 600.0);
   const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
-  const Camera camera =
-      metricCamera(Vec3(200.0f, 300.0f, hf.maxHeight() + 300.0f), Vec3(3000.0f, 3500.0f, 0.0f), 512);
-  CdlodSelection selection;
-  lod.select(camera, 4.0f, true, selection);
+  const Camera camera = acrossTheGrid(hf);
+  const CdlodSelection selection = lowSelection(lod, camera);
   const int p = lod.patchCells();
   size_t cells = 0;
   for (const CdlodNode& n : selection.nodes) {
@@ -296,10 +304,8 @@ TEST(CdlodSpriteError, AKeptSampleEqualsAFreshOneAlongAFlight) {
 TEST(CdlodSpriteError, HeightsThatStoodInAreAskedForAgainWhenPagesCame) {
   const Heightfield hf = cdlodTestFractal(257, 6, 600.0);
   const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
-  const Camera camera =
-      metricCamera(Vec3(200.0f, 300.0f, hf.maxHeight() + 300.0f), Vec3(3000.0f, 3500.0f, 0.0f), 512);
-  CdlodSelection selection;
-  lod.select(camera, 4.0f, true, selection);
+  const Camera camera = acrossTheGrid(hf);
+  const CdlodSelection selection = lowSelection(lod, camera);
   const Vec3 v1 = camera.eye + Vec3(-100.0f, 40.0f, 30.0f);
   size_t asked = 0;
   auto heights = [&](bool east_held) {
