@@ -32,7 +32,7 @@
 //     <= start of the node above P (k = 0): no crack; neighbours differ by at most one level (the same argument one
 //     level up); and a node replaced by its children at endD shows the same surface before and after (no pop).
 // The ranges depend on the camera only through s, so they are recomputed only when the image height, field of view
-// or bound change.
+// or bound change, and selections at the same s share one table.
 // Morphing: odd vertices of a patch (odd i or j) slide by k * 2^L cells towards the lower even vertex, and take the
 // height bilinearly interpolated from the full-resolution grid at the morphed position: at k = 1 the patch is the
 // coarser level's mesh (the (odd, odd) cell of each 2 x 2 block keeps its diagonal; the others collapse).
@@ -83,8 +83,8 @@ struct CdlodRanges {
 
 struct CdlodSelection {
   std::vector<CdlodNode> nodes;
-  CdlodRanges ranges;           // kept from frame to frame, remade when the scale changes
-  bool ranges_changed = false;  // remade by the last select()
+  CdlodRanges ranges;           // kept from frame to frame, taken anew when the scale changes
+  bool ranges_changed = false;  // taken anew by the last select() (made, or shared with another selection)
   size_t visited = 0;  // nodes tested
   size_t culled = 0;   // left out by the frustum
 };
@@ -119,7 +119,7 @@ class CdlodTerrain {
   // Nodes along x and y at a level (those that overlap the grid).
   int nodesX(int level) const;
   int nodesY(int level) const;
-  // Index of a node of any level in per-node arrays (CdlodRanges::node); levelOffset(l) is that of node (l, 0, 0).
+  // Index of a node of any level in per-node arrays (CdlodRanges::node(index)); levelOffset(l): node (l, 0, 0)'s.
   size_t nodeIndex(const CdlodNode& node) const;
   size_t levelOffset(int level) const { return box_offset_[size_t(level)]; }
   size_t nodeCount() const { return boxes_.size(); }
