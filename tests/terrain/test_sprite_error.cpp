@@ -296,6 +296,16 @@ TEST(CdlodSpriteError, AKeptSampleEqualsAFreshOneAlongAFlight) {
   EXPECT_GT(c.cells_kept, 2 * c.cells_gathered);
   EXPECT_GT(c.projections_kept, c.cells_gathered);
   EXPECT_LT(kept.heldNodes(), (CdlodSpriteError::kKeepMeasures + 1) * selection.nodes.size());
+  const Vec3 v2 = anchor + Vec3(60.0f, 30.0f, -10.0f), other = anchor + Vec3(-150.0f, 80.0f, 40.0f);
+  // Three keyframes in a random order, the view moving: still every measure a fresh one's.
+  std::mt19937 rng(11);
+  const Vec3 eyes[3] = {anchor, other, anchor + Vec3(90.0f, -60.0f, 20.0f)};
+  for (int m = 0; m < 30; ++m) {
+    const Vec3& v1 = eyes[rng() % 3];
+    const Vec3 moved = v2 + Vec3(5.0f * float(m), -3.0f * float(m), 0.0f);
+    expectSameError(kept.measure(lod, heightfieldHeights(hf), 0, selection.nodes, v1, moved, 512),
+                    spriteError(lod, selection.nodes, v1, moved, 512), "measure " + std::to_string(m));
+  }
 }
 
 // A height the terrain only stood in for (a paged terrain's overview, its page not held) is kept while the terrain's
