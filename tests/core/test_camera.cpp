@@ -4,6 +4,7 @@
 
 #include <random>
 #include <string>
+#include <utility>
 
 #include "farfield/core/error.h"
 
@@ -60,6 +61,25 @@ TEST(Camera, PointStraightAheadMapsToCentre) {
   // Reversed-Z formula by hand: depth(d) = n (f - d) / (d (f - n)).
   double n = c.near_plane, f = c.far_plane, d = 25.0;
   EXPECT_NEAR(p.z, n * (f - d) / (d * (f - n)), 1e-6);
+}
+
+// A resized camera keeps the pixel density: every point seen lands the same number of pixels from the image centre,
+// whether the image grew (a guard band) or shrank.
+TEST(Camera, ResizedKeepsThePixelDensity) {
+  const Camera c = testCamera();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (const auto& [w, h] : {std::pair{800, 600}, std::pair{320, 240}, std::pair{640, 700}}) {
+    const Camera r = c.resized(w, h);
+    EXPECT_EQ(r.width, w);
+    EXPECT_EQ(r.height, h);
+    for (int k = 0; k < 20; ++k) {
+      const Vec3 p = c.eye + 60.0f * glm::normalize(c.at - c.eye) + Vec3(10.0f * u(rng), 10.0f * u(rng), 8.0f * u(rng));
+      const Vec3 a = c.project(p), b = r.project(p);
+      EXPECT_NEAR(a.x - 0.5f * float(c.width), b.x - 0.5f * float(w), 1e-2f) << w << "x" << h;
+      EXPECT_NEAR(a.y - 0.5f * float(c.height), b.y - 0.5f * float(h), 1e-2f) << w << "x" << h;
+    }
+  }
 }
 
 TEST(Camera, AxesAndOffAxisPixels) {

@@ -9,6 +9,14 @@ namespace farfield {
 
 float Camera::fovX() const { return 2.0f * std::atan(std::tan(fov_y * 0.5f) * aspect()); }
 
+Camera Camera::resized(int w, int h) const {
+  Camera c = *this;
+  c.fov_y = 2.0f * std::atan(std::tan(fov_y * 0.5f) * float(h) / float(height));
+  c.width = w;
+  c.height = h;
+  return c;
+}
+
 Mat4 Camera::view() const { return glm::lookAt(eye, at, up); }
 
 Mat4 Camera::projection() const {

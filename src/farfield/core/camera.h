@@ -31,6 +31,9 @@ struct Camera {
   Mat4 projection() const;
   Mat4 viewProjection() const { return projection() * view(); }
   Vec3 forward() const { return glm::normalize(at - eye); }
+  // The same view on a w x h image at the same pixel density (the field of view grown or shrunk with the height):
+  // a guard band around the image, or a part of it.
+  Camera resized(int w, int h) const;
 
   // Distance along the view axis (metres) of a window depth value in [0,1] (reversed Z).
   float linearDepth(float window_depth) const;

@@ -173,8 +173,7 @@ SpriteError spriteError(const CdlodTerrain& lod, std::span<const CdlodNode> node
 
 GridHeightsFn heightfieldHeights(const Heightfield& hf) {
   return [&hf](std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) {
-    for (size_t k = 0; k < points.size(); ++k)
-      out[k] = hf.at(std::clamp(points[k].x, 0, hf.width - 1), std::clamp(points[k].y, 0, hf.height - 1));
+    for (size_t k = 0; k < points.size(); ++k) out[k] = hf.clampedAt(points[k].x, points[k].y);
     std::fill(own.begin(), own.end(), uint8_t(1));
   };
 }

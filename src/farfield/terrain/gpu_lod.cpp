@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "farfield/core/error.h"
+#include "farfield/terrain/sprite_error.h"
 
 #include "farfield/terrain/quadtree_lod.h"
 #include "farfield/terrain/terrain_texture.h"
@@ -60,10 +61,7 @@ void GpuLodTerrain::setHole(const GridRect& hole) {
 }
 
 void GpuLodTerrain::gridHeights(std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) const {
-  const Heightfield& hf = lod_.heightfield();
-  std::fill(own.begin(), own.end(), uint8_t(1));
-  for (size_t k = 0; k < points.size(); ++k)
-    out[k] = hf.at(std::clamp(points[k].x, 0, hf.width - 1), std::clamp(points[k].y, 0, hf.height - 1));
+  heightfieldHeights(lod_.heightfield())(points, out, own);
 }
 
 float GpuLodTerrain::gridHeight(int i, int j) const {

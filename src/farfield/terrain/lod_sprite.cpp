@@ -126,25 +126,15 @@ void LodSpriteRenderer::warmUpSpriteFrame() {
   gpu::RenderTarget key(8, 8), frame(8, 8);
   key.clear(options_.sky_color);
   frame.clear(options_.sky_color);
-  const int handle = options_.gpu_high->select(c, options_.low_error);
-  drawCdlodSprite(c, handle, frame, c, key);
-  // The keyframes' own targets, as many as can be alive at once (the kept ones and one more: the new or predicted
-  // keyframe before the old is let go), made and drawn into here, the first with a keyframe of the frame's size; and
-  // the selections of the frame's size at both bounds. A first draw into a new target, and the first selection at a
-  // new scale (its node ranges: 30 ms on the 16,385^2 terrain), were the first keyframe's frame otherwise (49 ms
-  // against 6 for the CDLOD frame there). The scales are those of a camera of Camera's field of view.
+  drawCdlodSprite(c, options_.gpu_high->select(c, options_.low_error), frame, c, key);
+  // The selections of the frame's size at both bounds and of the keyframe's at the high one: the first selection at
+  // a new scale makes its node ranges (30 ms on the 16,385^2 terrain), which was otherwise the first keyframe's frame
+  // (49 ms against 6 for the CDLOD frame there); the terrain's range slots keep them. For a camera of Camera's field
+  // of view.
   Camera view = c;
   view.width = width_;
   view.height = height_;
-  const Camera key_view = keyframeCamera(view);
-  std::vector<std::unique_ptr<Keyframe>> made;
-  for (int i = 0; i < std::min(options_.cache_size, 7) + 1; ++i) {
-    made.push_back(takeKeyframe());
-    gpu::RenderTarget& target = made.back()->target;
-    target.clear(options_.sky_color);
-    if (i == 0) drawHigh(key_view, target, high_, 0);
-  }
-  for (auto& k : made) spare_.push_back(std::move(k));
+  options_.gpu_high->select(keyframeCamera(view), options_.high_error);
   options_.gpu_high->select(view, options_.high_error);
   options_.gpu_high->select(view, options_.low_error);
   options_.gpu_high->renderer().finish();
@@ -204,11 +194,11 @@ std::unique_ptr<LodSpriteRenderer::Keyframe> LodSpriteRenderer::takeKeyframe() {
 }
 
 Camera guardBandCamera(const Camera& camera, int width, int height, float margin) {
-  Camera k = camera;
-  k.width = width + 2 * int(std::lround(margin * float(width)));
-  k.height = height + 2 * int(std::lround(margin * float(height)));
-  k.fov_y = 2.0f * std::atan(std::tan(camera.fov_y * 0.5f) * float(k.height) / float(height));
-  return k;
+  Camera frame = camera;
+  frame.width = width;
+  frame.height = height;
+  return frame.resized(width + 2 * int(std::lround(margin * float(width))),
+                       height + 2 * int(std::lround(margin * float(height))));
 }
 
 Camera LodSpriteRenderer::keyframeCamera(const Camera& camera) const {

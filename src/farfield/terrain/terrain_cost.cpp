@@ -65,14 +65,6 @@ void checkOptions(const TerrainCostOptions& options, bool sprite_calls, IVec2& f
                    options.keyframe_height > 0 ? options.keyframe_height : frame.y);
 }
 
-// The view's camera widened to a w x h target at the same pixel density (lod_sprite.h's guard band).
-Camera sized(Camera camera, int w, int h) {
-  camera.fov_y = 2.0f * std::atan(std::tan(camera.fov_y * 0.5f) * float(h) / float(camera.height));
-  camera.width = w;
-  camera.height = h;
-  return camera;
-}
-
 const Vec4 kSky{0.6f, 0.7f, 0.9f, 1.0f};
 
 // The CDLOD frames of one view at each threshold (gpu_high) and its sprite frames with the view's keyframe at the
@@ -129,7 +121,7 @@ TerrainCost calibrateTerrainCost(const QuadtreeLod& lod, gpu::TerrainRenderer& r
     sprite.clear(kSky);
     for (const Camera& view : options.views) {
       // The keyframe target is wider at the same pixel density (lod_sprite.h's guard band).
-      const Camera camera = sized(view, w, h);
+      const Camera camera = view.resized(w, h);
       const Mat4 sprite_view_proj = camera.viewProjection();
       // Warm-up (untimed): first use of this target, of both programs (llvmpipe compiles a shader variant at its first
       // draw) and the densest mesh.
@@ -194,7 +186,7 @@ TerrainCost calibrateCdlodCost(GpuLodTerrain& terrain, const TerrainCostOptions&
   for (const IVec2 size : {frame, keyframe}) {
     gpu::RenderTarget target(size.x, size.y), sprite(size.x, size.y);
     for (const Camera& view : options.views)
-      timeCdlodView(terrain, sized(view, size.x, size.y), options, target, sprite, high, sprite_frames);
+      timeCdlodView(terrain, view.resized(size.x, size.y), options, target, sprite, high, sprite_frames);
   }
   TerrainCost cost;
   cost.gpu_high = gpu::CostModel::fit(high);
