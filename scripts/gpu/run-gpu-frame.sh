@@ -35,8 +35,16 @@
 #   dynamic  (not in the default) the image-cache modes (dynamic-shade, dynamic-schaufler, layered) with their
 #            geometry through the GPU-driven frame and through the CPU's occlusion culling (a readback a frame),
 #            scripts/bench_dynamic_budget.sh's city and forest at 640x360, t_max 50 ms
+# A rehearsal before a GPU session (REHEARSE=1): every stage's commands at toy sizes (320x180, small cities, few
+# frames and agents) on any machine, llvmpipe included, with no check that the NVIDIA driver drew; each stage's "rc"
+# line must be 0. `scripts/gpu/rehearse.sh` makes the tarball and runs it so; an option a command no longer takes shows
+# there, not in a GPU session's 15 minutes.
 set -uo pipefail
 ROOT=$PWD
+R=${REHEARSE:-}
+pick() { if [ -n "$R" ]; then echo "$2"; else echo "$1"; fi; }  # pick FULL TOY
+HD=$(pick 1920x1080 320x180)
+SD=$(pick 640x360 320x180)
 STAGES=${STAGES:-smoke heldout model makedemo crowd terrain big check}
 DATA=$PWD/.gpu/data
 OUTD=${OUT:-/tmp/out}
@@ -55,7 +63,8 @@ export LD_LIBRARY_PATH=/tmp/ff/lib:/usr/local/nvidia/lib64:/usr/local/nvidia/lib
   export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
 export FF_PROGRESS=0
 FF=/tmp/ff/bin/farfield
-W=/tmp/w
+W=$(pick /tmp/w /tmp/w-rehearse)
+[ -z "$R" ] || rm -rf $W
 mkdir -p $W
 cd $W || exit 1
 t0=$(date +%s)
@@ -93,12 +102,12 @@ bench3() {  # bench3 DIR SIZE STRIDE [FRAMES]: frustum, culled-cpu, culled on DI
   summ $d/bench/bench.json
   # Where culled's GPU time goes (timestamp queries between its stages, read late; no wait on a GPU).
   timeout 200 $FF bench $d/city.glb --path $d/path.json --modes culled --mode-option gpu_stage_times=on \
-    --size "$size" --stride "$stride" --frames 60 -o $d/stages > $d/stages.txt 2>&1
+    --size "$size" --stride "$stride" --frames $(pick 60 10) -o $d/stages > $d/stages.txt 2>&1
   echo "rc $?"
   summ $d/stages/bench.json
 }
 say "machine"
-nvidia-smi -L
+nvidia-smi -L || [ -n "$R" ]
 nproc
 
 if [[ " $STAGES " == *" smoke "* ]]; then
@@ -108,7 +117,7 @@ if [[ " $STAGES " == *" smoke "* ]]; then
     timeout 120 $FF bench s.glb --path s.json --modes culled --size 640x360 -o smoke > smoke.txt 2>&1
   rc=$?
   summ smoke/bench.json
-  if [ $rc -ne 0 ] || ! grep -qi nvidia smoke/bench.json; then
+  if [ $rc -ne 0 ] || { [ -z "$R" ] && ! grep -qi nvidia smoke/bench.json; }; then
     say "SMOKE FAILED (rc $rc): not on the NVIDIA GPU"
     keep smoke smoke smoke.txt
     exit 3
@@ -118,19 +127,20 @@ fi
 if [[ " $STAGES " == *" heldout "* || " $STAGES " == *" check "* || " $STAGES " == *" model "* ]]; then
   H=heldout
   mkdir -p $H
-  [ -f $H/city.glb ] || timeout 300 $FF gen city --blocks 400 --detail 3 --seed 97 --objects buildings -o $H/city.glb > $H/gen.txt 2>&1
-  $FF path street $H/city.streets.json --frames 300 --seed 5 --car --fov 60 -o $H/path.json > /dev/null 2>&1
+  [ -f $H/city.glb ] || timeout 300 $FF gen city --blocks $(pick 400 30) --detail 3 --seed 97 --objects buildings \
+    -o $H/city.glb > $H/gen.txt 2>&1
+  $FF path street $H/city.streets.json --frames $(pick 300 20) --seed 5 --car --fov 60 -o $H/path.json > /dev/null 2>&1
 fi
 if [[ " $STAGES " == *" heldout "* ]]; then
   say "heldout: 400 blocks, detail 3, 1920x1080"
-  bench3 $H 1920x1080 1
+  bench3 $H $HD 1
   keep heldout $H/bench/bench.json $H/bench/frames.csv $H/stages/bench.json $H/*.txt
 fi
 
 if [[ " $STAGES " == *" model "* ]]; then
   say "model: calibrate on the held-out city's drive, 1920x1080"
-  timeout 300 $FF calibrate $H/city.glb -o $H/profile.json --csv $H/calibration.csv --size 1920x1080 --fov 60 \
-    --views 60 --fit-views 40 --around $H/path.json --margin 30 --layered-samples 0 > $H/calibrate.txt 2>&1
+  timeout 300 $FF calibrate $H/city.glb -o $H/profile.json --csv $H/calibration.csv --size $HD --fov 60 \
+    --views $(pick 60 12) --fit-views $(pick 40 8) --around $H/path.json --margin 30 --layered-samples 0 > $H/calibrate.txt 2>&1
   echo "rc $?"
   grep -E "^(renderer|model|measured/predicted|CPU term|GPU term|max\(CPU)" $H/calibrate.txt
   keep model $H/profile.json $H/calibration.csv $H/calibrate.txt
@@ -140,9 +150,9 @@ if [[ " $STAGES " == *" big "* ]]; then
   say "big: 100,000 blocks, detail 0, 1920x1080"
   B=big
   mkdir -p $B
-  timeout 300 $FF gen city --blocks 100000 --detail 0 --seed 3 -o $B/city.glb > $B/gen.txt 2>&1
-  $FF path street $B/city.streets.json --frames 300 --seed 41 --car --fov 60 -o $B/path.json > /dev/null 2>&1
-  bench3 $B 1920x1080 2 150
+  timeout 300 $FF gen city --blocks $(pick 100000 2000) --detail 0 --seed 3 -o $B/city.glb > $B/gen.txt 2>&1
+  $FF path street $B/city.streets.json --frames $(pick 300 20) --seed 41 --car --fov 60 -o $B/path.json > /dev/null 2>&1
+  bench3 $B $HD 2 $(pick 150 10)
   keep big $B/bench/bench.json $B/bench/frames.csv $B/stages/bench.json $B/*.txt
 fi
 
@@ -150,15 +160,16 @@ if [[ " $STAGES " == *" demo "* ]]; then
   say "demo: the default city, 640x360"
   D=demo
   mkdir -p $D
-  timeout 120 $FF gen city --blocks 400 --detail 2 --seed 1 --objects buildings -o $D/city.glb > $D/gen.txt 2>&1
-  $FF path street $D/city.streets.json --frames 300 --seed 1 --car --fov 60 -o $D/path.json > /dev/null 2>&1
-  bench3 $D 640x360 1
+  timeout 120 $FF gen city --blocks $(pick 400 30) --detail 2 --seed 1 --objects buildings -o $D/city.glb \
+    > $D/gen.txt 2>&1
+  $FF path street $D/city.streets.json --frames $(pick 300 20) --seed 1 --car --fov 60 -o $D/path.json > /dev/null 2>&1
+  bench3 $D $SD 1
   keep demo $D/bench/bench.json $D/bench/frames.csv $D/stages/bench.json $D/*.txt
 fi
 
 if [[ " $STAGES " == *" check "* ]]; then
   say "check: GPU-culled against frustum-culled frames, held-out city, 1920x1080"
-  timeout 300 $FF cull-check $H/city.glb --path $H/path.json --size 1920x1080 --stride 5 -o $H/check > $H/check.txt 2>&1
+  timeout 300 $FF cull-check $H/city.glb --path $H/path.json --size $HD --stride 5 -o $H/check > $H/check.txt 2>&1
   echo "rc $?"
   tail -6 $H/check.txt
   keep check $H/check $H/check.txt
@@ -168,10 +179,10 @@ if [[ " $STAGES " == *" terrain "* ]]; then
   mkdir -p $T
   tmodes=high,high-gpu,low,low-gpu,lod-sprite,lod-sprite-gpu,lod-sprite-gpu-predict
   dem=$(ls "$DATA"/terrain/*.tif 2>/dev/null | head -1)
-  for spec in ${dem:+"$dem"} fractal:8193:7; do
+  for spec in ${dem:+"$dem"} fractal:$(pick 8193 1025):7; do
     name=$(basename "$spec" .tif | tr ':' '-')
     say "terrain: $spec, 1920x1080"
-    timeout 900 $FF terrain bench "$spec" --modes $tmodes --frames 600 --size 1920x1080 --no-sweeps --no-section5 \
+    timeout 900 $FF terrain bench "$spec" --modes $tmodes --frames $(pick 600 30) --size $HD --no-sweeps --no-section5 \
       --no-plots -o $T/$name > $T/$name.txt 2>&1
     echo "rc $?"
     grep -E "^cost:" $T/$name.txt
@@ -183,8 +194,8 @@ if [[ " $STAGES " == *" terrain "* ]]; then
     say "terrain: the 8,193^2 fractal paged from disk, CDLOD and LOD-sprite ($variant), 1920x1080"
     reuse=""
     [ -f $T/f8193.tiles ] && reuse=--reuse-cache
-    timeout 600 $FF terrain tiles fractal:8193:23:relief=3000:roughness=0.6 --block 256 --tile-blocks 4 --budget-mb 256 \
-      --frames 600 --clearance 1000 --size 1920x1080 --render --gpu-budget-mb 1024 --cache $T/f8193.tiles $reuse \
+    timeout 600 $FF terrain tiles fractal:$(pick 8193 1025):23:relief=3000:roughness=0.6 --block 256 --tile-blocks 4 \
+      --budget-mb 256 --frames $(pick 600 30) --clearance 1000 --size $HD --render --gpu-budget-mb 1024 --cache $T/f8193.tiles $reuse \
       --lod-sprite $extra -o $T/paged-8193-$variant > $T/paged-8193-$variant.txt 2>&1
     echo "rc $?"
     grep -E "^drawn by|^LOD-sprite on" $T/paged-8193-$variant.txt
@@ -197,7 +208,7 @@ if [[ " $STAGES " == *" paged "* ]]; then
   P=paged
   mkdir -p $P
   say "paged: a 16,385^2 terrain exported and written as a tile cache"
-  timeout 300 $FF terrain export fractal:16385:41:relief=4000:roughness=0.6:cell=15 -o $P/f16385.tif > $P/export.txt 2>&1
+  timeout 300 $FF terrain export fractal:$(pick 16385 2049):41:relief=4000:roughness=0.6:cell=15 -o $P/f16385.tif > $P/export.txt 2>&1
   echo "rc $?"
   for variant in plain predict; do
     extra=""
@@ -205,8 +216,8 @@ if [[ " $STAGES " == *" paged "* ]]; then
     reuse=""
     [ -f $P/f16385.tiles ] && reuse=--reuse-cache
     say "paged: CDLOD and LOD-sprite ($variant), 1920x1080"
-    timeout 900 $FF terrain tiles $P/f16385.tif --block 256 --tile-blocks 4 --budget-mb 256 --frames 600 \
-      --clearance 1000 --size 1920x1080 --render --gpu-budget-mb 1024 --cache $P/f16385.tiles $reuse --lod-sprite \
+    timeout 900 $FF terrain tiles $P/f16385.tif --block 256 --tile-blocks 4 --budget-mb 256 --frames $(pick 600 30) \
+      --clearance 1000 --size $HD --render --gpu-budget-mb 1024 --cache $P/f16385.tiles $reuse --lod-sprite \
       $extra -o $P/$variant > $P/$variant.txt 2>&1
     echo "rc $?"
     grep -E "^drawn by|^LOD-sprite on" $P/$variant.txt
@@ -218,32 +229,38 @@ if [[ " $STAGES " == *" crowd "* ]]; then
   say "crowd: 10,000 to 1,000,000 agents, CPU and GPU paths, 1920x1080"
   C=crowd
   mkdir -p $C
-  timeout 900 $FF crowd bench -o $C/bench --agents 10000,100000,1000000 --frames 6 --gpu-crowd --no-shadows \
-    --size 1920x1080 > $C/bench.txt 2>&1
+  timeout 900 $FF crowd bench -o $C/bench --agents $(pick 10000,100000,1000000 1000,5000) --frames $(pick 6 2) --gpu-crowd \
+    --no-shadows --size $HD > $C/bench.txt 2>&1
   echo "rc $?"
   grep -E "^\| [0-9]" $C/bench/crowd.md | head -40
   # At 0.5 px with skinned levels of detail (30.5-41.7 dB at 10,000 and 100,000 agents on llvmpipe, where the
   # crowd pass is 1.4-2.0x crowd-impostor's), under a budget of 4 ms of skinned drawing timed on the GPU.
   say "crowd: 0.5 px, levels of detail, a budget of 4 ms, 10,000 and 100,000 agents"
-  timeout 600 $FF crowd bench -o $C/budget --agents 10000,100000 --frames 8 --gpu-crowd --no-shadows \
-    --error-px 0.5 --skinned-lod 0.25 --geometry-ms 4 --size 1920x1080 > $C/budget.txt 2>&1
+  timeout 600 $FF crowd bench -o $C/budget --agents $(pick 10000,100000 1000) --frames $(pick 8 2) --gpu-crowd \
+    --no-shadows --error-px 0.5 --skinned-lod 0.25 --geometry-ms 4 --size $HD > $C/budget.txt 2>&1
   echo "rc $?"
   grep -E "^\| [0-9]|^- [0-9]" $C/budget/crowd.md | head -40
   keep crowd $C/bench/crowd.json $C/bench/crowd.md $C/bench.txt $C/budget/crowd.json $C/budget/crowd.md $C/budget.txt
 fi
 if [[ " $STAGES " == *" makedemo "* ]]; then
   say "makedemo: scripts/demo.sh, 640x360"
+  [ -z "$R" ] || export FF_DEMO_BLOCKS=40 FF_DEMO_DETAIL=3 FF_DEMO_FRAMES=40  # places 3 impostors
   timeout 900 bash "$ROOT/scripts/demo.sh" $FF $W/makedemo > makedemo.txt 2>&1
-  echo "rc $?"
+  rc=$?
+  if [ -n "$R" ] && [ $rc -eq 1 ] && grep -q "placed no impostor" makedemo.txt; then
+    echo "rc 0 (the toy city's placement placed no impostor on this run: the demo's own stop, not a broken command)"
+  else
+    echo "rc $rc"
+  fi
   grep -E "frames over t_max|impostors placed|relaxed|t_max:|t_max = max" makedemo.txt | head -10
   summ makedemo/bench.json
   keep makedemo makedemo/bench.json makedemo/frames.csv makedemo/report.md makedemo/*.txt makedemo.txt
 fi
 if [[ " $STAGES " == *" dynamic "* ]]; then
   say "dynamic: the image-cache modes, geometry on the GPU and on the CPU, 640x360"
-  timeout 600 bash "$ROOT/scripts/bench_dynamic_budget.sh" $FF $W/dynamic 50 40 3 > dynamic.txt 2>&1
+  timeout 600 bash "$ROOT/scripts/bench_dynamic_budget.sh" $FF $W/dynamic 50 $(pick 40 6) 3 > dynamic.txt 2>&1
   echo "rc $?"
-  GEOMETRY=cpu timeout 600 bash "$ROOT/scripts/bench_dynamic_budget.sh" $FF $W/dynamic 50 40 3 >> dynamic.txt 2>&1
+  GEOMETRY=cpu timeout 600 bash "$ROOT/scripts/bench_dynamic_budget.sh" $FF $W/dynamic 50 $(pick 40 6) 3 >> dynamic.txt 2>&1
   echo "rc $?"
   summ dynamic/bench-*/bench.json
   keep dynamic dynamic/bench-*/bench.json dynamic/bench-*/frames.csv dynamic/*.txt dynamic.txt
@@ -252,13 +269,13 @@ if [[ " $STAGES " == *" stream "* ]]; then
   say "stream: cells uploaded in the entering frame and ahead, 400 blocks, 1920x1080"
   S=stream
   mkdir -p $S
-  timeout 300 $FF gen city --blocks 400 --detail 3 --seed 1 --objects buildings -o $S/city.glb > $S/gen.txt 2>&1
-  $FF path street $S/city.streets.json --frames 3000 --fps 30 --seed 41 --car -o $S/drive.json > /dev/null 2>&1
+  timeout 300 $FF gen city --blocks $(pick 400 30) --detail 3 --seed 1 --objects buildings -o $S/city.glb > $S/gen.txt 2>&1
+  $FF path street $S/city.streets.json --frames $(pick 3000 60) --fps 30 --seed 41 --car -o $S/drive.json > /dev/null 2>&1
   timeout 300 $FF bake $S/city.glb --pipeline pvs,near-far,single,mmi --error-px 2 --resolution 256 --pvs-spacing 10 \
     --pvs-face 64 --station-spacing 10 --path $S/drive.json -o $S/imp > $S/bake.txt 2>&1
   echo "rc $?"
   for ms in 0 2; do
-    timeout 300 $FF walk $S/city.glb --path $S/drive.json --mode mmi --size 1920x1080 --mode-option impostor_dir=$S/imp \
+    timeout 300 $FF walk $S/city.glb --path $S/drive.json --mode mmi --size $HD --mode-option impostor_dir=$S/imp \
       --mode-option read_ahead_ms=$ms --mode-option streaming_csv=$S/streaming-$ms.csv --csv $S/frames-$ms.csv \
       > $S/walk-$ms.txt 2>&1
     echo "rc $? read_ahead_ms $ms"

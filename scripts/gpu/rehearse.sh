@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The GPU machine's run rehearsed on this machine (llvmpipe), before a session that is lent a GPU spends its 15
+# minutes on it: `make dist`'s tarball in .gpu/ (as the device tool carries it), the shared DEM in .gpu/data/ when
+# ../shared/data has it, and scripts/gpu/run-gpu-frame.sh with REHEARSE=1 (toy sizes; no libglvnd unpacked). Prints
+# each stage's return codes and fails if any is not 0.
+#   scripts/gpu/rehearse.sh [OUT_DIR] [STAGES]     (defaults: out/rehearse; every stage of run-gpu-frame.sh)
+set -uo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+OUTD=$(realpath -m "${1:-$ROOT/out/rehearse}")
+STAGES=${2:-smoke heldout model big demo check terrain paged crowd makedemo dynamic stream}
+cd "$ROOT" || exit 1
+BIN=build/release/bin/farfield
+[ -x "$BIN" ] || { echo "rehearse: no $BIN (make build)" >&2; exit 1; }
+rm -rf "$OUTD" && mkdir -p "$OUTD"
+mkdir -p .gpu
+tarball=$(ls .gpu/farfield-*.tar.xz 2>/dev/null | head -1)
+if [ -z "$tarball" ] || [ "$BIN" -nt "$tarball" ]; then  # xz takes minutes: made again only for a newer build
+  rm -f .gpu/farfield-*.tar.xz
+  bash scripts/make_dist.sh "$BIN" .gpu > "$OUTD/dist.txt" 2>&1 || { cat "$OUTD/dist.txt"; exit 1; }
+fi
+dem=$ROOT/../shared/data/terrain/bigtujunga_srtm30m_utm11.tif
+if [ -f "$dem" ]; then
+  mkdir -p .gpu/data/terrain
+  cp -f "$dem" .gpu/data/terrain/
+fi
+grep -qx '.gpu/' .git/info/exclude 2>/dev/null || { mkdir -p .git/info; echo '.gpu/' >> .git/info/exclude; }
+REHEARSE=1 SKIP_GL=1 OUT="$OUTD" STAGES="$STAGES" bash scripts/gpu/run-gpu-frame.sh > /dev/null 2>&1
+echo "rehearsal of: $STAGES (log: $OUTD/log.txt)"
+grep -E "^== |^rc " "$OUTD/log.txt"
+grep -E " unreadable " "$OUTD/log.txt" | sed 's/^/warning: /'  # a bench.json a stage did not write
+ls "$OUTD"/*.tgz 2>/dev/null | sed 's/^/kept: /'
+bad=$(grep -cE "^rc [1-9]|SMOKE FAILED" "$OUTD/log.txt")
+[ "$bad" -eq 0 ] || { echo "rehearse: $bad command(s) failed" >&2; exit 1; }
+echo "rehearse: every command returned 0"
