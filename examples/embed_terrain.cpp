@@ -7,8 +7,8 @@
 // 10; default 120) of a flythrough at 640x360, drawing each frame with LOD-sprite (Chen et al. 1999) wholly on the
 // CDLOD terrain paged from the cache: keyframes and high frames are CDLOD frames at 1 px, sprite frames its 4 px
 // selection with the keyframe's visibility tested per vertex on the GPU; a cost model fitted on a few views of the
-// path chooses per frame between them; pages are read ahead on a worker. It prints what LOD-sprite chose and writes
-// the last frame.
+// path chooses per frame between them, corrected by the frames' GPU times read a few frames late (a timer query per
+// frame, no wait); pages are read ahead on a worker. It prints what LOD-sprite chose and writes the last frame.
 #include <algorithm>
 #include <cstdio>
 #include <exception>
@@ -19,6 +19,7 @@
 #include "farfield/core/error.h"
 #include "farfield/core/timer.h"
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/late_readback.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/image/png_io.h"
 #include "farfield/terrain/dem_io.h"
@@ -119,6 +120,7 @@ int run(int argc, char** argv) {
   terrain::LodSpriteRenderer sprite(ground, kWidth, kHeight, so);
 
   gpu::RenderTarget target(kWidth, kHeight);
+  gpu::LateTimer gpu_time;  // each frame's GPU time, read when the GPU has finished it (frames later)
   size_t sprite_frames = 0, slowest = 0;
   double slowest_ms = 0.0, total_ms = 0.0;
   for (int f = 0; f < frames; ++f) {
@@ -126,7 +128,12 @@ int run(int argc, char** argv) {
     const Stopwatch frame;
     target.clear(kSky);
     terrain::LodSpriteFrameInfo info;
+    gpu_time.begin(uint64_t(f) + 1);  // the renderer counts its frames from 1 (LodSpriteFrameInfo::frame)
     sprite.render(camera, target, &info);
+    gpu_time.end();
+    if (info.frame != uint64_t(f) + 1) throw Error("embed_terrain", "frame count out of step");
+    // The cost model corrected by what it got wrong: each frame's time as it comes back (LodSpriteRenderer::measured).
+    gpu_time.finished([&](uint64_t drawn, double gpu_ms) { sprite.measured(drawn, gpu_ms); });
     ground.prefetch(camera, so.high_error);  // pages read ahead for the frames to come
     ground.finish();                         // (a program that presents the frame does not wait here)
     const double ms = frame.milliseconds();
@@ -143,6 +150,12 @@ int run(int argc, char** argv) {
               "used); %.2f ms a frame on average, the slowest %.2f ms (frame %zu)\n",
               frames, sprite_frames, c.high_frames, c.fresh_keyframes, c.predicted_rendered, c.predicted_used,
               total_ms / double(frames), slowest_ms, slowest);
+  const terrain::CostCorrection& cc = sprite.costCorrection();
+  std::printf("the cost model against the measured frames (measured / predicted): high %.2f, sprite %.2f, keyframe "
+              "part %.2f, slice part %.2f (%zu frames measured)\n",
+              cc.factor(terrain::TerrainFrameKind::High), cc.factor(terrain::TerrainFrameKind::Sprite),
+              cc.factor(terrain::TerrainFrameKind::Keyframe), cc.factor(terrain::TerrainFrameKind::Slice),
+              cc.measurementsUsed());
   std::printf("pages: %zu held at most, %zu read by a draw (the calibration's included), %zu read ahead (%zu used)\n",
               s.peak_pages, s.page_loads, s.prefetched, s.prefetch_hits);
   if (argc > 4) {

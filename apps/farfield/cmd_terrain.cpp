@@ -181,6 +181,9 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
                     "LOD-sprite: a keyframe also once the sprite is magnified more than this on average (0 = Chen et "
                     "al.'s metric alone)")
       ->capture_default_str();
+  bench->add_flag("--no-cost-correction{false}", o.cost_correction,
+                  "LOD-sprite's per-frame choice by its cost model alone, not corrected by the measured frames (for "
+                  "comparison)");
   bench->add_option("-o,--output", o.out_dir, "Output directory")->required();
   bench->add_option("--size", a->size, "Frame size WxH")->capture_default_str();
   bench->add_option("--high-error", o.high_error, "High-resolution LOD threshold, pixels")->capture_default_str();
@@ -253,6 +256,8 @@ const RegisterCommand reg("terrain", [](CLI::App& app) {
                     "With --lod-sprite: a keyframe also once the sprite is magnified more than this on average (its "
                     "texels cover more pixels: it blurs); 0 = Chen et al.'s metric alone")
       ->capture_default_str();
+  tiles->add_flag("--no-cost-correction{false}", to.cost_correction,
+                  "With --lod-sprite: the choice by the cost model alone, not corrected by the measured frames");
   tiles->add_option("--psnr-stride", to.psnr_stride,
                     "With --lod-sprite: compare every K-th frame with the CDLOD frame (0 = never)")
       ->capture_default_str();

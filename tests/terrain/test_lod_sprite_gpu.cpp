@@ -169,6 +169,56 @@ TEST(LodSpriteGL, TheSpriteFrameOnTheGpuWaitsForNothing) {
   EXPECT_THROW(LodSpriteRenderer(*scene.lod, *scene.renderer, 128, 128, bad), Error);
 }
 
+// The choice's closed loop (LodSpriteRenderer::measured): where the model says sprites pay (0.25 against 50 ms) but
+// the measured frames, reported two frames late, say a sprite frame costs 60 ms and a high frame 1 ms, the renderer
+// turns to the high LOD within a few frames and stays there, its factors the measured ones; the same renderer with no
+// time reported keeps drawing sprites.
+TEST(LodSpriteGL, MeasuredFramesCorrectTheChoice) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  const std::vector<Camera> cameras = choicePath(scene.hf, 24);
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
+  options.gpu_low = true;
+  TerrainCost cost = spritesPay();  // high 50 ms, sprite 0.25 ms by the model
+  options.cost = &cost;
+  options.correction.min_ratio = 0.001;
+  options.correction.max_ratio = 1000.0;
+  gpu::RenderTarget frame(128, 128);
+  auto measuredMs = [](const LodSpriteFrameInfo& info) {
+    switch (info.kind) {
+      case TerrainFrameKind::High: return 1.0;
+      case TerrainFrameKind::Sprite: return 60.0;
+      case TerrainFrameKind::Keyframe: return 70.0;
+      case TerrainFrameKind::Slice: return 65.0;
+    }
+    return 0.0;
+  };
+  for (const bool report : {false, true}) {
+    LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+    std::vector<TerrainPath> paths;
+    for (const Camera& camera : cameras) {
+      frame.clear(kSky);
+      LodSpriteFrameInfo info;
+      sprite.render(camera, frame, &info);
+      EXPECT_EQ(info.frame, paths.size() + 1);
+      paths.push_back(info.path);
+      if (report) {
+        EXPECT_TRUE(sprite.measured(info.frame, measuredMs(info)));
+      }
+    }
+    const size_t sprites = size_t(std::count(paths.begin(), paths.end(), TerrainPath::Sprite));
+    if (!report) {
+      EXPECT_GE(sprites, cameras.size() * 3 / 4);
+      EXPECT_DOUBLE_EQ(sprite.costCorrection().factor(TerrainFrameKind::Sprite), 1.0);
+      continue;
+    }
+    EXPECT_NEAR(sprite.costCorrection().factor(TerrainFrameKind::High), 1.0 / 50.0, 1e-9);
+    EXPECT_NEAR(sprite.costCorrection().factor(TerrainFrameKind::Sprite), 60.0 / 0.25, 1e-9);
+    for (size_t f = cameras.size() / 2; f < cameras.size(); ++f)
+      EXPECT_EQ(paths[f], TerrainPath::High) << "frame " << f;
+    EXPECT_LT(sprites, cameras.size() / 3);
+  }
+}
 
 // predict_late on the GPU: along a straight, steady flight, each keyframe after the first is rendered ahead in slices
 // (no frame draws a whole keyframe, each draws at most one slice) and taken before the sprite trips; a keyframe made of

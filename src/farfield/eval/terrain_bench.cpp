@@ -304,6 +304,7 @@ TerrainBenchResult runTerrainBench(const TerrainBenchOptions& options) {
   run->low_error = options.low_error;
   run->epsilon = options.epsilon;
   run->max_magnification = options.max_magnification;
+  run->cost_correction = options.cost_correction;
   run->sprite_tile_cells = options.sprite_tile_cells;
   const ScopedTerrainRun scoped(run);  // the harness's terrain modes draw this terrain
   result.terrain = run->data->describe();

@@ -46,6 +46,7 @@ struct TerrainBenchOptions {
   float clearance = 0.0f;   // of the generated flythrough: metres above the highest ground near it (0 = its default)
   double epsilon = 1.0;     // LOD-sprite error threshold, pixels (> 0)
   double max_magnification = 0.0;  // LOD-sprite's keyframes also past this sprite magnification (0: equation 2 alone)
+  bool cost_correction = true;     // LOD-sprite's choice: its model corrected by the measured frames (false: alone)
   std::string out_dir;      // required
   int width = 512;          // frame size, pixels
   int height = 512;

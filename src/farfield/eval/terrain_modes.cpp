@@ -213,7 +213,12 @@ void SpriteMode::frame(FrameContext& frame) {
   SpriteLog log;
   log.path_frame = frame.pathFrame();
   frame.addStats(sprite_->render(frame.camera(), target, &log.info));
+  last_sprite_frame_ = log.info.frame;
   run_->logs[name_].push_back(log);
+}
+
+void SpriteMode::frameMeasured(size_t /*path_frame*/, double wall_ms) {
+  if (run_->cost_correction) sprite_->measured(last_sprite_frame_, wall_ms);
 }
 
 std::map<std::string, double> SpriteMode::info() const {
@@ -232,7 +237,12 @@ std::map<std::string, double> SpriteMode::info() const {
           {"high_frame_fraction", double(c.high_frames) / frames},
           {"virtual_keyframes", double(c.virtual_keyframes)},
           {"switches", double(c.switches)},
-          {"keyframe_decisions", double(c.fresh_keyframes - c.switches + c.virtual_keyframes)}};
+          {"keyframe_decisions", double(c.fresh_keyframes - c.switches + c.virtual_keyframes)},
+          {"correction_high", sprite_->costCorrection().factor(terrain::TerrainFrameKind::High)},
+          {"correction_sprite", sprite_->costCorrection().factor(terrain::TerrainFrameKind::Sprite)},
+          {"correction_keyframe", sprite_->costCorrection().factor(terrain::TerrainFrameKind::Keyframe)},
+          {"correction_slice", sprite_->costCorrection().factor(terrain::TerrainFrameKind::Slice)},
+          {"correction_measurements", double(sprite_->costCorrection().measurementsUsed())}};
 }
 
 bool isTileSpriteMode(const std::string& mode_name, bool* choose) {

@@ -46,6 +46,7 @@ struct TerrainRun {
   float low_error = 4.0f;
   double epsilon = 1.0;     // LOD-sprite error threshold, pixels
   double max_magnification = 0.0;  // LodSpriteOptions::max_magnification (0: equation 2 alone)
+  bool cost_correction = true;     // the sprite modes report each frame's measured time (LodSpriteRenderer::measured)
   int sprite_tile_cells = 128;  // tile side of lod-sprite-tiles, grid cells
   Vec4 sky{0.62f, 0.74f, 0.88f, 1.0f};
   std::optional<terrain::TerrainCost> cost;  // calibrated on this machine; "lod-sprite" chooses per frame with it
@@ -152,7 +153,11 @@ class SpriteMode : public Mode {
   // epsilon_px, frames, keyframes (fresh), keyframe_fraction, high_resolution_renders, predicted_rendered,
   // predicted_used, predicted_discarded, cache_hits, high_frames, high_frame_fraction, virtual_keyframes, switches,
   // keyframe_decisions (fresh - switches + virtual: where the error metric tripped) (of the last pass).
+  // correction_high, correction_sprite, correction_keyframe, correction_slice: the cost model's measured / predicted
+  // per kind of frame at the end (1: none measured), and correction_measurements.
   std::map<std::string, double> info() const override;
+  // The harness's wall time of the frame just drawn, to the renderer's cost correction (LodSpriteRenderer::measured).
+  void frameMeasured(size_t path_frame, double wall_ms) override;
   terrain::LodSpriteRenderer& sprite() { return *sprite_; }
 
  private:
@@ -164,6 +169,7 @@ class SpriteMode : public Mode {
   std::unique_ptr<terrain::LodSpriteRenderer> sprite_;
   bool started_ = false;
   size_t last_frame_ = 0;
+  uint64_t last_sprite_frame_ = 0;  // the renderer's count of the frame just drawn
 };
 
 // The options of the tile mode `mode_name` with the run's thresholds (the mode's and the quality pass's), with the

@@ -181,6 +181,7 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
         so.low_error = o.low_error;
         so.predict = o.lod_sprite_predict;
         so.max_magnification = o.max_magnification;
+        so.cost_correction = o.cost_correction;
         sprite_run = std::make_unique<PagedSpriteRun>(*cdlod, cameras, so);
         sprite_target = std::make_unique<gpu::RenderTarget>(o.width, o.height);
         std::fprintf(stderr, "LOD-sprite: cost model fitted on the path's views in %.1f s\n",

@@ -53,6 +53,7 @@ struct TerrainTilesOptions {
   bool lod_sprite = false;
   bool lod_sprite_predict = false;
   double max_magnification = 0.0;  // with lod_sprite: terrain::LodSpriteOptions::max_magnification
+  bool cost_correction = true;     // with lod_sprite: the choice's model corrected by the measured frames
   size_t psnr_stride = 10;
 };
 

@@ -101,6 +101,8 @@ PagedSpriteFrame PagedSpriteRun::draw(const Camera& camera, gpu::RenderTarget& t
   frame.ms = clock.milliseconds();
   frame.own_ms = ownCpuMs(frame.ms, before);
   frame.page_loads = terrain_.stats().page_loads - loads;
+  // The model corrected by what it got wrong, each measurement taken 2 frames late (as a timer query would come).
+  if (options_.cost_correction) renderer_->measured(frame.info.frame, frame.ms);
   return frame;
 }
 
@@ -145,8 +147,14 @@ nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame>
   j["low_error"] = options_.low_error;
   j["predict"] = options_.predict;
   j["max_magnification"] = options_.max_magnification;
+  j["cost_correction_on"] = options_.cost_correction;
   j["calibration_seconds"] = calibration_seconds_;
   j["cost"] = cost_.toJson();
+  const terrain::CostCorrection& cc = renderer_->costCorrection();
+  for (const auto kind : {terrain::TerrainFrameKind::High, terrain::TerrainFrameKind::Sprite,
+                          terrain::TerrainFrameKind::Keyframe, terrain::TerrainFrameKind::Slice})
+    j["cost_correction"][terrain::terrainFrameKindName(kind)] = cc.factor(kind);
+  j["cost_correction"]["measurements"] = cc.measurementsUsed();
   return j;
 }
 

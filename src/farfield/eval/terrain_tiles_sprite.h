@@ -28,6 +28,7 @@ struct PagedSpriteOptions {
   float low_error = 4.0f;    // sprite frames' bound, pixels
   bool predict = false;      // keyframes rendered ahead, late, in slices (lod-sprite-gpu-predict)
   double max_magnification = 0.0;  // terrain::LodSpriteOptions::max_magnification (0: equation 2 alone)
+  bool cost_correction = true;     // each frame's measured time to the renderer (LodSpriteRenderer::measured)
   int calibration_views = 5; // path cameras the cost model is fitted on (spread along the path)
 };
 

@@ -80,7 +80,8 @@ LodSpriteRenderer::LodSpriteRenderer(GpuLodTerrain& terrain, int width, int heig
 
 LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod* lod, gpu::TerrainRenderer* renderer, int width, int height,
                                      const LodSpriteOptions& options)
-    : lod_(lod), renderer_(renderer), width_(width), height_(height), options_(options) {
+    : lod_(lod), renderer_(renderer), width_(width), height_(height), options_(options),
+      correction_(options.correction) {
   if (!options.gpu_low && (!lod || !renderer))
     throw Error("lod-sprite", "the sprite frame on the CPU needs the quadtree LOD and its renderer");
   if (!(options.epsilon > 0.0)) throw Error("lod-sprite", "error threshold epsilon must be positive (pixels)");
@@ -174,6 +175,41 @@ void LodSpriteRenderer::reset() {
   high_triangles_frame_ = high_triangles_key_ = 0;
   high_latest_is_key_ = false;
   error_sample_.clear();
+  correction_.reset();
+}
+
+bool LodSpriteRenderer::measured(uint64_t frame, double ms) {
+  return options_.cost != nullptr && correction_.measured(frame, ms);
+}
+
+gpu::FrameStats LodSpriteRenderer::finish(const gpu::FrameStats& stats, LodSpriteFrameInfo& info,
+                                          LodSpriteFrameInfo* out) {
+  const PathCosts& m = model_costs_;
+  double base = m.sprite_ms, extra = 0.0;
+  if (info.path == TerrainPath::High) {
+    info.kind = TerrainFrameKind::High;
+    base = m.high_ms;
+  } else if (info.source == SpriteSource::Fresh) {
+    info.kind = TerrainFrameKind::Keyframe;
+    extra = std::max(m.keyframe_ms - m.sprite_ms, 0.0);
+  } else if (info.ahead_triangles > 0) {
+    info.kind = TerrainFrameKind::Slice;
+    extra = std::max(m.keyframe_ms - m.sprite_ms, 0.0) / double(std::max<size_t>(pending_chunks_, 1));
+  } else {
+    info.kind = TerrainFrameKind::Sprite;
+  }
+  if (options_.cost) correction_.drawn(frame_, info.kind, base, extra);
+  if (out) *out = info;
+  return stats;
+}
+
+PathCosts LodSpriteRenderer::correctedCosts(const PathCosts& model) const {
+  PathCosts c;
+  c.high_ms = model.high_ms * correction_.factor(TerrainFrameKind::High);
+  c.sprite_ms = model.sprite_ms * correction_.factor(TerrainFrameKind::Sprite);
+  c.keyframe_ms =
+      c.sprite_ms + std::max(model.keyframe_ms - model.sprite_ms, 0.0) * correction_.factor(TerrainFrameKind::Keyframe);
+  return c;
 }
 
 const Camera* LodSpriteRenderer::spriteCamera() const { return current_ ? &current_->camera : nullptr; }
@@ -281,7 +317,7 @@ gpu::FrameStats LodSpriteRenderer::drawCdlodSprite(const Camera& camera, int han
   return stats;
 }
 
-PathCosts LodSpriteRenderer::predictCosts(size_t low_triangles) const {
+PathCosts LodSpriteRenderer::modelCosts(size_t low_triangles) const {
   const TerrainCost& c = *options_.cost;
   const Camera key = keyframeCamera(Camera{});
   const double area_ratio = double(key.width) * double(key.height) / (double(width_) * double(height_));
@@ -317,6 +353,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   ++frame_;
   ++counters_.frames;
   LodSpriteFrameInfo info;
+  info.frame = frame_;
   gpu::FrameStats stats;
   history_.emplace_back(camera.eye, camera.at);
   while (history_.size() > size_t(options_.predict_history)) history_.pop_front();
@@ -337,10 +374,11 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   const bool choose = options_.cost != nullptr;
   PathCosts costs;
   if (choose) {
-    costs = predictCosts(low_triangles_);
-    info.predicted_high_ms = costs.high_ms;
-    info.predicted_sprite_ms = costs.sprite_ms;
-    info.predicted_keyframe_ms = costs.keyframe_ms;
+    model_costs_ = modelCosts(low_triangles_);
+    info.predicted_high_ms = model_costs_.high_ms;
+    info.predicted_sprite_ms = model_costs_.sprite_ms;
+    info.predicted_keyframe_ms = model_costs_.keyframe_ms;
+    costs = correctedCosts(model_costs_);
   }
   // The sprite frame on the GPU, where a sprite frame costs no less than the high LOD: no sprite can pay (a keyframe
   // costs a sprite frame more), so the frame is the high LOD without the error metric, whose sampled cells are most
@@ -348,9 +386,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   // stays where it was; the metric resumes when sprites are cheaper again.
   if (options_.gpu_low && choose && costs.sprite_ms >= costs.high_ms) {
     info.source = SpriteSource::None;
-    const gpu::FrameStats high_stats = renderHigh(camera, target, info);
-    if (out) *out = info;
-    return high_stats;
+    return finish(renderHigh(camera, target, info), info, out);
   }
 
   // Lines 3-5: error of the current sprite (or of the virtual keyframe the high LOD stands for); a new one when it
@@ -437,9 +473,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
         ++counters_.virtual_keyframes;
         info.source = SpriteSource::None;
         info.error_px = 0.0;
-        const gpu::FrameStats stats = renderHigh(camera, target, info);
-        if (out) *out = info;
-        return stats;
+        return finish(renderHigh(camera, target, info), info, out);
       }
     }
     if (!chosen) {
@@ -468,13 +502,11 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   } else if (!current_ || (choose && choosePath(costs, true, 0.0) == TerrainPath::High)) {
     // A virtual keyframe still valid, or a valid sprite that costs more to draw than the high LOD.
     info.source = SpriteSource::None;
-    const gpu::FrameStats high_stats = renderHigh(camera, target, info);
-    if (out) *out = info;
-    return high_stats;
+    return finish(renderHigh(camera, target, info), info, out);
   }
   current_->last_used = frame_;
   if (options_.predict && options_.predict_late && !due && !pending_)
-    scheduleLatePrediction(camera, progressPx(info.error_px, info.magnification), choose ? &costs : nullptr);
+    scheduleLatePrediction(camera, progressPx(info.error_px, info.magnification), choose ? &model_costs_ : nullptr);
 
   // Section 5: the keyframe rendered ahead, one step per frame, from the frame after a switch on (the switch frame
   // may already have drawn a whole keyframe).
@@ -487,8 +519,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     const gpu::FrameStats sprite = drawCdlodSprite(camera, low_handle_, target, current_->camera, current_->target);
     info.low_triangles = sprite.triangles;
     gpu::addDraw(stats, sprite);
-    if (out) *out = info;
-    return stats;
+    return finish(stats, info, out);
   }
   const size_t n = low_.triangleCount();
   const size_t visible = visibility_.partition(low_.indices);
@@ -499,8 +530,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   gpu::addDraw(stats, renderer_->drawTextured(camera, target, visible, n - visible, 0));
   info.low_triangles = n;
   info.visible_triangles = visible;
-  if (out) *out = info;
-  return stats;
+  return finish(stats, info, out);
 }
 
 }  // namespace farfield::terrain

@@ -43,6 +43,7 @@
 #include "farfield/gpu/terrain_renderer.h"
 #include "farfield/image/image.h"
 #include "farfield/terrain/cdlod_sprite_error.h"
+#include "farfield/terrain/cost_correction.h"
 #include "farfield/terrain/gpu_lod.h"
 #include "farfield/terrain/keyframe_visibility.h"
 #include "farfield/terrain/path_choice.h"
@@ -100,8 +101,11 @@ struct LodSpriteOptions {
   int cache_size = 1;       // keyframes kept (1 = only the current one, as in the paper)
   double reuse_coverage = 0.95;
   // The per-frame choice between the high LOD and the sprite path (path_choice.h); null = always the sprite path.
-  // Must outlive the renderer.
+  // Must outlive the renderer. Its predictions are corrected by the measured times of the frames drawn, where the
+  // caller reports them (LodSpriteRenderer::measured; cost_correction.h: per kind of frame, the median of measured /
+  // predicted of its recent frames, taken `correction.lag` frames late, as a timer query would come).
   const TerrainCost* cost = nullptr;
+  CostCorrectionOptions correction;
   int lifetime_history = 5;  // recent sprite lifetimes (real or virtual) the expected lifetime is the median of
   // Grid points whose triangles are not drawn (removeTrianglesInside; every mesh the renderer draws): ground that
   // something else draws, e.g. a city's. The error metric still counts the quadrants there.
@@ -139,6 +143,7 @@ enum class SpriteSource : uint8_t {
 const char* spriteSourceName(SpriteSource source);
 
 struct LodSpriteFrameInfo {
+  uint64_t frame = 0;  // the renderer's count of this frame (1, 2, ... from construction or reset): for measured()
   SpriteSource source = SpriteSource::Kept;
   double error_px = 0.0;          // error of the sprite used in this frame at this viewpoint (0 for a fresh one)
   double trigger_error_px = 0.0;  // error of the previous sprite at this viewpoint (what the test saw)
@@ -153,9 +158,10 @@ struct LodSpriteFrameInfo {
   bool keyframe_due = false;        // the error tripped here (or first frame): a keyframe, real or virtual
   bool switched = false;            // a keyframe taken before the virtual one tripped (its age made it pay)
   uint64_t high_triangles = 0;      // triangles of the high LOD drawn as this frame (path High)
-  double predicted_high_ms = 0.0;   // path_choice.h's PathCosts for this frame
-  double predicted_sprite_ms = 0.0;
+  double predicted_high_ms = 0.0;   // path_choice.h's PathCosts for this frame (the model's, before the correction
+  double predicted_sprite_ms = 0.0; // by measured frames; the choice used them corrected)
   double predicted_keyframe_ms = 0.0;
+  TerrainFrameKind kind = TerrainFrameKind::Sprite;  // what the frame drew, for the correction
   double expected_lifetime = 0.0;   // frames, when a keyframe was due
 };
 
@@ -188,8 +194,13 @@ class LodSpriteRenderer {
   // have the size given to the constructor.
   gpu::FrameStats render(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo* info = nullptr);
 
-  // Forgets every keyframe and counter (a new pass over a path); keeps the GPU allocations for reuse.
+  // Forgets every keyframe, counter and measured correction (a new pass over a path); keeps the GPU allocations.
   void reset();
+  // The measured time of frame `frame` (LodSpriteFrameInfo::frame), ms, whenever it is known: a GPU timer query read
+  // late, or a harness's wall time. With a cost model, the per-frame choice and the keyframe slices are then sized by
+  // the model corrected by what it got wrong (CostCorrection); without one, or for unknown frames, nothing (false).
+  bool measured(uint64_t frame, double ms);
+  const CostCorrection& costCorrection() const { return correction_; }
 
   const LodSpriteCounters& counters() const { return counters_; }
   const LodSpriteOptions& options() const { return options_; }
@@ -222,11 +233,17 @@ class LodSpriteRenderer {
   // The keyframe rendered ahead from the viewpoint extrapolated `ahead` frames on, drawn in `chunks` slices.
   void schedulePrediction(const Camera& camera, float ahead, size_t chunks);
   // With predict_late: schedules it when the current sprite's error (at its age) says it trips within 1.5 times the
-  // slices it needs (costs: the frame's predicted costs, which size the slices; null = predict_chunks slices).
-  void scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* costs);
+  // slices it needs (model: the frame's modelCosts, which size the slices; null = predict_chunks slices).
+  void scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* model);
   void advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info);
   void keep(std::unique_ptr<Keyframe> keyframe);
-  PathCosts predictCosts(size_t low_triangles) const;
+  // The cost model's predictions of this frame's alternatives, and the same corrected by the measured frames.
+  PathCosts modelCosts(size_t low_triangles) const;
+  PathCosts correctedCosts(const PathCosts& model) const;
+  // Slices a keyframe rendered ahead is drawn in, each at most kSliceShare of a sprite frame (model: modelCosts).
+  double slicesFor(const PathCosts& model) const;
+  // Tells the correction what this frame drew (with a cost model) and returns stats.
+  gpu::FrameStats finish(const gpu::FrameStats& stats, LodSpriteFrameInfo& info, LodSpriteFrameInfo* out);
   gpu::FrameStats renderHigh(const Camera& camera, gpu::RenderTarget& target, LodSpriteFrameInfo& info);
 
   LodSpriteRenderer(const QuadtreeLod* lod, gpu::TerrainRenderer* renderer, int width, int height,
@@ -236,6 +253,8 @@ class LodSpriteRenderer {
   int width_, height_;
   LodSpriteOptions options_;
   LodSpriteCounters counters_;
+  CostCorrection correction_;
+  PathCosts model_costs_;  // this frame's, uncorrected
   uint64_t frame_ = 0;
   uint64_t sprite_since_ = 0;    // frame the current sprite was taken into use
   double sprite_error_at_take_ = 0.0;  // its error then (pixels; 0 for a fresh one)

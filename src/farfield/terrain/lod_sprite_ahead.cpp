@@ -10,11 +10,19 @@
 namespace farfield::terrain {
 namespace {
 
-// A slice of a keyframe rendered ahead late costs at most this share of a sprite frame by the cost model (whose
-// sprite frames measure 1.2-1.5x its prediction on llvmpipe: about half a sprite frame measured).
+// A slice of a keyframe rendered ahead late costs at most this share of a sprite frame by the cost model, corrected
+// by the measured frames where they are reported (before that, on llvmpipe, whose sprite frames measure 1.2-1.5x the
+// model's prediction: about half a sprite frame measured).
 constexpr double kSliceShare = 1.0 / 3.0;
 
 }  // namespace
+
+double LodSpriteRenderer::slicesFor(const PathCosts& model) const {
+  // The slices' measured share of the keyframe's predicted part, over a sprite frame's measured cost.
+  const double slice = std::max(model.keyframe_ms - model.sprite_ms, 0.0) * correction_.factor(TerrainFrameKind::Slice);
+  const double sprite = model.sprite_ms * correction_.factor(TerrainFrameKind::Sprite);
+  return sprite > 0.0 ? std::ceil(slice / (kSliceShare * sprite)) : double(options_.predict_chunks);
+}
 
 double LodSpriteRenderer::coverage(Keyframe& keyframe) {
   if (options_.gpu_low) return nodeCoverage(options_.gpu_high->selection(low_handle_).nodes, keyframe);
@@ -95,16 +103,15 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     if (pending_chunk_ == 0) {
       terrain.lod().select(k.camera, options_.high_error, true, pending_selection_);
       k.target.clear(options_.sky_color);
-      // The freshest count of a keyframe's triangles, for the next predictions (predictCosts).
+      // The freshest count of a keyframe's triangles, for the next predictions (modelCosts).
       high_triangles_key_ = pending_selection_.nodes.size() * terrain.renderer().trianglesPerNode();
       high_latest_is_key_ = true;
       // Late: the slices sized from this keyframe's own triangles, now known, where the schedule had the last
       // keyframe's: more of them where it is larger (never fewer than scheduled; at most predict_chunks).
       if (options_.predict_late && options_.cost) {
-        const PathCosts costs = predictCosts(low_triangles_);
-        if (costs.sprite_ms > 0.0) {
-          const double want = std::ceil((costs.keyframe_ms - costs.sprite_ms) / (kSliceShare * costs.sprite_ms));
-          chunks = std::max(chunks, size_t(std::clamp(want, 1.0, double(options_.predict_chunks))));
+        const PathCosts model = modelCosts(low_triangles_);
+        if (model.sprite_ms > 0.0) {
+          chunks = std::max(chunks, size_t(std::clamp(slicesFor(model), 1.0, double(options_.predict_chunks))));
           if (pending_most_ > 0) chunks = std::min(chunks, pending_most_);
           pending_chunks_ = chunks;
         }
@@ -153,7 +160,7 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
   k.coverage_at_creation = probe_.visibleShare(probe_mesh_.indices);
 }
 
-void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* costs) {
+void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* model) {
   // The error grows roughly with the distance moved since the sprite was taken; at the rate seen since then it trips
   // in `left` frames. The next keyframe is started once about 1.5 times the frames it is drawn in are left, or once
   // the error has reached 3/4 of the threshold (an error that creeps near the threshold for a long time trips at a
@@ -164,9 +171,7 @@ void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double erro
   const double left = (options_.epsilon - error_px) * age / grown;
   // Slices of at most kSliceShare of a sprite frame each by the cost model (at most predict_chunks of them).
   double chunks = double(options_.predict_chunks);
-  if (costs && costs->sprite_ms > 0.0)
-    chunks = std::clamp(std::ceil((costs->keyframe_ms - costs->sprite_ms) / (kSliceShare * costs->sprite_ms)), 1.0,
-                        chunks);
+  if (model && model->sprite_ms > 0.0) chunks = std::clamp(slicesFor(*model), 1.0, chunks);
   if (left > 1.5 * chunks + 1.0 && error_px < 0.75 * options_.epsilon) return;
   // Ready before the trip: where the rate leaves fewer frames than the slices the cost model wants (sprites that
   // live 8-10 frames on the 16,385^2 flight's descent, keyframes of 14 slices there), larger slices, one a frame until
