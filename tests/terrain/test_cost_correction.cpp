@@ -14,6 +14,12 @@ namespace {
 
 using K = TerrainFrameKind;
 
+// Frame f drawn as `kind` with the model's prediction (base, extra), and measured at `ms` at once.
+void drawnAndMeasured(CostCorrection& c, uint64_t f, K kind, double base, double extra, double ms) {
+  c.drawn(f, kind, base, extra);
+  c.measured(f, ms);
+}
+
 TEST(CostCorrection, WithoutMeasurementsTheModelStands) {
   CostCorrection c;
   for (uint64_t f = 1; f <= 10; ++f) c.drawn(f, f % 2 ? K::Sprite : K::High, 4.0);
@@ -24,8 +30,7 @@ TEST(CostCorrection, WithoutMeasurementsTheModelStands) {
   o.lag = 0;
   CostCorrection few(o);
   for (uint64_t f = 1; f <= 3; ++f) {
-    few.drawn(f, K::Sprite, 1.0);
-    few.measured(f, 2.0);
+    drawnAndMeasured(few, f, K::Sprite, 1.0, 0.0, 2.0);
     EXPECT_DOUBLE_EQ(few.factor(K::Sprite), f < 3 ? 1.0 : 2.0) << "frame " << f;
   }
 }
@@ -37,10 +42,7 @@ TEST(CostCorrection, APartIsJudgedByTheSpriteFactorOfNow) {
   o.lag = 0;
   CostCorrection c(o);
   uint64_t f = 0;
-  auto frame = [&](K kind, double base, double extra, double ms) {
-    c.drawn(++f, kind, base, extra);
-    c.measured(f, ms);
-  };
+  auto frame = [&](K kind, double base, double extra, double ms) { drawnAndMeasured(c, ++f, kind, base, extra, ms); };
   for (int i = 0; i < 3; ++i) frame(K::Sprite, 10.0, 0.0, 16.0);  // slow first sprite frames: 1.6x
   for (int i = 0; i < 3; ++i) frame(K::Slice, 10.0, 2.0, 14.0);   // sprite 10 ms + a 4 ms slice
   EXPECT_DOUBLE_EQ(c.factor(K::Slice), o.min_ratio) << "14 - 1.6 x 10 < 0";
@@ -113,14 +115,10 @@ TEST(CostCorrection, OneSlowFrameDoesNotMoveTheMedian) {
   o.lag = 0;
   o.min_samples = 1;
   CostCorrection c(o);
-  for (uint64_t f = 1; f <= 9; ++f) {
-    c.drawn(f, K::Sprite, 1.0);
-    c.measured(f, f == 5 ? 40.0 : 1.2);
-  }
+  for (uint64_t f = 1; f <= 9; ++f) drawnAndMeasured(c, f, K::Sprite, 1.0, 0.0, f == 5 ? 40.0 : 1.2);
   EXPECT_DOUBLE_EQ(c.factor(K::Sprite), 1.2);
   CostCorrection one(o);
-  one.drawn(1, K::Sprite, 1.0);
-  one.measured(1, 40.0);
+  drawnAndMeasured(one, 1, K::Sprite, 1.0, 0.0, 40.0);
   EXPECT_DOUBLE_EQ(one.factor(K::Sprite), o.max_ratio);
 }
 
@@ -131,10 +129,7 @@ TEST(CostCorrection, AKindNoLongerMeasuredFallsBackToTheModel) {
   o.lag = 0;
   o.forget_frames = 30;
   CostCorrection c(o);
-  for (uint64_t f = 1; f <= 5; ++f) {
-    c.drawn(f, K::High, 2.0);
-    c.measured(f, 6.0);
-  }
+  for (uint64_t f = 1; f <= 5; ++f) drawnAndMeasured(c, f, K::High, 2.0, 0.0, 6.0);
   EXPECT_DOUBLE_EQ(c.factor(K::High), 3.0);
   for (uint64_t f = 6; f <= 33; ++f) c.drawn(f, K::Sprite, 1.0);
   EXPECT_DOUBLE_EQ(c.factor(K::High), 3.0) << "frames 3, 4 and 5 are at most 30 frames old";

@@ -36,6 +36,14 @@ LodSpriteOptions cdlodOptions(GpuLodTerrain& gpu_lod) {
   return options;
 }
 
+// ... with the sprite frame on the GPU too (gpu_low), choosing by `cost`, which must outlive the options.
+LodSpriteOptions gpuSpriteOptions(GpuLodTerrain& gpu_lod, const TerrainCost& cost) {
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
+  options.gpu_low = true;
+  options.cost = &cost;
+  return options;
+}
+
 // LodSpriteOptions::gpu_high: the high LOD is the CDLOD terrain's. Where its frames are predicted cheap, every frame
 // is the CDLOD frame, pixel for pixel; where they are expensive, the sprite path is taken and each keyframe is the
 // CDLOD terrain drawn at the keyframe's camera. Without a CDLOD cost model the choice is refused.
@@ -102,10 +110,8 @@ TEST(LodSpriteGL, TheSpriteFrameOnTheGpuWaitsForNothing) {
   Scene scene(testFractal());
   GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
   const std::vector<Camera> cameras = choicePath(scene.hf, 24);
-  LodSpriteOptions options = cdlodOptions(gpu_lod);
-  options.gpu_low = true;
   TerrainCost cost = spritesPay();  // the sprite path once a sprite has lasted
-  options.cost = &cost;
+  LodSpriteOptions options = gpuSpriteOptions(gpu_lod, cost);
   LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
   const bool counting = gpu::installGlCounters();
   gpu::RenderTarget frame(128, 128), expected(128, 128);
@@ -177,10 +183,8 @@ TEST(LodSpriteGL, MeasuredFramesCorrectTheChoice) {
   Scene scene(testFractal());
   GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
   const std::vector<Camera> cameras = choicePath(scene.hf, 24);
-  LodSpriteOptions options = cdlodOptions(gpu_lod);
-  options.gpu_low = true;
   TerrainCost cost = spritesPay();  // high 50 ms, sprite 0.25 ms by the model
-  options.cost = &cost;
+  LodSpriteOptions options = gpuSpriteOptions(gpu_lod, cost);
   options.correction.min_ratio = 0.001;
   options.correction.max_ratio = 1000.0;
   gpu::RenderTarget frame(128, 128);
@@ -289,10 +293,8 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
 TEST(LodSpriteGL, BoundedMagnificationTakesKeyframesBeforeTheSpriteBlurs) {
   Scene scene(testFractal());
   GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
-  LodSpriteOptions options = cdlodOptions(gpu_lod);
-  options.gpu_low = true;
   TerrainCost cost = spritesPay();
-  options.cost = &cost;
+  LodSpriteOptions options = gpuSpriteOptions(gpu_lod, cost);
   LodSpriteOptions bounded = options;
   bounded.max_magnification = 1.3;
   LodSpriteRenderer paper(*scene.lod, *scene.renderer, 128, 128, options);
