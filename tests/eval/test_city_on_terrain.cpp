@@ -221,7 +221,7 @@ TEST(CityOnTerrainGL, TheLodSpriteTerrainChoosesPerFrameByCostsMeasuredAtPrepare
     }
     FrameRunner runner(res.renderer, res.target);
     const Box3 b = city.scene.bounds();
-    for (size_t f = 0; f < 4; ++f) {
+    for (size_t f = 0; f < 8; ++f) {
       Camera camera;
       camera.eye = Vec3(b.lo.x + 5.0f * float(f), b.lo.y - 50.0f, b.hi.z + 100.0f);
       camera.at = Vec3(b.hi.x + 300.0f, b.hi.y + 300.0f, 0.0f);
@@ -233,6 +233,8 @@ TEST(CityOnTerrainGL, TheLodSpriteTerrainChoosesPerFrameByCostsMeasuredAtPrepare
     }
     // With the choice, the run starts on the high LOD (no sprite lifetime is known yet); always-sprite would not.
     EXPECT_GE(mode.info().at("terrain_high_frames"), 1.0);
+    // The runner's measured frames reach the choice's cost correction, two frames late: frames 0-5 of the 8.
+    EXPECT_EQ(mode.info().at("terrain_correction_measurements"), 6.0);
     currentTerrainRun().reset();
   }
 }

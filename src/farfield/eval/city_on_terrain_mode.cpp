@@ -141,7 +141,9 @@ void CityOnTerrainMode::frame(FrameContext& frame) {
   if (sprite_) {
     terrain::GpuLodTerrain* gpu = sprite_->options().gpu_high;
     if (gpu) gpu->renderer().setDepthBias(kDepthBiasSlopes, kDepthBiasSlopes);
-    stats = sprite_->render(camera, target);
+    terrain::LodSpriteFrameInfo info;
+    stats = sprite_->render(camera, target, &info);
+    last_sprite_frame_ = info.frame;
     if (gpu) gpu->renderer().setDepthBias(0.0f, 0.0f);
   } else if (terrain_ == "high-gpu") {
     terrain::GpuLodTerrain& lod = run_->gpuLod();
@@ -161,6 +163,11 @@ void CityOnTerrainMode::frame(FrameContext& frame) {
   city_mode_->frame(frame);
 }
 
+void CityOnTerrainMode::frameMeasured(size_t path_frame, double wall_ms) {
+  city_mode_->frameMeasured(path_frame, wall_ms);
+  if (sprite_ && run_->cost_correction) sprite_->measured(last_sprite_frame_, wall_ms);
+}
+
 std::map<std::string, double> CityOnTerrainMode::info() const {
   std::map<std::string, double> out;
   for (const auto& [key, value] : city_mode_->info()) out["city_" + key] = value;
@@ -175,6 +182,10 @@ std::map<std::string, double> CityOnTerrainMode::info() const {
     out["terrain_high_frames"] = double(c.high_frames);
     out["terrain_virtual_keyframes"] = double(c.virtual_keyframes);
     out["terrain_switches"] = double(c.switches);
+    const terrain::CostCorrection& k = sprite_->costCorrection();
+    out["terrain_correction_high"] = k.factor(terrain::TerrainFrameKind::High);
+    out["terrain_correction_sprite"] = k.factor(terrain::TerrainFrameKind::Sprite);
+    out["terrain_correction_measurements"] = double(k.measurementsUsed());
   }
   return out;
 }

@@ -38,6 +38,10 @@ class CityOnTerrainMode : public Mode {
   std::string name() const override { return "terrain-" + terrain_ + "+" + city_; }
   void prepare(const ModeContext& context) override;
   void frame(FrameContext& frame) override;
+  // To the city's mode (culled's occlusion_auto times its frames) and to LOD-sprite's cost correction: the whole
+  // frame's time, the city's part with it (it adds about the same to every kind of terrain frame, so the choice
+  // between them compares the same differences; the keyframe rendered ahead is sliced by the frames' own time).
+  void frameMeasured(size_t path_frame, double wall_ms) override;
   std::map<std::string, double> info() const override;
 
   // The terrain's camera for a city camera (moved by the city origin's position in the terrain's frame), and the
@@ -57,6 +61,7 @@ class CityOnTerrainMode : public Mode {
   terrain::LodMesh mesh_;
   bool started_ = false;
   size_t last_frame_ = 0;
+  uint64_t last_sprite_frame_ = 0;  // LodSpriteFrameInfo::frame of the last frame drawn
   uint64_t terrain_triangles_ = 0;
   size_t frames_ = 0;
 };

@@ -33,6 +33,7 @@ std::shared_ptr<TerrainRun> terrainRunFor(const ModeContext& context, const std:
     loaded->epsilon = positiveOption(context, "epsilon", loaded->epsilon);
     loaded->max_magnification = numberOption(context, "max_magnification", 0.0, 0.0);
     loaded->sprite_tile_cells = intOption(context, "tile_cells", loaded->sprite_tile_cells, 1, 1 << 20);
+    loaded->cost_correction = switchOption(context, "cost_correction", loaded->cost_correction);
     if (context.renderer) loaded->sky = context.renderer->light().sky_color;
     run = std::move(loaded);
   }

@@ -46,7 +46,8 @@ struct TerrainRun {
   float low_error = 4.0f;
   double epsilon = 1.0;     // LOD-sprite error threshold, pixels
   double max_magnification = 0.0;  // LodSpriteOptions::max_magnification (0: equation 2 alone)
-  bool cost_correction = true;     // the sprite modes report each frame's measured time (LodSpriteRenderer::measured)
+  bool cost_correction = true;     // the sprite modes report each frame's measured time (LodSpriteRenderer::measured;
+                                   // --mode-option cost_correction=off to compare)
   int sprite_tile_cells = 128;  // tile side of lod-sprite-tiles, grid cells
   Vec4 sky{0.62f, 0.74f, 0.88f, 1.0f};
   std::optional<terrain::TerrainCost> cost;  // calibrated on this machine; "lod-sprite" chooses per frame with it
