@@ -287,6 +287,50 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
   EXPECT_GT(worst_psnr, 25.0);
 }
 
+// A trip that catches a keyframe rendered ahead with half of its slices drawn (the camera jumped ahead faster than the
+// schedule saw): its last slices are drawn in the trip's frame and it is taken, where a whole fresh keyframe was
+// drawn before (on the 16,385^2 flight, keyframes one to three slices short of 8-11).
+TEST(LodSpriteGL, ATripFinishesAKeyframeRenderedAheadInsteadOfDrawingAFreshOne) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
+  options.gpu_low = true;
+  options.predict = true;
+  options.predict_late = true;
+  options.predict_chunks = 4;
+  TerrainCost cost = spritesPay();  // a keyframe is many sprite frames, so it takes all 4 slices
+  options.cost = &cost;
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const float top = scene.hf.maxHeight();
+  gpu::RenderTarget frame(128, 128);
+  float x = 300.0f;
+  size_t fresh_before = 0, run = 0;
+  bool jumped = false;
+  for (size_t f = 0; f < 120 && !jumped; ++f) {
+    x += 24.0f;
+    if (run == 2) {
+      // Two slices of the four drawn: ahead by eight frames at once.
+      x += 8.0f * 24.0f;
+      jumped = true;
+      fresh_before = sprite.counters().fresh_keyframes;
+    }
+    const Camera camera = makeCamera(Vec3(x, 300, top + 700), Vec3(x + 100, 1500, 0));
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    sprite.render(camera, frame, &info);
+    run = info.ahead_slices > 0 && sprite.counters().predicted_used > 0 ? run + 1 : 0;
+    if (!jumped) continue;
+    EXPECT_TRUE(info.keyframe_due) << "the jump trips the sprite";
+    EXPECT_EQ(info.source, SpriteSource::Predicted) << spriteSourceName(info.source);
+    EXPECT_EQ(info.keyframe_triangles, 0u) << "no whole keyframe";
+    EXPECT_EQ(info.ahead_slices, 2u) << "its last two slices";
+    EXPECT_LE(info.error_px, options.epsilon);
+  }
+  ASSERT_TRUE(jumped) << "no keyframe was rendered ahead after the first predicted one";
+  EXPECT_EQ(sprite.counters().predicted_finished, 1u);
+  EXPECT_EQ(sprite.counters().fresh_keyframes, fresh_before);
+}
+
 // LodSpriteOptions::max_magnification: approaching the terrain head-on, equation 2 alone lets the sprite be magnified
 // (its texels cover more than a pixel: it blurs) while theta stays small; with the bound a keyframe is taken before
 // the sprite is magnified past it, and the frames are nearer the CDLOD high frames.

@@ -233,6 +233,7 @@ std::map<std::string, double> SpriteMode::info() const {
           {"predicted_rendered", double(c.predicted_rendered)},
           {"predicted_used", double(c.predicted_used)},
           {"predicted_discarded", double(c.predicted_discarded)},
+          {"predicted_finished", double(c.predicted_finished)},
           {"cache_hits", double(c.cache_hits)},
           {"high_frames", double(c.high_frames)},
           {"high_frame_fraction", double(c.high_frames) / frames},

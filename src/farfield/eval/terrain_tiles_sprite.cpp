@@ -140,6 +140,7 @@ nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame>
   j["fresh_keyframes"] = c.fresh_keyframes;
   j["keyframes_rendered_ahead"] = c.predicted_rendered;
   j["keyframes_rendered_ahead_used"] = c.predicted_used;
+  j["keyframes_finished_at_a_trip"] = c.predicted_finished;
   j["psnr_vs_cdlod_frames"] = compared;
   j["psnr_vs_cdlod_min_db"] = compared ? psnr_min : 0.0;
   j["psnr_vs_cdlod_mean_db"] = compared ? psnr_sum / double(compared) : 0.0;
@@ -165,9 +166,9 @@ std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
                 "timed apart, the pages read ahead outside both): %.2f ms mean, %.2f median, %.2f p99, %.2f max; "
                 "%zu frames over twice its median; own CPU %.3f ms median, %.3f p95 (the CDLOD frame's %.3f, %.3f); "
                 "**%.2fx the CDLOD frame's mean** (%.2f ms; median %.2fx); "
-                "%zu sprite frames, %zu high frames, %zu keyframes drawn at once, %zu rendered ahead (%zu used); PSNR "
-                "against the CDLOD frame %.1f dB mean, %.1f min over %zu frames; cost model fitted in %.1f s; %zu pages read "
-                "in its frames (%zu frames waited)\n",
+                "%zu sprite frames, %zu high frames, %zu keyframes drawn at once, %zu rendered ahead (%zu used, "
+                "%zu finished at a trip); PSNR against the CDLOD frame %.1f dB mean, %.1f min over %zu frames; "
+                "cost model fitted in %.1f s; %zu pages read in its frames (%zu frames waited)\n",
                 bool(j["predict"]) ? ", keyframes rendered ahead" : "", double(j["epsilon"]), double(j["low_error"]),
                 double(j["frame_ms_mean"]), double(j["frame_ms_median"]), double(j["frame_ms_p99"]),
                 double(j["frame_ms_max"]), size_t(j["frames_over_twice_the_median"]),
@@ -176,7 +177,8 @@ std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
                 double(j["speedup_vs_cdlod_mean"]), double(j["cdlod"]["frame_ms_mean"]),
                 double(j["speedup_vs_cdlod_median"]), size_t(j["sprite_frames"]), size_t(j["high_frames"]),
                 size_t(j["fresh_keyframes"]), size_t(j["keyframes_rendered_ahead"]),
-                size_t(j["keyframes_rendered_ahead_used"]), double(j["psnr_vs_cdlod_mean_db"]),
+                size_t(j["keyframes_rendered_ahead_used"]), size_t(j["keyframes_finished_at_a_trip"]),
+                double(j["psnr_vs_cdlod_mean_db"]),
                 double(j["psnr_vs_cdlod_min_db"]), size_t(j["psnr_vs_cdlod_frames"]), double(j["calibration_seconds"]),
                 size_t(j["page_loads_waited_for"]), size_t(j["frames_that_waited_for_pages"]));
   return line;

@@ -194,7 +194,8 @@ gpu::FrameStats LodSpriteRenderer::finish(const gpu::FrameStats& stats, LodSprit
     extra = std::max(m.keyframe_ms - m.sprite_ms, 0.0);
   } else if (info.ahead_triangles > 0) {
     info.kind = TerrainFrameKind::Slice;
-    extra = std::max(m.keyframe_ms - m.sprite_ms, 0.0) / double(std::max<size_t>(pending_chunks_, 1));
+    extra = std::max(m.keyframe_ms - m.sprite_ms, 0.0) * double(std::max<size_t>(info.ahead_slices, 1)) /
+            double(std::max<size_t>(pending_chunks_, 1));
   } else {
     info.kind = TerrainFrameKind::Sprite;
   }
@@ -438,6 +439,14 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     anchor_since_ = frame_;
     Keyframe* chosen = nullptr;
     double chosen_error = 0.0;
+    // A keyframe rendered ahead that the trip caught with at most half of its slices left (the error's rate, or the
+    // magnification's, rose faster than the schedule saw): its last slices now, a fraction of a fresh keyframe, then
+    // the same test as a ready one. On the 16,385^2 flight the fresh keyframes at a trip were caught one or three
+    // slices short of 8-11.
+    if (options_.predict && pending_ && !pending_->ready && 2 * pending_chunk_ >= pending_chunks_) {
+      while (!pending_->ready) advancePrediction(stats, info);
+      ++counters_.predicted_finished;
+    }
     if (pending_ && pending_->ready) {
       double e = early_error;
       if (early || takesOver(*pending_, camera.eye, beta, &e)) {

@@ -152,6 +152,7 @@ struct LodSpriteFrameInfo {
   uint64_t visible_triangles = 0;   // low-resolution triangles textured with the sprite
   uint64_t keyframe_triangles = 0;  // high-resolution triangles of a keyframe rendered in this frame
   uint64_t ahead_triangles = 0;     // triangles of the predicted keyframe drawn in this frame
+  size_t ahead_slices = 0;          // its slices drawn in this frame (its last ones where a trip finished it)
   size_t quadrants = 0;             // n of equation 2
   // The per-frame choice (with LodSpriteOptions::cost; otherwise path Sprite and no predictions).
   TerrainPath path = TerrainPath::Sprite;
@@ -171,6 +172,7 @@ struct LodSpriteCounters {
   size_t predicted_rendered = 0;   // predicted keyframes completed
   size_t predicted_used = 0;
   size_t predicted_discarded = 0;  // completed or started but never used
+  size_t predicted_finished = 0;   // caught by the trip with at most half its slices left: those drawn at once
   size_t cache_hits = 0;
   size_t high_frames = 0;          // frames that drew the high LOD (path_choice.h)
   size_t virtual_keyframes = 0;    // error trips answered with the high LOD instead of a keyframe

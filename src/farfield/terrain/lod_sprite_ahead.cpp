@@ -126,6 +126,7 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     terrain.clearHole();
     gpu::addDraw(stats, ahead);
     info.ahead_triangles += ahead.triangles;
+    ++info.ahead_slices;
     if (++pending_chunk_ < chunks) return;
   } else {
     // The quadtree LOD: step 0 (the frame after the switch) builds the mesh; steps 1..chunks draw one slice of it each.
@@ -143,6 +144,7 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
     const size_t count = std::min(total - first, per_chunk);
     gpu::addDraw(stats, renderer_->drawTextured(k.camera, k.target, first, count, 1));
     info.ahead_triangles += count;
+    ++info.ahead_slices;
     if (++pending_chunk_ <= chunks) return;
   }
   k.ready = true;
