@@ -153,7 +153,8 @@ class SpriteMode : public Mode {
   void frame(FrameContext& frame) override;
   // epsilon_px, frames, keyframes (fresh), keyframe_fraction, high_resolution_renders, predicted_rendered,
   // predicted_used, predicted_discarded, predicted_finished, cache_hits, high_frames, high_frame_fraction,
-  // virtual_keyframes, switches, keyframe_decisions (fresh - switches + virtual: where the error metric tripped) (of the last pass).
+  // virtual_keyframes, switches, keyframe_decisions (fresh - switches + virtual: where the error metric tripped)
+  // (of the last pass).
   // correction_high, correction_sprite, correction_keyframe, correction_slice: the cost model's measured / predicted
   // per kind of frame at the end (1: none measured), and correction_measurements.
   std::map<std::string, double> info() const override;
