@@ -224,6 +224,17 @@ TEST(LodSpriteGL, MeasuredFramesCorrectTheChoice) {
   }
 }
 
+// predict_late on the GPU in 4 slices, choosing by `cost`.
+LodSpriteOptions lateSlicedOptions(GpuLodTerrain& gpu_lod, const TerrainCost& cost) {
+  LodSpriteOptions options = cdlodOptions(gpu_lod);
+  options.gpu_low = true;
+  options.predict = true;
+  options.predict_late = true;
+  options.predict_chunks = 4;
+  options.cost = &cost;
+  return options;
+}
+
 // predict_late on the GPU: along a straight, steady flight, each keyframe after the first is rendered ahead in slices
 // (no frame draws a whole keyframe, each draws at most one slice) and taken before the sprite trips; a keyframe made of
 // slices is the CDLOD frame at its camera pixel for pixel (the terrain's selections for other bounds and cameras,
@@ -231,13 +242,8 @@ TEST(LodSpriteGL, MeasuredFramesCorrectTheChoice) {
 TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) {
   Scene scene(testFractal());
   GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
-  LodSpriteOptions options = cdlodOptions(gpu_lod);
-  options.gpu_low = true;
-  options.predict = true;
-  options.predict_late = true;
-  options.predict_chunks = 4;
   TerrainCost cost = spritesPay();  // a keyframe is many sprite frames, so it takes all 4 slices
-  options.cost = &cost;
+  const LodSpriteOptions options = lateSlicedOptions(gpu_lod, cost);
   LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
   const float top = scene.hf.maxHeight();
   gpu::RenderTarget frame(128, 128), expected(128, 128);
@@ -293,13 +299,8 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
 TEST(LodSpriteGL, ATripFinishesAKeyframeRenderedAheadInsteadOfDrawingAFreshOne) {
   Scene scene(testFractal());
   GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
-  LodSpriteOptions options = cdlodOptions(gpu_lod);
-  options.gpu_low = true;
-  options.predict = true;
-  options.predict_late = true;
-  options.predict_chunks = 4;
   TerrainCost cost = spritesPay();  // a keyframe is many sprite frames, so it takes all 4 slices
-  options.cost = &cost;
+  const LodSpriteOptions options = lateSlicedOptions(gpu_lod, cost);
   LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
   const float top = scene.hf.maxHeight();
   gpu::RenderTarget frame(128, 128);
