@@ -443,7 +443,9 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     // magnification's, rose faster than the schedule saw): its last slices now, a fraction of a fresh keyframe, then
     // the same test as a ready one. On the 16,385^2 flight the fresh keyframes at a trip were caught one or three
     // slices short of 8-11.
-    if (options_.predict && pending_ && !pending_->ready && 2 * pending_chunk_ >= pending_chunks_) {
+    // (The quadtree's step 0 builds its mesh and draws no slice.)
+    const size_t sliced = options_.gpu_high || pending_chunk_ == 0 ? pending_chunk_ : pending_chunk_ - 1;
+    if (options_.predict && pending_ && !pending_->ready && 2 * sliced >= pending_chunks_) {
       while (!pending_->ready) advancePrediction(stats, info);
       ++counters_.predicted_finished;
     }
