@@ -120,6 +120,31 @@ TEST(SpriteError, ThetaMatchesIndependentComputationOnRandomQuadrants) {
   EXPECT_GT(compared, 150);
 }
 
+// spriteTheta's series for small angles against atan2 of the same sine and cosine, from a micro-radian to past the
+// series' range (1/16) and to obtuse angles: equal to a few units in the last place of a double (a term left out of
+// the series, or a wrong coefficient, shows as 1e-13 or more at the range's end).
+TEST(SpriteError, ThetaEqualsAtan2FromMicroradiansToObtuseAngles) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  size_t compared = 0;
+  for (double angle = 1e-6; angle < 3.0; angle *= 1.07) {
+    for (int trial = 0; trial < 4; ++trial) {
+      const DVec3 v2(unit(rng) * 500.0, unit(rng) * 500.0, 300.0 + unit(rng) * 100.0);
+      const DVec3 dir = glm::normalize(DVec3(unit(rng), unit(rng), unit(rng) - 2.0));
+      DVec3 side = glm::normalize(glm::cross(dir, DVec3(0.3, 1.0, 0.2)));
+      const double da = 200.0 + 800.0 * (unit(rng) + 1.0), db = 200.0 + 800.0 * (unit(rng) + 1.0);
+      const DVec3 c = v2 + da * dir;
+      const DVec3 c_prime = v2 + db * (std::cos(angle) * dir + std::sin(angle) * side);
+      const DVec3 a = c - v2, b = c_prime - v2;
+      const double expected = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+      EXPECT_NEAR(spriteTheta(c, c_prime, v2), expected, 4e-16 * expected + 1e-300) << "angle " << angle;
+      EXPECT_NEAR(spriteTheta(c, c_prime, v2), angle, 1e-9 * angle + 1e-12) << "angle " << angle;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 800u);
+}
+
 TEST(SpriteError, KeyframeDueWhenMeanSquareReachesThreshold) {
   Camera camera;
   camera.width = 512;

@@ -15,6 +15,27 @@ size_t CdlodSpriteError::KeyHash::operator()(const Key& key) const {
   return size_t(h ^ (h >> 29));
 }
 
+CdlodSpriteError::Sampling& CdlodSpriteError::sampling(Held& held, size_t first, size_t k) {
+  Sampling* slot = &held.samplings[0];
+  for (Sampling& s : held.samplings) {
+    if (s.k == k && s.first == first) return s;
+    if (s.used < slot->used) slot = &s;
+  }
+  std::vector<Cell> cells((held.count - std::min(first, held.count) + k - 1) / k);
+  for (size_t j = 0; j < cells.size(); ++j) {
+    const size_t c = first + j * k;
+    for (const Sampling& s : held.samplings)
+      if (s.k > 0 && c >= s.first && (c - s.first) % s.k == 0) {
+        cells[j] = s.cells[(c - s.first) / s.k];
+        break;
+      }
+  }
+  slot->first = first;
+  slot->k = k;
+  slot->cells = std::move(cells);
+  return *slot;
+}
+
 void CdlodSpriteError::clear() {
   held_.clear();
   measure_ = 0;
@@ -33,6 +54,7 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     int columns, rows;
     double weight;
     Held* held = nullptr;
+    Sampling* sample = nullptr;
     size_t first = 0, k = 1;  // its sampled cells: first, first + k, ...
   };
   std::vector<Stratum> strata;
@@ -51,8 +73,16 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     const Vec3 nearest = glm::clamp(v2, box.lo, box.hi);
     const double d = std::max(double(glm::length(v2 - nearest)), 1.0);
     const double w = double(lod.nodeError(n)) / (d * d);
-    strata.push_back({&n, columns, rows, w * w});
-    cells += size_t(columns) * size_t(rows);
+    // Its kept cells, looked up here, where the misses of one node overlap the arithmetic of the next.
+    Held& held = held_[Key{n.level, n.x, n.y}];
+    const size_t count = size_t(columns) * size_t(rows);
+    if (held.count != count) {
+      held = Held{};
+      held.count = count;
+    }
+    held.used = measure_;
+    strata.push_back({&n, columns, rows, w * w, &held});
+    cells += count;
     total_weight += w * w;
   }
   // A cell's five grid points: its corners, then its centre.
@@ -65,11 +95,9 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
   };
   // The sample: per stratum every k-th cell (k odd, so that the sample moves across the columns), from an offset
   // fixed by the node. The cells a node never had are asked for at once.
-  points_.clear();
-  asked_.clear();
   for (Stratum& st : strata) {
     const CdlodNode& n = *st.node;
-    const size_t count = size_t(st.columns) * size_t(st.rows);
+    const size_t count = st.held->count;
     if (max_quadrants > 0 && cells > max_quadrants) {
       const double share = total_weight > 0.0 ? st.weight / total_weight : 1.0 / double(strata.size());
       const size_t taken = std::clamp<size_t>(size_t(std::lround(share * double(max_quadrants))), 1, count);
@@ -78,26 +106,24 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     uint32_t h = uint32_t(n.x) * 0x9E3779B1u ^ uint32_t(n.y) * 0x85EBCA77u ^ uint32_t(n.level) * 0xC2B2AE3Du;
     h ^= h >> 15;
     st.first = st.k > 1 ? size_t(h) % st.k : 0;
-    Held& held = held_[Key{n.level, n.x, n.y}];
-    st.held = &held;
-    held.used = measure_;
-    if (held.have.size() != count) {
-      held.z.assign(5 * count, 0.0f);
-      held.have.assign(count, 0);
-      held.c_prime.assign(count, DVec3(0.0));
-      held.projected.assign(count, 0);
-    }
-    if (held.version != heights_version) {  // the heights that stood in may have been replaced
-      std::replace(held.have.begin(), held.have.end(), uint8_t(2), uint8_t(0));
-      held.version = heights_version;
-    }
-    for (size_t c = st.first; c < count; c += st.k) {
-      if (held.have[c]) {
+    st.sample = &sampling(*st.held, st.first, st.k);
+    st.sample->used = measure_;
+    __builtin_prefetch(st.sample->cells.data());
+  }
+  points_.clear();
+  asked_.clear();
+  for (Stratum& st : strata) {
+    Sampling& sample = *st.sample;
+    for (size_t j = 0; j < sample.cells.size(); ++j) {
+      const size_t c = st.first + j * st.k;
+      Cell& cell = sample.cells[j];
+      // Heights that stood in are asked for again once the terrain's heights changed (they may have been replaced).
+      if (cell.have == 1 || (cell.have == 2 && cell.version == heights_version)) {
         ++counters_.cells_kept;
         continue;
       }
       ++counters_.cells_gathered;
-      asked_.emplace_back(&held, c);
+      asked_.push_back(&cell);
       for (int corner = 0; corner < 5; ++corner) points_.push_back(cellPoint(st, c, corner));
     }
   }
@@ -105,47 +131,50 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
   own_.assign(points_.size(), uint8_t(1));
   if (!points_.empty()) heights(points_, z_, own_);
   for (size_t a = 0; a < asked_.size(); ++a) {
-    Held& held = *asked_[a].first;
-    const size_t c = asked_[a].second;
+    Cell& cell = *asked_[a];
     bool own = true;
     for (size_t corner = 0; corner < 5; ++corner) {
-      held.z[5 * c + corner] = z_[5 * a + corner];
+      cell.z[corner] = z_[5 * a + corner];
       own = own && own_[5 * a + corner] != 0;
     }
-    held.have[c] = own ? 1 : 2;
-    held.projected[c] = 0;
+    cell.have = own ? 1 : 2;
+    cell.version = heights_version;
+    cell.eye = 0;
   }
 
   SpriteError e;
   const DVec3 eye1(v1), eye2(v2);
   // As Heightfield::position: (i * cell_x, j * cell_y, height).
-  auto position = [&](const Stratum& st, size_t c, int corner) {
+  auto position = [&](const Stratum& st, size_t c, const Cell& cell, int corner) {
     const IVec2 g = cellPoint(st, c, corner);
-    return DVec3(Vec3(float(g.x * hf.cell_x), float(g.y * hf.cell_y), st.held->z[5 * c + size_t(corner)]));
+    return DVec3(Vec3(float(g.x * hf.cell_x), float(g.y * hf.cell_y), cell.z[corner]));
   };
   DVec3 corners[4];
   double weighted = 0.0, weighted_stretch = 0.0, represented = 0.0;
   for (const Stratum& st : strata) {
     Held& held = *st.held;
-    if (held.eye1 != eye1) {
-      std::fill(held.projected.begin(), held.projected.end(), uint8_t(0));
+    if (held.eye1 != eye1 || held.eye_generation == 0) {
       held.eye1 = eye1;
+      held.eye_generation = ++eye_generations_;
     }
     double sum = 0.0, stretch = 0.0;
     size_t used = 0;
-    for (size_t c = st.first; c < held.have.size(); c += st.k) {
-      const DVec3 centre = position(st, c, 4);
-      if (held.projected[c] == 0) {
-        for (int corner = 0; corner < 4; ++corner) corners[corner] = position(st, c, corner);
-        held.projected[c] = spriteProjection(centre, corners, eye1, held.c_prime[c], true) ? 1 : 2;
+    for (size_t j = 0; j < st.sample->cells.size(); ++j) {
+      const size_t c = st.first + j * st.k;
+      Cell& cell = st.sample->cells[j];
+      const DVec3 centre = position(st, c, cell, 4);
+      if (cell.eye != held.eye_generation) {
+        for (int corner = 0; corner < 4; ++corner) corners[corner] = position(st, c, cell, corner);
+        cell.projected = spriteProjection(centre, corners, eye1, cell.c_prime, true) ? 1 : 2;
+        cell.eye = held.eye_generation;
       } else {
         ++counters_.projections_kept;
       }
-      if (held.projected[c] == 2) {
+      if (cell.projected == 2) {
         ++e.skipped;
         continue;
       }
-      const double theta = spriteTheta(centre, held.c_prime[c], eye2);
+      const double theta = spriteTheta(centre, cell.c_prime, eye2);
       sum += theta * theta;
       stretch += spriteMagnification(centre, eye1, eye2);
       e.max_theta = std::max(e.max_theta, theta);

@@ -123,7 +123,15 @@ double quadrantTheta(const DVec3& c, std::span<const DVec3> corners, const DVec3
 
 double spriteTheta(const DVec3& c, const DVec3& c_prime, const DVec3& v2) {
   const DVec3 a = c - v2, b = c_prime - v2;
-  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+  const double sine = glm::length(glm::cross(a, b)), cosine = glm::dot(a, b);
+  // The metric's angles are a few pixels (thousandths of a radian): there atan's series to t^11 is exact to the last
+  // bit of a double (the first term left out, t^13 / 13, is under 2e-16 t for t < 1/16) and a third of atan2's cost,
+  // which was a tenth of a measure over 850 cells.
+  if (cosine > 0.0 && sine < 0.0625 * cosine) {
+    const double t = sine / cosine, t2 = t * t;
+    return t * (1.0 - t2 * (1.0 / 3.0 - t2 * (1.0 / 5.0 - t2 * (1.0 / 7.0 - t2 * (1.0 / 9.0 - t2 / 11.0)))));
+  }
+  return std::atan2(sine, cosine);
 }
 
 double spriteMagnification(const DVec3& c, const DVec3& v1, const DVec3& v2) {
