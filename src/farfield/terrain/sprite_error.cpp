@@ -20,11 +20,13 @@ bool insideXY(const DVec3& q, const DVec3& a, const DVec3& b, const DVec3& c) {
   return s * cross2(pb - pa, p - pa) >= eps && s * cross2(pc - pb, p - pb) >= eps && s * cross2(pa - pc, p - pc) >= eps;
 }
 
-// Ray v1 + t * dir against the plane through (p0, p1, p2); false when parallel.
-bool rayPlane(const DVec3& v1, const DVec3& dir, const DVec3& p0, const DVec3& p1, const DVec3& p2, double& t) {
+// Ray v1 + t * dir against the plane through (p0, p1, p2); false when parallel (|cos| under 1e-12, compared in
+// squares: dir_sq is the squared length of dir).
+bool rayPlane(const DVec3& v1, const DVec3& dir, double dir_sq, const DVec3& p0, const DVec3& p1, const DVec3& p2,
+              double& t) {
   const DVec3 n = glm::cross(p1 - p0, p2 - p0);
   const double denom = glm::dot(n, dir);
-  if (std::abs(denom) < 1e-12 * glm::length(n) * glm::length(dir)) return false;
+  if (denom * denom < 1e-24 * glm::dot(n, n) * dir_sq) return false;
   t = glm::dot(n, p0 - v1) / denom;
   return std::isfinite(t);
 }
@@ -35,7 +37,8 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
   const size_t n = corners.size();
   if (n < 3) return false;
   const DVec3 dir = c - v1;
-  if (glm::length(dir) <= 0.0) return false;
+  const double dir_sq = glm::dot(dir, dir);
+  if (!(dir_sq > 0.0)) return false;
   // C^: the low-resolution surface above the quadrant's centre.
   DVec3 centre(0.0);
   if (n == 4) {
@@ -50,9 +53,31 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
       if (dxy < best) best = dxy, centre = mid;
     }
   }
-  // Fan triangles (C^, Q_k, Q_k+1), skipping degenerate ones (the boundary edge through C^).
+  // Fan triangles (C^, Q_k, Q_k+1), skipping degenerate ones (the boundary edge through C^): the nearest one the ray
+  // meets inside it (a cell's C' is made once per keyframe, but for every sampled cell of a new one: 850 a measure).
+  constexpr size_t kMost = 8;
+  double plane_t[kMost];
+  bool plane_ok[kMost] = {};
   double best_t = std::numeric_limits<double>::max();
   bool hit = false;
+  for (size_t k = 0; k < n; ++k) {
+    const DVec3& a = corners[k];
+    const DVec3& b = corners[(k + 1) % n];
+    if (std::abs(cross2(DVec2(a) - DVec2(centre), DVec2(b) - DVec2(centre))) < 1e-9) continue;
+    double t = 0.0;
+    if (!rayPlane(v1, dir, dir_sq, centre, a, b, t)) continue;
+    if (k < kMost) plane_t[k] = t, plane_ok[k] = true;
+    if (t > 0.0 && t < best_t && insideXY(v1 + t * dir, centre, a, b)) {
+      best_t = t;
+      hit = true;
+    }
+  }
+  if (hit) {
+    c_prime = v1 + best_t * dir;
+    return true;
+  }
+  // Fallback: the fan triangle whose direction from C^ best matches the ray's xy direction (forward when C lies above
+  // C^, backward otherwise), if its plane lies ahead of v1.
   double fallback_t = 0.0;
   bool have_fallback = false;
   double fallback_score = -std::numeric_limits<double>::max();
@@ -62,16 +87,14 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
   for (size_t k = 0; k < n; ++k) {
     const DVec3& a = corners[k];
     const DVec3& b = corners[(k + 1) % n];
-    if (std::abs(cross2(DVec2(a) - DVec2(centre), DVec2(b) - DVec2(centre))) < 1e-9) continue;
     double t = 0.0;
-    if (!rayPlane(v1, dir, centre, a, b, t)) continue;
-    const DVec3 p = v1 + t * dir;
-    if (t > 0.0 && insideXY(p, centre, a, b) && t < best_t) {
-      best_t = t;
-      hit = true;
+    if (k < kMost) {
+      if (!plane_ok[k]) continue;
+      t = plane_t[k];
+    } else if (std::abs(cross2(DVec2(a) - DVec2(centre), DVec2(b) - DVec2(centre))) < 1e-9 ||
+               !rayPlane(v1, dir, dir_sq, centre, a, b, t)) {
+      continue;
     }
-    // Fallback: the fan triangle whose direction from C^ best matches the ray's xy direction (forward when C lies
-    // above C^, backward otherwise), if its plane lies ahead of v1.
     const DVec2 towards = 0.5 * (DVec2(a) + DVec2(b)) - DVec2(centre);
     const double score = ray_xy_len > 0.0 ? glm::dot(glm::normalize(towards), ray_xy / ray_xy_len) * (above ? 1 : -1)
                                           : 0.0;
@@ -80,10 +103,6 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
       fallback_t = t;
       have_fallback = true;
     }
-  }
-  if (hit) {
-    c_prime = v1 + best_t * dir;
-    return true;
   }
   if (!have_fallback) return false;
   if (!near) {
