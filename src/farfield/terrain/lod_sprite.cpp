@@ -416,8 +416,10 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   // otherwise it is stale (the camera went elsewhere than extrapolated) and dropped, so that a new one is made.
   bool early = false;
   double early_error = 0.0;  // the early-taken keyframe's error here (pixels)
+  SpriteError early_metric;
   if (options_.predict_late && !due && current_ && pending_ && pending_->ready) {
-    early_error = frameError(pending_->camera.eye, camera.eye).pixels(beta);
+    early_metric = frameError(pending_->camera.eye, camera.eye);
+    early_error = early_metric.pixels(beta);
     if (early_error < info.error_px && early_error < 0.75 * options_.epsilon) {
       const double cover = coverage(*pending_);
       early = cover >= options_.reuse_coverage * pending_->coverage_at_creation || cover >= coverage(*current_);
@@ -439,6 +441,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     anchor_since_ = frame_;
     Keyframe* chosen = nullptr;
     double chosen_error = 0.0;
+    SpriteError chosen_metric;  // its metric here, measured once (the magnification below is read from it)
     // A keyframe rendered ahead that the trip caught with at most half of its slices left (the error's rate, or the
     // magnification's, rose faster than the schedule saw): its last slices now, a fraction of a fresh keyframe, then
     // the same test as a ready one. On the 16,385^2 flight the fresh keyframes at a trip were caught one or three
@@ -450,10 +453,11 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       ++counters_.predicted_finished;
     }
     if (pending_ && pending_->ready) {
-      double e = early_error;
-      if (early || takesOver(*pending_, camera.eye, beta, &e)) {
+      SpriteError m = early_metric;
+      if (early || takesOver(*pending_, camera.eye, beta, &m)) {
         chosen = pending_.get();
-        chosen_error = e;
+        chosen_metric = m;
+        chosen_error = early ? early_error : m.pixels(beta);
         info.source = SpriteSource::Predicted;
         ++counters_.predicted_used;
         keep(std::move(pending_));
@@ -469,6 +473,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
         best = e.mean_theta_sq;
         chosen = k.get();
         chosen_error = e.pixels(beta);
+        chosen_metric = e;
       }
       if (chosen) {
         info.source = SpriteSource::Cached;
@@ -493,8 +498,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       info.source = SpriteSource::Fresh;
     }
     current_ = chosen;
-    info.magnification =
-        info.source == SpriteSource::Fresh ? 1.0 : frameError(chosen->camera.eye, camera.eye).mean_magnification;
+    info.magnification = info.source == SpriteSource::Fresh ? 1.0 : chosen_metric.mean_magnification;
     sprite_since_ = frame_;
     sprite_error_at_take_ = chosen_error;
     info.error_px = chosen_error;

@@ -228,8 +228,8 @@ class LodSpriteRenderer {
   Keyframe* renderKeyframe(const Camera& camera, gpu::FrameStats& stats, LodSpriteFrameInfo& info);
   double coverage(Keyframe& keyframe);
   // Whether a keyframe may become the sprite at viewpoint `eye`: its error there at most 3/4 of the threshold (some
-  // life left) and it covers the view; error_px: that error.
-  bool takesOver(Keyframe& keyframe, const Vec3& eye, double beta, double* error_px = nullptr);
+  // life left) and it covers the view; error: its metric there.
+  bool takesOver(Keyframe& keyframe, const Vec3& eye, double beta, SpriteError* error = nullptr);
   // With gpu_low: the share of CDLOD nodes whose box centre lies in the keyframe's image.
   double nodeCoverage(std::span<const CdlodNode> nodes, const Keyframe& keyframe) const;
   // The keyframe rendered ahead from the viewpoint extrapolated `ahead` frames on, drawn in `chunks` slices.

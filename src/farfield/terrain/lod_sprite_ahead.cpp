@@ -190,11 +190,11 @@ void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double erro
   schedulePrediction(camera, float(chunks), size_t(chunks));
 }
 
-bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, double* error_px) {
+bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, SpriteError* error) {
   // Only with some life left (error at most 3/4 of the threshold here, and magnification at most 3/4 of the way to
   // its bound), or it would trip again at once.
   const SpriteError e = frameError(keyframe.camera.eye, eye);
-  if (error_px) *error_px = e.pixels(beta);
+  if (error) *error = e;
   return !dueAt(e, beta, 0.75) &&
          coverage(keyframe) >= options_.reuse_coverage * keyframe.coverage_at_creation;
 }
