@@ -293,6 +293,47 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
   EXPECT_GT(worst_psnr, 25.0);
 }
 
+// predict_late where a high frame costs little more than a sprite frame (1.2 against 1 ms by the model, a keyframe
+// 2.2): the first switch from the high LOD waits for a keyframe rendered ahead in slices with the high frames before
+// it, so that no frame of the flight draws a whole keyframe (where high frames are dear, the test above, the first
+// keyframe is drawn whole at the switch).
+TEST(LodSpriteGL, WhereHighFramesAreCheapTheSwitchWaitsForAKeyframeRenderedAhead) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  TerrainCost cost = spritesPay();
+  cost.gpu_high->base_ms = 1.2;
+  cost.gpu_sprite->base_ms = 1.0;
+  const LodSpriteOptions options = lateSlicedOptions(gpu_lod, cost);
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const float top = scene.hf.maxHeight();
+  gpu::RenderTarget frame(128, 128);
+  size_t first_sprite = 0, slices_before = 0;
+  for (size_t f = 0; f < 90; ++f) {
+    const float x = 300.0f + 24.0f * float(f);
+    const Camera camera = makeCamera(Vec3(x, 300, top + 700), Vec3(x + 100, 1500, 0));
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    sprite.render(camera, frame, &info);
+    EXPECT_EQ(info.keyframe_triangles, 0u) << "frame " << f << ": a whole keyframe";
+    EXPECT_LE(info.error_px, options.epsilon + 1e-9) << "frame " << f;
+    if (info.path == TerrainPath::Sprite && first_sprite == 0) {
+      first_sprite = f;
+      EXPECT_EQ(info.source, SpriteSource::Predicted);
+      EXPECT_TRUE(info.switched);
+    }
+    if (first_sprite == 0 && info.ahead_slices > 0) {
+      EXPECT_EQ(info.path, TerrainPath::High) << "frame " << f;
+      ++slices_before;
+    }
+  }
+  const LodSpriteCounters& c = sprite.counters();
+  ASSERT_GT(first_sprite, 0u) << "sprites pay along the flight";
+  EXPECT_GE(slices_before, 2u) << "the first keyframe's slices drawn with high frames";
+  EXPECT_EQ(c.fresh_keyframes, 0u);
+  EXPECT_EQ(c.switches, 1u);
+  EXPECT_GE(c.predicted_used, 2u);
+}
+
 // A trip that catches a keyframe rendered ahead with half of its slices drawn (the camera jumped ahead faster than the
 // schedule saw): its last slices are drawn in the trip's frame and it is taken, where a whole fresh keyframe was
 // drawn before (on the 16,385^2 flight, keyframes one to three slices short of 8-11).

@@ -64,6 +64,10 @@ LodSpriteRenderer::LodSpriteRenderer(const QuadtreeLod& lod, gpu::TerrainRendere
 
 namespace {
 
+// predict_late waits for a keyframe rendered ahead in high frames that cost at most this many sprite frames (by the
+// corrected model): with a slice of a third of a sprite frame, under twice a sprite frame.
+constexpr double kMildHighFrame = 1.5;
+
 LodSpriteOptions onTheGpu(GpuLodTerrain& terrain, LodSpriteOptions options) {
   if (options.gpu_high && options.gpu_high != &terrain)
     throw Error("lod-sprite", "options name another CDLOD terrain than the renderer's");
@@ -404,11 +408,18 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   // While the high LOD stands in for a virtual keyframe, that keyframe has already lasted `age` frames: a sprite
   // lives at least that long here, so a keyframe may be taken now, before the metric trips, when that pays (the run's
   // first sprite has no lifetime measured yet, and a sprite that would last the whole path never trips).
-  bool switch_now = false;
+  // predict_late: where a high frame costs little more than a sprite frame, the switch waits for a keyframe rendered
+  // ahead in slices with the high frames before it (taken as a predicted one), instead of drawing a whole keyframe in
+  // its frame (4-5 times a sprite frame); where high frames cost more (the 16,385^2 flight's low passes: 3-4 times a
+  // sprite frame), waiting in them would cost more than the whole keyframe, which is drawn as before.
+  const bool ahead_of_switch =
+      options_.predict && options_.predict_late && choose && costs.high_ms <= kMildHighFrame * costs.sprite_ms;
+  bool switch_now = false, sprite_pays = false;
   if (!due && !current_ && choose) {
     const double age = double(frame_ - anchor_since_);
     info.expected_lifetime = std::max(spriteLifetimeEstimate(lifetimes_, 1.0), age);
-    switch_now = choosePath(costs, false, info.expected_lifetime) == TerrainPath::Sprite;
+    sprite_pays = choosePath(costs, false, info.expected_lifetime) == TerrainPath::Sprite;
+    switch_now = sprite_pays && (!ahead_of_switch || (pending_ && pending_->ready));
   }
   info.switched = switch_now;
   // predict_late: a keyframe rendered ahead is taken as soon as it is ready, where it has less error than the current
@@ -481,15 +492,25 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       }
     }
     if (chosen) anchor_eye_ = chosen->camera.eye;  // a reused sprite's error is measured from its own viewpoint
-    if (!chosen && choose && !switch_now) {
+    if (!chosen && choose && (ahead_of_switch || !switch_now)) {
       info.expected_lifetime = spriteLifetimeEstimate(lifetimes_, 1.0);
-      if (choosePath(costs, false, info.expected_lifetime) == TerrainPath::High) {
-        // No keyframe: this frame is the high LOD, and the metric goes on from a virtual keyframe here.
+      sprite_pays = choosePath(costs, false, info.expected_lifetime) == TerrainPath::Sprite;
+      if (!sprite_pays || ahead_of_switch) {
+        // No keyframe: this frame is the high LOD, and the metric goes on from a virtual keyframe here (predict_late:
+        // the next keyframe is rendered ahead of the switch; one that was refused here is dropped).
         current_ = nullptr;
         ++counters_.virtual_keyframes;
+        if (switch_now) --counters_.switches;  // the keyframe it waited for was refused: no switch
+        info.switched = false;
         info.source = SpriteSource::None;
         info.error_px = 0.0;
-        return finish(renderHigh(camera, target, info), info, out);
+        if (pending_ && pending_->ready) {
+          ++counters_.predicted_discarded;
+          spare_.push_back(std::move(pending_));
+        }
+        gpu::FrameStats high = renderHigh(camera, target, info);
+        if (sprite_pays) renderAheadOfSwitch(camera, high, info);
+        return finish(high, info, out);
       }
     }
     if (!chosen) {
@@ -517,7 +538,9 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   } else if (!current_ || (choose && choosePath(costs, true, 0.0) == TerrainPath::High)) {
     // A virtual keyframe still valid, or a valid sprite that costs more to draw than the high LOD.
     info.source = SpriteSource::None;
-    return finish(renderHigh(camera, target, info), info, out);
+    gpu::FrameStats high = renderHigh(camera, target, info);
+    if (ahead_of_switch && sprite_pays && !current_) renderAheadOfSwitch(camera, high, info);
+    return finish(high, info, out);
   }
   current_->last_used = frame_;
   if (options_.predict && options_.predict_late && !due && !pending_)

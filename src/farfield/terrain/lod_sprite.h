@@ -238,6 +238,9 @@ class LodSpriteRenderer {
   // slices it needs (model: the frame's modelCosts, which size the slices; null = predict_chunks slices).
   void scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* model);
   void advancePrediction(gpu::FrameStats& stats, LodSpriteFrameInfo& info);
+  // With predict_late, in a high frame of a virtual keyframe where a sprite would pay: the keyframe the switch will
+  // take, scheduled if none is, and one slice of it drawn (stats: the high frame's, the slice's added).
+  void renderAheadOfSwitch(const Camera& camera, gpu::FrameStats& stats, LodSpriteFrameInfo& info);
   void keep(std::unique_ptr<Keyframe> keyframe);
   // The cost model's predictions of this frame's alternatives, and the same corrected by the measured frames.
   PathCosts modelCosts(size_t low_triangles) const;

@@ -162,6 +162,17 @@ void LodSpriteRenderer::advancePrediction(gpu::FrameStats& stats, LodSpriteFrame
   k.coverage_at_creation = probe_.visibleShare(probe_mesh_.indices);
 }
 
+void LodSpriteRenderer::renderAheadOfSwitch(const Camera& camera, gpu::FrameStats& stats, LodSpriteFrameInfo& info) {
+  if (!pending_) {
+    // Slices of at most kSliceShare of a sprite frame each by the cost model (at most predict_chunks of them), from
+    // where the camera will be when it is ready, which is when the switch takes it.
+    const double chunks = std::clamp(slicesFor(model_costs_), 1.0, double(options_.predict_chunks));
+    pending_most_ = 0;
+    schedulePrediction(camera, float(chunks), size_t(chunks));
+  }
+  if (pending_ && !pending_->ready) advancePrediction(stats, info);
+}
+
 void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* model) {
   // The error grows roughly with the distance moved since the sprite was taken; at the rate seen since then it trips
   // in `left` frames. The next keyframe is started once about 1.5 times the frames it is drawn in are left, or once
