@@ -235,6 +235,15 @@ LodSpriteOptions lateSlicedOptions(GpuLodTerrain& gpu_lod, const TerrainCost& co
   return options;
 }
 
+// The straight, steady flight of the keyframes-ahead tests (x = 300 + 24 f at frame f), and one frame of it.
+Camera flightCamera(float top, float x) { return makeCamera(Vec3(x, 300, top + 700), Vec3(x + 100, 1500, 0)); }
+LodSpriteFrameInfo flightFrame(LodSpriteRenderer& sprite, gpu::RenderTarget& frame, float top, float x) {
+  frame.clear(kSky);
+  LodSpriteFrameInfo info;
+  sprite.render(flightCamera(top, x), frame, &info);
+  return info;
+}
+
 // predict_late on the GPU: along a straight, steady flight, each keyframe after the first is rendered ahead in slices
 // (no frame draws a whole keyframe, each draws at most one slice) and taken before the sprite trips; a keyframe made of
 // slices is the CDLOD frame at its camera pixel for pixel (the terrain's selections for other bounds and cameras,
@@ -251,8 +260,7 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
   uint64_t slice_max = 0;
   size_t first_fresh = 0, slices = 0, checked = 0;
   for (size_t f = 0; f < 90; ++f) {
-    const float x = 300.0f + 24.0f * float(f);
-    const Camera camera = makeCamera(Vec3(x, 300, top + 700), Vec3(x + 100, 1500, 0));
+    const Camera camera = flightCamera(top, 300.0f + 24.0f * float(f));
     frame.clear(kSky);
     LodSpriteFrameInfo info;
     sprite.render(camera, frame, &info);
@@ -309,11 +317,7 @@ TEST(LodSpriteGL, WhereHighFramesAreCheapTheSwitchWaitsForAKeyframeRenderedAhead
   gpu::RenderTarget frame(128, 128);
   size_t first_sprite = 0, slices_before = 0;
   for (size_t f = 0; f < 90; ++f) {
-    const float x = 300.0f + 24.0f * float(f);
-    const Camera camera = makeCamera(Vec3(x, 300, top + 700), Vec3(x + 100, 1500, 0));
-    frame.clear(kSky);
-    LodSpriteFrameInfo info;
-    sprite.render(camera, frame, &info);
+    const LodSpriteFrameInfo info = flightFrame(sprite, frame, top, 300.0f + 24.0f * float(f));
     EXPECT_EQ(info.keyframe_triangles, 0u) << "frame " << f << ": a whole keyframe";
     EXPECT_LE(info.error_px, options.epsilon + 1e-9) << "frame " << f;
     if (info.path == TerrainPath::Sprite && first_sprite == 0) {
@@ -356,10 +360,7 @@ TEST(LodSpriteGL, ATripFinishesAKeyframeRenderedAheadInsteadOfDrawingAFreshOne) 
       jumped = true;
       fresh_before = sprite.counters().fresh_keyframes;
     }
-    const Camera camera = makeCamera(Vec3(x, 300, top + 700), Vec3(x + 100, 1500, 0));
-    frame.clear(kSky);
-    LodSpriteFrameInfo info;
-    sprite.render(camera, frame, &info);
+    const LodSpriteFrameInfo info = flightFrame(sprite, frame, top, x);
     run = info.ahead_slices > 0 && sprite.counters().predicted_used > 0 ? run + 1 : 0;
     if (!jumped) continue;
     EXPECT_TRUE(info.keyframe_due) << "the jump trips the sprite";
