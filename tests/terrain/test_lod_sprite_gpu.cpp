@@ -235,6 +235,20 @@ LodSpriteOptions lateSlicedOptions(GpuLodTerrain& gpu_lod, const TerrainCost& co
   return options;
 }
 
+// LOD-sprite with lateSlicedOptions over the test fractal's CDLOD terrain, 128 x 128.
+struct LateSlicedRun {
+  explicit LateSlicedRun(const TerrainCost& model)
+      : cost(model),
+        options(lateSlicedOptions(gpu_lod, cost)),
+        sprite(*scene.lod, *scene.renderer, 128, 128, options) {}
+  Scene scene{testFractal()};
+  GpuLodTerrain gpu_lod{scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f}};
+  TerrainCost cost;
+  LodSpriteOptions options;
+  LodSpriteRenderer sprite;
+  float top = scene.hf.maxHeight();
+};
+
 // The straight, steady flight of the keyframes-ahead tests (x = 300 + 24 f at frame f), and one frame of it.
 Camera flightCamera(float top, float x) { return makeCamera(Vec3(x, 300, top + 700), Vec3(x + 100, 1500, 0)); }
 LodSpriteFrameInfo flightFrame(LodSpriteRenderer& sprite, gpu::RenderTarget& frame, float top, float x) {
@@ -249,12 +263,10 @@ LodSpriteFrameInfo flightFrame(LodSpriteRenderer& sprite, gpu::RenderTarget& fra
 // slices is the CDLOD frame at its camera pixel for pixel (the terrain's selections for other bounds and cameras,
 // made in between, do not change it), and every frame stays within the error threshold and close to the CDLOD frame.
 TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) {
-  Scene scene(testFractal());
-  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
-  TerrainCost cost = spritesPay();  // a keyframe is many sprite frames, so it takes all 4 slices
-  const LodSpriteOptions options = lateSlicedOptions(gpu_lod, cost);
-  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
-  const float top = scene.hf.maxHeight();
+  LateSlicedRun late(spritesPay());  // a keyframe is many sprite frames, so it takes all 4 slices
+  LodSpriteRenderer& sprite = late.sprite;
+  const LodSpriteOptions& options = late.options;
+  const float top = late.top;
   gpu::RenderTarget frame(128, 128), expected(128, 128);
   double worst_psnr = 1e9;
   uint64_t slice_max = 0;
@@ -280,12 +292,12 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
       const Camera& key = *sprite.spriteCamera();
       gpu::RenderTarget key_expected(key.width, key.height);
       key_expected.clear(kSky);
-      gpu_lod.draw(key, options.high_error, key_expected);
+      late.gpu_lod.draw(key, options.high_error, key_expected);
       EXPECT_EQ(sprite.spriteTarget()->readColor().pixels(), key_expected.readColor().pixels()) << "frame " << f;
       ++checked;
     }
     expected.clear(kSky);
-    gpu_lod.draw(camera, options.high_error, expected);
+    late.gpu_lod.draw(camera, options.high_error, expected);
     worst_psnr = std::min(worst_psnr, image::psnr(frame.readColor(), expected.readColor()));
   }
   const LodSpriteCounters& c = sprite.counters();
@@ -306,14 +318,13 @@ TEST(LodSpriteGL, KeyframesRenderedAheadOnTheGpuAreDrawnInSlicesAndTakenInTime) 
 // it, so that no frame of the flight draws a whole keyframe (where high frames are dear, the test above, the first
 // keyframe is drawn whole at the switch).
 TEST(LodSpriteGL, WhereHighFramesAreCheapTheSwitchWaitsForAKeyframeRenderedAhead) {
-  Scene scene(testFractal());
-  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
   TerrainCost cost = spritesPay();
   cost.gpu_high->base_ms = 1.2;
   cost.gpu_sprite->base_ms = 1.0;
-  const LodSpriteOptions options = lateSlicedOptions(gpu_lod, cost);
-  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
-  const float top = scene.hf.maxHeight();
+  LateSlicedRun late(cost);
+  LodSpriteRenderer& sprite = late.sprite;
+  const LodSpriteOptions& options = late.options;
+  const float top = late.top;
   gpu::RenderTarget frame(128, 128);
   size_t first_sprite = 0, slices_before = 0;
   for (size_t f = 0; f < 90; ++f) {
@@ -342,12 +353,10 @@ TEST(LodSpriteGL, WhereHighFramesAreCheapTheSwitchWaitsForAKeyframeRenderedAhead
 // schedule saw): its last slices are drawn in the trip's frame and it is taken, where a whole fresh keyframe was
 // drawn before (on the 16,385^2 flight, keyframes one to three slices short of 8-11).
 TEST(LodSpriteGL, ATripFinishesAKeyframeRenderedAheadInsteadOfDrawingAFreshOne) {
-  Scene scene(testFractal());
-  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
-  TerrainCost cost = spritesPay();  // a keyframe is many sprite frames, so it takes all 4 slices
-  const LodSpriteOptions options = lateSlicedOptions(gpu_lod, cost);
-  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
-  const float top = scene.hf.maxHeight();
+  LateSlicedRun late(spritesPay());  // a keyframe is many sprite frames, so it takes all 4 slices
+  LodSpriteRenderer& sprite = late.sprite;
+  const LodSpriteOptions& options = late.options;
+  const float top = late.top;
   gpu::RenderTarget frame(128, 128);
   float x = 300.0f;
   size_t fresh_before = 0, run = 0;

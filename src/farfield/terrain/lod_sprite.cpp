@@ -441,7 +441,6 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     }
   }
   if (due || switch_now || early) {
-    if (switch_now) ++counters_.switches;
     if (due && anchored_) {
       last_lifetime_ = std::max<uint64_t>(frame_ - anchor_since_, 1);
       lifetimes_.push_back(last_lifetime_);
@@ -500,8 +499,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
         // the next keyframe is rendered ahead of the switch; one that was refused here is dropped).
         current_ = nullptr;
         ++counters_.virtual_keyframes;
-        if (switch_now) --counters_.switches;  // the keyframe it waited for was refused: no switch
-        info.switched = false;
+        info.switched = false;  // the keyframe it waited for was refused: no switch
         info.source = SpriteSource::None;
         info.error_px = 0.0;
         if (pending_ && pending_->ready) {
@@ -518,6 +516,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       chosen_error = 0.0;
       info.source = SpriteSource::Fresh;
     }
+    if (switch_now) ++counters_.switches;
     current_ = chosen;
     info.magnification = info.source == SpriteSource::Fresh ? 1.0 : chosen_metric.mean_magnification;
     sprite_since_ = frame_;

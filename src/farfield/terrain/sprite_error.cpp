@@ -53,21 +53,20 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
       if (dxy < best) best = dxy, centre = mid;
     }
   }
-  // Fan triangles (C^, Q_k, Q_k+1), skipping degenerate ones (the boundary edge through C^): the nearest one the ray
-  // meets inside it (a cell's C' is made once per keyframe, but for every sampled cell of a new one: 850 a measure).
-  constexpr size_t kMost = 8;
-  double plane_t[kMost];
-  bool plane_ok[kMost] = {};
+  // Fan triangles (C^, Q_k, Q_k+1), skipping degenerate ones (the boundary edge through C^), and the plane of each.
+  auto fanPlane = [&](size_t k, double& t) {
+    const DVec3& a = corners[k];
+    const DVec3& b = corners[(k + 1) % n];
+    return std::abs(cross2(DVec2(a) - DVec2(centre), DVec2(b) - DVec2(centre))) >= 1e-9 &&
+           rayPlane(v1, dir, dir_sq, centre, a, b, t);
+  };
+  // The nearest one the ray meets inside it (a cell's C' is made once per keyframe, but for every sampled cell of a
+  // new one: 850 a measure).
   double best_t = std::numeric_limits<double>::max();
   bool hit = false;
   for (size_t k = 0; k < n; ++k) {
-    const DVec3& a = corners[k];
-    const DVec3& b = corners[(k + 1) % n];
-    if (std::abs(cross2(DVec2(a) - DVec2(centre), DVec2(b) - DVec2(centre))) < 1e-9) continue;
     double t = 0.0;
-    if (!rayPlane(v1, dir, dir_sq, centre, a, b, t)) continue;
-    if (k < kMost) plane_t[k] = t, plane_ok[k] = true;
-    if (t > 0.0 && t < best_t && insideXY(v1 + t * dir, centre, a, b)) {
+    if (fanPlane(k, t) && t > 0.0 && t < best_t && insideXY(v1 + t * dir, centre, corners[k], corners[(k + 1) % n])) {
       best_t = t;
       hit = true;
     }
@@ -76,8 +75,8 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
     c_prime = v1 + best_t * dir;
     return true;
   }
-  // Fallback: the fan triangle whose direction from C^ best matches the ray's xy direction (forward when C lies above
-  // C^, backward otherwise), if its plane lies ahead of v1.
+  // Fallback (rare: the planes are made again): the fan triangle whose direction from C^ best matches the ray's xy
+  // direction (forward when C lies above C^, backward otherwise), if its plane lies ahead of v1.
   double fallback_t = 0.0;
   bool have_fallback = false;
   double fallback_score = -std::numeric_limits<double>::max();
@@ -85,17 +84,9 @@ bool spriteProjection(const DVec3& c, std::span<const DVec3> corners, const DVec
   const double ray_xy_len = glm::length(ray_xy);
   const bool above = c.z > centre.z;
   for (size_t k = 0; k < n; ++k) {
-    const DVec3& a = corners[k];
-    const DVec3& b = corners[(k + 1) % n];
     double t = 0.0;
-    if (k < kMost) {
-      if (!plane_ok[k]) continue;
-      t = plane_t[k];
-    } else if (std::abs(cross2(DVec2(a) - DVec2(centre), DVec2(b) - DVec2(centre))) < 1e-9 ||
-               !rayPlane(v1, dir, dir_sq, centre, a, b, t)) {
-      continue;
-    }
-    const DVec2 towards = 0.5 * (DVec2(a) + DVec2(b)) - DVec2(centre);
+    if (!fanPlane(k, t)) continue;
+    const DVec2 towards = 0.5 * (DVec2(corners[k]) + DVec2(corners[(k + 1) % n])) - DVec2(centre);
     const double score = ray_xy_len > 0.0 ? glm::dot(glm::normalize(towards), ray_xy / ray_xy_len) * (above ? 1 : -1)
                                           : 0.0;
     if (t > 0.0 && score > fallback_score) {
