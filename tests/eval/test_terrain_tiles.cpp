@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -156,16 +157,24 @@ TEST(TerrainTilesGL, LodSpriteRunsOnThePagedTerrainBesideItsCdlodFrames) {
   size_t rows = 0, compared = 0;
   std::getline(csv, line);
   EXPECT_EQ(line, "frame,cdlod_ms,lod_sprite_ms,cdlod_own_cpu_ms,lod_sprite_own_cpu_ms,path,source,triangles,error_px,"
-                  "magnification,page_loads,psnr_vs_cdlod");
-  size_t loads = 0;
+                  "magnification,page_loads,ahead_triangles,ahead_slices,keyframe_triangles,psnr_vs_cdlod");
+  size_t loads = 0, keyframe_frames = 0;
   while (std::getline(csv, line)) {
     ++rows;
     compared += line.back() != ',' ? 1 : 0;
-    // page_loads: the 11th column.
+    // page_loads, ahead_triangles, ahead_slices, keyframe_triangles: the 11th to 14th columns.
     size_t at = 0;
     for (int column = 0; column < 10; ++column) at = line.find(',', at) + 1;
-    loads += std::stoul(line.substr(at, line.find(',', at) - at));
+    std::array<size_t, 4> v{};
+    for (size_t& x : v) {
+      x = std::stoul(line.substr(at, line.find(',', at) - at));
+      at = line.find(',', at) + 1;
+    }
+    loads += v[0];
+    EXPECT_EQ(v[1] > 0, v[2] > 0) << line;  // triangles of a keyframe rendered ahead only with its slices
+    keyframe_frames += v[3] > 0 ? 1 : 0;
   }
+  EXPECT_GE(keyframe_frames, 1u) << "the first keyframe is drawn whole";
   EXPECT_EQ(rows, frames);
   EXPECT_EQ(loads, s["page_loads_waited_for"].get<size_t>());
   EXPECT_LE(s["frames_that_waited_for_pages"].get<size_t>(), loads);

@@ -237,10 +237,15 @@ LodSpriteOptions lateSlicedOptions(GpuLodTerrain& gpu_lod, const TerrainCost& co
 
 // LOD-sprite with lateSlicedOptions over the test fractal's CDLOD terrain, 128 x 128.
 struct LateSlicedRun {
-  explicit LateSlicedRun(const TerrainCost& model)
+  // reuse_coverage: LodSpriteOptions::reuse_coverage.
+  explicit LateSlicedRun(const TerrainCost& model, double reuse_coverage = LodSpriteOptions{}.reuse_coverage)
       : cost(model),
-        options(lateSlicedOptions(gpu_lod, cost)),
+        options(withReuseCoverage(lateSlicedOptions(gpu_lod, cost), reuse_coverage)),
         sprite(*scene.lod, *scene.renderer, 128, 128, options) {}
+  static LodSpriteOptions withReuseCoverage(LodSpriteOptions o, double reuse_coverage) {
+    o.reuse_coverage = reuse_coverage;
+    return o;
+  }
   Scene scene{testFractal()};
   GpuLodTerrain gpu_lod{scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f}};
   TerrainCost cost;
@@ -349,38 +354,62 @@ TEST(LodSpriteGL, WhereHighFramesAreCheapTheSwitchWaitsForAKeyframeRenderedAhead
   EXPECT_GE(c.predicted_used, 2u);
 }
 
-// A trip that catches a keyframe rendered ahead with half of its slices drawn (the camera jumped ahead faster than the
-// schedule saw): its last slices are drawn in the trip's frame and it is taken, where a whole fresh keyframe was
-// drawn before (on the 16,385^2 flight, keyframes one to three slices short of 8-11).
-TEST(LodSpriteGL, ATripFinishesAKeyframeRenderedAheadInsteadOfDrawingAFreshOne) {
-  LateSlicedRun late(spritesPay());  // a keyframe is many sprite frames, so it takes all 4 slices
-  LodSpriteRenderer& sprite = late.sprite;
-  const LodSpriteOptions& options = late.options;
-  const float top = late.top;
+// A trip that catches a keyframe rendered ahead with half of its slices drawn: the camera jumps ahead by eight frames
+// at once, faster than the schedule saw. Returns the trip's frame (keyframe_due false: no trip), and the fresh
+// keyframes drawn before it and in all through `fresh_before` and `fresh_after`.
+LodSpriteFrameInfo tripAfterAJump(LateSlicedRun& late, size_t& fresh_before, size_t& fresh_after) {
   gpu::RenderTarget frame(128, 128);
   float x = 300.0f;
-  size_t fresh_before = 0, run = 0;
-  bool jumped = false;
-  for (size_t f = 0; f < 120 && !jumped; ++f) {
+  size_t run = 0;
+  LodSpriteFrameInfo trip;
+  for (size_t f = 0; f < 120; ++f) {
     x += 24.0f;
-    if (run == 2) {
-      // Two slices of the four drawn: ahead by eight frames at once.
+    const bool jump = run == 2;  // two slices of the four drawn
+    if (jump) {
       x += 8.0f * 24.0f;
-      jumped = true;
-      fresh_before = sprite.counters().fresh_keyframes;
+      fresh_before = late.sprite.counters().fresh_keyframes;
     }
-    const LodSpriteFrameInfo info = flightFrame(sprite, frame, top, x);
-    run = info.ahead_slices > 0 && sprite.counters().predicted_used > 0 ? run + 1 : 0;
-    if (!jumped) continue;
-    EXPECT_TRUE(info.keyframe_due) << "the jump trips the sprite";
-    EXPECT_EQ(info.source, SpriteSource::Predicted) << spriteSourceName(info.source);
-    EXPECT_EQ(info.keyframe_triangles, 0u) << "no whole keyframe";
-    EXPECT_EQ(info.ahead_slices, 2u) << "its last two slices";
-    EXPECT_LE(info.error_px, options.epsilon);
+    const LodSpriteFrameInfo info = flightFrame(late.sprite, frame, late.top, x);
+    run = info.ahead_slices > 0 && late.sprite.counters().predicted_used > 0 ? run + 1 : 0;
+    if (jump) {
+      trip = info;
+      break;
+    }
   }
-  ASSERT_TRUE(jumped) << "no keyframe was rendered ahead after the first predicted one";
-  EXPECT_EQ(sprite.counters().predicted_finished, 1u);
-  EXPECT_EQ(sprite.counters().fresh_keyframes, fresh_before);
+  fresh_after = late.sprite.counters().fresh_keyframes;
+  return trip;
+}
+
+// The trip's last slices are drawn in its frame and the keyframe is taken, where a whole fresh keyframe was drawn
+// before (on the 16,385^2 flight, keyframes one to three slices short of 8-11).
+TEST(LodSpriteGL, ATripFinishesAKeyframeRenderedAheadInsteadOfDrawingAFreshOne) {
+  LateSlicedRun late(spritesPay());  // a keyframe is many sprite frames, so it takes all 4 slices
+  size_t fresh_before = 0, fresh_after = 0;
+  const LodSpriteFrameInfo info = tripAfterAJump(late, fresh_before, fresh_after);
+  ASSERT_TRUE(info.keyframe_due) << "no keyframe was rendered ahead after the first predicted one, or no trip";
+  EXPECT_EQ(info.source, SpriteSource::Predicted) << spriteSourceName(info.source);
+  EXPECT_EQ(info.keyframe_triangles, 0u) << "no whole keyframe";
+  EXPECT_EQ(info.ahead_slices, 2u) << "its last two slices";
+  EXPECT_LE(info.error_px, late.options.epsilon);
+  EXPECT_EQ(late.sprite.counters().predicted_finished, 1u);
+  EXPECT_EQ(fresh_after, fresh_before);
+}
+
+// "Covers the view" at a trip: a keyframe rendered ahead that covers the view at least as well as the sprite it
+// replaces is taken, even where it covers less of it than at its own viewpoint (on the 16,385^2 flight's turns,
+// 0.80-0.88 of the low-resolution nodes against 0.88-0.94 at creation, each refusal a whole keyframe of 95-100 ms).
+// Here no keyframe can pass the test against its share at creation (reuse_coverage 1.5): the trip still takes the
+// one rendered ahead, which was extrapolated to the camera's path and covers the new view better than the old sprite.
+TEST(LodSpriteGL, AtATripAKeyframeRenderedAheadThatCoversTheViewAsWellAsTheOldSpriteIsTaken) {
+  LateSlicedRun late(spritesPay(), 1.5);
+  size_t fresh_before = 0, fresh_after = 0;
+  const LodSpriteFrameInfo info = tripAfterAJump(late, fresh_before, fresh_after);
+  ASSERT_TRUE(info.keyframe_due) << "no keyframe was rendered ahead after the first predicted one, or no trip";
+  EXPECT_EQ(info.source, SpriteSource::Predicted) << spriteSourceName(info.source);
+  EXPECT_EQ(info.keyframe_triangles, 0u) << "no whole keyframe";
+  EXPECT_LE(info.error_px, late.options.epsilon);
+  EXPECT_EQ(fresh_after, fresh_before);
+  EXPECT_EQ(fresh_after, 1u) << "only the first keyframe drawn whole";
 }
 
 // LodSpriteOptions::max_magnification: approaching the terrain head-on, equation 2 alone lets the sprite be magnified

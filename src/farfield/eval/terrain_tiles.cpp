@@ -426,13 +426,14 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
       render_md += PagedSpriteRun::markdown(j["render"]["lod_sprite"]);
       std::ostringstream sc;
       sc << "frame,cdlod_ms,lod_sprite_ms,cdlod_own_cpu_ms,lod_sprite_own_cpu_ms,path,source,triangles,error_px,"
-            "magnification,page_loads,psnr_vs_cdlod\n";
+            "magnification,page_loads,ahead_triangles,ahead_slices,keyframe_triangles,psnr_vs_cdlod\n";
       for (size_t f = 0; f < sprite_frames.size(); ++f) {
         const PagedSpriteFrame& sf = sprite_frames[f];
         sc << f << ',' << cdlod_ms[f] << ',' << sf.ms << ',' << rows[f].own_ms << ',' << sf.own_ms << ','
            << (sf.info.path == terrain::TerrainPath::Sprite ? "sprite" : "high") << ','
            << terrain::spriteSourceName(sf.info.source) << ',' << sf.triangles << ',' << sf.info.error_px << ','
-           << sf.info.magnification << ',' << sf.page_loads << ',';
+           << sf.info.magnification << ',' << sf.page_loads << ',' << sf.info.ahead_triangles << ','
+           << sf.info.ahead_slices << ',' << sf.info.keyframe_triangles << ',';
         if (sf.psnr_vs_high >= 0.0) sc << sf.psnr_vs_high;
         sc << '\n';
       }

@@ -431,10 +431,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   if (options_.predict_late && !due && current_ && pending_ && pending_->ready) {
     early_metric = frameError(pending_->camera.eye, camera.eye);
     early_error = early_metric.pixels(beta);
-    if (early_error < info.error_px && early_error < 0.75 * options_.epsilon) {
-      const double cover = coverage(*pending_);
-      early = cover >= options_.reuse_coverage * pending_->coverage_at_creation || cover >= coverage(*current_);
-    }
+    if (early_error < info.error_px && early_error < 0.75 * options_.epsilon) early = coversView(*pending_, current_);
     if (!early) {
       ++counters_.predicted_discarded;
       spare_.push_back(std::move(pending_));
@@ -464,7 +461,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     }
     if (pending_ && pending_->ready) {
       SpriteError m = early_metric;
-      if (early || takesOver(*pending_, camera.eye, beta, &m)) {
+      if (early || takesOver(*pending_, camera.eye, beta, current_, &m)) {
         chosen = pending_.get();
         chosen_metric = m;
         chosen_error = early ? early_error : m.pixels(beta);
@@ -479,7 +476,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
         if (k.get() == current_) continue;
         const SpriteError e = errorOf(*k);
         if (dueAt(e, beta, 1.0) || e.mean_theta_sq >= best) continue;
-        if (coverage(*k) < options_.reuse_coverage * k->coverage_at_creation) continue;
+        if (!coversView(*k, current_)) continue;
         best = e.mean_theta_sq;
         chosen = k.get();
         chosen_error = e.pixels(beta);

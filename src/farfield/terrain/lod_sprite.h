@@ -28,7 +28,9 @@
 // Without a cost model every frame takes the sprite path, as the paper does.
 // "Covers the view": the share of the current low-resolution triangles visible in that keyframe is at least
 // reuse_coverage times the share its own low-resolution mesh had when it was rendered (a keyframe looking the other
-// way passes the angular test but would texture little of the view).
+// way passes the angular test but would texture little of the view), or at least the share visible in the sprite it
+// replaces (which was drawn until now: a keyframe rendered ahead that the view turned a little away from is still
+// better than a whole keyframe drawn in the frame).
 #pragma once
 
 #include <cstdint>
@@ -227,9 +229,12 @@ class LodSpriteRenderer {
   Camera keyframeCamera(const Camera& camera) const;
   Keyframe* renderKeyframe(const Camera& camera, gpu::FrameStats& stats, LodSpriteFrameInfo& info);
   double coverage(Keyframe& keyframe);
-  // Whether a keyframe may become the sprite at viewpoint `eye`: its error there at most 3/4 of the threshold (some
-  // life left) and it covers the view; error: its metric there.
-  bool takesOver(Keyframe& keyframe, const Vec3& eye, double beta, SpriteError* error = nullptr);
+  // "Covers the view" (above): here its share is at least reuse_coverage times its share at creation, or at least the
+  // share of `replaced` (the sprite it would replace, in use until now; null: none).
+  bool coversView(Keyframe& keyframe, Keyframe* replaced);
+  // Whether a keyframe may become the sprite at viewpoint `eye` in place of `replaced`: its error there at most 3/4 of
+  // the threshold (some life left) and it covers the view; error: its metric there.
+  bool takesOver(Keyframe& keyframe, const Vec3& eye, double beta, Keyframe* replaced, SpriteError* error = nullptr);
   // With gpu_low: the share of CDLOD nodes whose box centre lies in the keyframe's image.
   double nodeCoverage(std::span<const CdlodNode> nodes, const Keyframe& keyframe) const;
   // The keyframe rendered ahead from the viewpoint extrapolated `ahead` frames on, drawn in `chunks` slices.

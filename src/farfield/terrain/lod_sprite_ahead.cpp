@@ -201,13 +201,19 @@ void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double erro
   schedulePrediction(camera, float(chunks), size_t(chunks));
 }
 
-bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, SpriteError* error) {
+bool LodSpriteRenderer::coversView(Keyframe& keyframe, Keyframe* replaced) {
+  const double cover = coverage(keyframe);
+  return cover >= options_.reuse_coverage * keyframe.coverage_at_creation ||
+         (replaced && cover >= coverage(*replaced));
+}
+
+bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, Keyframe* replaced,
+                                  SpriteError* error) {
   // Only with some life left (error at most 3/4 of the threshold here, and magnification at most 3/4 of the way to
   // its bound), or it would trip again at once.
   const SpriteError e = frameError(keyframe.camera.eye, eye);
   if (error) *error = e;
-  return !dueAt(e, beta, 0.75) &&
-         coverage(keyframe) >= options_.reuse_coverage * keyframe.coverage_at_creation;
+  return !dueAt(e, beta, 0.75) && coversView(keyframe, replaced);
 }
 
 }  // namespace farfield::terrain
