@@ -354,7 +354,7 @@ TEST(LodSpriteGL, WhereHighFramesAreCheapTheSwitchWaitsForAKeyframeRenderedAhead
   EXPECT_GE(c.predicted_used, 2u);
 }
 
-// A trip that catches a keyframe rendered ahead with half of its slices drawn: the camera jumps ahead by eight frames
+// A trip that catches a keyframe rendered ahead with half of its slices drawn: the camera jumps ahead by twelve frames
 // at once, faster than the schedule saw. Returns the trip's frame (keyframe_due false: no trip), and the fresh
 // keyframes drawn before it and in all through `fresh_before` and `fresh_after`.
 LodSpriteFrameInfo tripAfterAJump(LateSlicedRun& late, size_t& fresh_before, size_t& fresh_after) {
@@ -366,7 +366,7 @@ LodSpriteFrameInfo tripAfterAJump(LateSlicedRun& late, size_t& fresh_before, siz
     x += 24.0f;
     const bool jump = run == 2;  // two slices of the four drawn
     if (jump) {
-      x += 8.0f * 24.0f;
+      x += 12.0f * 24.0f;
       fresh_before = late.sprite.counters().fresh_keyframes;
     }
     const LodSpriteFrameInfo info = flightFrame(late.sprite, frame, late.top, x);
@@ -410,6 +410,49 @@ TEST(LodSpriteGL, AtATripAKeyframeRenderedAheadThatCoversTheViewAsWellAsTheOldSp
   EXPECT_LE(info.error_px, late.options.epsilon);
   EXPECT_EQ(fresh_after, fresh_before);
   EXPECT_EQ(fresh_after, 1u) << "only the first keyframe drawn whole";
+}
+
+// predict_late with the magnification bound, approaching the terrain head-on: the magnification grows as the inverse
+// of the distance, faster every frame, so a rate measured since the sprite was taken saw trips one to three frames
+// before they came (the 16,385^2 flight's descent: the keyframe rendered ahead was then caught with slices left, or
+// ready for a viewpoint the camera had not reached and covering too little of the view, and a whole keyframe was
+// drawn). With the last frame's rate where it is faster, no frame after the first keyframe draws a whole keyframe.
+TEST(LodSpriteGL, KeyframesRenderedAheadKeepUpWithAMagnificationThatGrowsFasterEveryFrame) {
+  Scene scene(testFractal());
+  GpuLodTerrain gpu_lod(scene.hf, scene.texture, CdlodOptions{8, 16, 0.2f});
+  const TerrainCost cost = spritesPay();
+  LodSpriteOptions options = lateSlicedOptions(gpu_lod, cost);
+  options.max_magnification = 1.3;
+  options.predict_chunks = 16;  // as the paged flight: slices as many as the frames left before the trip allow
+  LodSpriteRenderer sprite(*scene.lod, *scene.renderer, 128, 128, options);
+  const Vec3 target(1280.0f, 1280.0f, scene.hf.sample(1280.0, 1280.0));
+  const Vec3 start(1280.0f, -1200.0f, scene.hf.maxHeight() + 900.0f);
+  gpu::RenderTarget frame(128, 128);
+  size_t first_fresh = 0, whole_after = 0;
+  for (int f = 0; f < 45; ++f) {
+    const Camera camera = makeCamera(start + (target - start) * (0.02f * float(f)), target);
+    frame.clear(kSky);
+    LodSpriteFrameInfo info;
+    sprite.render(camera, frame, &info);
+    if (std::getenv("FF_TERRAIN_DUMP"))
+      std::printf("frame %d %s error %.3f magnification %.3f ahead %lu slices %zu whole %lu\n", f,
+                  spriteSourceName(info.source), info.error_px, info.magnification,
+                  (unsigned long)info.ahead_triangles, info.ahead_slices, (unsigned long)info.keyframe_triangles);
+    if (info.keyframe_triangles > 0) {
+      if (first_fresh == 0) first_fresh = size_t(f);
+      else ++whole_after;
+    }
+    if (info.path == TerrainPath::Sprite) {
+      EXPECT_LE(info.magnification, options.max_magnification) << "frame " << f;
+    }
+  }
+  const LodSpriteCounters& c = sprite.counters();
+  std::printf("%zu fresh, %zu rendered ahead (%zu used, %zu finished at a trip, %zu dropped)\n", c.fresh_keyframes,
+              c.predicted_rendered, c.predicted_used, c.predicted_finished, c.predicted_discarded);
+  ASSERT_GT(first_fresh, 0u);
+  EXPECT_GE(c.predicted_used, 3u) << "the approach must take several keyframes for the test to mean much";
+  EXPECT_EQ(whole_after, 0u);
+  EXPECT_EQ(c.fresh_keyframes, 1u);
 }
 
 // LodSpriteOptions::max_magnification: approaching the terrain head-on, equation 2 alone lets the sprite be magnified

@@ -169,6 +169,8 @@ void LodSpriteRenderer::reset() {
   frame_ = 0;
   sprite_since_ = 0;
   sprite_error_at_take_ = 0.0;
+  last_progress_ = 0.0;
+  last_progress_frame_ = 0;
   last_lifetime_ = 10;
   pending_chunk_ = 0;
   pending_chunks_ = 1;
@@ -539,8 +541,12 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     return finish(high, info, out);
   }
   current_->last_used = frame_;
-  if (options_.predict && options_.predict_late && !due && !pending_)
-    scheduleLatePrediction(camera, progressPx(info.error_px, info.magnification), choose ? &model_costs_ : nullptr);
+  if (options_.predict && options_.predict_late && !due) {
+    const double progress = progressPx(info.error_px, info.magnification);
+    if (!pending_) scheduleLatePrediction(camera, progress, choose ? &model_costs_ : nullptr);
+    last_progress_ = progress;
+    last_progress_frame_ = frame_;
+  }
 
   // Section 5: the keyframe rendered ahead, one step per frame, from the frame after a switch on (the switch frame
   // may already have drawn a whole keyframe).

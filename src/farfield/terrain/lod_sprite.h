@@ -268,6 +268,9 @@ class LodSpriteRenderer {
   uint64_t frame_ = 0;
   uint64_t sprite_since_ = 0;    // frame the current sprite was taken into use
   double sprite_error_at_take_ = 0.0;  // its error then (pixels; 0 for a fresh one)
+  // predict_late: the current sprite's progress towards its trip (progressPx) in the last frame that drew it.
+  double last_progress_ = 0.0;
+  uint64_t last_progress_frame_ = 0;
   uint64_t last_lifetime_ = 10;  // frames the previous sprite lasted
   std::vector<std::unique_ptr<Keyframe>> kept_;  // the current sprite and (with a cache) earlier ones
   std::vector<std::unique_ptr<Keyframe>> spare_;

@@ -174,14 +174,19 @@ void LodSpriteRenderer::renderAheadOfSwitch(const Camera& camera, gpu::FrameStat
 }
 
 void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double error_px, const PathCosts* model) {
-  // The error grows roughly with the distance moved since the sprite was taken; at the rate seen since then it trips
-  // in `left` frames. The next keyframe is started once about 1.5 times the frames it is drawn in are left, or once
-  // the error has reached 3/4 of the threshold (an error that creeps near the threshold for a long time trips at a
-  // jump the rate does not see).
+  // The error grows roughly with the distance moved since the sprite was taken; at the rate seen since then, or at
+  // the last frame's where it grows faster (the magnification of a descent towards the ground grows as the inverse of
+  // the height: the rate since the take put trips one to three frames after they came), it trips in `left` frames. The
+  // next keyframe is started once about 1.5 times the frames it is drawn in are left, or once the error has reached
+  // 3/4 of the threshold (an error that creeps near the threshold for a long time trips at a jump the rate does not
+  // see).
   const double age = double(frame_ - sprite_since_);
   const double grown = error_px - sprite_error_at_take_;
   if (age < 2.0 || !(grown > 0.05 * options_.epsilon)) return;
-  const double left = (options_.epsilon - error_px) * age / grown;
+  double rate = grown / age;
+  if (last_progress_frame_ + 1 == frame_ && last_progress_frame_ >= sprite_since_)
+    rate = std::max(rate, error_px - last_progress_);
+  const double left = (options_.epsilon - error_px) / rate;
   // Slices of at most kSliceShare of a sprite frame each by the cost model (at most predict_chunks of them).
   double chunks = double(options_.predict_chunks);
   if (model && model->sprite_ms > 0.0) chunks = std::clamp(slicesFor(*model), 1.0, chunks);
