@@ -94,11 +94,12 @@ struct LodSpriteOptions {
   float predict_lead = 1.25f;
   // When the keyframe is rendered ahead: false = right after a sprite is taken into use, from a viewpoint
   // predict_lead lifetimes of the previous sprite ahead (the paper's suggestion); true = once the current sprite's
-  // error, growing with its age, says it will trip within about 1.5 times the frames it is drawn in, or has reached
-  // 3/4 of the threshold (with a cost model, slices of at most a third of a sprite frame's predicted cost, at most
-  // predict_chunks of them), from where the camera will be when it is ready (eye extrapolated linearly, the view
-  // direction turned at its recent angular rate), and taken as soon as it is ready where it has less error than the
-  // current sprite (dropped otherwise). A short extrapolation, right on curving paths; predict_lead is not used.
+  // error, growing at its rate since the take or the last frame's where faster, says it will trip within about 1.5
+  // times the frames it is drawn in, or has reached 3/4 of the threshold (with a cost model, slices of at most a third
+  // of a sprite frame's predicted cost, at most predict_chunks of them), from where the camera will be when it is
+  // ready (eye extrapolated linearly, the view direction turned at its recent angular rate), and taken as soon as it
+  // is ready where it has less error than the current sprite (dropped otherwise). A short extrapolation, right on
+  // curving paths; predict_lead is not used.
   bool predict_late = false;
   int cache_size = 1;       // keyframes kept (1 = only the current one, as in the paper)
   double reuse_coverage = 0.95;
