@@ -354,6 +354,27 @@ TEST(LodSpriteGL, WhereHighFramesAreCheapTheSwitchWaitsForAKeyframeRenderedAhead
   EXPECT_GE(c.predicted_used, 2u);
 }
 
+// predict_late: a frame that takes a keyframe rendered ahead measures that keyframe's error alone, not the current
+// sprite's too, where the keyframe has less error than the current sprite had in the frame before; every other sprite
+// frame measures the current sprite once.
+TEST(LodSpriteGL, AKeyframeRenderedAheadIsTakenWithOneMeasure) {
+  LateSlicedRun late(spritesPay());
+  gpu::RenderTarget frame(128, 128);
+  size_t early_takes = 0;
+  for (size_t f = 0; f < 90; ++f) {
+    const size_t before = late.sprite.errorCounters().measures;
+    const LodSpriteFrameInfo info = flightFrame(late.sprite, frame, late.top, 300.0f + 24.0f * float(f));
+    const size_t measures = late.sprite.errorCounters().measures - before;
+    if (info.path != TerrainPath::Sprite || info.source == SpriteSource::Fresh) continue;
+    EXPECT_EQ(measures, 1u) << "frame " << f << " " << spriteSourceName(info.source);
+    if (info.source == SpriteSource::Predicted && !info.keyframe_due) {
+      ++early_takes;
+      EXPECT_LT(info.error_px, info.trigger_error_px) << "frame " << f;
+    }
+  }
+  EXPECT_GE(early_takes, 2u);
+}
+
 // A trip that catches a keyframe rendered ahead with half of its slices drawn: the camera jumps ahead by twelve frames
 // at once, faster than the schedule saw. Returns the trip's frame (keyframe_due false: no trip), and the fresh
 // keyframes drawn before it and in all through `fresh_before` and `fresh_after`.

@@ -170,6 +170,7 @@ void LodSpriteRenderer::reset() {
   sprite_since_ = 0;
   sprite_error_at_take_ = 0.0;
   last_progress_ = 0.0;
+  last_error_px_ = 0.0;
   last_progress_frame_ = 0;
   last_lifetime_ = 10;
   pending_chunk_ = 0;
@@ -222,65 +223,6 @@ PathCosts LodSpriteRenderer::correctedCosts(const PathCosts& model) const {
 const Camera* LodSpriteRenderer::spriteCamera() const { return current_ ? &current_->camera : nullptr; }
 const gpu::RenderTarget* LodSpriteRenderer::spriteTarget() const { return current_ ? &current_->target : nullptr; }
 const image::DepthImage* LodSpriteRenderer::spriteDepth() const { return current_ ? &current_->depth : nullptr; }
-
-std::unique_ptr<LodSpriteRenderer::Keyframe> LodSpriteRenderer::takeKeyframe() {
-  if (!spare_.empty()) {
-    std::unique_ptr<Keyframe> k = std::move(spare_.back());
-    spare_.pop_back();
-    k->ready = false;
-    return k;
-  }
-  auto k = std::make_unique<Keyframe>();
-  const Camera size = keyframeCamera(Camera{});
-  k->target = gpu::RenderTarget(size.width, size.height);
-  return k;
-}
-
-Camera guardBandCamera(const Camera& camera, int width, int height, float margin) {
-  Camera frame = camera;
-  frame.width = width;
-  frame.height = height;
-  return frame.resized(width + 2 * int(std::lround(margin * float(width))),
-                       height + 2 * int(std::lround(margin * float(height))));
-}
-
-Camera LodSpriteRenderer::keyframeCamera(const Camera& camera) const {
-  return guardBandCamera(camera, width_, height_, options_.keyframe_margin);
-}
-
-void LodSpriteRenderer::keep(std::unique_ptr<Keyframe> keyframe) {
-  // Least recently used out first; the current sprite is never evicted here (it is about to be replaced by the new
-  // one, but it was used in the previous frame, so it is the most recent of the others).
-  while (!kept_.empty() && kept_.size() >= size_t(options_.cache_size)) {
-    auto oldest = std::min_element(kept_.begin(), kept_.end(),
-                                   [](const auto& a, const auto& b) { return a->last_used < b->last_used; });
-    if (oldest->get() == current_) current_ = nullptr;
-    spare_.push_back(std::move(*oldest));
-    kept_.erase(oldest);
-  }
-  kept_.push_back(std::move(keyframe));
-}
-
-LodSpriteRenderer::Keyframe* LodSpriteRenderer::renderKeyframe(const Camera& camera, gpu::FrameStats& stats,
-                                                              LodSpriteFrameInfo& info) {
-  std::unique_ptr<Keyframe> k = takeKeyframe();
-  k->frame_camera = camera;
-  k->camera = keyframeCamera(camera);
-  k->view_proj = k->camera.viewProjection();
-  // Figure 3, lines 1 and 5: the high-resolution mesh rendered into the sprite; then the z-buffer is kept.
-  k->target.clear(options_.sky_color);
-  const gpu::FrameStats key = drawHigh(k->camera, k->target, high_, 0);
-  gpu::addDraw(stats, key);
-  info.keyframe_triangles += key.triangles;
-  high_triangles_key_ = key.triangles;
-  high_latest_is_key_ = true;
-  if (!options_.gpu_low) k->depth = k->target.readDepth();  // gpu_low: tested against on the GPU
-  k->ready = true;
-  ++counters_.fresh_keyframes;
-  Keyframe* raw = k.get();
-  keep(std::move(k));
-  return raw;
-}
 
 double LodSpriteRenderer::progressPx(double error_px, double magnification) const {
   const double m = options_.max_magnification;
@@ -396,10 +338,36 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     return finish(renderHigh(camera, target, info), info, out);
   }
 
+  // predict_late: a keyframe rendered ahead is taken as soon as it is ready, where it has less error than the current
+  // sprite and covers the view, or covers it at least as well as the current sprite (which is in use anyway);
+  // otherwise it is stale (the camera went elsewhere than extrapolated) and dropped, so that a new one is made. Its
+  // error is measured first: where it is under the current sprite's of the last frame (an error that grows), it is
+  // taken without measuring the current sprite here, a measure saved in the frames that take one (two measures, one
+  // projecting every sampled cell, made them the paged flight's 95th percentile of own CPU time).
+  bool early = false;
+  double early_error = 0.0;  // the early-taken keyframe's error here (pixels)
+  SpriteError early_metric;
+  const bool ready_ahead = options_.predict_late && anchored_ && current_ && pending_ && pending_->ready;
+  int covers = -1;  // coversView(*pending_, current_), once asked
+  auto coversNow = [&] {
+    if (covers < 0) covers = coversView(*pending_, current_) ? 1 : 0;
+    return covers == 1;
+  };
+  if (ready_ahead) {
+    early_metric = frameError(pending_->camera.eye, camera.eye);
+    early_error = early_metric.pixels(beta);
+    const bool last_known = last_progress_frame_ + 1 == frame_ && last_progress_frame_ >= sprite_since_;
+    early = last_known && early_error < last_error_px_ && early_error < 0.75 * options_.epsilon && coversNow();
+    if (early) {
+      if (options_.gpu_low) info.quadrants = early_metric.quadrants;
+      info.trigger_error_px = last_error_px_;
+    }
+  }
+
   // Lines 3-5: error of the current sprite (or of the virtual keyframe the high LOD stands for); a new one when it
   // reaches the threshold.
   bool due = !anchored_;
-  if (anchored_) {
+  if (anchored_ && !early) {
     const SpriteError e = frameError(anchor_eye_, camera.eye);
     if (options_.gpu_low) info.quadrants = e.quadrants;
     info.trigger_error_px = info.error_px = e.pixels(beta);
@@ -424,16 +392,8 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     switch_now = sprite_pays && (!ahead_of_switch || (pending_ && pending_->ready));
   }
   info.switched = switch_now;
-  // predict_late: a keyframe rendered ahead is taken as soon as it is ready, where it has less error than the current
-  // sprite and covers the view, or covers it at least as well as the current sprite (which is in use anyway);
-  // otherwise it is stale (the camera went elsewhere than extrapolated) and dropped, so that a new one is made.
-  bool early = false;
-  double early_error = 0.0;  // the early-taken keyframe's error here (pixels)
-  SpriteError early_metric;
-  if (options_.predict_late && !due && current_ && pending_ && pending_->ready) {
-    early_metric = frameError(pending_->camera.eye, camera.eye);
-    early_error = early_metric.pixels(beta);
-    if (early_error < info.error_px && early_error < 0.75 * options_.epsilon) early = coversView(*pending_, current_);
+  if (ready_ahead && !early && !due) {
+    early = early_error < info.error_px && early_error < 0.75 * options_.epsilon && coversNow();
     if (!early) {
       ++counters_.predicted_discarded;
       spare_.push_back(std::move(pending_));
@@ -462,8 +422,11 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       ++counters_.predicted_finished;
     }
     if (pending_ && pending_->ready) {
-      SpriteError m = early_metric;
-      if (early || takesOver(*pending_, camera.eye, beta, current_, &m)) {
+      // Taken with some life left (error at most 3/4 of the threshold here, and magnification at most 3/4 of the way
+      // to its bound; it would trip again at once otherwise) where it covers the view. Its metric here was measured
+      // above where it was ready at the frame's start.
+      const SpriteError m = early || ready_ahead ? early_metric : frameError(pending_->camera.eye, camera.eye);
+      if (early || (!dueAt(m, beta, 0.75) && coversNow())) {
         chosen = pending_.get();
         chosen_metric = m;
         chosen_error = early ? early_error : m.pixels(beta);
@@ -545,6 +508,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
     const double progress = progressPx(info.error_px, info.magnification);
     if (!pending_) scheduleLatePrediction(camera, progress, choose ? &model_costs_ : nullptr);
     last_progress_ = progress;
+    last_error_px_ = info.error_px;
     last_progress_frame_ = frame_;
   }
 

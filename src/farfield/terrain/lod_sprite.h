@@ -149,7 +149,9 @@ struct LodSpriteFrameInfo {
   uint64_t frame = 0;  // the renderer's count of this frame (1, 2, ... from construction or reset): for measured()
   SpriteSource source = SpriteSource::Kept;
   double error_px = 0.0;          // error of the sprite used in this frame at this viewpoint (0 for a fresh one)
-  double trigger_error_px = 0.0;  // error of the previous sprite at this viewpoint (what the test saw)
+  // Error of the previous sprite at this viewpoint (what the test saw), or in the last frame where a keyframe rendered
+  // ahead was taken without measuring it here (predict_late).
+  double trigger_error_px = 0.0;
   double magnification = 1.0;     // the drawn sprite's mean magnification here (SpriteError::mean_magnification)
   uint64_t low_triangles = 0;
   uint64_t visible_triangles = 0;   // low-resolution triangles textured with the sprite
@@ -208,6 +210,8 @@ class LodSpriteRenderer {
   const CostCorrection& costCorrection() const { return correction_; }
 
   const LodSpriteCounters& counters() const { return counters_; }
+  // Equation 2's measures over the CDLOD cells (gpu_low) and what they reused.
+  const CdlodSpriteError::Counters& errorCounters() const { return error_sample_.counters(); }
   const LodSpriteOptions& options() const { return options_; }
   // The current sprite's camera and colour (tests, figures); null before the first frame.
   const Camera* spriteCamera() const;
@@ -233,9 +237,6 @@ class LodSpriteRenderer {
   // "Covers the view" (above): here its share is at least reuse_coverage times its share at creation, or at least the
   // share of `replaced` (the sprite it would replace, in use until now; null: none).
   bool coversView(Keyframe& keyframe, Keyframe* replaced);
-  // Whether a keyframe may become the sprite at viewpoint `eye` in place of `replaced`: its error there at most 3/4 of
-  // the threshold (some life left) and it covers the view; error: its metric there.
-  bool takesOver(Keyframe& keyframe, const Vec3& eye, double beta, Keyframe* replaced, SpriteError* error = nullptr);
   // With gpu_low: the share of CDLOD nodes whose box centre lies in the keyframe's image.
   double nodeCoverage(std::span<const CdlodNode> nodes, const Keyframe& keyframe) const;
   // The keyframe rendered ahead from the viewpoint extrapolated `ahead` frames on, drawn in `chunks` slices.
@@ -269,8 +270,10 @@ class LodSpriteRenderer {
   uint64_t frame_ = 0;
   uint64_t sprite_since_ = 0;    // frame the current sprite was taken into use
   double sprite_error_at_take_ = 0.0;  // its error then (pixels; 0 for a fresh one)
-  // predict_late: the current sprite's progress towards its trip (progressPx) in the last frame that drew it.
+  // predict_late: the current sprite's progress towards its trip (progressPx) and its error in the last frame that drew
+  // it.
   double last_progress_ = 0.0;
+  double last_error_px_ = 0.0;
   uint64_t last_progress_frame_ = 0;
   uint64_t last_lifetime_ = 10;  // frames the previous sprite lasted
   std::vector<std::unique_ptr<Keyframe>> kept_;  // the current sprite and (with a cache) earlier ones

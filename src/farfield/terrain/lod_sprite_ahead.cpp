@@ -212,13 +212,4 @@ bool LodSpriteRenderer::coversView(Keyframe& keyframe, Keyframe* replaced) {
          (replaced && cover >= coverage(*replaced));
 }
 
-bool LodSpriteRenderer::takesOver(Keyframe& keyframe, const Vec3& eye, double beta, Keyframe* replaced,
-                                  SpriteError* error) {
-  // Only with some life left (error at most 3/4 of the threshold here, and magnification at most 3/4 of the way to
-  // its bound), or it would trip again at once.
-  const SpriteError e = frameError(keyframe.camera.eye, eye);
-  if (error) *error = e;
-  return !dueAt(e, beta, 0.75) && coversView(keyframe, replaced);
-}
-
 }  // namespace farfield::terrain
