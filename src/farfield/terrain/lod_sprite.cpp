@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
@@ -348,16 +349,19 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   double early_error = 0.0;  // the early-taken keyframe's error here (pixels)
   SpriteError early_metric;
   const bool ready_ahead = options_.predict_late && anchored_ && current_ && pending_ && pending_->ready;
-  int covers = -1;  // coversView(*pending_, current_), once asked
+  std::optional<bool> covers;  // coversView(*pending_, current_), once asked
   auto coversNow = [&] {
-    if (covers < 0) covers = coversView(*pending_, current_) ? 1 : 0;
-    return covers == 1;
+    if (!covers) covers = coversView(*pending_, current_);
+    return *covers;
+  };
+  // Taken early where it has less error than `current_error` (the current sprite's) and some life left.
+  auto takenEarly = [&](double current_error) {
+    return early_error < current_error && early_error < 0.75 * options_.epsilon && coversNow();
   };
   if (ready_ahead) {
     early_metric = frameError(pending_->camera.eye, camera.eye);
     early_error = early_metric.pixels(beta);
-    const bool last_known = last_progress_frame_ + 1 == frame_ && last_progress_frame_ >= sprite_since_;
-    early = last_known && early_error < last_error_px_ && early_error < 0.75 * options_.epsilon && coversNow();
+    early = lastFrameDrewCurrentSprite() && takenEarly(last_error_px_);
     if (early) {
       if (options_.gpu_low) info.quadrants = early_metric.quadrants;
       info.trigger_error_px = last_error_px_;
@@ -393,7 +397,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
   }
   info.switched = switch_now;
   if (ready_ahead && !early && !due) {
-    early = early_error < info.error_px && early_error < 0.75 * options_.epsilon && coversNow();
+    early = takenEarly(info.error_px);
     if (!early) {
       ++counters_.predicted_discarded;
       spare_.push_back(std::move(pending_));
@@ -425,7 +429,7 @@ gpu::FrameStats LodSpriteRenderer::render(const Camera& camera, gpu::RenderTarge
       // Taken with some life left (error at most 3/4 of the threshold here, and magnification at most 3/4 of the way
       // to its bound; it would trip again at once otherwise) where it covers the view. Its metric here was measured
       // above where it was ready at the frame's start.
-      const SpriteError m = early || ready_ahead ? early_metric : frameError(pending_->camera.eye, camera.eye);
+      const SpriteError m = ready_ahead ? early_metric : frameError(pending_->camera.eye, camera.eye);
       if (early || (!dueAt(m, beta, 0.75) && coversNow())) {
         chosen = pending_.get();
         chosen_metric = m;

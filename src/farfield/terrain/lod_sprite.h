@@ -275,6 +275,10 @@ class LodSpriteRenderer {
   double last_progress_ = 0.0;
   double last_error_px_ = 0.0;
   uint64_t last_progress_frame_ = 0;
+  // Whether those are the current sprite's in the frame before this one.
+  bool lastFrameDrewCurrentSprite() const {
+    return last_progress_frame_ + 1 == frame_ && last_progress_frame_ >= sprite_since_;
+  }
   uint64_t last_lifetime_ = 10;  // frames the previous sprite lasted
   std::vector<std::unique_ptr<Keyframe>> kept_;  // the current sprite and (with a cache) earlier ones
   std::vector<std::unique_ptr<Keyframe>> spare_;

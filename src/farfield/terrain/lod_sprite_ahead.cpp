@@ -184,8 +184,7 @@ void LodSpriteRenderer::scheduleLatePrediction(const Camera& camera, double erro
   const double grown = error_px - sprite_error_at_take_;
   if (age < 2.0 || !(grown > 0.05 * options_.epsilon)) return;
   double rate = grown / age;
-  if (last_progress_frame_ + 1 == frame_ && last_progress_frame_ >= sprite_since_)
-    rate = std::max(rate, error_px - last_progress_);
+  if (lastFrameDrewCurrentSprite()) rate = std::max(rate, error_px - last_progress_);
   const double left = (options_.epsilon - error_px) / rate;
   // Slices of at most kSliceShare of a sprite frame each by the cost model (at most predict_chunks of them).
   double chunks = double(options_.predict_chunks);
