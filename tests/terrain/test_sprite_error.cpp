@@ -371,5 +371,39 @@ TEST(CdlodSpriteError, HeightsThatStoodInAreAskedForAgainWhenPagesCame) {
   EXPECT_EQ(asked, 0u) << "every height is the grid's own now";
 }
 
+// A node's sample is every k-th of its cells with k a power of two, so that the samples of one node nest: where the
+// nodes' shares halve (here: half the sample), every sampled cell is one held already and no height is asked for;
+// where they double, at most about half of the sampled cells are new. Each measure still equals a fresh one.
+TEST(CdlodSpriteError, ANodesSamplesNestAsItsShareChanges) {
+  const Heightfield hf = cdlodTestFractal(257, 5, 600.0);
+  const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
+  const Camera camera = acrossTheGrid(hf);
+  const CdlodSelection selection = lowSelection(lod, camera);
+  const Vec3 v1 = camera.eye + Vec3(-100.0f, 40.0f, 30.0f);
+  size_t asked = 0;
+  const GridHeightsFn heights = [&](std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) {
+    asked += points.size();
+    heightfieldHeights(hf)(points, out, own);
+  };
+  CdlodSpriteError kept;
+  auto measure = [&](size_t sample, const std::string& where) {
+    asked = 0;
+    const SpriteError e = kept.measure(lod, heights, 0, selection.nodes, v1, camera.eye, sample);
+    expectSameError(e, spriteError(lod, selection.nodes, v1, camera.eye, sample), where);
+    return e;
+  };
+  const SpriteError first = measure(1024, "a sample of 1,024");
+  ASSERT_GT(asked, 0u);
+  const SpriteError half = measure(512, "half the sample");
+  EXPECT_EQ(asked, 0u) << "every cell of the half sample was in the whole one";
+  EXPECT_LT(half.quadrants, first.quadrants);
+  measure(256, "a quarter");
+  EXPECT_EQ(asked, 0u);
+  const SpriteError twice = measure(2048, "twice the first sample");
+  EXPECT_GT(twice.quadrants, first.quadrants + first.quadrants / 2);
+  EXPECT_GT(asked, 0u);
+  EXPECT_LE(asked / 5, (twice.quadrants + twice.skipped) * 6 / 10) << "at most about half of its cells are new";
+}
+
 }  // namespace
 }  // namespace farfield::terrain

@@ -141,6 +141,16 @@ nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame>
   j["keyframes_rendered_ahead"] = c.predicted_rendered;
   j["keyframes_rendered_ahead_used"] = c.predicted_used;
   j["keyframes_finished_at_a_trip"] = c.predicted_finished;
+  // Equation 2's sample kept between measures (terrain/cdlod_sprite_error.h): per measure, the cells whose heights
+  // came from an earlier one, those asked of the terrain, and the C' made anew (machine-independent, as draw calls).
+  const terrain::CdlodSpriteError::Counters& e = renderer_->errorCounters();
+  const double measures = double(std::max<size_t>(e.measures, 1));
+  j["error_measures"] = e.measures;
+  j["error_cells_kept_per_measure"] = double(e.cells_kept) / measures;
+  j["error_cells_gathered_per_measure"] = double(e.cells_gathered) / measures;
+  j["error_projections_made_per_measure"] =
+      double(e.cells_kept + e.cells_gathered - std::min(e.projections_kept, e.cells_kept + e.cells_gathered)) /
+      measures;
   j["psnr_vs_cdlod_frames"] = compared;
   j["psnr_vs_cdlod_min_db"] = compared ? psnr_min : 0.0;
   j["psnr_vs_cdlod_mean_db"] = compared ? psnr_sum / double(compared) : 0.0;
@@ -160,7 +170,7 @@ nlohmann::ordered_json PagedSpriteRun::summary(std::span<const PagedSpriteFrame>
 }
 
 std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
-  char line[1024];
+  char line[2048];
   std::snprintf(line, sizeof line,
                 "\nLOD-sprite on the same paged terrain%s (epsilon %.2g px, sprite frames at %.2g px; the same frames, "
                 "timed apart, the pages read ahead outside both): %.2f ms mean, %.2f median, %.2f p99, %.2f max; "
@@ -168,7 +178,8 @@ std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
                 "**%.2fx the CDLOD frame's mean** (%.2f ms; median %.2fx); "
                 "%zu sprite frames, %zu high frames, %zu keyframes drawn at once, %zu rendered ahead (%zu used, "
                 "%zu finished at a trip); PSNR against the CDLOD frame %.1f dB mean, %.1f min over %zu frames; "
-                "cost model fitted in %.1f s; %zu pages read in its frames (%zu frames waited)\n",
+                "cost model fitted in %.1f s; %zu pages read in its frames (%zu frames waited); equation 2 measured %zu "
+                "times, a measure %.0f cells kept and %.0f gathered, %.0f C' made\n",
                 bool(j["predict"]) ? ", keyframes rendered ahead" : "", double(j["epsilon"]), double(j["low_error"]),
                 double(j["frame_ms_mean"]), double(j["frame_ms_median"]), double(j["frame_ms_p99"]),
                 double(j["frame_ms_max"]), size_t(j["frames_over_twice_the_median"]),
@@ -180,7 +191,9 @@ std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
                 size_t(j["keyframes_rendered_ahead_used"]), size_t(j["keyframes_finished_at_a_trip"]),
                 double(j["psnr_vs_cdlod_mean_db"]),
                 double(j["psnr_vs_cdlod_min_db"]), size_t(j["psnr_vs_cdlod_frames"]), double(j["calibration_seconds"]),
-                size_t(j["page_loads_waited_for"]), size_t(j["frames_that_waited_for_pages"]));
+                size_t(j["page_loads_waited_for"]), size_t(j["frames_that_waited_for_pages"]),
+                size_t(j["error_measures"]), double(j["error_cells_kept_per_measure"]),
+                double(j["error_cells_gathered_per_measure"]), double(j["error_projections_made_per_measure"]));
   return line;
 }
 

@@ -3,6 +3,7 @@
 #include "farfield/terrain/cdlod_sprite_error.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <iterator>
 
@@ -36,6 +37,23 @@ CdlodSpriteError::Sampling& CdlodSpriteError::sampling(Held& held, size_t first,
   return *slot;
 }
 
+const std::vector<uint32_t>& CdlodSpriteError::cellOrder(int patch_cells, int columns, int rows) {
+  for (const Order& o : orders_)
+    if (o.patch_cells == patch_cells && o.columns == columns && o.rows == rows) return o.cells;
+  Order& o = orders_.emplace_back(Order{patch_cells, columns, rows, {}});
+  o.cells.reserve(size_t(columns) * size_t(rows));
+  // Morton codes over the patch (a power of two a side), each cell inside the grid in code order: even bits x, odd y.
+  for (uint32_t code = 0; code < uint32_t(patch_cells) * uint32_t(patch_cells); ++code) {
+    uint32_t x = 0, y = 0;
+    for (int bit = 0; bit < 16; ++bit) {
+      x |= ((code >> (2 * bit)) & 1u) << bit;
+      y |= ((code >> (2 * bit + 1)) & 1u) << bit;
+    }
+    if (int(x) < columns && int(y) < rows) o.cells.push_back(x | (y << 16));
+  }
+  return o.cells;
+}
+
 void CdlodSpriteError::clear() {
   held_.clear();
   measure_ = 0;
@@ -56,6 +74,7 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     Held* held = nullptr;
     Sampling* sample = nullptr;
     size_t first = 0, k = 1;  // its sampled cells: first, first + k, ...
+    const std::vector<uint32_t>* order = nullptr;  // its cells in sample order (cellOrder)
   };
   std::vector<Stratum> strata;
   strata.reserve(nodes.size());
@@ -82,26 +101,35 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     }
     held.used = measure_;
     strata.push_back({&n, columns, rows, w * w, &held});
+    strata.back().order = &cellOrder(p, columns, rows);
     cells += count;
     total_weight += w * w;
   }
   // A cell's five grid points: its corners, then its centre.
   auto cellPoint = [&](const Stratum& st, size_t c, int corner) {
     const int s = lod.spacing(st.node->level);
-    const int cx = st.node->x * p * s + int(c % size_t(st.columns)) * s;
-    const int cy = st.node->y * p * s + int(c / size_t(st.columns)) * s;
+    const uint32_t ij = (*st.order)[c];
+    const int cx = st.node->x * p * s + int(ij & 0xFFFFu) * s;
+    const int cy = st.node->y * p * s + int(ij >> 16) * s;
     constexpr int dx[5] = {0, 2, 2, 0, 1}, dy[5] = {0, 0, 2, 2, 1};
     return IVec2(cx + dx[corner] * s / 2, cy + dy[corner] * s / 2);
   };
-  // The sample: per stratum every k-th cell (k odd, so that the sample moves across the columns), from an offset
-  // fixed by the node. The cells a node never had are asked for at once.
+  // The sample: per stratum every k-th cell in the patch's Morton order, from an offset fixed by the node, k a power
+  // of two: each such sample is a regular subgrid of the node's cells (every other column, then every other row
+  // too, ...), and the samples of a node nest, so that a node whose share halves keeps every cell it had, and one
+  // whose share doubles finds half of its cells held (odd strides over rows, which changed with every few per cent
+  // of a share, turned all of a node's sampled cells over: 10-30 nodes a measure on the 16,385^2 flight, where a share
+  // goes as d^-4 and the eye moves 465 m a frame). k is the largest power of two up to 1.75 times the stride that
+  // would take the node's share of the cells, so that it takes between 4/7 and 8/7 of its share: on the flight about
+  // the size of sample the odd strides took (890 cells a measure for 840, of 1,024 asked). The cells a node never had
+  // are asked for at once.
   for (Stratum& st : strata) {
     const CdlodNode& n = *st.node;
     const size_t count = st.held->count;
     if (max_quadrants > 0 && cells > max_quadrants) {
       const double share = total_weight > 0.0 ? st.weight / total_weight : 1.0 / double(strata.size());
-      const size_t taken = std::clamp<size_t>(size_t(std::lround(share * double(max_quadrants))), 1, count);
-      st.k = ((count + taken - 1) / taken) | 1;
+      const double taken = std::clamp(share * double(max_quadrants), 1.0, double(count));
+      st.k = std::bit_floor(std::min(count, std::max<size_t>(1, size_t(1.75 * double(count) / taken))));
     }
     uint32_t h = uint32_t(n.x) * 0x9E3779B1u ^ uint32_t(n.y) * 0x85EBCA77u ^ uint32_t(n.level) * 0xC2B2AE3Du;
     h ^= h >> 15;
