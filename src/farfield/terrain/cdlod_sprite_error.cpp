@@ -86,22 +86,25 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     const int columns = std::clamp((hf.width - 1 - n.x * p * s) / s, 0, p);
     const int rows = std::clamp((hf.height - 1 - n.y * p * s) / s, 0, p);
     if (columns == 0 || rows == 0) continue;
-    // A cell's theta grows with its central vertex's deviation (at most the node's error E(N)) and falls with the
-    // square of its distance from the eye.
-    const Box3 box = lod.nodeBox(n);
-    const Vec3 nearest = glm::clamp(v2, box.lo, box.hi);
-    const double d = std::max(double(glm::length(v2 - nearest)), 1.0);
-    const double w = double(lod.nodeError(n)) / (d * d);
-    // Its kept cells, looked up here, where the misses of one node overlap the arithmetic of the next.
+    // Its kept cells, with its box, error and cell order: the terrain's arrays of these are megabytes, a cache miss
+    // each after the rasterizer's threads ran, where the held node is one.
     Held& held = held_[Key{n.level, n.x, n.y}];
     const size_t count = size_t(columns) * size_t(rows);
-    if (held.count != count) {
+    if (held.count != count || !held.order) {
       held = Held{};
       held.count = count;
+      held.box = lod.nodeBox(n);
+      held.error = lod.nodeError(n);
+      held.order = &cellOrder(p, columns, rows);
     }
     held.used = measure_;
+    // A cell's theta grows with its central vertex's deviation (at most the node's error E(N)) and falls with the
+    // square of its distance from the eye.
+    const Vec3 nearest = glm::clamp(v2, held.box.lo, held.box.hi);
+    const double d = std::max(double(glm::length(v2 - nearest)), 1.0);
+    const double w = double(held.error) / (d * d);
     strata.push_back({&n, columns, rows, w * w, &held});
-    strata.back().order = &cellOrder(p, columns, rows);
+    strata.back().order = held.order;
     cells += count;
     total_weight += w * w;
   }

@@ -80,6 +80,9 @@ class CdlodSpriteError {
   struct Held {
     uint64_t used = 0;  // the last measure that sampled it
     size_t count = 0;   // its cells inside the grid
+    Box3 box;           // the terrain's nodeBox and nodeError
+    float error = 0.0f;
+    const std::vector<uint32_t>* order = nullptr;  // cellOrder of its shape
     DVec3 eye1{0.0};    // the v1 of the cells' c_prime
     uint32_t eye_generation = 0;
     Sampling samplings[kSamplings];
