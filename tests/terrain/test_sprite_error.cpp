@@ -336,38 +336,52 @@ TEST(CdlodSpriteError, AKeptSampleEqualsAFreshOneAlongAFlight) {
 // A height the terrain only stood in for (a paged terrain's overview, its page not held) is kept while the terrain's
 // heights version stays, and asked for again once it changed (a page came): the measure then equals a fresh one over
 // the grid's own heights; the heights that were the grid's own are never asked for again.
+// The kept sample's tests' scene: a fractal, its CDLOD tree, the view across it with its 4 px selection, and a
+// keyframe's viewpoint v1 near the eye.
+struct KeptSampleScene {
+  explicit KeptSampleScene(uint64_t seed)
+      : hf(cdlodTestFractal(257, seed, 600.0)),
+        lod(hf, CdlodOptions{16, 16, 0.2f}),
+        camera(acrossTheGrid(hf)),
+        selection(lowSelection(lod, camera)),
+        v1(camera.eye + Vec3(-100.0f, 40.0f, 30.0f)) {}
+  KeptSampleScene(const KeptSampleScene&) = delete;  // lod refers to hf
+  KeptSampleScene& operator=(const KeptSampleScene&) = delete;
+  const Heightfield hf;
+  const CdlodTerrain lod;
+  const Camera camera;
+  const CdlodSelection selection;
+  const Vec3 v1;
+};
+
 TEST(CdlodSpriteError, HeightsThatStoodInAreAskedForAgainWhenPagesCame) {
-  const Heightfield hf = cdlodTestFractal(257, 6, 600.0);
-  const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
-  const Camera camera = acrossTheGrid(hf);
-  const CdlodSelection selection = lowSelection(lod, camera);
-  const Vec3 v1 = camera.eye + Vec3(-100.0f, 40.0f, 30.0f);
+  const KeptSampleScene s(6);
   size_t asked = 0;
   auto heights = [&](bool east_held) {
-    return [&hf, &asked, east_held](std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) {
+    return [&s, &asked, east_held](std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) {
       asked += points.size();
       for (size_t k = 0; k < points.size(); ++k) {
-        const int i = std::clamp(points[k].x, 0, hf.width - 1), j = std::clamp(points[k].y, 0, hf.height - 1);
-        const bool held = east_held || i < hf.width / 2;
-        out[k] = hf.at(i, j) + (held ? 0.0f : 80.0f);  // a coarse stand-in, off by 80 m
+        const int i = std::clamp(points[k].x, 0, s.hf.width - 1), j = std::clamp(points[k].y, 0, s.hf.height - 1);
+        const bool held = east_held || i < s.hf.width / 2;
+        out[k] = s.hf.at(i, j) + (held ? 0.0f : 80.0f);  // a coarse stand-in, off by 80 m
         own[k] = held ? 1 : 0;
       }
     };
   };
   CdlodSpriteError kept;
-  const SpriteError stood_in = kept.measure(lod, heights(false), 1, selection.nodes, v1, camera.eye, 512);
+  const SpriteError stood_in = kept.measure(s.lod, heights(false), 1, s.selection.nodes, s.v1, s.camera.eye, 512);
   const size_t first = asked;
   asked = 0;
-  expectSameError(kept.measure(lod, heights(false), 1, selection.nodes, v1, camera.eye, 512), stood_in,
+  expectSameError(kept.measure(s.lod, heights(false), 1, s.selection.nodes, s.v1, s.camera.eye, 512), stood_in,
                   "the same version");
   EXPECT_EQ(asked, 0u) << "the stand-ins are kept while the version stays";
-  const SpriteError own = kept.measure(lod, heights(true), 2, selection.nodes, v1, camera.eye, 512);
-  expectSameError(own, spriteError(lod, selection.nodes, v1, camera.eye, 512), "after the pages came");
+  const SpriteError own = kept.measure(s.lod, heights(true), 2, s.selection.nodes, s.v1, s.camera.eye, 512);
+  expectSameError(own, spriteError(s.lod, s.selection.nodes, s.v1, s.camera.eye, 512), "after the pages came");
   EXPECT_NE(stood_in.mean_theta_sq, own.mean_theta_sq);
   EXPECT_GT(asked, 0u);
   EXPECT_LT(asked, first);
   asked = 0;
-  kept.measure(lod, heights(true), 3, selection.nodes, v1, camera.eye, 512);
+  kept.measure(s.lod, heights(true), 3, s.selection.nodes, s.v1, s.camera.eye, 512);
   EXPECT_EQ(asked, 0u) << "every height is the grid's own now";
 }
 
@@ -375,21 +389,17 @@ TEST(CdlodSpriteError, HeightsThatStoodInAreAskedForAgainWhenPagesCame) {
 // nodes' shares halve (here: half the sample), every sampled cell is one held already and no height is asked for;
 // where they double, at most about half of the sampled cells are new. Each measure still equals a fresh one.
 TEST(CdlodSpriteError, ANodesSamplesNestAsItsShareChanges) {
-  const Heightfield hf = cdlodTestFractal(257, 5, 600.0);
-  const CdlodTerrain lod(hf, CdlodOptions{16, 16, 0.2f});
-  const Camera camera = acrossTheGrid(hf);
-  const CdlodSelection selection = lowSelection(lod, camera);
-  const Vec3 v1 = camera.eye + Vec3(-100.0f, 40.0f, 30.0f);
+  const KeptSampleScene s(5);
   size_t asked = 0;
   const GridHeightsFn heights = [&](std::span<const IVec2> points, std::span<float> out, std::span<uint8_t> own) {
     asked += points.size();
-    heightfieldHeights(hf)(points, out, own);
+    heightfieldHeights(s.hf)(points, out, own);
   };
   CdlodSpriteError kept;
   auto measure = [&](size_t sample, const std::string& where) {
     asked = 0;
-    const SpriteError e = kept.measure(lod, heights, 0, selection.nodes, v1, camera.eye, sample);
-    expectSameError(e, spriteError(lod, selection.nodes, v1, camera.eye, sample), where);
+    const SpriteError e = kept.measure(s.lod, heights, 0, s.selection.nodes, s.v1, s.camera.eye, sample);
+    expectSameError(e, spriteError(s.lod, s.selection.nodes, s.v1, s.camera.eye, sample), where);
     return e;
   };
   const SpriteError first = measure(1024, "a sample of 1,024");

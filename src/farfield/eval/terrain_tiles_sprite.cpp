@@ -178,8 +178,8 @@ std::string PagedSpriteRun::markdown(const nlohmann::ordered_json& j) {
                 "**%.2fx the CDLOD frame's mean** (%.2f ms; median %.2fx); "
                 "%zu sprite frames, %zu high frames, %zu keyframes drawn at once, %zu rendered ahead (%zu used, "
                 "%zu finished at a trip); PSNR against the CDLOD frame %.1f dB mean, %.1f min over %zu frames; "
-                "cost model fitted in %.1f s; %zu pages read in its frames (%zu frames waited); equation 2 measured %zu "
-                "times, a measure %.0f cells kept and %.0f gathered, %.0f C' made\n",
+                "cost model fitted in %.1f s; %zu pages read in its frames (%zu frames waited); equation 2 measured "
+                "%zu times, a measure %.0f cells kept and %.0f gathered, %.0f C' made\n",
                 bool(j["predict"]) ? ", keyframes rendered ahead" : "", double(j["epsilon"]), double(j["low_error"]),
                 double(j["frame_ms_mean"]), double(j["frame_ms_median"]), double(j["frame_ms_p99"]),
                 double(j["frame_ms_max"]), size_t(j["frames_over_twice_the_median"]),
