@@ -22,14 +22,18 @@ CdlodSpriteError::Sampling& CdlodSpriteError::sampling(Held& held, size_t first,
     if (s.k == k && s.first == first) return s;
     if (s.used < slot->used) slot = &s;
   }
+  // Strides are powers of two (measure): a cell is in another sampling where its offset from that one's first is a
+  // multiple of its stride, a mask and a shift.
   std::vector<Cell> cells((held.count - std::min(first, held.count) + k - 1) / k);
-  for (size_t j = 0; j < cells.size(); ++j) {
-    const size_t c = first + j * k;
-    for (const Sampling& s : held.samplings)
-      if (s.k > 0 && c >= s.first && (c - s.first) % s.k == 0) {
-        cells[j] = s.cells[(c - s.first) / s.k];
-        break;
-      }
+  for (const Sampling& s : held.samplings) {
+    if (s.k == 0) continue;
+    const size_t mask = s.k - 1;
+    const int shift = std::countr_zero(s.k);
+    for (size_t j = 0; j < cells.size(); ++j) {
+      const size_t c = first + j * k;
+      if (cells[j].have == 0 && c >= s.first && ((c - s.first) & mask) == 0)
+        cells[j] = s.cells[(c - s.first) >> shift];
+    }
   }
   slot->first = first;
   slot->k = k;
@@ -56,6 +60,8 @@ const std::vector<uint32_t>& CdlodSpriteError::cellOrder(int patch_cells, int co
 
 void CdlodSpriteError::clear() {
   held_.clear();
+  recent_.clear();
+  recent_next_.clear();
   measure_ = 0;
 }
 
@@ -80,6 +86,8 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
   strata.reserve(nodes.size());
   size_t cells = 0;
   double total_weight = 0.0;
+  size_t cursor = 0;  // in recent_: the last measure's nodes, in the order a selection lists them
+  recent_next_.clear();  // (a measure that threw left some)
   for (const CdlodNode& n : nodes) {
     if (n.level < 1) continue;
     const int s = lod.spacing(n.level);
@@ -87,8 +95,21 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     const int rows = std::clamp((hf.height - 1 - n.y * p * s) / s, 0, p);
     if (columns == 0 || rows == 0) continue;
     // Its kept cells, with its box, error and cell order: the terrain's arrays of these are megabytes, a cache miss
-    // each after the rasterizer's threads ran, where the held node is one.
-    Held& held = held_[Key{n.level, n.x, n.y}];
+    // each after the rasterizer's threads ran, where the held node is one. A selection lists its nodes in the same
+    // order from frame to frame, and most of them were the last measure's: they are found by walking that measure's
+    // list beside this one (a few entries ahead, where nodes split or merged), the next ones asked of memory early;
+    // the others through the hash map (a miss for its bucket, then one for the node).
+    const Key key{n.level, n.x, n.y};
+    Held* found = nullptr;
+    for (size_t look = cursor; look < std::min(recent_.size(), cursor + 4); ++look)
+      if (recent_[look].key == key) {
+        found = recent_[look].held;
+        cursor = look + 1;
+        if (cursor + 2 < recent_.size()) __builtin_prefetch(recent_[cursor + 2].held);
+        break;
+      }
+    Held& held = found ? *found : held_[key];
+    recent_next_.push_back({key, &held});
     const size_t count = size_t(columns) * size_t(rows);
     if (held.count != count || !held.order) {
       held = Held{};
@@ -221,8 +242,9 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
   }
   e.mean_theta_sq = represented > 0.0 ? weighted / represented : 0.0;
   e.mean_magnification = represented > 0.0 ? weighted_stretch / represented : 1.0;
-  // Nodes that no recent measure sampled are forgotten (the held set follows the path).
+  // Nodes that no recent measure sampled are forgotten (the held set follows the path; this measure's are all kept).
   std::erase_if(held_, [this](const auto& entry) { return entry.second.used + kKeepMeasures < measure_; });
+  recent_.swap(recent_next_);
   return e;
 }
 

@@ -96,7 +96,12 @@ class CdlodSpriteError {
     std::vector<uint32_t> cells;
   };
   std::deque<Order> orders_;  // a deque: the strata point at its elements while more are made
-  std::unordered_map<Key, Held, KeyHash> held_;
+  std::unordered_map<Key, Held, KeyHash> held_;  // node-based: a Held stays where it is until erased
+  struct Recent {
+    Key key;
+    Held* held;
+  };
+  std::vector<Recent> recent_, recent_next_;  // the last measure's nodes in its order; this measure's
   uint64_t measure_ = 0;
   uint32_t eye_generations_ = 0;
   Counters counters_;
