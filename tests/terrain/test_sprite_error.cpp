@@ -333,9 +333,6 @@ TEST(CdlodSpriteError, AKeptSampleEqualsAFreshOneAlongAFlight) {
   }
 }
 
-// A height the terrain only stood in for (a paged terrain's overview, its page not held) is kept while the terrain's
-// heights version stays, and asked for again once it changed (a page came): the measure then equals a fresh one over
-// the grid's own heights; the heights that were the grid's own are never asked for again.
 // The kept sample's tests' scene: a fractal, its CDLOD tree, the view across it with its 4 px selection, and a
 // keyframe's viewpoint v1 near the eye.
 struct KeptSampleScene {
@@ -354,6 +351,9 @@ struct KeptSampleScene {
   const Vec3 v1;
 };
 
+// A height the terrain only stood in for (a paged terrain's overview, its page not held) is kept while the terrain's
+// heights version stays, and asked for again once it changed (a page came): the measure then equals a fresh one over
+// the grid's own heights; the heights that were the grid's own are never asked for again.
 TEST(CdlodSpriteError, HeightsThatStoodInAreAskedForAgainWhenPagesCame) {
   const KeptSampleScene s(6);
   size_t asked = 0;

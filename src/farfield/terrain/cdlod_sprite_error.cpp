@@ -80,7 +80,6 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     Held* held = nullptr;
     Sampling* sample = nullptr;
     size_t first = 0, k = 1;  // its sampled cells: first, first + k, ...
-    const std::vector<uint32_t>* order = nullptr;  // its cells in sample order (cellOrder)
   };
   std::vector<Stratum> strata;
   strata.reserve(nodes.size());
@@ -111,7 +110,7 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     Held& held = found ? *found : held_[key];
     recent_next_.push_back({key, &held});
     const size_t count = size_t(columns) * size_t(rows);
-    if (held.count != count || !held.order) {
+    if (held.count != count) {  // new to the held set (count 0), or its shape changed
       held = Held{};
       held.count = count;
       held.box = lod.nodeBox(n);
@@ -125,14 +124,13 @@ SpriteError CdlodSpriteError::measure(const CdlodTerrain& lod, const GridHeights
     const double d = std::max(double(glm::length(v2 - nearest)), 1.0);
     const double w = double(held.error) / (d * d);
     strata.push_back({&n, columns, rows, w * w, &held});
-    strata.back().order = held.order;
     cells += count;
     total_weight += w * w;
   }
   // A cell's five grid points: its corners, then its centre.
   auto cellPoint = [&](const Stratum& st, size_t c, int corner) {
     const int s = lod.spacing(st.node->level);
-    const uint32_t ij = (*st.order)[c];
+    const uint32_t ij = (*st.held->order)[c];
     const int cx = st.node->x * p * s + int(ij & 0xFFFFu) * s;
     const int cy = st.node->y * p * s + int(ij >> 16) * s;
     constexpr int dx[5] = {0, 2, 2, 0, 1}, dy[5] = {0, 0, 2, 2, 1};
