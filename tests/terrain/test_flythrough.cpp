@@ -1,7 +1,8 @@
 // The Figure-8-style flythrough: starts away and high, zooms in, stays above the ground, passes the plain and the
-// mountains the heightfield has (checked against heights sampled independently); and the texture's layout.
+// mountains the heightfield has (checked against heights sampled independently); and the texture's layout and rock share.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "farfield/core/error.h"
@@ -116,5 +117,33 @@ TEST(TerrainTexture, TheDirectPathGivesTheBilinearLookupsTexels) {
   EXPECT_EQ(differ, 0u);
 }
 
+
+// The rock share skips the arccosine outside its band; every share is still the arccosine's, at and around the band's
+// edges (where the shortcut would first go wrong) and over every normal.
+TEST(TerrainTexture, TheRockShareIsTheArccosinesAtEveryNormal) {
+  for (const float deg : {35.0f, 20.0f, 50.0f}) {
+    const float rock = float(degToRad(deg));
+    const RockShare share(rock);
+    auto reference = [&](float nz) {
+      return std::clamp((std::acos(std::clamp(nz, -1.0f, 1.0f)) - rock * 0.7f) / (rock * 0.6f), 0.0f, 1.0f);
+    };
+    size_t checked = 0, inside = 0;
+    auto check = [&](float nz) {
+      const float want = reference(nz);
+      ASSERT_EQ(share(nz), want) << "normal z " << nz << ", rock slope " << deg << " degrees";
+      ++checked;
+      inside += want > 0.0f && want < 1.0f ? 1 : 0;
+    };
+    for (int k = 0; k <= 200000; ++k) check(-1.0f + 2.0f * float(k) / 200000.0f);
+    // Every float within 2,000 ulps of each band edge.
+    for (const float edge : {std::cos(rock * 0.7f), std::cos(rock * 1.3f)}) {
+      float nz = edge;
+      for (int k = 0; k < 2000; ++k) nz = std::nextafter(nz, -2.0f);
+      for (int k = 0; k < 4000; ++k, nz = std::nextafter(nz, 2.0f)) check(nz);
+    }
+    EXPECT_GT(inside, 1000u);  // the band itself was sampled
+    EXPECT_GT(checked, 200000u);
+  }
+}
 }  // namespace
 }  // namespace farfield::terrain

@@ -36,6 +36,16 @@ float hashNoise(int i, int j) {
 
 }  // namespace
 
+RockShare::RockShare(float rock_slope_rad)
+    : rock_(rock_slope_rad),
+      flat_z_(std::cos(rock_slope_rad * 0.7f) + 1e-4f),
+      steep_z_(std::cos(rock_slope_rad * 1.3f) - 1e-4f) {}
+
+float RockShare::inBand(float nz) const {
+  const float slope = std::acos(std::clamp(nz, -1.0f, 1.0f));
+  return std::clamp((slope - rock_ * 0.7f) / (rock_ * 0.6f), 0.0f, 1.0f);
+}
+
 image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& o) {
   if (hf.width < 2 || hf.height < 2) throw Error(hf.source, "heightfield too small for a texture");
   if (o.scale < 1 || o.scale > 4) throw Error("texture scale", "must be 1..4");
@@ -48,21 +58,22 @@ image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& o)
   const Vec3 to_light = -glm::normalize(o.light_direction);
   const float rock = float(degToRad(o.rock_slope_deg));
   const double dx = 0.5 * hf.cell_x, dy = 0.5 * hf.cell_y;
+  const RockShare rock_share(rock);
+  // lround of a channel in [0, 1] x 255 (a tenth of a texel's cost through libm): x + 0.5 is exact in double for a
+  // float x, and truncation is floor there.
+  auto byte = [](float x) { return uint8_t(int(double(x * 255) + 0.5)); };
   // The texel's colour from its height and the slopes of the bilinear surface there (central differences of half
   // a cell).
   auto shade = [&](int tx, int ty, float z, float zx, float zy) {
     const Vec3 n = glm::normalize(Vec3(-zx, -zy, 1.0f));
-    const float slope = std::acos(std::clamp(n.z, -1.0f, 1.0f));
     Vec3 c = elevationColor((z - lo) / span +
                             0.04f * (hashNoise(o.origin.x * o.scale + tx * o.step, o.origin.y * o.scale + ty * o.step) -
                                      0.5f));
-    const float r = std::clamp((slope - rock * 0.7f) / (rock * 0.6f), 0.0f, 1.0f);
-    c = glm::mix(c, Vec3(0.47f, 0.44f, 0.42f), r);
+    c = glm::mix(c, Vec3(0.47f, 0.44f, 0.42f), rock_share(n.z));
     const float light = o.ambient + (1.0f - o.ambient) * std::max(glm::dot(n, to_light), 0.0f);
     c *= light * 1.15f;
     c = glm::clamp(c, Vec3(0.0f), Vec3(1.0f));
-    tex.at(tx, ty) = image::Rgba8(uint8_t(std::lround(c.r * 255)), uint8_t(std::lround(c.g * 255)),
-                                  uint8_t(std::lround(c.b * 255)), 255);
+    tex.at(tx, ty) = image::Rgba8(byte(c.r), byte(c.g), byte(c.b), 255);
   };
   if (o.scale == 1 && !o.bilinear_lookups) {
     // Texel centres on grid points: the surface half a cell away is the mean of two neighbours (the point itself

@@ -1,0 +1,43 @@
+// The terrain's original texture (terrain_texture.h) per page: what a paged terrain's loading thread spends most of
+// a page on (a 1,027^2-point part with its margin, about 60 % of the 90 ms a page took on the 16,385^2 flight,
+// `perf` of `farfield terrain tiles --render --lod-sprite`), and what a frame waits for where a page is read at
+// once. Fractal parts of the relief a 1,025-point tile of the 16,385^2 terrain has (400 m) and of a steep one
+// (1,500 m: most slopes past the rock threshold). Counter: texels per second.
+#include <benchmark/benchmark.h>
+
+#include "farfield/terrain/fractal.h"
+#include "farfield/terrain/terrain_texture.h"
+
+namespace {
+
+using namespace farfield;
+
+const terrain::Heightfield& part(double relief) {
+  static terrain::Heightfield gentle, steep;
+  terrain::Heightfield& hf = relief < 1000.0 ? gentle : steep;
+  if (hf.width == 0) {
+    terrain::FractalOptions f;
+    f.size = 1025;
+    f.seed = 7;
+    f.cell_size = 30.0;
+    f.relief = relief;
+    f.roughness = 0.6;
+    hf = terrain::fractalTerrain(f);
+  }
+  return hf;
+}
+
+void BM_TerrainTexture(benchmark::State& state) {
+  const terrain::Heightfield& hf = part(double(state.range(0)));
+  terrain::TextureOptions o;
+  o.ramp_lo = 0.0f;
+  o.ramp_hi = 3000.0f;
+  for (auto _ : state) benchmark::DoNotOptimize(terrain::terrainTexture(hf, o));
+  state.counters["texels/s"] =
+      benchmark::Counter(double(hf.width) * double(hf.height) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_TerrainTexture)->Arg(400)->Arg(1500)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
