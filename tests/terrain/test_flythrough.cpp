@@ -1,5 +1,6 @@
 // The Figure-8-style flythrough: starts away and high, zooms in, stays above the ground, passes the plain and the
-// mountains the heightfield has (checked against heights sampled independently); and the texture's layout and rock share.
+// mountains the heightfield has (checked against heights sampled independently); and the texture's layout
+// and rock share.
 #include <gtest/gtest.h>
 
 #include <algorithm>
