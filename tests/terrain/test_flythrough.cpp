@@ -145,6 +145,13 @@ TEST(TerrainTexture, TheRockShareIsTheArccosinesAtEveryNormal) {
     EXPECT_GT(inside, 1000u);  // the band itself was sampled
     EXPECT_GT(checked, 200000u);
   }
+  // A rock slope out of range is refused, not shaded by a band that means nothing.
+  Heightfield hf(4, 4, 10.0);
+  for (const float deg : {0.0f, -5.0f, 95.0f}) {
+    TextureOptions o;
+    o.rock_slope_deg = deg;
+    EXPECT_THROW(terrainTexture(hf, o), Error) << deg;
+  }
 }
 }  // namespace
 }  // namespace farfield::terrain

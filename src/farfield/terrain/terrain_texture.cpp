@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "farfield/core/error.h"
 #include "farfield/image/png_io.h"
@@ -50,6 +51,8 @@ image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& o)
   if (hf.width < 2 || hf.height < 2) throw Error(hf.source, "heightfield too small for a texture");
   if (o.scale < 1 || o.scale > 4) throw Error("texture scale", "must be 1..4");
   if (o.step < 1) throw Error("texture step", "must be 1 or more");
+  if (!(o.rock_slope_deg > 0.0f && o.rock_slope_deg <= 90.0f))
+    throw Error("texture rock slope", "must be in (0, 90] degrees, got " + std::to_string(o.rock_slope_deg));
   const int tw = hf.width * o.scale, th = hf.height * o.scale;
   image::ColorImage tex(tw, th);
   const bool own_range = !(o.ramp_lo < o.ramp_hi);

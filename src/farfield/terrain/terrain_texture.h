@@ -20,7 +20,7 @@ struct TextureOptions {
   int scale = 1;                              // texels per grid cell along each axis (1..4)
   Vec3 light_direction{-0.5f, 0.6f, -0.62f};  // direction the light travels (from the north-west, down)
   float ambient = 0.45f;
-  float rock_slope_deg = 35.0f;  // slopes steeper than this turn to rock
+  float rock_slope_deg = 35.0f;  // slopes steeper than this turn to rock: (0, 90]
   // A part of a larger terrain (a paged tile, paged_terrain.h): the heights the elevation ramp spans (ramp_lo >=
   // ramp_hi: the heightfield's own range), and the larger grid's point at the heightfield's (0, 0) and the step
   // between its points, which place the per-texel variation. With the larger terrain's range, step 1 and scale 1,
@@ -42,7 +42,7 @@ image::ColorImage terrainTexture(const Heightfield& hf, const TextureOptions& op
 // slope, where acos's float error is 1e-7), so every share is the arccosine's.
 class RockShare {
  public:
-  explicit RockShare(float rock_slope_rad);
+  explicit RockShare(float rock_slope_rad);  // rock_slope_rad > 0 (terrainTexture checks its option)
   float operator()(float normal_z) const {
     if (normal_z >= flat_z_) return 0.0f;
     if (normal_z <= steep_z_) return 1.0f;
