@@ -386,6 +386,9 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
     for (const FrameRow& r : rows) own.push_back(r.own_ms);
     const nlohmann::ordered_json own_cpu = ownCpuSummary(own);
     const double own_median = own_cpu["median"], own_p95 = own_cpu["p95"];
+    // What a page costs its thread (read, texels, mips), over every page made by either thread.
+    const size_t pages_made = cs.page_loads + cs.prefetched;
+    const double page_ms = pages_made > 0 ? 1000.0 * cs.load_seconds / double(pages_made) : 0.0;
     j["render"] = {{"lod", "cdlod"},
                    {"frame_ms_mean", fsum / double(fms.size())},
                    {"frame_ms_median", fms[fms.size() / 2]},
@@ -405,21 +408,22 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                    {"prefetch_hits", cs.prefetch_hits},
                    {"page_evictions", cs.evictions},
                    {"page_seconds", cs.load_seconds},
+                   {"page_ms_mean", page_ms},
                    {"gpu_bytes", cdlod->gpuBytes()},
                    {"prefetch_frames", o.prefetch_frames}};
-    char line[640];
+    char line[704];
     std::snprintf(line, sizeof line,
                   "\ndrawn by the CDLOD terrain paged from the cache: frame %.2f ms mean, %.2f median, %.2f p99, "
                   "%.2f max (selection, pages waited for, draw, to the GPU's end); %zu frames over twice the "
                   "median; Farfield's own CPU time %.3f ms median, %.3f p95; %.0f triangles mean, %zu max; pages: %d "
                   "layers (%.0f MiB), %zu held at most, %zu read "
-                  "in frames, %zu read ahead %d frames (%zu used), %zu evictions, %.1f s reading; node data and "
+                  "in frames, %zu read ahead %d frames (%zu used), %zu evictions, %.1f s reading (%.0f ms a page); node data and "
                   "overview made in %.1f s\n",
                   fsum / double(fms.size()), fms[fms.size() / 2], double(j["render"]["frame_ms_p99"]), fms.back(),
                   over_twice, own_median, own_p95, double(drawn_sum) / double(rows.size()), drawn_max,
                   cdlod->pageLayers(),
                   mib(cdlod->gpuBytes()), cs.peak_pages, in_frames, cs.prefetched, o.prefetch_frames,
-                  cs.prefetch_hits, cs.evictions, cs.load_seconds, cdlod_prepare_seconds);
+                  cs.prefetch_hits, cs.evictions, cs.load_seconds, page_ms, cdlod_prepare_seconds);
     render_md = line;
     if (sprite_run) {
       j["render"]["lod_sprite"] = sprite_run->summary(sprite_frames, cdlod_ms, own);
