@@ -417,8 +417,8 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
                   "%.2f max (selection, pages waited for, draw, to the GPU's end); %zu frames over twice the "
                   "median; Farfield's own CPU time %.3f ms median, %.3f p95; %.0f triangles mean, %zu max; pages: %d "
                   "layers (%.0f MiB), %zu held at most, %zu read "
-                  "in frames, %zu read ahead %d frames (%zu used), %zu evictions, %.1f s reading (%.0f ms a page); node data and "
-                  "overview made in %.1f s\n",
+                  "in frames, %zu read ahead %d frames (%zu used), %zu evictions, %.1f s reading (%.0f ms a page); "
+                  "node data and overview made in %.1f s\n",
                   fsum / double(fms.size()), fms[fms.size() / 2], double(j["render"]["frame_ms_p99"]), fms.back(),
                   over_twice, own_median, own_p95, double(drawn_sum) / double(rows.size()), drawn_max,
                   cdlod->pageLayers(),
