@@ -485,7 +485,9 @@ TerrainTilesResult runTerrainTiles(const TerrainTilesOptions& o) {
         "| triangles mean / max | LOD build ms mean / median (loads included) | checked frames, mismatches |\n"
         "|---|---|---:|---:|---:|---:|---:|---:|\n";
   char line[1024];
-  std::snprintf(line, sizeof line, "| %s | %dx%d of %d cells | %.0f | %.1f (%.1f) | %zu / %zu / %zu | %.0f / %zu | %.1f / %.1f | %zu, %zu |\n",
+  std::snprintf(line, sizeof line,
+                "| %s | %dx%d of %d cells | %.0f | %.1f (%.1f) | %zu / %zu / %zu | %.0f / %zu | %.1f / %.1f | %zu, %zu "
+                "|\n",
                 source.c_str(), cache.layout().tilesX(), cache.layout().tilesY(),
                 o.block * o.tile_blocks, o.budget_mb, mib(st.peak_resident_bytes), mib(full_bytes), st.loads,
                 st.evictions, st.hits, mean_tri, max_tri, sum_ms / double(rows.size()), ms[ms.size() / 2],
