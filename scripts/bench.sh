@@ -7,6 +7,9 @@ OUT=${2:-out/bench}
 mkdir -p "$OUT"
 echo "== renderer throughput (bench_renderer)"
 "$BIN/bench_renderer" --benchmark_min_time=1 --benchmark_out="$OUT/bench_renderer.json" --benchmark_out_format=json
+echo "== a paged terrain's page texels (bench_terrain_texture)"
+"$BIN/bench_terrain_texture" --benchmark_min_time=1 --benchmark_out="$OUT/bench_terrain_texture.json" \
+  --benchmark_out_format=json
 echo "== procedural cities, full vs culled"
 # shellcheck disable=SC2086
 bash "$(dirname "$0")/bench_cities.sh" "$BIN/farfield" "$OUT/cities" ${FF_BENCH_CITIES:-100 1000}
