@@ -5,6 +5,8 @@
 // (1,500 m: most slopes past the rock threshold). Counter: texels per second.
 #include <benchmark/benchmark.h>
 
+#include <map>
+
 #include "farfield/terrain/fractal.h"
 #include "farfield/terrain/terrain_texture.h"
 
@@ -12,23 +14,24 @@ namespace {
 
 using namespace farfield;
 
-const terrain::Heightfield& part(double relief) {
-  static terrain::Heightfield gentle, steep;
-  terrain::Heightfield& hf = relief < 1000.0 ? gentle : steep;
-  if (hf.width == 0) {
+// One fractal part per relief (metres), made once.
+const terrain::Heightfield& part(int relief) {
+  static std::map<int, terrain::Heightfield> parts;
+  auto [it, made] = parts.try_emplace(relief);
+  if (made) {
     terrain::FractalOptions f;
     f.size = 1025;
     f.seed = 7;
     f.cell_size = 30.0;
-    f.relief = relief;
+    f.relief = double(relief);
     f.roughness = 0.6;
-    hf = terrain::fractalTerrain(f);
+    it->second = terrain::fractalTerrain(f);
   }
-  return hf;
+  return it->second;
 }
 
 void BM_TerrainTexture(benchmark::State& state) {
-  const terrain::Heightfield& hf = part(double(state.range(0)));
+  const terrain::Heightfield& hf = part(int(state.range(0)));
   terrain::TextureOptions o;
   o.ramp_lo = 0.0f;
   o.ramp_hi = 3000.0f;
