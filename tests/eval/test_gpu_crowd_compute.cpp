@@ -1,6 +1,7 @@
 // The GPU crowd's compute passes (gpu/gpu_crowd.h; issue 45) against CPU brute force on generated crowds: every
 // agent's pose and phase against gen::agentPose, the culled, classified lists and the geometry budget against the
 // same rules evaluated on the CPU for random cameras, and bad input. Needs a GL context (llvmpipe is enough).
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include "farfield/eval/gpu_crowd_input.h"
 #include "farfield/gen/street_network.h"
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/gl_barrier_check.h"
 #include "farfield/gpu/gl_counters.h"
 
 namespace farfield::eval {
@@ -250,6 +252,47 @@ TEST(GpuCrowdGL, TheGeometryBudgetKeepsTheNearestAgentsAsGeometry) {
                 (unsigned long long)budget, (unsigned long long)kept, (unsigned long long)cpu_kept, over);
   }
   EXPECT_GE(tried, 2u) << "the test needs views where the budget binds";
+}
+
+// Every pass's writes are followed by the barrier their readers need (gpu/gl_barrier_check.h): the classification's
+// storage reads of the simulation, the draws' indirect commands, the next frame's reset copy and clear, the late
+// readback of the commands and the counts read after a frame; under a budget, with levels of detail and shadow
+// casters, frame after frame. (llvmpipe finishes all work at any barrier: a missing bit changes nothing here.)
+TEST(GpuCrowdGL, EveryPassWriteIsFollowedByTheBarrierItsReadersNeed) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  if (!gpu::installGlCounters() || !gpu::setGlBarrierCheck(true))
+    GTEST_SKIP() << "GL counters unavailable (FF_GL_COUNTERS=0 or no EGL context)";
+  glMemoryBarrier(GL_ALL_BARRIER_BITS);
+  gpu::clearGlBarrierHazards();
+  const gen::Crowd crowd = testCrowd(3000, false);
+  const std::vector<gpu::GpuCrowdModel> models = testModels();
+  gpu::GpuCrowd gc(gpuCrowdRoutes(crowd), gpuCrowdAgents(crowd), models);  // compiled with the check on
+  gc.setGeometryBudget(12000);
+  gc.setLevelScale(0.002f);
+  const std::vector<float> switches{45.0f, 35.0f};
+  gc.simulate(0.0f);
+  const std::vector<Vec4> start = gc.readPoses();
+  size_t listed = 0;
+  for (uint64_t frame = 0; frame < 4; ++frame) {
+    const Vec4 p = start[frame * 700];
+    const Vec3 eye = Vec3(p) + Vec3(0.0f, 0.0f, 1.7f + 10.0f * float(frame % 2));
+    const Camera c = crowdCamera(eye, eye + Vec3(std::cos(p.w), std::sin(p.w), -0.2f));
+    gc.simulate(0.5f * float(frame));
+    gc.castShadows(c, switches, c.viewProjection(), 120.0f, 60.0f, Vec3(0.3f, 0.2f, 1.0f));
+    gc.cullAndClassify(c, switches);
+    gc.captureCommands(frame);
+    const gpu::GpuCrowd::Counts counts = gc.readCounts();
+    listed += counts.in_view;
+  }
+  glFinish();
+  size_t captured = 0;
+  gc.finishedCommands([&](uint64_t, std::span<const gpu::GpuCrowdCommand> commands) { captured += !commands.empty(); });
+  EXPECT_GT(listed, 0u);
+  EXPECT_GT(captured, 0u);
+  EXPECT_GE(gpu::glBarrierCheckCounts().checked, 4u * 5u);
+  EXPECT_EQ(gpu::glBarrierCheckCounts().unknown_program, 0u);
+  for (const gpu::GlBarrierHazard& h : gpu::glBarrierHazards())
+    ADD_FAILURE() << h.message << " (" << h.count << " calls)";
 }
 
 TEST(GpuCrowdGL, BadInputIsAnError) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "farfield/core/error.h"
+#include "farfield/gpu/gl_barrier_check.h"
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
 #include "gpu/gpu_fixture.h"
@@ -385,6 +386,37 @@ TEST_F(GpuCullerTest, AFrameWaitsForNothingAndDrawsOncePerMaterialGroupAndPhase)
     target_.readIds();  // the test's own readback is not the frame's
   }
   EXPECT_EQ((glCounters() - glCounters()).syncs, 0u);
+}
+
+// Every write of the culling stages is followed by the barrier its readers need (gpu/gl_barrier_check.h): the next
+// stages' storage reads, the indirect dispatches and draws, the clears of the next phase and frame, and the late
+// readback of the statistics; with each option that changes the frame's stages. (llvmpipe finishes all work at any
+// barrier, so a missing bit changes no frame here; the check follows the calls instead.)
+TEST_F(GpuCullerTest, EveryStageWriteIsFollowedByTheBarrierItsReadersNeed) {
+  if (!installGlCounters() || !setGlBarrierCheck(true))
+    GTEST_SKIP() << "GL counters unavailable (FF_GL_COUNTERS=0 or no EGL context)";
+  for (const bool occlusion : {true, false})
+    for (const bool compact : {true, false})
+      for (const bool history : {true, false}) {
+        SCOPED_TRACE(std::string(occlusion ? "occlusion" : "no occlusion") + (compact ? ", compact" : ", every slot") +
+                     (history ? ", history" : ""));
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+        clearGlBarrierHazards();
+        GpuCullOptions options;
+        options.occlusion = occlusion;
+        options.compact = compact;
+        options.refine_history = history;
+        GpuCuller culler(*arena_, options);  // its programs compiled with the check on: known to it
+        for (const Camera& camera : walk(4, 5)) culled(culler, camera, RenderMode::Shaded);
+        culler.setOcclusion(!occlusion);
+        culled(culler, walk(4, 5).back(), RenderMode::ItemBuffer);
+        glFinish();
+        EXPECT_FALSE(culler.finishedStats().empty());
+        const GlBarrierCheckCounts counts = glBarrierCheckCounts();
+        EXPECT_GE(counts.checked, 5u * 4u);  // dispatches and draws of five frames
+        EXPECT_EQ(counts.unknown_program, 0u);
+        for (const GlBarrierHazard& h : glBarrierHazards()) ADD_FAILURE() << h.message << " (" << h.count << " calls)";
+      }
 }
 
 // With stage times, the frames are the same, and each frame's GPU time comes back split into its stages: the

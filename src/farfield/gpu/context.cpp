@@ -18,6 +18,7 @@
 #endif
 
 #include "farfield/core/error.h"
+#include "farfield/gpu/gl_barrier_check.h"
 #include "farfield/core/log.h"
 
 namespace farfield::gpu {
@@ -230,6 +231,7 @@ std::unique_ptr<Context> tryEglDisplay(EGLDisplay display, const std::string& pl
     eglDestroyContext(display, context);
     return nullptr;
   }
+  enableGlBarrierCheckFromEnvironment();  // FF_GL_BARRIER_CHECK (gl_barrier_check.h)
   return std::make_unique<EglContext>(display, context, platform, info);
 }
 

@@ -16,6 +16,8 @@
 #include <tuple>
 #include <type_traits>
 
+#include "farfield/gpu/gl_barrier_check_hooks.h"
+
 namespace farfield::gpu {
 
 GlCounters& GlCounters::operator-=(const GlCounters& o) {
@@ -78,6 +80,65 @@ enum class Kind {
 PFNGLGETINTEGERVPROC g_get_integer = nullptr;
 PFNGLGETQUERYOBJECTIVPROC g_get_query_iv = nullptr;
 
+// The barrier check's view of an entry point (gl_barrier_check.h): none, unless specialised below.
+template <auto Slot>
+struct BarrierCheck {
+  static constexpr bool active = false;
+};
+#define FF_BARRIER_CHECK(fn, ...)                 \
+  template <>                                     \
+  struct BarrierCheck<&epoxy_##fn> {              \
+    static constexpr bool active = true;          \
+    template <class... A>                         \
+    static void check([[maybe_unused]] A... a) {  \
+      namespace bc = barrier_check;               \
+      __VA_ARGS__;                                \
+    }                                             \
+  };
+// (The arguments by position: std::get<N>(std::tie(a...)).)
+#define FF_ARG(n) std::get<n>(std::tie(a...))
+FF_BARRIER_CHECK(glShaderSource, bc::shaderSource(FF_ARG(0), FF_ARG(1), FF_ARG(2), FF_ARG(3)))
+FF_BARRIER_CHECK(glAttachShader, bc::attachShader(FF_ARG(0), FF_ARG(1)))
+FF_BARRIER_CHECK(glDeleteProgram, bc::deleteProgram(FF_ARG(0)))
+FF_BARRIER_CHECK(glUseProgram, bc::useProgram(FF_ARG(0)))
+FF_BARRIER_CHECK(glBindBufferBase, bc::bindBufferBase(FF_ARG(0), FF_ARG(1), FF_ARG(2)))
+FF_BARRIER_CHECK(glBindBufferRange, bc::bindBufferBase(FF_ARG(0), FF_ARG(1), FF_ARG(2)))
+FF_BARRIER_CHECK(glBindBuffer, bc::bindBuffer(FF_ARG(0), FF_ARG(1)))
+FF_BARRIER_CHECK(glBindTextureUnit, bc::bindTextureUnit(FF_ARG(0), FF_ARG(1)))
+FF_BARRIER_CHECK(glBindImageTexture, bc::bindImageTexture(FF_ARG(0), FF_ARG(1)))
+FF_BARRIER_CHECK(glDeleteBuffers, bc::deleteBuffers(FF_ARG(0), FF_ARG(1)))
+FF_BARRIER_CHECK(glDeleteTextures, bc::deleteTextures(FF_ARG(0), FF_ARG(1)))
+FF_BARRIER_CHECK(glMemoryBarrier, bc::memoryBarrier(FF_ARG(0)))
+FF_BARRIER_CHECK(glDispatchCompute, bc::dispatch("glDispatchCompute", false))
+FF_BARRIER_CHECK(glDispatchComputeIndirect, bc::dispatch("glDispatchComputeIndirect", true))
+FF_BARRIER_CHECK(glDrawArrays, bc::draw("glDrawArrays", false, false))
+FF_BARRIER_CHECK(glDrawArraysInstanced, bc::draw("glDrawArraysInstanced", false, false))
+FF_BARRIER_CHECK(glDrawElements, bc::draw("glDrawElements", false, false))
+FF_BARRIER_CHECK(glDrawElementsInstanced, bc::draw("glDrawElementsInstanced", false, false))
+FF_BARRIER_CHECK(glDrawElementsBaseVertex, bc::draw("glDrawElementsBaseVertex", false, false))
+FF_BARRIER_CHECK(glDrawElementsInstancedBaseVertexBaseInstance,
+                 bc::draw("glDrawElementsInstancedBaseVertexBaseInstance", false, false))
+FF_BARRIER_CHECK(glMultiDrawElementsIndirect, bc::draw("glMultiDrawElementsIndirect", true, false))
+FF_BARRIER_CHECK(glMultiDrawArraysIndirect, bc::draw("glMultiDrawArraysIndirect", true, false))
+FF_BARRIER_CHECK(glMultiDrawElementsIndirectCount, bc::draw("glMultiDrawElementsIndirectCount", true, true))
+FF_BARRIER_CHECK(glMultiDrawElementsIndirectCountARB, bc::draw("glMultiDrawElementsIndirectCountARB", true, true))
+FF_BARRIER_CHECK(glCopyNamedBufferSubData, bc::bufferUpdate("glCopyNamedBufferSubData", FF_ARG(0), true);
+                 bc::bufferUpdate("glCopyNamedBufferSubData", FF_ARG(1), false))
+FF_BARRIER_CHECK(glClearNamedBufferSubData, bc::bufferUpdate("glClearNamedBufferSubData", FF_ARG(0), false))
+FF_BARRIER_CHECK(glClearNamedBufferData, bc::bufferUpdate("glClearNamedBufferData", FF_ARG(0), false))
+FF_BARRIER_CHECK(glNamedBufferSubData, bc::bufferUpdate("glNamedBufferSubData", FF_ARG(0), false))
+FF_BARRIER_CHECK(glGetNamedBufferSubData, bc::bufferUpdate("glGetNamedBufferSubData", FF_ARG(0), true))
+FF_BARRIER_CHECK(glNamedBufferStorage, bc::bufferStorage(FF_ARG(0), FF_ARG(2) != nullptr))
+FF_BARRIER_CHECK(glNamedBufferData, bc::bufferStorage(FF_ARG(0), FF_ARG(2) != nullptr))
+FF_BARRIER_CHECK(glMapNamedBufferRange, bc::mapBuffer(FF_ARG(0), FF_ARG(3)))
+FF_BARRIER_CHECK(glGetTextureImage, bc::textureUpdate("glGetTextureImage", FF_ARG(0), true))
+FF_BARRIER_CHECK(glGetTextureSubImage, bc::textureUpdate("glGetTextureSubImage", FF_ARG(0), true))
+FF_BARRIER_CHECK(glClearTexImage, bc::textureUpdate("glClearTexImage", FF_ARG(0), false))
+FF_BARRIER_CHECK(glTextureSubImage2D, bc::textureUpdate("glTextureSubImage2D", FF_ARG(0), false))
+FF_BARRIER_CHECK(glTextureSubImage3D, bc::textureUpdate("glTextureSubImage3D", FF_ARG(0), false))
+#undef FF_ARG
+#undef FF_BARRIER_CHECK
+
 // The wrapper of one entry point: Slot is the address of libepoxy's function pointer (epoxy_glDrawElements, ...).
 // Extra, when not void, is a function object called with the counters and the call's arguments before the call.
 template <auto Slot, Kind K, typename Extra = void>
@@ -102,6 +163,9 @@ struct Hook<Slot, K, Extra> {
     // The wrapper's own bookkeeping is timed with the call, so that it is the measurement's, not Farfield's code.
     const uint64_t start = ticks();
     Profiled profiled;
+    // The barrier check follows every call, the measurement's too (its reads need barriers as much as a frame's).
+    if constexpr (BarrierCheck<Slot>::active)
+      if (barrier_check::on()) BarrierCheck<Slot>::check(args...);
     ThreadState& t = t_state;
     if (t.paused) return real(args...);
     GlCounters& c = t.counters;

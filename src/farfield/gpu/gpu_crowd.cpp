@@ -14,6 +14,11 @@
 namespace farfield::gpu {
 namespace {
 
+// After a pass that fills the lists: the draws read the records (storage) and the commands (indirect), and the next
+// frame's reset copies over the commands, the late readback copies them, and readCounts reads the counts (buffer
+// operations).
+constexpr GLbitfield kAfterPass = GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT;
+
 struct AgentRecord {
   uint32_t route, model, outfit, id;
   float start, speed, direction, phase;
@@ -177,7 +182,7 @@ void GpuCrowd::simulate(float t) {
   simulate_.set("u_time", t);
   bindBuffers();
   glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);  // (readPoses, readPhases)
 }
 
 void GpuCrowd::occludeBehind(const RenderTarget& target) {
@@ -203,7 +208,7 @@ void GpuCrowd::castShadows(const Camera& camera, std::span<const float> switch_m
   glUniform2f(casters_.uniformLocation("u_light_scale"), 2.0f / side_m, 1.0f / depth_range_m);
   glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
   if (lod_m_per_m_ > 0.0f) countLevels(camera, switch_m, true);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+  glMemoryBarrier(kAfterPass);
 }
 
 GpuCrowd::Counts GpuCrowd::readCounts() const {
@@ -236,6 +241,10 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
     throw Error("GPU crowd", std::to_string(switch_m.size()) + " switch distances for " + std::to_string(models_) +
                                  " models");
   camera.validate("GPU crowd camera");
+  // This pass rewrites the lists and commands that earlier draws read (the last view's, or the shadow casters' in the
+  // same buffers); its writes wait for those reads only across this barrier (a write after a read, OpenGL 4.6, 7.13.2;
+  // gl_barrier_check.h). After simulate() it costs nothing: simulate's own barrier came just before.
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   // The instance counts back to 0: the commands copied from their initial values on the GPU's side (no upload).
   glCopyNamedBufferSubData(initial_, commands_, 0, 0, GLsizeiptr(initial_commands_.size() * sizeof(GpuCrowdCommand)));
   glClearNamedBufferData(counts_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -279,7 +288,7 @@ void GpuCrowd::cullAndClassify(const Camera& camera, std::span<const float> swit
     glDispatchCompute(GLuint((agents_ + 63) / 64), 1, 1);
   }
   if (lod_m_per_m_ > 0.0f) countLevels(camera, switch_m, false);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+  glMemoryBarrier(kAfterPass);
   if (occlude) {
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);

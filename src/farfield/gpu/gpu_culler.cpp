@@ -24,6 +24,12 @@ constexpr size_t kCommandBytes = 5 * sizeof(uint32_t);
 constexpr size_t kStatCount = 10;        // gpu_cull.comp.glsl's statistics
 constexpr size_t kRing = 8;              // frames of statistics in flight
 constexpr int kMaxLevels = 16;
+// After each stage: its storage writes are read by the next stages, its list lengths by indirect dispatches and its
+// commands and counts by indirect draws, and its lists, counts and statistics are cleared or copied by buffer
+// operations (the next phase's, the next frame's, the statistics' late readback). Every write is followed by one such
+// barrier within its frame (the barrier check, gl_barrier_check.h, finds none missing).
+constexpr GLbitfield kAfterStage =
+    GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT;
 
 enum Variant { kPlain = 0, kTextured = 1, kItems = 2, kVariants = 3 };
 
@@ -141,11 +147,13 @@ GpuCuller::GpuCuller(const SceneArena& arena, const GpuCullOptions& options)
   im.visibility = createBuffer(size_t(im.instances) * sizeof(uint32_t), nullptr);
   glClearNamedBufferData(im.visibility, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   im.drawn = createBuffer(size_t(im.instances) * sizeof(uint32_t), nullptr);
+  glClearNamedBufferData(im.drawn, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   // The work list: the dispatch of the cluster stages (x, y, z) and its length, then the instances.
   im.work = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
   im.drawn_list = createBuffer((4 + size_t(im.instances)) * sizeof(uint32_t), nullptr);
   im.part_visible = createBuffer(arena.parts().size() * sizeof(uint32_t), nullptr);
   im.part_list = createBuffer(std::max<size_t>(arena.parts().size(), 1) * sizeof(uint32_t), nullptr);
+  glClearNamedBufferData(im.part_list, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);  // (read only when listed)
   glClearNamedBufferData(im.part_visible, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   std::vector<uint32_t> part_of(std::max<size_t>(im.instances, 1), 0);
   for (uint32_t p = 0; p < arena.parts().size(); ++p)
@@ -323,7 +331,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     glBindTextureUnit(2, target.depthTexture().handle());
     glBindTextureUnit(3, im.pyramid.texture());
     glDispatchCompute(std::min(part_groups, kMaxGroupsX), (part_groups + kMaxGroupsX - 1) / kMaxGroupsX, 1);
-    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(kAfterStage);
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, im.work);
@@ -340,7 +348,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
     glBindTextureUnit(2, target.depthTexture().handle());
     glBindTextureUnit(3, im.pyramid.texture());
     glDispatchComputeIndirect(0);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(kAfterStage);
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);
   };
@@ -354,7 +362,7 @@ FrameStats GpuCuller::draw(const Camera& camera, RenderTarget& target, RenderMod
       glClearNamedBufferData(im.commands[size_t(commands)], GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
     glUseProgram(e);
     glDispatchComputeIndirect(0);
-    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(kAfterStage);
   };
 
   auto drawPhase = [&](int commands) {

@@ -58,6 +58,9 @@ void GpuDepthPyramid::build(const RenderTarget& target) {
     sizes_uploaded_ = true;
   }
   program_.use();
+  // The levels are written as images: those writes wait for earlier reads of the pyramid (the last frame's tests)
+  // only across this barrier (OpenGL 4.6, 7.13.2: a write after a read; gl_barrier_check.h).
+  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   glBindTextureUnit(2, depth_);
   // Up to kLevelsPerDispatch levels a dispatch (depth_pyramid.comp.glsl), each invocation one texel of the last.
   for (int first = 0; first + 1 < levels; first += kLevelsPerDispatch) {
@@ -69,7 +72,7 @@ void GpuDepthPyramid::build(const RenderTarget& target) {
       glBindImageTexture(GLuint(j), texture_, GLint(first + j - 1), GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     const auto& made = level_size_[size_t(first + count)];
     glDispatchCompute(GLuint(made[0] + 7) / 8, GLuint(made[1] + 7) / 8, 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
   }
   glBindTextureUnit(2, 0);
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "farfield/core/error.h"
+#include "farfield/gpu/gl_barrier_check.h"
 #include "farfield/gpu/shader_source.h"
 
 namespace farfield::gpu {
@@ -58,6 +59,7 @@ std::string shaderLog(GLuint shader) {
 
 GLuint compile(GLenum stage, const ShaderStageSource& source) {
   GLuint shader = glCreateShader(stage);
+  nameGlShader(shader, source.name);  // for the barrier check's messages
   const char* text = source.source.c_str();
   const GLint length = GLint(source.source.size());
   glShaderSource(shader, 1, &text, &length);

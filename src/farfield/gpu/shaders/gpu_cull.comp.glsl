@@ -56,24 +56,39 @@ layout(std430, binding = 0) readonly buffer Clusters { Cluster clusters[]; };
 layout(std430, binding = 1) readonly buffer Instances { uvec4 instances[]; };  // cluster, object, material, group
 layout(std430, binding = 2) readonly buffer Objects { Object objects[]; };
 layout(std430, binding = 4) readonly buffer Enabled { uint enabled[]; };        // per object: drawn in the plan
+// Declared in the stages that use them, readonly where a stage only reads (the barrier check, gl_barrier_check.h,
+// takes a block not declared readonly as written): an implementation may also count every declared block against its
+// limit of storage blocks per compute shader (16 on llvmpipe).
+#ifdef FF_STAGE_CLUSTERS
 layout(std430, binding = 5) buffer Visibility { uint visible[]; };              // per instance: visible last frame
-// Declared in the stages that use them: an implementation may count every declared block against its limit of
-// storage blocks per compute shader (16 on llvmpipe).
+#endif
 #ifdef FF_STAGE_EMIT
 layout(std430, binding = 6) buffer Commands { Command commands[]; };
 layout(std430, binding = 7) buffer Counts { uint counts[]; };                   // per group: commands written
 layout(std430, binding = 8) readonly buffer GroupFirst { uint group_first[]; };
 #endif
 layout(std430, binding = 9) buffer Stats { uint stats[]; };
+#ifdef FF_STAGE_CLUSTERS
 layout(std430, binding = 10) buffer ObjectFrame { uint object_frame[]; };    // per object: last frame it was drawn
+#endif
 layout(std430, binding = 11) readonly buffer Parts { Part parts[]; };
+#ifdef FF_STAGE_PARTS
 layout(std430, binding = 12) buffer Work { uvec4 dispatch_args; uint work[]; };  // dispatch_args.w: list length
+#else
+layout(std430, binding = 12) readonly buffer Work { uvec4 dispatch_args; uint work[]; };
+#endif
+#ifdef FF_STAGE_CLUSTERS
 layout(std430, binding = 13) buffer Drawn { uint drawn_flag[]; };            // per instance: drawn in this phase
 layout(std430, binding = 14) buffer DrawnList { uvec4 drawn_args; uint drawn_list[]; };  // instances drawn this frame
+#elif defined(FF_STAGE_EMIT)
+layout(std430, binding = 13) readonly buffer Drawn { uint drawn_flag[]; };
+#endif
 // Per part: bit 0 visible in the last frame (a cluster of it visible in its final depth), bit 1 in view this frame,
 // bit 2 on this frame's early list (its clusters visible in the last frame drawn early: a cluster's own flag alone
 // may be older than its part's, from a frame before the part was hidden).
+#ifndef FF_STAGE_EMIT
 layout(std430, binding = 15) buffer PartVisible { uint part_visible[]; };
+#endif
 layout(std430, binding = 16) readonly buffer InstancePart { uint instance_part[]; };
 #ifdef FF_STAGE_PARTS
 layout(std430, binding = 17) readonly buffer PartList { uint part_list[]; };  // with u_listed: the plan's parts

@@ -1,0 +1,365 @@
+#include "farfield/gpu/gl_barrier_check.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "farfield/gpu/gl_barrier_check_hooks.h"
+#include "farfield/gpu/gl_counters.h"
+
+namespace farfield::gpu {
+
+namespace barrier_check {
+
+std::atomic<bool> g_on{false};
+std::atomic<bool> g_print{true};
+
+namespace {
+
+constexpr GLbitfield kAllBits = 0xFFFFFFFFu;
+
+// A command that accessed a resource: its entry point and program, named only when a message needs them.
+struct Command {
+  const char* entry = "";
+  GLuint program = 0;
+};
+
+// A buffer or a texture: the barrier bits it is still owed since a shader last wrote it (by which command, through
+// which binding), and whether a shader or an indirect command read it since the last barrier that orders a later
+// shader write after that read.
+struct Resource {
+  GLbitfield owed = 0;
+  Command writer;
+  const char* written_at = "";
+  int written_index = -1;
+  bool read = false;
+  Command reader;
+  // False from storage made without data until something writes it (a clear, an upload, a copy, a shader): a GPU's
+  // allocator may hand out memory another buffer of the process left behind.
+  bool defined = true;
+};
+
+struct Program {
+  GlslBindings declared;  // by its shaders together
+  std::vector<int> buffers, written_buffers, images, written_images, samplers;  // the same, for the checks' loops
+};
+
+// Binding points and units to the object bound there (0: none).
+struct Points {
+  std::vector<GLuint> bound;
+  void set(GLuint at, GLuint object) {
+    if (at >= bound.size()) bound.resize(at + 1, 0);
+    bound[at] = object;
+  }
+  GLuint at(int i) const { return size_t(i) < bound.size() ? bound[size_t(i)] : 0; }
+  void forget(GLuint object) {
+    for (GLuint& b : bound)
+      if (b == object) b = 0;
+  }
+};
+
+struct State {
+  std::unordered_map<GLuint, GlslBindings> shaders;
+  std::unordered_map<GLuint, std::string> shader_names;
+  std::unordered_map<GLuint, Program> programs;
+  std::unordered_map<GLuint, std::string> program_names;  // kept after a program is deleted (messages name it)
+  GLuint program = 0;
+  Points storage, images, units;
+  GLuint draw_indirect = 0, dispatch_indirect = 0, parameter = 0;
+  std::unordered_map<GLuint, Resource> buffers, textures;
+  std::vector<GlBarrierHazard> hazards;
+  std::unordered_map<std::string, size_t> hazard_index;
+  GlBarrierCheckCounts counts;
+};
+thread_local State t_state;
+
+const char* bitName(GLbitfield bit) {
+  switch (bit) {
+    case GL_SHADER_STORAGE_BARRIER_BIT: return "GL_SHADER_STORAGE_BARRIER_BIT";
+    case GL_COMMAND_BARRIER_BIT: return "GL_COMMAND_BARRIER_BIT";
+    case GL_BUFFER_UPDATE_BARRIER_BIT: return "GL_BUFFER_UPDATE_BARRIER_BIT";
+    case GL_TEXTURE_FETCH_BARRIER_BIT: return "GL_TEXTURE_FETCH_BARRIER_BIT";
+    case GL_SHADER_IMAGE_ACCESS_BARRIER_BIT: return "GL_SHADER_IMAGE_ACCESS_BARRIER_BIT";
+    case GL_TEXTURE_UPDATE_BARRIER_BIT: return "GL_TEXTURE_UPDATE_BARRIER_BIT";
+    default: return "a barrier bit";
+  }
+}
+
+std::string programName(GLuint program) {
+  const auto it = t_state.program_names.find(program);
+  return it != t_state.program_names.end() ? it->second : "program " + std::to_string(program);
+}
+
+// "glDispatchCompute (gpu_cull.comp.glsl)"; a buffer operation has no program.
+std::string name(const Command& c) {
+  return c.program ? std::string(c.entry) + " (" + programName(c.program) + ")" : std::string(c.entry);
+}
+
+// "shader storage binding 7", "its draw commands".
+std::string place(const char* kind, int index) {
+  return index >= 0 ? std::string(kind) + " " + std::to_string(index) : std::string(kind);
+}
+
+void record(std::string message) {
+  State& s = t_state;
+  const auto [it, fresh] = s.hazard_index.emplace(message, s.hazards.size());
+  if (fresh) {
+    s.hazards.push_back({std::move(message), 0});
+    if (g_print.load(std::memory_order_relaxed))
+      std::fprintf(stderr, "FF_GL_BARRIER_HAZARD: %s\n", s.hazards.back().message.c_str());
+  }
+  ++s.hazards[it->second].count;
+}
+
+// An access of `r` that needs `bit`: a hazard when a shader wrote it and no barrier with that bit came since.
+// Messages name a resource by how it was bound, not by its object number, so that one message stands for one place
+// in the code whatever objects met there.
+void needs(const Resource& r, GLbitfield bit, const Command& by, const char* verb, const char* kind, int index = -1) {
+  if (!(r.owed & bit)) return;
+  record(name(by) + " " + verb + " " + place(kind, index) + ", written at " + place(r.written_at, r.written_index) +
+         " by " + name(r.writer) + ", with no glMemoryBarrier(" + bitName(bit) + ") since");
+}
+
+// A shader's write to `r` after an earlier command's read that no barrier with `bit` ordered it after.
+void writeAfterRead(const Resource& r, GLbitfield bit, const Command& by, const char* kind, int index) {
+  if (!r.read || (r.owed & bit)) return;  // (a write after a write is the hazard `needs` reports)
+  record(name(by) + " writes " + place(kind, index) + ", read before by " + name(r.reader) +
+         ", with no glMemoryBarrier(" + bitName(bit) + ") since (a write after a read)");
+}
+
+// A read of a buffer whose storage was made without data and that nothing wrote since.
+void undefinedRead(const Resource& r, const Command& by, const char* kind, int index = -1) {
+  if (!r.defined)
+    record(name(by) + " reads " + place(kind, index) + ", a buffer made without data that nothing wrote since");
+}
+
+bool has(const std::vector<int>& v, int x) { return std::find(v.begin(), v.end(), x) != v.end(); }
+
+// The shader accesses of a dispatch or draw by program `p`: first every check, then what the command leaves (reads
+// that later writes must be ordered after, writes that later reads need a barrier for).
+void shaderAccesses(const Command& by, const Program& p) {
+  State& s = t_state;
+  for (int i : p.buffers)
+    if (const GLuint b = s.storage.at(i)) {
+      const Resource& r = s.buffers[b];
+      needs(r, GL_SHADER_STORAGE_BARRIER_BIT, by, "reads", "shader storage binding", i);
+      // (a block the program may write may only be written: only a readonly one is surely read)
+      if (!has(p.written_buffers, i)) undefinedRead(r, by, "shader storage binding", i);
+      if (has(p.written_buffers, i)) writeAfterRead(r, GL_SHADER_STORAGE_BARRIER_BIT, by, "shader storage binding", i);
+    }
+  for (int u : p.samplers)
+    if (const GLuint t = s.units.at(u))
+      needs(s.textures[t], GL_TEXTURE_FETCH_BARRIER_BIT, by, "reads", "texture unit", u);
+  for (int u : p.images)
+    if (const GLuint t = s.images.at(u)) {
+      const Resource& r = s.textures[t];
+      needs(r, GL_SHADER_IMAGE_ACCESS_BARRIER_BIT, by, "reads", "image unit", u);
+      if (has(p.written_images, u)) writeAfterRead(r, GL_SHADER_IMAGE_ACCESS_BARRIER_BIT, by, "image unit", u);
+    }
+  const auto leave = [&](Resource& r, bool written, const char* kind, int index) {
+    r.read = true;
+    r.reader = by;
+    if (!written) return;
+    r.defined = true;
+    r.owed = kAllBits;
+    r.writer = by;
+    r.written_at = kind;
+    r.written_index = index;
+  };
+  for (int i : p.buffers)
+    if (const GLuint b = s.storage.at(i)) leave(s.buffers[b], has(p.written_buffers, i), "shader storage binding", i);
+  for (int u : p.samplers)
+    if (const GLuint t = s.units.at(u)) leave(s.textures[t], false, "texture unit", u);
+  for (int u : p.images)
+    if (const GLuint t = s.images.at(u)) leave(s.textures[t], has(p.written_images, u), "image unit", u);
+}
+
+// The current program, or null (counted) when the check does not know it.
+const Program* current() {
+  State& s = t_state;
+  const auto it = s.programs.find(s.program);
+  if (it == s.programs.end()) {
+    ++s.counts.unknown_program;
+    return nullptr;
+  }
+  ++s.counts.checked;
+  return &it->second;
+}
+
+// A command's indirect buffer (its commands, dispatch size or draw count): checked before the command's shader
+// accesses, marked read after them (the command's own writes come after its indirect read).
+void indirect(GLuint buffer, const Command& by, const char* what, bool check) {
+  if (buffer == 0) return;
+  Resource& r = t_state.buffers[buffer];
+  if (check) {
+    needs(r, GL_COMMAND_BARRIER_BIT, by, "reads", what);
+    undefinedRead(r, by, what);
+  } else {
+    r.read = true;
+    r.reader = by;
+  }
+}
+
+std::vector<int> list(const std::set<int>& s) { return {s.begin(), s.end()}; }
+
+}  // namespace
+
+void shaderSource(GLuint shader, GLsizei count, const GLchar* const* strings, const GLint* lengths) {
+  std::string text;
+  for (GLsizei i = 0; i < count; ++i) {
+    if (!strings[i]) continue;
+    if (lengths && lengths[i] >= 0) text.append(strings[i], size_t(lengths[i]));
+    else text.append(strings[i]);
+  }
+  t_state.shaders[shader] = glslBindings(text);
+}
+
+void attachShader(GLuint program, GLuint shader) {
+  State& s = t_state;
+  Program& p = s.programs[program];
+  if (const auto it = s.shaders.find(shader); it != s.shaders.end()) p.declared |= it->second;
+  const GlslBindings& d = p.declared;
+  p.buffers = list(d.buffers), p.written_buffers = list(d.written_buffers), p.images = list(d.images);
+  p.written_images = list(d.written_images), p.samplers = list(d.samplers);
+  const auto named = s.shader_names.find(shader);
+  const std::string shader_name = named != s.shader_names.end() ? named->second : "shader " + std::to_string(shader);
+  std::string& program_name = s.program_names[program];
+  program_name += (program_name.empty() ? "" : " + ") + shader_name;
+}
+
+void deleteProgram(GLuint program) { t_state.programs.erase(program); }
+void useProgram(GLuint program) { t_state.program = program; }
+
+void bindBufferBase(GLenum target, GLuint index, GLuint buffer) {
+  if (target == GL_SHADER_STORAGE_BUFFER) t_state.storage.set(index, buffer);
+}
+
+void bindBuffer(GLenum target, GLuint buffer) {
+  State& s = t_state;
+  if (target == GL_DRAW_INDIRECT_BUFFER) s.draw_indirect = buffer;
+  else if (target == GL_DISPATCH_INDIRECT_BUFFER) s.dispatch_indirect = buffer;
+  else if (target == GL_PARAMETER_BUFFER_ARB) s.parameter = buffer;
+}
+
+void bindTextureUnit(GLuint unit, GLuint texture) { t_state.units.set(unit, texture); }
+void bindImageTexture(GLuint unit, GLuint texture) { t_state.images.set(unit, texture); }
+
+void deleteBuffers(GLsizei n, const GLuint* buffers) {
+  State& s = t_state;
+  for (GLsizei i = 0; i < n; ++i) {
+    const GLuint b = buffers[i];
+    s.buffers.erase(b);
+    s.storage.forget(b);
+    for (GLuint* bound : {&s.draw_indirect, &s.dispatch_indirect, &s.parameter})
+      if (*bound == b) *bound = 0;
+  }
+}
+
+void deleteTextures(GLsizei n, const GLuint* textures) {
+  State& s = t_state;
+  for (GLsizei i = 0; i < n; ++i) {
+    s.textures.erase(textures[i]);
+    s.units.forget(textures[i]);
+    s.images.forget(textures[i]);
+  }
+}
+
+void memoryBarrier(GLbitfield bits) {
+  State& s = t_state;
+  for (auto& [id, r] : s.buffers) {
+    r.owed &= ~bits;
+    if (bits & GL_SHADER_STORAGE_BARRIER_BIT) r.read = false;
+  }
+  for (auto& [id, r] : s.textures) {
+    r.owed &= ~bits;
+    if (bits & GL_SHADER_IMAGE_ACCESS_BARRIER_BIT) r.read = false;
+  }
+}
+
+void dispatch(const char* entry, bool indirect_size) {
+  const Program* p = current();
+  if (!p) return;
+  const Command by{entry, t_state.program};
+  if (indirect_size) indirect(t_state.dispatch_indirect, by, "its dispatch size", true);
+  shaderAccesses(by, *p);
+  if (indirect_size) indirect(t_state.dispatch_indirect, by, "its dispatch size", false);
+}
+
+void draw(const char* entry, bool indirect_commands, bool count) {
+  const Program* p = current();
+  if (!p) return;
+  const Command by{entry, t_state.program};
+  if (indirect_commands) indirect(t_state.draw_indirect, by, "its draw commands", true);
+  if (count) indirect(t_state.parameter, by, "its draw count", true);
+  shaderAccesses(by, *p);
+  if (indirect_commands) indirect(t_state.draw_indirect, by, "its draw commands", false);
+  if (count) indirect(t_state.parameter, by, "its draw count", false);
+}
+
+void bufferUpdate(const char* entry, GLuint buffer, bool reads) {
+  const auto it = t_state.buffers.find(buffer);
+  if (it == t_state.buffers.end()) return;
+  needs(it->second, GL_BUFFER_UPDATE_BARRIER_BIT, {entry, 0}, reads ? "reads" : "overwrites", "a buffer");
+  if (reads) undefinedRead(it->second, {entry, 0}, "a buffer");
+  else it->second.defined = true;  // (a partial write counts: the check does not follow ranges)
+}
+
+void bufferStorage(GLuint buffer, bool with_data) {
+  Resource fresh;
+  fresh.defined = with_data;
+  t_state.buffers[buffer] = fresh;
+}
+
+void mapBuffer(GLuint buffer, GLbitfield access) {
+  if (access & GL_MAP_WRITE_BIT)
+    if (const auto it = t_state.buffers.find(buffer); it != t_state.buffers.end()) it->second.defined = true;
+}
+
+void textureUpdate(const char* entry, GLuint texture, bool reads) {
+  const auto it = t_state.textures.find(texture);
+  if (it != t_state.textures.end())
+    needs(it->second, GL_TEXTURE_UPDATE_BARRIER_BIT, {entry, 0}, reads ? "reads" : "overwrites", "a texture");
+}
+
+}  // namespace barrier_check
+
+bool setGlBarrierCheck(bool on) {
+  if (on && !glCountersInstalled()) return false;
+  barrier_check::g_on = on;
+  return true;
+}
+
+bool glBarrierCheckOn() { return barrier_check::on(); }
+
+void setGlBarrierHazardsPrinted(bool on) { barrier_check::g_print = on; }
+
+std::vector<GlBarrierHazard> glBarrierHazards() { return barrier_check::t_state.hazards; }
+
+void clearGlBarrierHazards() {
+  barrier_check::t_state.hazards.clear();
+  barrier_check::t_state.hazard_index.clear();
+  barrier_check::t_state.counts = {};
+}
+
+GlBarrierCheckCounts glBarrierCheckCounts() { return barrier_check::t_state.counts; }
+
+void nameGlShader(uint32_t shader, const std::string& name) {
+  if (barrier_check::on()) barrier_check::t_state.shader_names[shader] = name;
+}
+
+void enableGlBarrierCheckFromEnvironment() {
+  const char* env = std::getenv("FF_GL_BARRIER_CHECK");
+  if (!env || !*env || std::strcmp(env, "0") == 0) return;
+  if (!installGlCounters() || !setGlBarrierCheck(true)) {
+    static bool warned = false;
+    if (!warned) std::fprintf(stderr, "FF_GL_BARRIER_CHECK: the GL counters could not be installed; no check\n");
+    warned = true;
+  }
+}
+
+}  // namespace farfield::gpu

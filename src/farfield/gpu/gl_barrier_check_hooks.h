@@ -1,0 +1,38 @@
+// The calls the GL counters' wrappers make into the barrier check (gl_barrier_check.h) before each followed entry
+// point, with its arguments. Internal to the gpu module.
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <atomic>
+
+namespace farfield::gpu::barrier_check {
+
+extern std::atomic<bool> g_on;
+inline bool on() { return g_on.load(std::memory_order_relaxed); }
+
+void shaderSource(GLuint shader, GLsizei count, const GLchar* const* strings, const GLint* lengths);
+void attachShader(GLuint program, GLuint shader);
+void deleteProgram(GLuint program);
+void useProgram(GLuint program);
+void bindBufferBase(GLenum target, GLuint index, GLuint buffer);
+void bindBuffer(GLenum target, GLuint buffer);
+void bindTextureUnit(GLuint unit, GLuint texture);
+void bindImageTexture(GLuint unit, GLuint texture);
+void deleteBuffers(GLsizei n, const GLuint* buffers);
+void deleteTextures(GLsizei n, const GLuint* textures);
+void memoryBarrier(GLbitfield bits);
+
+// A dispatch or a draw by the current program; `indirect`: its commands come from the bound dispatch or draw
+// indirect buffer, `count`: its draw count from the bound parameter buffer.
+void dispatch(const char* entry, bool indirect);
+void draw(const char* entry, bool indirect, bool count);
+
+// Buffer and texture operations that read or overwrite what a shader may have written.
+void bufferUpdate(const char* entry, GLuint buffer, bool reads);
+void textureUpdate(const char* entry, GLuint texture, bool reads);
+// A buffer's storage, made with or without data; a map for writing (its contents then count as written).
+void bufferStorage(GLuint buffer, bool with_data);
+void mapBuffer(GLuint buffer, GLbitfield access);
+
+}  // namespace farfield::gpu::barrier_check
