@@ -248,5 +248,52 @@ TEST_F(GlBarrierCheckTest, AReadOfABufferMadeWithoutDataBeforeAnythingWroteItIsF
   glDeleteBuffers(2, fresh);
 }
 
+// Indexed indirect draws: a command whose indices pass the end of the element buffer is found (llvmpipe fetches
+// zeros there; a GPU may fault), and the same command within it is not.
+TEST_F(GlBarrierCheckTest, AnIndirectCommandPastItsElementBufferIsFound) {
+  const char* vs = "#version 450 core\nvoid main() { gl_Position = vec4(0.0, 0.0, 0.0, 1.0); }\n";
+  const char* fs = "#version 450 core\nout vec4 c;\nvoid main() { c = vec4(1.0); }\n";
+  GLuint shaders[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
+  glShaderSource(shaders[0], 1, &vs, nullptr);
+  glShaderSource(shaders[1], 1, &fs, nullptr);
+  const GLuint program = glCreateProgram();
+  for (GLuint sh : shaders) {
+    glCompileShader(sh);
+    glAttachShader(program, sh);
+  }
+  glLinkProgram(program);
+  for (GLuint sh : shaders) glDeleteShader(sh);
+  const std::vector<uint32_t> indices{0, 1, 2, 0, 2, 3};  // 6 indices
+  GLuint elements = 0, commands = 0, vao = 0;
+  glCreateBuffers(1, &elements);
+  glNamedBufferStorage(elements, GLsizeiptr(indices.size() * 4), indices.data(), 0);
+  glCreateVertexArrays(1, &vao);
+  glVertexArrayElementBuffer(vao, elements);
+  // (count, instances, first index, base vertex, base instance): within, then 3 indices from index 5.
+  const std::vector<uint32_t> words{6, 1, 0, 0, 0, 3, 1, 5, 0, 0};
+  glCreateBuffers(1, &commands);
+  glNamedBufferStorage(commands, GLsizeiptr(words.size() * 4), words.data(), 0);
+  glUseProgram(program);
+  glBindVertexArray(vao);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
+  glEnable(GL_RASTERIZER_DISCARD);
+  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, nullptr, 1, 0);
+  EXPECT_EQ(hazards(), "");
+  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, reinterpret_cast<const void*>(uintptr_t(20)), 1, 0);
+  const std::string h = hazards();
+  EXPECT_NE(h.find("glMultiDrawElementsIndirect (shader "), std::string::npos) << h;
+  EXPECT_NE(h.find("draws a command whose indices [5, 8) pass the 6 of its element buffer"), std::string::npos) << h;
+  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, nullptr, 3, 0);  // a third command past the buffer
+  EXPECT_NE(hazards().find("reads 3 draw commands past the end of its indirect buffer"), std::string::npos);
+  glDisable(GL_RASTERIZER_DISCARD);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+  glBindVertexArray(0);
+  glUseProgram(0);
+  glDeleteVertexArrays(1, &vao);
+  glDeleteBuffers(1, &elements);
+  glDeleteBuffers(1, &commands);
+  glDeleteProgram(program);
+}
+
 }  // namespace
 }  // namespace farfield::gpu

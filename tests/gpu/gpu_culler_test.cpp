@@ -415,6 +415,7 @@ TEST_F(GpuCullerTest, EveryStageWriteIsFollowedByTheBarrierItsReadersNeed) {
         const GlBarrierCheckCounts counts = glBarrierCheckCounts();
         EXPECT_GE(counts.checked, 5u * 4u);  // dispatches and draws of five frames
         EXPECT_EQ(counts.unknown_program, 0u);
+        EXPECT_GT(counts.indirect_commands, 0u);  // the multi-draws' commands checked against the arena's indices
         for (const GlBarrierHazard& h : glBarrierHazards()) ADD_FAILURE() << h.message << " (" << h.count << " calls)";
       }
 }

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include <epoxy/egl.h>
+
 #include "farfield/gpu/gl_barrier_check_hooks.h"
 #include "farfield/gpu/gl_counters.h"
 
@@ -72,6 +74,9 @@ struct State {
   Points storage, images, units;
   GLuint draw_indirect = 0, dispatch_indirect = 0, parameter = 0;
   std::unordered_map<GLuint, Resource> buffers, textures;
+  std::unordered_map<GLuint, GLsizeiptr> buffer_bytes;  // storage sizes
+  std::unordered_map<GLuint, GLuint> element_buffers;   // vertex array -> its element buffer
+  GLuint vertex_array = 0;
   std::vector<GlBarrierHazard> hazards;
   std::unordered_map<std::string, size_t> hazard_index;
   GlBarrierCheckCounts counts;
@@ -254,6 +259,7 @@ void deleteBuffers(GLsizei n, const GLuint* buffers) {
   for (GLsizei i = 0; i < n; ++i) {
     const GLuint b = buffers[i];
     s.buffers.erase(b);
+    s.buffer_bytes.erase(b);
     s.storage.forget(b);
     for (GLuint* bound : {&s.draw_indirect, &s.dispatch_indirect, &s.parameter})
       if (*bound == b) *bound = 0;
@@ -309,10 +315,65 @@ void bufferUpdate(const char* entry, GLuint buffer, bool reads) {
   else it->second.defined = true;  // (a partial write counts: the check does not follow ranges)
 }
 
-void bufferStorage(GLuint buffer, bool with_data) {
+void bufferStorage(GLuint buffer, GLsizeiptr bytes, bool with_data) {
   Resource fresh;
   fresh.defined = with_data;
   t_state.buffers[buffer] = fresh;
+  t_state.buffer_bytes[buffer] = bytes;
+}
+
+void vertexArrayElementBuffer(GLuint vertex_array, GLuint buffer) { t_state.element_buffers[vertex_array] = buffer; }
+void bindVertexArray(GLuint vertex_array) { t_state.vertex_array = vertex_array; }
+
+namespace {
+
+// The driver's own entry points, not the counted wrappers: the check's readbacks are not the frame's calls.
+PFNGLGETNAMEDBUFFERSUBDATAPROC g_read = nullptr;
+
+template <class T>
+std::vector<T> readBack(GLuint buffer, GLintptr offset, size_t count) {
+  std::vector<T> out(count);
+  if (!g_read) g_read = reinterpret_cast<PFNGLGETNAMEDBUFFERSUBDATAPROC>(eglGetProcAddress("glGetNamedBufferSubData"));
+  if (g_read && count) g_read(buffer, offset, GLsizeiptr(count * sizeof(T)), out.data());
+  return out;
+}
+
+}  // namespace
+
+void indexedIndirect(const char* entry, GLenum type, const void* indirect, GLsizei drawcount, GLsizei stride,
+                     GLintptr count_offset) {
+  State& s = t_state;
+  const auto element = s.element_buffers.find(s.vertex_array);
+  if (s.draw_indirect == 0 || element == s.element_buffers.end() || element->second == 0) return;
+  const auto bytes = s.buffer_bytes.find(element->second);
+  const auto commands_bytes = s.buffer_bytes.find(s.draw_indirect);
+  if (bytes == s.buffer_bytes.end() || commands_bytes == s.buffer_bytes.end()) return;  // made before the check
+  const GLsizeiptr index_size = type == GL_UNSIGNED_SHORT ? 2 : type == GL_UNSIGNED_BYTE ? 1 : 4;
+  const uint64_t indices = uint64_t(bytes->second / index_size);
+  const GLintptr first = GLintptr(reinterpret_cast<uintptr_t>(indirect));
+  const GLsizei step = stride ? stride : GLsizei(5 * sizeof(uint32_t));
+  GLsizei n = drawcount;  // (the maximum, for a draw with a count)
+  if (count_offset >= 0 && s.parameter != 0)
+    n = std::min<GLsizei>(n, GLsizei(readBack<uint32_t>(s.parameter, count_offset, 1)[0]));
+  if (n <= 0) return;
+  if (first + GLintptr(n - 1) * step + GLintptr(5 * sizeof(uint32_t)) > commands_bytes->second) {
+    record(std::string(entry) + " (" + programName(s.program) + ") reads " + std::to_string(n) +
+           " draw commands past the end of its indirect buffer");
+    return;
+  }
+  const std::vector<uint32_t> words =
+      readBack<uint32_t>(s.draw_indirect, first, size_t(n - 1) * size_t(step / 4) + 5);
+  s.counts.indirect_commands += uint64_t(n);
+  for (GLsizei k = 0; k < n; ++k) {
+    const uint32_t* c = &words[size_t(k) * size_t(step / 4)];  // count, instances, first index, base vertex, base inst.
+    if (c[0] == 0 || c[1] == 0) continue;
+    if (uint64_t(c[2]) + c[0] > indices) {
+      record(std::string(entry) + " (" + programName(s.program) + ") draws a command whose indices [" +
+             std::to_string(c[2]) + ", " + std::to_string(uint64_t(c[2]) + c[0]) + ") pass the " +
+             std::to_string(indices) + " of its element buffer (a GPU may fault where llvmpipe reads zeros)");
+      return;
+    }
+  }
 }
 
 void mapBuffer(GLuint buffer, GLbitfield access) {

@@ -19,6 +19,9 @@
 // a hazard, recorded with the entry point, the program (by its shaders' names) and the resource. So is a read of a
 // buffer whose storage was made without data before anything wrote it (a readonly storage block, an indirect buffer,
 // a copy's source): llvmpipe's fresh memory is usually zero, a GPU driver's may hold another buffer's old contents.
+// And an indexed indirect draw's commands are read back (by the driver's own entry point, outside the counted calls:
+// a wait that only the check makes) and each command's indices checked against the bound vertex array's element
+// buffer: llvmpipe fetches zeros past its end, where a GPU may fault.
 //
 // Limits: whole buffers and textures (not ranges or levels); shaders' bindings as declared with layout(binding = N)
 // (a sampler unit set by glUniform1i is not followed); vertex and index buffers written by shaders are not followed
@@ -50,10 +53,11 @@ struct GlBarrierHazard {
 // The calling thread's hazards since the last clear, in the order first found.
 std::vector<GlBarrierHazard> glBarrierHazards();
 void clearGlBarrierHazards();
-// What the check followed on the calling thread since the last clear: dispatches and draws it checked, and those of
-// programs it did not know (compiled before the check was on).
+// What the check followed on the calling thread since the last clear: dispatches and draws it checked, those of
+// programs it did not know (compiled before the check was on), and indirect commands it checked.
 struct GlBarrierCheckCounts {
   uint64_t checked = 0, unknown_program = 0;
+  uint64_t indirect_commands = 0;  // indexed indirect draw commands read back and checked against their indices
 };
 GlBarrierCheckCounts glBarrierCheckCounts();
 

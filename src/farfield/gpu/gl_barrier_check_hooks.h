@@ -32,7 +32,13 @@ void draw(const char* entry, bool indirect, bool count);
 void bufferUpdate(const char* entry, GLuint buffer, bool reads);
 void textureUpdate(const char* entry, GLuint texture, bool reads);
 // A buffer's storage, made with or without data; a map for writing (its contents then count as written).
-void bufferStorage(GLuint buffer, bool with_data);
+void bufferStorage(GLuint buffer, GLsizeiptr bytes, bool with_data);
 void mapBuffer(GLuint buffer, GLbitfield access);
+// Indexed indirect draws: every command read back (outside the counted calls) and its indices checked against the
+// bound vertex array's element buffer. `count_offset` >= 0: the draw count is read from the parameter buffer there.
+void vertexArrayElementBuffer(GLuint vertex_array, GLuint buffer);
+void bindVertexArray(GLuint vertex_array);
+void indexedIndirect(const char* entry, GLenum type, const void* indirect, GLsizei drawcount, GLsizei stride,
+                     GLintptr count_offset);
 
 }  // namespace farfield::gpu::barrier_check

@@ -118,18 +118,25 @@ FF_BARRIER_CHECK(glDrawElementsInstanced, bc::draw("glDrawElementsInstanced", fa
 FF_BARRIER_CHECK(glDrawElementsBaseVertex, bc::draw("glDrawElementsBaseVertex", false, false))
 FF_BARRIER_CHECK(glDrawElementsInstancedBaseVertexBaseInstance,
                  bc::draw("glDrawElementsInstancedBaseVertexBaseInstance", false, false))
-FF_BARRIER_CHECK(glMultiDrawElementsIndirect, bc::draw("glMultiDrawElementsIndirect", true, false))
+FF_BARRIER_CHECK(glMultiDrawElementsIndirect, bc::draw("glMultiDrawElementsIndirect", true, false);
+                 bc::indexedIndirect("glMultiDrawElementsIndirect", FF_ARG(1), FF_ARG(2), FF_ARG(3), FF_ARG(4), -1))
 FF_BARRIER_CHECK(glMultiDrawArraysIndirect, bc::draw("glMultiDrawArraysIndirect", true, false))
-FF_BARRIER_CHECK(glMultiDrawElementsIndirectCount, bc::draw("glMultiDrawElementsIndirectCount", true, true))
-FF_BARRIER_CHECK(glMultiDrawElementsIndirectCountARB, bc::draw("glMultiDrawElementsIndirectCountARB", true, true))
+FF_BARRIER_CHECK(glMultiDrawElementsIndirectCount, bc::draw("glMultiDrawElementsIndirectCount", true, true);
+                 bc::indexedIndirect("glMultiDrawElementsIndirectCount", FF_ARG(1), FF_ARG(2), FF_ARG(4), FF_ARG(5),
+                                     FF_ARG(3)))
+FF_BARRIER_CHECK(glMultiDrawElementsIndirectCountARB, bc::draw("glMultiDrawElementsIndirectCountARB", true, true);
+                 bc::indexedIndirect("glMultiDrawElementsIndirectCountARB", FF_ARG(1), FF_ARG(2), FF_ARG(4),
+                                     FF_ARG(5), FF_ARG(3)))
 FF_BARRIER_CHECK(glCopyNamedBufferSubData, bc::bufferUpdate("glCopyNamedBufferSubData", FF_ARG(0), true);
                  bc::bufferUpdate("glCopyNamedBufferSubData", FF_ARG(1), false))
 FF_BARRIER_CHECK(glClearNamedBufferSubData, bc::bufferUpdate("glClearNamedBufferSubData", FF_ARG(0), false))
 FF_BARRIER_CHECK(glClearNamedBufferData, bc::bufferUpdate("glClearNamedBufferData", FF_ARG(0), false))
 FF_BARRIER_CHECK(glNamedBufferSubData, bc::bufferUpdate("glNamedBufferSubData", FF_ARG(0), false))
 FF_BARRIER_CHECK(glGetNamedBufferSubData, bc::bufferUpdate("glGetNamedBufferSubData", FF_ARG(0), true))
-FF_BARRIER_CHECK(glNamedBufferStorage, bc::bufferStorage(FF_ARG(0), FF_ARG(2) != nullptr))
-FF_BARRIER_CHECK(glNamedBufferData, bc::bufferStorage(FF_ARG(0), FF_ARG(2) != nullptr))
+FF_BARRIER_CHECK(glNamedBufferStorage, bc::bufferStorage(FF_ARG(0), FF_ARG(1), FF_ARG(2) != nullptr))
+FF_BARRIER_CHECK(glNamedBufferData, bc::bufferStorage(FF_ARG(0), FF_ARG(1), FF_ARG(2) != nullptr))
+FF_BARRIER_CHECK(glVertexArrayElementBuffer, bc::vertexArrayElementBuffer(FF_ARG(0), FF_ARG(1)))
+FF_BARRIER_CHECK(glBindVertexArray, bc::bindVertexArray(FF_ARG(0)))
 FF_BARRIER_CHECK(glMapNamedBufferRange, bc::mapBuffer(FF_ARG(0), FF_ARG(3)))
 FF_BARRIER_CHECK(glGetTextureImage, bc::textureUpdate("glGetTextureImage", FF_ARG(0), true))
 FF_BARRIER_CHECK(glGetTextureSubImage, bc::textureUpdate("glGetTextureSubImage", FF_ARG(0), true))
