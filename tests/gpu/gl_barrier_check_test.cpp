@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "farfield/gpu/gl_counters.h"
+#include "farfield/gpu/render_target.h"
 #include "gpu/gpu_fixture.h"
 
 namespace farfield::gpu {
@@ -273,6 +274,8 @@ TEST_F(GlBarrierCheckTest, AnIndirectCommandPastItsElementBufferIsFound) {
   const std::vector<uint32_t> words{6, 1, 0, 0, 0, 3, 1, 5, 0, 0};
   glCreateBuffers(1, &commands);
   glNamedBufferStorage(commands, GLsizeiptr(words.size() * 4), words.data(), 0);
+  RenderTarget target(4, 4);
+  target.bind();
   glUseProgram(program);
   glBindVertexArray(vao);
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands);
@@ -285,6 +288,8 @@ TEST_F(GlBarrierCheckTest, AnIndirectCommandPastItsElementBufferIsFound) {
   EXPECT_NE(h.find("draws a command whose indices [5, 8) pass the 6 of its element buffer"), std::string::npos) << h;
   glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, nullptr, 3, 0);  // a third command past the buffer
   EXPECT_NE(hazards().find("reads 3 draw commands past the end of its indirect buffer"), std::string::npos);
+  EXPECT_EQ(glGetError(), GLenum(GL_INVALID_OPERATION));  // (GL refuses that draw; the first two were drawn)
+  EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
   glDisable(GL_RASTERIZER_DISCARD);
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
   glBindVertexArray(0);
