@@ -300,5 +300,46 @@ TEST_F(GlBarrierCheckTest, AnIndirectCommandPastItsElementBufferIsFound) {
   glDeleteProgram(program);
 }
 
+// A draw that samples a texture attached to the framebuffer it draws into is a feedback loop (undefined on a GPU);
+// sampling another target's texture is not.
+TEST_F(GlBarrierCheckTest, ADrawSamplingATextureOfItsOwnFramebufferIsAFeedbackLoop) {
+  const char* vs = "#version 450 core\nvoid main() { gl_Position = vec4(0.0, 0.0, 0.0, 1.0); }\n";
+  const char* fs = "#version 450 core\nlayout(binding = 0) uniform sampler2D u_in;\nout vec4 c;\n"
+                   "void main() { c = texelFetch(u_in, ivec2(0), 0); }\n";
+  GLuint shaders[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
+  nameGlShader(shaders[1], "copy.frag");
+  glShaderSource(shaders[0], 1, &vs, nullptr);
+  glShaderSource(shaders[1], 1, &fs, nullptr);
+  const GLuint program = glCreateProgram();
+  for (GLuint sh : shaders) {
+    glCompileShader(sh);
+    glAttachShader(program, sh);
+  }
+  glLinkProgram(program);
+  for (GLuint sh : shaders) glDeleteShader(sh);
+  RenderTarget a(4, 4), b(4, 4);
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glUseProgram(program);
+  a.bind();
+  glBindTextureUnit(0, b.colorTexture().handle());
+  glDrawArrays(GL_POINTS, 0, 1);
+  EXPECT_EQ(hazards(), "");
+  glBindTextureUnit(0, a.colorTexture().handle());
+  glDrawArrays(GL_POINTS, 0, 1);
+  EXPECT_NE(hazards().find("glDrawArrays (shader "), std::string::npos);
+  glBindTextureUnit(0, a.colorTexture().handle());
+  glDrawArrays(GL_POINTS, 0, 1);
+  EXPECT_NE(hazards().find("copy.frag) samples texture unit 0, a texture attached to the framebuffer it draws into "
+                           "(a feedback loop)"),
+            std::string::npos);
+  glBindTextureUnit(0, 0);
+  glBindVertexArray(0);
+  glUseProgram(0);
+  glDeleteVertexArrays(1, &vao);
+  glDeleteProgram(program);
+}
+
 }  // namespace
 }  // namespace farfield::gpu

@@ -77,6 +77,8 @@ struct State {
   std::unordered_map<GLuint, GLsizeiptr> buffer_bytes;  // storage sizes
   std::unordered_map<GLuint, GLuint> element_buffers;   // vertex array -> its element buffer
   GLuint vertex_array = 0;
+  std::unordered_map<GLuint, std::unordered_map<GLenum, GLuint>> attachments;  // framebuffer -> attachment -> texture
+  GLuint draw_framebuffer = 0;
   std::vector<GlBarrierHazard> hazards;
   std::unordered_map<std::string, size_t> hazard_index;
   GlBarrierCheckCounts counts;
@@ -184,6 +186,20 @@ void shaderAccesses(const Command& by, const Program& p) {
     if (const GLuint t = s.images.at(u)) leave(s.textures[t], has(p.written_images, u), "image unit", u);
 }
 
+// A draw that samples a texture attached to the framebuffer it draws into: a feedback loop, whose texels and
+// fragments are undefined (OpenGL 4.6, 8.14.2.1 and 9.3.1) even where llvmpipe's tiles happen to give the old ones.
+void feedbackLoops(const Command& by, const Program& p) {
+  State& s = t_state;
+  const auto fb = s.attachments.find(s.draw_framebuffer);
+  if (s.draw_framebuffer == 0 || fb == s.attachments.end()) return;
+  for (int u : p.samplers)
+    if (const GLuint t = s.units.at(u))
+      for (const auto& [attachment, texture] : fb->second)
+        if (texture == t)
+          record(name(by) + " samples texture unit " + std::to_string(u) +
+                 ", a texture attached to the framebuffer it draws into (a feedback loop)");
+}
+
 // The current program, or null (counted) when the check does not know it.
 const Program* current() {
   State& s = t_state;
@@ -270,6 +286,9 @@ void deleteTextures(GLsizei n, const GLuint* textures) {
   State& s = t_state;
   for (GLsizei i = 0; i < n; ++i) {
     s.textures.erase(textures[i]);
+    for (auto& [fb, attached] : s.attachments)
+      for (auto& [attachment, texture] : attached)
+        if (texture == textures[i]) texture = 0;
     s.units.forget(textures[i]);
     s.images.forget(textures[i]);
   }
@@ -300,6 +319,7 @@ void draw(const char* entry, bool indirect_commands, bool count) {
   const Program* p = current();
   if (!p) return;
   const Command by{entry, t_state.program};
+  feedbackLoops(by, *p);
   if (indirect_commands) indirect(t_state.draw_indirect, by, "its draw commands", true);
   if (count) indirect(t_state.parameter, by, "its draw count", true);
   shaderAccesses(by, *p);
@@ -320,6 +340,19 @@ void bufferStorage(GLuint buffer, GLsizeiptr bytes, bool with_data) {
   fresh.defined = with_data;
   t_state.buffers[buffer] = fresh;
   t_state.buffer_bytes[buffer] = bytes;
+}
+
+void framebufferTexture(GLuint framebuffer, GLenum attachment, GLuint texture) {
+  t_state.attachments[framebuffer][attachment] = texture;
+}
+void bindFramebuffer(GLenum target, GLuint framebuffer) {
+  if (target == GL_FRAMEBUFFER || target == GL_DRAW_FRAMEBUFFER) t_state.draw_framebuffer = framebuffer;
+}
+void deleteFramebuffers(GLsizei n, const GLuint* framebuffers) {
+  for (GLsizei i = 0; i < n; ++i) {
+    t_state.attachments.erase(framebuffers[i]);
+    if (t_state.draw_framebuffer == framebuffers[i]) t_state.draw_framebuffer = 0;
+  }
 }
 
 void vertexArrayElementBuffer(GLuint vertex_array, GLuint buffer) { t_state.element_buffers[vertex_array] = buffer; }

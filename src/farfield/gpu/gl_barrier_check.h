@@ -21,7 +21,8 @@
 // a copy's source): llvmpipe's fresh memory is usually zero, a GPU driver's may hold another buffer's old contents.
 // And an indexed indirect draw's commands are read back (by the driver's own entry point, outside the counted calls:
 // a wait that only the check makes) and each command's indices checked against the bound vertex array's element
-// buffer: llvmpipe fetches zeros past its end, where a GPU may fault.
+// buffer: llvmpipe fetches zeros past its end, where a GPU may fault. And a draw that samples a texture attached to
+// the framebuffer it draws into is a feedback loop (undefined texels and fragments on a GPU).
 //
 // Limits: whole buffers and textures (not ranges or levels); shaders' bindings as declared with layout(binding = N)
 // (a sampler unit set by glUniform1i is not followed); vertex and index buffers written by shaders are not followed

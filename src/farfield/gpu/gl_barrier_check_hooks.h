@@ -37,6 +37,10 @@ void mapBuffer(GLuint buffer, GLbitfield access);
 // Indexed indirect draws: every command read back (outside the counted calls) and its indices checked against the
 // bound vertex array's element buffer. `count_offset` >= 0: the draw count is read from the parameter buffer there.
 void vertexArrayElementBuffer(GLuint vertex_array, GLuint buffer);
+// Framebuffer attachments and the draw framebuffer: a draw that samples a texture attached to it is a feedback loop.
+void framebufferTexture(GLuint framebuffer, GLenum attachment, GLuint texture);
+void bindFramebuffer(GLenum target, GLuint framebuffer);
+void deleteFramebuffers(GLsizei n, const GLuint* framebuffers);
 void bindVertexArray(GLuint vertex_array);
 void indexedIndirect(const char* entry, GLenum type, const void* indirect, GLsizei drawcount, GLsizei stride,
                      GLintptr count_offset);

@@ -114,6 +114,9 @@ void ShadowReceiver::apply(const Camera& camera, const ShadowMap& map, const Sha
   glBindVertexArray(vao_);
   glDrawArrays(GL_TRIANGLES, 0, GLsizei(corners.size()));
   glBindVertexArray(0);
+  // The target's depth and ids unbound again: a later pass that draws into the target with a shader declaring a
+  // sampler at these units would otherwise hold them (a feedback loop if it samples them; gl_barrier_check.h).
+  for (GLuint unit : {0u, 1u, 2u}) glBindTextureUnit(unit, 0);
   glDisable(GL_BLEND);
   glDepthMask(GL_TRUE);
   glEnable(GL_DEPTH_TEST);
