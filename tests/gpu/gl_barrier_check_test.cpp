@@ -1,6 +1,6 @@
 // The barrier check (gpu/gl_barrier_check.h): the hazards it finds in small compute programs with each barrier left
 // out, and does not find with it. The GPU culler's and the crowd's passes have tests of their own, and every test's
-// GL calls are checked under ctest (support/test_support.cpp turns the check on, tests/CMakeLists.txt fails a test
+// GL calls are checked under `make test` (the Makefile sets FF_GL_BARRIER_CHECK=1, tests/CMakeLists.txt fails a test
 // that prints a hazard).
 #include "farfield/gpu/gl_barrier_check.h"
 

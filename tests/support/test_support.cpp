@@ -5,14 +5,6 @@
 #include <cstdlib>
 
 namespace farfield::test {
-namespace {
-
-// Every test process checks the memory barriers of its GL calls (gpu/gl_barrier_check.h; FF_GL_BARRIER_CHECK=0 in
-// the environment turns it off): a hazard is printed as "FF_GL_BARRIER_HAZARD: ...", which ctest counts as a failure
-// (tests/CMakeLists.txt). Set before main, so before any context is made.
-[[maybe_unused]] const bool g_barrier_check = [] { return setenv("FF_GL_BARRIER_CHECK", "1", 0) == 0; }();
-
-}  // namespace
 
 std::filesystem::path sharedDataDir() {
   const char* dir = std::getenv("FF_SHARED_DATA");

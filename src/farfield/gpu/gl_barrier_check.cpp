@@ -242,6 +242,7 @@ void shaderSource(GLuint shader, GLsizei count, const GLchar* const* strings, co
 
 void attachShader(GLuint program, GLuint shader) {
   State& s = t_state;
+  if (!s.programs.count(program)) s.program_names[program].clear();  // a new program (its name may be reused)
   Program& p = s.programs[program];
   if (const auto it = s.shaders.find(shader); it != s.shaders.end()) p.declared |= it->second;
   const GlslBindings& d = p.declared;

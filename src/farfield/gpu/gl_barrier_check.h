@@ -29,7 +29,8 @@
 // (Farfield's are not); programs compiled before the check was turned on are unknown to it and not checked.
 //
 // FF_GL_BARRIER_CHECK=1 in the environment turns it on for every context Farfield makes (gpu/context.h) and prints
-// each new hazard to stderr as "FF_GL_BARRIER_HAZARD: ...", which fails a test under ctest (tests/CMakeLists.txt).
+// each new hazard to stderr as "FF_GL_BARRIER_HAZARD: ...", which fails a test under ctest (tests/CMakeLists.txt;
+// `make test` sets the variable for every test).
 #pragma once
 
 #include <cstdint>
