@@ -1,9 +1,11 @@
 #include "farfield/gpu/gl_barrier_check.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -20,6 +22,8 @@ namespace barrier_check {
 
 std::atomic<bool> g_on{false};
 std::atomic<bool> g_print{true};
+// Totals over every thread, for the summary printed at exit (a thread's own state is gone by then).
+std::atomic<uint64_t> g_hazard_calls{0}, g_distinct_hazards{0}, g_checked{0}, g_unknown{0};
 
 namespace {
 
@@ -115,7 +119,9 @@ std::string place(const char* kind, int index) {
 void record(std::string message) {
   State& s = t_state;
   const auto [it, fresh] = s.hazard_index.emplace(message, s.hazards.size());
+  ++g_hazard_calls;
   if (fresh) {
+    ++g_distinct_hazards;
     s.hazards.push_back({std::move(message), 0});
     if (g_print.load(std::memory_order_relaxed))
       std::fprintf(stderr, "FF_GL_BARRIER_HAZARD: %s\n", s.hazards.back().message.c_str());
@@ -206,9 +212,11 @@ const Program* current() {
   const auto it = s.programs.find(s.program);
   if (it == s.programs.end()) {
     ++s.counts.unknown_program;
+    ++g_unknown;
     return nullptr;
   }
   ++s.counts.checked;
+  ++g_checked;
   return &it->second;
 }
 
@@ -454,7 +462,22 @@ void enableGlBarrierCheckFromEnvironment() {
     static bool warned = false;
     if (!warned) std::fprintf(stderr, "FF_GL_BARRIER_CHECK: the GL counters could not be installed; no check\n");
     warned = true;
+    return;
   }
+  // One line at exit, so that a quiet run is known to have been checked.
+  static std::once_flag summary;
+  std::call_once(summary, [] {
+    std::atexit([] {
+      using barrier_check::g_checked, barrier_check::g_distinct_hazards, barrier_check::g_hazard_calls;
+      std::fprintf(stderr, "gl barrier check: %llu hazards (%llu calls) in %llu dispatches and draws checked",
+                   static_cast<unsigned long long>(g_distinct_hazards.load()),
+                   static_cast<unsigned long long>(g_hazard_calls.load()),
+                   static_cast<unsigned long long>(g_checked.load()));
+      if (const uint64_t unknown = barrier_check::g_unknown.load())
+        std::fprintf(stderr, ", %llu of programs made before the check", static_cast<unsigned long long>(unknown));
+      std::fprintf(stderr, "\n");
+    });
+  });
 }
 
 }  // namespace farfield::gpu

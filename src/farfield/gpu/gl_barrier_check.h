@@ -28,9 +28,9 @@
 // (a sampler unit set by glUniform1i is not followed); vertex and index buffers written by shaders are not followed
 // (Farfield's are not); programs compiled before the check was turned on are unknown to it and not checked.
 //
-// FF_GL_BARRIER_CHECK=1 in the environment turns it on for every context Farfield makes (gpu/context.h) and prints
+// FF_GL_BARRIER_CHECK=1 in the environment turns it on for every context Farfield makes (gpu/context.h), prints
 // each new hazard to stderr as "FF_GL_BARRIER_HAZARD: ...", which fails a test under ctest (tests/CMakeLists.txt;
-// `make test` sets the variable for every test).
+// `make test` sets the variable for every test), and at exit one line: "gl barrier check: N hazards ...".
 #pragma once
 
 #include <cstdint>
