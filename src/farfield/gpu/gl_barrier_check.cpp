@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <unordered_map>
@@ -87,7 +88,23 @@ struct State {
   std::unordered_map<std::string, size_t> hazard_index;
   GlBarrierCheckCounts counts;
 };
-thread_local State t_state;
+// Each thread's state, made on its first followed call and kept until the process ends. A thread_local State itself
+// (a dynamic initialiser and a destructor per thread) made LeakSanitizer's exit-time tracer crash in tests whose
+// worker threads make GL calls; a plain pointer per thread and a registry do not.
+std::mutex g_states_mutex;
+std::vector<std::unique_ptr<State>>& states() {
+  static std::vector<std::unique_ptr<State>> all;
+  return all;
+}
+State& threadState() {
+  thread_local State* mine = nullptr;
+  if (!mine) {
+    const std::lock_guard<std::mutex> lock(g_states_mutex);
+    states().push_back(std::make_unique<State>());
+    mine = states().back().get();
+  }
+  return *mine;
+}
 
 const char* bitName(GLbitfield bit) {
   switch (bit) {
@@ -102,8 +119,8 @@ const char* bitName(GLbitfield bit) {
 }
 
 std::string programName(GLuint program) {
-  const auto it = t_state.program_names.find(program);
-  return it != t_state.program_names.end() ? it->second : "program " + std::to_string(program);
+  const auto it = threadState().program_names.find(program);
+  return it != threadState().program_names.end() ? it->second : "program " + std::to_string(program);
 }
 
 // "glDispatchCompute (gpu_cull.comp.glsl)"; a buffer operation has no program.
@@ -117,7 +134,7 @@ std::string place(const char* kind, int index) {
 }
 
 void record(std::string message) {
-  State& s = t_state;
+  State& s = threadState();
   const auto [it, fresh] = s.hazard_index.emplace(message, s.hazards.size());
   ++g_hazard_calls;
   if (fresh) {
@@ -156,7 +173,7 @@ bool has(const std::vector<int>& v, int x) { return std::find(v.begin(), v.end()
 // The shader accesses of a dispatch or draw by program `p`: first every check, then what the command leaves (reads
 // that later writes must be ordered after, writes that later reads need a barrier for).
 void shaderAccesses(const Command& by, const Program& p) {
-  State& s = t_state;
+  State& s = threadState();
   for (int i : p.buffers)
     if (const GLuint b = s.storage.at(i)) {
       const Resource& r = s.buffers[b];
@@ -195,7 +212,7 @@ void shaderAccesses(const Command& by, const Program& p) {
 // A draw that samples a texture attached to the framebuffer it draws into: a feedback loop, whose texels and
 // fragments are undefined (OpenGL 4.6, 8.14.2.1 and 9.3.1) even where llvmpipe's tiles happen to give the old ones.
 void feedbackLoops(const Command& by, const Program& p) {
-  State& s = t_state;
+  State& s = threadState();
   const auto fb = s.attachments.find(s.draw_framebuffer);
   if (s.draw_framebuffer == 0 || fb == s.attachments.end()) return;
   for (int u : p.samplers)
@@ -208,7 +225,7 @@ void feedbackLoops(const Command& by, const Program& p) {
 
 // The current program, or null (counted) when the check does not know it.
 const Program* current() {
-  State& s = t_state;
+  State& s = threadState();
   const auto it = s.programs.find(s.program);
   if (it == s.programs.end()) {
     ++s.counts.unknown_program;
@@ -224,7 +241,7 @@ const Program* current() {
 // accesses, marked read after them (the command's own writes come after its indirect read).
 void indirect(GLuint buffer, const Command& by, const char* what, bool check) {
   if (buffer == 0) return;
-  Resource& r = t_state.buffers[buffer];
+  Resource& r = threadState().buffers[buffer];
   if (check) {
     needs(r, GL_COMMAND_BARRIER_BIT, by, "reads", what);
     undefinedRead(r, by, what);
@@ -245,11 +262,11 @@ void shaderSource(GLuint shader, GLsizei count, const GLchar* const* strings, co
     if (lengths && lengths[i] >= 0) text.append(strings[i], size_t(lengths[i]));
     else text.append(strings[i]);
   }
-  t_state.shaders[shader] = glslBindings(text);
+  threadState().shaders[shader] = glslBindings(text);
 }
 
 void attachShader(GLuint program, GLuint shader) {
-  State& s = t_state;
+  State& s = threadState();
   if (!s.programs.count(program)) s.program_names[program].clear();  // a new program (its name may be reused)
   Program& p = s.programs[program];
   if (const auto it = s.shaders.find(shader); it != s.shaders.end()) p.declared |= it->second;
@@ -262,25 +279,25 @@ void attachShader(GLuint program, GLuint shader) {
   program_name += (program_name.empty() ? "" : " + ") + shader_name;
 }
 
-void deleteProgram(GLuint program) { t_state.programs.erase(program); }
-void useProgram(GLuint program) { t_state.program = program; }
+void deleteProgram(GLuint program) { threadState().programs.erase(program); }
+void useProgram(GLuint program) { threadState().program = program; }
 
 void bindBufferBase(GLenum target, GLuint index, GLuint buffer) {
-  if (target == GL_SHADER_STORAGE_BUFFER) t_state.storage.set(index, buffer);
+  if (target == GL_SHADER_STORAGE_BUFFER) threadState().storage.set(index, buffer);
 }
 
 void bindBuffer(GLenum target, GLuint buffer) {
-  State& s = t_state;
+  State& s = threadState();
   if (target == GL_DRAW_INDIRECT_BUFFER) s.draw_indirect = buffer;
   else if (target == GL_DISPATCH_INDIRECT_BUFFER) s.dispatch_indirect = buffer;
   else if (target == GL_PARAMETER_BUFFER_ARB) s.parameter = buffer;
 }
 
-void bindTextureUnit(GLuint unit, GLuint texture) { t_state.units.set(unit, texture); }
-void bindImageTexture(GLuint unit, GLuint texture) { t_state.images.set(unit, texture); }
+void bindTextureUnit(GLuint unit, GLuint texture) { threadState().units.set(unit, texture); }
+void bindImageTexture(GLuint unit, GLuint texture) { threadState().images.set(unit, texture); }
 
 void deleteBuffers(GLsizei n, const GLuint* buffers) {
-  State& s = t_state;
+  State& s = threadState();
   for (GLsizei i = 0; i < n; ++i) {
     const GLuint b = buffers[i];
     s.buffers.erase(b);
@@ -292,7 +309,7 @@ void deleteBuffers(GLsizei n, const GLuint* buffers) {
 }
 
 void deleteTextures(GLsizei n, const GLuint* textures) {
-  State& s = t_state;
+  State& s = threadState();
   for (GLsizei i = 0; i < n; ++i) {
     s.textures.erase(textures[i]);
     for (auto& [fb, attached] : s.attachments)
@@ -304,7 +321,7 @@ void deleteTextures(GLsizei n, const GLuint* textures) {
 }
 
 void memoryBarrier(GLbitfield bits) {
-  State& s = t_state;
+  State& s = threadState();
   for (auto& [id, r] : s.buffers) {
     r.owed &= ~bits;
     if (bits & GL_SHADER_STORAGE_BARRIER_BIT) r.read = false;
@@ -318,27 +335,27 @@ void memoryBarrier(GLbitfield bits) {
 void dispatch(const char* entry, bool indirect_size) {
   const Program* p = current();
   if (!p) return;
-  const Command by{entry, t_state.program};
-  if (indirect_size) indirect(t_state.dispatch_indirect, by, "its dispatch size", true);
+  const Command by{entry, threadState().program};
+  if (indirect_size) indirect(threadState().dispatch_indirect, by, "its dispatch size", true);
   shaderAccesses(by, *p);
-  if (indirect_size) indirect(t_state.dispatch_indirect, by, "its dispatch size", false);
+  if (indirect_size) indirect(threadState().dispatch_indirect, by, "its dispatch size", false);
 }
 
 void draw(const char* entry, bool indirect_commands, bool count) {
   const Program* p = current();
   if (!p) return;
-  const Command by{entry, t_state.program};
+  const Command by{entry, threadState().program};
   feedbackLoops(by, *p);
-  if (indirect_commands) indirect(t_state.draw_indirect, by, "its draw commands", true);
-  if (count) indirect(t_state.parameter, by, "its draw count", true);
+  if (indirect_commands) indirect(threadState().draw_indirect, by, "its draw commands", true);
+  if (count) indirect(threadState().parameter, by, "its draw count", true);
   shaderAccesses(by, *p);
-  if (indirect_commands) indirect(t_state.draw_indirect, by, "its draw commands", false);
-  if (count) indirect(t_state.parameter, by, "its draw count", false);
+  if (indirect_commands) indirect(threadState().draw_indirect, by, "its draw commands", false);
+  if (count) indirect(threadState().parameter, by, "its draw count", false);
 }
 
 void bufferUpdate(const char* entry, GLuint buffer, bool reads) {
-  const auto it = t_state.buffers.find(buffer);
-  if (it == t_state.buffers.end()) return;
+  const auto it = threadState().buffers.find(buffer);
+  if (it == threadState().buffers.end()) return;
   needs(it->second, GL_BUFFER_UPDATE_BARRIER_BIT, {entry, 0}, reads ? "reads" : "overwrites", "a buffer");
   if (reads) undefinedRead(it->second, {entry, 0}, "a buffer");
   else it->second.defined = true;  // (a partial write counts: the check does not follow ranges)
@@ -347,25 +364,25 @@ void bufferUpdate(const char* entry, GLuint buffer, bool reads) {
 void bufferStorage(GLuint buffer, GLsizeiptr bytes, bool with_data) {
   Resource fresh;
   fresh.defined = with_data;
-  t_state.buffers[buffer] = fresh;
-  t_state.buffer_bytes[buffer] = bytes;
+  threadState().buffers[buffer] = fresh;
+  threadState().buffer_bytes[buffer] = bytes;
 }
 
 void framebufferTexture(GLuint framebuffer, GLenum attachment, GLuint texture) {
-  t_state.attachments[framebuffer][attachment] = texture;
+  threadState().attachments[framebuffer][attachment] = texture;
 }
 void bindFramebuffer(GLenum target, GLuint framebuffer) {
-  if (target == GL_FRAMEBUFFER || target == GL_DRAW_FRAMEBUFFER) t_state.draw_framebuffer = framebuffer;
+  if (target == GL_FRAMEBUFFER || target == GL_DRAW_FRAMEBUFFER) threadState().draw_framebuffer = framebuffer;
 }
 void deleteFramebuffers(GLsizei n, const GLuint* framebuffers) {
   for (GLsizei i = 0; i < n; ++i) {
-    t_state.attachments.erase(framebuffers[i]);
-    if (t_state.draw_framebuffer == framebuffers[i]) t_state.draw_framebuffer = 0;
+    threadState().attachments.erase(framebuffers[i]);
+    if (threadState().draw_framebuffer == framebuffers[i]) threadState().draw_framebuffer = 0;
   }
 }
 
-void vertexArrayElementBuffer(GLuint vertex_array, GLuint buffer) { t_state.element_buffers[vertex_array] = buffer; }
-void bindVertexArray(GLuint vertex_array) { t_state.vertex_array = vertex_array; }
+void vertexArrayElementBuffer(GLuint vertex_array, GLuint buffer) { threadState().element_buffers[vertex_array] = buffer; }
+void bindVertexArray(GLuint vertex_array) { threadState().vertex_array = vertex_array; }
 
 namespace {
 
@@ -384,7 +401,7 @@ std::vector<T> readBack(GLuint buffer, GLintptr offset, size_t count) {
 
 void indexedIndirect(const char* entry, GLenum type, const void* indirect, GLsizei drawcount, GLsizei stride,
                      GLintptr count_offset) {
-  State& s = t_state;
+  State& s = threadState();
   const auto element = s.element_buffers.find(s.vertex_array);
   if (s.draw_indirect == 0 || element == s.element_buffers.end() || element->second == 0) return;
   const auto bytes = s.buffer_bytes.find(element->second);
@@ -420,12 +437,12 @@ void indexedIndirect(const char* entry, GLenum type, const void* indirect, GLsiz
 
 void mapBuffer(GLuint buffer, GLbitfield access) {
   if (access & GL_MAP_WRITE_BIT)
-    if (const auto it = t_state.buffers.find(buffer); it != t_state.buffers.end()) it->second.defined = true;
+    if (const auto it = threadState().buffers.find(buffer); it != threadState().buffers.end()) it->second.defined = true;
 }
 
 void textureUpdate(const char* entry, GLuint texture, bool reads) {
-  const auto it = t_state.textures.find(texture);
-  if (it != t_state.textures.end())
+  const auto it = threadState().textures.find(texture);
+  if (it != threadState().textures.end())
     needs(it->second, GL_TEXTURE_UPDATE_BARRIER_BIT, {entry, 0}, reads ? "reads" : "overwrites", "a texture");
 }
 
@@ -441,18 +458,18 @@ bool glBarrierCheckOn() { return barrier_check::on(); }
 
 void setGlBarrierHazardsPrinted(bool on) { barrier_check::g_print = on; }
 
-std::vector<GlBarrierHazard> glBarrierHazards() { return barrier_check::t_state.hazards; }
+std::vector<GlBarrierHazard> glBarrierHazards() { return barrier_check::threadState().hazards; }
 
 void clearGlBarrierHazards() {
-  barrier_check::t_state.hazards.clear();
-  barrier_check::t_state.hazard_index.clear();
-  barrier_check::t_state.counts = {};
+  barrier_check::threadState().hazards.clear();
+  barrier_check::threadState().hazard_index.clear();
+  barrier_check::threadState().counts = {};
 }
 
-GlBarrierCheckCounts glBarrierCheckCounts() { return barrier_check::t_state.counts; }
+GlBarrierCheckCounts glBarrierCheckCounts() { return barrier_check::threadState().counts; }
 
 void nameGlShader(uint32_t shader, const std::string& name) {
-  if (barrier_check::on()) barrier_check::t_state.shader_names[shader] = name;
+  if (barrier_check::on()) barrier_check::threadState().shader_names[shader] = name;
 }
 
 void enableGlBarrierCheckFromEnvironment() {
