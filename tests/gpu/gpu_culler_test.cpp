@@ -395,6 +395,7 @@ TEST_F(GpuCullerTest, AFrameWaitsForNothingAndDrawsOncePerMaterialGroupAndPhase)
 TEST_F(GpuCullerTest, EveryStageWriteIsFollowedByTheBarrierItsReadersNeed) {
   if (!installGlCounters() || !setGlBarrierCheck(true))
     GTEST_SKIP() << "GL counters unavailable (FF_GL_COUNTERS=0 or no EGL context)";
+  const SceneArena arena(scene_);  // made with the check on: its buffers' sizes are known to it
   for (const bool occlusion : {true, false})
     for (const bool compact : {true, false})
       for (const bool history : {true, false}) {
@@ -406,7 +407,7 @@ TEST_F(GpuCullerTest, EveryStageWriteIsFollowedByTheBarrierItsReadersNeed) {
         options.occlusion = occlusion;
         options.compact = compact;
         options.refine_history = history;
-        GpuCuller culler(*arena_, options);  // its programs compiled with the check on: known to it
+        GpuCuller culler(arena, options);  // its programs compiled with the check on: known to it
         for (const Camera& camera : walk(4, 5)) culled(culler, camera, RenderMode::Shaded);
         culler.setOcclusion(!occlusion);
         culled(culler, walk(4, 5).back(), RenderMode::ItemBuffer);
