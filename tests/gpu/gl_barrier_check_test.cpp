@@ -36,6 +36,27 @@ GLuint computeProgram(const std::string& source, const std::string& name) {
   return program;
 }
 
+// A program drawing a point at the origin with fragment shader `fragment`, compiled with the check on.
+GLuint pointProgram(const char* fragment, const std::string& name) {
+  const char* vertex = "#version 450 core\nvoid main() { gl_Position = vec4(0.0, 0.0, 0.0, 1.0); }\n";
+  GLuint shaders[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
+  nameGlShader(shaders[0], "point.vert");
+  nameGlShader(shaders[1], name);
+  glShaderSource(shaders[0], 1, &vertex, nullptr);
+  glShaderSource(shaders[1], 1, &fragment, nullptr);
+  const GLuint program = glCreateProgram();
+  for (GLuint sh : shaders) {
+    glCompileShader(sh);
+    glAttachShader(program, sh);
+  }
+  glLinkProgram(program);
+  for (GLuint sh : shaders) glDeleteShader(sh);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  EXPECT_EQ(ok, GL_TRUE) << name;
+  return program;
+}
+
 class GlBarrierCheckTest : public test::GpuTest {
  protected:
   void SetUp() override {
@@ -252,18 +273,8 @@ TEST_F(GlBarrierCheckTest, AReadOfABufferMadeWithoutDataBeforeAnythingWroteItIsF
 // Indexed indirect draws: a command whose indices pass the end of the element buffer is found (llvmpipe fetches
 // zeros there; a GPU may fault), and the same command within it is not.
 TEST_F(GlBarrierCheckTest, AnIndirectCommandPastItsElementBufferIsFound) {
-  const char* vs = "#version 450 core\nvoid main() { gl_Position = vec4(0.0, 0.0, 0.0, 1.0); }\n";
-  const char* fs = "#version 450 core\nout vec4 c;\nvoid main() { c = vec4(1.0); }\n";
-  GLuint shaders[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
-  glShaderSource(shaders[0], 1, &vs, nullptr);
-  glShaderSource(shaders[1], 1, &fs, nullptr);
-  const GLuint program = glCreateProgram();
-  for (GLuint sh : shaders) {
-    glCompileShader(sh);
-    glAttachShader(program, sh);
-  }
-  glLinkProgram(program);
-  for (GLuint sh : shaders) glDeleteShader(sh);
+  const GLuint program =
+      pointProgram("#version 450 core\nout vec4 c;\nvoid main() { c = vec4(1.0); }\n", "white.frag");
   const std::vector<uint32_t> indices{0, 1, 2, 0, 2, 3};  // 6 indices
   GLuint elements = 0, commands = 0, vao = 0;
   glCreateBuffers(1, &elements);
@@ -284,7 +295,7 @@ TEST_F(GlBarrierCheckTest, AnIndirectCommandPastItsElementBufferIsFound) {
   EXPECT_EQ(hazards(), "");
   glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, reinterpret_cast<const void*>(uintptr_t(20)), 1, 0);
   const std::string h = hazards();
-  EXPECT_NE(h.find("glMultiDrawElementsIndirect (shader "), std::string::npos) << h;
+  EXPECT_NE(h.find("glMultiDrawElementsIndirect (point.vert + white.frag)"), std::string::npos) << h;
   EXPECT_NE(h.find("draws a command whose indices [5, 8) pass the 6 of its element buffer"), std::string::npos) << h;
   glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, nullptr, 3, 0);  // a third command past the buffer
   EXPECT_NE(hazards().find("reads 3 draw commands past the end of its indirect buffer"), std::string::npos);
@@ -303,20 +314,9 @@ TEST_F(GlBarrierCheckTest, AnIndirectCommandPastItsElementBufferIsFound) {
 // A draw that samples a texture attached to the framebuffer it draws into is a feedback loop (undefined on a GPU);
 // sampling another target's texture is not.
 TEST_F(GlBarrierCheckTest, ADrawSamplingATextureOfItsOwnFramebufferIsAFeedbackLoop) {
-  const char* vs = "#version 450 core\nvoid main() { gl_Position = vec4(0.0, 0.0, 0.0, 1.0); }\n";
-  const char* fs = "#version 450 core\nlayout(binding = 0) uniform sampler2D u_in;\nout vec4 c;\n"
-                   "void main() { c = texelFetch(u_in, ivec2(0), 0); }\n";
-  GLuint shaders[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
-  nameGlShader(shaders[1], "copy.frag");
-  glShaderSource(shaders[0], 1, &vs, nullptr);
-  glShaderSource(shaders[1], 1, &fs, nullptr);
-  const GLuint program = glCreateProgram();
-  for (GLuint sh : shaders) {
-    glCompileShader(sh);
-    glAttachShader(program, sh);
-  }
-  glLinkProgram(program);
-  for (GLuint sh : shaders) glDeleteShader(sh);
+  const GLuint program = pointProgram("#version 450 core\nlayout(binding = 0) uniform sampler2D u_in;\nout vec4 c;\n"
+                                      "void main() { c = texelFetch(u_in, ivec2(0), 0); }\n",
+                                      "copy.frag");
   RenderTarget a(4, 4), b(4, 4);
   GLuint vao = 0;
   glCreateVertexArrays(1, &vao);
@@ -328,11 +328,8 @@ TEST_F(GlBarrierCheckTest, ADrawSamplingATextureOfItsOwnFramebufferIsAFeedbackLo
   EXPECT_EQ(hazards(), "");
   glBindTextureUnit(0, a.colorTexture().handle());
   glDrawArrays(GL_POINTS, 0, 1);
-  EXPECT_NE(hazards().find("glDrawArrays (shader "), std::string::npos);
-  glBindTextureUnit(0, a.colorTexture().handle());
-  glDrawArrays(GL_POINTS, 0, 1);
-  EXPECT_NE(hazards().find("copy.frag) samples texture unit 0, a texture attached to the framebuffer it draws into "
-                           "(a feedback loop)"),
+  EXPECT_NE(hazards().find("glDrawArrays (point.vert + copy.frag) samples texture unit 0, a texture attached to the "
+                           "framebuffer it draws into (a feedback loop)"),
             std::string::npos);
   glBindTextureUnit(0, 0);
   glBindVertexArray(0);
