@@ -18,8 +18,8 @@
 #endif
 
 #include "farfield/core/error.h"
-#include "farfield/gpu/gl_barrier_check.h"
 #include "farfield/core/log.h"
+#include "farfield/gpu/gl_barrier_check.h"
 
 namespace farfield::gpu {
 
