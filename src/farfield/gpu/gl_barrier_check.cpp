@@ -239,16 +239,17 @@ const Program* current() {
 
 // A command's indirect buffer (its commands, dispatch size or draw count): checked before the command's shader
 // accesses, marked read after them (the command's own writes come after its indirect read).
-void indirect(GLuint buffer, const Command& by, const char* what, bool check) {
+void indirectNeeds(GLuint buffer, const Command& by, const char* what) {
+  if (buffer == 0) return;
+  const Resource& r = threadState().buffers[buffer];
+  needs(r, GL_COMMAND_BARRIER_BIT, by, "reads", what);
+  undefinedRead(r, by, what);
+}
+void indirectRead(GLuint buffer, const Command& by) {
   if (buffer == 0) return;
   Resource& r = threadState().buffers[buffer];
-  if (check) {
-    needs(r, GL_COMMAND_BARRIER_BIT, by, "reads", what);
-    undefinedRead(r, by, what);
-  } else {
-    r.read = true;
-    r.reader = by;
-  }
+  r.read = true;
+  r.reader = by;
 }
 
 std::vector<int> list(const std::set<int>& s) { return {s.begin(), s.end()}; }
@@ -336,9 +337,9 @@ void dispatch(const char* entry, bool indirect_size) {
   const Program* p = current();
   if (!p) return;
   const Command by{entry, threadState().program};
-  if (indirect_size) indirect(threadState().dispatch_indirect, by, "its dispatch size", true);
+  if (indirect_size) indirectNeeds(threadState().dispatch_indirect, by, "its dispatch size");
   shaderAccesses(by, *p);
-  if (indirect_size) indirect(threadState().dispatch_indirect, by, "its dispatch size", false);
+  if (indirect_size) indirectRead(threadState().dispatch_indirect, by);
 }
 
 void draw(const char* entry, bool indirect_commands, bool count) {
@@ -346,11 +347,11 @@ void draw(const char* entry, bool indirect_commands, bool count) {
   if (!p) return;
   const Command by{entry, threadState().program};
   feedbackLoops(by, *p);
-  if (indirect_commands) indirect(threadState().draw_indirect, by, "its draw commands", true);
-  if (count) indirect(threadState().parameter, by, "its draw count", true);
+  if (indirect_commands) indirectNeeds(threadState().draw_indirect, by, "its draw commands");
+  if (count) indirectNeeds(threadState().parameter, by, "its draw count");
   shaderAccesses(by, *p);
-  if (indirect_commands) indirect(threadState().draw_indirect, by, "its draw commands", false);
-  if (count) indirect(threadState().parameter, by, "its draw count", false);
+  if (indirect_commands) indirectRead(threadState().draw_indirect, by);
+  if (count) indirectRead(threadState().parameter, by);
 }
 
 void bufferUpdate(const char* entry, GLuint buffer, bool reads) {
