@@ -36,11 +36,11 @@ demo: build-cli
 test: build
 	@cd $(BUILD) && FF_GL_BARRIER_CHECK=1 $(XVFB) ctest --output-on-failure -j $(JOBS) --timeout 900
 
-# intercept_tls_get_addr=0: GCC 12's sanitizer runtime (Debian 12's) takes a dynamic TLS block that
-# malloc placed 16 bytes past a page boundary for a pre-2.25 glibc block with a header, reads the two words before it
-# as the block's bounds, and LeakSanitizer's tracer dies scanning them at exit ("Tracer caught signal 11"), in
-# whichever test's allocations happen to put a GL driver's TLS block there (docs/DESIGN-NOTES.md, Sanitizer build).
-# Without the interceptor the blocks are ordinary heap blocks, reached through the thread's DTV, and still scanned.
+# intercept_tls_get_addr=0: GCC 12's sanitizer runtime (Debian 12's) takes a dynamic TLS block that malloc placed 16
+# bytes past a page boundary for a pre-2.25 glibc block with a header, reads the two words before it as the block's
+# bounds, and LeakSanitizer's tracer dies scanning them at exit ("Tracer caught signal 11"), in whichever test's
+# allocations happen to put a GL driver's TLS block there (docs/DESIGN-NOTES.md, Sanitizer build). Without the
+# interceptor the blocks are ordinary heap blocks, reached through the thread's DTV, and still scanned.
 # scripts/lsan_tls_repro.sh shows the crash and the option's fix on a ten-line program.
 test-asan: deps
 	@cmake -S . -B $(BUILD_ASAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFF_SANITIZE=ON -DFF_BUILD_BENCH=OFF $(CMAKE_FLAGS) >/dev/null
