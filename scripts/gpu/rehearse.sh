@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The GPU machine's run rehearsed on this machine (llvmpipe), before a session that is lent a GPU spends its 15
-# minutes on it: `make dist`'s tarball in .gpu/ (as the device tool carries it), the shared DEM in .gpu/data/ when
-# ../shared/data has it, and scripts/gpu/run-gpu-frame.sh with REHEARSE=1 (toy sizes; no libglvnd unpacked). Prints
-# each stage's return codes and fails if any is not 0.
+# minutes on it: `make dist`'s tarball in .gpu/ (as the device tool carries it), the shared DEM and models in
+# .gpu/data/ when ../shared/data has them, and scripts/gpu/run-gpu-frame.sh with REHEARSE=1 (toy sizes; no libglvnd
+# unpacked). Prints each stage's return codes and fails if any is not 0.
 #   scripts/gpu/rehearse.sh [OUT_DIR] [STAGES]     (defaults: out/rehearse; every stage of run-gpu-frame.sh)
 set -uo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
@@ -22,6 +22,11 @@ dem=$ROOT/../shared/data/terrain/bigtujunga_srtm30m_utm11.tif
 if [ -f "$dem" ]; then
   mkdir -p .gpu/data/terrain
   cp -f "$dem" .gpu/data/terrain/
+fi
+models=$ROOT/../shared/data/models
+if [ -f "$models/CesiumMan.glb" ] && [ -f "$models/Fox.glb" ]; then
+  mkdir -p .gpu/data/models
+  cp -f "$models/CesiumMan.glb" "$models/Fox.glb" .gpu/data/models/
 fi
 grep -qx '.gpu/' .git/info/exclude 2>/dev/null || { mkdir -p .git/info; echo '.gpu/' >> .git/info/exclude; }
 REHEARSE=1 SKIP_GL=1 OUT="$OUTD" STAGES="$STAGES" bash scripts/gpu/run-gpu-frame.sh > /dev/null 2>&1
