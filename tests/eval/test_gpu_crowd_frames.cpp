@@ -1,6 +1,7 @@
 // The frames the crowd runtime draws from the GPU crowd (gpu/gpu_crowd.h; issue 45) against the CPU path's frames on
 // a crowd of the built-in figures: policies, blended views, occlusion, shadows, budgets and levels of detail. Needs a
 // GL context (llvmpipe is enough).
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include "farfield/eval/gpu_crowd_input.h"
 #include "farfield/gen/street_network.h"
 #include "farfield/gpu/context.h"
+#include "farfield/gpu/gl_barrier_check.h"
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
 #include "farfield/image/metrics.h"
@@ -223,6 +225,31 @@ TEST(GpuCrowdGL, ShadowsFallWhereTheCpuPathsFall) {
   EXPECT_GE(double(both_dark), 0.95 * double(cpu_dark));  // nearly every CPU shadow pixel is a GPU one
   // The GPU path's map spans every receiver, so its texels are coarser (2.5x here) and its shadows a little wider.
   EXPECT_GE(double(both_dark), 0.7 * double(gpu_dark));
+}
+
+// The viewer's loop, frame after frame: the crowd simulated, then classified and drawn. The simulation follows the
+// last frame's draws of the lists with no barrier before it, which is right because it writes the poses and phases
+// alone. The barrier check follows what a shader declares it may write (gpu/gl_barrier_check.h), and until the check
+// reached the viewer's window the simulation declared the lists writable too (unused there: no frame was wrong, but
+// the check saw a write after the draws' reads and could not tell).
+TEST(GpuCrowdGL, TheNextFramesSimulationFollowsTheLastFramesDrawsWithoutAHazard) {
+  gpu::sharedHeadlessContext().makeCurrent();
+  if (!gpu::installGlCounters() || !gpu::setGlBarrierCheck(true))
+    GTEST_SKIP() << "GL counters unavailable (FF_GL_COUNTERS=0 or no EGL context)";
+  glMemoryBarrier(GL_ALL_BARRIER_BITS);
+  gpu::clearGlBarrierHazards();
+  CrowdScene scene;  // its programs compiled with the check on
+  const gpu::LightSettings light;
+  gpu::RenderTarget target(scene.camera.width, scene.camera.height);
+  for (int f = 0; f < 3; ++f) {
+    scene.gc.simulate(scene.t + 0.1f * float(f));
+    target.bindForOpaquePass();
+    scene.rt.drawGpu(scene.camera, scene.gc, runtime::CrowdPolicy::Mixed, light);
+  }
+  EXPECT_EQ(gpu::glBarrierCheckCounts().unknown_program, 0u);
+  EXPECT_GE(gpu::glBarrierCheckCounts().checked, 3u * 3u);
+  for (const gpu::GlBarrierHazard& h : gpu::glBarrierHazards())
+    ADD_FAILURE() << h.message << " (" << h.count << " calls)";
 }
 
 // Mixed's budget in milliseconds on the GPU path: the skinned draws are timed and their triangles copied, both read

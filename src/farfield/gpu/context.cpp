@@ -404,6 +404,7 @@ std::unique_ptr<Context> createWindow(const ContextOptions& options) {
   if (!problem.empty()) throw Error("OpenGL context", "glfw-window: " + problem);
   info.platform = "glfw-window";
   context->setInfo(info);
+  enableGlBarrierCheckFromEnvironment(true);  // FF_GL_BARRIER_CHECK, in a viewer's window too (gl_barrier_check.h)
   return context;
 }
 

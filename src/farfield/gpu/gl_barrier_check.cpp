@@ -473,10 +473,10 @@ void nameGlShader(uint32_t shader, const std::string& name) {
   if (barrier_check::on()) barrier_check::threadState().shader_names[shader] = name;
 }
 
-void enableGlBarrierCheckFromEnvironment() {
+void enableGlBarrierCheckFromEnvironment(bool window_context) {
   const char* env = std::getenv("FF_GL_BARRIER_CHECK");
   if (!env || !*env || std::strcmp(env, "0") == 0) return;
-  if (!installGlCounters() || !setGlBarrierCheck(true)) {
+  if (!installGlCounters(window_context) || !setGlBarrierCheck(true)) {
     static bool warned = false;
     if (!warned) std::fprintf(stderr, "FF_GL_BARRIER_CHECK: the GL counters could not be installed; no check\n");
     warned = true;

@@ -28,9 +28,10 @@
 // (a sampler unit set by glUniform1i is not followed); vertex and index buffers written by shaders are not followed
 // (Farfield's are not); programs compiled before the check was turned on are unknown to it and not checked.
 //
-// FF_GL_BARRIER_CHECK=1 in the environment turns it on for every context Farfield makes (gpu/context.h), prints
-// each new hazard to stderr as "FF_GL_BARRIER_HAZARD: ...", which fails a test under ctest (tests/CMakeLists.txt;
-// `make test` sets the variable for every test), and at exit one line: "gl barrier check: N hazards ...".
+// FF_GL_BARRIER_CHECK=1 in the environment turns it on for every context Farfield makes (gpu/context.h; a viewer's
+// GLFW window too), prints each new hazard to stderr as "FF_GL_BARRIER_HAZARD: ...", which fails a test under ctest
+// (tests/CMakeLists.txt; `make test` sets the variable for every test), and at exit one line: "gl barrier check: N
+// hazards ...".
 #pragma once
 
 #include <cstdint>
@@ -67,7 +68,7 @@ GlBarrierCheckCounts glBarrierCheckCounts();
 void nameGlShader(uint32_t shader, const std::string& name);
 
 // FF_GL_BARRIER_CHECK set (and not "0"): installs the GL counters and turns the check on.
-// Called by every context Farfield makes current for the first time.
-void enableGlBarrierCheckFromEnvironment();
+// Called by every context Farfield makes current for the first time (`window_context`: a GLFW window's).
+void enableGlBarrierCheckFromEnvironment(bool window_context = false);
 
 }  // namespace farfield::gpu

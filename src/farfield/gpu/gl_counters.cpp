@@ -392,11 +392,20 @@ const Entry kEntries[] = {
 
 }  // namespace
 
-bool installGlCounters() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    if (const char* env = std::getenv("FF_GL_COUNTERS"); env && std::strcmp(env, "0") == 0) return;
-    if (!eglGetCurrentContext()) return;  // only EGL contexts: a GLX-only process keeps libepoxy's own pointers
+bool installGlCounters(bool window_context) {
+  static std::mutex mutex;
+  static bool tried = false;  // an install was attempted with a context current (or turned off): never again
+  const std::lock_guard lock(mutex);
+  if (tried) return g_installed;
+  [&] {
+    if (const char* env = std::getenv("FF_GL_COUNTERS"); env && std::strcmp(env, "0") == 0) {
+      tried = true;
+      return;
+    }
+    // The entry points resolve through a current context: an EGL one, or a GLFW window's (GLX), whose calls the same
+    // pointers reach under libglvnd. Without one nothing is decided, and a later call may install.
+    if (!window_context && !eglGetCurrentContext()) return;
+    tried = true;
     g_get_integer = reinterpret_cast<PFNGLGETINTEGERVPROC>(eglGetProcAddress("glGetIntegerv"));
     g_get_query_iv = reinterpret_cast<PFNGLGETQUERYOBJECTIVPROC>(eglGetProcAddress("glGetQueryObjectiv"));
     if (!g_get_integer || !g_get_query_iv) return;
@@ -411,7 +420,7 @@ bool installGlCounters() {
         for (const Entry& e : kEntries) e.report(e.name);
       });
     }
-  });
+  }();
   return g_installed;
 }
 

@@ -42,10 +42,11 @@ struct GlCounters {
   friend GlCounters operator-(GlCounters a, const GlCounters& b) { return a -= b; }
 };
 
-// Points Farfield's GL entry points at the counting wrappers; needs a current context. Idempotent and thread-safe; the
-// first call installs for the whole process. Returns false (and counts nothing) where the driver's entry points
-// cannot be resolved; FF_GL_COUNTERS=0 in the environment turns it off.
-bool installGlCounters();
+// Points Farfield's GL entry points at the counting wrappers; needs a current context, an EGL one, or with
+// `window_context` a GLFW window's (GLX: a viewer's process may have no other). Idempotent and thread-safe; the first
+// call with a context current installs for the whole process, a call without one decides nothing. Returns false (and
+// counts nothing) where the driver's entry points cannot be resolved; FF_GL_COUNTERS=0 in the environment turns it off.
+bool installGlCounters(bool window_context = false);
 bool glCountersInstalled();
 // The calling thread's totals since installation (all zero before it).
 GlCounters glCounters();

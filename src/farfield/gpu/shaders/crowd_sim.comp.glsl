@@ -45,11 +45,19 @@ struct Command {
 layout(std430, binding = 0) readonly buffer Agents { Agent agents[]; };
 layout(std430, binding = 1) readonly buffer Routes { Route routes[]; };
 layout(std430, binding = 2) readonly buffer Points { vec4 points[]; };  // x, y, arc length at the point, z (ground)
-layout(std430, binding = 3) buffer Poses { vec4 poses[]; };            // per agent: feet x y z, heading
-layout(std430, binding = 4) buffer Phases { float phases[]; };         // per agent: animation phase [0, 1)
-layout(std430, binding = 5) readonly buffer Models { Model models[]; };
+// Each pass declares the blocks it uses, readonly where it only reads them: what a pass may write is what the
+// barrier check (gl_barrier_check.h) follows, so the simulation, which writes poses and phases alone, must not
+// declare the lists that the last frame's draws read.
+#ifdef FF_SIMULATE
+layout(std430, binding = 3) writeonly buffer Poses { vec4 poses[]; };   // per agent: feet x y z, heading
+layout(std430, binding = 4) writeonly buffer Phases { float phases[]; };  // per agent: animation phase [0, 1)
+#else
+layout(std430, binding = 3) readonly buffer Poses { vec4 poses[]; };
+layout(std430, binding = 4) readonly buffer Phases { float phases[]; };
 layout(std430, binding = 6) buffer Commands { Command commands[]; };   // per list
 layout(std430, binding = 7) buffer Lists { Record lists[]; };          // per list, u_capacity agents
+#endif
+layout(std430, binding = 5) readonly buffer Models { Model models[]; };
 
 uniform uint u_agents;
 uniform float u_time;
@@ -60,7 +68,9 @@ uniform uint u_capacity;       // agents a list holds
 // Occlusion (GpuCrowd::occludeBehind): the target's depth pyramid, and the camera that projects agents into it.
 // in view, of them left out behind the depth; under a budget: the first bucket over it, candidates over it, the
 // triangles kept, the triangles wanted; with levels of detail, the agents past their level's part of the list
+#ifndef FF_SIMULATE
 layout(std430, binding = 8) buffer Stats { uint stats[]; };
+#endif
 layout(binding = 2) uniform sampler2D u_depth;               // level 0: the target's depth
 layout(binding = 3) uniform sampler2D u_pyramid;             // levels 1.. in its mips 0..
 uniform int u_occlusion;
@@ -74,8 +84,10 @@ uniform vec2 u_light_scale;
 uniform vec3 u_to_light;
 uniform uint u_first_list;
 // The geometry budget: skinned triangles a frame (0: none), and the candidates' distance buckets.
+#ifndef FF_SIMULATE
 layout(std430, binding = 9) buffer Candidates { uint candidates[]; };  // per agent: its bucket, or kNone
 layout(std430, binding = 10) buffer Buckets { uint buckets[]; };       // per bucket: the candidates' triangles
+#endif
 uniform uint u_budget;
 uniform uint u_buckets;
 uniform float u_buckets_per_m;
@@ -86,7 +98,9 @@ const uint kNone = 0xFFFFFFFFu;
 // + level; the casters' from 16 * 8) and written into the commands by FF_LEVEL_COUNTS; an agent past a level's
 // capacity is an impostor.
 const uint kMaxLevels = 8u;
+#ifndef FF_SIMULATE
 layout(std430, binding = 11) buffer LevelCounts { uint level_counts[]; };
+#endif
 uniform float u_lod_m_per_m;
 uniform uint u_level_capacity;
 uniform uint u_level_command0;  // the command of level 1 of model 0; model m's level l: + m * 7 + l - 1 (the
