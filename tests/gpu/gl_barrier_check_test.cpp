@@ -12,29 +12,11 @@
 
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/render_target.h"
+#include "gpu/barrier_check_helpers.h"
 #include "gpu/gpu_fixture.h"
 
 namespace farfield::gpu {
 namespace {
-
-// A compute program compiled with the check on; the shader is named for the messages.
-GLuint computeProgram(const std::string& source, const std::string& name) {
-  const GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-  nameGlShader(shader, name);
-  const char* text = source.c_str();
-  glShaderSource(shader, 1, &text, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  EXPECT_EQ(ok, GL_TRUE) << name;
-  const GLuint program = glCreateProgram();
-  glAttachShader(program, shader);
-  glLinkProgram(program);
-  glDeleteShader(shader);
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  EXPECT_EQ(ok, GL_TRUE) << name;
-  return program;
-}
 
 // A program drawing a point at the origin with fragment shader `fragment`, compiled with the check on.
 GLuint pointProgram(const char* fragment, const std::string& name) {
@@ -66,23 +48,23 @@ class GlBarrierCheckTest : public test::GpuTest {
     setGlBarrierHazardsPrinted(false);  // these hazards are made on purpose (ctest fails on printed ones)
     glMemoryBarrier(GL_ALL_BARRIER_BITS);  // nothing owed from earlier tests
     clearGlBarrierHazards();
-    writer_ = computeProgram(R"(#version 450 core
+    writer_ = test::computeProgram(R"(#version 450 core
 layout(local_size_x = 1) in;
 layout(std430, binding = 0) buffer Out { uvec4 args; uint v[]; };
 void main() { args = uvec4(1u, 1u, 1u, 7u); v[0] = 5u; })",
                              "writer.comp");
-    reader_ = computeProgram(R"(#version 450 core
+    reader_ = test::computeProgram(R"(#version 450 core
 layout(local_size_x = 1) in;
 layout(std430, binding = 1) readonly buffer In { uvec4 args; uint v[]; };
 layout(std430, binding = 2) buffer Sum { uint total; };
 void main() { total += v[0]; })",
                              "reader.comp");
-    imager_ = computeProgram(R"(#version 450 core
+    imager_ = test::computeProgram(R"(#version 450 core
 layout(local_size_x = 1) in;
 layout(r32f, binding = 0) writeonly uniform image2D u_out;
 void main() { imageStore(u_out, ivec2(0), vec4(0.5)); })",
                              "imager.comp");
-    sampler_ = computeProgram(R"(#version 450 core
+    sampler_ = test::computeProgram(R"(#version 450 core
 layout(local_size_x = 1) in;
 layout(binding = 3) uniform sampler2D u_in;
 layout(std430, binding = 2) buffer Sum { float total; };
@@ -124,12 +106,7 @@ void main() { total += texelFetch(u_in, ivec2(0), 0).r; })",
     glMemoryBarrier(GL_ALL_BARRIER_BITS);  // its own write of buffers_[2] settled
   }
   // The hazards since the last call, as one string (empty: none), and a fresh start.
-  std::string hazards() {
-    std::string all;
-    for (const GlBarrierHazard& h : glBarrierHazards()) all += h.message + "\n";
-    clearGlBarrierHazards();
-    return all;
-  }
+  std::string hazards() { return test::takeHazards(); }
 
   GLuint writer_ = 0, reader_ = 0, imager_ = 0, sampler_ = 0;
   GLuint buffers_[3] = {};

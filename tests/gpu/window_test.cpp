@@ -1,5 +1,4 @@
 // GLFW window context: runs only with a display (xvfb-run -a farfield_tests_gpu --gtest_filter=*Window*).
-#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -12,6 +11,7 @@
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/renderer.h"
 #include "farfield/scene/builtin.h"
+#include "gpu/barrier_check_helpers.h"
 #include "gpu/gpu_fixture.h"
 
 namespace farfield::gpu {
@@ -71,22 +71,6 @@ TEST(GpuWindow, WindowContextRendersAndHandsBackToHeadless) {
   EXPECT_EQ(target.readIds().at(16, 16), 6u);
 }
 
-// A compute program whose one shader is named for the barrier check's messages.
-GLuint namedComputeProgram(const char* source, const std::string& name) {
-  const GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-  nameGlShader(shader, name);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  const GLuint program = glCreateProgram();
-  glAttachShader(program, shader);
-  glLinkProgram(program);
-  glDeleteShader(shader);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  EXPECT_EQ(ok, GL_TRUE) << name;
-  return program;
-}
-
 // A viewer's process may make no EGL context: FF_GL_BARRIER_CHECK must reach its window's GL calls too. Under ctest
 // this test is a process of its own, so the window is its first context (before 2026-12-07 the GL counters
 // installed only under an EGL context, and the viewer went unchecked: it hid a write after a read in the GPU crowd).
@@ -108,11 +92,11 @@ TEST(GpuWindow, AWindowsCallsAreCheckedForBarriers) {
   setGlBarrierHazardsPrinted(false);  // made on purpose (ctest fails a test that prints one)
   clearGlBarrierHazards();
 
-  const GLuint writer = namedComputeProgram(R"(#version 450 core
+  const GLuint writer = test::computeProgram(R"(#version 450 core
 layout(local_size_x = 1) in;
 layout(std430, binding = 0) buffer Out { uint v[]; };
 void main() { v[0] = 5u; })", "window-writer.comp");
-  const GLuint reader = namedComputeProgram(R"(#version 450 core
+  const GLuint reader = test::computeProgram(R"(#version 450 core
 layout(local_size_x = 1) in;
 layout(std430, binding = 0) readonly buffer In { uint v[]; };
 layout(std430, binding = 1) buffer Sum { uint total; };
@@ -130,10 +114,7 @@ void main() { total += v[0]; })", "window-reader.comp");
     glUseProgram(reader);
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
-    std::string all;
-    for (const GlBarrierHazard& h : glBarrierHazards()) all += h.message + "\n";
-    clearGlBarrierHazards();
-    return all;
+    return test::takeHazards();
   };
   EXPECT_EQ(run(true), "");
   const std::string missing = run(false);

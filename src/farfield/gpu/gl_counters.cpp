@@ -392,35 +392,38 @@ const Entry kEntries[] = {
 
 }  // namespace
 
+// Points the entry points at the wrappers, with the driver's from eglGetProcAddress; false where it has none.
+static bool installEntries() {
+  g_get_integer = reinterpret_cast<PFNGLGETINTEGERVPROC>(eglGetProcAddress("glGetIntegerv"));
+  g_get_query_iv = reinterpret_cast<PFNGLGETQUERYOBJECTIVPROC>(eglGetProcAddress("glGetQueryObjectiv"));
+  if (!g_get_integer || !g_get_query_iv) return false;
+  for (const Entry& e : kEntries)
+    if (void* proc = reinterpret_cast<void*>(eglGetProcAddress(e.name))) e.install(proc);
+  g_tick0 = ticks();
+  g_ns0 = nowNs();
+  if (const char* env = std::getenv("FF_GL_PROFILE"); env && std::strcmp(env, "0") != 0) {
+    g_profile = true;
+    std::atexit([] {
+      for (const Entry& e : kEntries) e.report(e.name);
+    });
+  }
+  return true;
+}
+
 bool installGlCounters(bool window_context) {
   static std::mutex mutex;
-  static bool tried = false;  // an install was attempted with a context current (or turned off): never again
+  static bool decided = false;  // attempted with a context current, or turned off: never again
   const std::lock_guard lock(mutex);
-  if (tried) return g_installed;
-  [&] {
-    if (const char* env = std::getenv("FF_GL_COUNTERS"); env && std::strcmp(env, "0") == 0) {
-      tried = true;
-      return;
-    }
-    // The entry points resolve through a current context: an EGL one, or a GLFW window's (GLX), whose calls the same
-    // pointers reach under libglvnd. Without one nothing is decided, and a later call may install.
-    if (!window_context && !eglGetCurrentContext()) return;
-    tried = true;
-    g_get_integer = reinterpret_cast<PFNGLGETINTEGERVPROC>(eglGetProcAddress("glGetIntegerv"));
-    g_get_query_iv = reinterpret_cast<PFNGLGETQUERYOBJECTIVPROC>(eglGetProcAddress("glGetQueryObjectiv"));
-    if (!g_get_integer || !g_get_query_iv) return;
-    for (const Entry& e : kEntries)
-      if (void* proc = reinterpret_cast<void*>(eglGetProcAddress(e.name))) e.install(proc);
-    g_tick0 = ticks();
-    g_ns0 = nowNs();
-    g_installed = true;
-    if (const char* env = std::getenv("FF_GL_PROFILE"); env && std::strcmp(env, "0") != 0) {
-      g_profile = true;
-      std::atexit([] {
-        for (const Entry& e : kEntries) e.report(e.name);
-      });
-    }
-  }();
+  if (decided) return g_installed;
+  if (const char* env = std::getenv("FF_GL_COUNTERS"); env && std::strcmp(env, "0") == 0) {
+    decided = true;
+    return false;
+  }
+  // The entry points resolve through a current context: an EGL one, or a GLFW window's (GLX), whose calls the same
+  // pointers reach under libglvnd. Without one nothing is decided, and a later call may install.
+  if (!window_context && !eglGetCurrentContext()) return false;
+  decided = true;
+  g_installed = installEntries();
   return g_installed;
 }
 
