@@ -134,6 +134,9 @@ const RegisterCommand reg("crowd", [](CLI::App& app) {
                     "crowd-mixed's skinned agents at the coarsest level of detail within this many pixels "
                     "(0: the mesh)")
       ->capture_default_str();
+  bench->add_flag("!--lod-distance-only", o.runtime.lod_texture,
+                  "A level's error for --skinned-lod is its distance to the mesh alone, not the larger of that and "
+                  "how far it moves a texel (its texture deviation)");
   bench->add_option("--skinned-lod-ratios", o.runtime.lod_ratios,
                     "The levels' triangles as fractions of the mesh's, decreasing, comma-separated")
       ->delimiter(',')

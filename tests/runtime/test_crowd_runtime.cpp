@@ -93,6 +93,14 @@ TEST_F(CrowdRuntimeGl, MixedDrawsSkinnedAgentsAtTheCoarsestLevelWithinTheBound) 
   ASSERT_EQ(level_m.size(), 4u);
   ASSERT_EQ(gm.levelCount(), 4u);
   for (size_t l = 1; l < 4; ++l) EXPECT_LE(gm.triangleCount(l), gm.triangleCount(0) / (size_t(1) << l));
+  // A level's error for the rule: the larger of its distance to the mesh and how far it moves a texel.
+  const std::span<const double> surface_m = rt.levelSurfaceDistances(0), texture_m = rt.levelTextureDeviations(0);
+  ASSERT_EQ(surface_m.size(), 4u);
+  ASSERT_EQ(texture_m.size(), 4u);
+  for (size_t l = 1; l < 4; ++l) {
+    EXPECT_GT(texture_m[l], 0.0);
+    EXPECT_EQ(level_m[l], std::max(surface_m[l], texture_m[l]));
+  }
 
   Camera camera = viewCamera(Vec3(0, 0, 1.7f), Vec3(10, 0, 1.0f), 128);
   const double focal = 128.0 / (2.0 * std::tan(double(camera.fov_y) / 2.0));

@@ -168,12 +168,16 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
   if (options.runtime.geometry_lod_px > 0.0) {
     md << "- crowd-mixed's skinned agents at the coarsest level of detail within "
        << fmt("%.2f", options.runtime.geometry_lod_px) << " px (levels held over every palette pose; "
-       << fmt("%.1f", result.lod_seconds) << " s to build):";
+       << fmt("%.1f", result.lod_seconds) << " s to build; a level's error "
+       << (options.runtime.lod_texture ? "the larger of its distance to the mesh and its texture deviation"
+                                       : "its distance to the mesh alone")
+       << ", given as distance / texture deviation):";
     for (size_t m = 0; m < result.level_m.size(); ++m) {
       md << " " << result.model_names[m];
       for (size_t l = 0; l < result.level_m[m].size(); ++l)
         md << (l == 0 ? " " : ", ") << thousands(size_t(result.level_triangles[m][l])) << " triangles "
-           << fmt("%.1f", result.level_m[m][l] * 100.0) << " cm";
+           << fmt("%.1f", result.level_surface_m[m][l] * 100.0) << " / "
+           << fmt("%.1f", result.level_texture_m[m][l] * 100.0) << " cm";
       md << ";";
     }
     md << "\n";
@@ -241,7 +245,8 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                            {"atlas_bytes", result.atlas_bytes[m]},
                            {"atlas_kib_per_frame", double(result.atlas_bytes[m]) / 1024.0 / l.frames},
                            {"switch_m", result.switch_m[m]}, {"level_triangles", result.level_triangles[m]},
-                           {"level_m", result.level_m[m]}});
+                           {"level_m", result.level_m[m]}, {"level_surface_m", result.level_surface_m[m]},
+                           {"level_texture_m", result.level_texture_m[m]}});
   }
   for (const CrowdRun& run : result.runs)
     for (const CrowdModeResult& r : run.modes)
@@ -319,6 +324,10 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       result.level_triangles.back().push_back(rt.gpuModel(m).triangleCount(l));
     const std::span<const double> level_m = rt.levelDistances(m);
     result.level_m.emplace_back(level_m.begin(), level_m.end());
+    const std::span<const double> level_surface_m = rt.levelSurfaceDistances(m);
+    result.level_surface_m.emplace_back(level_surface_m.begin(), level_surface_m.end());
+    const std::span<const double> level_texture_m = rt.levelTextureDeviations(m);
+    result.level_texture_m.emplace_back(level_texture_m.begin(), level_texture_m.end());
   }
   result.lod_seconds = rt.lodSeconds();
 

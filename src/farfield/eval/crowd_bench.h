@@ -106,6 +106,7 @@ struct CrowdBenchResult {
   // Per model, per level of detail (level 0 the mesh): triangles and distance to the mesh over the palette (metres).
   std::vector<std::vector<uint64_t>> level_triangles;
   std::vector<std::vector<double>> level_m;
+  std::vector<std::vector<double>> level_surface_m, level_texture_m;  // the two parts of level_m (lod_texture)
   double lod_seconds = 0.0;
   std::vector<double> switch_m;  // per model at the bench's camera
   double bake_seconds = 0.0;

@@ -74,7 +74,11 @@ CrowdRuntime::CrowdRuntime(std::span<const scene::SkinnedModel> models,
       // The colour regions are not passed as groups: holding their borders measured worse on the crowd bench
       // (docs/BENCHMARKS.md, Crowds: skinned levels of detail).
       levels = scene::deformingLevels(sm.mesh.indices, pose_positions, lod, sm.name, {}, sm.mesh.uvs);
-      for (const scene::DeformingLevel& l : levels) model.level_m.push_back(l.error);
+      for (const scene::DeformingLevel& l : levels) {
+        model.level_m.push_back(options.lod_texture ? std::max(l.error, l.texture_error) : l.error);
+        model.level_surface_m.push_back(l.error);
+        model.level_texture_m.push_back(l.texture_error);
+      }
       lod_seconds_ += timer.seconds();
     }
     model.gpu = std::make_unique<gpu::SkinnedGpuModel>(sm, to_agent, poses, levels, options.skinning);

@@ -93,6 +93,10 @@ struct CrowdRuntimeOptions {
   // geometry takes the coarsest level whose distance stays within geometry_lod_px pixels at its distance; 0: the
   // mesh alone. The Geometry policy (the baseline) always draws the mesh.
   double geometry_lod_px = 0.0;
+  // A level's error for that rule is the larger of its distance to the mesh and its texture deviation (how far it
+  // moves a texel, scene::textureDeviation): a textured figure's colours move with its triangles inside its outline
+  // too, and a pixel bound is a bound on how far anything on screen moves. Off: the distance alone.
+  bool lod_texture = true;
   // The levels' triangles as fractions of the mesh's: close steps, so that the rule finds a level near each distance.
   std::vector<double> lod_ratios{0.5, 0.35, 0.25, 0.18, 0.125, 0.09, 0.0625};
   // How skinned agents reach their palette pose (gpu::Skinning), in every policy and the atlas bake: the same images;
@@ -213,6 +217,10 @@ class CrowdRuntime {
   uint64_t modelTriangles(size_t m) const { return models_[m].gpu->triangleCount(); }
   // Model m's levels of detail: level 0 is the mesh (distance 0); their distances to it in agent metres.
   std::span<const double> levelDistances(size_t m) const { return models_[m].level_m; }
+  // Their distances to the mesh and texture deviations (scene::textureDeviation) apart, in agent metres; with
+  // lod_texture levelDistances are the larger of the two, without it the first.
+  std::span<const double> levelSurfaceDistances(size_t m) const { return models_[m].level_surface_m; }
+  std::span<const double> levelTextureDeviations(size_t m) const { return models_[m].level_texture_m; }
   double lodSeconds() const { return lod_seconds_; }
   // After draw or drawShadowed: agent i's level of detail if that call drew it as geometry; -1 for an impostor or an
   // agent not drawn (out of view, hidden, or i past the agents given).
@@ -228,7 +236,9 @@ class CrowdRuntime {
     float radius = 1.0f;
     float cycle_s = 1.0f;
     CrowdAtlasChoice choice;
-    std::vector<double> level_m{0.0};  // per level of detail: its distance to the mesh (agent metres)
+    std::vector<double> level_m{0.0};  // per level of detail: its error for the rule (agent metres)
+    std::vector<double> level_surface_m{0.0};  // per level of detail: its distance to the mesh (agent metres)
+    std::vector<double> level_texture_m{0.0};  // per level of detail: its texture deviation (agent metres)
   };
   // The camera's focal length in pixels (its image height over the field of view).
   static double focalOf(const Camera& camera);

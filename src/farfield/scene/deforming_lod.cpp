@@ -18,6 +18,7 @@
 #include "farfield/core/check.h"
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
+#include "farfield/scene/texture_deviation.h"
 
 namespace farfield::scene {
 
@@ -463,6 +464,7 @@ std::vector<DeformingLevel> deformingLevels(std::span<const uint32_t> indices,
     }
     DeformingLevel level = simplifier.level();
     level.error = deformingDistance(indices, level.indices, poses);
+    if (!uvs.empty()) level.texture_error = textureDeviation(indices, level.indices, poses, uvs);
     levels.push_back(std::move(level));
   }
   return levels;

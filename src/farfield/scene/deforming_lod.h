@@ -23,6 +23,8 @@ struct DeformingLevel {
   std::vector<uint32_t> source_triangles;
   // The largest distance between the level's surface and the full mesh's over every pose (deformingDistance).
   double error = 0.0;
+  // With uvs: the largest distance by which the level moves a texel over every pose (textureDeviation); 0 without.
+  double texture_error = 0.0;
 };
 
 struct DeformingLodOptions {
