@@ -103,7 +103,7 @@ struct CrowdBenchResult {
   std::vector<size_t> atlas_bytes;
   std::vector<uint64_t> model_triangles;
   std::vector<bool> model_cutout;  // per model: texels cut out (gpu::SkinnedGpuModel::cutout)
-  // Per model, per level of detail (level 0 the mesh): triangles and distance to the mesh over the palette (metres).
+  // Per model, per level of detail (level 0 the mesh): triangles and error over the palette (metres; lod_texture).
   std::vector<std::vector<uint64_t>> level_triangles;
   std::vector<std::vector<double>> level_m;
   std::vector<std::vector<double>> level_surface_m, level_texture_m;  // the two parts of level_m (lod_texture)

@@ -54,7 +54,8 @@ struct GpuCrowdModel {
   // impostors' 4-vertex strip (a DrawArraysIndirectCommand in the same 20-byte slot).
   uint32_t geometry_indices = 0, geometry_first_index = 0;
   // Levels of detail after the mesh (level 0), at most GpuCrowd::kMaxLevels - 1: each one's index range in the same
-  // index buffer and its distance to the mesh (agent metres, increasing), as runtime::CrowdRuntime's levels.
+  // index buffer and its error (agent metres, increasing: runtime::CrowdRuntime::levelDistances, its distance to
+  // the mesh or the larger of that and its texture deviation), as runtime::CrowdRuntime's levels.
   struct Level {
     uint32_t indices = 0, first_index = 0;
     float distance_m = 0.0f;

@@ -230,8 +230,8 @@ void CrowdRuntime::classify(const Camera& camera, std::span<const CrowdAgentStat
 }
 
 void CrowdRuntime::fitBudget(const Camera& camera, std::span<const CrowdAgentState> agents, CrowdFrameStats& stats) {
-  // Each agent's ladder: the level the bound gives it, with budget_coarsens the coarser levels whose distance to the
-  // mesh is under what an impostor inside its switch shows (impostor_m_), then the impostor. Both errors on screen
+  // Each agent's ladder: the level the bound gives it, with budget_coarsens the coarser levels whose error (level_m)
+  // is under what an impostor inside its switch shows (impostor_m_), then the impostor. Both errors on screen
   // are metres over the agent's distance. While the triangles exceed the budget, the step taken is the agent's whose
   // next rung shows the least: the largest error on screen ends as small as the budget allows.
   const size_t n = near_.size();

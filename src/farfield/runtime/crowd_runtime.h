@@ -89,9 +89,9 @@ struct CrowdRuntimeOptions {
   // coarser levels kept the budget at a lower PSNR than impostors of the farthest (docs/BENCHMARKS.md, Crowds).
   bool budget_coarsens = false;
   // Mixed's skinned agents at levels of detail that hold in every pose (scene::deformingLevels over the palette's
-  // poses in agent space, each level's distance to the mesh measured over every palette pose): an agent drawn as
-  // geometry takes the coarsest level whose distance stays within geometry_lod_px pixels at its distance; 0: the
-  // mesh alone. The Geometry policy (the baseline) always draws the mesh.
+  // poses in agent space, each level's error measured over every palette pose): an agent drawn as geometry takes
+  // the coarsest level whose error (lod_texture) stays within geometry_lod_px pixels at its distance; 0: the mesh
+  // alone. The Geometry policy (the baseline) always draws the mesh.
   double geometry_lod_px = 0.0;
   // A level's error for that rule is the larger of its distance to the mesh and its texture deviation (how far it
   // moves a texel, scene::textureDeviation): a textured figure's colours move with its triangles inside its outline
@@ -215,7 +215,7 @@ class CrowdRuntime {
   size_t atlasBytes() const;
   float cycleSeconds(size_t m) const { return models_[m].cycle_s; }
   uint64_t modelTriangles(size_t m) const { return models_[m].gpu->triangleCount(); }
-  // Model m's levels of detail: level 0 is the mesh (distance 0); their distances to it in agent metres.
+  // Model m's levels of detail: level 0 is the mesh (error 0); their errors for the rule in agent metres (lod_texture).
   std::span<const double> levelDistances(size_t m) const { return models_[m].level_m; }
   // Their distances to the mesh and texture deviations (scene::textureDeviation) apart, in agent metres; with
   // lod_texture levelDistances are the larger of the two, without it the first.

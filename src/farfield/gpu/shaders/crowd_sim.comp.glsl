@@ -27,7 +27,7 @@ struct Model {
                       // z: the mesh's triangles, w: levels of detail (1: the mesh alone)
   uvec4 counts;       // palette poses, atlas frames, azimuths, elevations
   vec4 grid;          // x: the views' largest elevation (radians)
-  vec4 level_m[2];    // per level (0..7): its distance to the mesh (agent metres; level 0: 0)
+  vec4 level_m[2];    // per level (0..7): its error (runtime::CrowdRuntime::levelDistances; agent metres; level 0: 0)
   uvec4 level_tris[2];  // per level: its triangles
 };
 // An agent as the crowd renderer's shaders read it (gpu::CrowdAgentGpu, 48 bytes).
@@ -93,7 +93,7 @@ uniform uint u_buckets;
 uniform float u_buckets_per_m;
 const uint kNone = 0xFFFFFFFFu;
 // Levels of detail (GpuCrowd::setLevelScale; u_lod_m_per_m > 0): a skinned agent takes the coarsest level whose
-// distance to the mesh is at most u_lod_m_per_m times its distance (runtime::CrowdRuntime::levelFor); level l of a
+// error (level_m) is at most u_lod_m_per_m times its distance (runtime::CrowdRuntime::levelFor); level l of a
 // model's geometry list holds u_level_capacity records from l * u_level_capacity, counted in level_counts (model * 8
 // + level; the casters' from 16 * 8) and written into the commands by FF_LEVEL_COUNTS; an agent past a level's
 // capacity is an impostor.
