@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,33 @@ TEST(CrowdBenchBuiltin, RunsOnTheBuiltInFiguresWithoutFiles) {
   EXPECT_LT(run.modes[1].psnr_mean, 99.0);
   EXPECT_NE(r.markdown.find("builtin:walker"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(o.out_dir) / "crowd.json"));
+}
+
+// The crowd pass's GL traffic per frame (gl_counters.h): the CPU path sends its agents' instances every frame, more
+// bytes for more agents in view; the GPU path keeps the crowd on the GPU, the same bytes at ten times the agents; no
+// mode waits for the GPU inside the crowd pass.
+TEST(CrowdBenchBuiltin, TheGpuCrowdUploadsNoAgentsAndNoModeWaitsForTheGpu) {
+  eval::CrowdBenchOptions o = tinyBench({});
+  o.gpu_crowd = true;
+  o.agent_counts = {60, 600};
+  const eval::CrowdBenchResult r = eval::runCrowdBench(gpu::sharedHeadlessContext(), o);
+  ASSERT_EQ(r.runs.size(), 2u);
+  auto mode = [&](size_t run, const std::string& name) -> const eval::CrowdModeResult& {
+    for (const eval::CrowdModeResult& m : r.runs[run].modes)
+      if (m.name == name) return m;
+    throw std::runtime_error("no mode " + name);
+  };
+  for (size_t run = 0; run < 2; ++run)
+    for (const eval::CrowdModeResult& m : r.runs[run].modes) {
+      EXPECT_EQ(m.syncs_max, 0.0) << m.name;
+      EXPECT_GT(m.draw_calls, 0.0) << m.name;
+    }
+  const eval::CrowdModeResult &cpu_few = mode(0, "crowd-impostor"), &cpu_many = mode(1, "crowd-impostor");
+  ASSERT_GT(cpu_many.in_view, 2.0 * cpu_few.in_view);
+  EXPECT_GT(cpu_many.upload_bytes, cpu_few.upload_bytes);
+  EXPECT_GE(cpu_many.upload_bytes, 16.0 * cpu_many.in_view) << "an instance is more than 16 bytes";
+  EXPECT_EQ(mode(0, "crowd-impostor-gpu").upload_bytes, mode(1, "crowd-impostor-gpu").upload_bytes);
+  EXPECT_LT(mode(1, "crowd-impostor-gpu").upload_bytes, cpu_many.upload_bytes);
 }
 
 TEST(CrowdBenchBuiltin, BadOptionsAreErrors) {

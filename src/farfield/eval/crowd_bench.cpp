@@ -2,17 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
 #include "farfield/core/timer.h"
+#include "farfield/eval/crowd_bench_report.h"
 #include "farfield/eval/crowd_metrics.h"
 #include "farfield/eval/gpu_crowd_input.h"
 #include "farfield/gpu/gl_counters.h"
@@ -80,193 +77,6 @@ runtime::CrowdFrameStats drawCrowd(runtime::CrowdRuntime& rt, const Camera& came
   runtime::CrowdShadowOptions shadow = options.shadow;
   shadow.impostor_casters = options.impostor_shadows && policy == runtime::CrowdPolicy::Mixed;
   return drawCrowdFrame(rt, camera, states, policy, light, target, options.shadows, shadow);
-}
-
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), f, v);
-  return buf;
-}
-
-std::string thousands(size_t v) {
-  const std::string digits = std::to_string(v);
-  std::string out;
-  for (size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out.push_back(',');
-    out.push_back(digits[i]);
-  }
-  return out;
-}
-
-}  // namespace
-
-namespace {
-
-// The run as a Markdown table with the city, models, atlases and bake time above it.
-std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOptions& options) {
-  std::ostringstream md;
-  md << "- city: generated, " << options.blocks << " blocks, detail " << options.detail << ", seed " << options.city_seed
-     << " (" << thousands(result.city_triangles) << " triangles, drawn in every mode as "
-     << (options.city_cpu ? "culled-cpu draws it: frustum, facing and occlusion culled on the CPU, depth read back"
-                          : "culled draws it: the GPU-driven frame, no readback")
-     << ")\n";
-  md << "- size " << options.width << "x" << options.height << ", " << options.frames << " measured frames per run (every "
-     << options.frame_step << "th frame of a 30 fps street walk, seed " << options.path_seed << "), one warm-up frame"
-     << (options.timing_passes > 1 ? ", each frame's time the fastest of " + std::to_string(options.timing_passes) +
-                                         " passes over the path"
-                                   : std::string())
-     << "\n";
-  md << "- renderer: " << result.renderer << "\n";
-  for (size_t m = 0; m < result.layouts.size(); ++m) {
-    const gpu::AtlasLayout& l = result.layouts[m];
-    const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
-    md << "- " << result.model_names[m] << ": " << thousands(result.model_triangles[m]) << " triangles"
-       << (result.model_cutout[m] ? " (texels cut out)" : " (opaque: no cut-out test)") << "; atlas "
-       << (c.from_bound ? "chosen from the bound (" + fmt("%.2f", options.runtime.error_px) + " px from " +
-                              fmt("%.1f", options.runtime.bound_switch_m) + " m on)"
-                        : std::string("fixed"))
-       << ": " << l.azimuths << "x" << l.elevations << (l.octahedral ? " octahedral" : "") << " views x " << l.frames
-       << " frames (frame error "
-       << fmt("%.3f", c.frame_error_m) << " m), cells " << l.cell_width << "x" << l.cell_height << " texels ("
-       << fmt("%.3f", c.texel_m) << " m), " << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0)
-       << " MiB uncompressed (" << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames)
-       << " KiB per frame, the lecture: about 256 KB compressed); switch to impostor beyond "
-       << fmt("%.1f", result.switch_m[m]) << " m\n";
-  }
-  if (options.runtime.blend_views) md << "- impostors blend the four views around the direction to the eye\n";
-  if (options.agent_occlusion) {
-    md << "- agents hidden behind the city left out in every mode (not in the reference), per frame:";
-    for (const CrowdRun& run : result.runs)
-      md << " " << thousands(run.agents) << " " << run.path << " "
-         << fmt("%.0f", run.modes.empty() ? 0.0 : run.modes[0].occluded) << " of "
-         << fmt("%.0f", run.modes.empty() ? 0.0 : run.modes[0].in_view) << " in view;";
-    md << "\n";
-  }
-  if (options.shadows)
-    md << "- shadows: one " << options.shadow.map_size << "x" << options.shadow.map_size << " map, receivers within "
-       << fmt("%.0f", options.shadow.distance_m) << " m, in the reference and every mode"
-       << (options.impostor_shadows ? " (crowd-mixed's geometry agents cast as impostors)" : "") << "\n";
-  md << "- skinning: "
-     << (options.runtime.skinning == gpu::Skinning::BakedPoses
-             ? "baked poses (each palette pose's vertices skinned once, read per agent)"
-             : "palette (four joint matrices blended per vertex)")
-     << ", in the reference and every mode\n";
-  if (options.runtime.geometry_ms > 0.0)
-    md << "- crowd-mixed's geometry budget in time: " << fmt("%.1f", options.runtime.geometry_ms)
-       << " ms of skinned drawing a frame, as triangles at the measured time per triangle (moving average)\n";
-  if (options.runtime.max_geometry_triangles > 0)
-    md << "- crowd-mixed's geometry budget: " << thousands(size_t(options.runtime.max_geometry_triangles))
-       << " skinned triangles a frame, the nearest agents first; the others inside their switch distance drawn as "
-          "impostors (\"over the budget\")"
-       << (options.runtime.budget_coarsens
-               ? "; coarser levels of detail too (\"coarsened for the budget\"), each step the least error on screen"
-               : "")
-       << "\n";
-  if (options.gpu_crowd && options.runtime.budget_coarsens)
-    md << "- crowd-mixed-gpu does not coarsen for the budget (--budget-coarsens is the CPU path's): the agents its "
-          "budget leaves out are impostors\n";
-  if (options.runtime.geometry_lod_px > 0.0) {
-    md << "- crowd-mixed's skinned agents at the coarsest level of detail within "
-       << fmt("%.2f", options.runtime.geometry_lod_px) << " px (levels held over every palette pose; "
-       << fmt("%.1f", result.lod_seconds) << " s to build; a level's error "
-       << (options.runtime.lod_texture ? "the larger of its distance to the mesh and its texture deviation"
-                                       : "its distance to the mesh alone")
-       << ", given as distance / texture deviation):";
-    for (size_t m = 0; m < result.level_m.size(); ++m) {
-      md << " " << result.model_names[m];
-      for (size_t l = 0; l < result.level_m[m].size(); ++l)
-        md << (l == 0 ? " " : ", ") << thousands(size_t(result.level_triangles[m][l])) << " triangles "
-           << fmt("%.1f", result.level_surface_m[m][l] * 100.0) << " / "
-           << fmt("%.1f", result.level_texture_m[m][l] * 100.0) << " cm";
-      md << ";";
-    }
-    md << "\n";
-  }
-  md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
-  md << "| agents | path | mode | median ms | crowd ms | crowd own CPU ms | speedup | crowd speedup | "
-        "geometry / impostor agents | triangles | PSNR dB (min) | >8/255 | popping mean / max (ref change) | "
-        "shadow casters / receiver px off |\n";
-  md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const CrowdRun& run : result.runs)
-    for (const CrowdModeResult& r : run.modes)
-      md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << fmt("%.1f", r.wall.median)
-         << " | " << fmt("%.1f", r.crowd.median) << " | " << fmt("%.3f", r.crowd_cpu.median) << " | "
-         << fmt("%.2fx", r.speedup) << " | "
-         << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
-         << fmt("%.0f", r.impostor_agents)
-         << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string())
-         << (r.coarser > 0.0 ? " (" + fmt("%.0f", r.coarser) + " coarser)" : std::string())
-         << (r.coarsened > 0.0 ? " (" + fmt("%.0f", r.coarsened) + " coarsened for the budget)" : std::string())
-         << " | "
-         << thousands(size_t(r.triangles)) << " | "
-         << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
-         << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
-         << fmt("%.2f", run.reference_popping_mean) << ") | " << fmt("%.0f", r.shadow_casters) << " / "
-         << fmt("%.0f", r.receiver_bad_pixels) << " |\n";
-  md << "\nThe CPU modes' agent states (poses and phases of every agent, eval::crowdAgentStates) are made before the "
-        "crowd pass, outside its time:";
-  for (const CrowdRun& run : result.runs) md << " " << fmt("%.2f", run.cpu_states_ms) << " ms (" << thousands(run.agents) << ", " << run.path << ")";
-  md << ". The crowd-*-gpu modes simulate every agent inside it.\n";
-  if (options.runtime.geometry_ms > 0.0) {
-    md << "\ncrowd-mixed's skinned draws against the " << fmt("%.1f", options.runtime.geometry_ms)
-       << " ms budget (the frames that drew skinned agents):\n";
-    for (const CrowdRun& run : result.runs)
-      for (const CrowdModeResult& r : run.modes)
-        if (r.skinned_ms.count > 0)
-          md << "- " << thousands(run.agents) << " agents, " << run.path << ", " << r.name << ": median "
-             << fmt("%.2f", r.skinned_ms.median) << " ms, max " << fmt("%.2f", r.skinned_ms.max) << " ms; "
-             << r.skinned_over << " of " << r.skinned_ms.count << " frames over\n";
-  }
-  return md.str();
-}
-
-// crowd.json and crowd.md in the output directory.
-void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& options) {
-  nlohmann::json j;
-  j["renderer"] = result.renderer;
-  j["city"] = {{"blocks", options.blocks}, {"detail", options.detail}, {"seed", options.city_seed},
-               {"triangles", result.city_triangles}, {"gen_seconds", result.city_seconds}};
-  j["size"] = {options.width, options.height};
-  j["bake_seconds"] = result.bake_seconds;
-  j["max_geometry_triangles"] = options.runtime.max_geometry_triangles;
-  j["budget_coarsens"] = options.runtime.budget_coarsens;
-  j["skinning"] = options.runtime.skinning == gpu::Skinning::BakedPoses ? "baked-poses" : "palette";
-  j["geometry_lod_px"] = options.runtime.geometry_lod_px;
-  j["lod_seconds"] = result.lod_seconds;
-  for (size_t m = 0; m < result.layouts.size(); ++m) {
-    const gpu::AtlasLayout& l = result.layouts[m];
-    const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
-    j["models"].push_back({{"file", result.model_names[m]}, {"triangles", result.model_triangles[m]},
-                           {"cutout", bool(result.model_cutout[m])},
-                           {"azimuths", l.azimuths}, {"elevations", l.elevations},
-                           {"octahedral", l.octahedral}, {"frames", l.frames},
-                           {"cell", {l.cell_width, l.cell_height}}, {"texel_m", c.texel_m},
-                           {"frame_error_m", c.frame_error_m}, {"from_bound", c.from_bound},
-                           {"atlas_bytes", result.atlas_bytes[m]},
-                           {"atlas_kib_per_frame", double(result.atlas_bytes[m]) / 1024.0 / l.frames},
-                           {"switch_m", result.switch_m[m]}, {"level_triangles", result.level_triangles[m]},
-                           {"level_m", result.level_m[m]}, {"level_surface_m", result.level_surface_m[m]},
-                           {"level_texture_m", result.level_texture_m[m]}});
-  }
-  for (const CrowdRun& run : result.runs)
-    for (const CrowdModeResult& r : run.modes)
-      j["runs"].push_back({{"agents", run.agents}, {"path", run.path}, {"mode", r.name},
-                           {"median_ms", r.wall.median}, {"p95_ms", r.wall.p95}, {"crowd_median_ms", r.crowd.median},
-                           {"crowd_own_cpu_median_ms", r.crowd_cpu.median}, {"cpu_states_ms", run.cpu_states_ms},
-                           {"speedup", r.speedup}, {"crowd_speedup", r.crowd_speedup}, {"psnr_db_mean", r.psnr_mean},
-                           {"psnr_db_min", r.psnr_min}, {"bad_pixel_share_mean", r.bad_share_mean},
-                           {"crowd_pixels_mean", r.crowd_pixels_mean}, {"popping_mean", r.popping_mean},
-                           {"popping_max", r.popping_max}, {"reference_change_mean", run.reference_popping_mean},
-                           {"geometry_agents", r.geometry_agents}, {"impostor_agents", r.impostor_agents},
-                           {"in_view", r.in_view}, {"occluded", r.occluded}, {"over_budget_agents", r.over_budget},
-                           {"coarser_agents", r.coarser}, {"coarsened_for_budget_agents", r.coarsened},
-                           {"triangles", r.triangles},
-                           {"shadow_casters", r.shadow_casters}, {"shadow_texel_m", r.shadow_texel_m},
-                           {"receiver_bad_pixels", r.receiver_bad_pixels},
-                           {"skinned_ms_median", r.skinned_ms.median}, {"skinned_ms_max", r.skinned_ms.max},
-                           {"skinned_frames", r.skinned_ms.count}, {"skinned_frames_over_budget", r.skinned_over}});
-  std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
-  std::ofstream(fs::path(options.out_dir) / "crowd.md") << result.markdown;
 }
 
 }  // namespace
@@ -369,7 +179,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       run.agents = count;
       run.path = path_name;
       std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), crowd_cpu(specs.size()),
-          psnr(specs.size()),
+          draws(specs.size()), uploads(specs.size()), syncs(specs.size()), psnr(specs.size()),
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
           in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
           receiver_bad(specs.size()), occluded(specs.size()), over_budget(specs.size()), coarser(specs.size()),
@@ -406,6 +216,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       // reference's city pixels), then the crowd.
       struct Timed {
         double total = 0.0, crowd = 0.0, crowd_cpu = 0.0;
+        gpu::GlCounters gl;    // the crowd pass's GL calls (its draws, uploads and waits for the GPU)
         double skinned = -1.0;  // crowd-mixed's measured skinned draws under runtime.geometry_ms; -1: none
         runtime::CrowdFrameStats stats;
       };
@@ -431,11 +242,14 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           if (options.agent_occlusion) mode_rt.cullBehind(target);
           out.stats = drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
         }
-        mode_rt.finish();
+        {
+          const gpu::GlMeasurement harness;  // the timed frame's end: the harness's wait, not the crowd's
+          mode_rt.finish();
+        }
         out.total = clock.milliseconds();
         out.crowd = out.total - city_ms;
-        const gpu::GlCounters gl_used = gpu::glCounters() - gl_before;
-        out.crowd_cpu = std::max(0.0, out.crowd - gl_used.driver_ms - gl_used.measure_ms);  // as frame_runner.cpp
+        out.gl = gpu::glCounters() - gl_before;
+        out.crowd_cpu = std::max(0.0, out.crowd - out.gl.driver_ms - out.gl.measure_ms);  // as frame_runner.cpp
         if (specs[m].gpu) {  // the lists' sizes, read after the timed frame
           const std::vector<gpu::GpuCrowdCommand> commands = gpu_crowd->readCommands();
           for (size_t m2 = 0; m2 < gpu_crowd->modelCount(); ++m2) {  // the camera's lists, each level's
@@ -489,6 +303,9 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           wall[m].push_back(timed.total);
           crowd_ms[m].push_back(timed.crowd);
           crowd_cpu[m].push_back(timed.crowd_cpu);
+          draws[m].push_back(double(timed.gl.draw_calls));
+          uploads[m].push_back(double(timed.gl.upload_bytes));
+          syncs[m].push_back(double(timed.gl.syncs));
           skinned[m].push_back(timed.skinned);
           geo[m].push_back(double(st.geometry));
           imp[m].push_back(double(st.impostors));
@@ -557,6 +374,10 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.wall = summarize(wall[m]);
         r.crowd = summarize(crowd_ms[m]);
         r.crowd_cpu = summarize(crowd_cpu[m]);
+        r.draw_calls = mean(draws[m]);
+        r.upload_bytes = mean(uploads[m]);
+        r.syncs = mean(syncs[m]);
+        r.syncs_max = syncs[m].empty() ? 0.0 : *std::max_element(syncs[m].begin(), syncs[m].end());
         std::vector<double> timed_skinned;
         for (double v : skinned[m])
           if (v >= 0.0) timed_skinned.push_back(v);

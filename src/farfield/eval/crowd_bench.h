@@ -70,6 +70,9 @@ struct CrowdModeResult {
   // Farfield's own CPU time in the crowd pass: its wall time less the time inside GL calls (gpu/gl_counters.h), ms.
   // The CPU modes' agent states (their poses and phases, CrowdRun::cpu_states_ms) are made before it.
   FrameSummary crowd_cpu;
+  // The crowd pass's GL calls per frame (gpu/gl_counters.h), means: draw calls, bytes uploaded, calls that waited
+  // for the GPU (the harness's own wait at the frame's end not counted); syncs_max the most in one frame.
+  double draw_calls = 0.0, upload_bytes = 0.0, syncs = 0.0, syncs_max = 0.0;
   double speedup = 0.0;        // median wall of crowd-geometry / this mode's
   double crowd_speedup = 0.0;  // the same on crowd time
   double psnr_mean = 0.0, psnr_min = 0.0, bad_share_mean = 0.0, crowd_pixels_mean = 0.0;
