@@ -83,12 +83,12 @@ double bruteDeviation(std::span<const uint32_t> full, std::span<const uint32_t> 
             nearest = std::min(nearest, deviation(f, w));
             continue;
           }
-          const Vec3 n = nearestBarycentric2(uv, a, c, d);
-          const float duv = glm::length(a * n.x + c * n.y + d * n.z - uv);
+          const Vec3 at = nearestBarycentric2(uv, a, c, d);  // (not `n`: the samples' steps)
+          const float duv = glm::length(a * at.x + c * at.y + d * at.z - uv);
           if (duv < nearest_uv) {
             nearest_uv = duv;
             nearest_f = f;
-            nearest_w = n;
+            nearest_w = at;
           }
         }
         if (!std::isfinite(nearest) && std::isfinite(nearest_uv)) nearest = deviation(nearest_f, nearest_w);
