@@ -155,6 +155,14 @@ TEST_F(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgai
   for (const char* file : {"crowd.json", "crowd.md"})
     EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(o.out_dir) / file)) << file;
   EXPECT_NE(r.markdown.find("crowd-mixed"), std::string::npos);
+  // The GPU's time of each frame and of its crowd pass: measured (not 0), the crowd's part of the frame's, and both
+  // inside the frame's wall time (the marks lie within it; half a millisecond for the clock reads around them).
+  for (const eval::CrowdModeResult& m : run.modes) {
+    EXPECT_GT(m.crowd_gpu.median, 0.0) << m.name;
+    EXPECT_GT(m.gpu.median, m.crowd_gpu.median) << m.name << ": the frame's GPU time holds the city's too";
+    EXPECT_LE(m.gpu.max, m.wall.max + 0.5) << m.name;
+    EXPECT_LE(m.crowd_gpu.min, m.crowd.min + 0.5) << m.name;
+  }
 }
 
 // With the agents hidden behind the city left out, every mode's agents are those in view less the hidden ones, and

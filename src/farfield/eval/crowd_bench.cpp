@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <sstream>
 
 #include "farfield/core/error.h"
@@ -15,6 +16,7 @@
 #include "farfield/gpu/gl_counters.h"
 #include "farfield/gpu/gpu_crowd.h"
 #include "farfield/gpu/gpu_culler.h"
+#include "farfield/gpu/stage_clock.h"
 #include "farfield/eval/crowd_walk.h"
 #include "farfield/eval/frame_runner.h"
 #include "farfield/eval/mode.h"
@@ -158,6 +160,11 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
     city_gpu = std::make_unique<gpu::GpuCuller>(res.context.arena());
     city_gpu->setAllObjects();
   }
+  // The GPU's time of each timed frame, marked before the city, between the city and the crowd, and after the crowd
+  // (timestamps: they may lie inside the crowd's own timer of its skinned draws), read after the frame's end.
+  gpu::StageClock gpu_clock(3, 2);
+  result.gpu_time_queries = gpu_clock.source() == gpu::GpuTimer::Source::Query;
+  uint64_t gpu_frame = 0;
 
   for (const std::string& path_name : options.paths) {
     if (path_name != "pedestrian" && path_name != "elevated")
@@ -179,6 +186,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       run.agents = count;
       run.path = path_name;
       std::vector<std::vector<double>> wall(specs.size()), crowd_ms(specs.size()), crowd_cpu(specs.size()),
+          gpu_ms(specs.size()), crowd_gpu(specs.size()),
           draws(specs.size()), uploads(specs.size()), syncs(specs.size()), psnr(specs.size()),
           bad(specs.size()), pixels(specs.size()), popping(specs.size()), geo(specs.size()), imp(specs.size()),
           in_view(specs.size()), tris(specs.size()), casters(specs.size()), shadow_texel(specs.size()),
@@ -216,17 +224,20 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
       // reference's city pixels), then the crowd.
       struct Timed {
         double total = 0.0, crowd = 0.0, crowd_cpu = 0.0;
+        double gpu = 0.0, crowd_gpu = 0.0;  // the GPU's time: the city and the crowd, the crowd alone
         gpu::GlCounters gl;    // the crowd pass's GL calls (its draws, uploads and waits for the GPU)
         double skinned = -1.0;  // crowd-mixed's measured skinned draws under runtime.geometry_ms; -1: none
         runtime::CrowdFrameStats stats;
       };
       auto drawTimed = [&](size_t m, const Camera& camera, std::span<const runtime::CrowdAgentState> states) {
         Timed out;
+        gpu_clock.beginFrame(gpu_frame++);
         Stopwatch clock;
         target.bindForOpaquePass();
         target.clear(light.sky_color);
         if (city_gpu) city_gpu->draw(camera, target, gpu::RenderMode::Shaded, light);
         else city_culler.draw(renderer, camera, items, item_bounds, target);
+        gpu_clock.mark(1);
         rt.finish();
         const double city_ms = clock.milliseconds();
         runtime::CrowdRuntime& mode_rt = specs[m].palette && rt_palette ? *rt_palette : rt;
@@ -242,6 +253,7 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           if (options.agent_occlusion) mode_rt.cullBehind(target);
           out.stats = drawCrowd(mode_rt, camera, states, specs[m].policy, light, target, options);
         }
+        gpu_clock.mark(2);
         {
           const gpu::GlMeasurement harness;  // the timed frame's end: the harness's wait, not the crowd's
           mode_rt.finish();
@@ -249,6 +261,10 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         out.total = clock.milliseconds();
         out.crowd = out.total - city_ms;
         out.gl = gpu::glCounters() - gl_before;
+        gpu_clock.finished([&](uint64_t, std::span<const double> stage_ms) {
+          out.gpu = stage_ms[0] + stage_ms[1];
+          out.crowd_gpu = stage_ms[1];
+        });
         out.crowd_cpu = std::max(0.0, out.crowd - out.gl.driver_ms - out.gl.measure_ms);  // as frame_runner.cpp
         if (specs[m].gpu) {  // the lists' sizes, read after the timed frame
           const std::vector<gpu::GpuCrowdCommand> commands = gpu_crowd->readCommands();
@@ -303,6 +319,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
           wall[m].push_back(timed.total);
           crowd_ms[m].push_back(timed.crowd);
           crowd_cpu[m].push_back(timed.crowd_cpu);
+          gpu_ms[m].push_back(timed.gpu);
+          crowd_gpu[m].push_back(timed.crowd_gpu);
           draws[m].push_back(double(timed.gl.draw_calls));
           uploads[m].push_back(double(timed.gl.upload_bytes));
           syncs[m].push_back(double(timed.gl.syncs));
@@ -356,6 +374,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
             wall[m][k - 1] = std::min(wall[m][k - 1], timed.total);
             crowd_ms[m][k - 1] = std::min(crowd_ms[m][k - 1], timed.crowd);
             crowd_cpu[m][k - 1] = std::min(crowd_cpu[m][k - 1], timed.crowd_cpu);
+            gpu_ms[m][k - 1] = std::min(gpu_ms[m][k - 1], timed.gpu);
+            crowd_gpu[m][k - 1] = std::min(crowd_gpu[m][k - 1], timed.crowd_gpu);
             if (timed.skinned >= 0.0)
               skinned[m][k - 1] = skinned[m][k - 1] < 0.0 ? timed.skinned : std::min(skinned[m][k - 1], timed.skinned);
           }
@@ -374,6 +394,8 @@ CrowdBenchResult runCrowdBench(gpu::Context& context, const CrowdBenchOptions& o
         r.wall = summarize(wall[m]);
         r.crowd = summarize(crowd_ms[m]);
         r.crowd_cpu = summarize(crowd_cpu[m]);
+        r.gpu = summarize(gpu_ms[m]);
+        r.crowd_gpu = summarize(crowd_gpu[m]);
         r.draw_calls = mean(draws[m]);
         r.upload_bytes = mean(uploads[m]);
         r.syncs = mean(syncs[m]);

@@ -70,6 +70,9 @@ struct CrowdModeResult {
   // Farfield's own CPU time in the crowd pass: its wall time less the time inside GL calls (gpu/gl_counters.h), ms.
   // The CPU modes' agent states (their poses and phases, CrowdRun::cpu_states_ms) are made before it.
   FrameSummary crowd_cpu;
+  // The GPU's time (gpu::StageClock: timestamp queries read after the frame; on a software rasterizer the CPU clock
+  // between waits for the GPU, so there about the wall time): the city and the crowd, and the crowd pass alone, ms.
+  FrameSummary gpu, crowd_gpu;
   // The crowd pass's GL calls per frame (gpu/gl_counters.h), means: draw calls, bytes uploaded, calls that waited
   // for the GPU (the harness's own wait at the frame's end not counted); syncs_max the most in one frame.
   double draw_calls = 0.0, upload_bytes = 0.0, syncs = 0.0, syncs_max = 0.0;
@@ -100,6 +103,7 @@ struct CrowdRun {
 
 struct CrowdBenchResult {
   std::vector<CrowdRun> runs;
+  bool gpu_time_queries = false;  // the GPU times are timestamp queries (else a software rasterizer's CPU clock)
   std::vector<std::string> model_names;
   std::vector<gpu::AtlasLayout> layouts;
   std::vector<runtime::CrowdAtlasChoice> atlas_choices;
