@@ -158,6 +158,32 @@ TEST(TextureDeviation, TheLocatorFindsEveryTriangleThatHoldsATexelAndTheNearestO
   }
 }
 
+// Uvs at the ends of the float range (a defect of real data that validation lets through: they are finite) make the
+// charts' span overflow; the locator still finds the triangles that hold a texel of the ordinary chart.
+TEST(TextureDeviation, TheLocatorCopesWithUvsAtTheEndsOfTheFloatRange) {
+  Grid g(3);
+  const float big = 3.0e38f;
+  const uint32_t first = uint32_t(g.uvs.size());
+  g.uvs.insert(g.uvs.end(), {Vec2(-big, -big), Vec2(big, -big), Vec2(-big, big)});
+  g.indices.insert(g.indices.end(), {first, first + 1, first + 2});
+  const UvLocator locator(g.indices, g.uvs);
+  std::vector<UvLocator::Hit> hits;
+  for (const Vec2 uv : {Vec2(0.1f, 0.2f), Vec2(0.5f, 0.5f), Vec2(0.9f, 0.7f)}) {
+    locator.locate(uv, hits);
+    bool in_grid = false;
+    for (const UvLocator::Hit& h : hits) {
+      const uint32_t t = h.triangle;
+      const Vec2 q = g.uvs[g.indices[3 * t]] * h.barycentric.x + g.uvs[g.indices[3 * t + 1]] * h.barycentric.y +
+                     g.uvs[g.indices[3 * t + 2]] * h.barycentric.z;
+      if (t < uint32_t(g.n * g.n * 2)) {
+        in_grid = true;
+        EXPECT_NEAR(glm::length(q - uv), 0.0f, 1e-5f) << uv.x << " " << uv.y;
+      }
+    }
+    EXPECT_TRUE(in_grid) << uv.x << " " << uv.y << ": the grid's triangle holding it";
+  }
+}
+
 TEST(TextureDeviation, AMergeMovesTheTextureOnlyWhereTheSurfaceIsNotLinearInItsUvs) {
   const Grid g(4);
   const uint32_t centre = g.at(2, 2), right = g.at(3, 2);

@@ -12,6 +12,10 @@ namespace {
 
 constexpr float kInside = -1e-5f;  // barycentric tolerance: a texel on a shared edge is held by both triangles
 
+// Grid coordinate g (in cells) as a cell of 0..n - 1; not a number (uvs near the float range's ends, whose span
+// overflows) as cell 0, where the lookup of such a uv finds nothing and falls back to the nearest triangle.
+int clampCell(float g, int n) { return g >= 0.0f ? (g < float(n) ? int(g) : n - 1) : 0; }
+
 }  // namespace
 
 Vec3 barycentric2(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c) {
@@ -50,10 +54,10 @@ UvLocator::UvLocator(std::span<const uint32_t> indices, std::span<const Vec2> uv
     const Vec2 &a = uvs[indices[3 * t]], &b = uvs[indices[3 * t + 1]], &c = uvs[indices[3 * t + 2]];
     const Vec2 l = (glm::min(a, glm::min(b, c)) - lo_) / size_ * float(n_);
     const Vec2 h = (glm::max(a, glm::max(b, c)) - lo_) / size_ * float(n_);
-    x0 = std::clamp(int(std::floor(l.x)), 0, n_ - 1);
-    y0 = std::clamp(int(std::floor(l.y)), 0, n_ - 1);
-    x1 = std::clamp(int(std::floor(h.x)), 0, n_ - 1);
-    y1 = std::clamp(int(std::floor(h.y)), 0, n_ - 1);
+    x0 = clampCell(l.x, n_);
+    y0 = clampCell(l.y, n_);
+    x1 = std::max(x0, clampCell(h.x, n_));
+    y1 = std::max(y0, clampCell(h.y, n_));
   };
   first_.assign(size_t(n_) * size_t(n_) + 1, 0);
   int x0, y0, x1, y1;
