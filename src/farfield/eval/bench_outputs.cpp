@@ -15,6 +15,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/core/log.h"
+#include "farfield/core/number_format.h"
 #include "farfield/eval/bench.h"
 
 namespace fs = std::filesystem;
@@ -31,12 +32,6 @@ std::string shellQuote(const std::string& s) {
       out += c;
   }
   return out + "'";
-}
-
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), format, v);
-  return buf;
 }
 
 std::string markdownHeader(const BenchResult& r) {
@@ -60,7 +55,7 @@ std::string markdownHeader(const BenchResult& r) {
   if (r.baseline_added) md << "- \"full\" was not asked for; it ran anyway as the baseline.\n";
   if (r.reference)
     md << "- error against full-geometry reference frames: PSNR (identical frames are capped at "
-       << fmt("%.0f", kPsnrCapDb) << " dB), SSIM, share of pixels off by more than " << r.bad_pixel_threshold
+       << formatNumber("%.0f", kPsnrCapDb) << " dB), SSIM, share of pixels off by more than " << r.bad_pixel_threshold
        << "/255; cracks = share of pixels where the reference shows geometry and the mode's frame shows sky "
           "(object ids); parallax = 99th percentile, over the pixels that show an object, of the distance (pixels) "
           "from each pixel to where the reference shows the object drawn there (0 where the objects agree; object "
@@ -79,7 +74,7 @@ std::string markdownHeader(const BenchResult& r) {
 // "bound px | frames over bound": "-" without a bound; "k of n" frames checked (n/a when none could be).
 std::string boundCells(const ModeResult& m) {
   if (!m.error_bound_px) return "- | -";
-  std::string bound = fmt("%.2f", *m.error_bound_px) + (m.error_bound_source == "mode" ? " (mode)" : "");
+  std::string bound = formatNumber("%.2f", *m.error_bound_px) + (m.error_bound_source == "mode" ? " (mode)" : "");
   if (m.frames_checked == 0) return bound + " | n/a";
   return bound + " | " + std::to_string(m.frames_over_bound) + " of " + std::to_string(m.frames_checked);
 }
@@ -94,22 +89,22 @@ std::string markdownTable(const BenchResult& r) {
         "---:|---:|---:|---:|\n";
   for (const ModeResult& m : r.modes) {
     const auto counted = [&](const std::string& v) { return m.calls.counted ? v : std::string("n/a"); };
-    md << "| " << m.name << " | " << fmt("%.2f", m.wall.median) << " | " << fmt("%.2f", m.wall.p95) << " | "
-       << fmt("%.2f", m.wall.p99) << " | " << fmt("%.2f", m.wall.max) << " | " << fmt("%.2f", m.gpu.median)
-       << " | " << counted(fmt("%.3f", m.cpu.median)) << " | " << fmt("%.0f", m.mean_triangles) << " | "
-       << fmt("%.1f", m.mean_draw_calls) << " | " << counted(fmt("%.0f", m.calls.gl_calls_mean)) << " | "
-       << counted(fmt("%.1f", m.calls.upload_bytes_mean / 1024.0)) << " | " << counted(fmt("%.2f", m.calls.syncs_mean))
-       << " | " << fmt("%.1f", m.mean_objects) << " | " << fmt("%.2f", m.speedup_vs_full) << "x | ";
+    md << "| " << m.name << " | " << formatNumber("%.2f", m.wall.median) << " | " << formatNumber("%.2f", m.wall.p95) << " | "
+       << formatNumber("%.2f", m.wall.p99) << " | " << formatNumber("%.2f", m.wall.max) << " | " << formatNumber("%.2f", m.gpu.median)
+       << " | " << counted(formatNumber("%.3f", m.cpu.median)) << " | " << formatNumber("%.0f", m.mean_triangles) << " | "
+       << formatNumber("%.1f", m.mean_draw_calls) << " | " << counted(formatNumber("%.0f", m.calls.gl_calls_mean)) << " | "
+       << counted(formatNumber("%.1f", m.calls.upload_bytes_mean / 1024.0)) << " | " << counted(formatNumber("%.2f", m.calls.syncs_mean))
+       << " | " << formatNumber("%.1f", m.mean_objects) << " | " << formatNumber("%.2f", m.speedup_vs_full) << "x | ";
     if (m.has_errors) {
-      const auto psnr = [](double v) { return v >= kPsnrCapDb ? std::string("identical") : fmt("%.2f", v); };
-      md << psnr(m.psnr_db_mean) << " | " << psnr(m.psnr_db_min) << " | " << fmt("%.4f", m.ssim_mean) << " | "
-         << fmt("%.3f", 100.0 * m.bad_pixel_share_mean) << "% | " << fmt("%.3f", 100.0 * m.crack_share_mean)
-         << "% | " << (m.has_parallax ? fmt("%.2f", m.parallax_px_mean) : std::string("n/a")) << " | "
-         << (m.has_parallax ? fmt("%.2f", m.parallax_px_max) : std::string("n/a")) << " | "
+      const auto psnr = [](double v) { return v >= kPsnrCapDb ? std::string("identical") : formatNumber("%.2f", v); };
+      md << psnr(m.psnr_db_mean) << " | " << psnr(m.psnr_db_min) << " | " << formatNumber("%.4f", m.ssim_mean) << " | "
+         << formatNumber("%.3f", 100.0 * m.bad_pixel_share_mean) << "% | " << formatNumber("%.3f", 100.0 * m.crack_share_mean)
+         << "% | " << (m.has_parallax ? formatNumber("%.2f", m.parallax_px_mean) : std::string("n/a")) << " | "
+         << (m.has_parallax ? formatNumber("%.2f", m.parallax_px_max) : std::string("n/a")) << " | "
          << boundCells(m) << " | ";
       if (m.has_popping)
-        md << fmt("%.3f", m.popping_summary.mean) << " | " << fmt("%.3f", m.popping_summary.p99) << " | "
-           << fmt("%.3f", m.popping_summary.max) << " |\n";
+        md << formatNumber("%.3f", m.popping_summary.mean) << " | " << formatNumber("%.3f", m.popping_summary.p99) << " | "
+           << formatNumber("%.3f", m.popping_summary.max) << " |\n";
       else
         md << "n/a | n/a | n/a |\n";
     } else {
@@ -238,11 +233,11 @@ std::string governorLines(const BenchResult& r) {
   std::string out;
   for (const ModeResult& m : r.modes) {
     if (!m.governed) continue;
-    out += "\n- " + m.name + ": t_max " + (r.t_max_ms ? fmt("%.2f", *r.t_max_ms) : std::string("-")) + " ms, " +
+    out += "\n- " + m.name + ": t_max " + (r.t_max_ms ? formatNumber("%.2f", *r.t_max_ms) : std::string("-")) + " ms, " +
            std::to_string(m.frames_over_tmax) + " of " + std::to_string(m.frames.size()) + " frames over it; " +
            std::to_string(m.frames_relaxed) + " frames relaxed (drawn at a coarser level), the bound kept up to " +
-           fmt("%.2f", m.bound_scale_max) + "x the promised one" +
-           (m.error_bound_px ? " (" + fmt("%.2f", *m.error_bound_px * m.bound_scale_max) + " px)" : std::string()) +
+           formatNumber("%.2f", m.bound_scale_max) + "x the promised one" +
+           (m.error_bound_px ? " (" + formatNumber("%.2f", *m.error_bound_px * m.bound_scale_max) + " px)" : std::string()) +
            "\n";
   }
   return out;
@@ -270,7 +265,7 @@ void writeFramesCsv(const BenchResult& r, const std::string& file) {
         const image::ImageMetrics& e = m.errors[k];
         const double p = k < m.parallax_px.size() ? m.parallax_px[k] : std::numeric_limits<double>::quiet_NaN();
         std::snprintf(line, sizeof(line), "%.4f,%.6f,%.6f,", e.psnr_db, e.ssim, e.bad_pixel_share);
-        out << line << (std::isnan(p) ? std::string() : fmt("%.3f", p)) << ",";
+        out << line << (std::isnan(p) ? std::string() : formatNumber("%.3f", p)) << ",";
       } else {
         out << ",,,,";
       }
@@ -281,7 +276,7 @@ void writeFramesCsv(const BenchResult& r, const std::string& file) {
         out << m.over_bound[k];
       out << ",";
       const double pop = k < m.popping.size() ? m.popping[k] : std::numeric_limits<double>::quiet_NaN();
-      out << (std::isnan(pop) ? std::string() : fmt("%.4f", pop)) << ",";
+      out << (std::isnan(pop) ? std::string() : formatNumber("%.4f", pop)) << ",";
       // The GL counters: empty where they were not installed.
       if (f.counted)
         std::snprintf(line, sizeof(line), "%.4f,%.4f,%llu,%u,%llu,%u,", f.cpu_ms, f.driver_ms,

@@ -1,35 +1,17 @@
 // The crowd bench's report: crowd.md's tables and crowd.json.
 #include "farfield/eval/crowd_bench_report.h"
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "farfield/core/number_format.h"
+
 namespace fs = std::filesystem;
 
 namespace farfield::eval {
-namespace {
-
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), f, v);
-  return buf;
-}
-
-std::string thousands(size_t v) {
-  const std::string digits = std::to_string(v);
-  std::string out;
-  for (size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out.push_back(',');
-    out.push_back(digits[i]);
-  }
-  return out;
-}
-
-}  // namespace
 
 std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOptions& options) {
   std::ostringstream md;
@@ -55,29 +37,29 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
     const runtime::CrowdAtlasChoice& c = result.atlas_choices[m];
     md << "- " << result.model_names[m] << ": " << thousands(result.model_triangles[m]) << " triangles"
        << (result.model_cutout[m] ? " (texels cut out)" : " (opaque: no cut-out test)") << "; atlas "
-       << (c.from_bound ? "chosen from the bound (" + fmt("%.2f", options.runtime.error_px) + " px from " +
-                              fmt("%.1f", options.runtime.bound_switch_m) + " m on)"
+       << (c.from_bound ? "chosen from the bound (" + formatNumber("%.2f", options.runtime.error_px) + " px from " +
+                              formatNumber("%.1f", options.runtime.bound_switch_m) + " m on)"
                         : std::string("fixed"))
        << ": " << l.azimuths << "x" << l.elevations << (l.octahedral ? " octahedral" : "") << " views x " << l.frames
        << " frames (frame error "
-       << fmt("%.3f", c.frame_error_m) << " m), cells " << l.cell_width << "x" << l.cell_height << " texels ("
-       << fmt("%.3f", c.texel_m) << " m), " << fmt("%.1f", double(result.atlas_bytes[m]) / 1048576.0)
-       << " MiB uncompressed (" << fmt("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames)
+       << formatNumber("%.3f", c.frame_error_m) << " m), cells " << l.cell_width << "x" << l.cell_height << " texels ("
+       << formatNumber("%.3f", c.texel_m) << " m), " << formatNumber("%.1f", double(result.atlas_bytes[m]) / 1048576.0)
+       << " MiB uncompressed (" << formatNumber("%.0f", double(result.atlas_bytes[m]) / 1024.0 / l.frames)
        << " KiB per frame, the lecture: about 256 KB compressed); switch to impostor beyond "
-       << fmt("%.1f", result.switch_m[m]) << " m\n";
+       << formatNumber("%.1f", result.switch_m[m]) << " m\n";
   }
   if (options.runtime.blend_views) md << "- impostors blend the four views around the direction to the eye\n";
   if (options.agent_occlusion) {
     md << "- agents hidden behind the city left out in every mode (not in the reference), per frame:";
     for (const CrowdRun& run : result.runs)
       md << " " << thousands(run.agents) << " " << run.path << " "
-         << fmt("%.0f", run.modes.empty() ? 0.0 : run.modes[0].occluded) << " of "
-         << fmt("%.0f", run.modes.empty() ? 0.0 : run.modes[0].in_view) << " in view;";
+         << formatNumber("%.0f", run.modes.empty() ? 0.0 : run.modes[0].occluded) << " of "
+         << formatNumber("%.0f", run.modes.empty() ? 0.0 : run.modes[0].in_view) << " in view;";
     md << "\n";
   }
   if (options.shadows)
     md << "- shadows: one " << options.shadow.map_size << "x" << options.shadow.map_size << " map, receivers within "
-       << fmt("%.0f", options.shadow.distance_m) << " m, in the reference and every mode"
+       << formatNumber("%.0f", options.shadow.distance_m) << " m, in the reference and every mode"
        << (options.impostor_shadows ? " (crowd-mixed's geometry agents cast as impostors)" : "") << "\n";
   md << "- skinning: "
      << (options.runtime.skinning == gpu::Skinning::BakedPoses
@@ -85,7 +67,7 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
              : "palette (four joint matrices blended per vertex)")
      << ", in the reference and every mode\n";
   if (options.runtime.geometry_ms > 0.0)
-    md << "- crowd-mixed's geometry budget in time: " << fmt("%.1f", options.runtime.geometry_ms)
+    md << "- crowd-mixed's geometry budget in time: " << formatNumber("%.1f", options.runtime.geometry_ms)
        << " ms of skinned drawing a frame, as triangles at the measured time per triangle (moving average)\n";
   if (options.runtime.max_geometry_triangles > 0)
     md << "- crowd-mixed's geometry budget: " << thousands(size_t(options.runtime.max_geometry_triangles))
@@ -100,8 +82,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
           "budget leaves out are impostors\n";
   if (options.runtime.geometry_lod_px > 0.0) {
     md << "- crowd-mixed's skinned agents at the coarsest level of detail within "
-       << fmt("%.2f", options.runtime.geometry_lod_px) << " px (levels held over every palette pose; "
-       << fmt("%.1f", result.lod_seconds) << " s to build; a level's error "
+       << formatNumber("%.2f", options.runtime.geometry_lod_px) << " px (levels held over every palette pose; "
+       << formatNumber("%.1f", result.lod_seconds) << " s to build; a level's error "
        << (options.runtime.lod_texture ? "the larger of its distance to the mesh and its texture deviation"
                                        : "its distance to the mesh alone")
        << ", given as distance / texture deviation):";
@@ -109,13 +91,13 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
       md << " " << result.model_names[m];
       for (size_t l = 0; l < result.level_m[m].size(); ++l)
         md << (l == 0 ? " " : ", ") << thousands(size_t(result.level_triangles[m][l])) << " triangles "
-           << fmt("%.1f", result.level_surface_m[m][l] * 100.0) << " / "
-           << fmt("%.1f", result.level_texture_m[m][l] * 100.0) << " cm";
+           << formatNumber("%.1f", result.level_surface_m[m][l] * 100.0) << " / "
+           << formatNumber("%.1f", result.level_texture_m[m][l] * 100.0) << " cm";
       md << ";";
     }
     md << "\n";
   }
-  md << "- bake: " << fmt("%.2f", result.bake_seconds) << " s for all models\n\n";
+  md << "- bake: " << formatNumber("%.2f", result.bake_seconds) << " s for all models\n\n";
   md << "| agents | path | mode | median ms | GPU ms | crowd ms | crowd GPU ms | crowd own CPU ms | "
         "crowd draws / KiB up / syncs | speedup | "
         "crowd speedup | geometry / impostor agents | triangles | PSNR dB (min) | >8/255 | "
@@ -123,34 +105,34 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
   md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const CrowdRun& run : result.runs)
     for (const CrowdModeResult& r : run.modes)
-      md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << fmt("%.1f", r.wall.median)
-         << " | " << fmt("%.1f", r.gpu.median) << " | " << fmt("%.1f", r.crowd.median) << " | "
-         << fmt("%.2f", r.crowd_gpu.median) << " | " << fmt("%.3f", r.crowd_cpu.median) << " | "
-         << fmt("%.0f", r.draw_calls) << " / " << fmt("%.1f", r.upload_bytes / 1024.0) << " / " << fmt("%.0f", r.syncs)
-         << " | " << fmt("%.2fx", r.speedup) << " | "
-         << fmt("%.2fx", r.crowd_speedup) << " | " << fmt("%.0f", r.geometry_agents) << " / "
-         << fmt("%.0f", r.impostor_agents)
-         << (r.over_budget > 0.0 ? " (" + fmt("%.0f", r.over_budget) + " over the budget)" : std::string())
-         << (r.coarser > 0.0 ? " (" + fmt("%.0f", r.coarser) + " coarser)" : std::string())
-         << (r.coarsened > 0.0 ? " (" + fmt("%.0f", r.coarsened) + " coarsened for the budget)" : std::string())
+      md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << formatNumber("%.1f", r.wall.median)
+         << " | " << formatNumber("%.1f", r.gpu.median) << " | " << formatNumber("%.1f", r.crowd.median) << " | "
+         << formatNumber("%.2f", r.crowd_gpu.median) << " | " << formatNumber("%.3f", r.crowd_cpu.median) << " | "
+         << formatNumber("%.0f", r.draw_calls) << " / " << formatNumber("%.1f", r.upload_bytes / 1024.0) << " / " << formatNumber("%.0f", r.syncs)
+         << " | " << formatNumber("%.2fx", r.speedup) << " | "
+         << formatNumber("%.2fx", r.crowd_speedup) << " | " << formatNumber("%.0f", r.geometry_agents) << " / "
+         << formatNumber("%.0f", r.impostor_agents)
+         << (r.over_budget > 0.0 ? " (" + formatNumber("%.0f", r.over_budget) + " over the budget)" : std::string())
+         << (r.coarser > 0.0 ? " (" + formatNumber("%.0f", r.coarser) + " coarser)" : std::string())
+         << (r.coarsened > 0.0 ? " (" + formatNumber("%.0f", r.coarsened) + " coarsened for the budget)" : std::string())
          << " | "
          << thousands(size_t(r.triangles)) << " | "
-         << fmt("%.1f", r.psnr_mean) << " (" << fmt("%.1f", r.psnr_min) << ") | " << fmt("%.3f", r.bad_share_mean)
-         << " | " << fmt("%.2f", r.popping_mean) << " / " << fmt("%.2f", r.popping_max) << " ("
-         << fmt("%.2f", run.reference_popping_mean) << ") | " << fmt("%.0f", r.shadow_casters) << " / "
-         << fmt("%.0f", r.receiver_bad_pixels) << " |\n";
+         << formatNumber("%.1f", r.psnr_mean) << " (" << formatNumber("%.1f", r.psnr_min) << ") | " << formatNumber("%.3f", r.bad_share_mean)
+         << " | " << formatNumber("%.2f", r.popping_mean) << " / " << formatNumber("%.2f", r.popping_max) << " ("
+         << formatNumber("%.2f", run.reference_popping_mean) << ") | " << formatNumber("%.0f", r.shadow_casters) << " / "
+         << formatNumber("%.0f", r.receiver_bad_pixels) << " |\n";
   md << "\nThe CPU modes' agent states (poses and phases of every agent, eval::crowdAgentStates) are made before the "
         "crowd pass, outside its time:";
-  for (const CrowdRun& run : result.runs) md << " " << fmt("%.2f", run.cpu_states_ms) << " ms (" << thousands(run.agents) << ", " << run.path << ")";
+  for (const CrowdRun& run : result.runs) md << " " << formatNumber("%.2f", run.cpu_states_ms) << " ms (" << thousands(run.agents) << ", " << run.path << ")";
   md << ". The crowd-*-gpu modes simulate every agent inside it.\n";
   if (options.runtime.geometry_ms > 0.0) {
-    md << "\ncrowd-mixed's skinned draws against the " << fmt("%.1f", options.runtime.geometry_ms)
+    md << "\ncrowd-mixed's skinned draws against the " << formatNumber("%.1f", options.runtime.geometry_ms)
        << " ms budget (the frames that drew skinned agents):\n";
     for (const CrowdRun& run : result.runs)
       for (const CrowdModeResult& r : run.modes)
         if (r.skinned_ms.count > 0)
           md << "- " << thousands(run.agents) << " agents, " << run.path << ", " << r.name << ": median "
-             << fmt("%.2f", r.skinned_ms.median) << " ms, max " << fmt("%.2f", r.skinned_ms.max) << " ms; "
+             << formatNumber("%.2f", r.skinned_ms.median) << " ms, max " << formatNumber("%.2f", r.skinned_ms.max) << " ms; "
              << r.skinned_over << " of " << r.skinned_ms.count << " frames over\n";
   }
   return md.str();

@@ -1,12 +1,12 @@
 #include "farfield/eval/html_report.h"
 
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <vector>
 
 #include "farfield/core/error.h"
+#include "farfield/core/number_format.h"
 
 namespace farfield::eval {
 namespace fs = std::filesystem;
@@ -18,12 +18,6 @@ std::string readFileBytes(const fs::path& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-std::string format(const char* fmt, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, fmt, value);
-  return buffer;
 }
 
 // A number field of a mode, none when absent or null; an error naming the field when it is not a number.
@@ -48,11 +42,11 @@ const nlohmann::json& modesOf(const nlohmann::json& bench, const std::string& wh
 }
 
 std::string cell(const std::optional<double>& v, const char* fmt, const char* none = "n/a") {
-  return v ? format(fmt, *v) : std::string(none);
+  return v ? formatNumber(fmt, *v) : std::string(none);
 }
 
 // MB as `farfield place` and the other commands print them: 2^20 bytes.
-std::string megabytes(uint64_t bytes) { return format("%.1f MB", double(bytes) / 1048576.0); }
+std::string megabytes(uint64_t bytes) { return formatNumber("%.1f MB", double(bytes) / 1048576.0); }
 
 std::string dataUri(const fs::path& png) { return "data:image/png;base64," + base64(readFileBytes(png)); }
 
@@ -214,12 +208,12 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
   h << "<div class=\"verdict " << (v.kept() ? "kept" : "broken") << "\">\n<p><b>" << htmlEscape(v.mode) << "</b>: "
     << (v.kept() ? "both promises kept" : "a promise was broken") << "</p>\n";
   if (v.t_max_ms)
-    h << "<p>t_max " << format("%.3g", *v.t_max_ms) << " ms met on <b>" << (v.frames - v.frames_over_tmax)
+    h << "<p>t_max " << formatNumber("%.3g", *v.t_max_ms) << " ms met on <b>" << (v.frames - v.frames_over_tmax)
       << " of " << v.frames << "</b> frames</p>\n";
   else
     h << "<p>t_max not checked (bench --tmax)</p>\n";
   if (v.bound_px)
-    h << "<p>error bound " << format("%.3g", *v.bound_px) << " px met on <b>"
+    h << "<p>error bound " << formatNumber("%.3g", *v.bound_px) << " px met on <b>"
       << (v.frames_checked_against_bound - v.frames_over_bound) << " of " << v.frames
       << "</b> frames (parallax p99 against the full-geometry reference)</p>\n";
   else
@@ -228,8 +222,8 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
     h << "<p>frame governor: <b>" << *v.frames_relaxed << " of " << v.frames
       << "</b> frames relaxed (drawn at a coarser level)"
       << (*v.frames_relaxed > 0
-              ? ", the bound kept up to " + format("%.3g", v.bound_scale_max) + "x the promised one" +
-                    (v.bound_px ? " (" + format("%.3g", *v.bound_px * v.bound_scale_max) + " px)" : std::string()) +
+              ? ", the bound kept up to " + formatNumber("%.3g", v.bound_scale_max) + "x the promised one" +
+                    (v.bound_px ? " (" + formatNumber("%.3g", *v.bound_px * v.bound_scale_max) + " px)" : std::string()) +
                     ", each frame checked against the bound it kept"
               : std::string())
       << "</p>\n";
@@ -249,8 +243,8 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
       h << "</p>\n";
     }
   }
-  h << "<p>speedup <b>" << format("%.2fx", v.speedup_vs_full) << "</b> over full geometry";
-  if (v.speedup_vs_culled) h << ", " << format("%.2fx", *v.speedup_vs_culled) << " over view-frustum culling";
+  h << "<p>speedup <b>" << formatNumber("%.2fx", v.speedup_vs_full) << "</b> over full geometry";
+  if (v.speedup_vs_culled) h << ", " << formatNumber("%.2fx", *v.speedup_vs_culled) << " over view-frustum culling";
   h << " (median frame time)</p>\n";
   {
     // What the verdict's mode asks of the machine per frame (null in runs before GL calls were counted).
@@ -259,8 +253,8 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
     const std::optional<double> cpu = optionalNumber(mode, "cpu_median_ms", at);
     const std::optional<double> syncs = optionalNumber(mode, "mean_syncs", at);
     if (cpu && syncs)
-      h << "<p>Farfield's own CPU time " << format("%.3f", *cpu) << " ms a frame (median), "
-        << format("%.0f", number(mode, "mean_draw_calls", at)) << " draw calls and " << format("%.2f", *syncs)
+      h << "<p>Farfield's own CPU time " << formatNumber("%.3f", *cpu) << " ms a frame (median), "
+        << formatNumber("%.0f", number(mode, "mean_draw_calls", at)) << " draw calls and " << formatNumber("%.2f", *syncs)
         << " CPU-GPU synchronisations a frame</p>\n";
   }
   h << "</div>\n";
@@ -296,19 +290,19 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
     const std::optional<double> tmax = optionalNumber(mode, "t_max_ms", at);
     const std::optional<double> psnr = optionalNumber(mode, "psnr_db_mean", at);
     const std::optional<double> cracks = optionalNumber(mode, "crack_share_mean", at);
-    h << "<tr><td>" << htmlEscape(name) << "</td><td>" << format("%.2f", number(mode, "median_ms", at)) << "</td><td>"
-      << format("%.2f", number(mode, "p95_ms", at)) << "</td><td>" << format("%.2f", number(mode, "p99_ms", at))
-      << "</td><td>" << format("%.2f", number(mode, "max_ms", at)) << "</td><td>"
+    h << "<tr><td>" << htmlEscape(name) << "</td><td>" << formatNumber("%.2f", number(mode, "median_ms", at)) << "</td><td>"
+      << formatNumber("%.2f", number(mode, "p95_ms", at)) << "</td><td>" << formatNumber("%.2f", number(mode, "p99_ms", at))
+      << "</td><td>" << formatNumber("%.2f", number(mode, "max_ms", at)) << "</td><td>"
       << cell(optionalNumber(mode, "gpu_median_ms", at), "%.2f") << "</td><td>"
       << cell(optionalNumber(mode, "cpu_median_ms", at), "%.3f") << "</td><td>"
-      << format("%.0f", number(mode, "mean_triangles", at)) << "</td><td>"
-      << format("%.0f", number(mode, "mean_draw_calls", at)) << "</td><td>"
+      << formatNumber("%.0f", number(mode, "mean_triangles", at)) << "</td><td>"
+      << formatNumber("%.0f", number(mode, "mean_draw_calls", at)) << "</td><td>"
       << cell(optionalNumber(mode, "mean_gl_calls", at), "%.0f") << "</td><td>"
       << cell(kilobytes(optionalNumber(mode, "mean_upload_bytes", at)), "%.1f") << "</td><td>"
       << cell(optionalNumber(mode, "mean_syncs", at), "%.2f") << "</td><td>"
-      << format("%.2fx", number(mode, "speedup_vs_full", at)) << "</td><td>"
+      << formatNumber("%.2fx", number(mode, "speedup_vs_full", at)) << "</td><td>"
       << (psnr && *psnr >= psnr_cap ? std::string("identical") : cell(psnr, "%.2f")) << "</td><td>"
-      << (cracks ? format("%.3f%%", *cracks * 100.0) : std::string("n/a")) << "</td><td>"
+      << (cracks ? formatNumber("%.3f%%", *cracks * 100.0) : std::string("n/a")) << "</td><td>"
       << cell(optionalNumber(mode, "parallax_p99_px_mean", at), "%.2f") << "</td><td>"
       << (bound ? std::to_string(size_t(number(mode, "frames_over_bound", at))) + "/" + std::to_string(v.frames)
                 : std::string("-"))
