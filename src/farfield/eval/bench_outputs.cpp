@@ -89,22 +89,25 @@ std::string markdownTable(const BenchResult& r) {
         "---:|---:|---:|---:|\n";
   for (const ModeResult& m : r.modes) {
     const auto counted = [&](const std::string& v) { return m.calls.counted ? v : std::string("n/a"); };
-    md << "| " << m.name << " | " << formatNumber("%.2f", m.wall.median) << " | " << formatNumber("%.2f", m.wall.p95) << " | "
-       << formatNumber("%.2f", m.wall.p99) << " | " << formatNumber("%.2f", m.wall.max) << " | " << formatNumber("%.2f", m.gpu.median)
-       << " | " << counted(formatNumber("%.3f", m.cpu.median)) << " | " << formatNumber("%.0f", m.mean_triangles) << " | "
-       << formatNumber("%.1f", m.mean_draw_calls) << " | " << counted(formatNumber("%.0f", m.calls.gl_calls_mean)) << " | "
-       << counted(formatNumber("%.1f", m.calls.upload_bytes_mean / 1024.0)) << " | " << counted(formatNumber("%.2f", m.calls.syncs_mean))
-       << " | " << formatNumber("%.1f", m.mean_objects) << " | " << formatNumber("%.2f", m.speedup_vs_full) << "x | ";
+    md << "| " << m.name << " | " << formatNumber("%.2f", m.wall.median) << " | " << formatNumber("%.2f", m.wall.p95)
+       << " | " << formatNumber("%.2f", m.wall.p99) << " | " << formatNumber("%.2f", m.wall.max) << " | "
+       << formatNumber("%.2f", m.gpu.median) << " | " << counted(formatNumber("%.3f", m.cpu.median)) << " | "
+       << formatNumber("%.0f", m.mean_triangles) << " | " << formatNumber("%.1f", m.mean_draw_calls) << " | "
+       << counted(formatNumber("%.0f", m.calls.gl_calls_mean)) << " | "
+       << counted(formatNumber("%.1f", m.calls.upload_bytes_mean / 1024.0)) << " | "
+       << counted(formatNumber("%.2f", m.calls.syncs_mean)) << " | " << formatNumber("%.1f", m.mean_objects) << " | "
+       << formatNumber("%.2f", m.speedup_vs_full) << "x | ";
     if (m.has_errors) {
       const auto psnr = [](double v) { return v >= kPsnrCapDb ? std::string("identical") : formatNumber("%.2f", v); };
       md << psnr(m.psnr_db_mean) << " | " << psnr(m.psnr_db_min) << " | " << formatNumber("%.4f", m.ssim_mean) << " | "
-         << formatNumber("%.3f", 100.0 * m.bad_pixel_share_mean) << "% | " << formatNumber("%.3f", 100.0 * m.crack_share_mean)
-         << "% | " << (m.has_parallax ? formatNumber("%.2f", m.parallax_px_mean) : std::string("n/a")) << " | "
-         << (m.has_parallax ? formatNumber("%.2f", m.parallax_px_max) : std::string("n/a")) << " | "
-         << boundCells(m) << " | ";
+         << formatNumber("%.3f", 100.0 * m.bad_pixel_share_mean) << "% | "
+         << formatNumber("%.3f", 100.0 * m.crack_share_mean) << "% | "
+         << (m.has_parallax ? formatNumber("%.2f", m.parallax_px_mean) : std::string("n/a")) << " | "
+         << (m.has_parallax ? formatNumber("%.2f", m.parallax_px_max) : std::string("n/a")) << " | " << boundCells(m)
+         << " | ";
       if (m.has_popping)
-        md << formatNumber("%.3f", m.popping_summary.mean) << " | " << formatNumber("%.3f", m.popping_summary.p99) << " | "
-           << formatNumber("%.3f", m.popping_summary.max) << " |\n";
+        md << formatNumber("%.3f", m.popping_summary.mean) << " | " << formatNumber("%.3f", m.popping_summary.p99)
+           << " | " << formatNumber("%.3f", m.popping_summary.max) << " |\n";
       else
         md << "n/a | n/a | n/a |\n";
     } else {
@@ -233,11 +236,13 @@ std::string governorLines(const BenchResult& r) {
   std::string out;
   for (const ModeResult& m : r.modes) {
     if (!m.governed) continue;
-    out += "\n- " + m.name + ": t_max " + (r.t_max_ms ? formatNumber("%.2f", *r.t_max_ms) : std::string("-")) + " ms, " +
-           std::to_string(m.frames_over_tmax) + " of " + std::to_string(m.frames.size()) + " frames over it; " +
-           std::to_string(m.frames_relaxed) + " frames relaxed (drawn at a coarser level), the bound kept up to " +
+    out += "\n- " + m.name + ": t_max " + (r.t_max_ms ? formatNumber("%.2f", *r.t_max_ms) : std::string("-")) +
+           " ms, " + std::to_string(m.frames_over_tmax) + " of " + std::to_string(m.frames.size()) +
+           " frames over it; " + std::to_string(m.frames_relaxed) +
+           " frames relaxed (drawn at a coarser level), the bound kept up to " +
            formatNumber("%.2f", m.bound_scale_max) + "x the promised one" +
-           (m.error_bound_px ? " (" + formatNumber("%.2f", *m.error_bound_px * m.bound_scale_max) + " px)" : std::string()) +
+           (m.error_bound_px ? " (" + formatNumber("%.2f", *m.error_bound_px * m.bound_scale_max) + " px)"
+                             : std::string()) +
            "\n";
   }
   return out;

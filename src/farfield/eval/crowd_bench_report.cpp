@@ -15,16 +15,17 @@ namespace farfield::eval {
 
 std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOptions& options) {
   std::ostringstream md;
-  md << "- city: generated, " << options.blocks << " blocks, detail " << options.detail << ", seed " << options.city_seed
-     << " (" << thousands(result.city_triangles) << " triangles, drawn in every mode as "
+  md << "- city: generated, " << options.blocks << " blocks, detail " << options.detail << ", seed "
+     << options.city_seed << " (" << thousands(result.city_triangles) << " triangles, drawn in every mode as "
      << (options.city_cpu ? "culled-cpu draws it: frustum, facing and occlusion culled on the CPU, depth read back"
                           : "culled draws it: the GPU-driven frame, no readback")
      << ")\n";
-  md << "- size " << options.width << "x" << options.height << ", " << options.frames << " measured frames per run (every "
-     << options.frame_step << "th frame of a 30 fps street walk, seed " << options.path_seed << "), one warm-up frame"
-     << (options.timing_passes > 1 ? ", each frame's time the fastest of " + std::to_string(options.timing_passes) +
-                                         " passes over the path"
-                                   : std::string())
+  md << "- size " << options.width << "x" << options.height << ", " << options.frames
+     << " measured frames per run (every " << options.frame_step << "th frame of a 30 fps street walk, seed "
+     << options.path_seed << "), one warm-up frame"
+     << (options.timing_passes > 1
+             ? ", each frame's time the fastest of " + std::to_string(options.timing_passes) + " passes over the path"
+             : std::string())
      << "\n";
   md << "- renderer: " << result.renderer
      << "; GPU ms: the GPU's time of the city and the crowd, crowd GPU ms the crowd pass's ("
@@ -105,25 +106,26 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
   md << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const CrowdRun& run : result.runs)
     for (const CrowdModeResult& r : run.modes)
-      md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | " << formatNumber("%.1f", r.wall.median)
-         << " | " << formatNumber("%.1f", r.gpu.median) << " | " << formatNumber("%.1f", r.crowd.median) << " | "
-         << formatNumber("%.2f", r.crowd_gpu.median) << " | " << formatNumber("%.3f", r.crowd_cpu.median) << " | "
-         << formatNumber("%.0f", r.draw_calls) << " / " << formatNumber("%.1f", r.upload_bytes / 1024.0) << " / " << formatNumber("%.0f", r.syncs)
-         << " | " << formatNumber("%.2fx", r.speedup) << " | "
-         << formatNumber("%.2fx", r.crowd_speedup) << " | " << formatNumber("%.0f", r.geometry_agents) << " / "
-         << formatNumber("%.0f", r.impostor_agents)
+      md << "| " << thousands(run.agents) << " | " << run.path << " | " << r.name << " | "
+         << formatNumber("%.1f", r.wall.median) << " | " << formatNumber("%.1f", r.gpu.median) << " | "
+         << formatNumber("%.1f", r.crowd.median) << " | " << formatNumber("%.2f", r.crowd_gpu.median) << " | "
+         << formatNumber("%.3f", r.crowd_cpu.median) << " | " << formatNumber("%.0f", r.draw_calls) << " / "
+         << formatNumber("%.1f", r.upload_bytes / 1024.0) << " / " << formatNumber("%.0f", r.syncs) << " | "
+         << formatNumber("%.2fx", r.speedup) << " | " << formatNumber("%.2fx", r.crowd_speedup) << " | "
+         << formatNumber("%.0f", r.geometry_agents) << " / " << formatNumber("%.0f", r.impostor_agents)
          << (r.over_budget > 0.0 ? " (" + formatNumber("%.0f", r.over_budget) + " over the budget)" : std::string())
          << (r.coarser > 0.0 ? " (" + formatNumber("%.0f", r.coarser) + " coarser)" : std::string())
-         << (r.coarsened > 0.0 ? " (" + formatNumber("%.0f", r.coarsened) + " coarsened for the budget)" : std::string())
-         << " | "
-         << thousands(size_t(r.triangles)) << " | "
-         << formatNumber("%.1f", r.psnr_mean) << " (" << formatNumber("%.1f", r.psnr_min) << ") | " << formatNumber("%.3f", r.bad_share_mean)
-         << " | " << formatNumber("%.2f", r.popping_mean) << " / " << formatNumber("%.2f", r.popping_max) << " ("
-         << formatNumber("%.2f", run.reference_popping_mean) << ") | " << formatNumber("%.0f", r.shadow_casters) << " / "
-         << formatNumber("%.0f", r.receiver_bad_pixels) << " |\n";
+         << (r.coarsened > 0.0 ? " (" + formatNumber("%.0f", r.coarsened) + " coarsened for the budget)"
+                               : std::string())
+         << " | " << thousands(size_t(r.triangles)) << " | " << formatNumber("%.1f", r.psnr_mean) << " ("
+         << formatNumber("%.1f", r.psnr_min) << ") | " << formatNumber("%.3f", r.bad_share_mean) << " | "
+         << formatNumber("%.2f", r.popping_mean) << " / " << formatNumber("%.2f", r.popping_max) << " ("
+         << formatNumber("%.2f", run.reference_popping_mean) << ") | " << formatNumber("%.0f", r.shadow_casters)
+         << " / " << formatNumber("%.0f", r.receiver_bad_pixels) << " |\n";
   md << "\nThe CPU modes' agent states (poses and phases of every agent, eval::crowdAgentStates) are made before the "
         "crowd pass, outside its time:";
-  for (const CrowdRun& run : result.runs) md << " " << formatNumber("%.2f", run.cpu_states_ms) << " ms (" << thousands(run.agents) << ", " << run.path << ")";
+  for (const CrowdRun& run : result.runs)
+    md << " " << formatNumber("%.2f", run.cpu_states_ms) << " ms (" << thousands(run.agents) << ", " << run.path << ")";
   md << ". The crowd-*-gpu modes simulate every agent inside it.\n";
   if (options.runtime.geometry_ms > 0.0) {
     md << "\ncrowd-mixed's skinned draws against the " << formatNumber("%.1f", options.runtime.geometry_ms)
@@ -132,8 +134,8 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
       for (const CrowdModeResult& r : run.modes)
         if (r.skinned_ms.count > 0)
           md << "- " << thousands(run.agents) << " agents, " << run.path << ", " << r.name << ": median "
-             << formatNumber("%.2f", r.skinned_ms.median) << " ms, max " << formatNumber("%.2f", r.skinned_ms.max) << " ms; "
-             << r.skinned_over << " of " << r.skinned_ms.count << " frames over\n";
+             << formatNumber("%.2f", r.skinned_ms.median) << " ms, max " << formatNumber("%.2f", r.skinned_ms.max)
+             << " ms; " << r.skinned_over << " of " << r.skinned_ms.count << " frames over\n";
   }
   return md.str();
 }

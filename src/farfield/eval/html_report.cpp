@@ -223,7 +223,8 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
       << "</b> frames relaxed (drawn at a coarser level)"
       << (*v.frames_relaxed > 0
               ? ", the bound kept up to " + formatNumber("%.3g", v.bound_scale_max) + "x the promised one" +
-                    (v.bound_px ? " (" + formatNumber("%.3g", *v.bound_px * v.bound_scale_max) + " px)" : std::string()) +
+                    (v.bound_px ? " (" + formatNumber("%.3g", *v.bound_px * v.bound_scale_max) + " px)"
+                                : std::string()) +
                     ", each frame checked against the bound it kept"
               : std::string())
       << "</p>\n";
@@ -254,8 +255,8 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
     const std::optional<double> syncs = optionalNumber(mode, "mean_syncs", at);
     if (cpu && syncs)
       h << "<p>Farfield's own CPU time " << formatNumber("%.3f", *cpu) << " ms a frame (median), "
-        << formatNumber("%.0f", number(mode, "mean_draw_calls", at)) << " draw calls and " << formatNumber("%.2f", *syncs)
-        << " CPU-GPU synchronisations a frame</p>\n";
+        << formatNumber("%.0f", number(mode, "mean_draw_calls", at)) << " draw calls and "
+        << formatNumber("%.2f", *syncs) << " CPU-GPU synchronisations a frame</p>\n";
   }
   h << "</div>\n";
 
@@ -290,9 +291,10 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
     const std::optional<double> tmax = optionalNumber(mode, "t_max_ms", at);
     const std::optional<double> psnr = optionalNumber(mode, "psnr_db_mean", at);
     const std::optional<double> cracks = optionalNumber(mode, "crack_share_mean", at);
-    h << "<tr><td>" << htmlEscape(name) << "</td><td>" << formatNumber("%.2f", number(mode, "median_ms", at)) << "</td><td>"
-      << formatNumber("%.2f", number(mode, "p95_ms", at)) << "</td><td>" << formatNumber("%.2f", number(mode, "p99_ms", at))
-      << "</td><td>" << formatNumber("%.2f", number(mode, "max_ms", at)) << "</td><td>"
+    h << "<tr><td>" << htmlEscape(name) << "</td><td>" << formatNumber("%.2f", number(mode, "median_ms", at))
+      << "</td><td>" << formatNumber("%.2f", number(mode, "p95_ms", at)) << "</td><td>"
+      << formatNumber("%.2f", number(mode, "p99_ms", at)) << "</td><td>"
+      << formatNumber("%.2f", number(mode, "max_ms", at)) << "</td><td>"
       << cell(optionalNumber(mode, "gpu_median_ms", at), "%.2f") << "</td><td>"
       << cell(optionalNumber(mode, "cpu_median_ms", at), "%.3f") << "</td><td>"
       << formatNumber("%.0f", number(mode, "mean_triangles", at)) << "</td><td>"
@@ -335,7 +337,8 @@ std::string htmlReport(const fs::path& bench_dir, const HtmlReportOptions& optio
       auto image = [&](const char* group, const std::string& caption) {
         const auto g = s.find(group);
         if (g == s.end()) return;
-        const nlohmann::json* file = g->is_string() ? &*g : (g->is_object() && g->contains(v.mode) ? &(*g)[v.mode] : nullptr);
+        const nlohmann::json* file =
+            g->is_string() ? &*g : (g->is_object() && g->contains(v.mode) ? &(*g)[v.mode] : nullptr);
         if (file && file->is_string() && !file->get<std::string>().empty())
           h << figure(bench_dir, file->get<std::string>(), "frame " + frame + ": " + caption);
       };
