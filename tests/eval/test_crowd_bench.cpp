@@ -10,6 +10,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/eval/crowd_bench.h"
+#include "farfield/eval/crowd_bench_report.h"
 #include "farfield/gpu/context.h"
 #include "support/test_support.h"
 
@@ -163,6 +164,16 @@ TEST_F(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgai
     EXPECT_LE(m.gpu.max, m.wall.max + 0.5) << m.name;
     EXPECT_LE(m.crowd_gpu.min, m.crowd.min + 0.5) << m.name;
   }
+  // Issue 45's goals for crowd-mixed: against crowd-impostor, recomputed from the modes' own figures.
+  const std::vector<eval::MixedAgainstImpostor> goals = eval::mixedAgainstImpostor(run);
+  ASSERT_EQ(goals.size(), 1u) << "one mixed mode without --gpu-crowd";
+  EXPECT_EQ(goals[0].mixed, "crowd-mixed");
+  EXPECT_EQ(goals[0].impostor, "crowd-impostor");
+  EXPECT_DOUBLE_EQ(goals[0].psnr_mean, run.modes[2].psnr_mean);
+  EXPECT_DOUBLE_EQ(goals[0].crowd_ratio, run.modes[2].crowd.median / run.modes[1].crowd.median);
+  EXPECT_DOUBLE_EQ(goals[0].crowd_gpu_ratio, run.modes[2].crowd_gpu.median / run.modes[1].crowd_gpu.median);
+  EXPECT_EQ(goals[0].pass_met(), goals[0].crowd_ratio <= 1.2);
+  EXPECT_NE(r.markdown.find("Issue 45's goals"), std::string::npos);
 }
 
 // With the agents hidden behind the city left out, every mode's agents are those in view less the hidden ones, and
