@@ -8,9 +8,11 @@
 #
 # Without SCENE and PATH it makes the demo's city and drive of before 2026-12-05 (400 blocks, detail 2, seed 1). Environment: SIZE
 # (640x360), STRIDE (5), IMPOSTORS ("100:4 200:8": osgSim::Impostor threshold in metres and pixel error),
-# OSG_BUILD (build/osg-peer: where the peer is built). OpenSceneGraph draws into a GLX window: without a display the
-# peer runs under xvfb-run (Mesa's llvmpipe; on a GPU machine give it an X server of the GPU). The last frame of each
-# peer run is saved next to the table (osg-last.png, ...) as evidence of what it drew.
+# OSG_BUILD (build/osg-peer: where the peer is built), PEER (a peer built already, e.g. from a tarball of
+# scripts/make_dist.sh with EXTRA_BINS: nothing is installed or built), PEER_GL (glx: a GLX window of the display, under
+# xvfb-run where there is none; egl: an EGL pbuffer, no X server, the GPU machine's way; auto, the default: glx with a
+# display, else egl). The last frame of each peer run is saved next to the table (osg-last.png, ...) as evidence of
+# what it drew.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 FARFIELD=$(readlink -f "${1:-$here/build/release/bin/farfield}")
@@ -21,20 +23,24 @@ SIZE=${SIZE:-640x360}
 STRIDE=${STRIDE:-5}
 IMPOSTORS=${IMPOSTORS:-"100:4 200:8"}
 OSG_BUILD=${OSG_BUILD:-$here/build/osg-peer}
+PEER_GL=${PEER_GL:-auto}
 mkdir -p "$OUT"
 export FF_PROGRESS=0
 
-# OpenSceneGraph: a Debian package the project does not install by default.
-if ! dpkg-query -W -f='${Status}' libopenscenegraph-dev 2>/dev/null | grep -q "install ok installed"; then
-  echo "bench_peer_osg: installing libopenscenegraph-dev (apt-get)" >&2
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo=sudo
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q libopenscenegraph-dev > "$OUT/apt.txt"
+if [ -z "${PEER:-}" ]; then
+  # OpenSceneGraph: a Debian package the project does not install by default.
+  if ! dpkg-query -W -f='${Status}' libopenscenegraph-dev 2>/dev/null | grep -q "install ok installed"; then
+    echo "bench_peer_osg: installing libopenscenegraph-dev (apt-get)" >&2
+    sudo=""
+    [ "$(id -u)" -eq 0 ] || sudo=sudo
+    $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q libopenscenegraph-dev > "$OUT/apt.txt"
+  fi
+  cmake -S "$here" -B "$OSG_BUILD" -DCMAKE_BUILD_TYPE=Release -DFF_BUILD_TESTS=OFF -DFF_BUILD_BENCH=OFF \
+    -DFF_BUILD_OSG_PEER=ON > "$OUT/cmake.txt"
+  cmake --build "$OSG_BUILD" -j "$(nproc)" --target osg_peer > "$OUT/build.txt"
+  PEER=$OSG_BUILD/bin/osg_peer
 fi
-cmake -S "$here" -B "$OSG_BUILD" -DCMAKE_BUILD_TYPE=Release -DFF_BUILD_TESTS=OFF -DFF_BUILD_BENCH=OFF \
-  -DFF_BUILD_OSG_PEER=ON > "$OUT/cmake.txt"
-cmake --build "$OSG_BUILD" -j "$(nproc)" --target osg_peer > "$OUT/build.txt"
-PEER=$OSG_BUILD/bin/osg_peer
+[ -x "$PEER" ] || { echo "bench_peer_osg: no peer $PEER" >&2; exit 2; }
 
 if [ -z "$SCENE" ]; then
   SCENE=$OUT/city.glb
@@ -43,20 +49,28 @@ if [ -z "$SCENE" ]; then
   [ -f "$PATHFILE" ] || "$FARFIELD" path street "$OUT/city.streets.json" --frames 300 --seed 1 --car --fov 60 \
     -o "$PATHFILE" > /dev/null
 fi
+[ "$PEER_GL" != auto ] || { PEER_GL=egl; [ -z "${DISPLAY:-}" ] || PEER_GL=glx; }
 xvfb=()
-if [ -z "${DISPLAY:-}" ]; then
-  command -v xvfb-run > /dev/null || { echo "bench_peer_osg: no display and no xvfb-run" >&2; exit 2; }
-  xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24")
+# GLX: a window of the display (Mesa's GLX pbuffers answer its frame copies with X errors on Xvfb). EGL: a pbuffer.
+surface=(--egl)
+if [ "$PEER_GL" = glx ]; then
+  surface=(--window)
+  if [ -z "${DISPLAY:-}" ]; then
+    command -v xvfb-run > /dev/null || { echo "bench_peer_osg: no display and no xvfb-run" >&2; exit 2; }
+    xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24")
+  fi
 fi
 
-# A window of the display (Mesa's GLX pbuffers answer its frame copies with X errors on Xvfb); the last frame saved.
-"${xvfb[@]}" "$PEER" "$SCENE" "$PATHFILE" --size "$SIZE" --stride "$STRIDE" --mode full --tag osg --window \
-  --csv "$OUT/osg.csv" --screenshot "$OUT/osg-last.png" > "$OUT/osg.txt" 2>&1
+# The last frame of each run saved.
+"${xvfb[@]}" "$PEER" "$SCENE" "$PATHFILE" --size "$SIZE" --stride "$STRIDE" --mode full --tag osg "${surface[@]}" \
+  --csv "$OUT/osg.csv" --screenshot "$OUT/osg-last.png" > "$OUT/osg.txt" 2>&1 ||
+  echo "bench_peer_osg: the peer failed (osg.txt)" >&2
 for imp in $IMPOSTORS; do
   threshold=${imp%%:*} pixels=${imp##*:}
   "${xvfb[@]}" "$PEER" "$SCENE" "$PATHFILE" --size "$SIZE" --stride "$STRIDE" --mode impostor --threshold "$threshold" \
-    --pixel-error "$pixels" --tag "osg-impostor-$threshold-$pixels" --window \
-    --screenshot "$OUT/osg-impostor-$threshold-$pixels-last.png" > "$OUT/osg-impostor-$threshold-$pixels.txt" 2>&1
+    --pixel-error "$pixels" --tag "osg-impostor-$threshold-$pixels" "${surface[@]}" \
+    --screenshot "$OUT/osg-impostor-$threshold-$pixels-last.png" > "$OUT/osg-impostor-$threshold-$pixels.txt" 2>&1 ||
+    echo "bench_peer_osg: the peer failed (osg-impostor-$threshold-$pixels.txt)" >&2
 done
 "$FARFIELD" bench "$SCENE" --path "$PATHFILE" --modes frustum,culled-cpu,culled --size "$SIZE" --stride "$STRIDE" \
   -o "$OUT/farfield" > "$OUT/farfield.txt" 2>&1

@@ -13,6 +13,8 @@
 #   share/doc/PACKAGE/copyright of every bundled library's Debian package
 # The target machine needs glibc, libstdc++ and libglvnd (libEGL, libOpenGL) of at least Debian 12's versions and an
 # EGL driver. Needs patchelf (scripts/install-deps.sh). scripts/check_dist.sh proves a tarball on a minimal Debian 12.
+# EXTRA_BINS (space-separated executables, e.g. the OpenSceneGraph peer build/osg-peer/bin/osg_peer) go into bin/ beside
+# the tool, their libraries into lib/ likewise (scripts/gpu/rehearse.sh with OSG_PEER=1: the peer on a GPU machine).
 set -euo pipefail
 
 BIN=${1:?usage: make_dist.sh BINARY [OUT_DIR]}
@@ -36,10 +38,16 @@ trap 'rm -rf "$stage"' EXIT
 pkg=$stage/$name
 mkdir -p "$pkg/bin" "$pkg/lib" "$pkg/share/farfield" "$pkg/share/doc"
 
-cp "$BIN" "$pkg/bin/farfield"
-strip "$pkg/bin/farfield"
-# shellcheck disable=SC2016  # $ORIGIN is for the loader, not the shell
-patchelf --set-rpath '$ORIGIN/../lib' "$pkg/bin/farfield"
+read -r -a extra_bins <<< "${EXTRA_BINS:-}"
+for b in "$BIN" "${extra_bins[@]}"; do
+  [ -x "$b" ] || { echo "make_dist: no executable $b" >&2; exit 1; }
+  target=$pkg/bin/$(basename "$b")
+  [ "$b" = "$BIN" ] && target=$pkg/bin/farfield
+  cp "$b" "$target"
+  strip "$target"
+  # shellcheck disable=SC2016  # $ORIGIN is for the loader, not the shell
+  patchelf --set-rpath '$ORIGIN/../lib' "$target"
+done
 
 # The Debian package that holds a library: dpkg knows each file under the path it was packaged with, which after the
 # /usr merge may be /lib/... or /usr/lib/..., of the file or of its symlink.
@@ -52,7 +60,7 @@ package_of() {
   return 1
 }
 
-missing=$(ldd "$BIN" | awk '/not found/ {print $1}')
+missing=$(for b in "$BIN" "${extra_bins[@]}"; do ldd "$b"; done | awk '/not found/ {print $1}')
 [ -z "$missing" ] || { echo "make_dist: ldd finds no ${missing//$'\n'/ }" >&2; exit 1; }
 # GLFW opens the X11 extensions with dlopen when `farfield view` makes a window: ldd does not list them, so they and
 # their own libraries are added by name.
@@ -64,7 +72,7 @@ for d in libXcursor.so.1 libXrandr.so.2 libXinerama.so.1 libXi.so.6 libXxf86vm.s
 done
 # "needed path" lines of every library to bundle, each once.
 libraries() {
-  ldd "$BIN" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}'
+  for b in "$BIN" "${extra_bins[@]}"; do ldd "$b" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}'; done
   for path in "${dlopened[@]}"; do
     echo "$(basename "$path") $path"
     ldd "$path" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}'

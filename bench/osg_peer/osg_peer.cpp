@@ -7,11 +7,11 @@
 // --threshold metres, re-rendered when its error exceeds --pixel-error pixels).
 //
 //   osg_peer SCENE PATH.json [--size WxH] [--stride K] [--frames N] [--warmup N] [--mode full|impostor]
-//            [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE] [--window] [--screenshot FILE.png]
+//            [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE] [--window | --egl] [--screenshot FILE.png]
 //
 // Prints "RESULT tag=... mode=... frames=N median=... p95=... p99=... max=... mean=... first=..." (milliseconds per
-// frame: osgViewer::Viewer::frame(), update, cull and draw, through glFinish). Needs a display (GLX pbuffer): Xvfb
-// where there is none.
+// frame: osgViewer::Viewer::frame(), update, cull and draw, through glFinish). Draws into a GLX pbuffer of the display
+// (Xvfb where there is none), or with --egl into an EGL pbuffer without any X server (egl_pbuffer.h: a GPU machine).
 #include <osg/CullFace>
 #include <osg/GL>
 #include <osg/Geode>
@@ -32,6 +32,8 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,6 +41,7 @@
 #include "farfield/gen/camera_path.h"
 #include "farfield/image/png_io.h"
 #include "farfield/scene/import.h"
+#include "egl_pbuffer.h"
 
 namespace {
 
@@ -93,12 +96,13 @@ struct Args {
   size_t stride = 1, frames = 0, warmup = 1;
   float threshold = 100.0f, pixel_error = 4.0f;
   bool window = false;       // a window instead of a pbuffer
+  bool egl = false;          // an EGL pbuffer (no X server) instead of GLX's
   std::string screenshot;    // the last frame as a PNG
 };
 
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr, "error: %s\nusage: osg_peer SCENE PATH.json [--size WxH] [--stride K] [--frames N] [--warmup N] "
-                       "[--mode full|impostor] [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE] [--window] "
+                       "[--mode full|impostor] [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE] [--window | --egl] "
                        "[--screenshot FILE.png]\n",
                why.c_str());
   std::exit(2);
@@ -135,6 +139,8 @@ Args parseArgs(int argc, char** argv) {
       a.csv = value();
     } else if (k == "--window") {
       a.window = true;
+    } else if (k == "--egl") {
+      a.egl = true;
     } else if (k == "--screenshot") {
       a.screenshot = value();
     } else if (!k.empty() && k[0] == '-') {
@@ -144,6 +150,7 @@ Args parseArgs(int argc, char** argv) {
     }
   }
   if (positional.size() != 2) usage("give SCENE and PATH.json");
+  if (a.window && a.egl) usage("--window and --egl exclude each other");
   a.scene = positional[0];
   a.path = positional[1];
   if (a.tag.empty()) a.tag = a.mode;
@@ -269,32 +276,45 @@ int main(int argc, char** argv) {
   const double load_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start).count();
 
-  // ---- a headless viewer: a pbuffer of the frame's size ----
-  osg::ref_ptr<osg::GraphicsContext::Traits> traits = new osg::GraphicsContext::Traits;
-  traits->readDISPLAY();
-  traits->setUndefinedScreenDetailsToDefaultScreen();
-  traits->width = args.width;
-  traits->height = args.height;
-  traits->pbuffer = !args.window;
-  traits->windowDecoration = false;
-  traits->doubleBuffer = true;
-  traits->red = traits->green = traits->blue = traits->alpha = 8;
-  traits->depth = 24;
-  osg::ref_ptr<osg::GraphicsContext> gc = osg::GraphicsContext::createGraphicsContext(traits);
-  if (!gc) {
-    std::fprintf(stderr, "error: no pbuffer of %dx%d (OpenSceneGraph needs a display: run under xvfb-run)\n",
-                 args.width, args.height);
-    return 1;
-  }
+  // ---- a headless viewer: a pbuffer of the frame's size, GLX's or (--egl) EGL's as an embedded window ----
+  std::unique_ptr<osg_peer::EglPbuffer> egl;
   osgViewer::Viewer viewer;
   viewer.setThreadingModel(osgViewer::Viewer::SingleThreaded);
   osg::Camera* camera = viewer.getCamera();
-  camera->setGraphicsContext(gc);
+  osg::ref_ptr<osg::GraphicsContext> gc;
+  if (args.egl) {
+    try {
+      egl = std::make_unique<osg_peer::EglPbuffer>(args.width, args.height);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 1;
+    }
+    // The EGL context stays current on this thread: the embedded window's makeCurrent does nothing.
+    gc = viewer.setUpViewerAsEmbeddedInWindow(0, 0, args.width, args.height);
+  } else {
+    osg::ref_ptr<osg::GraphicsContext::Traits> traits = new osg::GraphicsContext::Traits;
+    traits->readDISPLAY();
+    traits->setUndefinedScreenDetailsToDefaultScreen();
+    traits->width = args.width;
+    traits->height = args.height;
+    traits->pbuffer = !args.window;
+    traits->windowDecoration = false;
+    traits->doubleBuffer = true;
+    traits->red = traits->green = traits->blue = traits->alpha = 8;
+    traits->depth = 24;
+    gc = osg::GraphicsContext::createGraphicsContext(traits);
+    if (!gc) {
+      std::fprintf(stderr, "error: no pbuffer of %dx%d (OpenSceneGraph needs a display: run under xvfb-run, or "
+                           "give --egl)\n", args.width, args.height);
+      return 1;
+    }
+    camera->setGraphicsContext(gc);
+  }
   camera->setViewport(0, 0, args.width, args.height);
   camera->setClearColor(osg::Vec4(0.62f, 0.74f, 0.88f, 1.0f));
   camera->setComputeNearFarMode(osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
   camera->setFinalDrawCallback(new Finish);
-  const GLenum buffer = traits->doubleBuffer ? GL_BACK : GL_FRONT;
+  const GLenum buffer = GL_BACK;  // a double-buffered GLX pbuffer's or window's back buffer; an EGL pbuffer's only one
   camera->setDrawBuffer(buffer);
   camera->setReadBuffer(buffer);
   viewer.setSceneData(root);
@@ -316,8 +336,9 @@ int main(int argc, char** argv) {
   gc->makeCurrent();
   std::printf("scene: %s objects=%zu tris=%llu impostors=%d load=%.0fms\n", args.scene.c_str(), scene.objects.size(),
               static_cast<unsigned long long>(triangles), impostors ? int(scene.objects.size()) : 0, load_ms);
-  std::printf("GL_RENDERER=%s GL_VERSION=%s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
-              reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+  std::printf("GL_RENDERER=%s GL_VERSION=%s%s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+              reinterpret_cast<const char*>(glGetString(GL_VERSION)),
+              egl ? (" via " + egl->source()).c_str() : " via GLX");
   gc->releaseContext();
   auto frame = [&](size_t i) {
     const farfield::gen::PathFrame& f = path.frames[i];

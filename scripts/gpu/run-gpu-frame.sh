@@ -5,8 +5,9 @@
 # set). Writes OUT/<stage>.tgz (bench.json, frames.csv, cull checks, logs; no images) and
 # OUT/log.txt; prints a summary per stage.
 #
-# Stages (STAGES, default "smoke heldout model makedemo crowd terrain big check"; they run in the script's order,
-# smoke, heldout, model, big, demo, check, terrain, paged, crowd, makedemo, dynamic, stream, each under a timeout; with
+# Stages (STAGES, default "smoke heldout model makedemo crowd terrain big check osg"; they run in the script's order,
+# smoke, heldout, model, big, demo, check, osg, terrain, paged, crowd, makedemo, dynamic, stream, each under a timeout;
+# with
 # 15 minutes of device time,
 # name a few per call, e.g. STAGES="smoke heldout makedemo" then STAGES="smoke crowd terrain"):
 #   smoke    a small city, one bench; stops everything unless the NVIDIA driver drew it
@@ -17,6 +18,9 @@
 #   big      the 100,000-block city (detail 0) at 1920x1080, 150 frames: the same modes
 #   demo     (not in the default) the 400-block detail-2 city at 640x360 (make demo's until 2026-12-05): the same modes
 #   check    farfield cull-check on the held-out city at 1920x1080 (GPU-culled frames against frustum-culled ones)
+#   osg      the OpenSceneGraph peer (scripts/bench_peer_osg.sh) on the held-out city and drive at 1920x1080 through an
+#            EGL pbuffer, its culling and osgSim::Impostor runs beside frustum, culled-cpu and culled (issue 42's "3x
+#            OSG"); needs the peer in the tarball (bin/osg_peer: scripts/gpu/rehearse.sh with OSG_PEER=1)
 #   crowd    the crowd bench at 1920x1080 with the GPU crowd beside the CPU path (--gpu-crowd), 10,000 to 1,000,000
 #            agents, no shadows (the crowd alone; shadows are measured on llvmpipe); then at 0.5 px with levels of
 #            detail under a budget of 4 ms of skinned drawing, on issue 45's walk (path seed 7) and on a walk no
@@ -46,7 +50,7 @@ R=${REHEARSE:-}
 pick() { if [ -n "$R" ]; then echo "$2"; else echo "$1"; fi; }  # pick FULL TOY
 HD=$(pick 1920x1080 320x180)
 SD=$(pick 640x360 320x180)
-STAGES=${STAGES:-smoke heldout model makedemo crowd terrain big check}
+STAGES=${STAGES:-smoke heldout model makedemo crowd terrain big check osg}
 DATA=$PWD/.gpu/data
 OUTD=${OUT:-/tmp/out}
 mkdir -p "$OUTD"
@@ -125,7 +129,8 @@ if [[ " $STAGES " == *" smoke "* ]]; then
   fi
 fi
 
-if [[ " $STAGES " == *" heldout "* || " $STAGES " == *" check "* || " $STAGES " == *" model "* ]]; then
+if [[ " $STAGES " == *" heldout "* || " $STAGES " == *" check "* || " $STAGES " == *" model "* ||
+  " $STAGES " == *" osg "* ]]; then
   H=heldout
   mkdir -p $H
   [ -f $H/city.glb ] || timeout 300 $FF gen city --blocks $(pick 400 30) --detail 3 --seed 97 --objects buildings \
@@ -174,6 +179,19 @@ if [[ " $STAGES " == *" check "* ]]; then
   echo "rc $?"
   tail -6 $H/check.txt
   keep check $H/check $H/check.txt
+fi
+if [[ " $STAGES " == *" osg "* ]]; then
+  say "osg: the OpenSceneGraph peer beside culled, held-out city, 1920x1080"
+  if [ -x /tmp/ff/bin/osg_peer ]; then
+    PEER=/tmp/ff/bin/osg_peer PEER_GL=egl SIZE=$HD STRIDE=5 timeout 600 bash "$ROOT/scripts/bench_peer_osg.sh" $FF \
+      $W/osg $H/city.glb $H/path.json > osg.txt 2>&1
+    echo "rc $?"
+    grep -h "GL_RENDERER" $W/osg/osg*.txt | sort -u
+    cat $W/osg/peer.md
+    keep osg osg/peer.md osg/*.txt osg/*.csv osg/farfield/bench.json osg.txt
+  else
+    echo "osg: no bin/osg_peer in the tarball (scripts/gpu/rehearse.sh with OSG_PEER=1 puts it there)"
+  fi
 fi
 if [[ " $STAGES " == *" terrain "* ]]; then
   T=terrain
