@@ -83,12 +83,14 @@ print("|---|---|---:|---:|---:|---:|---:|---:|")
 for f in sorted(glob.glob(f"{out}/osg*.txt")):
     text = open(f).read()
     gl = re.search(r"GL_RENDERER=(.*?) GL_VERSION", text)
+    via = re.search(r"GL_VERSION=.* via (.*)", text)  # the surface: GLX, or the EGL display of the pbuffer
     r = re.search(r"RESULT (.*)", text)
     if not r:
         print(f"| OpenSceneGraph | {f} | failed | | | | | |")
         continue
     v = dict(kv.split("=", 1) for kv in r.group(1).split())
-    print(f"| OpenSceneGraph 3.6 ({gl.group(1) if gl else '?'}) | {v['tag']} | {v['frames']} | {float(v['median']):.2f} | "
+    surface = f", {via.group(1)}" if via else ""
+    print(f"| OpenSceneGraph 3.6 ({gl.group(1) if gl else '?'}{surface}) | {v['tag']} | {v['frames']} | {float(v['median']):.2f} | "
           f"{float(v['p95']):.2f} | {float(v['p99']):.2f} | {float(v['max']):.2f} | {float(v['first']):.2f} |")
 b = json.load(open(f"{out}/farfield/bench.json"))
 for name, m in b["modes"].items():

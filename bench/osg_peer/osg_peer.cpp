@@ -102,8 +102,8 @@ struct Args {
 
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr, "error: %s\nusage: osg_peer SCENE PATH.json [--size WxH] [--stride K] [--frames N] [--warmup N] "
-                       "[--mode full|impostor] [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE] [--window | --egl] "
-                       "[--screenshot FILE.png]\n",
+                       "[--mode full|impostor] [--threshold M] [--pixel-error PX] [--tag TAG] [--csv FILE] "
+                       "[--window | --egl] [--screenshot FILE.png]\n",
                why.c_str());
   std::exit(2);
 }
