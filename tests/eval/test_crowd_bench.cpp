@@ -173,6 +173,7 @@ TEST_F(CrowdBench, GeometryModeEqualsTheReferenceAndImpostorModesAreMeasuredAgai
   EXPECT_DOUBLE_EQ(goals[0].crowd_ratio, run.modes[2].crowd.median / run.modes[1].crowd.median);
   EXPECT_DOUBLE_EQ(goals[0].crowd_gpu_ratio, run.modes[2].crowd_gpu.median / run.modes[1].crowd_gpu.median);
   EXPECT_EQ(goals[0].pass_met(), goals[0].crowd_ratio <= 1.2);
+  EXPECT_DOUBLE_EQ(goals[0].own_cpu_ms, run.modes[2].crowd_cpu.median);
   EXPECT_NE(r.markdown.find("Issue 45's goals"), std::string::npos);
 }
 

@@ -31,6 +31,7 @@ std::vector<MixedAgainstImpostor> mixedAgainstImpostor(const CrowdRun& run) {
     c.psnr_min = mixed->psnr_min;
     c.crowd_ratio = impostor->crowd.median > 0.0 ? mixed->crowd.median / impostor->crowd.median : 0.0;
     c.crowd_gpu_ratio = impostor->crowd_gpu.median > 0.0 ? mixed->crowd_gpu.median / impostor->crowd_gpu.median : 0.0;
+    c.own_cpu_ms = mixed->crowd_cpu.median;
     out.push_back(c);
   }
   return out;
@@ -146,18 +147,20 @@ std::string crowdMarkdown(const CrowdBenchResult& result, const CrowdBenchOption
          << formatNumber("%.2f", run.reference_popping_mean) << ") | " << formatNumber("%.0f", r.shadow_casters)
          << " / " << formatNumber("%.0f", r.receiver_bad_pixels) << " |\n";
   md << "\nIssue 45's goals: crowd-mixed at least 30 dB on the crowd's pixels, its crowd pass within 20 % of "
-        "crowd-impostor's (each against the impostor mode of its own path; median crowd ms, and crowd GPU ms):\n";
+        "crowd-impostor's (each against the impostor mode of its own path; median crowd ms, and crowd GPU ms), its own "
+        "CPU time at most 0.5 ms (median):\n";
   for (const CrowdRun& run : result.runs)
     for (const MixedAgainstImpostor& c : mixedAgainstImpostor(run))
       md << "- " << thousands(run.agents) << " agents, " << run.path << ", " << c.mixed << ": "
          << formatNumber("%.1f", c.psnr_mean) << " dB (min " << formatNumber("%.1f", c.psnr_min) << "), crowd pass "
          << formatNumber("%.2fx", c.crowd_ratio) << " " << c.impostor << "'s (GPU time "
          << formatNumber("%.2fx", c.crowd_gpu_ratio) << "): "
-         << (c.psnr_met() && c.pass_met() ? "both met"
+         << (c.psnr_met() && c.pass_met() ? "30 dB and the pass both met"
              : c.psnr_met()               ? "30 dB met, the pass not"
              : c.pass_met()               ? "the pass met, 30 dB not"
-                                          : "neither met")
-         << "\n";
+                                          : "neither 30 dB nor the pass met")
+         << "; own CPU " << formatNumber("%.3f", c.own_cpu_ms) << " ms (" << (c.cpu_met() ? "met" : "not met")
+         << ")\n";
   md << "\nThe CPU modes' agent states (poses and phases of every agent, eval::crowdAgentStates) are made before the "
         "crowd pass, outside its time:";
   for (const CrowdRun& run : result.runs)
@@ -231,7 +234,8 @@ void writeCrowdReport(const CrowdBenchResult& result, const CrowdBenchOptions& o
                                              {"impostor", c.impostor}, {"psnr_db_mean", c.psnr_mean},
                                              {"psnr_db_min", c.psnr_min}, {"crowd_ratio", c.crowd_ratio},
                                              {"crowd_gpu_ratio", c.crowd_gpu_ratio}, {"psnr_met", c.psnr_met()},
-                                             {"pass_met", c.pass_met()}});
+                                             {"pass_met", c.pass_met()}, {"own_cpu_median_ms", c.own_cpu_ms},
+                                             {"own_cpu_met", c.cpu_met()}});
   std::ofstream(fs::path(options.out_dir) / "crowd.json") << j.dump(2) << "\n";
   std::ofstream(fs::path(options.out_dir) / "crowd.md") << result.markdown;
 }
