@@ -27,19 +27,7 @@ PEER_GL=${PEER_GL:-auto}
 mkdir -p "$OUT"
 export FF_PROGRESS=0
 
-if [ -z "${PEER:-}" ]; then
-  # OpenSceneGraph: a Debian package the project does not install by default.
-  if ! dpkg-query -W -f='${Status}' libopenscenegraph-dev 2>/dev/null | grep -q "install ok installed"; then
-    echo "bench_peer_osg: installing libopenscenegraph-dev (apt-get)" >&2
-    sudo=""
-    [ "$(id -u)" -eq 0 ] || sudo=sudo
-    $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q libopenscenegraph-dev > "$OUT/apt.txt"
-  fi
-  cmake -S "$here" -B "$OSG_BUILD" -DCMAKE_BUILD_TYPE=Release -DFF_BUILD_TESTS=OFF -DFF_BUILD_BENCH=OFF \
-    -DFF_BUILD_OSG_PEER=ON > "$OUT/cmake.txt"
-  cmake --build "$OSG_BUILD" -j "$(nproc)" --target osg_peer > "$OUT/build.txt"
-  PEER=$OSG_BUILD/bin/osg_peer
-fi
+[ -n "${PEER:-}" ] || PEER=$(bash "$here/scripts/build_osg_peer.sh" "$OSG_BUILD" "$OUT")
 [ -x "$PEER" ] || { echo "bench_peer_osg: no peer $PEER" >&2; exit 2; }
 
 if [ -z "$SCENE" ]; then

@@ -4,8 +4,8 @@
 # .gpu/data/ when ../shared/data has them, and scripts/gpu/run-gpu-frame.sh with REHEARSE=1 (toy sizes; no libglvnd
 # unpacked). Prints each stage's return codes and fails if any is not 0.
 #   scripts/gpu/rehearse.sh [OUT_DIR] [STAGES]     (defaults: out/rehearse; every stage of run-gpu-frame.sh)
-# With OSG_PEER=1 the OpenSceneGraph peer is built (scripts/bench_peer_osg.sh's build: libopenscenegraph-dev) and put
-# in the tarball's bin/ for the osg stage.
+# With OSG_PEER=1 the OpenSceneGraph peer is built (scripts/build_osg_peer.sh) and put in the tarball's bin/ for the
+# osg stage.
 set -uo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 OUTD=$(realpath -m "${1:-$ROOT/out/rehearse}")
@@ -17,11 +17,8 @@ rm -rf "$OUTD" && mkdir -p "$OUTD"
 mkdir -p .gpu
 extra=""
 if [ -n "${OSG_PEER:-}" ]; then
-  PEER_OUT="$OUTD/peer-build" bash -c 'mkdir -p "$PEER_OUT"; cmake -S . -B build/osg-peer -DCMAKE_BUILD_TYPE=Release \
-    -DFF_BUILD_TESTS=OFF -DFF_BUILD_BENCH=OFF -DFF_BUILD_OSG_PEER=ON > "$PEER_OUT/cmake.txt" &&
-    cmake --build build/osg-peer -j "$(nproc)" --target osg_peer > "$PEER_OUT/build.txt"' ||
+  extra=$(bash scripts/build_osg_peer.sh build/osg-peer "$OUTD/peer-build") ||
     { echo "rehearse: the OpenSceneGraph peer did not build ($OUTD/peer-build)" >&2; exit 1; }
-  extra=build/osg-peer/bin/osg_peer
 fi
 tarball=$(ls .gpu/farfield-*.tar.xz 2>/dev/null | head -1)
 # xz takes minutes: made again only for a newer build, or when the peer is wanted and missing or newer.

@@ -186,7 +186,6 @@ if [[ " $STAGES " == *" osg "* ]]; then
     PEER=/tmp/ff/bin/osg_peer PEER_GL=egl SIZE=$HD STRIDE=5 timeout 600 bash "$ROOT/scripts/bench_peer_osg.sh" $FF \
       $W/osg $H/city.glb $H/path.json > osg.txt 2>&1
     echo "rc $?"
-    grep -h "GL_RENDERER" $W/osg/osg*.txt | sort -u
     cat $W/osg/peer.md
     keep osg osg/peer.md osg/*.txt osg/*.csv osg/farfield/bench.json osg.txt
   else
