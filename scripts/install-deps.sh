@@ -16,6 +16,8 @@ packages=(
   libcitygml-dev
   # CLI, threads, tests, benchmarks, plots
   libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev python3 python3-matplotlib python3-numpy
+  # a second GLSL compiler over the programs the tests link (the Khronos reference front end: scripts/check_shaders.sh)
+  glslang-tools
   # sharded bakes: a one-node Slurm for the tests and benchmarks (scripts/slurm/local-cluster.sh)
   slurm-wlm munge
   # the release tarball of `make dist` (scripts/make_dist.sh): RUNPATHs of the tool and its bundled libraries, and the

@@ -1,10 +1,18 @@
 #include "farfield/gpu/program.h"
 
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "farfield/core/error.h"
+#include "farfield/gpu/shader_dump.h"
 #include "farfield/gpu/shader_source.h"
 #include "gpu/gpu_fixture.h"
 
@@ -106,6 +114,45 @@ TEST_F(GpuTest, EmbeddedMeshShadersCompileInEveryVariant) {
     EXPECT_GE(program.uniformLocation("u_object_id"), 0) << defines;
     EXPECT_GE(program.uniformLocation("u_model"), 0) << defines;
   }
+}
+
+TEST(ShaderDump, AStageIsNamedAfterItsSourceAndStage) {
+  EXPECT_EQ(dumpedStageName("mesh.frag.glsl", GL_FRAGMENT_SHADER), "mesh.frag");
+  EXPECT_EQ(dumpedStageName("gpu_cull.comp.glsl", GL_COMPUTE_SHADER), "gpu_cull.comp");
+  EXPECT_EQ(dumpedStageName("a b/c.glsl", GL_VERTEX_SHADER), "a_b_c.vert");
+  EXPECT_EQ(dumpedStageName("viewer", GL_FRAGMENT_SHADER), "viewer.frag");
+}
+
+std::string fileText(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Under ctest every test runs with FF_SHADER_DUMP set (tests/CMakeLists.txt), so this checks the copy the second
+// compiler's check reads: a program of this run's own, written once, its stages under their names, byte for byte.
+TEST_F(GpuTest, ALinkedProgramIsCopiedOnceForTheSecondCompiler) {
+  const char* dir = std::getenv("FF_SHADER_DUMP");
+  if (!dir || !*dir) GTEST_SKIP() << "FF_SHADER_DUMP is not set (ctest sets it)";
+  const std::string marker = "// dump test " + std::to_string(::getpid()) + " " +
+                             std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "\n";
+  const std::string vertex = std::string(kVertex) + marker;
+  const std::string fragment = std::string(R"(#version 450 core
+in vec3 v_color;
+out vec4 o_color;
+void main() { o_color = vec4(v_color, 1.0); }
+)") + marker;
+  for (int i = 0; i < 2; ++i) Program::fromSources({"dump.vert.glsl", vertex}, {"dump.frag.glsl", fragment});
+  int copies = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const auto vert = entry.path() / "dump.vert";
+    if (!std::filesystem::exists(vert) || fileText(vert) != vertex) continue;
+    ++copies;
+    EXPECT_EQ(fileText(entry.path() / "dump.frag"), fragment);
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(entry.path()), {}), 2);
+  }
+  EXPECT_EQ(copies, 1);
 }
 
 }  // namespace

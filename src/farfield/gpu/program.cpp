@@ -13,6 +13,7 @@
 
 #include "farfield/core/error.h"
 #include "farfield/gpu/gl_barrier_check.h"
+#include "farfield/gpu/shader_dump.h"
 #include "farfield/gpu/shader_source.h"
 
 namespace farfield::gpu {
@@ -127,9 +128,11 @@ GLuint link(std::initializer_list<GLuint> shaders, const std::string& what) {
 }  // namespace
 
 Program Program::computeFromEmbedded(const std::string& compute, const std::string& defines) {
-  const GLuint cs = compile(GL_COMPUTE_SHADER, {compute, withDefines(compute, shaderSource(compute), defines)});
+  const ShaderStageSource source{compute, withDefines(compute, shaderSource(compute), defines)};
+  const GLuint cs = compile(GL_COMPUTE_SHADER, source);
   Program program;
   program.handle_ = link({cs}, compute);
+  dumpLinkedProgram({{GL_COMPUTE_SHADER, &source}});
   return program;
 }
 
@@ -145,6 +148,7 @@ Program Program::fromSources(const ShaderStageSource& vertex, const ShaderStageS
   const GLuint handle = link({vs, fs}, vertex.name + " + " + fragment.name);
   Program program;
   program.handle_ = handle;
+  dumpLinkedProgram({{GL_VERTEX_SHADER, &vertex}, {GL_FRAGMENT_SHADER, &fragment}});
   return program;
 }
 
