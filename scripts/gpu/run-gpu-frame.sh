@@ -381,6 +381,29 @@ for s in $ORDER; do
     say "$s: cut by the budget after $took s (not done; its results so far are kept)"
   fi
 done
+# The figures each goal is read from, last: the reply of a device call carries only the end of the output.
+key_figures() {
+  echo "== key figures (every stage done on this machine; the archives have the rest)"
+  python3 - $W/heldout/bench/bench.json $W/big/bench/bench.json $W/demo/bench/bench.json $W/makedemo/bench.json \
+    $W/terrain/*/bench.json <<'PY'
+import json, os, sys
+for p in sys.argv[1:]:
+    if not os.path.exists(p):
+        continue
+    j = json.load(open(p))
+    print(os.path.relpath(p, os.path.dirname(os.path.dirname(os.path.dirname(p)))), j.get("size"), j.get("renderer", "")[:40])
+    for name, m in j["modes"].items():
+        f = lambda k: "-" if m.get(k) is None else "%.3g" % m[k]
+        print("  %-24s wall %6s  GPU %6s  own CPU %6s  syncs %4s  draws %6s" % (name, f("median_ms"),
+              f("gpu_median_ms"), f("cpu_median_ms"), f("mean_syncs"), f("mean_draw_calls")))
+PY
+  grep -h "^- [0-9].*crowd-mixed.* dB" $W/crowd/*/crowd.md 2>/dev/null
+  grep -h "^| " $W/osg/peer.md 2>/dev/null | head -12
+  tail -2 $W/heldout/check.txt 2>/dev/null
+  grep -hE "^(CPU term|GPU term)" $W/heldout/calibrate.txt 2>/dev/null
+  grep -hE "frames over t_max|relaxed" $W/makedemo.txt 2>/dev/null | head -3
+}
+key_figures
 pack
 say "done in this command:${ran:- none}; in an earlier one on this machine:${before:- none}; not run:${notrun:- none}"
 [ -z "$notrun" ] || echo "(the same command again, on this machine while it is warm, goes on with:$notrun)"
