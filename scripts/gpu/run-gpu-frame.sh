@@ -28,7 +28,7 @@
 #            impostors placed, full, culled, placed and governed against reference frames; its verdict (issues 43, 46)
 #   crowd    the crowd bench at 1920x1080 with the GPU crowd beside the CPU path (--gpu-crowd), 10,000 to 1,000,000
 #            agents, no shadows (the crowd alone; shadows are measured on llvmpipe); then at 0.5 px with levels of
-#            detail under a budget of 4 ms of skinned drawing, on issue 45's walk (path seed 7) and on a walk no
+#            detail under a budget of 4 ms of skinned drawing (CROWD_GEOMETRY_MS), on issue 45's walk (seed 7), a walk no
 #            tuning used (seed 9, crowd seed 3); with the shared CesiumMan and Fox (.gpu/data/models/, when carried)
 #   terrain  the terrain LODs at 1920x1080, 600-frame flythroughs: the quadtree LOD (high, low, lod-sprite) against
 #            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu[-predict]) on the shared DEM (.gpu/data/terrain/*.tif, when
@@ -233,12 +233,15 @@ stage_crowd() {
   # At 0.5 px with skinned levels of detail at 0.1 px (a level's error the larger of its distance to the mesh and
   # how far it moves a texel), under a budget of 4 ms of skinned drawing timed on the GPU. With the shared models on
   # llvmpipe (512x512, 10,000 agents) that kept 32.6-60.9 dB on walks 7 and 9 (docs/BENCHMARKS.md, "A level's
-  # texture"): on 10-30 px figures a sub-pixel shift of the outline or the texture flips many pixels.
+  # texture"): on 10-30 px figures a sub-pixel shift of the outline or the texture flips many pixels. On a GPU 4 ms
+  # of skinned drawing is loose against issue 45's "within 20 % of crowd-impostor's pass" (on the H200 at 512x512
+  # that pass was 0.8 ms): CROWD_GEOMETRY_MS sets another budget, e.g. a fifth of the first run's impostor pass.
+  local gms=${CROWD_GEOMETRY_MS:-4}
   for walk in "7 2" "9 3"; do
     set -- $walk
-    say "crowd: 0.5 px, levels of detail at 0.1 px, a budget of 4 ms, 10,000 and 100,000 agents, walk seed $1"
+    say "crowd: 0.5 px, levels of detail at 0.1 px, a budget of $gms ms, 10,000 and 100,000 agents, walk seed $1"
     runc 600 $FF crowd bench -o $C/budget-s$1 --agents $(pick 10000,100000 1000) --frames $(pick 8 2) --gpu-crowd \
-      --no-shadows --error-px 0.5 --skinned-lod 0.1 --geometry-ms 4 --size $HD --path-seed $1 --crowd-seed $2 \
+      --no-shadows --error-px 0.5 --skinned-lod 0.1 --geometry-ms $gms --size $HD --path-seed $1 --crowd-seed $2 \
       $models > $C/budget-s$1.txt 2>&1
     echo "rc $?"
     grep -E "^\| [0-9]|^- [0-9]" $C/budget-s$1/crowd.md | head -40
