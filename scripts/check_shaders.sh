@@ -48,6 +48,7 @@ for p in "${programs[@]}"; do
   done
 done
 stages=$(find "${programs[@]}" -type f | sed 's|.*/||' | sort -u | tr '\n' ' ')
-echo "check_shaders: ${#programs[@]} programs ($(glslangValidator --version 2>/dev/null | head -1 | sed 's/^Glslang Version: //')," \
+version=$(glslangValidator --version 2>/dev/null | head -1 | sed 's/^Glslang Version: //')
+echo "check_shaders: ${#programs[@]} programs (glslang $version," \
   "stages $stages): $((${#programs[@]} - failed)) accepted, $failed refused"
 [ $failed -eq 0 ]

@@ -48,7 +48,8 @@ if [ "$(ls .gl/*.deb 2>/dev/null | wc -l)" -lt 7 ]; then
   o='-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 -oDir::State::Lists=/tmp/amd64'
   # shellcheck disable=SC2086  # $o is a list of options
   { apt-get $o update && (cd .gl && apt-get $o download libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 \
-    libgles2); } > "$OUTD/gl-debs.txt" 2>&1 || echo "warning: libglvnd's packages not downloaded into .gl/ ($OUTD/gl-debs.txt)"
+    libgles2); } > "$OUTD/gl-debs.txt" 2>&1 ||
+    echo "warning: libglvnd's packages not downloaded into .gl/ ($OUTD/gl-debs.txt)"
 fi
 # What a device call sends: the tracked files, the untracked ones git does not ignore, and the carried .gpu and .gl;
 # the device refuses more than 64 MiB.
@@ -67,7 +68,8 @@ cat "$OUTD"/results.tar* 2>/dev/null | tar -tf - 2>/dev/null | grep '\.tgz$' | s
 # The device returns at most 8 files of OUT, each of at most 16 MiB.
 n=$(find "$OUTD" -maxdepth 1 -type f \( -name 'results.tar*' -o -name log.txt \) | wc -l)
 big=$(find "$OUTD" -maxdepth 1 -type f \( -name 'results.tar*' -o -name log.txt \) -size +16M | wc -l)
-[ "$n" -le 8 ] && [ "$big" -eq 0 ] || { echo "rehearse: $n files in OUT, $big over 16 MiB: the device returns 8 of 16 MiB" >&2; exit 1; }
+[ "$n" -le 8 ] && [ "$big" -eq 0 ] ||
+  { echo "rehearse: $n files in OUT, $big over 16 MiB: the device returns 8 of 16 MiB" >&2; exit 1; }
 bad=$(grep -cE "^rc [1-9]|SMOKE FAILED" "$OUTD/log.txt")
 [ "$bad" -eq 0 ] || { echo "rehearse: $bad command(s) failed" >&2; exit 1; }
 echo "rehearse: every command returned 0"

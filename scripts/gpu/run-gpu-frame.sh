@@ -28,8 +28,8 @@
 #            impostors placed, full, culled, placed and governed against reference frames; its verdict (issues 43, 46)
 #   crowd    the crowd bench at 1920x1080 with the GPU crowd beside the CPU path (--gpu-crowd), 10,000 to 1,000,000
 #            agents, no shadows (the crowd alone; shadows are measured on llvmpipe); then at 0.5 px with levels of
-#            detail under a budget of 4 ms of skinned drawing (CROWD_GEOMETRY_MS), on issue 45's walk (seed 7), a walk no
-#            tuning used (seed 9, crowd seed 3); with the shared CesiumMan and Fox (.gpu/data/models/, when carried)
+#            detail under a budget of 4 ms of skinned drawing (CROWD_GEOMETRY_MS), on issue 45's walk (seed 7) and a
+#            walk no tuning used (seed 9, crowd seed 3); with the shared CesiumMan and Fox (.gpu/data/models/, carried)
 #   terrain  the terrain LODs at 1920x1080, 600-frame flythroughs: the quadtree LOD (high, low, lod-sprite) against
 #            CDLOD on the GPU (high-gpu, low-gpu, lod-sprite-gpu[-predict]) on the shared DEM (.gpu/data/terrain/*.tif, when
 #            carried) and on the 8,193^2 fractal; then the 8,193^2 fractal paged from disk (terrain tiles --render):
@@ -394,7 +394,8 @@ for p in sys.argv[1:]:
     if not os.path.exists(p):
         continue
     j = json.load(open(p))
-    print(os.path.relpath(p, os.path.dirname(os.path.dirname(os.path.dirname(p)))), j.get("size"), j.get("renderer", "")[:40])
+    name = os.path.relpath(p, os.path.dirname(os.path.dirname(os.path.dirname(p))))
+    print(name, j.get("size"), j.get("renderer", "")[:40])
     for name, m in j["modes"].items():
         f = lambda k: "-" if m.get(k) is None else "%.3g" % m[k]
         print("  %-24s wall %6s  GPU %6s  own CPU %6s  syncs %4s  draws %6s" % (name, f("median_ms"),
