@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -114,6 +115,15 @@ TEST_F(GpuTest, EmbeddedMeshShadersCompileInEveryVariant) {
     EXPECT_GE(program.uniformLocation("u_object_id"), 0) << defines;
     EXPECT_GE(program.uniformLocation("u_model"), 0) << defines;
   }
+}
+
+// Programs that draw the same things and are compared pixel for pixel (the GPU-culled and frustum-culled frames'
+// ids; the crowd's CPU and GPU paths and its reference) must declare their position invariant: GLSL promises equal
+// positions across programs only then, and Mesa's equal frames without it prove nothing for another driver.
+TEST(ShaderSources, ProgramsComparedPixelForPixelDeclareTheirPositionInvariant) {
+  const std::regex invariant(R"((^|\n)\s*invariant\s+gl_Position\s*;)");
+  for (const char* name : {"arena.vert.glsl", "mesh.vert.glsl", "skin.vert.glsl", "multiview.vert.glsl"})
+    EXPECT_TRUE(std::regex_search(std::string(shaderSource(name)), invariant)) << name;
 }
 
 TEST(ShaderDump, AStageIsNamedAfterItsSourceAndStage) {

@@ -19,6 +19,11 @@ layout(location = 11) in uvec4 a_info;  // object id, unlit, texture layer
 
 uniform mat4 u_view_proj;
 
+// gl_Position is invariant: GLSL guarantees the same position from the same inputs only across programs that declare
+// it so; otherwise a driver may compile the same expression differently in two programs (fused multiply-adds).
+// The frustum-culled frame draws the same objects through mesh.vert.glsl: cull-check wants equal ids at every pixel.
+invariant gl_Position;
+
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;

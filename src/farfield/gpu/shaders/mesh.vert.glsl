@@ -11,6 +11,11 @@ uniform mat4 u_model;
 uniform mat3 u_normal_matrix;  // inverse transpose of the model matrix's 3x3 part
 uniform mat4 u_texture_projection;  // projective texturing (GpuMaterial::projective_texture)
 
+// gl_Position is invariant: GLSL guarantees the same position from the same inputs only across programs that declare
+// it so; otherwise a driver may compile the same expression differently in two programs (fused multiply-adds).
+// (arena.vert.glsl draws the same objects; each variant here draws them in the reference and the item buffers.)
+invariant gl_Position;
+
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;

@@ -17,6 +17,10 @@ struct Agent {
 layout(std430, binding = 1) readonly buffer Agents { Agent agents[]; };
 
 uniform mat4 u_view_proj;
+// gl_Position is invariant: GLSL guarantees the same position from the same inputs only across programs that declare
+// it so; otherwise a driver may compile the same expression differently in two programs (fused multiply-adds).
+// (the CPU and GPU crowd paths draw the same impostors through variants of this shader.)
+invariant gl_Position;
 uniform vec3 u_eye;
 uniform vec3 u_fixed_dir;
 uniform vec2 u_half_size;

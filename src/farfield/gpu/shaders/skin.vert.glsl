@@ -31,6 +31,10 @@ uniform uint u_joint_count;
 layout(std430, binding = 1) readonly buffer Agents { Agent agents[]; };
 
 uniform mat4 u_view_proj;
+// gl_Position is invariant: GLSL guarantees the same position from the same inputs only across programs that declare
+// it so; otherwise a driver may compile the same expression differently in two programs (fused multiply-adds).
+// (the CPU and GPU crowd paths, and the reference, draw the same agents through variants of this shader.)
+invariant gl_Position;
 uniform mat4 u_model_to_agent;
 uniform uint u_first_instance;
 
