@@ -78,8 +78,9 @@ say() { echo "== [$(($(date +%s) - t0)) s] $*"; }
 [ -n "${SKIP_GL:-}" ] || { for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig; }
 dist=$(ls .gpu/farfield-*.tar.xz 2>/dev/null | head -1)
 [ -n "$dist" ] || dist=.gpu/ff.tar.xz
-# Unpacked once per machine: a command run again on the warm machine keeps /tmp/ff unless the tarball changed.
-stamp="$(stat -c '%n %s %Y' "$dist" 2>/dev/null)"
+# Unpacked once per machine: a command run again on the warm machine keeps /tmp/ff unless the tarball changed (by its
+# checksum: each call sends the carried folders anew, so their times may change).
+stamp="$dist $(md5sum < "$dist" 2>/dev/null | cut -d' ' -f1)"
 if [ "$(cat /tmp/ff/.unpacked-from 2>/dev/null)" != "$stamp" ]; then
   rm -rf /tmp/ff && mkdir -p /tmp/ff
   case $dist in
